@@ -1,0 +1,3 @@
+from robotale.cli import main
+
+raise SystemExit(main())

@@ -1,0 +1,1 @@
+"""Discovery: directly-follows graphs, aggregated EKG models and conformance."""

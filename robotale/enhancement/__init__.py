@@ -1,0 +1,2 @@
+"""Enhancement: spatial, communication, battery and performance perspectives as tables and
+plotly figures."""

@@ -1,0 +1,22 @@
+"""The one exception type a user can cause.
+
+Every error a user can provoke (a bad file, a bad model, a server that is down) is raised as a
+:class:`RobotaleError` whose message is one clear sentence naming the file, row or element id.
+The command line prints that sentence and exits with status 1; nothing is half-written.
+"""
+
+
+class RobotaleError(Exception):
+    """A problem with the user's input or environment, explained in one sentence."""
+
+
+class InputError(RobotaleError):
+    """A file or value the user gave cannot be used (missing, malformed, wrong column ...)."""
+
+
+class ModelError(RobotaleError):
+    """A BPMN model cannot be parsed, checked or run; the message names the element id."""
+
+
+class ServerError(RobotaleError):
+    """Neo4j (or another server robotale needs) cannot be reached or started."""

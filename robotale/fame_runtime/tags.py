@@ -1,0 +1,61 @@
+"""Tags: the events a running mission leaves behind (TALE's tags, emitted by the engines).
+
+Every activity start and completion and every signal throw and catch becomes a :class:`Tag`.
+On a bus and in a rosbag2 recording a tag is the ROS 2 message ``robotale_msgs/msg/Tag`` on the
+topic ``/<robot>/tag``; :data:`TAG_MSGDEF` is its definition and :func:`register_tag_type`
+adds it to a rosbags type store so bags can be written and read without a ROS installation.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+TAG_TYPE = "robotale_msgs/msg/Tag"
+
+TAG_MSGDEF = """\
+# One tagged event of a robot's mission (TALE).
+builtin_interfaces/Time stamp
+string robot
+string activity
+string lifecycle
+string msg_id
+string msg_role
+string payload
+"""
+
+
+@dataclass(frozen=True, slots=True)
+class Tag:
+    """One tagged event.
+
+    ``stamp`` is seconds since the Unix epoch on the engine's clock (simulated time in a
+    simulation). ``lifecycle`` is ``start``, ``complete`` or ``none`` (instant events such as a
+    timer firing). Message events name the message: ``msg_role`` is ``send`` or ``receive`` and
+    every receive carries the ``msg_id`` of the send it caught; ``payload`` is JSON text.
+    """
+
+    stamp: float
+    robot: str
+    activity: str
+    lifecycle: str
+    msg_id: str = ""
+    msg_role: str = ""
+    payload: str = ""
+
+
+#: where engines deliver tags: a recorder, a list's ``append``, a printer ...
+TagSink = Callable[[Tag], None]
+
+
+def tag_topic(robot: str) -> str:
+    """The topic a robot's tags are published on."""
+    return f"/{robot}/tag"
+
+
+def register_tag_type(typestore) -> None:
+    """Add ``robotale_msgs/msg/Tag`` to a rosbags type store (idempotent)."""
+    from rosbags.typesys import get_types_from_msg
+
+    if TAG_TYPE not in typestore.fielddefs:
+        typestore.register(get_types_from_msg(TAG_MSGDEF, TAG_TYPE))

@@ -1,0 +1,1 @@
+"""The dashboard: a Flask application factory with one blueprint per page."""
