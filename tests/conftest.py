@@ -2,8 +2,28 @@
 
 Each part keeps its own fixtures in ``tests/<part>/conftest.py``; only what several parts use
 lives here.
+
+Neo4j (always a real server, never a mock):
+
+- ``neo4j_server`` (session): the :class:`robotale.ekg.connection.Settings` of the server the
+  tests use. With ``NEO4J_URI`` set (plus ``NEO4J_USER``/``NEO4J_PASSWORD``) that server;
+  otherwise a local Neo4j started for this session in a temporary robotale home on free ports
+  (the jars come from the user's cache, so only the very first run downloads them) and
+  stopped at the end. While it runs, ``NEO4J_URI``, ``NEO4J_USER`` and ``NEO4J_PASSWORD`` point
+  at it, so code under test and ``robotale`` subprocesses use it without further setup.
+- ``neo4j_driver`` (session): a connected ``neo4j.Driver`` for that server.
+- ``log_name``: a log name no other test uses; whatever was stored under it is deleted after
+  the test. Tests share one database, so give every log you write such a name.
+- ``graph_counts``: a function returning ``{"node:Event": n, "relationship:DF": m, ...}`` for
+  the whole database; compare two calls to assert that a failed operation changed nothing.
 """
 
+from __future__ import annotations
+
+import os
+import re
+import uuid
+from collections.abc import Callable, Iterator
 from pathlib import Path
 
 import pytest
@@ -22,3 +42,62 @@ def thesis_csv() -> Path:
 def fame_models() -> Path:
     """The thesis authors' own FAME models (fame-modeler/ and fame-ros/)."""
     return EXAMPLES / "thesis" / "fame-models"
+
+
+@pytest.fixture(scope="session")
+def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object]:
+    """The Neo4j server of this test session (see the module docstring)."""
+    from robotale.ekg.connection import settings
+
+    if os.environ.get("NEO4J_URI"):
+        yield settings()
+        return
+    from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port
+
+    server = LocalServer(tmp_path_factory.mktemp("robotale-home"))
+    for attempt in range(3):  # a free port can be taken by someone else before Neo4j binds it
+        options = ServerOptions(free_port(), free_port(), heap="1g", pagecache="256m")
+        try:
+            running = server.start(options)
+            break
+        except PortInUse:
+            if attempt == 2:
+                raise
+    environment = pytest.MonkeyPatch()
+    environment.setenv("NEO4J_URI", running.bolt_uri)
+    environment.setenv("NEO4J_USER", "neo4j")
+    environment.setenv("NEO4J_PASSWORD", server.password() or "")
+    try:
+        yield settings()
+    finally:
+        environment.undo()
+        server.stop()
+
+
+@pytest.fixture(scope="session")
+def neo4j_driver(neo4j_server: object) -> Iterator[object]:
+    """A driver connected to the session's Neo4j server."""
+    from robotale.ekg.connection import connect
+
+    driver = connect(neo4j_server)
+    yield driver
+    driver.close()
+
+
+@pytest.fixture
+def log_name(request: pytest.FixtureRequest, neo4j_driver: object) -> Iterator[str]:
+    """A fresh log name for this test; its data is deleted afterwards."""
+    from robotale.ekg.logs import delete_log
+
+    test = re.sub(r"\W+", "_", request.node.name)[:40]
+    name = f"test_{test}_{uuid.uuid4().hex[:8]}"
+    yield name
+    delete_log(neo4j_driver, name)
+
+
+@pytest.fixture
+def graph_counts(neo4j_driver: object) -> Callable[[], dict[str, int]]:
+    """Counts of nodes per label and relationships per type in the whole database."""
+    from robotale.ekg.logs import graph_counts
+
+    return lambda: graph_counts(neo4j_driver)

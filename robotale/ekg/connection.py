@@ -1,0 +1,115 @@
+"""Where Neo4j is and how to talk to it.
+
+With ``NEO4J_URI`` set (plus ``NEO4J_USER``, default ``neo4j``, and ``NEO4J_PASSWORD``)
+robotale uses that server: docker compose, a cluster, Aura. Otherwise it uses the local server
+of ``robotale neo4j start`` (its port and generated password live under the robotale home).
+``NEO4J_DATABASE`` picks the database (default ``neo4j``).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+from collections.abc import Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any
+
+from neo4j import Driver, GraphDatabase
+from neo4j.exceptions import AuthError, ServiceUnavailable
+
+from robotale.ekg.queries import cypher
+from robotale.ekg.server import HOST, USER, LocalServer, ServerOptions
+from robotale.errors import ServerError
+
+# The driver logs every refused connection attempt as a warning; robotale turns the failure
+# into one sentence instead.
+logging.getLogger("neo4j").setLevel(logging.ERROR)
+
+
+@dataclass(frozen=True)
+class Settings:
+    uri: str
+    user: str
+    password: str
+    from_env: bool  # True when NEO4J_URI chose the server
+
+    @property
+    def auth(self) -> tuple[str, str]:
+        return (self.user, self.password)
+
+
+def database() -> str:
+    """The Neo4j database robotale uses (``NEO4J_DATABASE``, default ``neo4j``)."""
+    return os.environ.get("NEO4J_DATABASE") or "neo4j"
+
+
+def settings() -> Settings:
+    """The server robotale talks to, from the environment or the local server's records."""
+    if uri := os.environ.get("NEO4J_URI"):
+        user = os.environ.get("NEO4J_USER") or USER
+        return Settings(uri, user, os.environ.get("NEO4J_PASSWORD", ""), True)
+    server = LocalServer()
+    running = server.running()
+    port = running.bolt_port if running else ServerOptions.from_env().bolt_port
+    return Settings(f"bolt://{HOST}:{port}", USER, server.password() or "", False)
+
+
+def connect(where: Settings | None = None) -> Driver:
+    """A driver for the server that answers; a :class:`ServerError` saying what to do if not."""
+    where = where or settings()
+    driver = GraphDatabase.driver(where.uri, auth=where.auth, connection_timeout=5)
+    try:
+        driver.verify_connectivity()
+    except AuthError:
+        driver.close()
+        raise ServerError(
+            f"Neo4j at {where.uri} refused user {where.user!r}: set NEO4J_USER and "
+            "NEO4J_PASSWORD to that server's credentials."
+        ) from None
+    except (ServiceUnavailable, OSError):
+        driver.close()
+        raise ServerError(unreachable_message(where)) from None
+    return driver
+
+
+@contextmanager
+def session_driver(where: Settings | None = None) -> Iterator[Driver]:
+    """:func:`connect` as a context manager that closes the driver."""
+    driver = connect(where)
+    try:
+        yield driver
+    finally:
+        driver.close()
+
+
+def unreachable_message(where: Settings) -> str:
+    if where.from_env:
+        return (
+            f"Neo4j is not reachable at {where.uri} (NEO4J_URI): start that server, or unset "
+            "NEO4J_URI and run `robotale neo4j start`."
+        )
+    return (
+        f"Neo4j is not running at {where.uri}: start it with `robotale neo4j start`, "
+        "or set NEO4J_URI to a running server."
+    )
+
+
+def bolt_answers(uri: str, auth: tuple[str, str]) -> bool:
+    """True when a Bolt server answers at ``uri`` (even if it refuses these credentials)."""
+    driver = GraphDatabase.driver(uri, auth=auth, connection_timeout=2)
+    try:
+        driver.verify_connectivity()
+        return True
+    except AuthError:
+        return True
+    except (ServiceUnavailable, OSError):
+        return False
+    finally:
+        driver.close()
+
+
+def server_version(driver: Driver) -> dict[str, Any]:
+    """Name, version and edition of the server behind ``driver``."""
+    records, _, _ = driver.execute_query(cypher("ekg_server_version"))
+    return records[0].data()

@@ -1,0 +1,189 @@
+"""The Neo4j server's jars: pinned in ``neo4j_jars.lock``, fetched from Maven Central.
+
+:func:`ensure_jars` makes ``cache_dir()/neo4j-<version>/lib`` hold exactly the locked jars.
+Each jar is downloaded with urllib, checked against its sha1 and moved into place atomically;
+a file lock lets several processes (parallel test runs, two terminals) provision at once. Once
+everything is in place a marker file records it, so later starts never touch the network.
+"""
+
+from __future__ import annotations
+
+import fcntl
+import hashlib
+import os
+import sys
+import time
+import urllib.error
+import urllib.request
+from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
+from contextlib import contextmanager
+from dataclasses import dataclass
+from pathlib import Path
+
+from tqdm import tqdm
+
+from robotale.config import cache_dir
+from robotale.errors import ServerError
+
+NEO4J_VERSION = "5.26.30"
+BROWSER_VERSION = "5.24.0"
+LOCK_FILE = Path(__file__).with_name("neo4j_jars.lock")
+#: Maven Central, or a mirror of it (``ROBOTALE_MAVEN_REPO``).
+DEFAULT_REPOSITORY = "https://repo1.maven.org/maven2"
+_MARKER = ".complete"
+_ATTEMPTS = 3
+
+
+@dataclass(frozen=True)
+class Jar:
+    group: str
+    artifact: str
+    version: str
+    classifier: str
+    sha1: str
+    size: int
+
+    @property
+    def filename(self) -> str:
+        suffix = f"-{self.classifier}" if self.classifier else ""
+        return f"{self.artifact}-{self.version}{suffix}.jar"
+
+    def url(self, repository: str) -> str:
+        group_path = self.group.replace(".", "/")
+        return f"{repository}/{group_path}/{self.artifact}/{self.version}/{self.filename}"
+
+    def lock_line(self) -> str:
+        coordinates = f"{self.group}:{self.artifact}:{self.version}"
+        if self.classifier:
+            coordinates += f":{self.classifier}"
+        return f"{coordinates} {self.sha1} {self.size}"
+
+
+def read_lock(lock: Path = LOCK_FILE) -> list[Jar]:
+    """The jars a lock file pins (``group:artifact:version[:classifier] sha1 size`` lines)."""
+    jars = []
+    for line in lock.read_text().splitlines():
+        if not line.strip() or line.startswith("#"):
+            continue
+        coordinates, sha1, size = line.split()
+        group, artifact, version, *classifier = coordinates.split(":")
+        jars.append(Jar(group, artifact, version, "".join(classifier), sha1, int(size)))
+    return jars
+
+
+def server_dir() -> Path:
+    """Where this Neo4j version's jars live, shared by every robotale home."""
+    return cache_dir() / f"neo4j-{NEO4J_VERSION}"
+
+
+def ensure_jars(
+    lib: Path | None = None, repository: str | None = None, lock: Path = LOCK_FILE
+) -> Path:
+    """Download whatever jar of ``lock`` is missing from ``lib``; returns ``lib``.
+
+    Raises :class:`ServerError` naming the jar when a download fails or its sha1 differs.
+    """
+    lib = lib or server_dir() / "lib"
+    jars = read_lock(lock)
+    marker = lib / _MARKER
+    fingerprint = hashlib.sha1(lock.read_bytes()).hexdigest()
+    if _marker_matches(marker, fingerprint):
+        return lib
+    lib.mkdir(parents=True, exist_ok=True)
+    with _file_lock(lib.parent / f"{lib.name}.lock"):
+        if _marker_matches(marker, fingerprint):  # another process finished meanwhile
+            return lib
+        missing = [jar for jar in jars if not _is_in_place(lib / jar.filename, jar)]
+        if missing:
+            _download_all(missing, lib, repository or _repository())
+        _remove_strays(lib, {jar.filename for jar in jars})
+        marker.write_text(fingerprint)
+    return lib
+
+
+def _repository() -> str:
+    return os.environ.get("ROBOTALE_MAVEN_REPO", DEFAULT_REPOSITORY).rstrip("/")
+
+
+def _marker_matches(marker: Path, fingerprint: str) -> bool:
+    return marker.is_file() and marker.read_text() == fingerprint
+
+
+def _is_in_place(path: Path, jar: Jar) -> bool:
+    return path.is_file() and path.stat().st_size == jar.size and _sha1(path) == jar.sha1
+
+
+def _sha1(path: Path) -> str:
+    digest = hashlib.sha1()
+    with path.open("rb") as stream:
+        for block in iter(lambda: stream.read(1 << 20), b""):
+            digest.update(block)
+    return digest.hexdigest()
+
+
+@contextmanager
+def _file_lock(path: Path) -> Iterator[None]:
+    with path.open("a") as handle:
+        fcntl.flock(handle, fcntl.LOCK_EX)
+        try:
+            yield
+        finally:
+            fcntl.flock(handle, fcntl.LOCK_UN)
+
+
+def _download_all(jars: list[Jar], lib: Path, repository: str) -> None:
+    total = sum(jar.size for jar in jars)
+    with (
+        tqdm(
+            total=total,
+            unit="B",
+            unit_scale=True,
+            file=sys.stderr,
+            desc=f"Neo4j {NEO4J_VERSION} jars",
+        ) as progress,
+        ThreadPoolExecutor(max_workers=8) as pool,
+    ):
+        list(pool.map(lambda jar: _download(jar, lib, repository, progress), jars))
+
+
+def _download(jar: Jar, lib: Path, repository: str, progress: tqdm) -> None:
+    url = jar.url(repository)
+    for attempt in range(1, _ATTEMPTS + 1):
+        part = lib / f".{jar.filename}.{os.getpid()}.part"
+        try:
+            digest = _fetch(url, part, progress)
+            if digest != jar.sha1:
+                raise ServerError(
+                    f"The Neo4j jar {url} has sha1 {digest}, not the pinned {jar.sha1}; "
+                    "check ROBOTALE_MAVEN_REPO or your network proxy."
+                )
+            os.replace(part, lib / jar.filename)
+            return
+        except (urllib.error.URLError, OSError) as error:
+            part.unlink(missing_ok=True)
+            if attempt == _ATTEMPTS:
+                raise ServerError(
+                    f"Could not download the Neo4j jar {url} ({error}); "
+                    "check the network or set ROBOTALE_MAVEN_REPO to a Maven Central mirror."
+                ) from error
+            time.sleep(attempt)
+        finally:
+            part.unlink(missing_ok=True)
+
+
+def _fetch(url: str, target: Path, progress: tqdm) -> str:
+    digest = hashlib.sha1()
+    with urllib.request.urlopen(url, timeout=60) as response, target.open("wb") as out:
+        for block in iter(lambda: response.read(1 << 16), b""):
+            digest.update(block)
+            out.write(block)
+            progress.update(len(block))
+    return digest.hexdigest()
+
+
+def _remove_strays(lib: Path, wanted: set[str]) -> None:
+    # Jars of another lock (an older pin) must not end up on the class path.
+    for path in lib.glob("*.jar"):
+        if path.name not in wanted:
+            path.unlink()

@@ -1,0 +1,348 @@
+"""The local Neo4j server: start, stop and status.
+
+Neo4j Community runs from the jars of :mod:`robotale.ekg.jars` through its real server entry
+point (Bolt, HTTP and Neo4j Browser at ``/browser/``), bound to 127.0.0.1 only. Its home is
+``$ROBOTALE_HOME/neo4j``: ``conf/neo4j.conf``, ``data/``, ``logs/``, ``server.json`` (pid and
+ports of the running server) and ``password`` (mode 0600; user ``neo4j``). The password is
+``NEO4J_PASSWORD`` when that is set at the first start, otherwise a generated one.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import secrets
+import shutil
+import signal
+import socket
+import subprocess
+import time
+import urllib.request
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from robotale.config import robotale_home
+from robotale.ekg.jars import ensure_jars
+from robotale.errors import ServerError
+
+HOST = "127.0.0.1"
+USER = "neo4j"
+DEFAULT_BOLT_PORT = 7687
+DEFAULT_HTTP_PORT = 7474
+ENTRY_POINT = "org.neo4j.server.CommunityEntryPoint"
+_ADMIN_TOOL = "org.neo4j.cli.AdminTool"
+# The JVM options of Neo4j's own launcher (we start java directly, so we pass them ourselves).
+_JVM_OPTIONS = (
+    "-XX:+UseG1GC",
+    "-XX:-OmitStackTraceInFastThrow",
+    "-XX:+UnlockExperimentalVMOptions",
+    "-XX:+TrustFinalNonStaticFields",
+    "-XX:+DisableExplicitGC",
+    "-Djdk.nio.maxCachedBufferSize=1024",
+    "-Dio.netty.tryReflectionSetAccessible=true",
+    "-Djdk.tls.ephemeralDHKeySize=2048",
+    "-Djdk.tls.rejectClientInitiatedRenegotiation=true",
+    "--add-opens=java.base/java.nio=ALL-UNNAMED",
+    "--add-opens=java.base/java.io=ALL-UNNAMED",
+    "--add-opens=java.base/sun.nio.ch=ALL-UNNAMED",
+    "-Dlog4j2.disable.jmx=true",
+    "-Dfile.encoding=UTF-8",
+)
+
+
+@dataclass(frozen=True)
+class ServerOptions:
+    """How to run the server; every field has a flag and an environment variable."""
+
+    bolt_port: int = DEFAULT_BOLT_PORT
+    http_port: int = DEFAULT_HTTP_PORT
+    heap: str = "1g"
+    pagecache: str = "512m"
+
+    @classmethod
+    def from_env(cls) -> ServerOptions:
+        env = os.environ
+        return cls(
+            bolt_port=int(env.get("ROBOTALE_NEO4J_BOLT_PORT", DEFAULT_BOLT_PORT)),
+            http_port=int(env.get("ROBOTALE_NEO4J_HTTP_PORT", DEFAULT_HTTP_PORT)),
+            heap=env.get("ROBOTALE_NEO4J_HEAP", cls.heap),
+            pagecache=env.get("ROBOTALE_NEO4J_PAGECACHE", cls.pagecache),
+        )
+
+
+@dataclass(frozen=True)
+class RunningServer:
+    """What ``server.json`` records about a started server."""
+
+    pid: int
+    bolt_port: int
+    http_port: int
+
+    @property
+    def bolt_uri(self) -> str:
+        return f"bolt://{HOST}:{self.bolt_port}"
+
+    @property
+    def browser_url(self) -> str:
+        return f"http://{HOST}:{self.http_port}/browser/"
+
+
+class PortInUse(ServerError):
+    """The port the server should listen on is taken."""
+
+
+class LocalServer:
+    """The Neo4j server whose home is ``<robotale home>/neo4j``."""
+
+    def __init__(self, home: Path | None = None) -> None:
+        self.home = (home or robotale_home()) / "neo4j"
+        self.state_file = self.home / "server.json"
+        self.password_file = self.home / "password"
+        self.log_file = self.home / "logs" / "neo4j.log"
+        self.console_file = self.home / "logs" / "console.log"
+
+    # -- queries -------------------------------------------------------------------------
+
+    def running(self) -> RunningServer | None:
+        """The recorded server if its process is alive (a stale record is removed)."""
+        if not self.state_file.is_file():
+            return None
+        state = RunningServer(**json.loads(self.state_file.read_text()))
+        if _is_our_process(state.pid, self.home):
+            return state
+        self.state_file.unlink(missing_ok=True)
+        return None
+
+    def password(self) -> str | None:
+        return self.password_file.read_text().strip() if self.password_file.is_file() else None
+
+    # -- start / stop --------------------------------------------------------------------
+
+    def start(self, options: ServerOptions | None = None, timeout: float = 180) -> RunningServer:
+        """Start the server in the background and wait until Bolt answers.
+
+        Returns the already running server if there is one.
+        """
+        if (state := self.running()) is not None:
+            return state
+        options = options or ServerOptions.from_env()
+        for port, flag in ((options.bolt_port, "bolt"), (options.http_port, "http")):
+            _require_free(port, flag)
+        java = _java()
+        lib = ensure_jars()
+        self._write_config(options)
+        self._ensure_password(java, lib)
+        process = self._launch(java, lib, options)
+        state = RunningServer(process.pid, options.bolt_port, options.http_port)
+        self.state_file.write_text(json.dumps(asdict(state)))
+        try:
+            self._wait_until_answering(process, state, timeout)
+        except BaseException:
+            _terminate(process.pid, grace=30)
+            self.state_file.unlink(missing_ok=True)
+            raise
+        return state
+
+    def stop(self, grace: float = 60) -> RunningServer | None:
+        """End the server cleanly (SIGTERM, then SIGKILL after ``grace`` seconds).
+
+        Returns what was running, or None when nothing was.
+        """
+        state = self.running()
+        if state is not None:
+            _terminate(state.pid, grace)
+        self.state_file.unlink(missing_ok=True)
+        return state
+
+    # -- helpers -------------------------------------------------------------------------
+
+    def _write_config(self, options: ServerOptions) -> None:
+        conf = self.home / "conf"
+        conf.mkdir(parents=True, exist_ok=True)
+        (self.home / "logs").mkdir(exist_ok=True)
+        settings = {
+            "server.default_listen_address": HOST,
+            "server.default_advertised_address": HOST,
+            "server.bolt.listen_address": f"{HOST}:{options.bolt_port}",
+            "server.bolt.advertised_address": f"{HOST}:{options.bolt_port}",
+            "server.http.listen_address": f"{HOST}:{options.http_port}",
+            "server.http.advertised_address": f"{HOST}:{options.http_port}",
+            "server.https.enabled": "false",
+            "server.memory.pagecache.size": options.pagecache,
+            "dbms.security.auth_enabled": "true",
+            "dbms.usage_report.enabled": "false",
+            # Transaction logs are for backups and clusters; a local analysis server needs none.
+            "db.tx_log.rotation.retention_policy": "keep_none",
+            # Bolt waits 5 s twice on shutdown for clients of a server that is already closed
+            # (the databases stop and checkpoint first); a local server need not.
+            "internal.server.bolt.connection_shutdown_wait_time": "1s",
+            "internal.server.bolt.thread_pool_shutdown_wait_time": "1s",
+        }
+        lines = ["# Written by `robotale neo4j start` on every start; edits are overwritten."]
+        lines += [f"{key}={value}" for key, value in settings.items()]
+        (conf / "neo4j.conf").write_text("\n".join(lines) + "\n")
+
+    def _ensure_password(self, java: str, lib: Path) -> None:
+        auth_store = self.home / "data" / "dbms" / "auth.ini"
+        password = self.password()
+        if password is not None and auth_store.is_file():
+            return
+        if auth_store.is_file():
+            raise ServerError(
+                f"The Neo4j password file {self.password_file} is missing but the database "
+                f"already has one; restore the file or delete {self.home / 'data'} to start over."
+            )
+        if password is None:
+            password = os.environ.get("NEO4J_PASSWORD") or secrets.token_urlsafe(18)
+            _write_private(self.password_file, password)
+        env = {**os.environ, "NEO4J_HOME": str(self.home), "NEO4J_CONF": str(self.home / "conf")}
+        result = subprocess.run(
+            [java, "-cp", f"{lib}/*", _ADMIN_TOOL, "dbms", "set-initial-password", password],
+            env=env,
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        if result.returncode != 0:
+            raise ServerError(f"Could not set the Neo4j password: {result.stderr.strip()}")
+
+    def _launch(self, java: str, lib: Path, options: ServerOptions) -> subprocess.Popen:
+        command = [
+            java,
+            f"-Xms{options.heap}",
+            f"-Xmx{options.heap}",
+            *_JVM_OPTIONS,
+            "-cp",
+            f"{lib}/*",
+            ENTRY_POINT,
+            f"--home-dir={self.home}",
+            f"--config-dir={self.home / 'conf'}",
+        ]
+        with self.console_file.open("ab") as console:
+            # A new session: the server outlives the command that started it and ignores
+            # the Ctrl-C meant for that command.
+            return subprocess.Popen(
+                command,
+                cwd=self.home,
+                stdin=subprocess.DEVNULL,
+                stdout=console,
+                stderr=subprocess.STDOUT,
+                start_new_session=True,
+            )
+
+    def _wait_until_answering(
+        self, process: subprocess.Popen, state: RunningServer, timeout: float
+    ) -> None:
+        from robotale.ekg.connection import bolt_answers
+
+        deadline = time.monotonic() + timeout
+        while time.monotonic() < deadline:
+            if process.poll() is not None:
+                self._fail(f"Neo4j exited with status {process.returncode} while starting")
+            # HTTP comes up last: once it answers, Bolt, Browser and the databases are ready.
+            if _http_answers(state) and bolt_answers(state.bolt_uri, (USER, self.password() or "")):
+                return
+            time.sleep(0.5)
+        self._fail(f"Neo4j did not answer on {state.bolt_uri} within {timeout:.0f} s")
+
+    def _fail(self, what: str) -> None:
+        tail = _last_lines(self.log_file, 15) or _last_lines(self.console_file, 15)
+        if "Address already in use" in tail:
+            raise PortInUse(f"{what}: a port it needs is in use; see {self.log_file}.")
+        raise ServerError(f"{what}; the last lines of {self.log_file}:\n{tail}")
+
+
+def _http_answers(state: RunningServer) -> bool:
+    try:
+        with urllib.request.urlopen(f"http://{HOST}:{state.http_port}/", timeout=2) as response:
+            return response.status == 200
+    except OSError:
+        return False
+
+
+def _java() -> str:
+    java_home = os.environ.get("JAVA_HOME")
+    java = str(Path(java_home) / "bin" / "java") if java_home else shutil.which("java")
+    if not java or not Path(java).is_file():
+        raise ServerError(
+            "Neo4j 5.26 needs Java 17 and no `java` was found: install it (Debian: "
+            "openjdk-17-jre-headless) or set JAVA_HOME, or set NEO4J_URI to use another server."
+        )
+    return java
+
+
+def _require_free(port: int, what: str) -> None:
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        try:
+            probe.bind((HOST, port))
+        except OSError:
+            raise PortInUse(
+                f"The Neo4j {what} port {port} on {HOST} is in use; choose another with "
+                f"--{what}-port (or ROBOTALE_NEO4J_{what.upper()}_PORT), or set NEO4J_URI "
+                "to use the server that is listening there."
+            ) from None
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 that nobody listens on right now."""
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind((HOST, 0))
+        return int(probe.getsockname()[1])
+
+
+def _write_private(path: Path, text: str) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    descriptor = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o600)
+    with os.fdopen(descriptor, "w") as stream:
+        stream.write(text + "\n")
+
+
+def _is_our_process(pid: int, home: Path) -> bool:
+    # A pid can be reused after a crash: only a Neo4j with this home counts.
+    _reap(pid)
+    try:
+        cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
+    except OSError:
+        return False
+    return f"--home-dir={home}".encode() in cmdline and ENTRY_POINT.encode() in cmdline
+
+
+def _reap(pid: int) -> bool:
+    """Collect ``pid`` if it is a finished child of ours; True once it is gone."""
+    try:
+        done, _ = os.waitpid(pid, os.WNOHANG)
+    except ChildProcessError:  # not our child: ask the kernel instead
+        try:
+            os.kill(pid, 0)
+        except ProcessLookupError:
+            return True
+        try:
+            stat = Path(f"/proc/{pid}/stat").read_text()
+        except OSError:
+            return True
+        return stat.rsplit(")", 1)[-1].split()[0] == "Z"
+    return done == pid
+
+
+def _terminate(pid: int, grace: float) -> None:
+    try:
+        os.kill(pid, signal.SIGTERM)
+    except ProcessLookupError:
+        return
+    deadline = time.monotonic() + grace
+    while time.monotonic() < deadline:
+        if _reap(pid):
+            return
+        time.sleep(0.2)
+    try:
+        os.kill(pid, signal.SIGKILL)
+    except ProcessLookupError:
+        return
+    while not _reap(pid):
+        time.sleep(0.1)
+
+
+def _last_lines(path: Path, count: int) -> str:
+    if not path.is_file():
+        return ""
+    return "\n".join(path.read_text(errors="replace").splitlines()[-count:])
