@@ -382,8 +382,7 @@ class Engine:
         if node.throw is not None and node.throw.kind == "signal":
             self._publish(node)
         if node.throw is not None and node.throw.kind == "error":
-            self._tag_pair(node.throw.label)
-            self._throw_error(token, node.throw.topic)
+            self._throw_error(token, node.throw.topic)  # the catching event is tagged
             return None
         self._consume(token)
         return None

@@ -110,7 +110,7 @@ class Node:
 
     def describe(self) -> str:
         """``Activity_1 (Take Off)``: how messages name this element."""
-        return f"{self.id} ({self.name})" if self.name else self.id
+        return f"{self.id} ({self.name})" if self.name and self.name != self.id else self.id
 
 
 @dataclass(slots=True)
@@ -134,7 +134,7 @@ class Process(Scope):
     definitions: Definitions | None = field(default=None, repr=False)
 
     def describe(self) -> str:
-        return f"{self.id} ({self.name})" if self.name else self.id
+        return f"{self.id} ({self.name})" if self.name and self.name != self.id else self.id
 
     def walk(self):
         """Every node of the process, those of sub-processes included."""

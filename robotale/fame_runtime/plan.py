@@ -36,6 +36,16 @@ OUTSIDE = {
     "implicitThrowEvent": "is an implicit throw event",
 }
 
+_ROLES = {
+    "start": "process start event",
+    "event_start": "event sub-process start event",
+    "sub_start": "sub-process start event",
+    "intermediateCatchEvent": "catching intermediate event",
+    "intermediateThrowEvent": "throwing intermediate event",
+    "endEvent": "end event",
+    "boundaryEvent": "boundary event",
+}
+
 #: the event kinds each kind of event may have ("none" = no event definition)
 ALLOWED = {
     "start": {"none", "signal", "timer", "conditional"},
@@ -191,16 +201,22 @@ class _Planner:
         self.library = library
         self.problems: list[str] = []
         self.called: dict[int, ScopePlan] = {}
+        self.where = ""  # which called process the planner is in, for messages
 
     def refuse(self, node: Node, reason: str) -> None:
-        self.problems.append(f"{node.kind} {node.describe()} {reason}")
+        self.problems.append(f"{node.kind} {node.describe()}{self.where} {reason}")
 
     def process(self, process: Process, *, top: bool = False) -> ScopePlan:
         if id(process) in self.called:  # recursive calls share one plan
             return self.called[id(process)]
         plan = ScopePlan(process, data_objects=list(process.data_objects.values()))
         self.called[id(process)] = plan
+        outer = self.where
+        if not top:
+            file = f" ({process.file.name})" if process.file else ""
+            self.where = f" of called process {process.describe()}{file}"
         self.scope(process, plan, top=top)
+        self.where = outer
         if top and not plan.starts and not plan.triggered_starts:
             self.problems.append(f"process {process.describe()} has no start event")
         return plan
@@ -329,8 +345,10 @@ class _Planner:
         if node.kind == "startEvent":
             role = "start" if top else ("event_start" if event else "sub_start")
         if node.event_kind not in ALLOWED[role]:
-            where = "here" if node.kind == "startEvent" else f"on a {node.kind}"
-            self.refuse(node, f"has a {node.event_kind} event definition, not supported {where}")
+            hint = " (use a signal event, guideline G3)" if node.event_kind == "message" else ""
+            self.refuse(
+                node, f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run{hint}"
+            )
             return
         if node.kind in ("startEvent", "intermediateCatchEvent", "boundaryEvent"):
             self.catching(plan, scope)

@@ -14,13 +14,23 @@ def trace(tags, *, messages: bool = False) -> list[tuple]:
     return [(t.stamp, t.robot, t.activity, t.lifecycle) for t in tags]
 
 
-def run(model, *, robots=None, skills=None, until=None, variables=None, latency=0.0, **kw):
-    """Run a model of the suite on a fresh clock and in-process bus; returns (mission, tags)."""
+def pair(time, robot, activity) -> list[tuple]:
+    """The start and complete tags of an instant activity or event."""
+    return [(time, robot, activity, "start"), (time, robot, activity, "complete")]
+
+
+def of(tags, robot: str) -> list[tuple]:
+    """One robot's trace."""
+    return [t for t in trace(tags) if t[1] == robot]
+
+
+def build(model, *, robots=None, skills=None, variables=None, latency=0.0, start=0.0, **kw):
+    """A mission of a suite model on a fresh clock and in-process bus: (mission, tags)."""
     from robotale.fame_runtime.bus import InProcessBus
     from robotale.fame_runtime.clock import SimClock
 
     tags: list = []
-    clock = SimClock()
+    clock = SimClock(start)
     bus = InProcessBus(clock, latency=latency)
     path = model if isinstance(model, Path) else MODELS / model
     mission = Mission(
@@ -33,5 +43,11 @@ def run(model, *, robots=None, skills=None, until=None, variables=None, latency=
         tag_sink=tags.append,
         variables=variables,
     )
+    return mission, tags
+
+
+def run(model, *, until=None, **kw):
+    """Run a suite model until the mission is done (or ``until``): (mission, tags)."""
+    mission, tags = build(model, **kw)
     mission.run(until=until)
     return mission, tags

@@ -1,13 +1,9 @@
 """The engine core: each model of the suite and the exact trace of tags it must leave."""
 
 import pytest
-from fame_helpers import run, trace
+from fame_helpers import pair, run, trace
 
 from robotale.errors import ModelError
-
-
-def pair(time, robot, activity):
-    return [(time, robot, activity, "start"), (time, robot, activity, "complete")]
 
 
 def test_tasks_scripts_exclusive_gateway_and_data_objects():
