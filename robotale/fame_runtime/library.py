@@ -46,6 +46,17 @@ class Library:
         return None
 
 
+def resolve_call(name: str, caller: Process, library: Library | None) -> Process | None:
+    """The process a call activity of ``caller`` calls by ``name``: one of the caller's file,
+    else a building block of the library (skills are matched before, by the caller)."""
+    if not name:
+        return None
+    found = find_process(caller.definitions, name) if caller.definitions else None
+    if found is None and library is not None:
+        found = library.find(name)
+    return found
+
+
 def find_process(definitions: Definitions, name: str) -> Process | None:
     """The process of a file whose id, name or pool name is ``name``."""
     if name in definitions.processes:

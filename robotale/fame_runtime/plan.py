@@ -14,7 +14,7 @@ from dataclasses import dataclass, field
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
-from robotale.fame_runtime.library import Library, find_process
+from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import DataObject, Node, Process, RosMessage, Scope
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.tags import activity_label
@@ -303,7 +303,7 @@ class _Planner:
         if name and name in self.skills:
             plan.behaviour, plan.skill = "skill", name
             return
-        process = node.embedded_process or self.resolve(name, plan.scope.process)
+        process = node.embedded_process or resolve_call(name, plan.scope.process, self.library)
         if process is None:
             where = "no skill, no process of the file" + (
                 f" and no building block in {self.library.folder}" if self.library else ""
@@ -315,14 +315,6 @@ class _Planner:
             return
         plan.behaviour = "call"
         plan.child = self.process(process)
-
-    def resolve(self, name: str, caller: Process) -> Process | None:
-        if not name:
-            return None
-        found = find_process(caller.definitions, name) if caller.definitions else None
-        if found is None and self.library is not None:
-            found = self.library.find(name)
-        return found
 
     def subprocess(self, plan: NodePlan, scope: ScopePlan) -> None:
         node = plan.node

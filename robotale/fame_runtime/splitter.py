@@ -10,8 +10,12 @@ from __future__ import annotations
 import re
 from collections.abc import Iterable
 from dataclasses import dataclass
+from pathlib import Path
+
+from lxml import etree
 
 from robotale.errors import ModelError
+from robotale.fame_runtime.library import find_process
 from robotale.fame_runtime.model import Definitions, Participant, Process
 
 
@@ -35,19 +39,20 @@ def split(definitions: Definitions, robots: Iterable[str] | None = None) -> list
     namespace and each multi-instance pool its minimum number of robots (at least one)."""
     pools = definitions.pools()
     names = _default_robots(pools) if robots is None else [r.strip() for r in robots if r.strip()]
-    assignments = []
-    bound: set[str] = set()
-    for pool, process in pools:
-        mine = [r for r in names if r not in bound and _binds(pool, r, pools)]
-        _check_count(definitions, pool, mine, robots is not None)
-        bound.update(mine)
-        assignments += [Assignment(r, pool.name, process, pool) for r in _ordered(mine)]
-    unknown = [r for r in names if r not in bound]
+    bound: dict[str, list[str]] = {}
+    for pool, _ in pools:
+        taken = {r for robots_of in bound.values() for r in robots_of}
+        bound[pool.id] = [r for r in names if r not in taken and _binds(pool, r, pools)]
+    unknown = [r for r in names if not any(r in robots_of for robots_of in bound.values())]
     if unknown:
         listed = ", ".join(p.name + ("_<n>" if p.multi_instance else "") for p, _ in pools)
         raise ModelError(
             f"{definitions.file}: robot {', '.join(unknown)} matches no pool (pools: {listed})"
         )
+    assignments = []
+    for pool, process in pools:
+        _check_count(definitions, pool, bound[pool.id], robots is not None)
+        assignments += [Assignment(r, pool.name, process, pool) for r in _ordered(bound[pool.id])]
     return assignments
 
 
@@ -75,7 +80,7 @@ def _check_count(definitions: Definitions, pool: Participant, robots: list[str],
     if given and pool.minimum and len(robots) < pool.minimum:
         raise ModelError(
             f"{definitions.file}:{pool.line}: pool {pool.name} needs at least {pool.minimum} "
-            f"robots, {len(robots)} given"
+            f"robot{'s' if pool.minimum > 1 else ''}, {len(robots)} given"
         )
 
 
@@ -99,3 +104,54 @@ def unbound_pools(definitions: Definitions, assignments: list[Assignment]) -> li
     """The pools no robot runs."""
     used = {a.pool.id for a in assignments}
     return [p.name for p, _ in definitions.pools() if p.id not in used]
+
+
+def process_file(assignment: Assignment) -> bytes:
+    """A .bpmn file with only ``assignment``'s pool and process (and the processes of the same
+    file it calls, and the signal and error declarations): what FAME's splitter sends a robot.
+    The diagram is left out, since it would show elements that are no longer there."""
+    process = assignment.process
+    source = process.file
+    if source is None or not source.is_file():
+        raise ModelError(f"process {process.describe()} has no file to split")
+    root = etree.fromstring(
+        source.read_bytes(), etree.XMLParser(resolve_entities=False, no_network=True)
+    )
+    keep = _same_file_calls(process)
+    for child in list(root):
+        kind = etree.QName(child).localname if isinstance(child.tag, str) else ""
+        if (kind == "process" and child.get("id") not in keep) or kind == "BPMNDiagram":
+            root.remove(child)
+        elif kind == "collaboration":
+            for part in list(child):
+                if part.get("processRef") != process.id:
+                    child.remove(part)  # other pools, message flows between them
+    return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
+
+
+def _same_file_calls(process: Process) -> set[str]:
+    """The ids of ``process`` and of the processes of its file it calls, transitively."""
+    definitions = process.definitions
+    keep, stack = set(), [process]
+    while stack:
+        current = stack.pop()
+        if current.id in keep:
+            continue
+        keep.add(current.id)
+        for node in current.walk():
+            called = find_process(definitions, node.called_element) if definitions else None
+            if node.kind == "callActivity" and called is not None:
+                stack.append(called)
+    return keep
+
+
+def write_split(assignments: list[Assignment], folder: Path) -> list[Path]:
+    """One ``<robot>.bpmn`` per assignment in ``folder``; every file is prepared before the
+    first is written, and each is written whole (temporary file, then renamed)."""
+    contents = [(folder / f"{a.robot}.bpmn", process_file(a)) for a in assignments]
+    folder.mkdir(parents=True, exist_ok=True)
+    for path, data in contents:
+        temporary = path.with_suffix(".bpmn.tmp")
+        temporary.write_bytes(data)
+        temporary.replace(path)
+    return [path for path, _ in contents]

@@ -133,6 +133,8 @@ def test_agri_splits_into_drone_and_tractors(fame_models):
         split(agri, ["drone", "tractor_1", "tractor_2", "tractor_3", "tractor_4"])
     with pytest.raises(ModelError, match="robot rover matches no pool"):
         split(agri, ["drone", "tractor_1", "rover"])
+    with pytest.raises(ModelError, match="pool Tractor needs at least 1 robot, 0 given"):
+        split(agri, ["drone"])
 
 
 NS = (
