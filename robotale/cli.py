@@ -12,6 +12,7 @@ import argparse
 import importlib
 import sys
 from collections.abc import Callable, Sequence
+from pathlib import Path
 
 from robotale import __version__
 from robotale.errors import RobotaleError
@@ -26,6 +27,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands = parser.add_subparsers(dest="command", metavar="COMMAND")
     commands.required = True
     # One line per command group, in the order of the data flow (see DESIGN.md).
+    _add_fame(commands)
     _add_neo4j(commands)
     return parser
 
@@ -60,6 +62,85 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
     stop.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_stop"))
     status = actions.add_parser("status", help="where the server is and whether it answers")
     status.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_status"))
+
+
+def _add_fame(commands) -> None:
+    fame = commands.add_parser(
+        "fame",
+        help="BPMN missions: check, split and run collaborations",
+        description="Missions as BPMN collaborations (FAME): one pool per robot, one engine each.",
+    )
+    sub = fame.add_subparsers(dest="fame_command", metavar="COMMAND")
+    sub.required = True
+    library = {"type": Path, "metavar": "DIR", "help": "folder of .bpmn building blocks"}
+    skills = {"metavar": "MODULE", "help": "Python module (or .py file) with a SKILLS mapping"}
+    robots = {"metavar": "A,B", "help": "robot namespaces, e.g. drone,tractor_1,tractor_2"}
+
+    check = sub.add_parser("check", help="structure and QoS report; exit status 1 on problems")
+    check.add_argument("model", type=Path, help="the .bpmn collaboration")
+    check.add_argument("--library", **library)
+    check.add_argument("--skills", **skills)
+    check.set_defaults(handler=_fame_check)
+
+    split = sub.add_parser("split", help="one process per robot")
+    split.add_argument("model", type=Path, help="the .bpmn collaboration")
+    split.add_argument("--robots", **robots)
+    split.add_argument("--out", type=Path, metavar="DIR", help="write <robot>.bpmn files here")
+    split.set_defaults(handler=_fame_split)
+
+    run = sub.add_parser("run", help="run in process on a simulated clock, printing tags")
+    run.add_argument("model", type=Path, help="the .bpmn collaboration")
+    run.add_argument("--robots", **robots)
+    run.add_argument("--skills", **skills)
+    run.add_argument("--library", **library)
+    run.add_argument(
+        "--until",
+        type=float,
+        default=3600.0,
+        metavar="SECONDS",
+        help="stop at this simulated time at the latest (default 3600)",
+    )
+    run.add_argument(
+        "--latency",
+        type=float,
+        default=0.0,
+        metavar="SECONDS",
+        help="message delivery delay on the bus (default 0)",
+    )
+    run.add_argument(
+        "--set",
+        action="append",
+        default=[],
+        metavar="ROBOT.NAME=VALUE",
+        help="an initial variable, e.g. drone.delay=10 (repeatable)",
+    )
+    run.set_defaults(handler=_fame_run)
+
+
+def _fame_check(args: argparse.Namespace) -> int:
+    from robotale.fame_runtime.commands import check_command
+
+    return check_command(args.model, library=args.library, skills=args.skills)
+
+
+def _fame_split(args: argparse.Namespace) -> int:
+    from robotale.fame_runtime.commands import split_command
+
+    return split_command(args.model, robots=args.robots, out_dir=args.out)
+
+
+def _fame_run(args: argparse.Namespace) -> int:
+    from robotale.fame_runtime.commands import run_command
+
+    return run_command(
+        args.model,
+        robots=args.robots,
+        skills=args.skills,
+        library=args.library,
+        until=args.until,
+        latency=args.latency,
+        assignments=args.set,
+    )
 
 
 def main(argv: Sequence[str] | None = None) -> int:

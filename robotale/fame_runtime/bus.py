@@ -87,6 +87,9 @@ class InProcessBus:
         self._subscribers: dict[str, list[Subscription]] = defaultdict(list)
         self._taps: list[Subscription] = []
         self._ids = itertools.count(1)
+        #: deliveries scheduled on the clock but not made yet (a mission is not over while
+        #: a message is in flight)
+        self.pending = 0
 
     def new_msg_id(self) -> str:
         """A message id unique on this bus (``m_1``, ``m_2`` ... as in the thesis' log)."""
@@ -101,7 +104,8 @@ class InProcessBus:
         for subscription in list(self._subscribers.get(topic, ())):
             if self.drop and self.drop(envelope, subscription):
                 continue
-            self.clock.call_later(self.latency, _delivery(subscription, envelope))
+            self.pending += 1
+            self.clock.call_later(self.latency, self._delivery(subscription, envelope))
         return envelope
 
     def subscribe(self, topic, callback, *, msgtype=None, qos=None, owner="") -> Subscription:
@@ -123,11 +127,11 @@ class InProcessBus:
         if subscription in group:
             group.remove(subscription)
 
+    def _delivery(self, subscription: Subscription, envelope: Envelope) -> Callable[[], None]:
+        def deliver() -> None:
+            self.pending -= 1
+            # A subscriber that left between publish and delivery does not receive it.
+            if subscription.active:
+                subscription.callback(envelope)
 
-def _delivery(subscription: Subscription, envelope: Envelope) -> Callable[[], None]:
-    def deliver() -> None:
-        # A subscriber that left between publish and delivery does not receive it.
-        if subscription.active:
-            subscription.callback(envelope)
-
-    return deliver
+        return deliver

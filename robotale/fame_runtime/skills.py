@@ -17,7 +17,11 @@ events (``/tractor_1/low_battery``, ``std_msgs/msg/Empty``).
 from __future__ import annotations
 
 import importlib
+import importlib.util
+import sys
 from collections.abc import Callable, Mapping
+from pathlib import Path
+from types import ModuleType
 from typing import Any, Protocol
 
 from robotale.errors import ModelError
@@ -45,6 +49,7 @@ class Robot(Protocol):
     ) -> Subscription: ...
 
 
+#: ``done(outputs)`` ends the activity; ``done(BpmnError(name))`` throws a BPMN error from it
 Done = Callable[[Mapping[str, Any] | None], None]
 Cancel = Callable[[], None]
 
@@ -57,15 +62,27 @@ def load_skills(module_name: str) -> dict[str, Skill]:
     """The skills a module offers: its ``SKILLS`` mapping of called-element name to skill.
 
     ``robotale fame run --skills mymodule`` uses this, so a user's own skills are a plain
-    Python module on the path.
+    Python module on the path (or in the current folder), or a ``.py`` file given by its path.
     """
-    try:
-        module = importlib.import_module(module_name)
-    except ImportError as error:
-        raise ModelError(f"cannot import the skills module {module_name!r}: {error}") from error
+    module = _import(module_name)
     skills = getattr(module, "SKILLS", None)
     if not isinstance(skills, Mapping):
         raise ModelError(
             f"the skills module {module_name!r} has no SKILLS mapping of name to skill"
         )
     return dict(skills)
+
+
+def _import(module_name: str) -> ModuleType:
+    path = Path(module_name)
+    try:
+        if path.suffix == ".py" and path.is_file():
+            spec = importlib.util.spec_from_file_location(path.stem, path)
+            module = importlib.util.module_from_spec(spec)
+            spec.loader.exec_module(module)
+            return module
+        if "" not in sys.path and str(Path.cwd()) not in sys.path:
+            sys.path.insert(0, str(Path.cwd()))
+        return importlib.import_module(module_name)
+    except ImportError as error:
+        raise ModelError(f"cannot import the skills module {module_name!r}: {error}") from error

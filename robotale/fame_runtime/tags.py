@@ -69,6 +69,16 @@ def tag_topic(robot: str) -> str:
     return f"/{robot}/tag"
 
 
+def bus_sink(bus) -> TagSink:
+    """A tag sink that publishes every tag on its robot's ``/<robot>/tag`` topic, where a
+    recorder tapping the bus writes it to a bag like any other message."""
+
+    def publish(tag: Tag) -> None:
+        bus.publish(tag_topic(tag.robot), tag, msgtype=TAG_TYPE, sender=tag.robot)
+
+    return publish
+
+
 def register_tag_type(typestore) -> None:
     """Add ``robotale_msgs/msg/Tag`` to a rosbags type store (idempotent)."""
     from rosbags.typesys import get_types_from_msg

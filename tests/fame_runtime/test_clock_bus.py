@@ -35,9 +35,9 @@ def test_bus_delivers_through_the_clock_not_inside_publish():
         sender="drone",
         msg_id=bus.new_msg_id(),
     )
-    assert got == [] and tapped == [envelope]
+    assert got == [] and tapped == [envelope] and bus.pending == 1
     clock.run()
-    assert got == [envelope] and clock.now() == 0.5
+    assert got == [envelope] and clock.now() == 0.5 and bus.pending == 0
     assert envelope.msg_id == "m_1" and envelope.sender == "drone"
 
 

@@ -1,0 +1,210 @@
+"""Engine throughput against SpiffWorkflow, and signal latency between engines.
+
+Both engines run the same .bpmn files (written to a temporary folder): a sequence of 10 script
+tasks, and a parallel split of 10 script-task branches joined again. For each, the process is
+parsed once and then instantiated and run to completion again and again; the figures are
+process instances and flow nodes per second, and robotale's throughput as a multiple of
+SpiffWorkflow's measured in the same run (target: at least 10x).
+
+Then the latency of a signal: one engine throws ``ping`` once a simulated second, another
+catches it; the wall time from the throw to the catching token moving, on the in-process bus
+driven by a SimClock run loop (target: median under 100 microseconds).
+
+    .venv/bin/python benchmarks/engine_throughput.py [--seconds 2]
+"""
+
+from __future__ import annotations
+
+import argparse
+import itertools
+import statistics
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+from tqdm import tqdm
+
+from robotale.fame_runtime.bus import InProcessBus
+from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.engine import Engine
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.plan import deploy
+
+HEADER = (
+    '<?xml version="1.0" encoding="UTF-8"?>\n'
+    '<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" '
+    'id="bench" targetNamespace="http://robotale/bench">\n'
+    '<bpmn:process id="bench" isExecutable="true">\n<bpmn:startEvent id="start" />\n'
+)
+FOOTER = '<bpmn:endEvent id="end" />\n</bpmn:process>\n</bpmn:definitions>\n'
+TASKS = 10
+
+
+def script_task(i: int) -> str:
+    return (
+        f'<bpmn:scriptTask id="task_{i}" name="Task {i}" scriptFormat="python">'
+        f"<bpmn:script>value_{i} = {i} * 2</bpmn:script></bpmn:scriptTask>\n"
+    )
+
+
+def flow(source: str, target: str) -> str:
+    return (
+        f'<bpmn:sequenceFlow id="f_{source}_{target}" sourceRef="{source}" '
+        f'targetRef="{target}" />\n'
+    )
+
+
+def sequential() -> str:
+    chain = ["start", *[f"task_{i}" for i in range(TASKS)], "end"]
+    body = "".join(script_task(i) for i in range(TASKS))
+    return HEADER + body + "".join(flow(a, b) for a, b in itertools.pairwise(chain)) + FOOTER
+
+
+def parallel() -> str:
+    body = '<bpmn:parallelGateway id="split" />\n<bpmn:parallelGateway id="join" />\n'
+    body += "".join(script_task(i) for i in range(TASKS))
+    flows = flow("start", "split") + flow("join", "end")
+    flows += "".join(flow("split", f"task_{i}") + flow(f"task_{i}", "join") for i in range(TASKS))
+    return HEADER + body + flows + FOOTER
+
+
+def rate(run_once: Callable[[], None], seconds: float) -> float:
+    """Runs per second of ``run_once``, over at least ``seconds`` of wall time."""
+    run_once()  # warm up caches and lazy imports
+    count, start = 0, time.perf_counter()
+    while True:
+        for _ in range(50):
+            run_once()
+        count += 50
+        elapsed = time.perf_counter() - start
+        if elapsed >= seconds:
+            return count / elapsed
+
+
+def robotale_runner(path: Path) -> Callable[[], None]:
+    clock = SimClock()
+    engine = Engine(
+        deploy(parse(path).processes["bench"]),
+        robot="bench",
+        bus=InProcessBus(clock),
+        clock=clock,
+        tag_sink=[].append,
+    )
+
+    def run_once() -> None:
+        engine.start_instance()
+        assert engine.idle
+
+    run_once()
+    assert engine.variables[f"value_{TASKS - 1}"] == (TASKS - 1) * 2, "the scripts did not run"
+    return run_once
+
+
+def spiff_runner(path: Path) -> Callable[[], None]:
+    from SpiffWorkflow.bpmn import BpmnWorkflow
+    from SpiffWorkflow.bpmn.parser import BpmnParser
+
+    parser = BpmnParser()
+    parser.add_bpmn_file(str(path))
+    spec = parser.get_spec("bench")
+
+    def run_once() -> None:
+        workflow = BpmnWorkflow(spec)
+        workflow.do_engine_steps()
+        assert workflow.is_completed()
+
+    return run_once
+
+
+PING = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="ping">
+  <bpmn:process id="pinger">
+    <bpmn:startEvent id="p_start" />
+    <bpmn:exclusiveGateway id="p_loop" />
+    <bpmn:intermediateThrowEvent id="p_throw" name="ping">
+      <bpmn:signalEventDefinition />
+    </bpmn:intermediateThrowEvent>
+    <bpmn:intermediateCatchEvent id="p_wait" name="1 s">
+      <bpmn:timerEventDefinition><bpmn:timeDuration>PT1S</bpmn:timeDuration></bpmn:timerEventDefinition>
+    </bpmn:intermediateCatchEvent>
+    <bpmn:sequenceFlow id="p1" sourceRef="p_start" targetRef="p_loop" />
+    <bpmn:sequenceFlow id="p2" sourceRef="p_loop" targetRef="p_throw" />
+    <bpmn:sequenceFlow id="p3" sourceRef="p_throw" targetRef="p_wait" />
+    <bpmn:sequenceFlow id="p4" sourceRef="p_wait" targetRef="p_loop" />
+  </bpmn:process>
+  <bpmn:process id="ponger">
+    <bpmn:startEvent id="q_start" />
+    <bpmn:exclusiveGateway id="q_loop" />
+    <bpmn:intermediateCatchEvent id="q_catch" name="ping">
+      <bpmn:signalEventDefinition />
+    </bpmn:intermediateCatchEvent>
+    <bpmn:sequenceFlow id="q1" sourceRef="q_start" targetRef="q_loop" />
+    <bpmn:sequenceFlow id="q2" sourceRef="q_loop" targetRef="q_catch" />
+    <bpmn:sequenceFlow id="q3" sourceRef="q_catch" targetRef="q_loop" />
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+
+def signal_latencies(path: Path, count: int) -> list[float]:
+    """Wall seconds from each ``ping!`` to the catching token moving in the other engine."""
+    definitions = parse(path)
+    clock = SimClock()
+    bus = InProcessBus(clock)
+    thrown: dict[str, float] = {}
+    latencies: list[float] = []
+
+    def sink(tag) -> None:
+        now = time.perf_counter()
+        if tag.activity == "ping!" and tag.lifecycle == "start":
+            thrown[tag.msg_id] = now
+        elif tag.activity == "ping?" and tag.lifecycle == "complete":
+            latencies.append(now - thrown.pop(tag.msg_id))
+
+    for process in ("ponger", "pinger"):
+        Engine(
+            definitions.processes[process], robot=process, bus=bus, clock=clock, tag_sink=sink
+        ).start()
+    with tqdm(total=count, desc="signal latency", unit="msg", file=sys.stderr, leave=False) as bar:
+        while len(latencies) < count:
+            before = len(latencies)
+            clock.run(until=clock.now() + 100)
+            bar.update(len(latencies) - before)
+    return latencies[:count]
+
+
+def main() -> int:
+    arguments = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    arguments.add_argument("--seconds", type=float, default=2.0, help="wall time per measurement")
+    arguments.add_argument("--messages", type=int, default=5000, help="signals for the latency")
+    options = arguments.parse_args()
+    with tempfile.TemporaryDirectory() as folder:
+        models = {"sequential, 10 script tasks": (sequential(), TASKS + 2)}
+        models["parallel split of 10 branches"] = (parallel(), TASKS + 4)
+        print(f"{'model':32} {'engine':12} {'instances/s':>12} {'nodes/s':>12} {'ratio':>7}")
+        for label, (text, nodes) in tqdm(
+            models.items(), desc="throughput", file=sys.stderr, leave=False
+        ):
+            path = Path(folder) / "bench.bpmn"
+            path.write_text(text)
+            ours = rate(robotale_runner(path), options.seconds)
+            spiff = rate(spiff_runner(path), options.seconds)
+            for engine, value in (("robotale", ours), ("SpiffWorkflow", spiff)):
+                ratio = value / spiff
+                print(f"{label:32} {engine:12} {value:12.0f} {value * nodes:12.0f} {ratio:6.1f}x")
+        ping = Path(folder) / "ping.bpmn"
+        ping.write_text(PING)
+        latencies = signal_latencies(ping, options.messages)
+    median = statistics.median(latencies) * 1e6
+    p95 = statistics.quantiles(latencies, n=20)[-1] * 1e6
+    print(
+        f"signal throw -> catch across engines: median {median:.1f} us, p95 {p95:.1f} us "
+        f"({len(latencies)} signals; target median < 100 us: {median / 100:.2f} of it)"
+    )
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,138 @@
+"""What ``robotale fame check|split|run`` do; :mod:`robotale.cli` only parses arguments."""
+
+from __future__ import annotations
+
+import json
+import sys
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any, TextIO
+
+from robotale.errors import InputError
+from robotale.fame_runtime.bus import InProcessBus
+from robotale.fame_runtime.check import Report, check
+from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.library import Library
+from robotale.fame_runtime.mission import Mission
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.skills import load_skills
+from robotale.fame_runtime.splitter import split, unbound_pools, write_split
+from robotale.fame_runtime.tags import Tag
+
+
+def robot_list(text: str | None) -> list[str] | None:
+    """``drone,tractor_1`` -> ["drone", "tractor_1"]."""
+    return [r.strip() for r in text.split(",") if r.strip()] if text else None
+
+
+def check_command(
+    model: Path, *, library: Path | None, skills: str | None, out: TextIO | None = None
+) -> int:
+    """Print the structure and QoS report; 1 when something is wrong."""
+    out = out or sys.stdout
+    names = load_skills(skills) if skills else {}
+    report = check(parse(model), skills=names, library=Library(library) if library else None)
+    print_report(report, out)
+    return 0 if report.ok else 1
+
+
+def print_report(report: Report, out: TextIO) -> None:
+    print(f"{report.file}: pools {', '.join(report.pools)}", file=out)
+    print(f"structure: {'ok' if not report.problems else 'the engine cannot run'}", file=out)
+    for problem in report.problems:
+        print(f"  {problem}", file=out)
+    incompatible = sum(not p.compatible for p in report.pairs)
+    print(
+        f"QoS: {len(report.pairs)} publisher/subscriber pairs, {incompatible} incompatible",
+        file=out,
+    )
+    for pair in report.pairs:
+        verdict = "compatible" if pair.compatible else "INCOMPATIBLE: " + "; ".join(pair.reasons)
+        print(
+            f"  {pair.publisher.topic}: {pair.publisher.describe()} -> "
+            f"{pair.subscriber.describe()}: {verdict}",
+            file=out,
+        )
+    for note in report.notes:
+        print(f"note: {note}", file=out)
+
+
+def split_command(
+    model: Path, *, robots: str | None, out_dir: Path | None, out: TextIO | None = None
+) -> int:
+    """Print which robot runs which pool's process; with ``out_dir`` write one file each."""
+    out = out or sys.stdout
+    definitions = parse(model)
+    assignments = split(definitions, robot_list(robots))
+    for a in assignments:
+        print(f"{a.robot}\t{a.robot_type}\t{a.process.describe()}", file=out)
+    for pool in unbound_pools(definitions, assignments):
+        print(f"# pool {pool}: no robot", file=out)
+    if out_dir is not None:
+        for path in write_split(assignments, out_dir):
+            print(f"# wrote {path}", file=out)
+    return 0
+
+
+def run_command(
+    model: Path,
+    *,
+    robots: str | None,
+    skills: str | None,
+    library: Path | None,
+    until: float,
+    latency: float,
+    assignments: Sequence[str] = (),
+    out: TextIO | None = None,
+    err: TextIO | None = None,
+) -> int:
+    """Run the mission on the in-process bus and a simulated clock, printing every tag as it
+    happens; 1 when a BPMN error went uncaught."""
+    out, err = out or sys.stdout, err or sys.stderr
+    clock = SimClock()
+    mission = Mission(
+        parse(model),
+        robots=robot_list(robots),
+        clock=clock,
+        bus=InProcessBus(clock, latency=latency),
+        skills=load_skills(skills) if skills else None,
+        library=library,
+        tag_sink=lambda tag: print(tag_line(tag), file=out),
+        variables=parse_assignments(assignments),
+    )
+    reached = mission.run(until=until)
+    state = "done" if mission.done else "still running"
+    counts = ", ".join(f"{r} {e.completed}" for r, e in mission.engines.items())
+    print(f"# {state} at {reached:.3f} s; instances completed: {counts}", file=err)
+    for failure in mission.failures:
+        print(f"# {failure}", file=err)
+    return 1 if mission.failures else 0
+
+
+def tag_line(tag: Tag) -> str:
+    fields = (
+        f"{tag.stamp:10.3f}",
+        tag.robot,
+        tag.activity,
+        tag.lifecycle,
+        tag.msg_id,
+        tag.msg_role,
+        tag.payload,
+    )
+    return "\t".join(fields).rstrip()
+
+
+def parse_assignments(assignments: Sequence[str]) -> dict[str, dict[str, Any]]:
+    """``drone.delay=10`` -> {"drone": {"delay": 10}} (values are JSON, else text)."""
+    variables: dict[str, dict[str, Any]] = {}
+    for text in assignments:
+        target, equals, value = text.partition("=")
+        robot, dot, name = target.partition(".")
+        if not equals or not dot or not name.isidentifier():
+            raise InputError(f"--set {text!r} is not ROBOT.NAME=VALUE (for example drone.delay=10)")
+        try:
+            parsed: Any = json.loads(value)
+        except ValueError:
+            parsed = value
+        variables.setdefault(robot, {})[name] = parsed
+    return variables

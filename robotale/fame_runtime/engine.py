@@ -1,0 +1,863 @@
+"""The token engine: one per robot, running that robot's process (BPMN 2.0 section 13).
+
+Tokens move through the process as far as they can without waiting; a token waits at a skill
+that takes time, a catching event, a sub-process, a join. Everything that wakes a token up --
+a message on the bus, a timer, a skill's ``done``, a variable change satisfying a condition --
+is queued and run by the engine's own loop, never inside another engine's step or inside the
+bus. Every activity start and completion, every signal thrown or caught, every timer, error
+and conditional event becomes a :class:`~robotale.fame_runtime.tags.Tag`.
+
+See ``docs/fame_runtime.md`` for the API and the exact semantics.
+"""
+
+from __future__ import annotations
+
+import builtins
+import json
+import types
+from collections.abc import Callable, Iterable, Mapping
+from pathlib import Path
+from typing import Any
+
+from robotale.errors import ModelError
+from robotale.fame_runtime.bus import Bus, Envelope
+from robotale.fame_runtime.clock import Clock
+from robotale.fame_runtime.expressions import BpmnError, Compiled, render_json, self_reference
+from robotale.fame_runtime.expressions import substitute as substitute_text
+from robotale.fame_runtime.library import Library
+from robotale.fame_runtime.model import DataObject, Process
+from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, reachable_flows
+from robotale.fame_runtime.robot import RobotHandle
+from robotale.fame_runtime.skills import Skill
+from robotale.fame_runtime.tags import Tag, TagSink
+from robotale.fame_runtime.triggers import Triggers
+
+#: values a script leaves behind that are not variables (``import math``, helper functions)
+_NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
+
+
+class _Token:
+    __slots__ = ("alive", "boundaries", "child", "flow", "generation", "node", "scope", "waits")
+
+    def __init__(self, scope: _Scope, node: NodePlan) -> None:
+        self.scope = scope
+        self.node = node
+        self.flow = ""  # the sequence flow it arrived by (joins count them)
+        self.waits: list[Callable[[], Any]] = []  # undo what it waits for
+        self.boundaries: list[Callable[[], Any]] = []  # disarm its activity's boundary events
+        self.child: _Scope | None = None
+        self.alive = True
+        self.generation = 0  # stale skill completions are ignored
+
+
+class _Scope:
+    """A running process, called process, sub-process or event sub-process."""
+
+    __slots__ = ("armed", "depth", "ended", "holder", "joins", "parent", "plan", "safe", "tokens")
+
+    def __init__(self, plan: ScopePlan, parent: _Scope | None, holder: _Token | None) -> None:
+        self.plan = plan
+        self.parent = parent
+        self.holder = holder  # the token of the activity this scope runs inside
+        self.depth = parent.depth + 1 if parent else 0
+        self.tokens: set[_Token] = set()
+        self.joins: dict[str, list[_Token]] = {}
+        self.armed: dict[str, Callable[[], Any]] = {}  # event sub-process id -> disarm
+        self.ended = False
+        self.safe = False  # its safe-state handler runs before it ends
+
+
+class Engine:
+    """Runs one robot's process.
+
+    ``process`` is a parsed :class:`~robotale.fame_runtime.model.Process` (or an already
+    deployed plan); ``skills`` maps called-element names to Python skills; ``library`` is a
+    folder of .bpmn building blocks for call activities; ``variables`` are initial variables
+    (they win over the data objects' literal values); ``tag_sink`` receives every tag.
+    """
+
+    def __init__(
+        self,
+        process: Process | ScopePlan,
+        *,
+        robot: str,
+        bus: Bus,
+        clock: Clock,
+        robot_type: str = "",
+        skills: Mapping[str, Skill] | None = None,
+        tag_sink: TagSink | None = None,
+        library: Library | str | Path | None = None,
+        variables: Mapping[str, Any] | None = None,
+    ) -> None:
+        self.skills = dict(skills or {})
+        if library is not None and not isinstance(library, Library):
+            library = Library(library)
+        self.library = library
+        self.plan = self._deploy(process)
+        self.bus, self.clock = bus, clock
+        self.tag_sink = tag_sink
+        self.variables: dict[str, Any] = dict(variables or {})
+        self._given = frozenset(self.variables)
+        robot_type = robot_type or self.plan.process.name or self.plan.process.id
+        self.robot = RobotHandle(robot, robot_type, bus, clock, self.variables, self._changed)
+        self.env: dict[str, Any] = {
+            "__builtins__": builtins,
+            "robot": self.robot,
+            "BpmnError": BpmnError,
+        }
+        self.triggers = Triggers(
+            robot, bus, clock, self._call, self._value, self.env, self.variables
+        )
+        self._work: list[Callable[[], Any]] = []
+        self._busy = False
+        self._roots: list[_Scope] = []
+        self._start_disarms: list[Callable[[], Any]] = []
+        self._inclusive: set[_Scope] = set()
+        self._when_idle: list[Callable[[], Any]] = []
+        self._msg_ids = 0
+        self._starting = 0  # none-start instances scheduled but not begun
+        self._behaviours = {
+            name.removeprefix("_run_"): getattr(self, name)
+            for name in dir(self)
+            if name.startswith("_run_")
+        }
+        self.started = False
+        self.stopped = False
+        self.completed = 0  # process instances that ended
+        self.failures: list[str] = []  # BPMN errors nobody caught
+
+    def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
+        if isinstance(process, ScopePlan):
+            return process
+        return deploy(process, skills=self.skills, library=self.library)
+
+    def __repr__(self) -> str:
+        return f"Engine({self.robot.name!r}, {self.plan.process.describe()!r})"
+
+    # -- life cycle ----------------------------------------------------------------------------
+
+    @property
+    def idle(self) -> bool:
+        """No process instance is running or about to (one may still start on a signal or
+        a timer)."""
+        return not self._roots and not self._starting
+
+    @property
+    def ended(self) -> bool:
+        """Nothing runs and nothing can start an instance any more."""
+        return self.started and self.idle and (self.stopped or not self._start_disarms)
+
+    def start(self) -> None:
+        """Arm the start events; an instance for the none start events begins at the clock's
+        next step (so every engine of a mission subscribes before anyone throws)."""
+        if self.started and not self.stopped:
+            return
+        self.started, self.stopped = True, False
+        for start in self.plan.triggered_starts:
+            self._start_disarms.append(
+                self.triggers.arm(start.trigger, self._starter(start), repeat=True)
+            )
+        if self.plan.starts:
+            self._starting += 1
+            self.clock.call_soon(self._first_instance)
+
+    def _first_instance(self) -> None:
+        self._starting -= 1
+        if not self.stopped:
+            self._call(self.start_instance)
+
+    def start_instance(self) -> None:
+        """Start one more instance at the none start events, now."""
+        root = self._open(self.plan, None, None)
+        for start in reversed(self.plan.starts):
+            self._push(self._new_token(root, start), start)
+
+    def _starter(self, start: NodePlan) -> Callable[[Envelope | None], None]:
+        def fire(envelope: Envelope | None) -> None:
+            if self.stopped:
+                return
+            root = self._open(self.plan, None, None)
+            self._caught(self._new_token(root, start), start, envelope)
+
+        return fire
+
+    def stop(self, *, safe: bool = True, then: Callable[[], Any] | None = None) -> None:
+        """End every instance -- after its safe-state handler ran, when ``safe`` and the model
+        has one -- and start nothing more; ``then`` runs once everything has ended."""
+        self.stopped = True
+        for disarm in self._start_disarms:
+            disarm()
+        self._start_disarms.clear()
+        if then is not None:
+            self._when_idle.append(then)
+        self._call(lambda: self._stop_all(safe))
+
+    def _stop_all(self, safe: bool) -> None:
+        for root in list(self._roots):
+            self._kill(root, safe=safe)
+
+    def replace(self, process: Process | ScopePlan) -> None:
+        """Run ``process`` from now on instead: the running instances end first (their
+        safe-state handler runs), then the new process starts."""
+        plan = self._deploy(process)
+
+        def restart() -> None:
+            self.plan = plan
+            self.robot.close()
+            self.start()
+
+        self.stop(safe=True, then=restart)
+
+    def set_variables(self, **values: Any) -> None:
+        """Set variables from outside (the simulation, a test); conditional events that read
+        them are re-evaluated."""
+        self.robot.set(**values)
+
+    # -- the work loop ---------------------------------------------------------------------------
+
+    def _call(self, work: Callable[[], Any]) -> None:
+        self._work.append(work)
+        if not self._busy:
+            self._drain()
+
+    def _push(self, token: _Token, node: NodePlan) -> None:
+        self._call(lambda: self._advance(token, node))
+
+    def _drain(self) -> None:
+        self._busy = True
+        try:
+            while self._work:
+                self._work.pop()()
+                if not self._work and self._inclusive:
+                    self._recheck_joins()
+        except BaseException:
+            self._work.clear()
+            raise
+        finally:
+            self._busy = False
+        self._idle_check()
+
+    def _idle_check(self) -> None:
+        if self._roots or not self._when_idle or self._busy:
+            return
+        waiting, self._when_idle = self._when_idle, []
+        for then in waiting:
+            then()
+
+    def _advance(self, token: _Token, node: NodePlan | None) -> None:
+        """Move ``token`` from ``node`` on until it has to wait."""
+        while node is not None and token.alive:
+            token.node = node
+            node = self._behaviours[node.behaviour](token, node)
+
+    # -- tokens and scopes ---------------------------------------------------------------------
+
+    def _new_token(self, scope: _Scope, node: NodePlan) -> _Token:
+        token = _Token(scope, node)
+        scope.tokens.add(token)
+        return token
+
+    def _open(self, plan: ScopePlan, parent: _Scope | None, holder: _Token | None) -> _Scope:
+        scope = _Scope(plan, parent, holder)
+        if parent is None:
+            self._roots.append(scope)
+        if holder is not None:
+            holder.child = scope
+        self._declare(plan.data_objects)
+        for esp in plan.event_subprocesses:
+            self._arm_event_subprocess(scope, esp)
+        return scope
+
+    def _consume(self, token: _Token) -> None:
+        token.alive = False
+        scope = token.scope
+        scope.tokens.discard(token)
+        if not scope.tokens and not scope.ended:
+            self._close(scope)
+
+    def _cancel(self, token: _Token) -> None:
+        """Stop what ``token`` does (skills cancelled, timers and subscriptions dropped)."""
+        if not token.alive:
+            return
+        token.alive = False
+        token.scope.tokens.discard(token)
+        waiting = token.scope.joins.get(token.node.id)
+        if waiting and token in waiting:
+            waiting.remove(token)
+        self._disarm(token)
+        if token.child is not None:
+            self._cancel_scope(token.child)
+
+    def _disarm(self, token: _Token) -> None:
+        token.generation += 1  # whatever fires for the old wait from now on is stale
+        for undo in (*token.waits, *token.boundaries):
+            undo()
+        token.waits.clear()
+        token.boundaries.clear()
+
+    def _cancel_scope(self, scope: _Scope) -> None:
+        scope.ended = True
+        for disarm in scope.armed.values():
+            disarm()
+        scope.armed.clear()
+        for token in list(scope.tokens):
+            self._cancel(token)
+        self._inclusive.discard(scope)
+
+    def _close(self, scope: _Scope) -> None:
+        """``scope`` has no token left: it completes."""
+        self._cancel_scope(scope)
+        if scope.holder is None:
+            self._roots.remove(scope)
+            self.completed += 1
+        elif scope.holder.alive:
+            self._activity_done(scope.holder)
+
+    def _kill(self, scope: _Scope, *, safe: bool) -> None:
+        """End every token of ``scope``; a top-level scope with a safe-state handler runs it
+        first (thesis 4.1.3)."""
+        handler = scope.plan.safe_state if safe and scope.holder is None else None
+        if handler is not None and not scope.safe:
+            scope.safe = True
+            self._event_subprocess(scope, handler, None, interrupting=True, triggered=False)
+            return
+        for token in list(scope.tokens):
+            self._cancel(token)
+        if not scope.ended:
+            self._close(scope)
+
+    # -- leaving a node ----------------------------------------------------------------------------
+
+    def _follow(self, token: _Token, flows: list[FlowPlan]) -> NodePlan | None:
+        """Send ``token`` along ``flows`` (more than one: new tokens for the others)."""
+        if not flows:
+            self._consume(token)
+            return None
+        for flow in reversed(flows[1:]):
+            other = self._new_token(token.scope, flow.target)
+            other.flow = flow.id
+            self._push(other, flow.target)
+        token.flow = flows[0].id
+        return flows[0].target
+
+    def _taken(self, node: NodePlan, *, first: bool) -> list[FlowPlan]:
+        """The outgoing flows whose condition holds (the default flow when none does)."""
+        taken = []
+        for flow in node.outgoing:
+            if flow is node.default:
+                continue
+            if flow.condition is None or self._condition(flow.condition, flow.id):
+                taken.append(flow)
+                if first:
+                    break
+        if not taken and node.default is not None:
+            taken.append(node.default)
+        return taken
+
+    def _condition(self, condition: Compiled, where: str) -> bool:
+        try:
+            return bool(eval(condition.code, self.env, self.variables))
+        except BpmnError:
+            raise
+        except Exception as error:
+            raise ModelError(
+                f"robot {self.robot.name}: the condition of {where} ({condition.source}) "
+                f"failed: {type(error).__name__}: {error}"
+            ) from error
+
+    def _value(self, condition: Compiled) -> Any:
+        return self._condition(condition, "a conditional event")
+
+    # -- behaviours: each runs a token at a node and returns where it goes next --------------
+
+    def _run_start(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        return self._follow(token, self._taken(node, first=False))
+
+    def _run_pass(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        if node.throw is not None:
+            self._publish(node)
+        return self._follow(token, self._taken(node, first=False))
+
+    def _run_end(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        if node.throw is not None and node.throw.kind == "signal":
+            self._publish(node)
+        if node.throw is not None and node.throw.kind == "error":
+            self._throw_error(token, node.throw.topic)  # the catching event is tagged
+            return None
+        self._consume(token)
+        return None
+
+    def _run_terminate(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        self._kill(token.scope, safe=True)
+        return None
+
+    def _run_task(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        self._tag(node.label, "start")
+        self._inputs(node)
+        self._tag(node.label, "complete")
+        self._outputs(node, {})
+        return self._follow(token, self._taken(node, first=False))
+
+    def _run_script(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        self._tag(node.label, "start")
+        self._inputs(node)
+        if node.script is not None:
+            try:
+                self._exec(node)
+            except BpmnError as error:
+                self._throw_error(token, error.name)
+                return None
+        self._tag(node.label, "complete")
+        self._outputs(node, {})
+        return self._follow(token, self._taken(node, first=False))
+
+    def _exec(self, node: NodePlan) -> None:
+        script = node.script
+        try:
+            exec(script.code, self.env, self.variables)
+        except BpmnError:
+            raise
+        except Exception as error:
+            raise ModelError(
+                f"robot {self.robot.name}: script task {node.node.describe()} failed: "
+                f"{type(error).__name__}: {error}"
+            ) from error
+        for name in script.writes:
+            if isinstance(self.variables.get(name), _NOT_VARIABLES):
+                del self.variables[name]
+        self._changed(script.writes)
+
+    def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        self._tag(node.label, "start")
+        inputs = self._inputs(node)
+        self._arm_boundaries(token, node)
+        generation = token.generation
+
+        def done(outputs: Mapping[str, Any] | BpmnError | None = None) -> None:
+            self._call(lambda: self._skill_done(token, generation, outputs))
+
+        try:
+            cancel = self.skills[node.skill](self.robot, types.MappingProxyType(inputs), done)
+        except BpmnError as error:
+            self._throw_error(token, error.name)
+            return None
+        if callable(cancel):
+            token.waits.append(cancel)
+        return None
+
+    def _skill_done(self, token: _Token, generation: int, outputs: Any) -> None:
+        if not token.alive or token.generation != generation:
+            return  # cancelled meanwhile, or called twice
+        token.waits.clear()  # the skill ended: nothing to cancel any more
+        if isinstance(outputs, BpmnError):
+            self._throw_error(token, outputs.name)
+            return
+        values = dict(outputs or {})
+        self.variables.update(values)
+        self._changed(values)
+        self._activity_done(token, values)
+
+    def _run_call(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        self._tag(node.label, "start")
+        self._inputs(node)
+        self._arm_boundaries(token, node)
+        child = self._open(node.child, token.scope, token)
+        for start in reversed(node.child.starts):
+            self._push(self._new_token(child, start), start)
+        if not node.child.starts:
+            self._close(child)
+        return None
+
+    _run_subprocess = _run_call
+
+    def _activity_done(self, token: _Token, outputs: Mapping[str, Any] | None = None) -> None:
+        """A waiting activity (skill, call, sub-process, event sub-process) completed."""
+        node = token.node
+        token.child = None
+        self._disarm(token)
+        self._tag(node.label, "complete")
+        if node.behaviour == "event_subprocess":
+            self._consume(token)
+            return
+        self._outputs(node, outputs or {})
+        self._go_on(token, node)
+
+    def _go_on(self, token: _Token, node: NodePlan) -> None:
+        """Queue ``token``'s move out of ``node`` (from a callback, not a behaviour)."""
+        next_node = self._follow(token, self._taken(node, first=False))
+        if next_node is not None:
+            self._push(token, next_node)
+
+    def _run_catch(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        token.waits.append(self.triggers.arm(node.trigger, self._waker(token, node)))
+        return None
+
+    def _waker(self, token: _Token, node: NodePlan) -> Callable[[Envelope | None], None]:
+        generation = token.generation
+
+        def fire(envelope: Envelope | None) -> None:
+            if token.alive and token.generation == generation:
+                self._disarm(token)
+                self._caught(token, node, envelope)
+
+        return fire
+
+    def _caught(self, token: _Token, node: NodePlan, envelope: Envelope | None) -> None:
+        """A catching event fired for ``token``: tag it, store the message, move on."""
+        values = self._received(node, envelope)
+        self._outputs(node, values)
+        token.node = node
+        self._go_on(token, node)
+
+    def _run_exclusiveGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        return self._split(token, node, first=True)
+
+    def _split(self, token: _Token, node: NodePlan, *, first: bool) -> NodePlan | None:
+        """An exclusive (``first``) or inclusive split; no flow to take is a model error."""
+        flows = self._taken(node, first=first)
+        if not flows:
+            raise ModelError(
+                f"robot {self.robot.name}: {node.node.kind} {node.node.describe()} has no "
+                "outgoing flow whose condition holds and no default flow"
+            )
+        return self._follow(token, flows)
+
+    def _run_parallelGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        if len(node.incoming) > 1 and not self._joined(token, node):
+            return None
+        return self._follow(token, list(node.outgoing))
+
+    def _run_inclusiveGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        if len(node.incoming) > 1:
+            token.scope.joins.setdefault(node.id, []).append(token)
+            self._inclusive.add(token.scope)
+            return None
+        return self._split(token, node, first=False)
+
+    def _run_eventBasedGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        for flow in node.outgoing:
+            target = flow.target
+            if target.trigger is not None:
+                token.waits.append(self.triggers.arm(target.trigger, self._waker(token, target)))
+        return None
+
+    def _joined(self, token: _Token, node: NodePlan) -> bool:
+        """A parallel join: True (with one token going on) once every incoming flow has a
+        token waiting."""
+        waiting = token.scope.joins.setdefault(node.id, [])
+        waiting.append(token)
+        arrived = {t.flow for t in waiting}
+        if not arrived.issuperset(node.incoming):
+            return False
+        for flow_id in node.incoming:
+            first = next(t for t in waiting if t.flow == flow_id)
+            waiting.remove(first)
+            if first is not token:
+                first.alive = False
+                token.scope.tokens.discard(first)
+        return True
+
+    def _recheck_joins(self) -> None:
+        for scope in list(self._inclusive):
+            for node_id, waiting in list(scope.joins.items()):
+                node = scope.plan.nodes[node_id]
+                if node.behaviour == "inclusiveGateway" and waiting and self._may_go(scope, node):
+                    self._merge_inclusive(scope, node, waiting)
+            if not any(scope.joins.values()):
+                self._inclusive.discard(scope)
+
+    def _may_go(self, scope: _Scope, node: NodePlan) -> bool:
+        """An inclusive join fires when no other token can still reach an incoming flow that
+        has no token yet."""
+        arrived = {t.flow for t in scope.joins[node.id]}
+        missing = set(node.incoming) - arrived
+        for token in scope.tokens:
+            if token.node is node and token in scope.joins[node.id]:
+                continue
+            if missing & reachable_flows(token.node):
+                return False
+        return True
+
+    def _merge_inclusive(self, scope: _Scope, node: NodePlan, waiting: list[_Token]) -> None:
+        survivor, *others = waiting
+        scope.joins[node.id] = []
+        for other in others:
+            other.alive = False
+            scope.tokens.discard(other)
+        next_node = self._split(survivor, node, first=False)
+        if next_node is not None:
+            self._push(survivor, next_node)
+
+    def _run_boundary(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        return self._follow(token, self._taken(node, first=False))
+
+    def _run_event_subprocess(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        return None  # never entered by a sequence flow; _event_subprocess starts it
+
+    # -- boundary events and event sub-processes -----------------------------------------------
+
+    def _arm_boundaries(self, token: _Token, node: NodePlan) -> None:
+        depth = token.scope.depth + 0.5  # inside the scope, around the activity
+        for boundary in node.boundaries:
+            repeat = not boundary.node.cancel_activity
+            fire = self._boundary_fire(token, boundary)
+            token.boundaries.append(
+                self.triggers.arm(boundary.trigger, fire, repeat=repeat, depth=depth)
+            )
+
+    def _boundary_fire(
+        self, token: _Token, boundary: NodePlan
+    ) -> Callable[[Envelope | None], None]:
+        generation = token.generation
+
+        def fire(envelope: Envelope | None) -> None:
+            if token.alive and token.generation == generation:
+                self._boundary(token, boundary, envelope)
+
+        return fire
+
+    def _boundary(self, token: _Token, boundary: NodePlan, envelope: Envelope | None) -> None:
+        if boundary.node.cancel_activity:
+            scope = token.scope
+            self._cancel(token)
+            token = self._new_token(scope, boundary)
+        else:
+            token = self._new_token(token.scope, boundary)
+        self._caught(token, boundary, envelope)
+
+    def _arm_event_subprocess(self, scope: _Scope, esp: NodePlan) -> None:
+        start = esp.child.triggered_starts[0]
+        interrupting = start.node.interrupting
+
+        def fire(envelope: Envelope | None) -> None:
+            if not scope.ended and esp.id in scope.armed:
+                self._event_subprocess(scope, esp, envelope, interrupting=interrupting)
+
+        scope.armed[esp.id] = self.triggers.arm(
+            start.trigger, fire, repeat=not interrupting, depth=scope.depth
+        )
+
+    def _event_subprocess(
+        self,
+        scope: _Scope,
+        esp: NodePlan,
+        envelope: Envelope | None,
+        *,
+        interrupting: bool,
+        triggered: bool = True,
+    ) -> None:
+        if interrupting and esp.id in scope.armed:
+            scope.armed.pop(esp.id)()  # an interrupting handler runs once per scope
+        holder = self._new_token(scope, esp)
+        if interrupting:
+            for token in list(scope.tokens):
+                if token is not holder:
+                    self._cancel(token)
+        self._tag(esp.label, "start")
+        child = self._open(esp.child, scope, holder)
+        start = esp.child.triggered_starts[0]
+        token = self._new_token(child, start)
+        if triggered:
+            self._caught(token, start, envelope)
+        else:
+            self._go_on(token, start)
+
+    # -- errors ------------------------------------------------------------------------------------
+
+    def _throw_error(self, token: _Token, name: str) -> None:
+        """Hand a thrown BPMN error to the nearest catcher: the activity's own boundary
+        events, then the event sub-processes of each enclosing scope and the boundary events
+        of the activity holding it; nobody catching it ends the instance."""
+        catcher = self._boundary_catcher(token, name)
+        if catcher is not None:
+            self._boundary(token, catcher, None)
+            return
+        scope: _Scope | None = token.scope
+        while scope is not None:
+            esp = self._esp_catcher(scope, name)
+            if esp is not None:
+                self._event_subprocess(scope, esp, None, interrupting=True)
+                return
+            holder = scope.holder
+            if holder is not None:
+                catcher = self._boundary_catcher(holder, name)
+                if catcher is not None:
+                    self._boundary(holder, catcher, None)
+                    return
+            scope = scope.parent
+        self._uncaught(token, name)
+
+    def _boundary_catcher(self, token: _Token, name: str) -> NodePlan | None:
+        for boundary in token.node.boundaries:
+            trigger = boundary.trigger
+            if trigger.kind == "error" and trigger.topic in ("", name):
+                return boundary
+        return None
+
+    def _esp_catcher(self, scope: _Scope, name: str) -> NodePlan | None:
+        for esp in scope.plan.event_subprocesses:
+            trigger = esp.child.triggered_starts[0].trigger
+            if esp.id in scope.armed and trigger.kind == "error" and trigger.topic in ("", name):
+                return esp
+        return None
+
+    def _uncaught(self, token: _Token, name: str) -> None:
+        root = token.scope
+        while root.parent is not None:
+            root = root.parent
+        self.failures.append(
+            f"robot {self.robot.name}: error {name!r} thrown at {token.node.node.describe()} "
+            "was not caught; the process instance ended"
+        )
+        self._kill(root, safe=False)
+
+    # -- data: data objects, associations, messages -------------------------------------------
+
+    def _declare(self, data_objects: Iterable[DataObject]) -> None:
+        """Data objects' literal values become variables; ``name = ${name}`` declares
+        ``name`` (None until something sets it)."""
+        changed = []
+        for data_object in data_objects:
+            for name, value in data_object.parameters.items():
+                if name in self._given:
+                    continue
+                if self_reference(value) == name:
+                    self.variables.setdefault(name, None)
+                elif "${" not in value:
+                    self.variables[name] = substitute_text(value, self.variables, self.env)
+                    changed.append(name)
+        self._changed(changed)
+
+    def _resolve(self, data_objects: Iterable[DataObject], extra: Mapping[str, Any]) -> dict:
+        names = {**self.variables, **extra} if extra else self.variables
+        values = {}
+        for data_object in data_objects:
+            for name, text in data_object.parameters.items():
+                try:
+                    values[name] = substitute_text(text, names, self.env)
+                except Exception as error:
+                    raise ModelError(
+                        f"robot {self.robot.name}: data object {data_object.id} "
+                        f"({data_object.name}) parameter {name} = {text}: "
+                        f"{type(error).__name__}: {error}"
+                    ) from error
+        return values
+
+    def _inputs(self, node: NodePlan) -> dict[str, Any]:
+        """Data input associations and input parameters, set as variables before the activity
+        runs; a skill gets them as its inputs."""
+        values = self._resolve(node.data_inputs, {}) if node.data_inputs else {}
+        for name, value in node.node.inputs.items():
+            values[name] = self._parameter(value, self.variables)
+        if values:
+            self.variables.update(values)
+            self._changed(values)
+        return values
+
+    def _outputs(self, node: NodePlan, extra: Mapping[str, Any]) -> None:
+        """Output parameters and data output associations, evaluated after the activity (or
+        catch) with its outputs (or the message's fields) in scope."""
+        if not node.node.outputs and not node.data_outputs:
+            return
+        names = {**self.variables, **extra}
+        values = {n: self._parameter(v, names) for n, v in node.node.outputs.items() if v}
+        values.update(self._resolve(node.data_outputs, extra))
+        self.variables.update(values)
+        self._changed(values)
+
+    def _parameter(self, value: Any, names: Mapping[str, Any]) -> Any:
+        if isinstance(value, str):
+            return substitute_text(value, names, self.env)
+        if isinstance(value, list):
+            return [self._parameter(v, names) for v in value]
+        if isinstance(value, dict):
+            return {k: self._parameter(v, names) for k, v in value.items()}
+        return value
+
+    def _received(self, node: NodePlan, envelope: Envelope | None) -> dict[str, Any]:
+        """Tag a fired catching event; a message's data becomes the variable named after the
+        signal, and its fields are in scope for the data output associations."""
+        trigger = node.trigger
+        if envelope is None or trigger.kind != "signal":
+            self._tag_pair(trigger.label)
+            return {}
+        payload = _json(envelope.data)
+        self._tag_pair(trigger.label, envelope.msg_id, "receive", payload)
+        variable = trigger.topic.strip("/").replace("/", "_")
+        if variable.isidentifier():
+            self.variables[variable] = envelope.data
+            self._changed((variable,))
+        return dict(envelope.data) if isinstance(envelope.data, Mapping) else {}
+
+    def _publish(self, node: NodePlan) -> None:
+        throw = node.throw
+        data = self._payload(node)
+        msg_id = self._new_msg_id()
+        payload = _json(data)
+        self._tag(throw.label, "start", msg_id, "send", payload)
+        self.bus.publish(
+            throw.topic,
+            data,
+            msgtype=throw.msgtype,
+            sender=self.robot.name,
+            msg_id=msg_id,
+            qos=throw.qos,
+        )
+        self._tag(throw.label, "complete", msg_id, "send", payload)
+
+    def _payload(self, node: NodePlan) -> dict[str, Any]:
+        template = node.throw.payload
+        try:
+            if isinstance(template, dict):
+                return _nest(
+                    {k: substitute_text(v, self.variables, self.env) for k, v in template.items()}
+                )
+            if not template or not template.strip():
+                return {}
+            value = render_json(template, self.variables, self.env)
+        except Exception as error:
+            raise ModelError(
+                f"robot {self.robot.name}: the payload of signal event {node.node.describe()} "
+                f"cannot be filled in: {type(error).__name__}: {error}"
+            ) from error
+        return value if isinstance(value, dict) else {"data": value}
+
+    def _new_msg_id(self) -> str:
+        new_msg_id = getattr(self.bus, "new_msg_id", None)
+        if new_msg_id is not None:
+            return new_msg_id()
+        # Robot namespaces are unique in a mission, so this is unique on any bus.
+        self._msg_ids += 1
+        return f"m_{self.robot.name}_{self._msg_ids}"
+
+    def _changed(self, names: Iterable[str]) -> None:
+        self.triggers.changed(names)
+
+    # -- tags --------------------------------------------------------------------------------------
+
+    def _tag(
+        self, activity: str, lifecycle: str, msg_id: str = "", role: str = "", payload: str = ""
+    ):
+        if self.tag_sink is not None:
+            stamp = self.clock.now()
+            self.tag_sink(Tag(stamp, self.robot.name, activity, lifecycle, msg_id, role, payload))
+
+    def _tag_pair(self, activity: str, msg_id: str = "", role: str = "", payload: str = "") -> None:
+        self._tag(activity, "start", msg_id, role, payload)
+        self._tag(activity, "complete", msg_id, role, payload)
+
+
+def _json(data: Any) -> str:
+    return json.dumps(data, default=str, separators=(",", ":"))
+
+
+def _nest(flat: Mapping[str, Any]) -> dict[str, Any]:
+    """``{"linear.x": 1}`` -> ``{"linear": {"x": 1}}`` (ros:parameter names may be dotted)."""
+    nested: dict[str, Any] = {}
+    for key, value in flat.items():
+        *path, last = key.split(".")
+        target = nested
+        for part in path:
+            target = target.setdefault(part, {})
+        target[last] = value
+    return nested

@@ -1,0 +1,187 @@
+"""The typed model a BPMN collaboration is read into.
+
+Both extension flavours found in FAME models -- the thesis' ``ros:``/``data:``/``qos:`` elements
+and Camunda's ``camunda:properties``/``camunda:inputOutput`` -- end up in the same fields here,
+so nothing after the parser knows which modeler wrote a file. The model keeps everything the
+file says, including elements the engine cannot run: refusing those is the deployer's job
+(:mod:`robotale.fame_runtime.plan`), so that ``robotale fame check`` can list them all.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
+from robotale.fame_runtime.timers import TimerSpec
+
+PYTHON, JAVASCRIPT = "python", "javascript"
+
+
+@dataclass(frozen=True, slots=True)
+class Expression:
+    """A condition or script as written in the model, with where it was written."""
+
+    text: str
+    language: str  # python | javascript | the raw scriptFormat of anything else
+    element_id: str
+    line: int = 0
+
+
+@dataclass(frozen=True, slots=True)
+class RosMessage:
+    """The ROS side of a signal event: message type, payload template, QoS (guideline G3).
+
+    ``payload`` is either a mapping of (possibly dotted) field name to value template
+    (``ros:parameter``) or one JSON text template (Camunda's ``payload`` property), in both
+    cases with ``${expression}`` placeholders filled in when the signal is thrown.
+    """
+
+    msgtype: str = ""
+    payload: dict[str, str] | str | None = None
+    qos: QoS = DEFAULT_QOS
+    qos_given: bool = False
+
+
+@dataclass(frozen=True, slots=True)
+class EventDefinition:
+    """What triggers or is thrown by an event."""
+
+    kind: str  # signal timer conditional error terminate message escalation compensate cancel link
+    ref: str = ""  # signalRef / errorRef / messageRef as written
+    ref_name: str = ""  # the name of the referenced signal / error, "" when not declared
+    timer: TimerSpec | None = None
+    condition: Expression | None = None
+
+
+@dataclass(slots=True)
+class DataObject:
+    """A data object reference and its parameters (``${var}`` = filled in at run time)."""
+
+    id: str
+    name: str
+    parameters: dict[str, str]
+    line: int = 0
+
+
+@dataclass(slots=True)
+class Flow:
+    id: str
+    source: str
+    target: str
+    name: str = ""
+    condition: Expression | None = None
+    line: int = 0
+
+
+@dataclass(slots=True)
+class Node:
+    """One flow node (event, activity, gateway) of a process or sub-process."""
+
+    id: str
+    kind: str  # the BPMN tag: startEvent, scriptTask, exclusiveGateway, subProcess ...
+    name: str = ""
+    line: int = 0
+    events: list[EventDefinition] = field(default_factory=list)
+    message: RosMessage | None = None
+    script: Expression | None = None
+    called_element: str = ""
+    embedded_process: Process | None = None  # FAME-modeler's callActivity:process
+    attached_to: str = ""  # boundary events
+    cancel_activity: bool = True  # boundary events
+    interrupting: bool = True  # start events of event sub-processes
+    default_flow: str = ""
+    data_inputs: list[str] = field(default_factory=list)  # data object reference ids
+    data_outputs: list[str] = field(default_factory=list)
+    inputs: dict[str, object] = field(default_factory=dict)  # camunda:inputParameter
+    outputs: dict[str, object] = field(default_factory=dict)  # camunda:outputParameter
+    scope: Scope | None = None  # sub-process content
+    triggered_by_event: bool = False
+    quirks: list[str] = field(default_factory=list)  # what the engine would have to refuse
+
+    @property
+    def event(self) -> EventDefinition | None:
+        return self.events[0] if self.events else None
+
+    @property
+    def event_kind(self) -> str:
+        """``none`` for an event without a definition, else the definition's kind."""
+        return self.events[0].kind if self.events else "none"
+
+    def describe(self) -> str:
+        """``Activity_1 (Take Off)``: how messages name this element."""
+        return f"{self.id} ({self.name})" if self.name and self.name != self.id else self.id
+
+
+@dataclass(slots=True)
+class Scope:
+    """The content of a process or sub-process: nodes and sequence flows, in file order."""
+
+    nodes: dict[str, Node] = field(default_factory=dict)
+    flows: dict[str, Flow] = field(default_factory=dict)
+
+
+@dataclass(slots=True)
+class Process(Scope):
+    id: str = ""
+    name: str = ""
+    executable: bool = True
+    line: int = 0
+    file: Path | None = None
+    #: every data object reference of the process, sub-processes included (associations
+    #: may cross scopes)
+    data_objects: dict[str, DataObject] = field(default_factory=dict)
+    definitions: Definitions | None = field(default=None, repr=False)
+
+    def describe(self) -> str:
+        return f"{self.id} ({self.name})" if self.name and self.name != self.id else self.id
+
+    def walk(self):
+        """Every node of the process, those of sub-processes included."""
+        stack = [self]
+        while stack:
+            scope = stack.pop()
+            for node in scope.nodes.values():
+                yield node
+                if node.scope is not None:
+                    stack.append(node.scope)
+
+
+@dataclass(slots=True)
+class Participant:
+    """A pool: one robot (single instance) or a robot type (multi-instance, guideline G1)."""
+
+    id: str
+    name: str
+    process_ref: str
+    multi_instance: bool = False
+    minimum: int | None = None
+    maximum: int | None = None
+    line: int = 0
+
+
+@dataclass(slots=True)
+class Definitions:
+    """One .bpmn file."""
+
+    file: Path
+    id: str = ""
+    processes: dict[str, Process] = field(default_factory=dict)
+    participants: list[Participant] = field(default_factory=list)
+    signals: dict[str, str] = field(default_factory=dict)  # id -> name
+    errors: dict[str, str] = field(default_factory=dict)  # id -> name (or errorCode)
+    message_flows: list[tuple[str, str, str]] = field(default_factory=list)
+
+    def pools(self) -> list[tuple[Participant, Process]]:
+        """Every pool with the process it holds; a file without a collaboration has one pool
+        per process, named after the process."""
+        if self.participants:
+            return [
+                (p, self.processes[p.process_ref])
+                for p in self.participants
+                if p.process_ref in self.processes
+            ]
+        return [
+            (Participant(proc.id, proc.name or proc.id, proc.id, line=proc.line), proc)
+            for proc in self.processes.values()
+        ]

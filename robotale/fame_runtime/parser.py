@@ -1,0 +1,426 @@
+"""Read BPMN 2.0 collaborations (.bpmn) into the typed model.
+
+Reads what FAME's two modelers write: the thesis' ``ros:message``/``ros:payload``/
+``data:parameters``/``qos:policy`` extension elements and Camunda's ``camunda:properties``/
+``camunda:inputOutput``, matched by local name so any namespace URI or prefix works. It keeps
+the authors' quirks readable: signals referenced before (or without) being declared, pools
+without names, message flows, elements outside the FAME subset. A file that cannot be read
+raises :class:`~robotale.errors.ModelError` naming the file, the line and the element id.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from lxml import etree
+
+from robotale.errors import ModelError
+from robotale.fame_runtime.model import (
+    JAVASCRIPT,
+    PYTHON,
+    DataObject,
+    Definitions,
+    EventDefinition,
+    Expression,
+    Flow,
+    Node,
+    Participant,
+    Process,
+    RosMessage,
+    Scope,
+)
+from robotale.fame_runtime.qos import policy_name, qos_from_policies
+from robotale.fame_runtime.timers import KINDS as TIMER_KINDS
+from robotale.fame_runtime.timers import parse_timer
+
+BPMN_NS = "http://www.omg.org/spec/BPMN/20100524/MODEL"
+_B = f"{{{BPMN_NS}}}"
+
+EVENTS = ("startEvent", "endEvent", "intermediateCatchEvent", "intermediateThrowEvent")
+EVENTS += ("boundaryEvent", "implicitThrowEvent")
+ACTIVITIES = ("task", "scriptTask", "callActivity", "subProcess", "transaction")
+ACTIVITIES += ("adHocSubProcess", "userTask", "serviceTask", "sendTask", "receiveTask")
+ACTIVITIES += ("manualTask", "businessRuleTask")
+GATEWAYS = ("exclusiveGateway", "parallelGateway", "inclusiveGateway", "eventBasedGateway")
+GATEWAYS += ("complexGateway",)
+FLOW_NODES = frozenset(EVENTS + ACTIVITIES + GATEWAYS)
+SCOPES = frozenset(("subProcess", "transaction", "adHocSubProcess"))
+
+
+def parse(path: str | Path) -> Definitions:
+    """The model of one .bpmn file."""
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except OSError as error:
+        raise ModelError(f"cannot read the BPMN file {path}: {error.strerror}") from error
+    return parse_bytes(data, path)
+
+
+def parse_bytes(data: bytes, file: str | Path = "<string>") -> Definitions:
+    """The model of BPMN XML given as bytes; ``file`` names it in error messages."""
+    file = Path(file)
+    root = _xml_root(data, file)
+    return _Reader(file).definitions(root)
+
+
+def _xml_root(data: bytes, file: Path) -> etree._Element:
+    parser = etree.XMLParser(resolve_entities=False, no_network=True, remove_comments=True)
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as error:
+        line = error.lineno or 0
+        raise ModelError(f"{file}:{line}: malformed XML: {error.msg}") from None
+    if root.tag != f"{_B}definitions":
+        raise ModelError(
+            f"{file}:{root.sourceline}: not a BPMN 2.0 file: the root element is "
+            f"{etree.QName(root).localname}, not bpmn:definitions"
+        )
+    return root
+
+
+def _local(element: etree._Element) -> str:
+    tag = element.tag
+    return tag.rsplit("}", 1)[-1] if isinstance(tag, str) else ""
+
+
+def _bpmn_children(element: etree._Element, name: str) -> list[etree._Element]:
+    return element.findall(f"{_B}{name}")
+
+
+def _text(element: etree._Element | None) -> str:
+    return (element.text or "").strip() if element is not None else ""
+
+
+class _Reader:
+    """Reads one file; remembers it for error messages and for signal names."""
+
+    def __init__(self, file: Path) -> None:
+        self.file = file
+        self.signals: dict[str, str] = {}
+        self.errors: dict[str, str] = {}
+
+    def fail(self, element: etree._Element, message: str) -> ModelError:
+        return ModelError(f"{self.file}:{element.sourceline}: {message}")
+
+    def definitions(self, root: etree._Element) -> Definitions:
+        # Signals and errors first: the authors' models reference them before declaring them.
+        self.signals = {s.get("id", ""): s.get("name", "") for s in root.iter(f"{_B}signal")}
+        self.errors = {
+            e.get("id", ""): e.get("name") or e.get("errorCode") or ""
+            for e in root.iter(f"{_B}error")
+        }
+        definitions = Definitions(self.file, root.get("id", ""), signals=dict(self.signals))
+        definitions.errors = dict(self.errors)
+        for element in _bpmn_children(root, "process"):
+            process = self.process(element)
+            process.definitions = definitions
+            definitions.processes[process.id] = process
+        for collaboration in _bpmn_children(root, "collaboration"):
+            self.collaboration(collaboration, definitions)
+        return definitions
+
+    def collaboration(self, element: etree._Element, definitions: Definitions) -> None:
+        for pool in _bpmn_children(element, "participant"):
+            ref = pool.get("processRef", "")
+            if not ref:
+                continue  # a black-box pool: nobody runs it
+            if ref not in definitions.processes:
+                raise self.fail(
+                    pool, f"pool {pool.get('id')} refers to process {ref}, which is not in the file"
+                )
+            definitions.participants.append(self.participant(pool, definitions.processes[ref]))
+        for flow in _bpmn_children(element, "messageFlow"):
+            definitions.message_flows.append(
+                (flow.get("id", ""), flow.get("sourceRef", ""), flow.get("targetRef", ""))
+            )
+
+    def participant(self, pool: etree._Element, process: Process) -> Participant:
+        multiplicity = pool.find(f"{_B}participantMultiplicity")
+        bound = (
+            (_int_or_none(multiplicity.get("minimum")), _int_or_none(multiplicity.get("maximum")))
+            if multiplicity is not None
+            else (None, None)
+        )
+        name = pool.get("name") or process.name or process.id
+        return Participant(
+            pool.get("id", ""),
+            name.strip(),
+            process.id,
+            multi_instance=multiplicity is not None,
+            minimum=bound[0],
+            maximum=bound[1],
+            line=pool.sourceline or 0,
+        )
+
+    def process(self, element: etree._Element) -> Process:
+        process = Process(
+            id=self.required_id(element),
+            name=(element.get("name") or "").strip(),
+            executable=element.get("isExecutable", "true") != "false",
+            line=element.sourceline or 0,
+            file=self.file,
+        )
+        self.scope(element, process, process)
+        self.check_data_associations(process)
+        return process
+
+    def required_id(self, element: etree._Element) -> str:
+        identifier = element.get("id")
+        if not identifier:
+            raise self.fail(element, f"a bpmn:{_local(element)} has no id")
+        return identifier
+
+    def scope(self, element: etree._Element, scope: Scope, process: Process) -> None:
+        for child in element:
+            kind = _local(child)
+            if kind in FLOW_NODES:
+                node = self.node(child, kind, process)
+                scope.nodes[node.id] = node
+            elif kind == "sequenceFlow":
+                flow = self.flow(child)
+                scope.flows[flow.id] = flow
+            elif kind == "dataObjectReference":
+                data_object = self.data_object(child, element)
+                process.data_objects[data_object.id] = data_object
+        self.check_flows(scope, element)
+
+    def check_flows(self, scope: Scope, element: etree._Element) -> None:
+        for flow in scope.flows.values():
+            for end, ref in (("source", flow.source), ("target", flow.target)):
+                if ref not in scope.nodes:
+                    where = f" ({ref})" if ref else ""
+                    raise ModelError(
+                        f"{self.file}:{flow.line}: sequence flow {flow.id} is dangling: its "
+                        f"{end}{where} is not an element of the same process or sub-process"
+                    )
+        for node in scope.nodes.values():
+            if node.kind == "boundaryEvent" and node.attached_to not in scope.nodes:
+                raise ModelError(
+                    f"{self.file}:{node.line}: boundary event {node.id} is attached to "
+                    f"{node.attached_to or 'nothing'}, which is not in the same process"
+                )
+
+    def check_data_associations(self, process: Process) -> None:
+        for node in process.walk():
+            for ref in (*node.data_inputs, *node.data_outputs):
+                if ref not in process.data_objects:
+                    raise ModelError(
+                        f"{self.file}:{node.line}: {node.kind} {node.id} has a data association "
+                        f"with {ref}, which is not a data object of process {process.id}"
+                    )
+
+    def node(self, element: etree._Element, kind: str, process: Process) -> Node:
+        node = Node(
+            id=self.required_id(element),
+            kind=kind,
+            name=(element.get("name") or "").strip(),
+            line=element.sourceline or 0,
+            attached_to=element.get("attachedToRef", ""),
+            cancel_activity=element.get("cancelActivity", "true") != "false",
+            interrupting=element.get("isInterrupting", "true") != "false",
+            default_flow=element.get("default", ""),
+            called_element=(element.get("calledElement") or "").strip(),
+            triggered_by_event=element.get("triggeredByEvent") == "true",
+        )
+        node.events = [self.event_definition(d, node) for d in element if _is_definition(d)]
+        self.data_associations(element, node, process)
+        self.markers(element, node)
+        extensions = _Extensions(element.find(f"{_B}extensionElements"))
+        node.inputs, node.outputs = extensions.inputs, extensions.outputs
+        if kind in EVENTS and node.events and node.events[0].kind in ("signal", "error"):
+            node.message = self.ros_message(extensions, element, node)
+        if kind == "scriptTask":
+            node.script = self.script(element, node)
+        if kind == "callActivity" and extensions.embedded_process:
+            node.embedded_process = self.embedded_process(extensions.embedded_process, element)
+        if kind in SCOPES:
+            node.scope = Scope()
+            self.scope(element, node.scope, process)
+        return node
+
+    def markers(self, element: etree._Element, node: Node) -> None:
+        for child in element:
+            if _local(child) in ("standardLoopCharacteristics", "multiInstanceLoopCharacteristics"):
+                node.quirks.append("has a loop or multi-instance marker")
+        if element.get("isForCompensation") == "true":
+            node.quirks.append("is a compensation activity")
+
+    def data_associations(self, element: etree._Element, node: Node, process: Process) -> None:
+        for assoc in _bpmn_children(element, "dataInputAssociation"):
+            node.data_inputs += [_text(r) for r in _bpmn_children(assoc, "sourceRef")]
+        for assoc in _bpmn_children(element, "dataOutputAssociation"):
+            node.data_outputs += [_text(r) for r in _bpmn_children(assoc, "targetRef")]
+
+    def event_definition(self, element: etree._Element, node: Node) -> EventDefinition:
+        kind = _local(element).removesuffix("EventDefinition")
+        if kind == "signal":
+            ref = element.get("signalRef", "")
+            return EventDefinition("signal", ref, self.signals.get(ref, ""))
+        if kind == "error":
+            ref = element.get("errorRef", "")
+            return EventDefinition("error", ref, self.errors.get(ref, ""))
+        if kind == "timer":
+            return EventDefinition("timer", timer=self.timer(element, node))
+        if kind == "conditional":
+            condition = element.find(f"{_B}condition")
+            text = _text(condition)
+            expression = self.expression(condition, text, node.id) if text else None
+            return EventDefinition("conditional", condition=expression)
+        return EventDefinition(kind, element.get("messageRef", ""))
+
+    def timer(self, element: etree._Element, node: Node):
+        for child in element:
+            if _local(child) in TIMER_KINDS:
+                try:
+                    return parse_timer(_local(child), _text(child))
+                except ValueError as error:
+                    raise ModelError(
+                        f"{self.file}:{child.sourceline}: timer event {node.describe()} is "
+                        f"malformed: {error}"
+                    ) from None
+        return None
+
+    def expression(self, element: etree._Element, text: str, element_id: str) -> Expression:
+        language = (element.get("language") or "").lower()
+        if "javascript" in language or language == "js" or text.startswith("next("):
+            language = JAVASCRIPT
+        return Expression(text, language or PYTHON, element_id, element.sourceline or 0)
+
+    def flow(self, element: etree._Element) -> Flow:
+        flow = Flow(
+            id=self.required_id(element),
+            source=element.get("sourceRef", ""),
+            target=element.get("targetRef", ""),
+            name=(element.get("name") or "").strip(),
+            line=element.sourceline or 0,
+        )
+        condition = element.find(f"{_B}conditionExpression")
+        if condition is not None and _text(condition):
+            flow.condition = self.expression(condition, _text(condition), flow.id)
+        return flow
+
+    def script(self, element: etree._Element, node: Node) -> Expression:
+        body = element.find(f"{_B}script")
+        text = body.text if body is not None and body.text else ""
+        script_format = (element.get("scriptFormat") or "").strip().lower()
+        if not script_format or script_format in ("python", "py", "python3"):
+            language = PYTHON
+        elif script_format.startswith("javascript") or script_format in ("js", "ecmascript"):
+            language = JAVASCRIPT
+        else:
+            language = script_format
+        return Expression(text, language, node.id, body.sourceline if body is not None else 0)
+
+    def data_object(self, element: etree._Element, container: etree._Element) -> DataObject:
+        ref = element.get("dataObjectRef", "")
+        target = next(
+            (d for d in _bpmn_children(container, "dataObject") if d.get("id") == ref), None
+        )
+        name = element.get("name") or (target.get("name") if target is not None else "") or ""
+        extensions = _Extensions(element.find(f"{_B}extensionElements"))
+        parameters = {**extensions.properties, **extensions.parameters}
+        return DataObject(
+            self.required_id(element), name.strip(), parameters, element.sourceline or 0
+        )
+
+    def ros_message(
+        self, extensions: _Extensions, element: etree._Element, node: Node
+    ) -> RosMessage:
+        properties = dict(extensions.properties)
+        listed = extensions.signal_list(node.name)
+        msgtype = extensions.msgtype or properties.pop("type", "") or (listed[0] if listed else "")
+        payload: dict[str, str] | str | None = extensions.payload
+        if payload is None and "payload" in properties:
+            payload = properties.pop("payload")
+        if payload is None and len(listed) > 1:
+            payload = listed[1]
+        policies = dict(extensions.policies)
+        policies.update({k: v for k, v in properties.items() if policy_name(k)})
+        try:
+            qos = qos_from_policies(policies)
+        except ValueError as error:
+            raise self.fail(element, f"signal event {node.describe()}: {error}") from None
+        return RosMessage(msgtype.strip(), payload, qos, bool(policies))
+
+    def embedded_process(self, text: str, element: etree._Element) -> Process:
+        wrapped = (
+            f'<bpmn:definitions xmlns:bpmn="{BPMN_NS}" '
+            'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" '
+            'xmlns:camunda="http://camunda.org/schema/1.0/bpmn">'
+            f"{text}</bpmn:definitions>"
+        ).encode()
+        try:
+            definitions = parse_bytes(wrapped, self.file)
+        except ModelError as error:
+            raise self.fail(
+                element,
+                f"the process embedded in call activity {element.get('id')} is unreadable: {error}",
+            ) from None
+        if not definitions.processes:
+            raise self.fail(element, f"call activity {element.get('id')} embeds no bpmn:process")
+        return next(iter(definitions.processes.values()))
+
+
+def _is_definition(element: etree._Element) -> bool:
+    return _local(element).endswith("EventDefinition") and isinstance(element.tag, str)
+
+
+def _int_or_none(text: str | None) -> int | None:
+    return int(text) if text and text.strip().isdigit() else None
+
+
+class _Extensions:
+    """What one ``bpmn:extensionElements`` holds, whatever the modeler that wrote it."""
+
+    def __init__(self, element: etree._Element | None) -> None:
+        self.properties: dict[str, str] = {}
+        self.parameters: dict[str, str] = {}
+        self.policies: dict[str, str] = {}
+        self.inputs: dict[str, object] = {}
+        self.outputs: dict[str, object] = {}
+        self.payload: dict[str, str] | None = None
+        self.msgtype = ""
+        self.embedded_process = ""
+        if element is not None:
+            for child in element.iter():
+                self.read(child)
+
+    def read(self, child: etree._Element) -> None:
+        kind, parent = _local(child), _local(child.getparent())
+        if kind == "property" and parent == "properties":
+            self.properties[child.get("name", "")] = child.get("value") or _text(child)
+        elif kind == "parameter" and parent == "payload":
+            self.payload = self.payload or {}
+            self.payload[child.get("name", "").rstrip(":")] = child.get("value", "")
+        elif kind == "parameter" and parent == "parameters":
+            self.parameters[child.get("name", "")] = child.get("value", "")
+        elif kind == "policy":
+            self.policies[child.get("name", "")] = child.get("value", "")
+        elif kind == "message" and child.get("type"):
+            self.msgtype = child.get("type", "")
+        elif kind == "process" and child.get("process"):
+            self.embedded_process = child.get("process", "")
+        elif kind in ("inputParameter", "outputParameter"):
+            target = self.inputs if kind == "inputParameter" else self.outputs
+            target[child.get("name", "")] = _parameter_value(child)
+
+    def signal_list(self, name: str) -> list[str]:
+        """Camunda flavour of a signal: an input parameter holding the list [type, payload]."""
+        for key, value in self.inputs.items():
+            if isinstance(value, list) and (key == name or len(self.inputs) == 1):
+                return [str(v) for v in value]
+        return []
+
+
+def _parameter_value(element: etree._Element) -> object:
+    """A camunda input/output parameter: text, a list of texts or a map of texts."""
+    for child in element:
+        kind = _local(child)
+        if kind == "list":
+            return [_text(v) for v in child if _local(v) == "value"]
+        if kind == "map":
+            return {e.get("key", ""): _text(e) for e in child if _local(e) == "entry"}
+        if kind == "script":
+            return _text(child)
+    return _text(element)

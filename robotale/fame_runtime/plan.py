@@ -1,0 +1,419 @@
+"""Deploying a process: the model compiled into what the engine runs, or refused.
+
+:func:`deploy` checks every element once -- scripts and conditions compiled, signal topics and
+timers resolved, call activities bound to a skill or a process -- and refuses the process with
+one :class:`~robotale.errors.ModelError` naming every element the engine cannot run.
+:func:`problems` lists the same without raising, for ``robotale fame check``.
+"""
+
+from __future__ import annotations
+
+import re
+from collections.abc import Collection
+from dataclasses import dataclass, field
+
+from robotale.errors import ModelError
+from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
+from robotale.fame_runtime.library import Library, resolve_call
+from robotale.fame_runtime.model import DataObject, Node, Process, RosMessage, Scope
+from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
+from robotale.fame_runtime.tags import activity_label
+from robotale.fame_runtime.timers import TimerSpec
+
+EMPTY_MSGTYPE = "std_msgs/msg/Empty"
+
+#: elements of BPMN the engine does not run, and why
+OUTSIDE = {
+    "userTask": "needs a person",
+    "manualTask": "needs a person",
+    "serviceTask": "is a service call (use a call activity bound to a skill)",
+    "businessRuleTask": "needs a rule engine",
+    "sendTask": "uses messages (use a signal throw event, guideline G3)",
+    "receiveTask": "uses messages (use a signal catch event, guideline G3)",
+    "transaction": "is a transaction",
+    "adHocSubProcess": "is an ad-hoc sub-process",
+    "complexGateway": "is a complex gateway",
+    "implicitThrowEvent": "is an implicit throw event",
+}
+
+_ROLES = {
+    "start": "process start event",
+    "event_start": "event sub-process start event",
+    "sub_start": "sub-process start event",
+    "intermediateCatchEvent": "catching intermediate event",
+    "intermediateThrowEvent": "throwing intermediate event",
+    "endEvent": "end event",
+    "boundaryEvent": "boundary event",
+}
+
+#: the event kinds each kind of event may have ("none" = no event definition)
+ALLOWED = {
+    "start": {"none", "signal", "timer", "conditional"},
+    "event_start": {"signal", "timer", "conditional", "error"},
+    "sub_start": {"none"},
+    "intermediateCatchEvent": {"signal", "timer", "conditional"},
+    "intermediateThrowEvent": {"none", "signal"},
+    "endEvent": {"none", "terminate", "signal", "error"},
+    "boundaryEvent": {"signal", "timer", "conditional", "error"},
+}
+_SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
+
+
+@dataclass(slots=True, eq=False)
+class Trigger:
+    """What a catching event waits for."""
+
+    kind: str  # signal | timer | conditional | error
+    label: str  # the activity its tags carry
+    topic: str = ""  # signal: /name; error: the robot-relative name ("" catches any error)
+    msgtype: str = ""
+    qos: QoS = DEFAULT_QOS
+    timer: TimerSpec | None = None
+    condition: Compiled | None = None
+
+
+@dataclass(slots=True, eq=False)
+class Throw:
+    """What a throwing event publishes or raises."""
+
+    kind: str  # signal | error
+    label: str
+    topic: str
+    msgtype: str = EMPTY_MSGTYPE
+    payload: dict[str, str] | str | None = None
+    qos: QoS = DEFAULT_QOS
+
+
+@dataclass(slots=True, eq=False)
+class FlowPlan:
+    id: str
+    target: NodePlan
+    condition: Compiled | None = None
+
+
+@dataclass(slots=True, eq=False)
+class NodePlan:
+    node: Node
+    behaviour: str  # how the engine runs it; see Engine._enter
+    label: str
+    scope: ScopePlan
+    outgoing: list[FlowPlan] = field(default_factory=list)
+    default: FlowPlan | None = None
+    incoming: list[str] = field(default_factory=list)  # sequence flow ids
+    boundaries: list[NodePlan] = field(default_factory=list)
+    trigger: Trigger | None = None
+    throw: Throw | None = None
+    script: Compiled | None = None
+    skill: str = ""
+    child: ScopePlan | None = None  # sub-process content or called process
+    data_inputs: list[DataObject] = field(default_factory=list)
+    data_outputs: list[DataObject] = field(default_factory=list)
+    reach: frozenset[str] | None = None  # see reachable_flows
+
+    @property
+    def id(self) -> str:
+        return self.node.id
+
+
+@dataclass(slots=True, eq=False)
+class ScopePlan:
+    """A process, a called process or a sub-process, ready to run."""
+
+    process: Process
+    nodes: dict[str, NodePlan] = field(default_factory=dict)
+    starts: list[NodePlan] = field(default_factory=list)  # none start events
+    triggered_starts: list[NodePlan] = field(default_factory=list)  # top level only
+    event_subprocesses: list[NodePlan] = field(default_factory=list)
+    data_objects: list[DataObject] = field(default_factory=list)  # initialised on entry
+    safe_state: NodePlan | None = None
+
+
+def deploy(
+    process: Process,
+    *,
+    skills: Collection[str] = (),
+    library: Library | None = None,
+) -> ScopePlan:
+    """The process ready to run, or a ModelError naming every element the engine cannot run."""
+    planner = _Planner(skills, library)
+    plan = planner.process(process, top=True)
+    if planner.problems:
+        file = f"{process.file}: " if process.file else ""
+        raise ModelError(
+            f"{file}the engine cannot run process {process.describe()}: "
+            + "; ".join(planner.problems)
+        )
+    return plan
+
+
+def problems(
+    process: Process, *, skills: Collection[str] = (), library: Library | None = None
+) -> list[str]:
+    """What :func:`deploy` would refuse in ``process``, one phrase per element."""
+    planner = _Planner(skills, library)
+    planner.process(process, top=True)
+    return planner.problems
+
+
+def signal_name(node: Node) -> str:
+    """The topic name of a signal event: the event's name (the thesis correlates by it), else
+    the referenced signal's; without the thesis' ``!``/``?`` suffix."""
+    name = (node.name or (node.event.ref_name if node.event else "")).strip().rstrip("!?")
+    return "_".join(name.split())
+
+
+def signal_topic(node: Node) -> str:
+    name = signal_name(node)
+    return name if name.startswith("/") or not name else f"/{name}"
+
+
+def error_name(node: Node) -> str:
+    """The error an error event throws or catches ("" catches any): the referenced error's
+    name, else the event's name."""
+    event = node.event
+    name = (event.ref_name if event else "") or node.name
+    return "_".join(name.strip().split())
+
+
+def reachable_flows(node: NodePlan) -> frozenset[str]:
+    """The sequence flows a token at ``node`` may still take (boundary events included);
+    an inclusive join waits while some token can still reach one of its incoming flows."""
+    if node.reach is None:
+        seen: set[str] = set()
+        stack = [node]
+        visited: set[int] = set()
+        while stack:
+            current = stack.pop()
+            if id(current) in visited:
+                continue
+            visited.add(id(current))
+            for flow in current.outgoing:
+                seen.add(flow.id)
+                stack.append(flow.target)
+            stack.extend(current.boundaries)
+        node.reach = frozenset(seen)
+    return node.reach
+
+
+class _Planner:
+    def __init__(self, skills: Collection[str], library: Library | None) -> None:
+        self.skills = skills
+        self.library = library
+        self.problems: list[str] = []
+        self.called: dict[int, ScopePlan] = {}
+        self.where = ""  # which called process the planner is in, for messages
+
+    def refuse(self, node: Node, reason: str) -> None:
+        self.problems.append(f"{node.kind} {node.describe()}{self.where} {reason}")
+
+    def process(self, process: Process, *, top: bool = False) -> ScopePlan:
+        if id(process) in self.called:  # recursive calls share one plan
+            return self.called[id(process)]
+        plan = ScopePlan(process, data_objects=list(process.data_objects.values()))
+        self.called[id(process)] = plan
+        outer = self.where
+        if not top:
+            file = f" ({process.file.name})" if process.file else ""
+            self.where = f" of called process {process.describe()}{file}"
+        self.scope(process, plan, top=top)
+        self.where = outer
+        if top and not plan.starts and not plan.triggered_starts:
+            self.problems.append(f"process {process.describe()} has no start event")
+        return plan
+
+    def scope(self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False):
+        for node in scope.nodes.values():
+            plan.nodes[node.id] = NodePlan(node, "", "", plan)
+        for node_plan in plan.nodes.values():
+            self.node(node_plan, plan, top=top, event=event)
+        self.flows(scope, plan)
+        for node_plan in plan.nodes.values():
+            self.gateway(node_plan)
+        plan.safe_state = next(
+            (n for n in plan.event_subprocesses if _SAFE_STATE.search(n.node.name)), None
+        )
+
+    def flows(self, scope: Scope, plan: ScopePlan) -> None:
+        for flow in scope.flows.values():
+            source, target = plan.nodes[flow.source], plan.nodes[flow.target]
+            condition = None
+            if flow.condition is not None:
+                try:
+                    condition = compile_condition(flow.condition)
+                except ValueError as error:
+                    self.problems.append(f"sequence flow {flow.id} has a condition that {error}")
+            flow_plan = FlowPlan(flow.id, target, condition)
+            source.outgoing.append(flow_plan)
+            target.incoming.append(flow.id)
+            if source.node.default_flow == flow.id:
+                source.default = flow_plan
+
+    def gateway(self, plan: NodePlan) -> None:
+        node = plan.node
+        if node.kind.endswith("Gateway") and not plan.outgoing:
+            self.refuse(node, "has no outgoing sequence flow")
+        if node.kind == "eventBasedGateway":
+            for flow in plan.outgoing:
+                target = flow.target.node
+                if target.kind != "intermediateCatchEvent":
+                    self.refuse(node, f"leads to {target.describe()}, which is no catching event")
+        if node.kind.startswith("start") and plan.incoming:
+            self.refuse(node, "has incoming sequence flows")
+        if node.kind == "endEvent" and plan.outgoing:
+            self.refuse(node, "has outgoing sequence flows")
+
+    def node(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
+        node = plan.node
+        plan.label = activity_label(node.name, node.id)
+        plan.data_inputs = [scope.process.data_objects[r] for r in node.data_inputs]
+        plan.data_outputs = [scope.process.data_objects[r] for r in node.data_outputs]
+        for quirk in node.quirks:
+            self.refuse(node, quirk)
+        if node.kind in OUTSIDE:
+            self.refuse(node, OUTSIDE[node.kind])
+            return
+        if len(node.events) > 1:
+            self.refuse(node, "has several event definitions")
+            return
+        if node.kind.endswith("Event"):
+            self.event(plan, scope, top=top, event=event)
+        else:
+            self.activity(plan, scope)
+
+    def activity(self, plan: NodePlan, scope: ScopePlan) -> None:
+        node = plan.node
+        if node.kind.endswith("Gateway"):
+            plan.behaviour = node.kind
+        elif node.kind == "task":
+            plan.behaviour = "task"
+        elif node.kind == "scriptTask":
+            plan.behaviour = "script"
+            try:
+                plan.script = compile_script(node.script) if node.script else None
+            except ValueError as error:
+                self.refuse(node, f"has a script that cannot run: {error}")
+        elif node.kind == "callActivity":
+            self.call(plan)
+        elif node.kind == "subProcess":
+            self.subprocess(plan, scope)
+
+    def call(self, plan: NodePlan) -> None:
+        node = plan.node
+        name = node.called_element
+        if name and name in self.skills:
+            plan.behaviour, plan.skill = "skill", name
+            return
+        process = node.embedded_process or resolve_call(name, plan.scope.process, self.library)
+        if process is None:
+            where = "no skill, no process of the file" + (
+                f" and no building block in {self.library.folder}" if self.library else ""
+            )
+            what = (
+                f"calls {name!r}, which is {where}" if name else "calls nothing (no calledElement)"
+            )
+            self.refuse(node, what)
+            return
+        plan.behaviour = "call"
+        plan.child = self.process(process)
+
+    def subprocess(self, plan: NodePlan, scope: ScopePlan) -> None:
+        node = plan.node
+        child = ScopePlan(scope.process)
+        plan.child = child
+        if node.triggered_by_event:
+            plan.behaviour = "event_subprocess"
+            scope.event_subprocesses.append(plan)
+        else:
+            plan.behaviour = "subprocess"
+        self.scope(node.scope or Scope(), child, event=node.triggered_by_event)
+        if node.triggered_by_event and len(child.triggered_starts) != 1:
+            self.refuse(node, "needs exactly one start event with a trigger")
+        if not node.triggered_by_event and len(child.starts) != 1:
+            self.refuse(node, "needs exactly one none start event")
+
+    def event(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
+        node = plan.node
+        role = node.kind
+        if node.kind == "startEvent":
+            role = "start" if top else ("event_start" if event else "sub_start")
+        if node.event_kind not in ALLOWED[role]:
+            hint = " (use a signal event, guideline G3)" if node.event_kind == "message" else ""
+            self.refuse(
+                node, f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run{hint}"
+            )
+            return
+        if node.kind in ("startEvent", "intermediateCatchEvent", "boundaryEvent"):
+            self.catching(plan, scope)
+        else:
+            self.throwing(plan)
+
+    def catching(self, plan: NodePlan, scope: ScopePlan) -> None:
+        node = plan.node
+        if node.kind == "boundaryEvent":
+            plan.behaviour = "boundary"
+            host = scope.nodes.get(node.attached_to)
+            if host is None or host.node.kind.endswith(("Event", "Gateway")):
+                self.refuse(node, "is attached to something that is no activity")
+            else:
+                host.boundaries.append(plan)
+            if node.event_kind == "error" and not node.cancel_activity:
+                self.refuse(node, "is a non-interrupting error event (errors always interrupt)")
+        else:
+            plan.behaviour = "start" if node.kind == "startEvent" else "catch"
+        if node.kind == "startEvent" and node.event_kind == "none":
+            scope.starts.append(plan)
+            return
+        if node.kind == "startEvent":
+            scope.triggered_starts.append(plan)
+        plan.trigger = self.trigger(plan)
+
+    def trigger(self, plan: NodePlan) -> Trigger | None:
+        node = plan.node
+        kind = node.event_kind
+        message = node.message or RosMessage()
+        if kind == "signal":
+            topic = signal_topic(node)
+            if not topic:
+                self.refuse(node, "names no signal (give the event or its signal a name)")
+            label = activity_label(f"{signal_name(node)}?", node.id)
+            return Trigger("signal", label, topic, message.msgtype, message.qos)
+        if kind == "error":
+            name = error_name(node)
+            return Trigger("error", activity_label(name, node.id), name, EMPTY_MSGTYPE, message.qos)
+        if kind == "timer":
+            timer = node.event.timer if node.event else None
+            if timer is None:
+                self.refuse(node, "is a timer without a date, duration or cycle")
+            return Trigger("timer", plan.label, timer=timer)
+        return self.conditional(plan)
+
+    def conditional(self, plan: NodePlan) -> Trigger | None:
+        node = plan.node
+        expression = node.event.condition if node.event else None
+        if expression is None:
+            self.refuse(node, "is a conditional event without a condition")
+            return None
+        try:
+            return Trigger("conditional", plan.label, condition=compile_condition(expression))
+        except ValueError as error:
+            self.refuse(node, f"has a condition that {error}")
+            return None
+
+    def throwing(self, plan: NodePlan) -> None:
+        node = plan.node
+        kind = node.event_kind
+        if node.kind == "endEvent":
+            plan.behaviour = {"none": "end", "terminate": "terminate"}.get(kind, "end")
+        else:
+            plan.behaviour = "pass"
+        message = node.message or RosMessage()
+        if kind == "signal":
+            topic = signal_topic(node)
+            if not topic:
+                self.refuse(node, "names no signal (give the event or its signal a name)")
+            msgtype = message.msgtype or EMPTY_MSGTYPE
+            label = activity_label(f"{signal_name(node)}!", node.id)
+            plan.throw = Throw("signal", label, topic, msgtype, message.payload, message.qos)
+        elif kind == "error":
+            name = error_name(node)
+            plan.throw = Throw("error", activity_label(name, node.id), name)

@@ -1,0 +1,134 @@
+"""``robotale fame check|split|run`` on real model files."""
+
+import pytest
+
+from robotale.cli import main
+from robotale.fame_runtime.parser import parse
+
+
+def test_check_reports_qos_and_fails_on_incompatible_pairs(models, capsys):
+    assert main(["fame", "check", str(models / "qos.bpmn")]) == 1
+    out = capsys.readouterr().out
+    assert "structure: ok" in out
+    assert "QoS: 3 publisher/subscriber pairs, 2 incompatible" in out
+    assert (
+        "/weed_position: Drone d_weed (weed_position) -> Tractor t_weed (weed_position): "
+        "INCOMPATIBLE: reliability: the publisher offers best_effort, the subscriber requests "
+        "reliable"
+    ) in out
+
+
+def test_check_passes_a_runnable_model(models, capsys):
+    code = main(
+        [
+            "fame",
+            "check",
+            str(models / "calls.bpmn"),
+            "--library",
+            str(models / "library"),
+            "--skills",
+            str(models / "library" / "rover_skills.py"),
+        ]
+    )
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "structure: ok" in out and "QoS: 0 publisher/subscriber pairs" in out
+
+
+def test_check_lists_what_the_engine_cannot_run(fame_models, capsys):
+    assert main(["fame", "check", str(fame_models / "fame-modeler" / "example.bpmn")]) == 1
+    out = capsys.readouterr().out
+    assert "structure: the engine cannot run" in out
+    assert "  Process_1: userTask Task_026c0id (Insert Card) needs a person" in out
+
+
+def test_split_prints_and_writes_one_process_per_robot(fame_models, tmp_path, capsys):
+    agri = fame_models / "fame-ros" / "agri.bpmn"
+    code = main(
+        [
+            "fame",
+            "split",
+            str(agri),
+            "--robots",
+            "drone,tractor_1,tractor_2",
+            "--out",
+            str(tmp_path),
+        ]
+    )
+    out = capsys.readouterr().out
+    assert code == 0
+    assert out.splitlines()[:3] == [
+        "tractor_1\tTractor\tProcess_169rpm3",
+        "tractor_2\tTractor\tProcess_169rpm3",
+        "drone\tDrone\tdrone_process",
+    ]
+    assert sorted(p.name for p in tmp_path.iterdir()) == [
+        "drone.bpmn",
+        "tractor_1.bpmn",
+        "tractor_2.bpmn",
+    ]
+    drone = parse(tmp_path / "drone.bpmn")
+    assert [(pool.name, process.id) for pool, process in drone.pools()] == [
+        ("Drone", "drone_process")
+    ]
+    original = parse(agri).processes["drone_process"]
+    assert [n.id for n in drone.processes["drone_process"].walk()] == [
+        n.id for n in original.walk()
+    ]
+
+
+def test_split_of_an_unknown_robot_is_one_sentence(fame_models, capsys):
+    agri = fame_models / "fame-ros" / "agri.bpmn"
+    assert main(["fame", "split", str(agri), "--robots", "drone,rover_1"]) == 1
+    err = capsys.readouterr().err
+    assert err == f"robotale: {agri}: robot rover_1 matches no pool (pools: Tractor_<n>, Drone)\n"
+
+
+def test_run_prints_every_tag_with_skills_from_a_file(models, capsys):
+    code = main(
+        [
+            "fame",
+            "run",
+            str(models / "calls.bpmn"),
+            "--library",
+            str(models / "library"),
+            "--skills",
+            str(models / "library" / "rover_skills.py"),
+            "--set",
+            "rover.home_y=0",
+            "--set",
+            "rover.top_speed=2.5",
+        ]
+    )
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    lines = captured.out.splitlines()
+    assert lines[0].split("\t") == ["     0.000", "rover", "blink", "start"]
+    assert lines[-1].split("\t") == ["     5.000", "rover", "celebrate", "complete"]
+    assert "# done at 5.000 s; instances completed: rover 1" in captured.err
+
+
+def test_run_reports_uncaught_errors_with_exit_status_1(models, capsys):
+    code = main(
+        [
+            "fame",
+            "run",
+            str(models / "errors.bpmn"),
+            "--robots",
+            "tractor_1",
+            "--set",
+            "tractor_1.jammed=false",
+            "--set",
+            'tractor_1.fail_loudly="overheat"',
+        ]
+    )
+    assert code == 1
+    assert (
+        "error 'overheat' thrown at check (Check Blade) was not caught" in capsys.readouterr().err
+    )
+
+
+@pytest.mark.parametrize("bad", ["delay=10", "drone.=1", "drone.delay"])
+def test_run_rejects_malformed_variables(models, capsys, bad):
+    assert main(["fame", "run", str(models / "event_race.bpmn"), "--set", bad]) == 1
+    assert "is not ROBOT.NAME=VALUE" in capsys.readouterr().err

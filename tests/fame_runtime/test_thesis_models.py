@@ -1,0 +1,144 @@
+"""The thesis authors' own engine test models run where their scripts are plain, and leave the
+trace their structure implies; the rest is refused at deploy time, naming the elements."""
+
+import pytest
+from fame_helpers import pair, run, trace
+
+from robotale.errors import ModelError
+from robotale.fame_runtime.library import Library
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.plan import deploy, problems
+
+
+@pytest.fixture
+def tests_folder(fame_models):
+    return fame_models / "fame-ros" / "tests"
+
+
+def test_data_model_loops_through_building_blocks_of_the_tests_folder(tests_folder):
+    # Set Value: variable_name = 5, loop = 0 -> "variable > 0" -> MySecondCallActivity (Scnd:
+    # variable_name = 0) -> Scnd (loop = -1) -> loop back -> "variable <= 0" -> MyCallActivity
+    # (loop = 1) -> loop (loop = 1) -> "loop > 0" -> end.
+    mission, tags = run(tests_folder / "data.bpmn", library=tests_folder)
+    assert trace(tags) == [
+        *pair(0, "paperino", "set_value"),
+        (0, "paperino", "call_activity_2", "start"),
+        *pair(0, "paperino", "scnd"),
+        (0, "paperino", "call_activity_2", "complete"),
+        *pair(0, "paperino", "scnd"),
+        (0, "paperino", "call_activity", "start"),
+        *pair(0, "paperino", "Activity_1"),  # unnamed: tagged with its id
+        (0, "paperino", "call_activity", "complete"),
+        *pair(0, "paperino", "loop"),
+    ]
+    variables = mission.engines["paperino"].variables
+    assert (variables["x"], variables["y"], variables["ciaoname"]) == (10, 15, "paperino")
+    assert (variables["variable_name"], variables["loop"]) == (0, 1)
+
+
+def test_and_model_joins_two_timed_signal_throws_then_calls_a_process_of_the_file(tests_folder):
+    _, tags = run(tests_folder / "and.bpmn", robots=["process_04zetxl"])
+    robot = "process_04zetxl"
+    assert trace(tags, messages=True) == [
+        (1, robot, "timer1", "start", "", ""),
+        (1, robot, "timer1", "complete", "", ""),
+        (1, robot, "cmd_vel!", "start", "m_1", "send"),
+        (1, robot, "cmd_vel!", "complete", "m_1", "send"),
+        (1, robot, "timer2", "start", "", ""),
+        (1, robot, "timer2", "complete", "", ""),
+        (1, robot, "name!", "start", "m_2", "send"),
+        (1, robot, "name!", "complete", "m_2", "send"),
+        (1, robot, "my", "start", "", ""),
+        (1, robot, "pippo", "start", "", ""),
+        (1, robot, "pippo", "complete", "", ""),
+        (1, robot, "name!", "start", "m_3", "send"),
+        (1, robot, "name!", "complete", "m_3", "send"),
+        (1, robot, "my", "complete", "", ""),
+    ]
+    assert (
+        tags[2].payload
+        == '{"linear":{"x":2.0,"y":0.0,"z":0.0},"angular":{"x":0.0,"y":0.0,"z":1.8}}'
+    )
+    assert tags[6].payload == '{"data":"pluto"}'
+
+
+def test_rexdingo_signal_starts_dingo(fame_models):
+    _, tags = run(fame_models / "fame-modeler" / "rexdingo.bpmn")
+    assert [(t.robot, t.activity, t.lifecycle, t.msg_id) for t in tags] == [
+        ("rex", "Activity_0nt1x8y", "start", ""),
+        ("rex", "Activity_0nt1x8y", "complete", ""),
+        ("rex", "ciao!", "start", "m_1"),
+        ("rex", "ciao!", "complete", "m_1"),
+        ("rex", "Activity_1bv1788", "start", ""),
+        ("rex", "Activity_1bv1788", "complete", ""),
+        ("dingo", "ciao?", "start", "m_1"),
+        ("dingo", "ciao?", "complete", "m_1"),
+        ("dingo", "Activity_1u2gj9k", "start", ""),
+        ("dingo", "Activity_1u2gj9k", "complete", ""),
+        ("dingo", "Activity_1mzyhfq", "start", ""),
+        ("dingo", "Activity_1mzyhfq", "complete", ""),
+    ]
+    assert tags[2].payload == '{"data":false}'  # ros:parameter name="data:" value="false"
+
+
+def test_process_2_each_robot_catches_its_own_signal(tests_folder):
+    mission, tags = run(tests_folder / "process_2.bpmn", robots=["paperino_1", "pluto"])
+    assert [(t.stamp, t.robot, t.activity, t.msg_id) for t in tags if t.lifecycle == "start"] == [
+        (0, "paperino_1", "set_hello_world", ""),
+        (0, "pluto", "pippo", ""),
+        (5, "paperino_1", "Event_1rw6r0k", ""),
+        (5, "paperino_1", "hello_world!", "m_1"),
+        (5, "pluto", "Event_0iddt4k", ""),
+        (5, "pluto", "cmd_vel!", "m_2"),
+        (5, "paperino_1", "hello_world?", "m_1"),
+        (5, "pluto", "cmd_vel?", "m_2"),
+    ]
+    assert mission.engines["paperino_1"].variables["hello_world"] == {"data": "Hello World!"}
+
+
+def test_general_bpmn_elements_are_refused_naming_each(fame_models):
+    example = parse(fame_models / "fame-modeler" / "example.bpmn").processes["Process_1"]
+    found = problems(example)
+    assert sorted(found) == sorted(
+        [
+            "userTask Task_026c0id (Insert Card) needs a person",
+            "userTask Task_0p47z7h (Select Amount) needs a person",
+            "userTask Task_0po6mda (Select Interaction) needs a person",
+            "intermediateCatchEvent IntermediateThrowEvent_02yoqsl (Cash Withdrawn) is a "
+            "conditional event without a condition",
+            "intermediateCatchEvent IntermediateCatchEvent_09tc0wh (New Interaction Requested) "
+            "is a message catching intermediate event, which the engine does not run (use a "
+            "signal event, guideline G3)",
+            "intermediateCatchEvent IntermediateCatchEvent_087fl8m (No Further Interaction "
+            "Requested) is a message catching intermediate event, which the engine does not run "
+            "(use a signal event, guideline G3)",
+            "intermediateCatchEvent IntermediateCatchEvent_12qf66u (30 seconds elapsed) is a timer "
+            "without a date, duration or cycle",
+            "intermediateCatchEvent IntermediateThrowEvent_10vhtou (Balance checked) is a "
+            "conditional event without a condition",
+            "boundaryEvent BoundaryEvent_07intkn (Message received) is a message boundary event, "
+            "which the engine does not run (use a signal event, guideline G3)",
+            "boundaryEvent BoundaryEvent_Timer_non_interrupting is a timer without a date, "
+            "duration or cycle",
+        ]
+    )
+    with pytest.raises(ModelError) as error:
+        deploy(example)
+    assert str(error.value).startswith(
+        f"{fame_models / 'fame-modeler' / 'example.bpmn'}: the engine cannot run process "
+        "Process_1: intermediateCatchEvent IntermediateThrowEvent_02yoqsl (Cash Withdrawn) is a "
+        "conditional event without a condition; "
+    )
+
+
+def test_ros_javascript_of_the_agri_building_blocks_is_refused_naming_the_called_process(
+    fame_models,
+):
+    agri = parse(fame_models / "fame-ros" / "agri.bpmn")
+    found = problems(agri.processes["drone_process"], library=Library(fame_models / "fame-ros"))
+    assert (
+        "scriptTask Activity_nav (Navigate) of called process GoTo (GoTo.bpmn) has a "
+        "script that cannot run: the JavaScript statement 'var node = "
+        "this.environment.variables.ros_node' is not an assignment to "
+        "this.environment.variables.<name>; write the script in Python"
+    ) in found
