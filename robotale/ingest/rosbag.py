@@ -1,0 +1,396 @@
+"""rosbag2 recordings as tables: one pandas DataFrame per topic.
+
+A recording is read with ``rosbags`` (sqlite3 or MCAP storage, any ROS 2 distribution) without a
+ROS installation. Message types come, in this order of precedence, from the definitions the bag
+carries (Iron and later embed them), from ``.msg`` / ``.idl`` files the user names, from the ROS 2
+distribution the bag was recorded with (Humble when the bag does not say), and robotale's own
+``robotale_msgs/msg/Tag``.
+
+Every table has a ``time`` column (tz-aware UTC): the message's own stamp (``header.stamp`` or a
+top-level ``stamp``) when it has a non-zero one, else the time the bag recorded it. The other
+columns are the message fields asked for, by dotted path (``pose.pose.position.x``).
+"""
+
+from __future__ import annotations
+
+import contextlib
+import struct
+from collections.abc import Iterator, Mapping, Sequence
+from dataclasses import dataclass, field
+from operator import attrgetter
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from rosbags.interfaces import Connection, MessageDefinitionFormat
+from rosbags.rosbag2 import Reader, ReaderError
+from rosbags.serde import SerdeError
+from rosbags.typesys import (
+    Stores,
+    TypesysError,
+    get_types_from_idl,
+    get_types_from_msg,
+    get_typestore,
+)
+from rosbags.typesys.store import Typestore
+
+from robotale.errors import InputError
+from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
+
+TIME = "time"
+HEADER_TYPE = "std_msgs/msg/Header"
+TIME_TYPE = "builtin_interfaces/msg/Time"
+
+# rosbags' field descriptors are (nodetype, detail); NAME is a nested message type.
+_BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4
+
+
+def is_bag(path: Path) -> bool:
+    """Whether ``path`` is a rosbag2 directory (it has a ``metadata.yaml``)."""
+    return path.is_dir() and (path / "metadata.yaml").is_file()
+
+
+def message_types(paths: Sequence[Path]) -> dict:
+    """Type definitions from ``.msg`` / ``.idl`` files, or folders holding them.
+
+    A ``.msg`` file's type is named by where it lives, as in a ROS package:
+    ``my_pkg/msg/Event.msg`` defines ``my_pkg/msg/Event``.
+    """
+    typs: dict = {}
+    for path in paths:
+        files = (
+            sorted(path.rglob("*.msg")) + sorted(path.rglob("*.idl")) if path.is_dir() else [path]
+        )
+        if not files:
+            raise InputError(f"{path} holds no .msg or .idl files.")
+        for file in files:
+            typs.update(_types_from_file(file))
+    return typs
+
+
+def _types_from_file(file: Path) -> dict:
+    if not file.is_file():
+        raise InputError(f"Message definition {file} does not exist.")
+    try:
+        text = file.read_text(encoding="utf-8")
+        if file.suffix == ".idl":
+            return get_types_from_idl(text)
+        if file.suffix != ".msg" or file.parent.name != "msg":
+            raise InputError(
+                f"Cannot tell the type name of {file}: put it at <package>/msg/<Type>.msg."
+            )
+        return get_types_from_msg(text, f"{file.parent.parent.name}/msg/{file.stem}")
+    except (TypesysError, UnicodeDecodeError) as error:
+        reason = " ".join(str(error).split())
+        raise InputError(f"Message definition {file} cannot be parsed: {reason}") from None
+
+
+@dataclass
+class Bag:
+    """An open rosbag2 directory; use as a context manager.
+
+    ``topics`` maps each topic to its message type; :meth:`tables` decodes the chosen topics'
+    fields in one pass over the recording.
+    """
+
+    path: Path
+    extra_types: Mapping = field(default_factory=dict)
+    _reader: Reader | None = field(default=None, init=False, repr=False)
+    typestore: Typestore | None = field(default=None, init=False, repr=False)
+
+    def __enter__(self) -> Bag:
+        if not self.path.exists():
+            raise InputError(f"{self.path} does not exist.")
+        if not is_bag(self.path):
+            raise InputError(f"{self.path} is not a rosbag2 directory (it has no metadata.yaml).")
+        try:
+            reader = Reader(self.path)
+            reader.open()
+        except (ReaderError, OSError, KeyError, ValueError) as error:
+            reason = " ".join(str(error).split())
+            raise InputError(f"{self.path} is not a readable rosbag2 directory: {reason}") from None
+        self._reader = reader
+        self.typestore = _typestore(reader, self.extra_types, self.path)
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        if self._reader is not None:
+            self._reader.close()
+            self._reader = None
+
+    @property
+    def reader(self) -> Reader:
+        if self._reader is None:
+            raise RuntimeError("the bag is not open; use it in a with statement")
+        return self._reader
+
+    @property
+    def name(self) -> str:
+        return self.path.name
+
+    @property
+    def topics(self) -> dict[str, str]:
+        """Topic name -> message type, in the order of the topic names."""
+        return {name: info.msgtype or "" for name, info in sorted(self.reader.topics.items())}
+
+    def fields(self, topic: str) -> list[str]:
+        """The dotted paths of every scalar field of a topic's message type (arrays left out)."""
+        return scalar_fields(self._decodable(self.topics[topic], topic), self.typestore)
+
+    def tables(
+        self,
+        columns: Mapping[str, Mapping[str, str]],
+        *,
+        bag_time: bool = False,
+        progress=None,
+    ) -> dict[str, pd.DataFrame]:
+        """One table per topic: ``time`` plus ``columns[topic]`` (column name -> field path).
+
+        ``bag_time`` uses the recording time instead of the message stamps. ``progress`` is a
+        tqdm bar to advance by one per message read.
+        """
+        unknown = [topic for topic in columns if topic not in self.reader.topics]
+        if unknown:
+            raise InputError(f"{self.path} has no topic {unknown[0]}.")
+        connections = [c for c in self.reader.connections if c.topic in columns]
+        layouts = {topic: self._layout(topic, paths) for topic, paths in columns.items()}
+        extract = {topic: _extractor(paths) for topic, (paths, _) in layouts.items()}
+        rows: dict[str, list] = {topic: [] for topic in columns}
+        for topic, recorded, message in self._messages(connections, progress):
+            rows[topic].append((recorded, *extract[topic](message)))
+        tables = {}
+        for topic, (_, stamped) in layouts.items():
+            table = _table(rows[topic], list(columns[topic]), stamped, bag_time)
+            msgtype = self.topics[topic]
+            for column, path in columns[topic].items():
+                if field_type(msgtype, path, self.typestore) == "float32":
+                    table[column] = _shortest_float32(table[column])
+            tables[topic] = table
+        return tables
+
+    def _layout(self, topic: str, paths: Mapping[str, str]) -> tuple[list[str], bool]:
+        """The field paths to read from a topic's messages, and whether they lead with a stamp."""
+        msgtype = self._decodable(self.topics[topic], topic)
+        known = set(all_fields(msgtype, self.typestore))
+        for column, path in paths.items():
+            if path not in known:
+                raise InputError(
+                    f"{self.path}: {topic} ({msgtype}) has no field {path!r} for column "
+                    f"{column!r}; its fields are "
+                    f"{', '.join(scalar_fields(msgtype, self.typestore))}."
+                )
+        stamp = stamp_path(msgtype, self.typestore)
+        stamp_paths = [f"{stamp}.sec", f"{stamp}.nanosec"] if stamp else []
+        return [*stamp_paths, *paths.values()], bool(stamp)
+
+    def _decodable(self, msgtype: str, topic: str) -> str:
+        if msgtype not in self.typestore.fielddefs:
+            package, _, name = msgtype.rpartition("/msg/")
+            raise InputError(
+                f"{self.path}: cannot decode {topic}: its message type {msgtype} is not defined "
+                f"in the bag; register it with --msg {package or 'my_pkg'}/msg/{name}.msg "
+                "(or a folder of .msg files)."
+            )
+        return msgtype
+
+    def _messages(
+        self, connections: list[Connection], progress
+    ) -> Iterator[tuple[str, int, object]]:
+        deserialize = self.typestore.deserialize_cdr
+        last = -1
+        try:
+            for connection, recorded, raw in self.reader.messages(connections=connections):
+                if recorded < last:
+                    raise InputError(
+                        _out_of_order(self.reader, self.path, connection.topic, recorded, last)
+                    )
+                last = recorded
+                try:
+                    message = deserialize(raw, connection.msgtype)
+                except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
+                    raise InputError(
+                        f"{self.path}: a message on {connection.topic} cannot be decoded as "
+                        f"{connection.msgtype} ({error or type(error).__name__}); the definition "
+                        "registered for it does not match the recording."
+                    ) from None
+                if progress is not None:
+                    progress.update()
+                yield connection.topic, recorded, message
+        except ReaderError as error:
+            raise InputError(f"{self.path} cannot be read: {error}") from None
+
+
+def read_bag(
+    path: Path,
+    topics: Sequence[str] | None = None,
+    *,
+    msg_files: Sequence[Path] = (),
+    bag_time: bool = False,
+) -> dict[str, pd.DataFrame]:
+    """Every scalar field of every topic (or of ``topics``), one DataFrame per topic."""
+    with Bag(Path(path), message_types(msg_files)) as bag:
+        chosen = list(bag.topics) if topics is None else list(topics)
+        columns = {topic: {f: f for f in bag.fields(topic)} for topic in chosen}
+        return bag.tables(columns, bag_time=bag_time)
+
+
+def _extractor(paths: list[str]):
+    """A function from a message to the tuple of its values at ``paths``."""
+    if not paths:
+        return lambda message: ()
+    get = attrgetter(*paths)
+    return get if len(paths) > 1 else lambda message: (get(message),)
+
+
+def _table(rows: list, columns: list[str], stamped: bool, bag_time: bool) -> pd.DataFrame:
+    stamp = ["_sec", "_nanosec"] if stamped else []
+    frame = pd.DataFrame.from_records(rows, columns=["_recorded", *stamp, *columns])
+    nanos = frame["_recorded"].to_numpy(np.int64)
+    if stamped and not bag_time:
+        sec, nanosec = (frame[c].to_numpy(np.int64) for c in stamp)
+        stamps = sec * 1_000_000_000 + nanosec
+        # real robots often leave stamps unset (zero): the recording time is the next best.
+        nanos = np.where(stamps > 0, stamps, nanos)
+    frame = frame.drop(columns=["_recorded", *stamp])
+    frame.insert(0, TIME, pd.to_datetime(nanos, unit="ns", utc=True))
+    return frame
+
+
+def _out_of_order(reader: Reader, path: Path, topic: str, recorded: int, last: int) -> str:
+    files = ", ".join(Path(f).name for f in _storage_files(reader)) or "its storage files"
+    at, before = (pd.Timestamp(t, unit="ns", tz="UTC").isoformat() for t in (recorded, last))
+    return (
+        f"{path}: timestamps are out of order across its files ({files}): a message on {topic} "
+        f"at {at} comes after one at {before}; the files overlap or are listed out of order in "
+        "metadata.yaml."
+    )
+
+
+def _storage_files(reader: Reader) -> list[str]:
+    with contextlib.suppress(AttributeError):
+        return [str(storage.path) for storage in reader.storage.storages]
+    return []
+
+
+def _typestore(reader: Reader, extra: Mapping, path: Path) -> Typestore:
+    """The types the bag carries, then the user's, then the distribution's, then robotale's.
+
+    Only the types the bag's topics need are registered: a distribution has hundreds, and a
+    batch of runs opens one bag after another.
+    """
+    typs: dict = {}
+    for connection in reader.connections:
+        typs.update(_embedded_types(connection, path))
+    for source in (extra, _distribution_types(reader), get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
+        typs.update({name: spec for name, spec in source.items() if name not in typs})
+    store = get_typestore(Stores.EMPTY)
+    try:
+        store.register(_closure(typs, {c.msgtype for c in reader.connections}))
+    except TypesysError as error:
+        raise InputError(f"{path}: its message definitions cannot be used: {error}") from None
+    return store
+
+
+def _closure(typs: Mapping, roots: set[str]) -> dict:
+    """The definitions of ``roots`` and of every type they contain."""
+    needed: dict = {}
+    todo = list(roots)
+    while todo:
+        name = todo.pop()
+        if name in needed or name not in typs:
+            continue
+        needed[name] = typs[name]
+        todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
+    return needed
+
+
+def _references(desc: tuple) -> list[str]:
+    nodetype, detail = desc
+    if nodetype == _NAME:
+        return [detail]
+    if nodetype in (_ARRAY, _SEQUENCE):
+        return _references(detail[0])
+    return []
+
+
+def _embedded_types(connection: Connection, path: Path) -> dict:
+    definition = connection.msgdef
+    try:
+        if definition.format == MessageDefinitionFormat.MSG:
+            return get_types_from_msg(definition.data, connection.msgtype)
+        if definition.format == MessageDefinitionFormat.IDL:
+            separator = "=" * 80 + "\n"
+            parts = definition.data.split(separator)[1:] or [definition.data]
+            typs: dict = {}
+            for part in parts:
+                typs.update(
+                    get_types_from_idl(part.split("\n", 1)[1] if part.startswith("IDL: ") else part)
+                )
+            return typs
+    except TypesysError as error:
+        raise InputError(
+            f"{path}: the definition of {connection.msgtype} stored in the bag cannot be parsed: "
+            f"{error}."
+        ) from None
+    return {}
+
+
+def _distribution_types(reader: Reader) -> Mapping:
+    distro = (reader.ros_distro or "humble").lower()
+    store = getattr(Stores, f"ROS2_{distro.upper()}", Stores.ROS2_HUMBLE)
+    return get_typestore(store).fielddefs
+
+
+def all_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
+    """Dotted paths of every field, nested messages included as well as their leaves."""
+    paths = []
+    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
+        path = f"{prefix}{name}"
+        paths.append(path)
+        if nodetype == _NAME:
+            paths.extend(all_fields(detail, typestore, f"{path}."))
+    return paths
+
+
+def scalar_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
+    """Dotted paths of the scalar leaves (numbers, strings, booleans) of a message type."""
+    paths = []
+    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
+        if nodetype == _BASE:
+            paths.append(f"{prefix}{name}")
+        elif nodetype == _NAME:
+            paths.extend(scalar_fields(detail, typestore, f"{prefix}{name}."))
+    return paths
+
+
+def field_type(msgtype: str, path: str, typestore: Typestore) -> str | None:
+    """The base type (``float32``, ``string`` ...) of a scalar field, ``None`` for others."""
+    head, _, rest = path.partition(".")
+    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
+        if name == head:
+            if rest:
+                return field_type(detail, rest, typestore) if nodetype == _NAME else None
+            return detail[0] if nodetype == _BASE else None
+    return None
+
+
+def _shortest_float32(values: pd.Series) -> pd.Series:
+    """float32 readings as the decimals they were written as (0.98, not 0.9800000190734863)."""
+    as_text = values.to_numpy(np.float32).astype(str)
+    return pd.Series(as_text.astype(np.float64), index=values.index)
+
+
+def stamp_path(msgtype: str, typestore: Typestore) -> str | None:
+    """Where a message type keeps its time: ``header.stamp``, ``stamp``, or nowhere."""
+    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
+        if nodetype == _NAME and name == "header" and detail == HEADER_TYPE:
+            return "header.stamp"
+    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
+        if nodetype == _NAME and name == "stamp" and detail == TIME_TYPE:
+            return "stamp"
+    return None
+
+
+def namespace(topic: str) -> str:
+    """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``."""
+    return topic.strip("/").rpartition("/")[0]
