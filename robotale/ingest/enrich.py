@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import warnings
 from collections import defaultdict, deque
-from collections.abc import Mapping, Sequence
+from collections.abc import Mapping
 from dataclasses import dataclass
 from fnmatch import fnmatchcase
 
@@ -214,10 +214,7 @@ def _orphan_message(orphans: pd.DataFrame) -> str:
     )
 
 
-def robots_without_samples(
-    tags: pd.DataFrame, samples: pd.DataFrame, perspective: str
-) -> Sequence[str]:
+def robots_without_samples(tags: pd.DataFrame, samples: pd.DataFrame) -> list[str]:
     """``case/robot`` of each robot with tags but no sample of a perspective."""
-    tagged = set(zip(tags[CASE], tags[ROBOT], strict=True))
-    sampled = set(zip(samples[CASE], samples[ROBOT], strict=True))
-    return sorted(f"{case}/{robot}" for case, robot in tagged - sampled)
+    pairs = lambda frame: set(frame[KEYS].drop_duplicates().itertuples(index=False))  # noqa: E731
+    return sorted(f"{case}/{robot}" for case, robot in pairs(tags) - pairs(samples))

@@ -305,7 +305,7 @@ def _warn_missing_samples(
                 stacklevel=3,
             )
             continue
-        missing = robots_without_samples(tags, samples[p.name], p.name)
+        missing = robots_without_samples(tags, samples[p.name])
         if missing:
             warnings.warn(
                 f"{len(missing)} robot(s) have tags but no {p.name} samples ({p.topic}): "

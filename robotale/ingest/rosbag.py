@@ -36,6 +36,7 @@ from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
+from robotale.ingest.cdrlayout import Layout, columns
 
 TIME = "time"
 HEADER_TYPE = "std_msgs/msg/Header"
@@ -153,20 +154,23 @@ class Bag:
         if unknown:
             raise InputError(f"{self.path} has no topic {unknown[0]}.")
         connections = [c for c in self.reader.connections if c.topic in columns]
-        layouts = {topic: self._layout(topic, paths) for topic, paths in columns.items()}
-        extract = {topic: _extractor(paths) for topic, (paths, _) in layouts.items()}
-        rows: dict[str, list] = {topic: [] for topic in columns}
-        for topic, recorded, message in self._messages(connections, progress):
-            rows[topic].append((recorded, *extract[topic](message)))
+        rows = {topic: self._rows(topic, paths) for topic, paths in columns.items()}
+        for topic, recorded, raw in self._raw_messages(connections, progress):
+            rows[topic].add(recorded, raw)
         tables = {}
-        for topic, (_, stamped) in layouts.items():
-            table = _table(rows[topic], list(columns[topic]), stamped, bag_time)
+        for topic, topic_rows in rows.items():
+            table = topic_rows.table(list(columns[topic]), bag_time)
             msgtype = self.topics[topic]
             for column, path in columns[topic].items():
                 if field_type(msgtype, path, self.typestore) == "float32":
                     table[column] = _shortest_float32(table[column])
             tables[topic] = table
         return tables
+
+    def _rows(self, topic: str, paths: Mapping[str, str]) -> _TopicRows:
+        msgtype = self._decodable(self.topics[topic], topic)
+        field_paths, stamped = self._layout(topic, paths)
+        return _TopicRows(msgtype, field_paths, stamped, self.typestore, self._decoder(topic))
 
     def _layout(self, topic: str, paths: Mapping[str, str]) -> tuple[list[str], bool]:
         """The field paths to read from a topic's messages, and whether they lead with a stamp."""
@@ -193,10 +197,24 @@ class Bag:
             )
         return msgtype
 
-    def _messages(
+    def _decoder(self, topic: str):
+        msgtype, deserialize = self.topics[topic], self.typestore.deserialize_cdr
+
+        def decode(raw: bytes) -> object:
+            try:
+                return deserialize(raw, msgtype)
+            except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
+                raise InputError(
+                    f"{self.path}: a message on {topic} cannot be decoded as {msgtype} "
+                    f"({error or type(error).__name__}); the definition registered for it does "
+                    "not match the recording."
+                ) from None
+
+        return decode
+
+    def _raw_messages(
         self, connections: list[Connection], progress
-    ) -> Iterator[tuple[str, int, object]]:
-        deserialize = self.typestore.deserialize_cdr
+    ) -> Iterator[tuple[str, int, bytes]]:
         last = -1
         try:
             for connection, recorded, raw in self.reader.messages(connections=connections):
@@ -205,19 +223,70 @@ class Bag:
                         _out_of_order(self.reader, self.path, connection.topic, recorded, last)
                     )
                 last = recorded
-                try:
-                    message = deserialize(raw, connection.msgtype)
-                except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
-                    raise InputError(
-                        f"{self.path}: a message on {connection.topic} cannot be decoded as "
-                        f"{connection.msgtype} ({error or type(error).__name__}); the definition "
-                        "registered for it does not match the recording."
-                    ) from None
                 if progress is not None:
                     progress.update()
-                yield connection.topic, recorded, message
+                yield connection.topic, recorded, raw
         except ReaderError as error:
             raise InputError(f"{self.path} cannot be read: {error}") from None
+
+
+class _TopicRows:
+    """The recording times and field values of one topic's messages.
+
+    Numeric fields are read in bulk from the raw bytes of every message that shares the first
+    message's layout (:mod:`robotale.ingest.cdrlayout`); other messages, and other fields, are
+    decoded one by one with rosbags.
+    """
+
+    def __init__(self, msgtype, paths: list[str], stamped: bool, typestore, decode) -> None:
+        self.msgtype, self.paths, self.stamped = msgtype, paths, stamped
+        self.typestore, self.decode = typestore, decode
+        self.extract = _extractor(paths)
+        self.layout: Layout | None = None
+        self.recorded: list[int] = []
+        self.bulk = bytearray()
+        self.bulk_at: list[int] = []
+        self.one_by_one: list[tuple] = []
+        self.one_by_one_at: list[int] = []
+
+    def add(self, recorded: int, raw: bytes) -> None:
+        if not self.recorded and self.paths:
+            self.layout = self._checked_layout(raw)
+        position = len(self.recorded)
+        self.recorded.append(recorded)
+        if not self.paths:
+            return
+        if self.layout is not None and self.layout.fits(raw):
+            self.bulk += raw[: self.layout.end]
+            self.bulk_at.append(position)
+        else:
+            self.one_by_one.append(self.extract(self.decode(raw)))
+            self.one_by_one_at.append(position)
+
+    def _checked_layout(self, raw: bytes) -> Layout | None:
+        """The first message's layout, if reading it in bulk gives what rosbags decodes."""
+        layout = Layout.of(raw, self.msgtype, self.paths, self.typestore.fielddefs)
+        if layout is None:
+            return None
+        bulk = [values[0].item() for values in columns(layout, raw[: layout.end])]
+        decoded = self.extract(self.decode(raw))
+        same = all(a == b or (a != a and b != b) for a, b in zip(bulk, decoded, strict=True))
+        return layout if same else None
+
+    def table(self, names: list[str], bag_time: bool) -> pd.DataFrame:
+        count = len(self.recorded)
+        bulk = columns(self.layout, self.bulk) if self.bulk_at else None
+        values = {}
+        for k, name in enumerate(["_sec", "_nanosec"][: 2 * self.stamped] + names):
+            if not self.one_by_one_at:
+                values[name] = bulk[k] if bulk is not None else np.empty(count, dtype=object)
+                continue
+            column = np.empty(count, dtype=object)
+            if bulk is not None:
+                column[self.bulk_at] = bulk[k]
+            column[self.one_by_one_at] = [row[k] for row in self.one_by_one]
+            values[name] = pd.Series(column).infer_objects().to_numpy()
+        return _table(np.asarray(self.recorded, dtype=np.int64), values, names, bag_time)
 
 
 def read_bag(
@@ -242,16 +311,15 @@ def _extractor(paths: list[str]):
     return get if len(paths) > 1 else lambda message: (get(message),)
 
 
-def _table(rows: list, columns: list[str], stamped: bool, bag_time: bool) -> pd.DataFrame:
-    stamp = ["_sec", "_nanosec"] if stamped else []
-    frame = pd.DataFrame.from_records(rows, columns=["_recorded", *stamp, *columns])
-    nanos = frame["_recorded"].to_numpy(np.int64)
-    if stamped and not bag_time:
-        sec, nanosec = (frame[c].to_numpy(np.int64) for c in stamp)
-        stamps = sec * 1_000_000_000 + nanosec
+def _table(recorded: np.ndarray, values: dict, names: list[str], bag_time: bool) -> pd.DataFrame:
+    nanos = recorded
+    if "_sec" in values and not bag_time:
+        stamps = values["_sec"].astype(np.int64) * 1_000_000_000 + values["_nanosec"].astype(
+            np.int64
+        )
         # real robots often leave stamps unset (zero): the recording time is the next best.
-        nanos = np.where(stamps > 0, stamps, nanos)
-    frame = frame.drop(columns=["_recorded", *stamp])
+        nanos = np.where(stamps > 0, stamps, recorded)
+    frame = pd.DataFrame({name: values[name] for name in names})
     frame.insert(0, TIME, pd.to_datetime(nanos, unit="ns", utc=True))
     return frame
 

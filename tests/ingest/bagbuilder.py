@@ -80,7 +80,7 @@ class BagBuilder:
         )
         return self._add(seconds, topic or f"/{robot}/tag", TAG_TYPE, message, recorded)
 
-    def odom(self, seconds, robot, x, y, z, *, topic=None):
+    def odom(self, seconds, robot, x, y, z, *, topic=None, frame="odom"):
         t = self.typestore.types
         pose = t["geometry_msgs/msg/Pose"](
             position=t["geometry_msgs/msg/Point"](x=float(x), y=float(y), z=float(z)),
@@ -88,7 +88,7 @@ class BagBuilder:
         )
         vector = t["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
         message = t["nav_msgs/msg/Odometry"](
-            header=self._header(seconds, "odom"),
+            header=self._header(seconds, frame),
             child_frame_id="base_link",
             pose=t["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
             twist=t["geometry_msgs/msg/TwistWithCovariance"](

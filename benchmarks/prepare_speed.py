@@ -1,0 +1,311 @@
+"""How fast TALE preparation turns bags into an event log.
+
+Two workloads:
+
+1. a synthetic rosbag2 directory with 1M odometry samples and 50k tags (5 robots, plus battery
+   at 1 Hz), written here with the rosbags writer;
+2. the 70-run agri batch of the simulator (``robotale simulate agri --runs 70``), or any batch
+   folder given with ``--batch``.
+
+Figures are printed as ratios against baselines measured in the same process: the time to only
+read and decode every message of the bag with rosbags (the floor any preparation has to pay),
+and a search per event over the samples (what the sorted joins replace). The agri batch's target
+is under 30 s.
+
+    python benchmarks/prepare_speed.py [--samples 1000000] [--tags 50000] [--batch runs/agri]
+"""
+
+from __future__ import annotations
+
+import argparse
+import shutil
+import struct
+import subprocess
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+from rosbags.rosbag2 import Reader, Writer
+from rosbags.typesys import Stores, get_typestore
+
+from robotale.fame_runtime.tags import TAG_TYPE, register_tag_type
+from robotale.ingest import schema
+from robotale.ingest.prepare import prepare
+from robotale.ingest.rosbag import Bag
+
+ROBOTS = ("drone", "tractor_1", "tractor_2", "tractor_3", "tractor_4")
+START = 1_700_000_000 * 10**9
+MARK = 123456.789  # a value to find a field's byte offset in a serialized message
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--samples", type=int, default=1_000_000, help="odometry samples")
+    parser.add_argument("--tags", type=int, default=50_000, help="tags")
+    parser.add_argument("--batch", type=Path, help="an existing folder of runs to prepare")
+    parser.add_argument("--runs", type=int, default=70, help="runs to simulate without --batch")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")
+    with tempfile.TemporaryDirectory(prefix="robotale-bench-") as scratch:
+        synthetic(Path(scratch) / "synthetic", args.samples, args.tags)
+        batch = args.batch or simulate(Path(scratch) / "agri", args.runs)
+        if batch is not None:
+            agri(batch)
+    return 0
+
+
+# ------------------------------------------------------------------------------ workloads
+
+
+def synthetic(path: Path, samples: int, tags: int) -> None:
+    began = time.perf_counter()
+    write_synthetic_bag(path, samples, tags)
+    print(
+        f"synthetic bag: {samples:,} odometry samples, {tags:,} tags, {len(ROBOTS)} robots "
+        f"(written in {time.perf_counter() - began:.1f} s)"
+    )
+    decode, messages = timed(read_everything, path)
+    report_baseline(decode, messages)
+    seconds, log = timed(prepare, path)
+    report_prepare(seconds, log, messages, decode)
+    compare_with_search(path)
+
+
+def agri(batch: Path) -> None:
+    runs = sorted(p for p in batch.iterdir() if (p / "metadata.yaml").is_file())
+    print(f"agri batch: {len(runs)} runs in {batch}")
+    decode, messages = 0.0, 0
+    for run in runs:
+        seconds, count = timed(read_everything, run)
+        decode, messages = decode + seconds, messages + count
+    report_baseline(decode, messages)
+    seconds, log = timed(prepare, batch)
+    report_prepare(seconds, log, messages, decode)
+    verdict = "met" if seconds < 30 else "NOT met"
+    print(f"  target: the batch prepares in under 30 s: {verdict} ({seconds:.1f} s)")
+
+
+def simulate(out: Path, runs: int) -> Path | None:
+    """The agri batch from robotale's simulator, when it is installed."""
+    command = [sys.executable, "-m", "robotale", "simulate", "agri", "--runs", str(runs)]
+    command += ["--tractors", "2", "--seed", "1", "--out", str(out)]
+    available = subprocess.run(
+        [sys.executable, "-m", "robotale", "simulate", "--help"], capture_output=True
+    )
+    if available.returncode != 0:
+        print("agri batch: skipped, `robotale simulate` is not available (or pass --batch DIR)")
+        return None
+    began = time.perf_counter()
+    subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
+    print(f"agri batch: {runs} runs simulated in {time.perf_counter() - began:.0f} s")
+    return out
+
+
+# ------------------------------------------------------------------------------- measures
+
+
+def timed(function, *args):
+    began = time.perf_counter()
+    result = function(*args)
+    return time.perf_counter() - began, result
+
+
+def read_everything(path: Path) -> int:
+    """Read and decode every message of a bag with rosbags: the floor of any preparation."""
+    count = 0
+    with Bag(path) as bag, Reader(path) as reader:
+        deserialize = bag.typestore.deserialize_cdr
+        for connection, _, raw in reader.messages():
+            deserialize(raw, connection.msgtype)
+            count += 1
+    return count
+
+
+def report_baseline(seconds: float, messages: int) -> None:
+    rate = messages / seconds
+    print(f"  baseline, read and decode every message: {seconds:.2f} s ({rate:,.0f} msg/s)")
+
+
+def report_prepare(seconds: float, log: pd.DataFrame, messages: int, decode: float) -> None:
+    progress = int((log[schema.STATE] == schema.INPROGRESS).sum())
+    print(
+        f"  prepare: {seconds:.2f} s = {seconds / decode:.2f}x the baseline; "
+        f"{len(log) / seconds:,.0f} events/s written to the log ({len(log):,} events, "
+        f"{progress:,} inprogress), {messages / seconds:,.0f} recorded messages/s"
+    )
+
+
+def compare_with_search(path: Path, searched: int = 2000) -> None:
+    """The sorted join against a search per event over that robot's samples."""
+    from robotale.ingest.enrich import upper_closest
+
+    samples = _odometry(path)
+    events = _odometry(path, tags=True)
+    join, _ = timed(upper_closest, events, samples)
+    subset = events.sample(searched, random_state=1)
+    search, _ = timed(_search_each, subset, samples)
+    per_join, per_search = join / len(events), search / searched
+    print(
+        f"  upper-closest join of {len(events):,} tags to {len(samples):,} samples: {join:.2f} s; "
+        f"a search per event: {per_search * 1e3:.2f} ms each -> the join is "
+        f"{per_search / per_join:,.0f}x faster per event"
+    )
+
+
+def _odometry(path: Path, tags: bool = False) -> pd.DataFrame:
+    with Bag(path) as bag:
+        if tags:
+            topics = {f"/{r}/tag": {schema.ROBOT: "robot"} for r in ROBOTS}
+        else:
+            topics = {f"/{r}/odom": {"x": "pose.pose.position.x"} for r in ROBOTS}
+        tables = bag.tables(topics)
+    frame = pd.concat(
+        [
+            t.assign(**({} if tags else {schema.ROBOT: topic.split("/")[1]}))
+            for topic, t in tables.items()
+        ],
+        ignore_index=True,
+    )
+    return frame.rename(columns={"time": schema.TIMESTAMP}).assign(**{schema.CASE: path.name})
+
+
+def _search_each(events: pd.DataFrame, samples: pd.DataFrame) -> list[float]:
+    values = []
+    for _, event in events.iterrows():
+        mine = samples[samples[schema.ROBOT] == event[schema.ROBOT]]
+        later = mine[mine[schema.TIMESTAMP] >= event[schema.TIMESTAMP]]
+        values.append(later["x"].iloc[0] if len(later) else mine["x"].iloc[-1])
+    return values
+
+
+# ------------------------------------------------------------------------- the synthetic bag
+
+
+def write_synthetic_bag(path: Path, samples: int, tags: int) -> None:
+    """Odometry at a steady rate per robot, battery at 1 Hz, activities of 0.2 to 3 s.
+
+    Messages are serialized once and their stamp and position patched in place, so writing a
+    million of them takes seconds, not minutes; the bytes are ordinary CDR all the same.
+    """
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    register_tag_type(store)
+    per_robot = samples // len(ROBOTS)
+    duration = per_robot // 50 * 10**9  # 50 Hz odometry
+    rng = np.random.default_rng(1)
+    odom, odom_offsets = _template(store, "nav_msgs/msg/Odometry")
+    battery, battery_offsets = _template(store, "sensor_msgs/msg/BatteryState")
+    if path.exists():
+        shutil.rmtree(path)
+    with Writer(path, version=9) as writer:
+        streams = []
+        for robot in ROBOTS:
+            odom_topic = writer.add_connection(
+                f"/{robot}/odom", "nav_msgs/msg/Odometry", typestore=store
+            )
+            battery_topic = writer.add_connection(
+                f"/{robot}/battery", "sensor_msgs/msg/BatteryState", typestore=store
+            )
+            tag_topic = writer.add_connection(f"/{robot}/tag", TAG_TYPE, typestore=store)
+            times = START + np.arange(per_robot) * (duration // per_robot)
+            streams.append(
+                (times, odom_topic, lambda t, i: _patched(odom, odom_offsets, t, float(i) / 50))
+            )
+            seconds = START + np.arange(duration // 10**9) * 10**9
+            streams.append(
+                (
+                    seconds,
+                    battery_topic,
+                    lambda t, i: _patched(battery, battery_offsets, t, 1 - i / 1e5),
+                )
+            )
+            streams.append(_tag_stream(store, tag_topic, robot, tags // len(ROBOTS), duration, rng))
+        for when, connection, data in _merged(streams):
+            writer.write(connection, when, data)
+
+
+def _template(store, msgtype: str) -> tuple[bytes, tuple[int, int, str]]:
+    """A serialized message, the byte offsets of its stamp and its value, the value's format."""
+    types = store.types
+    stamp = types["builtin_interfaces/msg/Time"](sec=1_111_111_111, nanosec=222_222_222)
+    header = types["std_msgs/msg/Header"](stamp=stamp, frame_id="odom")
+    if msgtype == "nav_msgs/msg/Odometry":
+        vector = types["geometry_msgs/msg/Vector3"](x=0.0, y=0.0, z=0.0)
+        pose = types["geometry_msgs/msg/Pose"](
+            position=types["geometry_msgs/msg/Point"](x=MARK, y=1.0, z=0.5),
+            orientation=types["geometry_msgs/msg/Quaternion"](x=0.0, y=0.0, z=0.0, w=1.0),
+        )
+        message = types[msgtype](
+            header=header,
+            child_frame_id="base_link",
+            pose=types["geometry_msgs/msg/PoseWithCovariance"](pose=pose, covariance=np.zeros(36)),
+            twist=types["geometry_msgs/msg/TwistWithCovariance"](
+                twist=types["geometry_msgs/msg/Twist"](linear=vector, angular=vector),
+                covariance=np.zeros(36),
+            ),
+        )
+        fmt = "<d"
+    else:
+        empty = np.zeros(0, dtype=np.float32)
+        message = types[msgtype](
+            header=header, voltage=12.0, temperature=20.0, current=-1.0, charge=1.0,
+            capacity=2.0, design_capacity=2.0, percentage=np.float32(MARK),
+            power_supply_status=2, power_supply_health=1, power_supply_technology=3,
+            present=True, cell_voltage=empty, cell_temperature=empty, location="",
+            serial_number="",
+        )  # fmt: skip
+        fmt = "<f"
+    raw = bytes(store.serialize_cdr(message, msgtype))
+    stamp_at = raw.index(struct.pack("<I", 1_111_111_111))
+    return raw, (stamp_at, raw.index(struct.pack(fmt, MARK)), fmt)
+
+
+def _patched(template: bytes, layout: tuple[int, int, str], when: int, value: float) -> bytes:
+    stamp_at, value_at, fmt = layout
+    data = bytearray(template)
+    struct.pack_into("<iI", data, stamp_at, when // 10**9, when % 10**9)
+    struct.pack_into(fmt, data, value_at, value)
+    return bytes(data)
+
+
+def _tag_stream(store, connection, robot: str, count: int, duration: int, rng):
+    pairs = count // 2
+    starts = np.sort(rng.integers(0, duration - 4 * 10**9, pairs)) + START
+    # activities of one robot follow each other: each ends before the next starts
+    gaps = np.diff(np.append(starts, START + duration))
+    ends = starts + np.minimum(rng.integers(2 * 10**8, 3 * 10**9, pairs), gaps - 1)
+    times = np.empty(2 * pairs, dtype=np.int64)
+    times[0::2], times[1::2] = starts, ends
+    Tag, Time = store.types[TAG_TYPE], store.types["builtin_interfaces/msg/Time"]
+    activities = rng.choice(["explore", "move", "cut_grass", "weed_found"], pairs)
+
+    def tag(when: int, index: int) -> bytes:
+        message = Tag(
+            stamp=Time(sec=int(when // 10**9), nanosec=int(when % 10**9)),
+            robot=robot,
+            activity=str(activities[index // 2]),
+            lifecycle="start" if index % 2 == 0 else "complete",
+            msg_id="",
+            msg_role="",
+            payload="",
+        )
+        return bytes(store.serialize_cdr(message, TAG_TYPE))
+
+    return times, connection, tag
+
+
+def _merged(streams):
+    """All messages of all streams in time order: (time, connection, serialized message)."""
+    times = np.concatenate([s[0] for s in streams])
+    stream = np.concatenate([np.full(len(s[0]), k) for k, s in enumerate(streams)])
+    index = np.concatenate([np.arange(len(s[0])) for s in streams])
+    for k in np.argsort(times, kind="stable"):
+        when, which, i = int(times[k]), int(stream[k]), int(index[k])
+        yield when, streams[which][1], streams[which][2](when, i)
+
+
+if __name__ == "__main__":
+    sys.exit(main())
