@@ -67,7 +67,10 @@ class Layout:
         """Whether the wanted fields of ``raw`` are where this layout says."""
         if len(raw) < self.end or raw[:_HEADER] != self.header:
             return False
-        return all(raw[offset : offset + 4] == length for offset, length in self.checks)
+        for offset, length in self.checks:  # noqa: SIM110 -- a plain loop: it runs per message
+            if raw[offset : offset + 4] != length:
+                return False
+        return True
 
 
 def columns(layout: Layout, data: bytes | bytearray) -> list[np.ndarray]:

@@ -129,6 +129,12 @@ def prepare(
     return _canonical(log, chosen)
 
 
+def is_recording(path: str | Path) -> bool:
+    """Whether ``path`` is what :func:`prepare` reads: a bag directory or a folder of them."""
+    path = Path(path)
+    return is_bag(path) or (path.is_dir() and any(is_bag(c) for c in path.iterdir() if c.is_dir()))
+
+
 def find_runs(source: Path) -> list[Path]:
     """The bag directories of ``source``: itself, or its sub-directories that are bags."""
     if not source.exists():
@@ -334,7 +340,8 @@ def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.Dat
 def _message_count(run: Path, globs: Sequence[str]) -> int:
     """How many messages of a bag the preparation reads, from its metadata alone."""
     try:
-        meta = yaml.safe_load((run / "metadata.yaml").read_text(encoding="utf-8"))
+        text = (run / "metadata.yaml").read_text(encoding="utf-8")
+        meta = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
         topics = meta["rosbag2_bagfile_information"]["topics_with_message_count"]
         return sum(
             int(t["message_count"])
@@ -351,6 +358,7 @@ __all__ = [
     "TAG_TOPICS",
     "TagFields",
     "find_runs",
+    "is_recording",
     "prepare",
     "robot_type",
     "run_manifests",

@@ -14,6 +14,7 @@ columns are the message fields asked for, by dotted path (``pose.pose.position.x
 from __future__ import annotations
 
 import contextlib
+import functools
 import struct
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -98,6 +99,8 @@ class Bag:
     extra_types: Mapping = field(default_factory=dict)
     _reader: Reader | None = field(default=None, init=False, repr=False)
     typestore: Typestore | None = field(default=None, init=False, repr=False)
+    _definitions: Mapping = field(default_factory=dict, init=False, repr=False)
+    _topics: dict[str, str] = field(default_factory=dict, init=False, repr=False)
 
     def __enter__(self) -> Bag:
         if not self.path.exists():
@@ -111,7 +114,14 @@ class Bag:
             reason = " ".join(str(error).split())
             raise InputError(f"{self.path} is not a readable rosbag2 directory: {reason}") from None
         self._reader = reader
-        self.typestore = _typestore(reader, self.extra_types, self.path)
+        self._topics = {n: i.msgtype or "" for n, i in sorted(reader.topics.items())}
+        try:
+            self._definitions = _definitions(reader, self.extra_types, self.path)
+            roots = {c.msgtype for c in reader.connections}
+            self.typestore = _typestore(self._definitions, roots, self.path)
+        except BaseException:
+            self.__exit__()
+            raise
         return self
 
     def __exit__(self, *exc: object) -> None:
@@ -132,7 +142,8 @@ class Bag:
     @property
     def topics(self) -> dict[str, str]:
         """Topic name -> message type, in the order of the topic names."""
-        return {name: info.msgtype or "" for name, info in sorted(self.reader.topics.items())}
+        self.reader  # noqa: B018 -- raises when the bag is not open
+        return self._topics
 
     def fields(self, topic: str) -> list[str]:
         """The dotted paths of every scalar field of a topic's message type (arrays left out)."""
@@ -150,7 +161,7 @@ class Bag:
         ``bag_time`` uses the recording time instead of the message stamps. ``progress`` is a
         tqdm bar to advance by one per message read.
         """
-        unknown = [topic for topic in columns if topic not in self.reader.topics]
+        unknown = [topic for topic in columns if topic not in self.topics]
         if unknown:
             raise InputError(f"{self.path} has no topic {unknown[0]}.")
         connections = [c for c in self.reader.connections if c.topic in columns]
@@ -169,10 +180,10 @@ class Bag:
 
     def _rows(self, topic: str, paths: Mapping[str, str]) -> _TopicRows:
         msgtype = self._decodable(self.topics[topic], topic)
-        field_paths, stamped = self._layout(topic, paths)
+        field_paths, stamped = self._field_paths(topic, paths)
         return _TopicRows(msgtype, field_paths, stamped, self.typestore, self._decoder(topic))
 
-    def _layout(self, topic: str, paths: Mapping[str, str]) -> tuple[list[str], bool]:
+    def _field_paths(self, topic: str, paths: Mapping[str, str]) -> tuple[list[str], bool]:
         """The field paths to read from a topic's messages, and whether they lead with a stamp."""
         msgtype = self._decodable(self.topics[topic], topic)
         known = set(all_fields(msgtype, self.typestore))
@@ -189,10 +200,12 @@ class Bag:
 
     def _decodable(self, msgtype: str, topic: str) -> str:
         if msgtype not in self.typestore.fielddefs:
-            package, _, name = msgtype.rpartition("/msg/")
+            missing = _missing(self._definitions, msgtype) or msgtype
+            package, _, name = missing.rpartition("/msg/")
+            part = "" if missing == msgtype else f", which {msgtype} contains,"
             raise InputError(
-                f"{self.path}: cannot decode {topic}: its message type {msgtype} is not defined "
-                f"in the bag; register it with --msg {package or 'my_pkg'}/msg/{name}.msg "
+                f"{self.path}: cannot decode {topic}: the message type {missing}{part} is not "
+                f"defined in the bag; register it with --msg {package or 'my_pkg'}/msg/{name}.msg "
                 "(or a folder of .msg files)."
             )
         return msgtype
@@ -284,7 +297,8 @@ class _TopicRows:
             column = np.empty(count, dtype=object)
             if bulk is not None:
                 column[self.bulk_at] = bulk[k]
-            column[self.one_by_one_at] = [row[k] for row in self.one_by_one]
+            for position, row in zip(self.one_by_one_at, self.one_by_one, strict=True):
+                column[position] = row[k]  # one at a time: a value may itself be an array
             values[name] = pd.Series(column).infer_objects().to_numpy()
         return _table(np.asarray(self.recorded, dtype=np.int64), values, names, bag_time)
 
@@ -340,27 +354,42 @@ def _storage_files(reader: Reader) -> list[str]:
     return []
 
 
-def _typestore(reader: Reader, extra: Mapping, path: Path) -> Typestore:
-    """The types the bag carries, then the user's, then the distribution's, then robotale's.
-
-    Only the types the bag's topics need are registered: a distribution has hundreds, and a
-    batch of runs opens one bag after another.
-    """
+def _definitions(reader: Reader, extra: Mapping, path: Path) -> dict:
+    """The types the bag carries, then the user's, then the distribution's, then robotale's."""
     typs: dict = {}
     for connection in reader.connections:
         typs.update(_embedded_types(connection, path))
     for source in (extra, _distribution_types(reader), get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
         typs.update({name: spec for name, spec in source.items() if name not in typs})
-    store = get_typestore(Stores.EMPTY)
-    try:
-        store.register(_closure(typs, {c.msgtype for c in reader.connections}))
-    except TypesysError as error:
-        raise InputError(f"{path}: its message definitions cannot be used: {error}") from None
-    return store
+    return typs
+
+
+def _typestore(definitions: Mapping, roots: set[str], path: Path) -> Typestore:
+    """A store of the types ``roots`` need whose definitions are all there.
+
+    Only those: a distribution has hundreds of types. Stores are shared between bags that
+    need the same definitions (the runs of a batch), as building one generates code.
+    """
+    needed = _closure(definitions, roots)
+    usable = {n: spec for n, spec in needed.items() if _missing(definitions, n) is None}
+    key = repr(sorted(usable.items()))
+    if key not in _STORES:
+        store = get_typestore(Stores.EMPTY)
+        try:
+            store.register(usable)
+        except TypesysError as error:
+            raise InputError(f"{path}: its message definitions cannot be used: {error}") from None
+        if len(_STORES) >= 32:
+            _STORES.clear()
+        _STORES[key] = store
+    return _STORES[key]
+
+
+_STORES: dict[str, Typestore] = {}
 
 
 def _closure(typs: Mapping, roots: set[str]) -> dict:
-    """The definitions of ``roots`` and of every type they contain."""
+    """The definitions of ``roots`` and of every type they contain (those there are)."""
     needed: dict = {}
     todo = list(roots)
     while todo:
@@ -370,6 +399,20 @@ def _closure(typs: Mapping, roots: set[str]) -> dict:
         needed[name] = typs[name]
         todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
     return needed
+
+
+def _missing(typs: Mapping, msgtype: str) -> str | None:
+    """The first type ``msgtype`` needs (itself included) that has no definition, if any."""
+    seen, todo = set(), [msgtype]
+    while todo:
+        name = todo.pop(0)
+        if name in seen:
+            continue
+        if name not in typs:
+            return name
+        seen.add(name)
+        todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
+    return None
 
 
 def _references(desc: tuple) -> list[str]:
@@ -384,23 +427,29 @@ def _references(desc: tuple) -> list[str]:
 def _embedded_types(connection: Connection, path: Path) -> dict:
     definition = connection.msgdef
     try:
-        if definition.format == MessageDefinitionFormat.MSG:
-            return get_types_from_msg(definition.data, connection.msgtype)
-        if definition.format == MessageDefinitionFormat.IDL:
-            separator = "=" * 80 + "\n"
-            parts = definition.data.split(separator)[1:] or [definition.data]
-            typs: dict = {}
-            for part in parts:
-                typs.update(
-                    get_types_from_idl(part.split("\n", 1)[1] if part.startswith("IDL: ") else part)
-                )
-            return typs
+        return dict(_parsed(definition.format, definition.data, connection.msgtype))
     except TypesysError as error:
+        reason = " ".join(str(error).split())
         raise InputError(
             f"{path}: the definition of {connection.msgtype} stored in the bag cannot be parsed: "
-            f"{error}."
+            f"{reason}"
         ) from None
-    return {}
+
+
+@functools.lru_cache(maxsize=256)
+def _parsed(kind: MessageDefinitionFormat, data: str, msgtype: str) -> tuple:
+    """A stored definition parsed once: the runs of a batch all store the same ones."""
+    if kind == MessageDefinitionFormat.MSG:
+        return tuple(get_types_from_msg(data, msgtype).items())
+    if kind == MessageDefinitionFormat.IDL:
+        separator = "=" * 80 + "\n"
+        typs: dict = {}
+        for part in data.split(separator)[1:] or [data]:
+            typs.update(
+                get_types_from_idl(part.split("\n", 1)[1] if part.startswith("IDL: ") else part)
+            )
+        return tuple(typs.items())
+    return ()
 
 
 def _distribution_types(reader: Reader) -> Mapping:

@@ -12,7 +12,7 @@ from bagbuilder import agri_like, at
 from robotale.errors import InputError
 from robotale.ingest import schema
 from robotale.ingest.enrich import PreparationWarning
-from robotale.ingest.prepare import TagFields, find_runs, prepare, robot_type
+from robotale.ingest.prepare import TagFields, find_runs, is_recording, prepare, robot_type
 
 COLUMNS = [
     schema.CASE,
@@ -170,6 +170,14 @@ def test_bag_time_replaces_message_stamps(tmp_path, bag_builder):
     log = prepare(bag, perspectives=["odom"], bag_time=True)
     assert log[schema.TIMESTAMP].tolist() == [at(4)]
     assert log[schema.X].tolist() == [2.0]
+
+
+def test_what_counts_as_a_recording(tmp_path, bag_builder):
+    bag = agri_like(bag_builder).write(tmp_path / "runs" / "run_0001")
+    (tmp_path / "log.csv").write_text("case,time,activity\n")
+    assert is_recording(bag) and is_recording(tmp_path / "runs")
+    assert not is_recording(tmp_path / "log.csv")
+    assert not is_recording(tmp_path) and not is_recording(tmp_path / "missing")
 
 
 def test_robot_type_from_the_name():

@@ -69,9 +69,32 @@ def test_a_type_the_bag_does_not_define_is_named_with_how_to_register_it(tmp_pat
     with pytest.raises(InputError) as error:
         read_bag(bag)
     assert str(error.value) == (
-        f"{bag}: cannot decode /turtle/events: its message type {EVENT_TYPE} is not defined in "
+        f"{bag}: cannot decode /turtle/events: the message type {EVENT_TYPE} is not defined in "
         f"the bag; register it with --msg turtle_msgs/msg/Event.msg (or a folder of .msg files)."
     )
+
+
+def test_a_missing_type_inside_a_registered_one_is_named(tmp_path, bag_builder):
+    b = bag_builder()
+    b.custom(0, "/arm/goal", "arm_msgs/msg/Target", "float64 x\n", x=0.5)
+    b.custom(
+        1, "/arm/plan", "arm_msgs/msg/Plan", "arm_msgs/Target goal\nstring name\n",
+        goal=b.typestore.types["arm_msgs/msg/Target"](x=1.0), name="p",
+    )  # fmt: skip
+    bag = without_definitions(b.write(tmp_path / "bag"))
+    given = tmp_path / "arm_msgs" / "msg" / "Plan.msg"
+    given.parent.mkdir(parents=True)
+    given.write_text("arm_msgs/Target goal\nstring name\n")
+    with pytest.raises(InputError) as error:
+        read_bag(bag, ["/arm/plan"], msg_files=[given])
+    assert str(error.value).startswith(
+        f"{bag}: cannot decode /arm/plan: the message type arm_msgs/msg/Target, which "
+        "arm_msgs/msg/Plan contains, is not defined in the bag; register it with --msg "
+        "arm_msgs/msg/Target.msg"
+    )
+    (given.parent / "Target.msg").write_text("float64 x\n")
+    plan = read_bag(bag, ["/arm/plan"], msg_files=[given.parent])["/arm/plan"]
+    assert (plan["goal.x"].tolist(), plan["name"].tolist()) == ([1.0], ["p"])
 
 
 def test_types_registered_from_msg_files_decode_the_bag(tmp_path, bag_builder):
@@ -167,3 +190,18 @@ def test_unreadable_bags_are_named(tmp_path, bag_builder):
     next(other.glob("*.db3")).write_bytes(b"not a database" * 64)
     with pytest.raises(InputError, match=r"other is not a readable rosbag2 directory: .*database"):
         prepare(other)
+
+
+@pytest.mark.parametrize("distro", ["humble", "jazzy", None])
+def test_standard_types_come_from_the_distribution_when_the_bag_has_none(
+    tmp_path, bag_builder, distro
+):
+    b = bag_builder().odom(1, "drone", 1.5, 2.5, 0).battery(1, "drone", 0.5)
+    bag = without_definitions(b.write(tmp_path / "bag"))
+    metadata = yaml.safe_load((bag / "metadata.yaml").read_text())
+    info = metadata["rosbag2_bagfile_information"]
+    info.pop("ros_distro") if distro is None else info.update(ros_distro=distro)
+    (bag / "metadata.yaml").write_text(yaml.safe_dump(metadata))
+    tables = read_bag(bag)
+    assert tables["/drone/odom"]["pose.pose.position.y"].tolist() == [2.5]
+    assert tables["/drone/battery"]["percentage"].tolist() == [0.5]
