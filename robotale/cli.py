@@ -153,7 +153,9 @@ def _add_prepare(commands) -> None:
         "position and battery, with inprogress events between each start and complete.",
     )
     prepare.add_argument("source", help="a rosbag2 directory or a folder of run directories")
-    prepare.add_argument("--out", metavar="CSV", help="CSV file (default: SOURCE_NAME.csv)")
+    prepare.add_argument(
+        "--out", metavar="CSV", help="CSV file (default: SOURCE_NAME.csv if no other output)"
+    )
     prepare.add_argument("--xes", metavar="FILE", help="also write IEEE XES")
     prepare.add_argument("--ocel", metavar="FILE", help="also write OCEL 2.0 JSON")
     prepare.add_argument(

@@ -119,6 +119,8 @@ def prepare(
     ) as bar:
         parts = [_read_run(run, extra_types, tags, fields_, chosen, bag_time, bar) for run in runs]
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
+    if tag_rows.empty:
+        raise InputError(f"{source} has no tags: its topics matching {tags!r} hold no messages.")
     samples = {
         p.name: pd.concat([sample_parts[p.name] for _, sample_parts in parts], ignore_index=True)
         for p in chosen
@@ -305,8 +307,8 @@ def _warn_missing_samples(
     for p in perspectives:
         if samples[p.name].empty:
             warnings.warn(
-                f"No topic matches the {p.name} perspective ({p.topic}) in any bag, so the "
-                f"log's {', '.join(p.columns)} column(s) are empty.",
+                f"No bag has samples of the {p.name} perspective ({p.topic}), so the log's "
+                f"{', '.join(p.columns)} column(s) are empty.",
                 PreparationWarning,
                 stacklevel=3,
             )

@@ -8,8 +8,10 @@ import warnings
 import pandas as pd
 import pytest
 from bagbuilder import agri_like, at
+from rosbags.rosbag2 import Writer
 
 from robotale.errors import InputError
+from robotale.fame_runtime.tags import TAG_TYPE
 from robotale.ingest import schema
 from robotale.ingest.enrich import PreparationWarning
 from robotale.ingest.prepare import TagFields, find_runs, is_recording, prepare, robot_type
@@ -221,6 +223,13 @@ def test_a_bag_with_no_tag_topic_lists_its_topics(tmp_path, bag_builder):
         f"{bag} has no tag topic matching '/*/tag'; its topics are /drone/battery, /drone/odom "
         "(name the tag topics with --tags)."
     )
+
+
+def test_tag_topics_without_messages_are_an_error(tmp_path, bag_builder):
+    with Writer(tmp_path / "quiet", version=9) as writer:
+        writer.add_connection("/drone/tag", TAG_TYPE, typestore=bag_builder().typestore)
+    with pytest.raises(InputError, match=r"quiet has no tags: its topics matching '/\*/tag' hold"):
+        prepare(tmp_path / "quiet")
 
 
 def test_tags_without_the_activity_field_say_which_fields_they_have(tmp_path, bag_builder):
