@@ -1,10 +1,12 @@
 """How fast TALE preparation turns bags into an event log.
 
-Two workloads:
+Three workloads:
 
 1. a synthetic rosbag2 directory with 1M odometry samples and 50k tags (5 robots, plus battery
    at 1 Hz), written here with the rosbags writer;
-2. the 70-run agri batch of the simulator (``robotale simulate agri --runs 70``), or any batch
+2. a synthetic batch of 70 small bags (3 robots, 10 Hz odometry, 5 minutes each), for the cost
+   of opening one bag after another;
+3. the 70-run agri batch of the simulator (``robotale simulate agri --runs 70``), or any batch
    folder given with ``--batch``.
 
 Figures are printed as ratios against baselines measured in the same process: the time to only
@@ -52,6 +54,7 @@ def main() -> int:
     warnings.simplefilter("ignore")
     with tempfile.TemporaryDirectory(prefix="robotale-bench-") as scratch:
         synthetic(Path(scratch) / "synthetic", args.samples, args.tags)
+        synthetic_batch(Path(scratch) / "batch", args.runs)
         batch = args.batch or simulate(Path(scratch) / "agri", args.runs)
         if batch is not None:
             agri(batch)
@@ -75,18 +78,35 @@ def synthetic(path: Path, samples: int, tags: int) -> None:
     compare_with_search(path)
 
 
-def agri(batch: Path) -> None:
-    runs = sorted(p for p in batch.iterdir() if (p / "metadata.yaml").is_file())
-    print(f"agri batch: {len(runs)} runs in {batch}")
+def synthetic_batch(root: Path, runs: int) -> None:
+    began = time.perf_counter()
+    robots = ROBOTS[:3]
+    for run in range(1, runs + 1):
+        write_synthetic_bag(root / f"run_{run:04d}", 9000, 360, robots=robots, hz=10, seed=run)
+    print(
+        f"synthetic batch: {runs} bags of 9,000 odometry samples and 360 tags, {len(robots)} "
+        f"robots (written in {time.perf_counter() - began:.1f} s)"
+    )
+    batch(root, target=False)
+
+
+def agri(root: Path) -> None:
+    print(f"agri batch: {root}")
+    batch(root, target=True)
+
+
+def batch(root: Path, target: bool) -> None:
+    runs = sorted(p for p in root.iterdir() if (p / "metadata.yaml").is_file())
     decode, messages = 0.0, 0
     for run in runs:
         seconds, count = timed(read_everything, run)
         decode, messages = decode + seconds, messages + count
     report_baseline(decode, messages)
-    seconds, log = timed(prepare, batch)
+    seconds, log = timed(prepare, root)
     report_prepare(seconds, log, messages, decode)
-    verdict = "met" if seconds < 30 else "NOT met"
-    print(f"  target: the batch prepares in under 30 s: {verdict} ({seconds:.1f} s)")
+    if target:
+        verdict = "met" if seconds < 30 else "NOT met"
+        print(f"  target: {len(runs)} runs prepare in under 30 s: {verdict} ({seconds:.1f} s)")
 
 
 def simulate(out: Path, runs: int) -> Path | None:
@@ -157,19 +177,12 @@ def compare_with_search(path: Path, searched: int = 2000) -> None:
 
 
 def _odometry(path: Path, tags: bool = False) -> pd.DataFrame:
+    """The bag's odometry x (or its tags' robot field) with the robot of each row."""
+    suffix, field = ("/tag", "robot") if tags else ("/odom", "pose.pose.position.x")
     with Bag(path) as bag:
-        if tags:
-            topics = {f"/{r}/tag": {schema.ROBOT: "robot"} for r in ROBOTS}
-        else:
-            topics = {f"/{r}/odom": {"x": "pose.pose.position.x"} for r in ROBOTS}
-        tables = bag.tables(topics)
-    frame = pd.concat(
-        [
-            t.assign(**({} if tags else {schema.ROBOT: topic.split("/")[1]}))
-            for topic, t in tables.items()
-        ],
-        ignore_index=True,
-    )
+        tables = bag.tables({t: {"x": field} for t in bag.topics if t.endswith(suffix)})
+    parts = [t.assign(**{schema.ROBOT: topic.split("/")[1]}) for topic, t in tables.items()]
+    frame = pd.concat(parts, ignore_index=True)
     return frame.rename(columns={"time": schema.TIMESTAMP}).assign(**{schema.CASE: path.name})
 
 
@@ -185,7 +198,9 @@ def _search_each(events: pd.DataFrame, samples: pd.DataFrame) -> list[float]:
 # ------------------------------------------------------------------------- the synthetic bag
 
 
-def write_synthetic_bag(path: Path, samples: int, tags: int) -> None:
+def write_synthetic_bag(
+    path: Path, samples: int, tags: int, robots=ROBOTS, hz: int = 50, seed: int = 1
+) -> None:
     """Odometry at a steady rate per robot, battery at 1 Hz, activities of 0.2 to 3 s.
 
     Messages are serialized once and their stamp and position patched in place, so writing a
@@ -193,16 +208,16 @@ def write_synthetic_bag(path: Path, samples: int, tags: int) -> None:
     """
     store = get_typestore(Stores.ROS2_HUMBLE)
     register_tag_type(store)
-    per_robot = samples // len(ROBOTS)
-    duration = per_robot // 50 * 10**9  # 50 Hz odometry
-    rng = np.random.default_rng(1)
+    per_robot = samples // len(robots)
+    duration = per_robot // hz * 10**9
+    rng = np.random.default_rng(seed)
     odom, odom_offsets = _template(store, "nav_msgs/msg/Odometry")
     battery, battery_offsets = _template(store, "sensor_msgs/msg/BatteryState")
     if path.exists():
         shutil.rmtree(path)
     with Writer(path, version=9) as writer:
         streams = []
-        for robot in ROBOTS:
+        for robot in robots:
             odom_topic = writer.add_connection(
                 f"/{robot}/odom", "nav_msgs/msg/Odometry", typestore=store
             )
@@ -212,7 +227,7 @@ def write_synthetic_bag(path: Path, samples: int, tags: int) -> None:
             tag_topic = writer.add_connection(f"/{robot}/tag", TAG_TYPE, typestore=store)
             times = START + np.arange(per_robot) * (duration // per_robot)
             streams.append(
-                (times, odom_topic, lambda t, i: _patched(odom, odom_offsets, t, float(i) / 50))
+                (times, odom_topic, lambda t, i: _patched(odom, odom_offsets, t, float(i) / hz))
             )
             seconds = START + np.arange(duration // 10**9) * 10**9
             streams.append(
@@ -222,7 +237,7 @@ def write_synthetic_bag(path: Path, samples: int, tags: int) -> None:
                     lambda t, i: _patched(battery, battery_offsets, t, 1 - i / 1e5),
                 )
             )
-            streams.append(_tag_stream(store, tag_topic, robot, tags // len(ROBOTS), duration, rng))
+            streams.append(_tag_stream(store, tag_topic, robot, tags // len(robots), duration, rng))
         for when, connection, data in _merged(streams):
             writer.write(connection, when, data)
 
