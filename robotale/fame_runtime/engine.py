@@ -15,6 +15,7 @@ from __future__ import annotations
 import builtins
 import json
 import types
+from collections import deque
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any
@@ -108,7 +109,7 @@ class Engine:
         self.triggers = Triggers(
             robot, bus, clock, self._call, self._value, self.env, self.variables
         )
-        self._work: list[Callable[[], Any]] = []
+        self._work: deque[Callable[[], Any]] = deque()  # first queued, first run
         self._busy = False
         self._roots: list[_Scope] = []
         self._start_disarms: list[Callable[[], Any]] = []
@@ -169,7 +170,7 @@ class Engine:
     def start_instance(self) -> None:
         """Start one more instance at the none start events, now."""
         root = self._open(self.plan, None, None)
-        for start in reversed(self.plan.starts):
+        for start in self.plan.starts:
             self._push(self._new_token(root, start), start)
 
     def _starter(self, start: NodePlan) -> Callable[[Envelope | None], None]:
@@ -208,6 +209,11 @@ class Engine:
 
         self.stop(safe=True, then=restart)
 
+    def when_idle(self, callback: Callable[[], Any]) -> None:
+        """Call ``callback`` once no instance runs (now, if none does)."""
+        self._when_idle.append(callback)
+        self._idle_check()
+
     def set_variables(self, **values: Any) -> None:
         """Set variables from outside (the simulation, a test); conditional events that read
         them are re-evaluated."""
@@ -227,7 +233,7 @@ class Engine:
         self._busy = True
         try:
             while self._work:
-                self._work.pop()()
+                self._work.popleft()()
                 if not self._work and self._inclusive:
                     self._recheck_joins()
         except BaseException:
@@ -318,7 +324,6 @@ class Engine:
         first (thesis 4.1.3)."""
         handler = scope.plan.safe_state if safe and scope.holder is None else None
         if handler is not None and not scope.safe:
-            scope.safe = True
             self._event_subprocess(scope, handler, None, interrupting=True, triggered=False)
             return
         for token in list(scope.tokens):
@@ -333,7 +338,7 @@ class Engine:
         if not flows:
             self._consume(token)
             return None
-        for flow in reversed(flows[1:]):
+        for flow in flows[1:]:
             other = self._new_token(token.scope, flow.target)
             other.flow = flow.id
             self._push(other, flow.target)
@@ -441,6 +446,11 @@ class Engine:
         except BpmnError as error:
             self._throw_error(token, error.name)
             return None
+        except Exception as error:
+            raise ModelError(
+                f"robot {self.robot.name}: skill {node.skill!r} of call activity "
+                f"{node.node.describe()} failed: {type(error).__name__}: {error}"
+            ) from error
         if callable(cancel):
             token.waits.append(cancel)
         return None
@@ -462,7 +472,7 @@ class Engine:
         self._inputs(node)
         self._arm_boundaries(token, node)
         child = self._open(node.child, token.scope, token)
-        for start in reversed(node.child.starts):
+        for start in node.child.starts:
             self._push(self._new_token(child, start), start)
         if not node.child.starts:
             self._close(child)
@@ -648,6 +658,8 @@ class Engine:
     ) -> None:
         if interrupting and esp.id in scope.armed:
             scope.armed.pop(esp.id)()  # an interrupting handler runs once per scope
+        if esp is scope.plan.safe_state:
+            scope.safe = True
         holder = self._new_token(scope, esp)
         if interrupting:
             for token in list(scope.tokens):

@@ -130,3 +130,37 @@ def test_terminate_ends_every_token_of_the_process():
 def test_unknown_called_element_is_refused_at_deploy(models):
     with pytest.raises(ModelError, match=r"callActivity go \(Go To Goal\) calls 'navigate'"):
         run("calls.bpmn", skills={})
+
+
+def test_a_failing_skill_or_script_is_a_model_error_naming_the_element():
+    def broken(robot, inputs, done):
+        raise KeyError("x_goal")
+
+    variables = {"rover": {"home_y": 0, "top_speed": 1}}
+    with pytest.raises(
+        ModelError,
+        match=r"robot rover: skill 'navigate' of call activity go \(Go To Goal\) failed: "
+        r"KeyError: 'x_goal'",
+    ):
+        run("calls.bpmn", skills={"navigate": broken}, variables=variables)
+    with pytest.raises(
+        ModelError,
+        match=r"robot rover: script task measure \(Measure\) failed: NameError: "
+        r"name 'offset' is not defined",
+    ):
+        run("sequence.bpmn")
+
+
+def test_a_skill_that_calls_done_twice_or_after_cancel_is_ignored():
+    calls = []
+
+    def twice(robot, inputs, done):
+        done({"arrival": 5.0, "distance": 5.0})
+        done({"arrival": 99.0, "distance": 0.0})
+        calls.append(robot.now())
+
+    mission, tags = run(
+        "calls.bpmn", skills={"navigate": twice}, variables={"rover": {"home_y": 0, "top_speed": 1}}
+    )
+    assert [t.activity for t in tags].count("celebrate") == 2  # one start, one complete
+    assert mission.engines["rover"].variables["arrived_at"] == 5.0 and calls == [1.0]

@@ -392,3 +392,70 @@ def test_conditional_catch_waits_for_a_variable_then_for_a_topic():
         *pair(4, "rover", "battery_full"),
         *pair(4, "rover", "leave_dock"),
     ]
+
+
+def test_interrupting_signal_boundary_event():
+    drive = Drive()
+    mission, tags = build(
+        "boundary.bpmn",
+        skills={"drive": drive},
+        variables={"rover": {"drive_time": 20, "beats": 0}},
+    )
+    mission.clock.call_at(
+        1.5, lambda: mission.bus.publish("/obstacle", {}, msgtype="std_msgs/msg/Empty")
+    )
+    mission.run()
+    assert trace(tags) == [
+        (0, "rover", "drive", "start"),
+        *pair(1, "rover", "heartbeat"),
+        *pair(1, "rover", "beat"),
+        *pair(1.5, "rover", "obstacle?"),
+        *pair(1.5, "rover", "avoid"),
+    ]
+    assert drive.cancelled and mission.clock.next_time() is None
+
+
+def survey(blink_done=1):
+    return [
+        (0, "rover", "survey", "start"),
+        (0, "rover", "blink", "start"),
+        *pair(0, "rover", "led_on"),
+        *pair(blink_done, "rover", "1_s"),
+        *pair(blink_done, "rover", "led_off"),
+        (blink_done, "rover", "blink", "complete"),
+    ]
+
+
+def test_event_sub_process_of_a_sub_process_and_a_building_block_inside_it():
+    mission, tags = build("nested.bpmn", variables={"rover": {"abort_survey": False}})
+    mission.clock.call_at(
+        3, lambda: mission.bus.publish("/photo_request", {}, msgtype="std_msgs/msg/Empty")
+    )
+    mission.run()
+    assert trace(tags) == [
+        *survey(),
+        *handler(3, "rover", "photos", "photo_request?", "take_photo"),
+        *pair(11, "rover", "scan"),
+        (11, "rover", "survey", "complete"),
+        *pair(11, "rover", "report"),
+    ]
+
+
+@pytest.mark.parametrize("when", [0.5, 5])
+def test_conditional_boundary_event_cancels_nested_scopes(when):
+    mission, tags = build("nested.bpmn", variables={"rover": {"abort_survey": False}})
+    rover = mission.engines["rover"]
+    mission.clock.call_at(when, lambda: rover.set_variables(abort_survey=True))
+    mission.clock.call_at(
+        6, lambda: mission.bus.publish("/photo_request", {}, msgtype="std_msgs/msg/Empty")
+    )
+    mission.run()
+    before = survey() if when > 1 else survey()[:4]  # the building block is cut short at 0.5 s
+    assert trace(tags) == [
+        *before,
+        *pair(when, "rover", "abort_survey"),
+        *pair(when, "rover", "abandon"),
+    ]
+    assert mission.bus.topics() == []  # the 6 s photo request finds nobody listening
+    mission.clock.run()
+    assert len(tags) == len(before) + 4
