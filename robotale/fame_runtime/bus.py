@@ -49,6 +49,10 @@ class Subscription:
 
 
 class Bus(Protocol):
+    """What engines need of a bus. Two optional members help them: ``new_msg_id()`` (message
+    ids unique on the bus; engines otherwise use ``m_<robot>_<n>``, unique because robot
+    namespaces are) and ``pending`` (deliveries in flight, so a mission knows it is over)."""
+
     def publish(
         self,
         topic: str,

@@ -371,7 +371,14 @@ class Engine:
             ) from error
 
     def _value(self, condition: Compiled) -> Any:
-        return self._condition(condition, "a conditional event")
+        """A conditional event's condition; one reading a variable nobody set yet is false
+        (it cannot have become true), unlike a gateway's, where that is a model error."""
+        try:
+            return eval(condition.code, self.env, self.variables)
+        except NameError:
+            return False
+        except Exception:
+            return self._condition(condition, "a conditional event")
 
     # -- behaviours: each runs a token at a node and returns where it goes next --------------
 

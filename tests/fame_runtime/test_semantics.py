@@ -459,3 +459,12 @@ def test_conditional_boundary_event_cancels_nested_scopes(when):
     assert mission.bus.topics() == []  # the 6 s photo request finds nobody listening
     mission.clock.run()
     assert len(tags) == len(before) + 4
+
+
+def test_conditional_event_reading_a_variable_not_set_yet_waits_for_it():
+    mission, tags = build("start_events.bpmn", robots=["watcher"])  # no level yet
+    watcher = mission.engines["watcher"]
+    mission.clock.call_at(2, lambda: watcher.set_variables(level=9))
+    mission.start()
+    mission.clock.run(until=5)
+    assert trace(tags) == [*pair(2, "watcher", "level_high"), *pair(2, "watcher", "alarm")]
