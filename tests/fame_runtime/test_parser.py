@@ -3,6 +3,7 @@
 from pathlib import Path
 
 import pytest
+from fame_helpers import run
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.parser import parse
@@ -233,3 +234,42 @@ def test_not_bpmn_and_missing_file(tmp_path):
         parse(path)
     with pytest.raises(ModelError, match="cannot read the BPMN file"):
         parse(tmp_path / "missing.bpmn")
+
+
+def test_call_activity_with_the_process_embedded_as_in_listing_5_6(tmp_path):
+    embedded = (
+        "&lt;bpmn:process id='Process_GoTo' isExecutable='true'&gt;"
+        "&lt;bpmn:startEvent id='s' /&gt;"
+        "&lt;bpmn:scriptTask id='go' name='Go'&gt;&lt;bpmn:script&gt;went = True"
+        "&lt;/bpmn:script&gt;&lt;/bpmn:scriptTask&gt;"
+        "&lt;bpmn:endEvent id='e' /&gt;"
+        "&lt;bpmn:sequenceFlow id='a' sourceRef='s' targetRef='go' /&gt;"
+        "&lt;bpmn:sequenceFlow id='b' sourceRef='go' targetRef='e' /&gt;"
+        "&lt;/bpmn:process&gt;"
+    )
+    path = tmp_path / "embedded.bpmn"
+    path.write_text(
+        f"""<bpmn:definitions {NS} xmlns:callActivity="http://fame/callActivity" id="d">
+      <bpmn:process id="Rover">
+        <bpmn:startEvent id="start" />
+        <bpmn:callActivity id="Activity_1rktq6o" name="GoTo" calledElement="GoTo">
+          <bpmn:extensionElements>
+            <callActivity:process process="{embedded}" />
+          </bpmn:extensionElements>
+        </bpmn:callActivity>
+        <bpmn:endEvent id="end" />
+        <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="Activity_1rktq6o" />
+        <bpmn:sequenceFlow id="f2" sourceRef="Activity_1rktq6o" targetRef="end" />
+      </bpmn:process></bpmn:definitions>"""
+    )
+    call = parse(path).processes["Rover"].nodes["Activity_1rktq6o"]
+    assert call.embedded_process.id == "Process_GoTo"
+    assert list(call.embedded_process.nodes) == ["s", "go", "e"]
+    mission, tags = run(path)
+    assert [(t.activity, t.lifecycle) for t in tags] == [
+        ("go_to", "start"),
+        ("go", "start"),
+        ("go", "complete"),
+        ("go_to", "complete"),
+    ]
+    assert mission.engines["rover"].variables["went"] is True
