@@ -132,3 +132,32 @@ def test_run_reports_uncaught_errors_with_exit_status_1(models, capsys):
 def test_run_rejects_malformed_variables(models, capsys, bad):
     assert main(["fame", "run", str(models / "event_race.bpmn"), "--set", bad]) == 1
     assert "is not ROBOT.NAME=VALUE" in capsys.readouterr().err
+
+
+def test_run_imports_a_skills_module_from_the_current_folder(models, capsys, monkeypatch):
+    monkeypatch.chdir(models / "library")
+    code = main(
+        [
+            "fame",
+            "run",
+            "../calls.bpmn",
+            "--library",
+            ".",
+            "--skills",
+            "rover_skills",
+            "--set",
+            "rover.home_y=0",
+            "--set",
+            "rover.top_speed=2.5",
+        ]
+    )
+    assert code == 0 and capsys.readouterr().out.splitlines()[-1].endswith("celebrate\tcomplete")
+
+
+def test_a_skills_module_without_skills_is_one_sentence(models, tmp_path, capsys):
+    empty = tmp_path / "empty_skills.py"
+    empty.write_text("NOTHING = 1\n")
+    assert main(["fame", "run", str(models / "calls.bpmn"), "--skills", str(empty)]) == 1
+    assert capsys.readouterr().err == (
+        f"robotale: the skills module {str(empty)!r} has no SKILLS mapping of name to skill\n"
+    )
