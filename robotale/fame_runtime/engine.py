@@ -13,7 +13,6 @@ See ``docs/fame_runtime.md`` for the API and the exact semantics.
 from __future__ import annotations
 
 import builtins
-import json
 import types
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
@@ -23,14 +22,14 @@ from typing import Any
 from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock
-from robotale.fame_runtime.expressions import BpmnError, Compiled, render_json, self_reference
-from robotale.fame_runtime.expressions import substitute as substitute_text
+from robotale.fame_runtime.data import Data
+from robotale.fame_runtime.expressions import BpmnError, Compiled
 from robotale.fame_runtime.library import Library
-from robotale.fame_runtime.model import DataObject, Process
+from robotale.fame_runtime.model import Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, reachable_flows
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
-from robotale.fame_runtime.tags import Tag, TagSink
+from robotale.fame_runtime.tags import Tagger, TagSink, payload_text
 from robotale.fame_runtime.triggers import Triggers
 
 #: values a script leaves behind that are not variables (``import math``, helper functions)
@@ -96,9 +95,7 @@ class Engine:
         self.library = library
         self.plan = self._deploy(process)
         self.bus, self.clock = bus, clock
-        self.tag_sink = tag_sink
         self.variables: dict[str, Any] = dict(variables or {})
-        self._given = frozenset(self.variables)
         robot_type = robot_type or self.plan.process.name or self.plan.process.id
         self.robot = RobotHandle(robot, robot_type, bus, clock, self.variables, self._changed)
         self.env: dict[str, Any] = {
@@ -106,6 +103,8 @@ class Engine:
             "robot": self.robot,
             "BpmnError": BpmnError,
         }
+        self.data = Data(robot, self.variables, self.env, self._changed)
+        self._tag = Tagger(robot, clock, tag_sink, bus)
         self.triggers = Triggers(
             robot, bus, clock, self._call, self._value, self.env, self.variables
         )
@@ -115,7 +114,6 @@ class Engine:
         self._start_disarms: list[Callable[[], Any]] = []
         self._inclusive: set[_Scope] = set()
         self._when_idle: list[Callable[[], Any]] = []
-        self._msg_ids = 0
         self._starting = 0  # none-start instances scheduled but not begun
         self._behaviours = {
             name.removeprefix("_run_"): getattr(self, name)
@@ -269,7 +267,7 @@ class Engine:
             self._roots.append(scope)
         if holder is not None:
             holder.child = scope
-        self._declare(plan.data_objects)
+        self.data.declare(plan.data_objects)
         for esp in plan.event_subprocesses:
             self._arm_event_subprocess(scope, esp)
         return scope
@@ -405,14 +403,14 @@ class Engine:
 
     def _run_task(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")
-        self._inputs(node)
+        self.data.inputs(node)
         self._tag(node.label, "complete")
-        self._outputs(node, {})
+        self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
     def _run_script(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")
-        self._inputs(node)
+        self.data.inputs(node)
         if node.script is not None:
             try:
                 self._exec(node)
@@ -420,7 +418,7 @@ class Engine:
                 self._throw_error(token, error.name)
                 return None
         self._tag(node.label, "complete")
-        self._outputs(node, {})
+        self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
     def _exec(self, node: NodePlan) -> None:
@@ -441,7 +439,7 @@ class Engine:
 
     def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")
-        inputs = self._inputs(node)
+        inputs = self.data.inputs(node)
         self._arm_boundaries(token, node)
         generation = token.generation
 
@@ -470,13 +468,12 @@ class Engine:
             self._throw_error(token, outputs.name)
             return
         values = dict(outputs or {})
-        self.variables.update(values)
-        self._changed(values)
+        self.data.set(values)
         self._activity_done(token, values)
 
     def _run_call(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")
-        self._inputs(node)
+        self.data.inputs(node)
         self._arm_boundaries(token, node)
         child = self._open(node.child, token.scope, token)
         for start in node.child.starts:
@@ -496,7 +493,7 @@ class Engine:
         if node.behaviour == "event_subprocess":
             self._consume(token)
             return
-        self._outputs(node, outputs or {})
+        self.data.outputs(node, outputs or {})
         self._go_on(token, node)
 
     def _go_on(self, token: _Token, node: NodePlan) -> None:
@@ -522,7 +519,7 @@ class Engine:
     def _caught(self, token: _Token, node: NodePlan, envelope: Envelope | None) -> None:
         """A catching event fired for ``token``: tag it, store the message, move on."""
         values = self._received(node, envelope)
-        self._outputs(node, values)
+        self.data.outputs(node, values)
         token.node = node
         self._go_on(token, node)
 
@@ -730,89 +727,23 @@ class Engine:
         )
         self._kill(root, safe=False)
 
-    # -- data: data objects, associations, messages -------------------------------------------
-
-    def _declare(self, data_objects: Iterable[DataObject]) -> None:
-        """Data objects' literal values become variables; ``name = ${name}`` declares
-        ``name`` (None until something sets it)."""
-        changed = []
-        for data_object in data_objects:
-            for name, value in data_object.parameters.items():
-                if name in self._given:
-                    continue
-                if self_reference(value) == name:
-                    self.variables.setdefault(name, None)
-                elif "${" not in value:
-                    self.variables[name] = substitute_text(value, self.variables, self.env)
-                    changed.append(name)
-        self._changed(changed)
-
-    def _resolve(self, data_objects: Iterable[DataObject], extra: Mapping[str, Any]) -> dict:
-        names = {**self.variables, **extra} if extra else self.variables
-        values = {}
-        for data_object in data_objects:
-            for name, text in data_object.parameters.items():
-                try:
-                    values[name] = substitute_text(text, names, self.env)
-                except Exception as error:
-                    raise ModelError(
-                        f"robot {self.robot.name}: data object {data_object.id} "
-                        f"({data_object.name}) parameter {name} = {text}: "
-                        f"{type(error).__name__}: {error}"
-                    ) from error
-        return values
-
-    def _inputs(self, node: NodePlan) -> dict[str, Any]:
-        """Data input associations and input parameters, set as variables before the activity
-        runs; a skill gets them as its inputs."""
-        values = self._resolve(node.data_inputs, {}) if node.data_inputs else {}
-        for name, value in node.node.inputs.items():
-            values[name] = self._parameter(value, self.variables)
-        if values:
-            self.variables.update(values)
-            self._changed(values)
-        return values
-
-    def _outputs(self, node: NodePlan, extra: Mapping[str, Any]) -> None:
-        """Output parameters and data output associations, evaluated after the activity (or
-        catch) with its outputs (or the message's fields) in scope."""
-        if not node.node.outputs and not node.data_outputs:
-            return
-        names = {**self.variables, **extra}
-        values = {n: self._parameter(v, names) for n, v in node.node.outputs.items() if v}
-        values.update(self._resolve(node.data_outputs, extra))
-        self.variables.update(values)
-        self._changed(values)
-
-    def _parameter(self, value: Any, names: Mapping[str, Any]) -> Any:
-        if isinstance(value, str):
-            return substitute_text(value, names, self.env)
-        if isinstance(value, list):
-            return [self._parameter(v, names) for v in value]
-        if isinstance(value, dict):
-            return {k: self._parameter(v, names) for k, v in value.items()}
-        return value
+    # -- messages ------------------------------------------------------------------------------
 
     def _received(self, node: NodePlan, envelope: Envelope | None) -> dict[str, Any]:
-        """Tag a fired catching event; a message's data becomes the variable named after the
-        signal, and its fields are in scope for the data output associations."""
+        """Tag a fired catching event; a message's data goes to the variables."""
         trigger = node.trigger
         if envelope is None or trigger.kind != "signal":
-            self._tag_pair(trigger.label)
+            self._tag.pair(trigger.label)
             return {}
-        payload = _json(envelope.data)
-        self._tag_pair(trigger.label, envelope.msg_id, "receive", payload)
-        variable = trigger.topic.strip("/").replace("/", "_")
-        if variable.isidentifier():
-            self.variables[variable] = envelope.data
-            self._changed((variable,))
-        return dict(envelope.data) if isinstance(envelope.data, Mapping) else {}
+        payload = payload_text(envelope.data)
+        self._tag.pair(trigger.label, envelope.msg_id, "receive", payload)
+        return self.data.received(trigger.topic, envelope.data)
 
     def _publish(self, node: NodePlan) -> None:
         throw = node.throw
-        data = self._payload(node)
-        msg_id = self._new_msg_id()
-        payload = _json(data)
+        data = self.data.payload(node)
+        msg_id = self._tag.new_msg_id()
+        payload = payload_text(data)
         self._tag(throw.label, "start", msg_id, "send", payload)
         self.bus.publish(
             throw.topic,
@@ -824,59 +755,5 @@ class Engine:
         )
         self._tag(throw.label, "complete", msg_id, "send", payload)
 
-    def _payload(self, node: NodePlan) -> dict[str, Any]:
-        template = node.throw.payload
-        try:
-            if isinstance(template, dict):
-                return _nest(
-                    {k: substitute_text(v, self.variables, self.env) for k, v in template.items()}
-                )
-            if not template or not template.strip():
-                return {}
-            value = render_json(template, self.variables, self.env)
-        except Exception as error:
-            raise ModelError(
-                f"robot {self.robot.name}: the payload of signal event {node.node.describe()} "
-                f"cannot be filled in: {type(error).__name__}: {error}"
-            ) from error
-        return value if isinstance(value, dict) else {"data": value}
-
-    def _new_msg_id(self) -> str:
-        new_msg_id = getattr(self.bus, "new_msg_id", None)
-        if new_msg_id is not None:
-            return new_msg_id()
-        # Robot namespaces are unique in a mission, so this is unique on any bus.
-        self._msg_ids += 1
-        return f"m_{self.robot.name}_{self._msg_ids}"
-
     def _changed(self, names: Iterable[str]) -> None:
         self.triggers.changed(names)
-
-    # -- tags --------------------------------------------------------------------------------------
-
-    def _tag(
-        self, activity: str, lifecycle: str, msg_id: str = "", role: str = "", payload: str = ""
-    ):
-        if self.tag_sink is not None:
-            stamp = self.clock.now()
-            self.tag_sink(Tag(stamp, self.robot.name, activity, lifecycle, msg_id, role, payload))
-
-    def _tag_pair(self, activity: str, msg_id: str = "", role: str = "", payload: str = "") -> None:
-        self._tag(activity, "start", msg_id, role, payload)
-        self._tag(activity, "complete", msg_id, role, payload)
-
-
-def _json(data: Any) -> str:
-    return json.dumps(data, default=str, separators=(",", ":"))
-
-
-def _nest(flat: Mapping[str, Any]) -> dict[str, Any]:
-    """``{"linear.x": 1}`` -> ``{"linear": {"x": 1}}`` (ros:parameter names may be dotted)."""
-    nested: dict[str, Any] = {}
-    for key, value in flat.items():
-        *path, last = key.split(".")
-        target = nested
-        for part in path:
-            target = target.setdefault(part, {})
-        target[last] = value
-    return nested

@@ -8,6 +8,7 @@ adds it to a rosbags type store so bags can be written and read without a ROS in
 
 from __future__ import annotations
 
+import json
 import re
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -62,6 +63,39 @@ def activity_label(name: str | None, element_id: str = "") -> str:
     suffix = text[-1] if text[-1] in "!?" else ""
     words = re.sub(r"([a-z0-9])([A-Z])", r"\1_\2", text.rstrip("!?"))
     return re.sub(r"[^0-9a-zA-Z]+", "_", words).strip("_").lower() + suffix
+
+
+class Tagger:
+    """Tags one robot's events on its clock, and numbers its messages when the bus does not."""
+
+    def __init__(self, robot: str, clock, sink: TagSink | None, bus=None) -> None:
+        self.robot, self.clock, self.sink = robot, clock, sink
+        self._bus_ids = getattr(bus, "new_msg_id", None)
+        self._count = 0
+
+    def __call__(
+        self, activity: str, lifecycle: str, msg_id: str = "", role: str = "", payload: str = ""
+    ) -> None:
+        if self.sink is not None:
+            self.sink(Tag(self.clock.now(), self.robot, activity, lifecycle, msg_id, role, payload))
+
+    def pair(self, activity: str, msg_id: str = "", role: str = "", payload: str = "") -> None:
+        """A start and a complete tag at the same instant (events, messages)."""
+        self(activity, "start", msg_id, role, payload)
+        self(activity, "complete", msg_id, role, payload)
+
+    def new_msg_id(self) -> str:
+        """The bus's next message id, or ``m_<robot>_<n>``: robot namespaces are unique in a
+        mission, so that is unique on any bus."""
+        if self._bus_ids is not None:
+            return self._bus_ids()
+        self._count += 1
+        return f"m_{self.robot}_{self._count}"
+
+
+def payload_text(data) -> str:
+    """A message's data as the JSON text tags carry."""
+    return json.dumps(data, default=str, separators=(",", ":"))
 
 
 def tag_topic(robot: str) -> str:
