@@ -160,7 +160,10 @@ def _tokens(text: str) -> list[tuple[str, str]]:
     while position < len(text):
         match = _TOKEN.match(text, position)
         if not match or match.end() == position:
-            raise ValueError(f"cannot translate the JavaScript {text!r} (at {text[position:]!r})")
+            raise ValueError(
+                f"cannot translate the JavaScript {text!r} (at {text[position:]!r}); only "
+                "variables, literals, comparisons and ! && || are translated: write it in Python"
+            )
         kind = match.lastgroup or ""
         tokens.append((kind, match.group(kind)))
         position = match.end()
@@ -176,7 +179,9 @@ def _js_term(tokens: list[tuple[str, str]], position: int) -> tuple[str, int]:
         return f"(not {operand})", position
     if kind == "name":
         if position + 1 < len(tokens) and tokens[position + 1] == ("op", "("):
-            raise ValueError(f"cannot translate the JavaScript call {value}(...)")
+            raise ValueError(
+                f"cannot translate the JavaScript call {value}(...): write it in Python"
+            )
         return _js_name(value), position + 1
     if kind == "op":
         return _JS_OPS.get(value, value), position + 1

@@ -241,7 +241,10 @@ class _Planner:
                 try:
                     condition = compile_condition(flow.condition)
                 except ValueError as error:
-                    self.problems.append(f"sequence flow {flow.id} has a condition that {error}")
+                    self.problems.append(
+                        f"sequence flow {flow.id}{self.where} has a condition the engine "
+                        f"cannot run: {error}"
+                    )
             flow_plan = FlowPlan(flow.id, target, condition)
             source.outgoing.append(flow_plan)
             target.incoming.append(flow.id)
@@ -396,7 +399,7 @@ class _Planner:
         try:
             return Trigger("conditional", plan.label, condition=compile_condition(expression))
         except ValueError as error:
-            self.refuse(node, f"has a condition that {error}")
+            self.refuse(node, f"has a condition the engine cannot run: {error}")
             return None
 
     def throwing(self, plan: NodePlan) -> None:
