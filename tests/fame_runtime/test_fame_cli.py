@@ -1,5 +1,7 @@
 """``robotale fame check|split|run`` on real model files."""
 
+import sys
+
 import pytest
 
 from robotale.cli import main
@@ -136,6 +138,7 @@ def test_run_rejects_malformed_variables(models, capsys, bad):
 
 def test_run_imports_a_skills_module_from_the_current_folder(models, capsys, monkeypatch):
     monkeypatch.chdir(models / "library")
+    monkeypatch.setattr(sys, "path", list(sys.path))  # the folder joins the path for this test
     code = main(
         [
             "fame",
