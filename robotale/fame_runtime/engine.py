@@ -32,7 +32,7 @@ from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.tags import Tagger, TagSink, payload_text
 from robotale.fame_runtime.triggers import Triggers
 
-#: values a script leaves behind that are not variables (``import math``, helper functions)
+#: values a script leaves behind that are not variables (``import math``, functions it defines)
 _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 
 

@@ -1,7 +1,7 @@
 """The engine core: each model of the suite and the exact trace of tags it must leave."""
 
 import pytest
-from fame_helpers import pair, run, trace
+from fame_suite import pair, run, trace
 
 from robotale.errors import ModelError
 

@@ -3,7 +3,7 @@ they are and discovers the directly-follows graph the models imply."""
 
 import pandas as pd
 import pm4py
-from fame_helpers import run
+from fame_suite import run
 
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import SimClock

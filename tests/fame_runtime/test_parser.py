@@ -3,7 +3,7 @@
 from pathlib import Path
 
 import pytest
-from fame_helpers import run
+from fame_suite import run
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.parser import parse

@@ -5,7 +5,7 @@ states the exact trace of tags the model must leave, worked out by hand from the
 from datetime import UTC, datetime
 
 import pytest
-from fame_helpers import build, of, pair, run, trace
+from fame_suite import build, of, pair, run, trace
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.parser import parse

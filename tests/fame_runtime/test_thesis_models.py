@@ -2,7 +2,7 @@
 trace their structure implies; the rest is refused at deploy time, naming the elements."""
 
 import pytest
-from fame_helpers import pair, run, trace
+from fame_suite import pair, run, trace
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.library import Library

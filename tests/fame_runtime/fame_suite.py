@@ -1,4 +1,4 @@
-"""Helpers for the FAME runtime tests: run a model of the suite, read its tags."""
+"""Running the models of the semantics suite and reading their tags."""
 
 from pathlib import Path
 
