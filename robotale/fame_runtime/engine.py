@@ -32,6 +32,9 @@ from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.tags import Tagger, TagSink, payload_text
 from robotale.fame_runtime.triggers import Triggers
 
+#: steps one engine may take without its clock moving on: more means a loop with no wait
+MAX_STEPS = 1_000_000
+
 #: values a script leaves behind that are not variables (``import math``, functions it defines)
 _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 
@@ -110,6 +113,7 @@ class Engine:
         )
         self._work: deque[Callable[[], Any]] = deque()  # first queued, first run
         self._busy = False
+        self._steps = 0
         self._roots: list[_Scope] = []
         self._start_disarms: list[Callable[[], Any]] = []
         self._inclusive: set[_Scope] = set()
@@ -229,6 +233,7 @@ class Engine:
 
     def _drain(self) -> None:
         self._busy = True
+        self._steps = 0
         try:
             while self._work:
                 self._work.popleft()()
@@ -252,6 +257,12 @@ class Engine:
         """Move ``token`` from ``node`` on until it has to wait."""
         while node is not None and token.alive:
             token.node = node
+            self._steps += 1
+            if self._steps > MAX_STEPS:
+                raise ModelError(
+                    f"robot {self.robot.name}: {node.node.kind} {node.node.describe()} is in a "
+                    f"loop that ran {MAX_STEPS} steps without waiting for anything"
+                )
             node = self._behaviours[node.behaviour](token, node)
 
     # -- tokens and scopes ---------------------------------------------------------------------

@@ -4,6 +4,7 @@ import pytest
 from fame_suite import pair, run, trace
 
 from robotale.errors import ModelError
+from robotale.fame_runtime import engine as engine_module
 
 
 def test_tasks_scripts_exclusive_gateway_and_data_objects():
@@ -164,3 +165,21 @@ def test_a_skill_that_calls_done_twice_or_after_cancel_is_ignored():
     )
     assert [t.activity for t in tags].count("celebrate") == 2  # one start, one complete
     assert mission.engines["rover"].variables["arrived_at"] == 5.0 and calls == [1.0]
+
+
+def test_a_loop_that_never_waits_is_a_model_error_not_a_hang(tmp_path, monkeypatch):
+    monkeypatch.setattr(engine_module, "MAX_STEPS", 1000)
+    path = tmp_path / "spin.bpmn"
+    path.write_text(
+        '<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="d">'
+        '<bpmn:process id="Rover"><bpmn:startEvent id="s" />'
+        '<bpmn:exclusiveGateway id="again" name="again?" />'
+        '<bpmn:scriptTask id="spin" name="Spin"><bpmn:script>turns = 1</bpmn:script>'
+        "</bpmn:scriptTask>"
+        '<bpmn:sequenceFlow id="a" sourceRef="s" targetRef="again" />'
+        '<bpmn:sequenceFlow id="b" sourceRef="again" targetRef="spin" />'
+        '<bpmn:sequenceFlow id="c" sourceRef="spin" targetRef="again" />'
+        "</bpmn:process></bpmn:definitions>"
+    )
+    with pytest.raises(ModelError, match="in a loop that ran 1000 steps without waiting"):
+        run(path)
