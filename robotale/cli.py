@@ -30,6 +30,9 @@ def build_parser() -> argparse.ArgumentParser:
     _add_fame(commands)
     _add_prepare(commands)
     _add_neo4j(commands)
+    _add_ingest(commands)
+    _add_logs(commands)
+    _add_demo(commands)
     return parser
 
 
@@ -236,6 +239,66 @@ def _prepare(args: argparse.Namespace) -> int:
     cases = log["case:concept:name"].nunique()
     print(f"{len(log)} events from {cases} run(s) written to {', '.join(written)}")
     return 0
+
+
+def _add_ingest(commands: argparse._SubParsersAction) -> None:
+    ingest = commands.add_parser(
+        "ingest",
+        help="load an event log (CSV or XES) into Neo4j as an event knowledge graph",
+        description="Read an event log and store it in Neo4j: Event, Entity and Class nodes, "
+        "CORR, DF, COMM, OBSERVED and DF_C edges. Nothing is written if the log is refused, "
+        "and a failed ingest leaves the database as it was.",
+    )
+    ingest.add_argument("path", help="the event log: a .csv or .xes file")
+    ingest.add_argument("--log", help="name of the log in Neo4j (default: the file's name)")
+    ingest.add_argument(
+        "--entities",
+        help="comma-separated columns whose values are entities (default: robot,msg_id "
+        "where present, else case); a cell may hold several ids separated by commas",
+    )
+    ingest.add_argument(
+        "--aggregate",
+        action="append",
+        metavar="KEY",
+        help="an aggregation key: activity, or activity plus entity columns such as "
+        "activity,robot; repeat for several (default: activity)",
+    )
+    ingest.add_argument(
+        "--map",
+        action="append",
+        default=[],
+        metavar="COLUMN=FIELD",
+        help="read COLUMN as FIELD (time, activity, case, robot, lifecycle, msg_id ...); "
+        "repeatable",
+    )
+    ingest.add_argument("--case", metavar="COLUMN", help="the column that tells cases apart")
+    ingest.add_argument("--replace", action="store_true", help="rebuild a log that exists")
+    ingest.set_defaults(handler=_lazy("robotale.ekg.log_commands.ingest"))
+
+
+def _add_logs(commands: argparse._SubParsersAction) -> None:
+    logs = commands.add_parser("logs", help="the event logs stored in Neo4j")
+    actions = logs.add_subparsers(dest="action", metavar="ACTION", required=True)
+    actions.add_parser("list", help="every stored log").set_defaults(
+        handler=_lazy("robotale.ekg.log_commands.logs_list")
+    )
+    show = actions.add_parser("show", help="what one log holds, counted in the graph")
+    show.add_argument("name")
+    show.set_defaults(handler=_lazy("robotale.ekg.log_commands.logs_show"))
+    delete = actions.add_parser("delete", help="remove a log and everything of it")
+    delete.add_argument("name")
+    delete.set_defaults(handler=_lazy("robotale.ekg.log_commands.logs_delete"))
+
+
+def _add_demo(commands: argparse._SubParsersAction) -> None:
+    demo = commands.add_parser(
+        "demo",
+        help="start Neo4j, load the thesis' event log and show what came out",
+        description="Starts the local Neo4j (unless NEO4J_URI names a server), ingests "
+        "examples/thesis/robotic_data.csv as the log 'thesis' (replacing an earlier one) and "
+        "prints a summary.",
+    )
+    demo.set_defaults(handler=_lazy("robotale.ekg.log_commands.demo"))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

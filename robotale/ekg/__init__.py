@@ -1,2 +1,28 @@
 """Event Knowledge Graph in Neo4j: the local server, the connection, the schema, loading,
-and aggregation into Class graphs. Every query is a file in ``cypher/``."""
+and aggregation into Class graphs. Every query is a file in ``cypher/``.
+
+``build_ekg(driver, log, name, ...)`` stores a canonical event log; ``connect()`` returns a
+driver for the configured server; ``aggregate(driver, name, key)`` (re)builds a Class graph.
+"""
+
+from typing import Any
+
+_EXPORTS = {
+    "build_ekg": "robotale.ekg.build",
+    "BuildSummary": "robotale.ekg.build",
+    "connect": "robotale.ekg.connection",
+    "aggregate": "robotale.ekg.aggregate",
+    "delete_log": "robotale.ekg.logs",
+    "list_logs": "robotale.ekg.logs",
+    "log_summary": "robotale.ekg.logs",
+}
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    # Imported on first use, so `robotale neo4j status` does not load pandas.
+    if name in _EXPORTS:
+        import importlib
+
+        return getattr(importlib.import_module(_EXPORTS[name]), name)
+    raise AttributeError(f"module 'robotale.ekg' has no attribute {name!r}")

@@ -8,6 +8,8 @@ own names in both forms.
 
 from __future__ import annotations
 
+import re
+
 import numpy as np
 import pandas as pd
 
@@ -22,6 +24,8 @@ MSG_ID = "msg_id"
 MSG_ROLE = "msg_role"
 MSG_PAYLOAD = "msg_payload"
 EVENT_ID = "event_id"
+#: names one activity instance: the start and the complete event of one execution share it.
+EXECUTION_ID = "execution_id"
 X, Y, Z = "x", "y", "z"
 BATTERY = "battery"
 
@@ -42,7 +46,18 @@ CSV_NAMES: dict[str, str] = {
     Z: "z",
     BATTERY: "battery",
     EVENT_ID: "event_id",
+    EXECUTION_ID: "execution_id",
 }
+
+# Column names become Neo4j property keys: text that can never close a backtick-quoted name
+# (no quotes, backticks, brackets or operators), as in `case:concept:name` or `robot id`.
+_PROPERTY_NAME = re.compile(r"^[^\W\d][\w:. -]{0,99}$")
+
+
+def is_property_name(name: object) -> bool:
+    """True if ``name`` can be a column of a log and so a Neo4j property key."""
+    return isinstance(name, str) and bool(_PROPERTY_NAME.match(name))
+
 
 #: the columns every canonical log has (readers fill defaults where a source lacks them).
 REQUIRED = (CASE, ACTIVITY, TIMESTAMP)
@@ -78,7 +93,8 @@ def message_roles(log: pd.DataFrame) -> pd.Series:
     roles[activity.str.endswith("!").fillna(False).to_numpy(bool)] = SEND
     roles[activity.str.endswith("?").fillna(False).to_numpy(bool)] = RECEIVE
     if MSG_ROLE in log.columns:
-        explicit = log[MSG_ROLE].to_numpy(object)
+        # fillna: comparing pandas' NA (nullable string columns) with a role has no truth value
+        explicit = log[MSG_ROLE].astype("string").fillna("").to_numpy(object)
         for role in (SEND, RECEIVE):
             roles[explicit == role] = role
     return pd.Series(roles, index=log.index, dtype=object, name=MSG_ROLE)

@@ -25,7 +25,7 @@ def test_statements_split_on_semicolons_and_drop_comments():
     parts = statements("ekg_delete_log")
     assert len(parts) == 4
     assert all(not part.startswith("//") and not part.endswith(";") for part in parts)
-    assert parts[-1].startswith("MATCH (n:Log {name: $log})")
+    assert parts[-1].startswith("MATCH (l:Log {name: $log})")
 
 
 @pytest.mark.slow

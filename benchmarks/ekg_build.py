@@ -1,0 +1,189 @@
+"""How fast robotale builds an event knowledge graph in Neo4j.
+
+    python benchmarks/ekg_build.py [--sizes 100000 1000000] [--baseline-size 20000]
+
+Starts a private Neo4j (a temporary robotale home on free ports; the jars come from the
+usual cache) and, in the same run:
+
+1. builds synthetic logs of the given sizes with three entity types (case, robot, msg_id) and
+   an activity aggregation, and reports events/s for the whole build (events, entities, CORR,
+   DF, COMM, Class, OBSERVED, DF_C). Targets on a 2-core machine: 100k events in under 10 s,
+   1M in under 90 s;
+2. builds a log of ``--baseline-size`` events once with the thesis' own Cypher (section 7.1.2:
+   one query creating every event, per-event MERGE of entities and CORR edges, DF edges by
+   collecting each entity's events) and once with robotale, and prints robotale's speed as a
+   ratio to the thesis' (target: at least 10x);
+3. times robotale's DF_C aggregation (in Neo4j) against ``pm4py.discover_dfg`` on the same
+   log and prints the ratio.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+from robotale.ingest import schema
+
+ACTIVITIES = ["explore", "move", "cut_grass", "scan", "charge", "wait", "dock", "report"]
+MESSAGES = ["weed_position", "tractor_position", "closest_tractor"]
+
+
+def synthetic_log(events: int, seed: int = 7) -> pd.DataFrame:
+    """A multi-robot log: 100 events per case, 10 robots, a third of events exchange messages.
+
+    Every message is one send (``name!``) and two receives (``name?``) by other robots.
+    """
+    rng = np.random.default_rng(seed)
+    triples = events // 9  # a third of the events are in send/receive/receive triples
+    singles = events - 3 * triples
+    kinds = np.concatenate([np.zeros(singles, int), np.ones(triples, int)])
+    rng.shuffle(kinds)
+    rows_activity, rows_robot, rows_msg = [], [], []
+    robots = np.array([f"robot_{i}" for i in range(10)])
+    for message, kind in enumerate(kinds):
+        if kind == 0:
+            rows_activity.append(ACTIVITIES[rng.integers(len(ACTIVITIES))])
+            rows_robot.append(robots[rng.integers(10)])
+            rows_msg.append(None)
+        else:
+            name = MESSAGES[rng.integers(len(MESSAGES))]
+            sender, *receivers = rng.choice(10, size=3, replace=False)
+            rows_activity += [f"{name}!", f"{name}?", f"{name}?"]
+            rows_robot += [robots[sender], robots[receivers[0]], robots[receivers[1]]]
+            rows_msg += [f"m{message}"] * 3
+    size = len(rows_activity)
+    gaps = rng.exponential(2.0, size)
+    start = pd.Timestamp("2024-03-01T08:00:00+01:00")
+    return pd.DataFrame({
+        schema.CASE: (np.arange(size) // 100).astype(str),
+        schema.TIMESTAMP: start + pd.to_timedelta(np.cumsum(gaps), unit="s"),
+        schema.ACTIVITY: rows_activity,
+        schema.LIFECYCLE: "complete",
+        schema.ROBOT: rows_robot,
+        schema.MSG_ID: pd.array(rows_msg, dtype="string"),
+        schema.X: rng.random(size) * 10,
+        schema.Y: rng.random(size) * 10,
+        schema.BATTERY: 100 - rng.random(size) * 50,
+        schema.EVENT_ID: [f"e{i}" for i in range(size)],
+    })  # fmt: skip
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[100_000, 1_000_000])
+    parser.add_argument("--baseline-size", type=int, default=20_000)
+    parser.add_argument("--heap", default="3g", help="heap of the private Neo4j (3g)")
+    args = parser.parse_args()
+    with private_neo4j(args.heap) as driver:
+        for size in args.sizes:
+            measure_build(driver, size)
+        compare_with_thesis(driver, args.baseline_size)
+        compare_df_c_with_pm4py(driver, min(args.sizes))
+    return 0
+
+
+class private_neo4j:
+    """A Neo4j for this benchmark only, started in a temporary home and stopped at the end."""
+
+    def __init__(self, heap: str) -> None:
+        self.heap = heap
+
+    def __enter__(self):
+        from robotale.ekg.connection import Settings, connect
+        from robotale.ekg.server import LocalServer, ServerOptions, free_port
+
+        self.home = tempfile.TemporaryDirectory(prefix="robotale-bench-")
+        self.server = LocalServer(Path(self.home.name))
+        options = ServerOptions(free_port(), free_port(), heap=self.heap, pagecache="2g")
+        running = self.server.start(options)
+        password = self.server.password() or ""
+        self.driver = connect(Settings(running.bolt_uri, "neo4j", password, True))
+        os.environ.update(NEO4J_URI=running.bolt_uri, NEO4J_PASSWORD=password)
+        return self.driver
+
+    def __exit__(self, *exc: object) -> None:
+        self.driver.close()
+        self.server.stop()
+        self.home.cleanup()
+
+
+def measure_build(driver, size: int) -> float:
+    from robotale.ekg.build import build_ekg
+    from robotale.ekg.logs import delete_log
+
+    log = synthetic_log(size)
+    started = time.perf_counter()
+    summary = build_ekg(driver, log, f"bench{size}", entities=["case", "robot", "msg_id"],
+                        aggregate=["activity"], progress=False)  # fmt: skip
+    seconds = time.perf_counter() - started
+    edges = summary.corr + sum(summary.df.values()) + summary.comm
+    print(f"build {len(log):>9,} events ({edges:,} CORR/DF/COMM edges): {seconds:6.1f} s, "
+          f"{len(log) / seconds:,.0f} events/s")  # fmt: skip
+    delete_log(driver, f"bench{size}")
+    return seconds
+
+
+def compare_with_thesis(driver, size: int) -> None:
+    from robotale.ekg.build import build_ekg
+    from robotale.ekg.logs import delete_log
+
+    log = synthetic_log(size)
+    thesis = thesis_build(driver, log, ["case", "robot", "msg_id"])
+    started = time.perf_counter()
+    build_ekg(driver, log, "bench_ours", entities=["case", "robot", "msg_id"],
+              aggregate=["activity"], progress=False)  # fmt: skip
+    ours = time.perf_counter() - started
+    delete_log(driver, "bench_ours")
+    print(f"thesis Cypher, {len(log):,} events: {thesis:6.1f} s; robotale: {ours:6.1f} s; "
+          f"robotale is {thesis / ours:.1f}x faster (target >= 10x)")  # fmt: skip
+
+
+def thesis_build(driver, log: pd.DataFrame, entity_types: list[str]) -> float:
+    """The thesis' queries (section 7.1.2) on an empty database; returns their seconds."""
+    from robotale.ekg.queries import cypher
+
+    rows = schema.to_csv_names(log).astype(object).where(log.notna().to_numpy(), None)
+    rows["time"] = log[schema.TIMESTAMP].map(lambda t: t.isoformat())
+    records = rows.to_dict("records")
+    started = time.perf_counter()
+    # LOAD CSV ... CREATE (e:Event {...}) per line: here the lines come as a parameter.
+    driver.execute_query(cypher("ekg_thesis_events"), rows=records, log="thesis")
+    for entity_type in entity_types:
+        driver.execute_query(cypher("ekg_thesis_corr"), entitytype=entity_type)
+        driver.execute_query(cypher("ekg_thesis_df"), entitytype=entity_type)
+    seconds = time.perf_counter() - started
+    with driver.session() as session:
+        session.run(cypher("ekg_thesis_cleanup")).consume()
+    return seconds
+
+
+def compare_df_c_with_pm4py(driver, size: int) -> None:
+    import pm4py
+
+    from robotale.ekg.aggregate import aggregate
+    from robotale.ekg.build import build_ekg
+    from robotale.ekg.logs import delete_log
+
+    log = synthetic_log(size)
+    build_ekg(driver, log, "bench_df_c", entities=["robot"], aggregate=[], progress=False)
+    started = time.perf_counter()
+    edges = aggregate(driver, "bench_df_c", ["activity"])
+    ours = time.perf_counter() - started
+    started = time.perf_counter()
+    dfg, _, _ = pm4py.discover_dfg(log, case_id_key=schema.ROBOT)
+    theirs = time.perf_counter() - started
+    delete_log(driver, "bench_df_c")
+    print(f"DF_C aggregation of {len(log):,} events (Class, OBSERVED, {edges} DF_C) in Neo4j: "
+          f"{ours:.2f} s; pm4py.discover_dfg ({len(dfg)} edges): {theirs:.2f} s; "
+          f"ratio {ours / theirs:.1f}")  # fmt: skip
+
+
+if __name__ == "__main__":
+    sys.exit(main())

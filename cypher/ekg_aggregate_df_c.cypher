@@ -1,0 +1,12 @@
+// DF_C edges between the classes of type $type in log $log: one per pair of classes and
+// entity type, with how many DF edges it aggregates and the mean and median seconds
+// between their events.
+MATCH (c1:Class {log: $log, type: $type})<-[:OBSERVED]-(e1:Event)-[df:DF]->(e2:Event)
+      -[:OBSERVED]->(c2:Class {log: $log, type: $type})
+WITH c1, c2, df.entityType AS entityType,
+     (e2.timestamp.epochMillis - e1.timestamp.epochMillis) / 1000.0 AS seconds
+WITH c1, c2, entityType, count(*) AS count,
+     avg(seconds) AS meanSeconds, percentileCont(seconds, 0.5) AS medianSeconds
+CREATE (c1)-[r:DF_C {entityType: entityType, count: count, meanSeconds: meanSeconds,
+                     medianSeconds: medianSeconds}]->(c2)
+RETURN count(r) AS edges

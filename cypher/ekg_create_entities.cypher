@@ -1,0 +1,5 @@
+// One batch of entities of type $type for log $log; returns [row, node id] pairs so the
+// edges written next can find the nodes directly.
+UNWIND range(0, size($ids) - 1) AS i
+CREATE (n:Entity {log: $log, type: $type, id: $ids[i]})
+RETURN collect([i, id(n)]) AS nodes

@@ -1,0 +1,10 @@
+// Constraints and indexes of the event knowledge graph (idempotent). Several logs share one
+// database, so every key starts with the log's name.
+CREATE CONSTRAINT ekg_event_key IF NOT EXISTS
+FOR (e:Event) REQUIRE (e.log, e.id) IS UNIQUE;
+CREATE CONSTRAINT ekg_entity_key IF NOT EXISTS
+FOR (n:Entity) REQUIRE (n.log, n.type, n.id) IS UNIQUE;
+CREATE CONSTRAINT ekg_class_key IF NOT EXISTS
+FOR (c:Class) REQUIRE (c.log, c.type, c.id) IS UNIQUE;
+CREATE CONSTRAINT ekg_log_name IF NOT EXISTS
+FOR (l:Log) REQUIRE l.name IS UNIQUE;

@@ -1,0 +1,65 @@
+"""Aggregate a stored log into a Class graph: Class nodes, OBSERVED and DF_C edges.
+
+The aggregation runs in Neo4j (``cypher/ekg_aggregate_*.cypher``), so any log already in the
+database can be aggregated again by another key, e.g. ``["activity", "robot"]`` (the thesis'
+"multi-slider": one class per activity and robot).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+from neo4j import Driver
+
+from robotale.ekg.connection import database
+from robotale.ekg.queries import cypher, statements
+from robotale.ekg.tables import check_name, property_name
+from robotale.errors import InputError
+
+
+def aggregation_key(key: str | Sequence[str]) -> list[str]:
+    """``"activity,robot"`` or ``["activity", "robot"]`` as Event property names."""
+    names = key.split(",") if isinstance(key, str) else list(key)
+    properties = [property_name(name.strip()) for name in names if name.strip()]
+    if not properties:
+        raise InputError("An aggregation key needs at least one property, e.g. activity.")
+    return [check_name(name, "aggregation key") for name in properties]
+
+
+def class_type(key: Sequence[str]) -> str:
+    """The Class ``type`` of a key: its properties joined by ``+`` (``activity+robot``)."""
+    return "+".join(key)
+
+
+def aggregate(driver: Driver, log: str, key: str | Sequence[str]) -> int:
+    """(Re)build the classes of ``key`` for the stored log ``log``; returns the DF_C count.
+
+    Raises :class:`InputError` when there is no complete log of that name or its events lack
+    one of the key's properties.
+    """
+    properties = aggregation_key(key)
+    records, _, _ = driver.execute_query(cypher("ekg_log_info"), log=log, database_=database())
+    info = records[0]
+    if info["name"] is None:
+        raise InputError(f"There is no log named {log!r} in Neo4j (see `robotale logs list`).")
+    missing = [p for p in properties if p not in (info["properties"] or [])]
+    if missing:
+        raise InputError(
+            f"The events of log {log!r} have no property {missing[0]!r} to aggregate by; "
+            f"they have {', '.join(info['properties'] or [])}."
+        )
+    return aggregate_unchecked(driver, log, properties)
+
+
+def aggregate_unchecked(driver: Driver, log: str, key: list[str]) -> int:
+    """:func:`aggregate` for a key already checked against the log's properties."""
+    kind = class_type(key)
+    with driver.session(database=database()) as session:
+        for statement in statements("ekg_delete_classes"):
+            session.run(statement, log=log, type=kind).consume()
+        session.run(cypher("ekg_aggregate_classes"), log=log, type=kind, key=key).consume()
+    records, _, _ = driver.execute_query(
+        cypher("ekg_aggregate_df_c"), log=log, type=kind, database_=database()
+    )
+    driver.execute_query(cypher("ekg_log_add_class_type"), log=log, type=kind, database_=database())
+    return int(records[0]["edges"])

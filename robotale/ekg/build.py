@@ -1,0 +1,220 @@
+"""Build the event knowledge graph of one event log in Neo4j: :func:`build_ekg`.
+
+The log is checked and turned into tables first (:mod:`robotale.ekg.tables`), so bad input is
+refused before Neo4j is touched. If writing fails anyway (the server goes away, the user presses
+Ctrl-C), what was written is removed again; a rebuild with ``replace=True`` writes the new log
+under a temporary name and only swaps it in once it is complete, so a failed rebuild keeps the
+old log.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import itertools
+import time
+import uuid
+from collections.abc import Sequence
+from dataclasses import dataclass, field
+
+import numpy as np
+import pandas as pd
+from neo4j import Driver
+from neo4j.exceptions import DriverError, Neo4jError
+from tqdm import tqdm
+
+from robotale.ekg.aggregate import aggregate_unchecked, aggregation_key, class_type
+from robotale.ekg.connection import database
+from robotale.ekg.load import Loader
+from robotale.ekg.logs import delete_log, log_exists
+from robotale.ekg.queries import cypher, statements
+from robotale.ekg.tables import GraphTables, entity_types, graph_tables
+from robotale.errors import InputError, ServerError
+from robotale.ingest import schema
+
+#: entity columns used when none are named: those of these the log has.
+DEFAULT_ENTITIES = ("robot", "msg_id")
+DEFAULT_AGGREGATE = (("activity",),)
+
+
+@dataclass(frozen=True)
+class BuildSummary:
+    """What :func:`build_ekg` wrote."""
+
+    log: str
+    events: int
+    entities: dict[str, int]
+    corr: int
+    df: dict[str, int]
+    comm: int
+    df_c: dict[str, int] = field(default_factory=dict)
+    seconds: float = 0.0
+
+
+def build_ekg(
+    driver: Driver,
+    log: pd.DataFrame,
+    name: str,
+    entities: Sequence[str] | None = None,
+    aggregate: Sequence[str | Sequence[str]] = DEFAULT_AGGREGATE,
+    replace: bool = False,
+    source: str = "",
+    progress: bool = True,
+) -> BuildSummary:
+    """Store ``log`` (a canonical event log) in Neo4j as the EKG named ``name``.
+
+    ``entities`` are the columns whose values become Entity nodes (CORR and DF edges per
+    entity type; default: ``robot`` and ``msg_id`` where present, else ``case``). Each item
+    of ``aggregate`` is one aggregation key (``"activity"``, ``"activity,robot"``) that gets
+    Class nodes and DF_C edges. An existing log of that name is refused unless ``replace``.
+    """
+    started = time.perf_counter()
+    check_log_name(name)
+    tables = graph_tables(log, default_entities(log) if entities is None else entities)
+    keys = [aggregation_key(key) for key in aggregate]
+    _check_keys(tables.events, keys)
+    ensure_schema(driver)
+    existing = log_exists(driver, name)
+    if existing and not replace:
+        raise InputError(
+            f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
+            f"or `robotale logs delete {name}` first."
+        )
+    target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
+    summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress))
+    if existing:
+        delete_log(driver, name)
+        _rename(driver, target, name)
+    return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
+
+
+def default_entities(log: pd.DataFrame) -> list[str]:
+    present = [e for e in DEFAULT_ENTITIES if e in log.columns]
+    return present or [schema.CSV_NAMES[schema.CASE]]
+
+
+def check_log_name(name: object) -> str:
+    if not isinstance(name, str) or not name.strip() or len(name) > 200 or not name.isprintable():
+        raise InputError(f"{name!r} is not a usable log name: give 1 to 200 printable characters.")
+    return name
+
+
+def ensure_schema(driver: Driver) -> None:
+    """Create the constraints and indexes of ``cypher/ekg_schema.cypher`` if missing."""
+    for statement in statements("ekg_schema"):
+        driver.execute_query(statement, database_=database())
+
+
+def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
+    for key in keys:
+        entity_types(list(events.columns), key, what="aggregate by")
+
+
+@dataclass(frozen=True)
+class _Job:
+    tables: GraphTables
+    keys: list[list[str]]
+    target: str  # the log's name, or a temporary one while an existing log is rebuilt
+    source: str
+    progress: bool
+
+
+def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
+    target = job.target
+    try:
+        return _write(driver, job)
+    except BaseException as error:
+        try:
+            delete_log(driver, target)
+        except (Neo4jError, DriverError, OSError):
+            raise ServerError(
+                f"Writing the log {target!r} to Neo4j failed ({error}) and what was written could "
+                f"not be removed; remove it with `robotale logs delete {target!r}`."
+            ) from error
+        if isinstance(error, Neo4jError | DriverError | OSError):
+            raise ServerError(
+                f"Writing the log {target!r} to Neo4j failed ({error}); nothing of it was kept."
+            ) from error
+        raise
+
+
+def _write(driver: Driver, job: _Job) -> BuildSummary:
+    tables, target = job.tables, job.target
+    events, entities = tables.events, tables.entities
+    driver.execute_query(
+        cypher("ekg_log_begin"),
+        log=target,
+        source=job.source,
+        properties=list(events.columns),
+        entityTypes=entities["type"].unique().tolist(),
+        database_=database(),
+    )
+    rows = len(events) + len(entities) + len(tables.df) + len(tables.comm)
+    with tqdm(
+        total=rows,
+        unit="row",
+        desc=f"EKG {target}",
+        disable=None if job.progress else True,
+        leave=False,
+    ) as bar:
+        _write_graph(Loader(driver, target, bar), tables)
+    df_c = {class_type(key): aggregate_unchecked(driver, target, key) for key in job.keys}
+    driver.execute_query(
+        cypher("ekg_log_finish"), log=target, events=len(events), database_=database()
+    )
+    return BuildSummary(
+        log=target,
+        events=len(events),
+        entities=entities.groupby("type").size().to_dict(),
+        corr=len(tables.corr),
+        df=tables.df.groupby("entityType").size().to_dict(),
+        comm=len(tables.comm),
+        df_c=df_c,
+    )
+
+
+def _write_graph(loader: Loader, tables: GraphTables) -> None:
+    """Entities, then events with their CORR edges, then DF and COMM edges."""
+    entity_nodes = _write_entities(loader, tables.entities)
+    per_event = _per_event(tables.corr, entity_nodes, len(tables.events))
+    event_nodes = loader.events(tables.events, per_event)
+    for entity_type, part in tables.df.groupby("entityType", sort=True):
+        loader.run(
+            "ekg_create_df",
+            {
+                "sources": event_nodes[part["source"]].tolist(),
+                "targets": event_nodes[part["target"]].tolist(),
+                "entityIds": part["entityId"].tolist(),
+            },
+            entityType=entity_type,
+        )
+    if len(tables.comm):
+        loader.run(
+            "ekg_create_comm",
+            {
+                "sources": event_nodes[tables.comm["source"]].tolist(),
+                "targets": event_nodes[tables.comm["target"]].tolist(),
+                "msgIds": tables.comm["msgId"].tolist(),
+            },
+        )
+
+
+def _write_entities(loader: Loader, entities: pd.DataFrame) -> np.ndarray:
+    nodes = np.zeros(len(entities), dtype=np.int64)
+    for entity_type, part in entities.groupby("type", sort=False):
+        created = loader.run("ekg_create_entities", {"ids": part["id"].tolist()}, type=entity_type)
+        nodes[part.index.to_numpy()] = created
+    return nodes
+
+
+def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> list[list[int]]:
+    """The entity node ids of each event, as one list per event."""
+    ordered = corr.sort_values("event", kind="stable")
+    nodes = entity_nodes[ordered["entity"].to_numpy()].tolist()
+    bounds = np.searchsorted(ordered["event"].to_numpy(), np.arange(events + 1)).tolist()
+    return [nodes[start:end] for start, end in itertools.pairwise(bounds)]
+
+
+def _rename(driver: Driver, old: str, new: str) -> None:
+    with driver.session(database=database()) as session:
+        for statement in statements("ekg_rename_log"):
+            session.run(statement, log=old, name=new).consume()

@@ -1,0 +1,124 @@
+"""Write the tables of :mod:`robotale.ekg.tables` into Neo4j in batches.
+
+Each batch is one ``UNWIND`` query from ``cypher/`` run in a managed transaction (retried on
+transient errors). Values travel as columns (one list per property) rather than one map per row:
+that is much less to encode. Nodes are created first and their internal ids returned, so each
+edge finds its two ends directly instead of through an index.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import math
+from collections.abc import Mapping, Sequence
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from neo4j import Driver
+from tqdm import tqdm
+
+from robotale.ekg.connection import database
+from robotale.ekg.queries import cypher
+
+BATCH = 10_000
+
+
+class Loader:
+    """Runs the batched writes of one build and shows their progress."""
+
+    def __init__(self, driver: Driver, log: str, progress: tqdm | None = None) -> None:
+        self.driver = driver
+        self.log = log
+        self.progress = progress
+
+    def run(
+        self,
+        query: str,
+        columns: Mapping[str, Sequence[Any]],
+        maps: Mapping[str, Mapping[str, Sequence[Any]]] | None = None,
+        **constants: Any,
+    ) -> list[int]:
+        """Run ``cypher/<query>.cypher`` once per batch of ``columns``.
+
+        ``maps`` are parameters that are maps of columns ({key: [values]}); they are cut into
+        the same batches. Returns the node ids of the queries' ``nodes`` results in row order.
+        """
+        text = cypher(query)
+        size = len(next(iter(columns.values())))
+
+        def write(start: int) -> list[int]:
+            params = {name: _slice(values, start) for name, values in columns.items()}
+            for name, columns_of_map in (maps or {}).items():
+                params[name] = {k: _slice(v, start) for k, v in columns_of_map.items()}
+            records, _, _ = self.driver.execute_query(
+                text, params | constants, log=self.log, database_=database()
+            )
+            if self.progress is not None:
+                self.progress.update(min(BATCH, size - start))
+            created = records[0].get("nodes") if records else None
+            return [node for _, node in sorted(created or [])]
+
+        return [node for start in range(0, size, BATCH) for node in write(start)]
+
+    def events(self, events: pd.DataFrame, entities: list[list[int]]) -> np.ndarray:
+        """Create the events and their CORR edges (``entities``: node ids per event).
+
+        Returns the events' node ids by row.
+        """
+        times = events["timestamp"]
+        nanos = times.dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
+        columns = {
+            "ids": events["id"].tolist(),
+            "orders": list(range(len(events))),
+            "seconds": (nanos // 1_000_000_000).tolist(),
+            "nanos": (nanos % 1_000_000_000).tolist(),
+            "entities": entities,
+        }
+        others = [c for c in events.columns if c not in ("id", "timestamp")]
+        properties = {name: neo4j_values(events[name]) for name in others}
+        nodes = self.run(
+            "ekg_create_events", columns, {"properties": properties}, timezone=timezone_name(times)
+        )
+        return np.asarray(nodes, dtype=np.int64)
+
+
+def _slice(values: Sequence[Any], start: int) -> Sequence[Any]:
+    return values[start : start + BATCH]
+
+
+def neo4j_values(column: pd.Series) -> list[Any]:
+    """The column as Python values Neo4j can store; missing values become None."""
+    if pd.api.types.is_bool_dtype(column) or pd.api.types.is_integer_dtype(column):
+        return column.astype(object).where(column.notna(), None).tolist()
+    if pd.api.types.is_float_dtype(column):
+        return [None if math.isnan(v) else v for v in column.to_numpy(float).tolist()]
+    if pd.api.types.is_datetime64_any_dtype(column):
+        return [None if pd.isna(v) else v.to_pydatetime() for v in column]
+    return [_storable(v) for v in column.astype(object).tolist()]
+
+
+def _storable(value: Any) -> Any:
+    if value is None or value is pd.NA or (isinstance(value, float) and math.isnan(value)):
+        return None
+    if isinstance(value, str | bool | int | float):
+        return value
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, list | tuple | np.ndarray):
+        return [str(v) for v in value]
+    if isinstance(value, dt.datetime | pd.Timestamp):
+        return value
+    return str(value)
+
+
+def timezone_name(times: pd.Series) -> str:
+    """The zone Neo4j should show the times in: an IANA name or a fixed offset like +01:00."""
+    zone = times.dt.tz
+    name = getattr(zone, "key", None) or getattr(zone, "zone", None)
+    if name is not None and ("/" in name or name == "UTC"):
+        return str(name)
+    offset = times.iloc[0].utcoffset() or dt.timedelta(0)
+    minutes = int(offset.total_seconds() // 60)
+    sign = "-" if minutes < 0 else "+"
+    return f"{sign}{abs(minutes) // 60:02d}:{abs(minutes) % 60:02d}"

@@ -1,0 +1,132 @@
+"""Handlers of the ``ingest``, ``logs`` and ``demo`` commands (parsers in :mod:`robotale.cli`)."""
+
+from __future__ import annotations
+
+import argparse
+import os
+from pathlib import Path
+
+from robotale.ekg.build import BuildSummary, build_ekg
+from robotale.ekg.connection import session_driver
+from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
+from robotale.errors import InputError
+from robotale.ingest.readers import read_log
+
+THESIS_LOG = Path("examples") / "thesis" / "robotic_data.csv"
+
+
+def ingest(args: argparse.Namespace) -> int:
+    path = Path(args.path)
+    if path.is_dir():
+        raise InputError(f"{path} is a directory; give an event log file (.csv or .xes).")
+    with session_driver() as driver:
+        log = read_log(path, parse_mapping(args.map), args.case)
+        summary = build_ekg(
+            driver,
+            log,
+            args.log or path.stem,
+            entities=split_names(args.entities) if args.entities else None,
+            aggregate=args.aggregate or ["activity"],
+            replace=args.replace,
+            source=str(path),
+        )
+    print(describe(summary))
+    return 0
+
+
+def logs_list(args: argparse.Namespace) -> int:
+    with session_driver() as driver:
+        logs = list_logs(driver)
+    if not logs:
+        print("No event logs in Neo4j yet: load one with `robotale ingest FILE`.")
+    for log in logs:
+        events = f"{log['events']:,} events" if log["events"] is not None else "no events yet"
+        print(
+            f"{log['name']}  [{log['status']}]  {events}  "
+            f"entities: {', '.join(log['entityTypes'] or []) or '-'}  "
+            f"classes: {', '.join(log['classTypes'] or []) or '-'}  created {log['created']}"
+        )
+    return 0
+
+
+def logs_show(args: argparse.Namespace) -> int:
+    with session_driver() as driver:
+        summary = log_summary(driver, args.name)
+    print(f"{summary['name']}  [{summary['status']}]  from {summary['source'] or '-'}")
+    for what, count in summary["counts"].items():
+        print(f"  {what:<40} {count:>10,}")
+    return 0
+
+
+def logs_delete(args: argparse.Namespace) -> int:
+    with session_driver() as driver:
+        if not log_exists(driver, args.name):
+            raise InputError(f"There is no log named {args.name!r} in Neo4j.")
+        delete_log(driver, args.name)
+    print(f"Deleted the log {args.name!r}.")
+    return 0
+
+
+def demo(args: argparse.Namespace) -> int:
+    from robotale.ekg.server import LocalServer, ServerOptions
+
+    if not os.environ.get("NEO4J_URI"):
+        running = LocalServer().start(ServerOptions.from_env())
+        print(f"Neo4j is running at {running.bolt_uri}; Neo4j Browser: {running.browser_url}")
+    path = thesis_log()
+    with session_driver() as driver:
+        log = read_log(path)
+        summary = build_ekg(
+            driver,
+            log,
+            "thesis",
+            entities=["robot", "msg_id"],
+            aggregate=["activity", "activity,robot"],
+            replace=True,
+            source=str(path),
+        )
+    print(describe(summary))
+    print(
+        "See it in Neo4j Browser:\n"
+        "  MATCH (c:Class {log: 'thesis', type: 'activity+robot'})-[r:DF_C]->(d) "
+        "RETURN c, r, d"
+    )
+    return 0
+
+
+def thesis_log() -> Path:
+    """The thesis' event log in a source checkout (or below the current directory)."""
+    for root in (Path(__file__).resolve().parents[2], Path.cwd()):
+        if (root / THESIS_LOG).is_file():
+            return root / THESIS_LOG
+    raise InputError(f"{THESIS_LOG} was not found; run the demo from robotale's source tree.")
+
+
+def parse_mapping(items: list[str]) -> dict[str, str]:
+    """``["Zeit=time", ...]`` as ``{"Zeit": "time"}``."""
+    mapping = {}
+    for item in items or []:
+        column, sep, field = item.partition("=")
+        if not sep or not column.strip() or not field.strip():
+            raise InputError(f"--map {item!r} is not COLUMN=FIELD (e.g. --map Zeit=time).")
+        mapping[column.strip()] = field.strip()
+    return mapping
+
+
+def split_names(text: str) -> list[str]:
+    return [name.strip() for name in text.split(",") if name.strip()]
+
+
+def describe(summary: BuildSummary) -> str:
+    def counts(values: dict[str, int]) -> str:
+        return ", ".join(f"{k} {v:,}" for k, v in sorted(values.items())) or "-"
+
+    return "\n".join(
+        [
+            f"Log {summary.log!r}: {summary.events:,} events in {summary.seconds:.1f} s",
+            f"  entities  {counts(summary.entities)} (CORR {summary.corr:,})",
+            f"  DF        {counts(summary.df)}",
+            f"  COMM      {summary.comm:,}",
+            f"  DF_C      {counts(summary.df_c)}",
+        ]
+    )
