@@ -119,6 +119,10 @@ def simulate_run(
     if mission is not None:
         manifest["failures"] = mission.failures
         manifest["robots"] = {a.robot: a.robot_type for a in mission.assignments}
+        manifest["instances"] = {
+            name: {"completed": engine.completed, "running": not engine.idle}
+            for name, engine in mission.engines.items()
+        }
     if sim is not None:
         manifest.update(sim.report(start))
         manifest.update(_counts(manifest.pop("counts")))
