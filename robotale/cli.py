@@ -28,6 +28,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands.required = True
     # One line per command group, in the order of the data flow (see DESIGN.md).
     _add_fame(commands)
+    _add_simulate(commands)
     _add_prepare(commands)
     _add_neo4j(commands)
     _add_ingest(commands)
@@ -299,6 +300,61 @@ def _add_demo(commands: argparse._SubParsersAction) -> None:
         "prints a summary.",
     )
     demo.set_defaults(handler=_lazy("robotale.ekg.log_commands.demo"))
+
+
+def _add_simulate(commands) -> None:
+    simulate = commands.add_parser(
+        "simulate",
+        help="run missions with simulated robots (pybullet), one rosbag2 per run",
+        description="Simulated robots carry out a BPMN mission, each run recorded as a rosbag2 "
+        "directory (<out>/run_0001/ ...) with a robotale-run.json manifest. Scenarios: agri "
+        "(drone + tractors, thesis ch. 3) and rexdingo (thesis 5.3); or your own --model with a "
+        "--world file.",
+    )
+    simulate.add_argument("scenario", nargs="?", help="agri or rexdingo (or omit with --world)")
+    simulate.add_argument("--model", type=Path, metavar="BPMN", help="the mission to run instead")
+    simulate.add_argument("--world", type=Path, metavar="YAML", help="a world file of your own")
+    simulate.add_argument("--runs", type=int, default=1, metavar="N", help="how many runs (1)")
+    simulate.add_argument("--seed", type=int, default=1, help="the batch's seed (1)")
+    simulate.add_argument(
+        "--first", type=int, default=1, metavar="N", help="number of the first run (1)"
+    )
+    simulate.add_argument("--out", metavar="DIR", help="where the runs go (runs/<scenario>)")
+    simulate.add_argument("--tractors", type=int, metavar="N", help="agri: how many tractors")
+    simulate.add_argument(
+        "--count",
+        action="append",
+        default=[],
+        metavar="GROUP=N",
+        help="robots of a group, e.g. tractor=3 (repeatable)",
+    )
+    simulate.add_argument("--weeds", metavar="N|LOW-HIGH", help="weeds per run, e.g. 2 or 3-6")
+    simulate.add_argument(
+        "--fault",
+        action="append",
+        default=[],
+        metavar="SPEC",
+        help="die:ROBOT@T, drop:/TOPIC[,to=ROBOT][,nth=N], battery:ROBOT@T[,rate=R]; "
+        "@FROM-TO and ,p=P vary it per run (repeatable)",
+    )
+    simulate.add_argument(
+        "--storage", choices=("sqlite3", "mcap"), default="sqlite3", help="bag storage (sqlite3)"
+    )
+    simulate.add_argument(
+        "--rate", type=float, metavar="HZ", help="odometry and battery samples a second (2)"
+    )
+    simulate.add_argument("--topics", metavar="A,B", help="also record these robot topics")
+    simulate.add_argument("--time-limit", type=float, metavar="SECONDS", help="per run (900)")
+    simulate.add_argument(
+        "--workers", type=int, metavar="N", help="worker processes (one per CPU); 0: none"
+    )
+    simulate.add_argument("--gui", action="store_true", help="watch in pybullet's window")
+    simulate.add_argument(
+        "--pace", type=float, metavar="X", help="simulated seconds per wall second (--gui: 1)"
+    )
+    simulate.add_argument("--overwrite", action="store_true", help="replace runs already in --out")
+    simulate.add_argument("--quiet", action="store_true", help="no progress bar")
+    simulate.set_defaults(handler=_lazy("robotale.sim.commands.simulate_command"))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -1,0 +1,243 @@
+"""One simulated run: the world, the mission's engines and the recorder on one clock.
+
+:func:`simulate_run` draws the run's setup from its seed, builds the pybullet world, one
+engine per robot (the mission split by :mod:`robotale.fame_runtime`) and a recorder tapping
+the bus, runs the clock until every engine has ended or the time limit, and writes the bag and
+its manifest (``robotale-run.json``) into a folder. A run that raises is recorded as crashed,
+with the reason; whatever was recorded until then stays in the bag.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import math
+import time
+import traceback
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from robotale.fame_runtime.bus import InProcessBus
+from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.mission import Mission
+from robotale.fame_runtime.model import Definitions
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.plan import error_name, signal_topic
+from robotale.fame_runtime.skills import Skill, load_skills
+from robotale.fame_runtime.tags import bus_sink
+from robotale.sim import faults as fault_model
+from robotale.sim.faults import Fault, Planned
+from robotale.sim.recorder import Recorder
+from robotale.sim.setup import Setup, draw, run_seed
+from robotale.sim.skills import SKILLS
+from robotale.sim.world import SimWorld, WindowClosed
+from robotale.sim.worldspec import World
+
+MANIFEST = "robotale-run.json"
+ENDED, TIME_LIMIT, CRASHED = "ended", "time limit", "crashed"
+
+
+@dataclass(frozen=True)
+class RunPlan:
+    """Everything one run needs (it crosses into a worker process, so it pickles)."""
+
+    world: World
+    index: int  # 1-based
+    batch_seed: int
+    scenario: str = ""
+    faults: tuple[Fault, ...] = ()
+    storage: str = "sqlite3"
+    extra_topics: tuple[str, ...] = ()
+    settings: Mapping[str, Any] = field(default_factory=dict)  # as given, for the manifest
+
+    @property
+    def case(self) -> str:
+        return f"run_{self.index:04d}"
+
+    @property
+    def seed(self) -> int:
+        return run_seed(self.batch_seed, self.index)
+
+    @property
+    def start(self) -> float:
+        """Runs of a batch start an hour (or a time limit) apart, so no two overlap."""
+        spacing = 3600.0 * max(1, math.ceil(self.world.time_limit / 3600.0))
+        return self.world.start + (self.index - 1) * spacing
+
+
+def skills_of(world: World) -> dict[str, Skill]:
+    """The simulator's skills, and the world's own skills module over them."""
+    return {**SKILLS, **(load_skills(world.skills) if world.skills else {})}
+
+
+def simulate_run(
+    plan: RunPlan, folder: Path, *, gui: bool = False, pace: float | None = None
+) -> dict[str, Any]:
+    """Simulate and record one run into ``folder`` (created); returns its manifest."""
+    began = time.perf_counter()
+    world, start = plan.world, plan.start
+    setup = draw(world, plan.seed)
+    planned = fault_model.plan(plan.faults, plan.seed)
+    clock = SimClock(start)
+    bus = InProcessBus(clock, latency=world.latency, drop=fault_model.drop_rule(planned, start))
+    recorder = sim = mission = None
+    status, reason, detail = CRASHED, "", ""
+    try:
+        definitions = parse(world.model)
+        mission = _mission(world, definitions, setup, clock, bus)
+        signals, errors = model_topics(definitions)
+        recorder = Recorder(
+            folder,
+            robots=mission.engines,
+            announced=signals,
+            storage=plan.storage,
+            rate=world.record_rate,
+            errors=errors,
+            extra=plan.extra_topics,
+        )
+        bus.tap(recorder.tap)
+        sim = SimWorld(world, setup, clock=clock, bus=bus, gui=gui)
+        mission.start()
+        sim.start()
+        _schedule(planned, clock, start, sim, mission)
+        clock.run(until=start + world.time_limit, stop_when=lambda: mission.done, pace=pace)
+        status = ENDED if mission.done else TIME_LIMIT
+    except WindowClosed:
+        raise
+    except Exception as error:  # a crashed run is reported, never hidden
+        reason = f"{type(error).__name__}: {error}"
+        detail = traceback.format_exc(limit=8)
+    finally:
+        if recorder is not None:
+            recorder.close()
+        if sim is not None:
+            sim.close()
+    manifest = _manifest(plan, setup, planned, clock.now(), status, reason, detail)
+    manifest["wall_time"] = round(time.perf_counter() - began, 3)
+    if mission is not None:
+        manifest["failures"] = mission.failures
+        manifest["robots"] = {a.robot: a.robot_type for a in mission.assignments}
+        manifest["instances"] = {
+            name: {"completed": engine.completed, "running": not engine.idle}
+            for name, engine in mission.engines.items()
+        }
+    if sim is not None:
+        manifest.update(sim.report(start))
+        manifest.update(_counts(manifest.pop("counts")))
+    if recorder is not None:
+        manifest["topics"] = recorder.topics()
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    return manifest
+
+
+def _mission(world: World, definitions: Definitions, setup: Setup, clock, bus) -> Mission:
+    variables = {}
+    for start in setup.robots:
+        spec = next(r for r in world.robots if r.name == start.group)
+        variables[start.name] = {
+            **world.variables,
+            **spec.variables,
+            "x_base": start.home[0],
+            "y_base": start.home[1],
+        }
+    return Mission(
+        definitions,
+        robots=[r.name for r in setup.robots],
+        clock=clock,
+        bus=bus,
+        skills=skills_of(world),
+        library=world.library,
+        tag_sink=bus_sink(bus),
+        variables=variables,
+    )
+
+
+def model_topics(definitions: Definitions) -> tuple[dict[str, str], set[str]]:
+    """The signal topics of a model with their message types (a throw's type wins over a
+    catch's), and the names of the errors it catches."""
+    signals: dict[str, str] = {}
+    errors: set[str] = set()
+    for _, process in definitions.pools():
+        for node in process.walk():
+            if node.event_kind == "error" and error_name(node):
+                errors.add(error_name(node))
+            if node.event_kind != "signal" or not signal_topic(node):
+                continue
+            msgtype = node.message.msgtype if node.message else ""
+            throws = node.kind in ("intermediateThrowEvent", "endEvent")
+            topic = signal_topic(node)
+            if msgtype and (throws or topic not in signals):
+                signals[topic] = msgtype
+            signals.setdefault(topic, "std_msgs/msg/Empty")
+    return signals, errors
+
+
+def _schedule(planned: list[Planned], clock: SimClock, start, sim: SimWorld, mission: Mission):
+    for item in planned:
+        fault = item.fault
+        if not item.applied or item.at is None:
+            continue
+        if fault.kind == "die":
+
+            def die(name: str = fault.target) -> None:
+                sim.kill(name)
+                if name in mission.engines:
+                    mission.engines[name].stop(safe=False)
+
+            clock.call_at(start + item.at, die)
+        elif fault.kind == "battery":
+            clock.call_at(start + item.at, lambda n=fault.target, r=fault.rate: sim.drain(n, r))
+
+
+def _manifest(
+    plan: RunPlan,
+    setup: Setup,
+    planned: list[Planned],
+    now: float,
+    status: str,
+    reason: str,
+    detail: str,
+) -> dict[str, Any]:
+    world = plan.world
+    manifest: dict[str, Any] = {
+        "case": plan.case,
+        "scenario": plan.scenario or world.file.stem,
+        "model": str(world.model),
+        "world": str(world.file),
+        "seed": plan.seed,
+        "batch_seed": plan.batch_seed,
+        "index": plan.index,
+        "start": _iso(plan.start),
+        "duration": round(now - plan.start, 3),
+        "outcome": {"status": status, "reason": reason},
+        "settings": {
+            "time_limit": world.time_limit,
+            "control_rate": world.control_rate,
+            "record_rate": world.record_rate,
+            "latency": world.latency,
+            "storage": plan.storage,
+            "robots": world.robot_names(),
+            **plan.settings,
+        },
+        "faults": [p.as_dict() for p in planned],
+        "setup": setup.as_dict(),
+    }
+    if detail:
+        manifest["outcome"]["traceback"] = detail
+    return manifest
+
+
+def _counts(counts: Mapping[str, Mapping[str, int]]) -> dict[str, Any]:
+    """``weeds: {total, found, cut}``, ``targets: {total, found, destroyed}``."""
+    verbs = {"weeds": "cut", "targets": "destroyed"}
+    return {
+        kind: {"total": c["total"], "found": c["found"], verbs.get(kind, "done"): c["done"]}
+        for kind, c in counts.items()
+    }
+
+
+def _iso(seconds: float) -> str:
+    return dt.datetime.fromtimestamp(seconds, dt.UTC).isoformat().replace("+00:00", "Z")

@@ -1,0 +1,23 @@
+"""The scenarios robotale ships: each is a mission model (``<name>.bpmn``, a BPMN
+collaboration following the FAME guidelines) and its world (``<name>.yaml``).
+
+- ``agri``: the running scenario of the thesis (chapter 3, section 5.2): a drone explores a
+  field, the closest of the tractors cuts each weed it finds.
+- ``rexdingo``: the physical scenario of section 5.3: REX explores and finds a target, DINGO
+  drives there and fires.
+"""
+
+from pathlib import Path
+
+FOLDER = Path(__file__).resolve().parent
+
+
+def names() -> list[str]:
+    """The scenarios shipped, by name."""
+    return sorted(p.stem for p in FOLDER.glob("*.yaml"))
+
+
+def world_file(name: str) -> Path | None:
+    """The world file of a shipped scenario, or None."""
+    path = FOLDER / f"{name}.yaml"
+    return path if path.is_file() else None

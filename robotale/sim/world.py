@@ -1,0 +1,268 @@
+"""The simulated world: a field with bases, weeds or targets, and robots, stepped on the
+mission's :class:`~robotale.fame_runtime.clock.SimClock` at a modest control rate.
+
+Every control step moves each robot from its last command, drains or charges its battery, and
+publishes what its sensors read on its topics (the thesis' names):
+
+=========================  =================================  ==============================
+topic                      type                               when
+=========================  =================================  ==============================
+``/<robot>/odom``          ``nav_msgs/msg/Odometry``          every control step
+``/<robot>/battery``       ``sensor_msgs/msg/BatteryState``   once a second (percentage 0-1)
+``/<robot>/low_battery``   ``std_msgs/msg/Empty``             below the threshold, repeated
+``/<robot>/range``         ``sensor_msgs/msg/Range``          every control step (if fitted)
+``/<robot>/detection``     ``geometry_msgs/msg/PointStamped`` once per object seen
+=========================  =================================  ==============================
+
+A tractor's blade cuts the weeds within its radius while ``blade_force`` > 0; a robot whose
+LED turns red destroys the targets within :data:`FIRE_RANGE`. The engines never see this
+module: they reach the robots through the bus only.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+from robotale.errors import RobotaleError
+from robotale.fame_runtime.bus import Bus
+from robotale.fame_runtime.clock import SimClock
+from robotale.sim import sensors
+from robotale.sim.battery import Battery
+from robotale.sim.physics import Physics
+from robotale.sim.robots import BATTERY, EMPTY, ODOM, Pose, SimRobot, place
+from robotale.sim.setup import Setup
+from robotale.sim.worldspec import World
+
+FIRE_RANGE = 1.5  # metres
+BATTERY_PERIOD = 1.0  # seconds between battery messages
+FIELD_COLOR = (0.55, 0.45, 0.3, 1.0)
+CUT_COLOR = (0.35, 0.25, 0.15, 1.0)
+DESTROYED_COLOR = (0.1, 0.1, 0.1, 1.0)
+
+
+class WindowClosed(RobotaleError):
+    """The person watching closed pybullet's window."""
+
+
+@dataclass
+class Thing:
+    """A weed or a target."""
+
+    kind: str
+    id: str
+    x: float
+    y: float
+    body: int
+    state: str = "present"  # present | cut | destroyed
+    found_by: str = ""
+    found_at: float | None = None
+    done_by: str = ""  # who cut or destroyed it
+    done_at: float | None = None
+
+
+class SimWorld:
+    def __init__(
+        self, world: World, setup: Setup, *, clock: SimClock, bus: Bus, gui: bool = False
+    ) -> None:
+        self.spec, self.setup = world, setup
+        self.clock, self.bus = clock, bus
+        self.dt = 1.0 / world.control_rate
+        self.physics = Physics(gui=gui)
+        try:
+            self._build()
+        except BaseException:
+            self.physics.close()
+            raise
+        self._seen: dict[str, set[str]] = {name: set() for name in self.robots}
+
+    def _build(self) -> None:
+        world, physics = self.spec, self.physics
+        physics.ground(world.field, FIELD_COLOR)
+        for base in world.bases.values():
+            physics.cylinder(base.radius, 0.01, (*base.position, 0.005), base.color, collide=False)
+        specs = {name: spec for spec in world.robots for name in spec.names()}
+        self.robots: dict[str, SimRobot] = {}
+        for start in self.setup.robots:
+            spec = specs[start.name]
+            battery = spec.battery
+            robot = SimRobot(
+                name=start.name,
+                spec=spec,
+                base=world.bases[spec.base],
+                pose=Pose(start.x, start.y, start.yaw),
+                battery=Battery(
+                    start.level,
+                    start.drain,
+                    start.move_drain,
+                    battery.charge,
+                    battery.low,
+                    battery.warn_period,
+                ),
+                home=start.home,
+            )
+            half = [s / 2 for s in spec.size]
+            robot.body = physics.box(half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw)
+            robot.connect(self.bus)
+            self.robots[start.name] = robot
+        looks = {o.kind: o for o in world.objects}
+        self.things: dict[int, Thing] = {}
+        for placed in self.setup.objects:
+            look = looks[placed.kind]
+            if placed.kind == "weed":
+                body = physics.cylinder(look.size / 2, 0.1, (placed.x, placed.y, 0.05), look.color)
+            else:
+                half = look.size / 2
+                body = physics.box((half, half, half), (placed.x, placed.y, half), look.color)
+            self.things[body] = Thing(placed.kind, placed.id, placed.x, placed.y, body)
+        if physics.gui:
+            physics.follow((world.field[0] / 2, world.field[1] / 2, 0.0))
+
+    # -- running ----------------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start each robot's control loop at its phase: it reads its sensors, publishes and
+        moves every ``1 / control_rate`` seconds."""
+        now = self.clock.now()
+        for start in self.setup.robots:
+            robot = self.robots[start.name]
+            self.clock.call_at(now + start.phase * self.dt, self._loop(robot, now))
+
+    def close(self) -> None:
+        for robot in self.robots.values():
+            robot.disconnect()
+        self.physics.close()
+
+    def _loop(self, robot: SimRobot, began: float):
+        state = {"battery_due": began, "dt": 0.0}
+
+        def tick() -> None:
+            if self.physics.gui and not self.physics.connected():
+                raise WindowClosed("the pybullet window was closed; the run stopped")
+            if not robot.alive:
+                return  # a dead robot's loop stops
+            now = self.clock.now()
+            battery_due = now >= state["battery_due"] - 1e-9
+            if battery_due:
+                state["battery_due"] = now + BATTERY_PERIOD
+            self._step(robot, now, state["dt"], battery_due)
+            state["dt"] = self.dt
+            self.clock.call_later(self.dt, tick)
+
+        return tick
+
+    def _step(self, robot: SimRobot, now: float, dt: float, battery_due: bool) -> None:
+        robot.move(dt)
+        place(self.physics, robot)
+        on_charger = robot.on_charger()
+        if robot.battery.step(dt, robot.speed, on_charger, now):
+            self._publish(robot, "low_battery", {}, EMPTY)
+        self._publish(robot, "odom", robot.odometry(now), ODOM)
+        if battery_due:
+            self._publish(robot, "battery", robot.battery.message(now, robot.name), BATTERY)
+        self._sense(robot, now)
+        self._act(robot, now)
+
+    def _publish(self, robot: SimRobot, name: str, data: Any, msgtype: str) -> None:
+        self.bus.publish(robot.topic(name), data, msgtype=msgtype, sender=robot.name)
+
+    def _sense(self, robot: SimRobot, now: float) -> None:
+        spec = robot.spec
+        if spec.range is not None:
+            distance, body = sensors.sonar(self.physics, robot, spec.range)
+            message = sensors.range_message(now, robot, spec.range, distance)
+            self._publish(robot, "range", message, sensors.RANGE)
+            if spec.range.detects and distance <= spec.range.detect_distance:
+                self._detected(robot, {body}, spec.range.detects, now)
+        if spec.camera is not None:
+            seen = sensors.camera_view(self.physics, robot, spec.camera)
+            self._detected(robot, seen, spec.camera.detects, now)
+
+    def _detected(self, robot: SimRobot, bodies: set[int], kind: str, now: float) -> None:
+        for body in sorted(bodies):
+            thing = self.things.get(body)
+            if thing is None or thing.kind != kind or thing.state != "present":
+                continue
+            if thing.id in self._seen[robot.name]:
+                continue
+            self._seen[robot.name].add(thing.id)
+            if not thing.found_by:
+                thing.found_by, thing.found_at = robot.name, now
+            message = sensors.detection_message(now, robot, thing.id, thing.x, thing.y)
+            self._publish(robot, "detection", message, sensors.DETECTION)
+
+    def _act(self, robot: SimRobot, now: float) -> None:
+        if robot.blade > 0:
+            self._affect(robot, "weed", robot.spec.blade_radius, "cut", CUT_COLOR, now)
+        red, green, blue, _ = robot.led
+        if red > 0.5 and green < 0.5 and blue < 0.5:
+            self._affect(robot, "target", FIRE_RANGE, "destroyed", DESTROYED_COLOR, now)
+
+    def _affect(self, robot: SimRobot, kind: str, reach: float, state: str, color, now) -> None:
+        for thing in self.things.values():
+            if thing.kind != kind or thing.state != "present":
+                continue
+            if math.hypot(thing.x - robot.pose.x, thing.y - robot.pose.y) <= reach:
+                thing.state, thing.done_by, thing.done_at = state, robot.name, now
+                self.physics.recolor(thing.body, color)
+
+    # -- faults -----------------------------------------------------------------------------------
+
+    def kill(self, name: str) -> None:
+        """The robot dies: it stops where it is and publishes nothing more."""
+        robot = self.robots[name]
+        robot.alive = False
+        robot.disconnect()
+
+    def drain(self, name: str, per_second: float) -> None:
+        """The robot's battery starts emptying at ``per_second`` (0-1 per second)."""
+        self.robots[name].battery.fault_drain = per_second
+
+    # -- the outcome ------------------------------------------------------------------------------
+
+    def report(self, start: float) -> dict[str, Any]:
+        """What happened to the objects and the robots, for the run's manifest."""
+        things = sorted(self.things.values(), key=lambda t: (t.kind, _number(t.id)))
+        counts: dict[str, dict[str, int]] = {}
+        for thing in things:
+            count = counts.setdefault(thing.kind + "s", {"total": 0, "found": 0, "done": 0})
+            count["total"] += 1
+            count["found"] += bool(thing.found_by)
+            count["done"] += thing.state != "present"
+        return {
+            "objects": [
+                {
+                    "id": t.id,
+                    "kind": t.kind,
+                    "x": round(t.x, 4),
+                    "y": round(t.y, 4),
+                    "state": t.state,
+                    "found_by": t.found_by,
+                    "found_after": _since(t.found_at, start),
+                    "done_by": t.done_by,
+                    "done_after": _since(t.done_at, start),
+                }
+                for t in things
+            ],
+            "counts": counts,
+            "robots_final": {
+                name: {
+                    "x": round(r.pose.x, 4),
+                    "y": round(r.pose.y, 4),
+                    "z": round(r.pose.z, 4),
+                    "battery": round(r.battery.level, 4),
+                    "alive": r.alive,
+                }
+                for name, r in self.robots.items()
+            },
+        }
+
+
+def _since(moment: float | None, start: float) -> float | None:
+    return None if moment is None else round(moment - start, 3)
+
+
+def _number(identifier: str) -> int:
+    tail = identifier.rsplit("_", 1)[-1]
+    return int(tail) if tail.isdigit() else 0

@@ -1,0 +1,468 @@
+"""The world file: where things are, which robots exist, what varies from run to run.
+
+A world is a YAML file next to its mission model (see ``docs/sim.md`` for every key)::
+
+    model: agri.bpmn
+    field: [10, 10]
+    bases:
+      drone_base: {position: [-1, 5]}
+    robots:
+      drone: {kind: drone, base: drone_base}
+      tractor: {kind: ground, base: tractor_base, count: 2, blade: true}
+    weeds: {count: [3, 6]}
+
+:func:`load_world` reads and checks it; every mistake is one :class:`InputError` naming the
+file and the key. Numbers that vary between runs are written ``[low, high]`` and drawn
+uniformly per run.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections.abc import Mapping
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from robotale.errors import InputError
+
+Range = tuple[float, float]
+
+KINDS = ("drone", "ground")
+DEFAULT_START = "2024-05-16T10:00:00Z"
+
+
+@dataclass(frozen=True)
+class BatterySpec:
+    level: Range = (1.0, 1.0)  # charge at the start, 0-1
+    drain: Range = (0.0005, 0.0005)  # per second, always
+    move_drain: Range = (0.001, 0.001)  # per second at 1 m/s
+    charge: float = 0.02  # per second while resting on a charging base
+    low: float = 0.2  # low_battery below this
+    warn_period: float = 10.0  # low_battery repeats this often while low
+
+
+@dataclass(frozen=True)
+class CameraSpec:
+    fov: float = 90.0  # degrees, a square footprint under the robot
+    detects: str = "weed"
+
+
+@dataclass(frozen=True)
+class RangeSpec:
+    max_range: float = 2.0
+    cone: float = 20.0  # half angle in degrees (an ultrasonic beam)
+    rays: int = 7
+    direction: str = "forward"  # forward | down
+    detects: str = ""  # an object kind the sensor reports on the detection topic
+    detect_distance: float = 1.5
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    name: str  # the namespace, or the base of ``<name>_<n>`` when count is given
+    kind: str
+    base: str
+    count: int | None = None
+    max_speed: float = 0.5
+    max_turn: float = 1.5  # rad/s
+    altitude: float = 1.5  # drones fly here
+    climb: float = 0.75  # drones take off and land at this vertical speed (m/s)
+    size: tuple[float, float, float] = (0.6, 0.4, 0.3)
+    color: tuple[float, float, float, float] = (0.8, 0.1, 0.1, 1.0)
+    blade: bool = False
+    blade_radius: float = 0.5
+    led: bool = False
+    camera: CameraSpec | None = None
+    range: RangeSpec | None = None
+    battery: BatterySpec = field(default_factory=BatterySpec)
+    spacing: tuple[float, float] = (0.0, 1.0)  # start offset between instances of a group
+    start_jitter: float = 0.0  # metres, drawn per run
+    variables: Mapping[str, Any] = field(default_factory=dict)
+
+    def names(self) -> list[str]:
+        if self.count is None:
+            return [self.name]
+        return [f"{self.name}_{n}" for n in range(1, self.count + 1)]
+
+
+@dataclass(frozen=True)
+class BaseSpec:
+    name: str
+    position: tuple[float, float]
+    radius: float = 0.75
+    charging: bool = True
+    color: tuple[float, float, float, float] = (0.2, 0.4, 0.9, 0.6)
+
+
+@dataclass(frozen=True)
+class ObjectsSpec:
+    """Weeds or targets: how many, where (an area, default the field), how big."""
+
+    kind: str
+    count: tuple[int, int] = (0, 0)
+    area: tuple[Range, Range] | None = None
+    margin: float = 0.5
+    size: float = 0.2
+    color: tuple[float, float, float, float] = (0.1, 0.7, 0.1, 1.0)
+
+
+@dataclass(frozen=True)
+class World:
+    file: Path
+    model: Path
+    field: tuple[float, float]
+    bases: Mapping[str, BaseSpec]
+    robots: tuple[RobotSpec, ...]
+    objects: tuple[ObjectsSpec, ...] = ()
+    time_limit: float = 900.0
+    control_rate: float = 10.0
+    record_rate: float = 2.0
+    latency: float = 0.01
+    start: float = dt.datetime.fromisoformat(DEFAULT_START).timestamp()
+    variables: Mapping[str, Any] = field(default_factory=dict)
+    faults: tuple[str, ...] = ()
+    library: Path | None = None  # a folder of .bpmn building blocks
+    skills: str | None = None  # a Python module (or .py file) with more SKILLS
+
+    def robot_names(self) -> list[str]:
+        return [name for robot in self.robots for name in robot.names()]
+
+    def with_counts(self, counts: Mapping[str, int]) -> World:
+        """The world with ``<group>: n`` robots for groups that have a count."""
+        groups = {r.name: r for r in self.robots if r.count is not None}
+        for group, count in counts.items():
+            if group not in groups:
+                known = ", ".join(sorted(groups)) or "none"
+                raise InputError(
+                    f"{self.file}: there is no robot group {group!r} to count (groups: {known})"
+                )
+            if count < 1:
+                raise InputError(f"{self.file}: robot group {group!r} needs at least 1 robot")
+        robots = tuple(
+            replace(r, count=counts[r.name]) if r.name in counts else r for r in self.robots
+        )
+        return replace(self, robots=robots)
+
+
+def load_world(path: str | Path, model: str | Path | None = None) -> World:
+    """Read and check a world file; ``model`` overrides the file's ``model`` key."""
+    path = Path(path)
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except OSError as error:
+        raise InputError(f"{path}: cannot read the world file ({error.strerror})") from None
+    except yaml.YAMLError as error:
+        raise InputError(f"{path}: not valid YAML ({_yaml_problem(error)})") from None
+    reader = _Reader(path)
+    return reader.world(reader.mapping(data, "the file"), model)
+
+
+def _yaml_problem(error: yaml.YAMLError) -> str:
+    mark = getattr(error, "problem_mark", None)
+    problem = getattr(error, "problem", None) or "syntax error"
+    return f"{problem} at line {mark.line + 1}" if mark else problem
+
+
+class _Reader:
+    """Checks one world file; every error names the file and the key."""
+
+    def __init__(self, path: Path) -> None:
+        self.path = path
+
+    def fail(self, where: str, message: str) -> InputError:
+        return InputError(f"{self.path}: {where} {message}")
+
+    def world(self, data: Mapping[str, Any], model_override: str | Path | None) -> World:
+        self.known(data, "the file", _WORLD_KEYS)
+        model = model_override or data.get("model")
+        if not model:
+            raise self.fail("the file", "names no mission model (key 'model')")
+        model_path = Path(model) if model_override else self.path.parent / str(model)
+        bases = {
+            name: self.base(name, self.mapping(spec, f"bases.{name}"))
+            for name, spec in self.mapping(data.get("bases", {}), "bases").items()
+        }
+        robots = tuple(
+            self.robot(name, self.mapping(spec, f"robots.{name}"), bases)
+            for name, spec in self.mapping(data.get("robots"), "robots").items()
+        )
+        if not robots:
+            raise self.fail("robots", "lists no robot")
+        objects = tuple(
+            self.objects(kind, self.mapping(data[kind], kind))
+            for kind in ("weeds", "targets")
+            if data.get(kind) is not None
+        )
+        return World(
+            file=self.path,
+            model=model_path,
+            field=self.pair(data.get("field", [10.0, 10.0]), "field", positive=True),
+            bases=bases,
+            robots=robots,
+            objects=objects,
+            time_limit=self.number(data.get("time_limit", 900.0), "time_limit", positive=True),
+            control_rate=self.number(data.get("control_rate", 10.0), "control_rate", True),
+            record_rate=self.number(data.get("record_rate", 2.0), "record_rate", positive=True),
+            latency=self.number(data.get("latency", 0.01), "latency"),
+            start=self.start(data.get("start", DEFAULT_START)),
+            variables=self.mapping(data.get("variables", {}), "variables"),
+            faults=tuple(str(f) for f in self.sequence(data.get("faults", []), "faults")),
+            library=self.folder(data.get("library"), "library"),
+            skills=self.skills(data.get("skills")),
+        )
+
+    def folder(self, value: Any, where: str) -> Path | None:
+        if value is None:
+            return None
+        path = self.path.parent / str(value)
+        if not path.is_dir():
+            raise self.fail(where, f"names {value!r}, which is not a folder")
+        return path
+
+    def skills(self, value: Any) -> str | None:
+        if value is None:
+            return None
+        text = str(value)
+        local = self.path.parent / text
+        return str(local) if text.endswith(".py") and local.is_file() else text
+
+    def base(self, name: str, data: Mapping[str, Any]) -> BaseSpec:
+        where = f"bases.{name}"
+        self.known(data, where, {"position", "radius", "charging", "color"})
+        return BaseSpec(
+            name=name,
+            position=self.pair(data.get("position"), f"{where}.position"),
+            radius=self.number(data.get("radius", 0.75), f"{where}.radius", positive=True),
+            charging=bool(data.get("charging", True)),
+            color=self.color(data.get("color", BaseSpec.color), f"{where}.color"),
+        )
+
+    def robot(self, name: str, data: Mapping[str, Any], bases: Mapping[str, BaseSpec]):
+        where = f"robots.{name}"
+        self.known(data, where, _ROBOT_KEYS)
+        kind = data.get("kind")
+        if kind not in KINDS:
+            raise self.fail(f"{where}.kind", f"is {kind!r}; it must be one of {', '.join(KINDS)}")
+        base = data.get("base")
+        if base not in bases:
+            raise self.fail(
+                f"{where}.base", f"is {base!r}, which is not one of the bases ({', '.join(bases)})"
+            )
+        count = data.get("count")
+        if count is not None and (not isinstance(count, int) or count < 1):
+            raise self.fail(f"{where}.count", f"is {count!r}; it must be a whole number >= 1")
+        defaults = RobotSpec(name, kind, base)
+        numbers = {
+            key: self.number(data.get(key, getattr(defaults, key)), f"{where}.{key}", True)
+            for key in ("max_speed", "max_turn", "altitude", "climb", "blade_radius")
+        }
+        return RobotSpec(
+            name=name,
+            kind=kind,
+            base=base,
+            count=count,
+            size=self.triple(data.get("size", defaults.size), f"{where}.size"),
+            color=self.color(data.get("color", defaults.color), f"{where}.color"),
+            blade=bool(data.get("blade", False)),
+            led=bool(data.get("led", False)),
+            camera=self.camera(data.get("camera"), f"{where}.camera"),
+            range=self.range_sensor(data.get("range"), f"{where}.range"),
+            battery=self.battery(self.mapping(data.get("battery", {}), f"{where}.battery"), where),
+            spacing=self.pair(data.get("spacing", defaults.spacing), f"{where}.spacing"),
+            start_jitter=self.number(data.get("start_jitter", 0.0), f"{where}.start_jitter"),
+            variables=self.mapping(data.get("variables", {}), f"{where}.variables"),
+            **numbers,
+        )
+
+    def camera(self, data: Any, where: str) -> CameraSpec | None:
+        if data is None:
+            return None
+        data = self.mapping(data, where)
+        self.known(data, where, {"fov", "detects"})
+        return CameraSpec(
+            fov=self.number(data.get("fov", 90.0), f"{where}.fov", positive=True),
+            detects=str(data.get("detects", "weed")),
+        )
+
+    def range_sensor(self, data: Any, where: str) -> RangeSpec | None:
+        if data is None:
+            return None
+        data = self.mapping(data, where)
+        self.known(data, where, {f for f in RangeSpec.__dataclass_fields__})
+        direction = data.get("direction", "forward")
+        if direction not in ("forward", "down"):
+            raise self.fail(f"{where}.direction", f"is {direction!r}; use forward or down")
+        rays = data.get("rays", 7)
+        if not isinstance(rays, int) or rays < 1:
+            raise self.fail(f"{where}.rays", f"is {rays!r}; it must be a whole number >= 1")
+        return RangeSpec(
+            max_range=self.number(data.get("max_range", 2.0), f"{where}.max_range", True),
+            cone=self.number(data.get("cone", 20.0), f"{where}.cone"),
+            rays=rays,
+            direction=direction,
+            detects=str(data.get("detects", "")),
+            detect_distance=self.number(
+                data.get("detect_distance", 1.5), f"{where}.detect_distance", True
+            ),
+        )
+
+    def battery(self, data: Mapping[str, Any], robot: str) -> BatterySpec:
+        where = f"{robot}.battery"
+        self.known(data, where, {f for f in BatterySpec.__dataclass_fields__})
+        defaults = BatterySpec()
+        level = self.range(data.get("level", defaults.level), f"{where}.level")
+        if not 0 <= level[0] <= level[1] <= 1:
+            raise self.fail(f"{where}.level", "must lie between 0 and 1")
+        return BatterySpec(
+            level=level,
+            drain=self.range(data.get("drain", defaults.drain), f"{where}.drain"),
+            move_drain=self.range(
+                data.get("move_drain", defaults.move_drain), f"{where}.move_drain"
+            ),
+            charge=self.number(data.get("charge", defaults.charge), f"{where}.charge"),
+            low=self.number(data.get("low", defaults.low), f"{where}.low"),
+            warn_period=self.number(
+                data.get("warn_period", defaults.warn_period), f"{where}.warn_period", True
+            ),
+        )
+
+    def objects(self, kind: str, data: Mapping[str, Any]) -> ObjectsSpec:
+        self.known(data, kind, {"count", "area", "margin", "size", "color"})
+        low, high = self.range(data.get("count", 0), f"{kind}.count")
+        if low < 0 or low != int(low) or high != int(high):
+            raise self.fail(f"{kind}.count", "must be a whole number or [low, high]")
+        return ObjectsSpec(
+            kind=kind.rstrip("s"),
+            count=(int(low), int(high)),
+            area=self.area(data.get("area"), f"{kind}.area"),
+            margin=self.number(data.get("margin", 0.5), f"{kind}.margin"),
+            size=self.number(data.get("size", 0.2), f"{kind}.size", positive=True),
+            color=self.color(data.get("color", ObjectsSpec.color), f"{kind}.color"),
+        )
+
+    def area(self, value: Any, where: str) -> tuple[Range, Range] | None:
+        if value is None:
+            return None
+        if not isinstance(value, list) or len(value) != 2:
+            raise self.fail(where, "must be [[x_low, x_high], [y_low, y_high]]")
+        return (self.range(value[0], f"{where}[0]"), self.range(value[1], f"{where}[1]"))
+
+    def start(self, value: Any) -> float:
+        if isinstance(value, dt.datetime):
+            moment = value
+        else:
+            try:
+                moment = dt.datetime.fromisoformat(str(value).replace("Z", "+00:00"))
+            except ValueError:
+                raise self.fail("start", f"{value!r} is not an ISO 8601 date-time") from None
+        if moment.tzinfo is None:
+            moment = moment.replace(tzinfo=dt.UTC)
+        return moment.timestamp()
+
+    # -- primitive values ----------------------------------------------------------------------
+
+    def known(self, data: Mapping[str, Any], where: str, keys) -> None:
+        unknown = sorted(set(data) - set(keys))
+        if unknown:
+            raise self.fail(
+                where,
+                f"has unknown key {', '.join(map(repr, unknown))} "
+                f"(known: {', '.join(sorted(keys))})",
+            )
+
+    def mapping(self, value: Any, where: str) -> Mapping[str, Any]:
+        if value is None:
+            return {}
+        if not isinstance(value, Mapping):
+            raise self.fail(where, f"must be a mapping of names to values, not {value!r}")
+        return value
+
+    def sequence(self, value: Any, where: str) -> list[Any]:
+        if not isinstance(value, list):
+            raise self.fail(where, f"must be a list, not {value!r}")
+        return value
+
+    def number(self, value: Any, where: str, positive: bool = False) -> float:
+        if isinstance(value, bool) or not isinstance(value, int | float):
+            raise self.fail(where, f"is {value!r}, not a number")
+        if positive and value <= 0:
+            raise self.fail(where, f"is {value!r}; it must be positive")
+        if value < 0:
+            raise self.fail(where, f"is {value!r}; it must not be negative")
+        return float(value)
+
+    def numbers(self, value: Any, where: str, length: int) -> tuple[float, ...]:
+        if not isinstance(value, list | tuple) or len(value) != length:
+            raise self.fail(where, f"is {value!r}; it must be a list of {length} numbers")
+        out = []
+        for item in value:
+            if isinstance(item, bool) or not isinstance(item, int | float):
+                raise self.fail(where, f"is {value!r}; it must be a list of {length} numbers")
+            out.append(float(item))
+        return tuple(out)
+
+    def pair(self, value: Any, where: str, positive: bool = False) -> tuple[float, float]:
+        pair = self.numbers(value, where, 2)
+        if positive and min(pair) <= 0:
+            raise self.fail(where, f"is {value!r}; both numbers must be positive")
+        return pair  # type: ignore[return-value]
+
+    def triple(self, value: Any, where: str) -> tuple[float, float, float]:
+        return self.numbers(value, where, 3)  # type: ignore[return-value]
+
+    def color(self, value: Any, where: str) -> tuple[float, float, float, float]:
+        if isinstance(value, list | tuple) and len(value) == 3:
+            value = [*value, 1.0]
+        return self.numbers(value, where, 4)  # type: ignore[return-value]
+
+    def range(self, value: Any, where: str) -> Range:
+        """``x`` or ``[low, high]``."""
+        if isinstance(value, list | tuple):
+            low, high = self.numbers(value, where, 2)
+        else:
+            low = high = self.number(value, where)
+        if low > high or low < 0:
+            raise self.fail(where, f"is {value!r}; it must be [low, high] with 0 <= low <= high")
+        return (low, high)
+
+
+_WORLD_KEYS = {
+    "model",
+    "field",
+    "bases",
+    "robots",
+    "weeds",
+    "targets",
+    "time_limit",
+    "control_rate",
+    "record_rate",
+    "latency",
+    "start",
+    "variables",
+    "faults",
+    "library",
+    "skills",
+}
+_ROBOT_KEYS = {
+    "kind",
+    "base",
+    "count",
+    "max_speed",
+    "max_turn",
+    "altitude",
+    "climb",
+    "size",
+    "color",
+    "blade",
+    "blade_radius",
+    "led",
+    "camera",
+    "range",
+    "battery",
+    "spacing",
+    "start_jitter",
+    "variables",
+}

@@ -1,0 +1,71 @@
+"""The running scenario of the thesis, simulated: the tags a short run leaves follow the model
+(5.2.1, 5.2.3), and every weed is cut by the tractor closest to it."""
+
+from __future__ import annotations
+
+import json
+import math
+
+from conftest import manifest, record, seconds, tags
+
+
+def test_a_short_agri_run_cuts_every_weed_and_its_tags_follow_the_model(short_agri, tmp_path):
+    bag = record(short_agri, tmp_path / "runs")
+    run = manifest(bag)
+    assert run["outcome"] == {"status": "ended", "reason": ""}
+    assert run["robots"] == {"drone": "Drone", "tractor_1": "Tractor", "tractor_2": "Tractor"}
+    assert run["weeds"] == {"total": 2, "found": 2, "cut": 2}
+    everything = tags(bag)
+    cuts = [t for t in everything if t.activity == "cut_grass" and t.lifecycle == "complete"]
+    assert len(cuts) == 2
+
+    # weed_position! precedes the matching weed_position? of both tractors
+    sends = [t for t in everything if t.activity == "weed_position!" and t.lifecycle == "start"]
+    assert sends
+    for send in sends:
+        receivers = {
+            t.robot: t
+            for t in everything
+            if t.activity == "weed_position?" and t.msg_id == send.msg_id
+        }
+        assert set(receivers) == {"tractor_1", "tractor_2"}
+        assert all(seconds(r) > seconds(send) for r in receivers.values())
+        assert all(r.payload == send.payload for r in receivers.values())
+
+    # only the closest tractor (by the positions the tractors reported) moves and cuts
+    for weed_sent in sends:
+        weed = json.loads(weed_sent.payload)
+        replies = [
+            t
+            for t in everything
+            if t.activity == "tractor_position?"
+            and t.robot == "drone"
+            and t.lifecycle == "start"
+            and seconds(weed_sent) < seconds(t) < seconds(weed_sent) + 10.5
+        ]
+        distance = {}
+        for reply in replies:
+            data = json.loads(reply.payload)
+            where = data["vector"]
+            distance[data["header"]["frame_id"]] = math.hypot(
+                where["x"] - weed["x"], where["y"] - weed["y"]
+            )
+        closest = min(distance, key=distance.get)
+        chosen = next(
+            t
+            for t in everything
+            if t.activity == "closest_tractor!" and seconds(t) > seconds(weed_sent)
+        )
+        assert json.loads(chosen.payload) == {"data": closest}
+    movers = sorted(t.robot for t in everything if t.activity == "move" and t.lifecycle == "start")
+    cutters = sorted(t.robot for t in cuts)
+    assert movers == cutters
+    done_by = sorted(o["done_by"] for o in run["objects"])
+    assert cutters == done_by
+
+    # the drone takes off first and lands last
+    drone = [t for t in everything if t.robot == "drone"]
+    assert (drone[0].activity, drone[0].lifecycle) == ("take_off", "start")
+    assert (drone[-1].activity, drone[-1].lifecycle) == ("land", "complete")
+    order = [t.activity for t in drone if t.lifecycle == "start"]
+    assert order.index("field_cleaned!") < order.index("return_to_base") < order.index("land")

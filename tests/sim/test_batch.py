@@ -1,0 +1,174 @@
+"""Batches: runs spread over worker processes, each one bag; a crashed run is reported and
+does not stop the batch; nothing is left half-written."""
+
+from __future__ import annotations
+
+import json
+import time
+from pathlib import Path
+
+import pytest
+from conftest import manifest
+
+from robotale.cli import main
+from robotale.errors import InputError
+from robotale.sim.batch import SUMMARY, simulate_batch
+from robotale.sim.commands import plans
+from robotale.sim.worldspec import load_world
+
+ROVER = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="d">
+  <bpmn:process id="Rover" name="Rover" isExecutable="true">
+    <bpmn:startEvent id="start" />
+    <bpmn:callActivity id="where" name="Get Position" calledElement="GetPosition" />
+    <bpmn:scriptTask id="check" name="Check" scriptFormat="python">
+      <bpmn:script>
+if my_x &gt; 0:
+    {action}
+      </bpmn:script>
+    </bpmn:scriptTask>
+    <bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="where" />
+    <bpmn:sequenceFlow id="f2" sourceRef="where" targetRef="check" />
+    <bpmn:sequenceFlow id="f3" sourceRef="check" targetRef="end" />
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+WORLD = """model: rover.bpmn
+field: [4, 4]
+time_limit: 30
+bases:
+  home: {position: [0, 0]}
+robots:
+  rover: {kind: ground, base: home, start_jitter: 0.3}
+"""
+
+
+def rover_world(folder: Path, action: str):
+    """A rover that checks where it started, and ``action`` when east of its base."""
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "rover.bpmn").write_text(ROVER.format(action=action), encoding="utf-8")
+    (folder / "rover.yaml").write_text(WORLD, encoding="utf-8")
+    return load_world(folder / "rover.yaml")
+
+
+def east(run: dict) -> bool:
+    return run["setup"]["robots"]["rover"]["x"] > 0
+
+
+def test_a_run_that_raises_is_reported_crashed_and_the_batch_goes_on(tmp_path):
+    world = rover_world(tmp_path / "model", 'raise RuntimeError("started east of its base")')
+    out = tmp_path / "runs"
+    summary = simulate_batch(plans(world, "rover", runs=6, seed=5), out, workers=0)
+    runs = [manifest(out / f"run_{i:04d}") for i in range(1, 7)]
+    crashed = [r for r in runs if r["outcome"]["status"] == "crashed"]
+    ended = [r for r in runs if r["outcome"]["status"] == "ended"]
+    assert crashed and ended  # the seed gives both kinds
+    assert all(east(r) for r in crashed) and not any(east(r) for r in ended)
+    reason = crashed[0]["outcome"]["reason"]
+    assert reason == (
+        "ModelError: robot rover: script task check (Check) failed: RuntimeError: "
+        "started east of its base"
+    )
+    assert all((out / r["case"] / "metadata.yaml").is_file() for r in runs)  # bags closed
+    assert summary["outcomes"] == {"crashed": len(crashed), "ended": len(ended)}
+    assert json.loads((out / SUMMARY).read_text())["cases"][0]["case"] == "run_0001"
+    assert not list(out.glob(".*"))
+
+
+@pytest.mark.slow
+def test_a_run_that_kills_its_worker_process_is_reported_and_the_others_finish(tmp_path):
+    world = rover_world(tmp_path / "model", "import os; os._exit(3)")
+    out = tmp_path / "runs"
+    summary = simulate_batch(plans(world, "rover", runs=4, seed=5), out, workers=2)
+    runs = {f"run_{i:04d}": manifest(out / f"run_{i:04d}") for i in range(1, 5)}
+    died = {c for c, r in runs.items() if r["outcome"]["status"] == "crashed"}
+    assert died and len(died) < 4
+    for case, run in runs.items():
+        if case in died:
+            assert "worker process running it died" in run["outcome"]["reason"]
+            assert not (out / case / "metadata.yaml").exists()
+        else:
+            assert run["outcome"]["status"] == "ended"
+            assert (out / case / "metadata.yaml").is_file()
+    assert summary["outcomes"]["crashed"] == len(died)
+    assert not list(out.glob(".*"))
+
+
+def test_earlier_runs_are_kept_unless_overwrite_is_given(tmp_path):
+    world = rover_world(tmp_path / "model", "pass")
+    out = tmp_path / "runs"
+    simulate_batch(plans(world, "rover", runs=1, seed=1), out, workers=0)
+    with pytest.raises(InputError, match=r"already holds recorded runs \(run_0001 \.\.\.\)"):
+        simulate_batch(plans(world, "rover", runs=1, seed=2), out, workers=0)
+    assert manifest(out / "run_0001")["batch_seed"] == 1
+    simulate_batch(plans(world, "rover", runs=1, seed=2), out, workers=0, overwrite=True)
+    assert manifest(out / "run_0001")["batch_seed"] == 2
+
+
+def test_the_command_simulates_a_batch_and_reports_it(tmp_path, capsys):
+    out = tmp_path / "agri"
+    status = main(
+        [
+            "simulate",
+            "agri",
+            "--runs",
+            "2",
+            "--tractors",
+            "3",
+            "--weeds",
+            "2",
+            "--seed",
+            "4",
+            "--out",
+            str(out),
+            "--workers",
+            "2",
+        ]
+    )
+    captured = capsys.readouterr()
+    assert status == 0
+    assert captured.out.startswith("2 runs of agri in ")
+    assert "simulate" in captured.err  # the progress bar
+    runs = sorted(p.name for p in out.iterdir())
+    assert runs == ["robotale-batch.json", "run_0001", "run_0002"]
+    first = manifest(out / "run_0001")
+    assert set(first["robots"]) == {"drone", "tractor_1", "tractor_2", "tractor_3"}
+    assert first["weeds"]["total"] == 2
+    assert first["settings"]["tractors"] == 3
+
+
+@pytest.mark.parametrize(
+    ("arguments", "message"),
+    [
+        (["farm"], "there is no scenario 'farm'; the scenarios are agri, rexdingo"),
+        (["agri", "--tractors", "11"], "pool Tractor allows at most 10 robots, 11 given"),
+        (["agri", "--fault", "die:tractor_7@5"], "there is no robot 'tractor_7'"),
+        (["agri", "--weeds", "many"], "--weeds 'many' must be a number or LOW-HIGH"),
+        (["rexdingo", "--weeds", "2"], "this world has no weeds to count"),
+        (["agri", "--gui"], "--gui needs a display"),
+    ],
+)
+def test_mistakes_are_one_sentence_and_write_nothing(
+    tmp_path, capsys, monkeypatch, arguments, message
+):
+    monkeypatch.delenv("DISPLAY", raising=False)
+    monkeypatch.delenv("WAYLAND_DISPLAY", raising=False)
+    out = tmp_path / "runs"
+    assert main(["simulate", *arguments, "--out", str(out)]) == 1
+    error = capsys.readouterr().err
+    assert error.startswith("robotale: ") and message in error
+    assert len(error.strip().splitlines()) == 1
+    assert not out.exists()
+
+
+def test_pace_slows_a_run_down_to_the_wall_clock_for_a_person_watching(tmp_path, capsys):
+    out = tmp_path / "watched"
+    began = time.perf_counter()
+    assert main(["simulate", "rexdingo", "--pace", "200", "--out", str(out)]) == 0
+    wall = time.perf_counter() - began
+    line = capsys.readouterr().out.strip()
+    assert line.startswith("run_0001: ended after ")
+    duration = manifest(out / "run_0001")["duration"]
+    assert wall >= duration / 200
