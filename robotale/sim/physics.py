@@ -65,7 +65,8 @@ class Physics:
     def close(self) -> None:
         if self.client >= 0:
             if self.connected():
-                pybullet.disconnect(physicsClientId=self.client)
+                with _quiet():
+                    pybullet.disconnect(physicsClientId=self.client)
             self.client = -1
 
     def connected(self) -> bool:

@@ -3,7 +3,8 @@ camera whose footprint grows with altitude (a pybullet box query).
 
 Both can report objects of one kind (weeds, targets) on ``/<robot>/detection``
 (``geometry_msgs/msg/PointStamped``, ``header.frame_id`` = the object's id, ``point`` = where
-it is), once per object: the detector a real robot would run on its camera or sonar.
+it is), every control step the object is in view: the detector a real robot would run on its
+camera or sonar. Telling a new object from one seen before is the listener's job.
 """
 
 from __future__ import annotations

@@ -48,6 +48,7 @@ ODOM = "nav_msgs/msg/Odometry"
 TURN_GAIN = 2.0
 SLOW_DOWN = 0.8  # forward speed <= this times the remaining distance
 HEADING_WINDOW = 0.6  # radians of heading error beyond which a robot turns on the spot
+SAME_OBJECT = 0.25  # metres: detections closer than this are one object
 
 
 def _number(inputs: Mapping[str, Any], robot: Robot, name: str, default: float | None = None):
@@ -266,7 +267,10 @@ class _Explorer:
 
     def _detected(self, envelope: Envelope) -> None:
         point = envelope.data["point"]
-        self.queue.append((point["x"], point["y"]))
+        spot = (point["x"], point["y"])
+        if any(math.dist(spot, seen) < SAME_OBJECT for seen in (*self.found, *self.queue)):
+            return  # seen before: a detector reports an object every frame it is in view
+        self.queue.append(spot)
         if not self.waiting:
             self._next()
 

@@ -11,7 +11,7 @@ topic                      type                               when
 ``/<robot>/battery``       ``sensor_msgs/msg/BatteryState``   once a second (percentage 0-1)
 ``/<robot>/low_battery``   ``std_msgs/msg/Empty``             below the threshold, repeated
 ``/<robot>/range``         ``sensor_msgs/msg/Range``          every control step (if fitted)
-``/<robot>/detection``     ``geometry_msgs/msg/PointStamped`` once per object seen
+``/<robot>/detection``     ``geometry_msgs/msg/PointStamped`` each step an object is seen
 =========================  =================================  ==============================
 
 A tractor's blade cuts the weeds within its radius while ``blade_force`` > 0; a robot whose
@@ -75,7 +75,6 @@ class SimWorld:
         except BaseException:
             self.physics.close()
             raise
-        self._seen: dict[str, set[str]] = {name: set() for name in self.robots}
 
     def _build(self) -> None:
         world, physics = self.spec, self.physics
@@ -184,9 +183,6 @@ class SimWorld:
             thing = self.things.get(body)
             if thing is None or thing.kind != kind or thing.state != "present":
                 continue
-            if thing.id in self._seen[robot.name]:
-                continue
-            self._seen[robot.name].add(thing.id)
             if not thing.found_by:
                 thing.found_by, thing.found_at = robot.name, now
             message = sensors.detection_message(now, robot, thing.id, thing.x, thing.y)

@@ -1,0 +1,83 @@
+"""How fast the simulator runs the agri scenario, headless.
+
+1. One agri run (drone + 2 tractors, the scenario's random weeds and batteries), recorded as a
+   rosbag2: simulated seconds per wall second, against the wall clock itself (1x = real time).
+   Target: at least 50x real time.
+2. A batch of agri runs (70 by default, as in thesis 7.2.1) on worker processes: its wall time,
+   and its speed against running the same runs one after another in this process (projected
+   from the single runs of step 1). Target: under 3 minutes on 2 cores.
+
+    python benchmarks/sim_speed.py [--runs 70] [--single 5] [--workers N]
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from robotale.sim import scenarios
+from robotale.sim.batch import run_into, simulate_batch
+from robotale.sim.commands import adjust, plans
+from robotale.sim.worldspec import load_world
+
+SINGLE_TARGET = 50.0  # x real time
+BATCH_TARGET = 180.0  # seconds
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--runs", type=int, default=70, help="runs in the batch (70)")
+    parser.add_argument("--single", type=int, default=5, help="single runs to time (5)")
+    parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
+    args = parser.parse_args()
+    world = adjust(load_world(scenarios.world_file("agri")), counts={"tractor": 2})
+    with tempfile.TemporaryDirectory(prefix="sim-speed-") as scratch:
+        walls, simulated = single_runs(world, Path(scratch) / "single", args.single)
+        batch_runs(world, Path(scratch) / "batch", args.runs, args.workers, walls, simulated)
+    return 0
+
+
+def single_runs(world, folder: Path, count: int) -> tuple[list[float], list[float]]:
+    folder.mkdir(parents=True)
+    walls, simulated = [], []
+    for plan in plans(world, "agri", runs=count, seed=1):
+        began = time.perf_counter()
+        manifest = run_into(plan, folder)
+        walls.append(time.perf_counter() - began)
+        simulated.append(manifest["duration"])
+    factor = sum(simulated) / sum(walls)
+    verdict = "met" if factor >= SINGLE_TARGET else "NOT met"
+    print(
+        f"one agri run, headless, recorded ({count} runs, seed 1): "
+        f"{statistics.mean(simulated):.1f} simulated s in {statistics.mean(walls):.3f} s wall "
+        f"on average = {factor:.0f}x real time (target >= {SINGLE_TARGET:.0f}x: {verdict})"
+    )
+    return walls, simulated
+
+
+def batch_runs(world, folder: Path, runs: int, workers: int, walls, simulated) -> None:
+    began = time.perf_counter()
+    summary = simulate_batch(plans(world, "agri", runs=runs, seed=1), folder, workers=workers)
+    wall = time.perf_counter() - began
+    outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
+    serial = summary["simulated_seconds"] / (sum(simulated) / sum(walls))
+    verdict = "met" if wall < BATCH_TARGET else "NOT met"
+    print(
+        f"agri batch: {runs} runs on {summary['workers']} workers in {wall:.1f} s wall "
+        f"(target < {BATCH_TARGET:.0f} s: {verdict}); {outcomes}"
+    )
+    print(
+        f"  {summary['simulated_seconds']:.0f} simulated s = "
+        f"{summary['simulated_seconds'] / wall:.0f}x real time overall; "
+        f"{serial / wall:.2f}x the speed of the same runs one after another in one process "
+        f"(projected: {serial:.1f} s)"
+    )
+
+
+if __name__ == "__main__":
+    sys.exit(main())
