@@ -334,7 +334,7 @@ def _add_simulate(commands) -> None:
         action="append",
         default=[],
         metavar="SPEC",
-        help="die:ROBOT@T, drop:/TOPIC[,to=ROBOT][,nth=N], battery:ROBOT@T[,rate=R]; "
+        help="die:ROBOT@T, drop:/TOPIC[,to=ROBOT][,nth=N], battery:ROBOT@T[,rate=R][,for=S]; "
         "@FROM-TO and ,p=P vary it per run (repeatable)",
     )
     simulate.add_argument(

@@ -7,7 +7,8 @@
   that time window. The sender's tag and the recording still have the message; the receiver
   never tags it, as on a real lossy network.
 - ``battery:drone@40,rate=0.02``: from 40 s the battery empties at 2 % a second (default
-  1 %): the robot warns low_battery, and at zero it stops (a drone drops).
+  1 %): the robot warns low_battery, and at zero it stops (a drone drops). ``for=10`` ends the
+  drain after 10 s (a stalled motor, a short circuit); meanwhile the battery cannot charge.
 
 ``@T1-T2`` draws the time uniformly per run; ``p=0.3`` applies the fault in that share of
 the runs. Both draws come from the run's seed, so a run replays with the same faults.
@@ -26,7 +27,7 @@ from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope, Subscription
 
 KINDS = ("die", "drop", "battery")
-_KEYS = {"die": {"p"}, "drop": {"p", "to", "nth"}, "battery": {"p", "rate"}}
+_KEYS = {"die": {"p"}, "drop": {"p", "to", "nth"}, "battery": {"p", "rate", "for"}}
 
 
 @dataclass(frozen=True)
@@ -39,6 +40,7 @@ class Fault:
     nth: int = 0
     rate: float = 0.01
     probability: float = 1.0
+    duration: float | None = None  # battery: how long the drain lasts (None: for good)
 
 
 @dataclass(frozen=True)
@@ -73,6 +75,7 @@ def parse_fault(text: str, robots: Iterable[str]) -> Fault:
         nth=int(_number(text, "nth", values.get("nth", "0"))),
         rate=_number(text, "rate", values.get("rate", "0.01")),
         probability=_number(text, "p", values.get("p", "1")),
+        duration=_number(text, "for", values["for"]) if "for" in values else None,
     )
     _check(fault, robots)
     return fault

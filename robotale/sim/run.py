@@ -189,7 +189,10 @@ def _schedule(planned: list[Planned], clock: SimClock, start, sim: SimWorld, mis
 
             clock.call_at(start + item.at, die)
         elif fault.kind == "battery":
-            clock.call_at(start + item.at, lambda n=fault.target, r=fault.rate: sim.drain(n, r))
+            began = start + item.at
+            clock.call_at(began, lambda n=fault.target, r=fault.rate: sim.drain(n, r))
+            if fault.duration is not None:
+                clock.call_at(began + fault.duration, lambda n=fault.target: sim.drain(n, 0.0))
 
 
 def _manifest(

@@ -27,7 +27,7 @@ def sonar(physics: Physics, robot: SimRobot, spec: RangeSpec) -> tuple[float, in
     (-1 when none)."""
     pose = robot.pose
     if spec.direction == "down":
-        start = (pose.x, pose.y, pose.z + 0.01)
+        start = (pose.x, pose.y, pose.z)
         starts, ends = [start], [(pose.x, pose.y, pose.z - spec.max_range)]
     else:
         height = pose.z + robot.spec.size[2] / 2

@@ -6,7 +6,10 @@ from __future__ import annotations
 import json
 import math
 
-from conftest import manifest, record, seconds, tags
+from conftest import manifest, messages, record, seconds, tags
+
+from robotale.sim.commands import adjust
+from robotale.sim.faults import parse_fault
 
 
 def test_a_short_agri_run_cuts_every_weed_and_its_tags_follow_the_model(short_agri, tmp_path):
@@ -69,3 +72,39 @@ def test_a_short_agri_run_cuts_every_weed_and_its_tags_follow_the_model(short_ag
     assert (drone[-1].activity, drone[-1].lifecycle) == ("land", "complete")
     order = [t.activity for t in drone if t.lifecycle == "start"]
     assert order.index("field_cleaned!") < order.index("return_to_base") < order.index("land")
+
+
+def test_a_tractor_running_low_goes_home_charges_until_full_and_leaves_its_weed(
+    short_agri, tmp_path
+):
+    one = adjust(short_agri, counts={"tractor": 1}, weeds=(1, 1))
+    healthy = record(one, tmp_path / "healthy")
+    move = next(t for t in tags(healthy) if t.activity == "move")
+    begin = tags(healthy)[0].stamp.sec
+    when = round(seconds(move) - begin + 1.0, 1)
+    # runs are deterministic, so the faulty run has the healthy run's charge until the fault
+    level = next(
+        m.percentage
+        for _, stamp, m in messages(healthy, {"/tractor_1/battery"})
+        if stamp / 1e9 - begin >= when
+    )
+    rate = round((level - 0.1) / 5.0, 4)  # five seconds that leave it at about 10 %
+    fault = parse_fault(f"battery:tractor_1@{when},rate={rate},for=5", ["drone", "tractor_1"])
+    bag = record(one, tmp_path / "faulty", faults=(fault,))
+    run = manifest(bag)
+    assert run["outcome"]["status"] == "ended"
+    assert run["weeds"] == {"total": 1, "found": 1, "cut": 0}
+    tractor = [t for t in tags(bag) if t.robot == "tractor_1"]
+    started = [t.activity for t in tractor if t.lifecycle == "start"]
+    handler = started.index("low_battery_handler")
+    assert "move" in started[:handler] and "cut_grass" not in started
+    after = [t for t in started[handler:] if not t.startswith("field_cleaned")]
+    assert after[:4] == ["low_battery_handler", "low_battery", "return_to_base", "battery_full"]
+    assert [t.lifecycle for t in tractor if t.activity == "move"] == ["start"]  # interrupted
+    full = next(t for t in tractor if t.activity == "battery_full")
+    levels = [
+        m.percentage
+        for _, stamp, m in messages(bag, {"/tractor_1/battery"})
+        if stamp <= seconds(full) * 1e9
+    ]
+    assert min(levels) < 0.2 and levels[-1] >= 0.99 - 1e-6  # drained, then charged at home

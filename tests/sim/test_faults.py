@@ -111,7 +111,7 @@ def test_faults_vary_per_run_from_the_seed_and_bad_ones_are_refused():
         ("die:tractor_9@3", "there is no robot 'tractor_9'"),
         ("die:drone", "say when with @SECONDS"),
         ("drop:closest_tractor", "a drop names a topic"),
-        ("battery:drone@10,speed=2", "'speed=2' is not one of p=..., rate=..."),
+        ("battery:drone@10,speed=2", "'speed=2' is not one of for=..., p=..., rate=..."),
         ("die:drone@9-3", "ends before it starts"),
     ]:
         with pytest.raises(InputError, match=words):

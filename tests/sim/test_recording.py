@@ -86,3 +86,18 @@ def test_odometry_and_battery_are_recorded_at_the_chosen_rate_in_simulated_time(
         "y",
         "z",
     }
+
+
+def test_more_robot_topics_are_recorded_when_asked_and_sensors_read_the_world(short_agri, tmp_path):
+    bag = record(short_agri, tmp_path / "runs", extra_topics=("range", "cmd_vel"))
+    announced = manifest(bag)["topics"]
+    assert announced["/drone/range"]["type"] == "sensor_msgs/msg/Range"
+    assert announced["/tractor_1/cmd_vel"]["type"] == "geometry_msgs/msg/Twist"
+    assert "/drone/cmd_vel" in announced and "/tractor_2/range" in announced
+    heights = [m.range for _, _, m in messages(bag, {"/drone/range"})]
+    assert max(heights) == pytest.approx(1.5, abs=1e-3)  # the ground, seen from its altitude
+    assert min(heights) == pytest.approx(0.0, abs=1e-3)  # landed
+    tractor = [m.range for _, _, m in messages(bag, {"/tractor_1/range"})]
+    assert all(0 < r <= 2.0 for r in tractor)
+    forward = [m.linear.x for _, _, m in messages(bag, {"/tractor_1/cmd_vel"})]
+    assert max(forward) > 0 and forward[-1] == 0.0  # it drove, and stopped
