@@ -47,11 +47,22 @@ with _quiet():
 Color = tuple[float, float, float, float]
 
 
+#: headless clients of this process, emptied and unused
+_SPARE: list[int] = []
+
+
 class Physics:
-    """One pybullet client (``DIRECT`` headless, ``GUI`` with a window)."""
+    """One pybullet client (``DIRECT`` headless, ``GUI`` with a window).
+
+    Headless clients are kept for the next world of the same process once closed (emptied
+    with ``resetSimulation``), since connecting costs more than a short run's physics.
+    """
 
     def __init__(self, *, gui: bool = False) -> None:
         self.gui = gui
+        if not gui and _SPARE:
+            self.client = _SPARE.pop()
+            return
         mode = pybullet.GUI if gui else pybullet.DIRECT
         with _quiet():
             self.client = pybullet.connect(mode)
@@ -63,11 +74,16 @@ class Physics:
             )
 
     def close(self) -> None:
-        if self.client >= 0:
-            if self.connected():
+        if self.client < 0:
+            return
+        if self.connected():
+            if self.gui:
                 with _quiet():
                     pybullet.disconnect(physicsClientId=self.client)
-            self.client = -1
+            else:
+                pybullet.resetSimulation(physicsClientId=self.client)
+                _SPARE.append(self.client)
+        self.client = -1
 
     def connected(self) -> bool:
         """False once a person closed the window."""

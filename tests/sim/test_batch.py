@@ -172,3 +172,19 @@ def test_pace_slows_a_run_down_to_the_wall_clock_for_a_person_watching(tmp_path,
     assert line.startswith("run_0001: ended after ")
     duration = manifest(out / "run_0001")["duration"]
     assert wall >= duration / 200
+
+
+def test_a_model_and_world_of_ones_own_run_from_the_command_line(tmp_path, capsys):
+    folder = tmp_path / "mine"
+    rover_world(folder, "pass")
+    out = tmp_path / "runs"
+    arguments = ["simulate", "--world", str(folder / "rover.yaml"), "--runs", "3"]
+    assert main([*arguments, "--out", str(out), "--quiet", "--workers", "0"]) == 0
+    assert capsys.readouterr().out.startswith("3 runs of rover in ")
+    assert all(manifest(out / f"run_{i:04d}")["outcome"]["status"] == "ended" for i in (1, 2, 3))
+    broken = folder / "broken.bpmn"
+    broken.write_text(ROVER.format(action="pass").replace("GetPosition", "Teleport"))
+    assert main([*arguments, "--model", str(broken), "--out", str(tmp_path / "other")]) == 1
+    error = capsys.readouterr().err
+    assert "where (Get Position)" in error and "Teleport" in error
+    assert not (tmp_path / "other").exists()
