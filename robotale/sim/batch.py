@@ -37,18 +37,22 @@ def simulate_batch(
     workers: int | None = None,
     overwrite: bool = False,
     progress: bool = False,
+    gui: bool = False,
+    pace: float | None = None,
 ) -> dict[str, Any]:
     """Simulate every run of ``plans`` into ``out``; returns the batch summary.
 
     ``workers`` processes run them (default: one per CPU, at most one per run; 0 runs them in
-    this process). ``overwrite`` replaces the runs of an earlier batch in ``out``.
+    this process). ``overwrite`` replaces the runs of an earlier batch in ``out``. With ``gui``
+    (pybullet's window) or ``pace`` (simulated seconds per wall second) the runs go one after
+    the other in this process, for a person to watch.
     """
     out = Path(out)
     prepare_folder(out, overwrite)
     began = time.perf_counter()
     if workers is None:
         workers = os.cpu_count() or 1
-    workers = min(workers, len(plans))
+    workers = 0 if gui or pace or len(plans) == 1 else min(workers, len(plans))
     manifests: dict[str, dict[str, Any]] = {}
     with tqdm(
         total=len(plans), unit="run", desc="simulate", disable=not progress, leave=False
@@ -60,9 +64,9 @@ def simulate_batch(
             bar.set_postfix(Counter(m["outcome"]["status"] for m in manifests.values()))
 
         try:
-            if workers == 0 or len(plans) == 1:
+            if workers == 0:
                 for plan in plans:
-                    finished(run_into(plan, out))
+                    finished(run_into(plan, out, gui=gui, pace=pace))
             else:
                 _in_pool(plans, out, workers, finished)
         except BaseException:

@@ -15,7 +15,7 @@ from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.parser import parse
 from robotale.sim import messages, scenarios
-from robotale.sim.batch import prepare_folder, run_into, simulate_batch
+from robotale.sim.batch import simulate_batch
 from robotale.sim.faults import Fault, parse_fault
 from robotale.sim.run import RunPlan, model_topics, skills_of
 from robotale.sim.setup import draw
@@ -150,33 +150,29 @@ def simulate_command(args: Any, out: TextIO | None = None) -> int:
         settings=_overrides(args),
     )
     target = Path(args.out) if args.out else Path("runs") / scenario
-    if args.gui or args.pace:
-        return _watch(batch, target, args, out)
+    if args.gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+        raise InputError("--gui needs a display (DISPLAY is not set); run without --gui")
+    watching = args.gui or bool(args.pace)
     summary = simulate_batch(
-        batch, target, workers=args.workers, overwrite=args.overwrite, progress=not args.quiet
+        batch,
+        target,
+        workers=args.workers,
+        overwrite=args.overwrite,
+        progress=not (args.quiet or watching),
+        gui=args.gui,
+        pace=(args.pace or 1.0) if watching else None,
     )
     print_summary(summary, target, out)
     return 0
 
 
-def _watch(batch: list[RunPlan], target: Path, args: Any, out: TextIO) -> int:
-    """Runs one after the other in this process, paced to wall time (in a window with --gui)."""
-    if args.gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        raise InputError("--gui needs a display (DISPLAY is not set); run without --gui")
-    pace = args.pace or 1.0
-    prepare_folder(target, args.overwrite)
-    for plan in batch:
-        manifest = run_into(plan, target, gui=args.gui, pace=pace)
-        print(_case_line(manifest), file=out)
-    return 0
-
-
 def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
     outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
+    runs, workers = summary["runs"], summary["workers"]
+    where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
     print(
-        f"{summary['runs']} run{'s' if summary['runs'] != 1 else ''} of {summary['scenario']} "
-        f"in {summary['wall_time']:.1f} s ({summary['workers']} worker"
-        f"{'s' if summary['workers'] != 1 else ''}): {outcomes}",
+        f"{runs} run{'s' if runs != 1 else ''} of {summary['scenario']} "
+        f"in {summary['wall_time']:.1f} s ({where}): {outcomes}",
         file=out,
     )
     for case in summary["cases"]:
@@ -189,12 +185,6 @@ def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
             done = sum(t[verb] for t in totals)
             print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
     print(f"recorded in {target} (summary: {target / 'robotale-batch.json'})", file=out)
-
-
-def _case_line(manifest: dict[str, Any]) -> str:
-    outcome = manifest["outcome"]
-    reason = f" ({outcome['reason']})" if outcome["reason"] else ""
-    return f"{manifest['case']}: {outcome['status']}{reason} after {manifest['duration']:.1f} s"
 
 
 def _overrides(args: Any) -> dict[str, Any]:

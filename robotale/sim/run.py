@@ -115,22 +115,31 @@ def simulate_run(
         if sim is not None:
             sim.close()
     manifest = _manifest(plan, setup, planned, clock.now(), status, reason, detail)
+    manifest.update(_what_happened(mission, sim, recorder, start))
     manifest["wall_time"] = round(time.perf_counter() - began, 3)
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    return manifest
+
+
+def _what_happened(
+    mission: Mission | None, sim: SimWorld | None, recorder: Recorder | None, start: float
+) -> dict[str, Any]:
+    """The engines', the world's and the recorder's side of a manifest (as far as they got)."""
+    facts: dict[str, Any] = {}
     if mission is not None:
-        manifest["failures"] = mission.failures
-        manifest["robots"] = {a.robot: a.robot_type for a in mission.assignments}
-        manifest["instances"] = {
+        facts["failures"] = mission.failures
+        facts["robots"] = {a.robot: a.robot_type for a in mission.assignments}
+        facts["instances"] = {
             name: {"completed": engine.completed, "running": not engine.idle}
             for name, engine in mission.engines.items()
         }
     if sim is not None:
-        manifest.update(sim.report(start))
-        manifest.update(_counts(manifest.pop("counts")))
+        facts.update(sim.report(start))
+        facts.update(_counts(facts.pop("counts")))
     if recorder is not None:
-        manifest["topics"] = recorder.topics()
-    folder.mkdir(parents=True, exist_ok=True)
-    (folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
-    return manifest
+        facts["topics"] = recorder.topics()
+    return facts
 
 
 def _mission(world: World, definitions: Definitions, setup: Setup, clock, bus) -> Mission:

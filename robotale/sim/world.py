@@ -32,8 +32,8 @@ from robotale.sim import sensors
 from robotale.sim.battery import Battery
 from robotale.sim.physics import Physics
 from robotale.sim.robots import BATTERY, EMPTY, ODOM, Pose, SimRobot, place
-from robotale.sim.setup import Setup
-from robotale.sim.worldspec import World
+from robotale.sim.setup import Placed, RobotStart, Setup
+from robotale.sim.worldspec import ObjectsSpec, RobotSpec, World
 
 FIRE_RANGE = 1.5  # metres
 BATTERY_PERIOD = 1.0  # seconds between battery messages
@@ -82,41 +82,44 @@ class SimWorld:
         for base in world.bases.values():
             physics.cylinder(base.radius, 0.01, (*base.position, 0.005), base.color, collide=False)
         specs = {name: spec for spec in world.robots for name in spec.names()}
-        self.robots: dict[str, SimRobot] = {}
-        for start in self.setup.robots:
-            spec = specs[start.name]
-            battery = spec.battery
-            robot = SimRobot(
-                name=start.name,
-                spec=spec,
-                base=world.bases[spec.base],
-                pose=Pose(start.x, start.y, start.yaw),
-                battery=Battery(
-                    start.level,
-                    start.drain,
-                    start.move_drain,
-                    battery.charge,
-                    battery.low,
-                    battery.warn_period,
-                ),
-                home=start.home,
-            )
-            half = [s / 2 for s in spec.size]
-            robot.body = physics.box(half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw)
-            robot.connect(self.bus)
-            self.robots[start.name] = robot
+        self.robots = {s.name: self._robot(s, specs[s.name]) for s in self.setup.robots}
         looks = {o.kind: o for o in world.objects}
         self.things: dict[int, Thing] = {}
         for placed in self.setup.objects:
-            look = looks[placed.kind]
-            if placed.kind == "weed":
-                body = physics.cylinder(look.size / 2, 0.1, (placed.x, placed.y, 0.05), look.color)
-            else:
-                half = look.size / 2
-                body = physics.box((half, half, half), (placed.x, placed.y, half), look.color)
-            self.things[body] = Thing(placed.kind, placed.id, placed.x, placed.y, body)
+            thing = self._thing(placed, looks[placed.kind])
+            self.things[thing.body] = thing
         if physics.gui:
             physics.follow((world.field[0] / 2, world.field[1] / 2, 0.0))
+
+    def _robot(self, start: RobotStart, spec: RobotSpec) -> SimRobot:
+        battery = spec.battery
+        robot = SimRobot(
+            name=start.name,
+            spec=spec,
+            base=self.spec.bases[spec.base],
+            pose=Pose(start.x, start.y, start.yaw),
+            battery=Battery(
+                start.level,
+                start.drain,
+                start.move_drain,
+                battery.charge,
+                battery.low,
+                battery.warn_period,
+            ),
+            home=start.home,
+        )
+        half = [size / 2 for size in spec.size]
+        robot.body = self.physics.box(half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw)
+        robot.connect(self.bus)
+        return robot
+
+    def _thing(self, placed: Placed, look: ObjectsSpec) -> Thing:
+        if placed.kind == "weed":
+            body = self.physics.cylinder(look.size / 2, 0.1, (placed.x, placed.y, 0.05), look.color)
+        else:
+            half = look.size / 2
+            body = self.physics.box((half, half, half), (placed.x, placed.y, half), look.color)
+        return Thing(placed.kind, placed.id, placed.x, placed.y, body)
 
     # -- running ----------------------------------------------------------------------------------
 
