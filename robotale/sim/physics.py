@@ -60,6 +60,7 @@ class Physics:
 
     def __init__(self, *, gui: bool = False) -> None:
         self.gui = gui
+        self._drawn: dict[str, list[int]] = {}
         if not gui and _SPARE:
             self.client = _SPARE.pop()
             return
@@ -187,6 +188,22 @@ class Physics:
         """The bodies whose bounding boxes overlap the box from ``low`` to ``high``."""
         found = pybullet.getOverlappingObjects(low, high, physicsClientId=self.client)
         return {body for body, _ in found or ()}
+
+    def show(self, key: str, segments: Sequence[tuple[Sequence[float], Sequence[float]]]) -> None:
+        """Draw (or move) the line segments named ``key`` in the window (a sensor's view)."""
+        drawn = self._drawn.setdefault(key, [])
+        for index, (start, end) in enumerate(segments):
+            replace = drawn[index] if index < len(drawn) else -1
+            item = pybullet.addUserDebugLine(
+                start,
+                end,
+                lineColorRGB=(0.2, 0.4, 1.0),
+                lineWidth=2.0,
+                replaceItemUniqueId=replace,
+                physicsClientId=self.client,
+            )
+            if replace < 0:
+                drawn.append(item)
 
     def follow(self, position: Sequence[float]) -> None:
         """Keep the window's camera on a point."""

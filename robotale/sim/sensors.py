@@ -25,6 +25,23 @@ ULTRASOUND = 0  # sensor_msgs/msg/Range radiation_type
 def sonar(physics: Physics, robot: SimRobot, spec: RangeSpec) -> tuple[float, int]:
     """The distance to the nearest body in the beam (``max_range`` when none) and that body
     (-1 when none)."""
+    starts, ends = _beam(robot, spec)
+    hits = physics.rays(starts, ends, ignore=robot.body)
+    if physics.gui:  # each ray up to what it hits, like the thesis' blue cones
+        physics.show(
+            f"{robot.name}/range",
+            [(a, _along(a, b, f)) for a, b, (_, f) in zip(starts, ends, hits, strict=True)],
+        )
+    fraction, body = min((f, b) for b, f in hits)
+    return fraction * spec.max_range, body
+
+
+def _along(start, end, fraction: float) -> tuple[float, ...]:
+    return tuple(a + (b - a) * fraction for a, b in zip(start, end, strict=True))
+
+
+def _beam(robot: SimRobot, spec: RangeSpec):
+    """The rays of a range sensor: start and end points."""
     pose = robot.pose
     if spec.direction == "down":
         start = (pose.x, pose.y, pose.z)
@@ -45,9 +62,7 @@ def sonar(physics: Physics, robot: SimRobot, spec: RangeSpec) -> tuple[float, in
                     height,
                 )
             )
-    hits = physics.rays(starts, ends, ignore=robot.body)
-    fraction, body = min((f, b) for b, f in hits)
-    return fraction * spec.max_range, body
+    return starts, ends
 
 
 def range_message(now: float, robot: SimRobot, spec: RangeSpec, distance: float) -> dict[str, Any]:
@@ -68,9 +83,17 @@ def camera_view(physics: Physics, robot: SimRobot, spec: CameraSpec) -> set[int]
     if pose.z < 0.3:
         return set()
     half = pose.z * math.tan(math.radians(spec.fov) / 2)
+    if physics.gui:
+        corners = [(pose.x + dx * half, pose.y + dy * half, 0.02) for dx, dy in _SQUARE]
+        physics.show(
+            f"{robot.name}/camera", list(zip(corners, [*corners[1:], corners[0]], strict=True))
+        )
     return physics.overlapping(
         (pose.x - half, pose.y - half, -0.05), (pose.x + half, pose.y + half, 0.3)
     )
+
+
+_SQUARE = ((-1, -1), (1, -1), (1, 1), (-1, 1))
 
 
 def detection_message(now: float, robot: SimRobot, object_id: str, x: float, y: float):
