@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import math
 
-from conftest import manifest, messages, record, seconds, tags
+from simbags import manifest, messages, record, seconds, tags
 
 from robotale.sim.commands import adjust
 from robotale.sim.faults import parse_fault

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 import pytest
-from conftest import manifest
+from simbags import manifest
 
 from robotale.cli import main
 from robotale.errors import InputError

@@ -7,7 +7,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 import pytest
-from conftest import manifest, messages, record, seconds, tags
+from simbags import manifest, messages, record, seconds, tags
 
 from robotale.errors import InputError
 from robotale.sim.commands import adjust

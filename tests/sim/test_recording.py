@@ -7,8 +7,8 @@ import itertools
 import json
 
 import pytest
-from conftest import manifest, messages, record, typestore
 from rosbags.rosbag2 import Reader
+from simbags import manifest, messages, record, typestore
 
 from robotale.fame_runtime.tags import TAG_TYPE
 

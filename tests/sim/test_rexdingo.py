@@ -6,7 +6,7 @@ from __future__ import annotations
 import json
 import math
 
-from conftest import manifest, messages, record, tags
+from simbags import manifest, messages, record, tags
 
 
 def test_rexdingo_ends_with_dingos_fire_and_both_processes_ended_by_done(rexdingo, tmp_path):
