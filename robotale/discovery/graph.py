@@ -18,6 +18,8 @@ import math
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
+import pandas as pd
+
 START_NODE = "__start__"
 END_NODE = "__end__"
 
@@ -69,7 +71,7 @@ class ProcessGraph:
         }
 
     def to_dict(self) -> dict[str, Any]:
-        return _finite(
+        return json_ready(
             {
                 "kind": self.kind,
                 "info": self.info,
@@ -117,14 +119,19 @@ def format_seconds(seconds: float | None) -> str:
     return f"{hours}h{minutes:02d}m"
 
 
-def _finite(value: Any) -> Any:
-    """NaN and infinities become ``None`` so the output is strict JSON."""
-    if isinstance(value, float):
-        return value if math.isfinite(value) else None
+def json_ready(value: Any) -> Any:
+    """``value`` with NaN, NaT, NA and infinities as ``None``, timestamps as ISO text and
+    numpy scalars as Python numbers, so ``json.dumps`` writes strict JSON."""
     if isinstance(value, dict):
-        return {k: _finite(v) for k, v in value.items()}
+        return {str(k): json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):
-        return [_finite(v) for v in value]
+        return [json_ready(v) for v in value]
+    if pd.api.types.is_scalar(value) and pd.isna(value):
+        return None
+    if hasattr(value, "isoformat"):
+        return value.isoformat()
     if hasattr(value, "item"):  # numpy scalars
-        return _finite(value.item())
+        value = value.item()
+    if isinstance(value, float) and not math.isfinite(value):
+        return None
     return value

@@ -11,6 +11,8 @@ firing) is an instance that starts and completes at once.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 import pandas as pd
 
@@ -44,13 +46,14 @@ def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
     return log[keep.to_numpy(bool)]
 
 
-def activity_instances(log: pd.DataFrame) -> pd.DataFrame:
+def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
     """One row per activity instance, ordered by case, start and completion.
 
     Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
-    completion), ``duration`` in seconds and ``finished``. A start that never completes is an
-    unfinished instance (no completion, no duration); a completion without a start, and an
-    instant event, starts when it completes.
+    completion), ``duration`` in seconds and ``finished``; for every column named in ``carry``
+    its value at the start as ``start_<column>`` (a battery level, say). A start that never
+    completes is an unfinished instance (no completion, no duration); a completion without a
+    start, and an instant event, starts when it completes.
     """
     events = control_flow_events(log)
     if events.empty:
@@ -62,16 +65,20 @@ def activity_instances(log: pd.DataFrame) -> pd.DataFrame:
     starts = (lifecycle == START).to_numpy()
     completes = (lifecycle == COMPLETE).to_numpy()
     matched = _matched_completes(group.to_numpy(), starts, completes)
-    start_times = _paired_start_times(events, group.to_numpy(), starts, matched)
+    from_start = {TIMESTAMP: START_TIMESTAMP} | {c: f"start_{c}" for c in carry}
+    paired_starts = _paired_starts(events, group.to_numpy(), starts, matched, list(from_start))
 
     anchors = ~starts  # completes and instant events
     finished = events[anchors].copy()
-    finished[START_TIMESTAMP] = finished[TIMESTAMP]
     paired = matched[anchors]
-    finished.loc[paired, START_TIMESTAMP] = start_times.set_axis(finished.index[paired])
+    for column, renamed in from_start.items():
+        finished[renamed] = finished[column]
+        values = paired_starts[column].set_axis(finished.index[paired])
+        finished.loc[paired, renamed] = values
     finished[FINISHED] = True
     unfinished = events[starts & ~_consumed_starts(group.to_numpy(), starts, matched)].copy()
-    unfinished[START_TIMESTAMP] = unfinished[TIMESTAMP]
+    for column, renamed in from_start.items():
+        unfinished[renamed] = unfinished[column]
     unfinished[TIMESTAMP] = pd.Series(pd.NaT, index=unfinished.index, dtype=events[TIMESTAMP].dtype)
     unfinished[FINISHED] = False
 
@@ -110,18 +117,21 @@ def _matched_completes(group: np.ndarray, starts: np.ndarray, completes: np.ndar
     return completes & (open_before.to_numpy() > 0)
 
 
-def _paired_start_times(
-    events: pd.DataFrame, group: np.ndarray, starts: np.ndarray, matched: np.ndarray
-) -> pd.Series:
-    """Start timestamps for the matched completes: first in, first out within each group,
-    so the k-th matched complete of a group pairs with the group's k-th start."""
+def _paired_starts(
+    events: pd.DataFrame,
+    group: np.ndarray,
+    starts: np.ndarray,
+    matched: np.ndarray,
+    columns: list[str],
+) -> pd.DataFrame:
+    """The start events' ``columns`` for the matched completes: first in, first out within
+    each group, so the k-th matched complete of a group pairs with the group's k-th start."""
     start_rank = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
     match_rank = pd.Series(group[matched]).groupby(group[matched]).cumcount().to_numpy()
-    start_table = pd.DataFrame(
-        {"g": group[starts], "k": start_rank, "t": events[TIMESTAMP][starts].to_numpy()}
-    )
-    wanted = pd.DataFrame({"g": group[matched], "k": match_rank})
-    return wanted.merge(start_table, on=["g", "k"], how="left")["t"]
+    start_table = events.loc[starts, columns].reset_index(drop=True)
+    start_table = start_table.assign(_g=group[starts], _k=start_rank)
+    wanted = pd.DataFrame({"_g": group[matched], "_k": match_rank})
+    return wanted.merge(start_table, on=["_g", "_k"], how="left")
 
 
 def _consumed_starts(group: np.ndarray, starts: np.ndarray, matched: np.ndarray) -> np.ndarray:
