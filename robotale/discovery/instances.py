@@ -47,7 +47,8 @@ def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
 
 
 def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
-    """One row per activity instance, ordered by case, start and completion.
+    """One row per activity instance, ordered by case and start (ties: the order in which
+    the start events appear in the log).
 
     Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
     completion), ``duration`` in seconds and ``finished``; for every column named in ``carry``
@@ -65,7 +66,9 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     starts = (lifecycle == START).to_numpy()
     completes = (lifecycle == COMPLETE).to_numpy()
     matched = _matched_completes(group.to_numpy(), starts, completes)
-    from_start = {TIMESTAMP: START_TIMESTAMP} | {c: f"start_{c}" for c in carry}
+    # the start event's position breaks ties between instances that start at the same time
+    from_start = {TIMESTAMP: START_TIMESTAMP, "_order": "_start_order"}
+    from_start |= {c: f"start_{c}" for c in carry}
     paired_starts = _paired_starts(events, group.to_numpy(), starts, matched, list(from_start))
 
     anchors = ~starts  # completes and instant events
@@ -84,8 +87,8 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
 
     instances = pd.concat([finished, unfinished])
     instances[DURATION] = (instances[TIMESTAMP] - instances[START_TIMESTAMP]).dt.total_seconds()
-    instances = instances.sort_values([CASE, START_TIMESTAMP, TIMESTAMP, "_order"], kind="stable")
-    return instances.drop(columns="_order").reset_index(drop=True)
+    instances = instances.sort_values([CASE, START_TIMESTAMP, "_start_order"], kind="stable")
+    return instances.drop(columns=["_order", "_start_order"]).reset_index(drop=True)
 
 
 def _lifecycle(log: pd.DataFrame) -> pd.Series:
