@@ -2,11 +2,11 @@
 
 Tags mark where an activity starts and where it completes; control flow is about the activity
 instances those pairs delimit. Pairing follows pm4py's interval logs (first in, first out per
-activity), but per robot and per instance key (``concept:instance`` when the log has it,
-otherwise ``msg_id``), because robots run at the same time within one case and a message
-activity's start and complete always share the message id. ``inprogress`` rows carry
-continuous data and are never instances; an instant event (lifecycle ``none``, such as a timer
-firing) is an instance that starts and completes at once.
+activity), but per robot and per instance key (``execution_id`` or ``concept:instance`` when
+the log has one, otherwise ``msg_id``), because robots run at the same time within one case
+and a message activity's start and complete always share the message id. ``inprogress`` rows
+carry continuous data and are never instances; an instant event (lifecycle ``none``, such as a
+timer firing) is an instance that starts and completes at once.
 """
 
 from __future__ import annotations
@@ -31,8 +31,9 @@ from robotale.ingest.schema import (
 
 #: pm4py's column for the start of an interval event.
 START_TIMESTAMP = "start_timestamp"
-#: XES's lifecycle instance attribute (pairs a start with its complete when present).
-INSTANCE = "concept:instance"
+#: columns naming an activity instance (a start and its complete share the value), in the
+#: order they are looked for: robotale's own, XES's lifecycle instance, the message id.
+INSTANCE_KEYS = ("execution_id", "concept:instance", MSG_ID)
 DURATION = "duration"
 FINISHED = "finished"
 
@@ -99,7 +100,7 @@ def _lifecycle(log: pd.DataFrame) -> pd.Series:
 
 def _pairing_keys(events: pd.DataFrame) -> list[str]:
     keys = [column for column in (CASE, ROBOT, ACTIVITY) if column in events.columns]
-    for instance_key in (INSTANCE, MSG_ID):
+    for instance_key in INSTANCE_KEYS:
         if instance_key in events.columns:
             return [*keys, instance_key]
     return keys
