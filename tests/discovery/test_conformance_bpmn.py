@@ -1,0 +1,128 @@
+"""Conformance against BPMN collaborations, with logs the engine itself produced."""
+
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from robotale.discovery.bpmn_net import process_net
+from robotale.discovery.conformance import check_conformance
+from robotale.errors import InputError
+from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, MSG_ID, MSG_ROLE, ROBOT, TIMESTAMP
+
+# the BPMN parser, splitter and engine of robotale.fame_runtime
+Mission = pytest.importorskip("robotale.fame_runtime.mission").Mission
+from robotale.fame_runtime.library import Library, find_process  # noqa: E402
+from robotale.fame_runtime.parser import parse  # noqa: E402
+from robotale.fame_runtime.plan import signal_name  # noqa: E402
+
+MODEL = Path(__file__).parent / "models" / "scout_workers.bpmn"
+
+
+def engine_log(case: str, robots: list[str], planned: int) -> pd.DataFrame:
+    """Run the mission on the in-process bus and turn its tags into an event log."""
+    tags = []
+    mission = Mission(
+        MODEL, robots=robots, tag_sink=tags.append, variables={"scout": {"planned": planned}}
+    )
+    mission.run(until=10_000)
+    return pd.DataFrame(
+        {
+            CASE: case,
+            TIMESTAMP: pd.to_datetime([t.stamp for t in tags], unit="s", utc=True),
+            ACTIVITY: [t.activity for t in tags],
+            LIFECYCLE: [t.lifecycle for t in tags],
+            ROBOT: [t.robot for t in tags],
+            MSG_ID: [t.msg_id or None for t in tags],
+            MSG_ROLE: [t.msg_role or None for t in tags],
+        }
+    )
+
+
+@pytest.fixture(scope="module")
+def runs() -> pd.DataFrame:
+    """Three runs taking different paths: two finds with two workers, three finds with one,
+    and one find with no worker at all, so the scout gives up waiting (its timer fires)."""
+    return pd.concat(
+        [
+            engine_log("1", ["scout", "worker_1", "worker_2"], planned=2),
+            engine_log("2", ["scout", "worker_1"], planned=3),
+            engine_log("3", ["scout"], planned=1),
+        ],
+        ignore_index=True,
+    )
+
+
+def test_runs_the_engine_produced_fit_the_model(runs):
+    assert "give_up" in set(runs[ACTIVITY])  # the timer path was taken
+    report = check_conformance(runs, MODEL)
+    assert report.summary["fitting"] and report.summary["fitness"] == 1.0
+    robots = report.robots.set_index("robot")
+    assert robots.loc["scout", "pool"] == "Scout" and robots.loc["scout", "runs"] == 3
+    assert robots.loc["worker_1", "pool"] == "Worker" and robots.loc["worker_1", "runs"] == 2
+    assert set(report.runs["method"]) == {"alignment"}
+    assert report.deviations.empty
+
+
+def test_a_missing_activity_is_named(runs):
+    treat = runs.index[
+        (runs[CASE] == "2") & (runs[ROBOT] == "worker_1") & (runs[ACTIVITY] == "treat")
+    ]
+    report = check_conformance(runs.drop(treat[:2]), MODEL)  # the first treatment's two tags
+    run = report.runs.set_index(["case", "robot"]).loc[("2", "worker_1")]
+    assert run["fitness"] < 1 and run["deviations"] == "missing treat"
+    assert report.deviations.to_dict("records") == [
+        {"robot": "worker_1", "activity": "treat", "kind": "missing", "count": 1, "runs": 1}
+    ]
+    others = report.runs[(report.runs["case"] != "2") | (report.runs["robot"] != "worker_1")]
+    assert others["fits"].all()
+
+
+def test_swapped_activities_are_named(runs):
+    scout = runs[(runs[CASE] == "1") & (runs[ROBOT] == "scout")]
+    first_two = scout[scout[ACTIVITY].isin(["take_off", "survey"])].index[:4]
+    # every tag carries the same simulated time, so the order of the rows is the order of events
+    order = list(runs.index)
+    take_off, survey = list(first_two[:2]), list(first_two[2:])
+    position = order.index(take_off[0])
+    order[position : position + 4] = survey + take_off
+    swapped = runs.loc[order].reset_index(drop=True)
+    report = check_conformance(swapped, MODEL)
+    run = report.runs.set_index(["case", "robot"]).loc[("1", "scout")]
+    assert run["fitness"] < 1
+    assert {"take_off", "survey"} & set(report.deviations["activity"])
+    assert report.summary["fitness"] < 1
+
+
+def test_pools_that_do_not_match_the_robots_are_refused(runs):
+    strangers = runs.assign(**{ROBOT: runs[ROBOT].replace({"scout": "drone"})})
+    with pytest.raises(InputError, match=r"drone.*matches no pool.*Scout.*robots are drone"):
+        check_conformance(strangers, MODEL)
+
+
+def test_every_thesis_model_becomes_a_net(fame_models):
+    library = Library(fame_models / "fame-ros")
+    for path in sorted(fame_models.rglob("*.bpmn")):
+        definitions = parse(path)
+        for pool, process in definitions.pools():
+
+            def resolve(name, definitions=definitions):
+                return find_process(definitions, name) or library.find(name)
+
+            net, _, _ = process_net(process, set(), resolve, signal_name)
+            assert net.transitions, f"{path.name}: pool {pool.name} has no transition"
+
+
+def test_agricultural_pools_carry_the_message_labels(fame_models):
+    definitions = parse(fame_models / "fame-ros" / "agri.bpmn")
+    library = Library(fame_models / "fame-ros")
+    labels = {}
+    for pool, process in definitions.pools():
+        net, _, _ = process_net(process, set(), library.find, signal_name)
+        labels[pool.name] = {t.label for t in net.transitions if t.label}
+    assert {"weed_position!", "tractor_position?", "closest_tractor!", "weed_found?"} <= labels[
+        "Drone"
+    ]
+    assert {"weed_position?", "tractor_position!", "closest_tractor?", "cut_grass"} <= labels[
+        "Tractor"
+    ]
