@@ -127,12 +127,12 @@ class _Builder:
 
     # -- scopes ----------------------------------------------------------------------------------
 
-    def scope(self, content, scope: _Scope, entry, interrupts: _Scope | None = None) -> None:
+    def scope(self, content, scope: _Scope, entry, entries=None) -> None:
         """Translate the nodes and flows of a process or sub-process.
 
-        ``entry`` is the place a token enters the scope through. Without one (the top level,
-        an event sub-process) a none start event gets the initial token and a triggered start
-        needs none. ``interrupts`` is the scope an interrupting start event cancels.
+        ``entry`` is the place a token enters the scope through; ``entries`` gives start
+        events their own (an event sub-process's triggers). Without either (the top level) a
+        none start event gets the initial token and a triggered start needs none.
         """
         flows = {fid: self.place(scope, f"flow_{fid}") for fid in content.flows}
         incoming = _by(content.flows.values(), "target")
@@ -145,11 +145,11 @@ class _Builder:
             outs = [flows[f.id] for f in outgoing.get(node.id, [])]
             conditional = any(f.condition is not None for f in outgoing.get(node.id, []))
             if node.kind == "startEvent":
-                self.start(node, scope, entry, outs, interrupts)
+                self.start(node, scope, (entries or {}).get(node.id, entry), outs)
             elif node.kind == "boundaryEvent":
                 continue  # translated with the activity it is attached to
             elif node.kind == "subProcess" and node.triggered_by_event:
-                self.scope(node.scope, _Scope(done=None), entry=None, interrupts=scope)
+                self.event_subprocess(node, scope)
             elif node.kind in ACTIVITY_KINDS or node.kind not in _EVENT_AND_GATEWAY_KINDS:
                 ready = self.merge(scope, node.id, ins, entry)
                 boundaries = [
@@ -162,6 +162,18 @@ class _Builder:
                 self.flow_node(node, scope, entry, ins, outs, conditional)
         if scope.cancel is not None:
             self.drain(scope.places, scope.cancel, [scope.done] if scope.done else [])
+
+    def event_subprocess(self, node, parent: _Scope) -> None:
+        """An event sub-process starts (and is tagged with its own name) each time one of
+        its start events' triggers fires; an interrupting one cancels its parent scope."""
+        inner = _Scope(done=None)
+        entries = {}
+        for start in (n for n in node.scope.nodes.values() if n.kind == "startEvent"):
+            entries[start.id] = self.place(inner, f"triggered_{start.id}")
+            cancels = [self.cancel(parent)] if start.interrupting else []
+            label = activity_label(node.name, node.id)
+            self.transition(f"esp_{node.id}", label, [], [entries[start.id], *cancels])
+        self.scope(node.scope, inner, entry=None, entries=entries)
 
     def flow_node(self, node, scope: _Scope, entry, ins, outs, conditional: bool) -> None:
         """End events, gateways and intermediate events."""
@@ -186,18 +198,19 @@ class _Builder:
             self.transition(node.id, self.event_label(node), [ready], [done])
             self.split(scope, node.id, done, outs, conditional)
 
-    def start(self, node, scope: _Scope, entry, outs, interrupts: _Scope | None) -> None:
+    def start(self, node, scope: _Scope, entry, outs) -> None:
         label = self.event_label(node)
         if entry is not None:
             self.transition(f"start_{node.id}", label, [entry], outs)
-        elif interrupts is not None:  # an event sub-process: starts whenever triggered
-            cancels = [self.cancel(interrupts)] if node.interrupting else []
-            self.transition(f"start_{node.id}", label, [], [*outs, *cancels])
         elif node.event_kind == "none":
             source = self.place(scope, f"source_{node.id}")
             self.initial[source] = 1
             self.transition(f"start_{node.id}", label, [source], outs)
-        else:  # a triggered process start: one more instance each time its trigger fires
+        else:
+            # a triggered process start: one more instance each time its trigger fires. It
+            # stays visible even if never tagged: a silent transition that can always fire
+            # would let the alignment search wander without end.
+            label = label or activity_label(node.name, node.id)
             self.transition(f"start_{node.id}", label, [], outs)
 
     def end(self, node, scope: _Scope, ins) -> None:

@@ -1,11 +1,12 @@
 """Directly-follows graphs with pm4py (thesis 7.1.2, DFG-discovery).
 
 The DFG relates activity instances (:mod:`robotale.discovery.instances`) that follow each other
-directly within a case, ordered by start then completion as pm4py orders interval logs. Like
-the thesis' tool it adds an artificial start node joined to every first activity of a case and
-an end node joined from every last one. Edge durations are pm4py's: the time from the first
-activity's completion to the next one's start (zero when they overlap). Node durations are the
-activity instances' own.
+directly within a case, ordered by their start (instances that start at the same moment in the
+order of their start events in the log). Like the thesis' tool it adds an artificial start node
+joined to every first activity of a case and an end node joined from every last one. Edge
+durations are the time from the first activity's completion to the next one's start (zero when
+they overlap, as in pm4py's performance DFG of interval logs); node durations are the
+instances' own.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ import pandas as pd
 
 from robotale.discovery.filters import LogFilter, filter_log
 from robotale.discovery.graph import END_NODE, START_NODE, Edge, Node, ProcessGraph, duration_stats
-from robotale.discovery.instances import DURATION, FINISHED, activity_instances
+from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.errors import InputError
 from robotale.ingest.schema import ACTIVITY, CASE, REQUIRED, ROBOT, TIMESTAMP
 
@@ -34,9 +35,11 @@ def discover_dfg(log: pd.DataFrame, selection: LogFilter | None = None) -> Proce
     finished = instances[instances[FINISHED]]
     if finished.empty:
         raise InputError("the selected events contain no started or completed activity.")
-    interval_log = finished[[CASE, ACTIVITY, TIMESTAMP, "start_timestamp"]]
-    frequency, starts, ends = pm4py.discover_dfg(interval_log)
-    performance, _, _ = pm4py.discover_performance_dfg(interval_log, perf_aggregation_key="all")
+    # pm4py orders a case's events by timestamp, stably: given the start times it keeps the
+    # instances' own order, in which simultaneous starts follow the log
+    by_start = finished[[CASE, ACTIVITY]].assign(**{TIMESTAMP: finished[START_TIMESTAMP]})
+    frequency, starts, ends = pm4py.discover_dfg(by_start)
+    waits = _waits(finished)
 
     graph = ProcessGraph(kind="dfg", info=_info(events, selection))
     graph.nodes = _activity_nodes(instances)
@@ -50,7 +53,7 @@ def discover_dfg(log: pd.DataFrame, selection: LogFilter | None = None) -> Proce
             target=b,
             count=int(count),
             label=str(int(count)),
-            durations=_pm4py_durations(performance.get((a, b), {})),
+            durations=duration_stats(waits.get((a, b), [])),
         )
         for (a, b), count in sorted(frequency.items())
     ]
@@ -84,10 +87,15 @@ def _activity_nodes(instances: pd.DataFrame) -> list[Node]:
     return [node for node in nodes if node.count or node.properties["unfinished"]]
 
 
-def _pm4py_durations(stats: dict) -> dict[str, float | None]:
-    return {
-        key: None if stats.get(key) is None else float(stats[key]) for key in ("mean", "median")
-    }
+def _waits(finished: pd.DataFrame) -> dict[tuple[str, str], list[float]]:
+    """Seconds from each instance's completion to the next one's start in its case (zero
+    when they overlap), per pair of activities."""
+    following = finished.groupby(CASE, sort=False)[[ACTIVITY, START_TIMESTAMP]].shift(-1)
+    gap = (following[START_TIMESTAMP] - finished[TIMESTAMP]).dt.total_seconds()
+    pairs = pd.DataFrame(
+        {"a": finished[ACTIVITY], "b": following[ACTIVITY], "wait": gap.clip(lower=0)}
+    ).dropna(subset=["b"])
+    return {key: list(group) for key, group in pairs.groupby(["a", "b"])["wait"]}
 
 
 def _start_end_edge(source: str, target: str, count: int) -> Edge:

@@ -63,7 +63,7 @@ def robot_steps(instances: pd.DataFrame) -> pd.DataFrame:
     """Each robot's consecutive activity instances within a case and the wait between them
     (with the two instances' message ids when the log has them)."""
     keys = [CASE, ROBOT] if ROBOT in instances.columns else [CASE]
-    ordered = instances.sort_values([*keys, START_TIMESTAMP, TIMESTAMP], kind="stable")
+    ordered = instances.sort_values(keys, kind="stable")  # instances come in start order
     following = ordered.groupby(keys, sort=False, dropna=False).shift(-1)
     steps = pd.DataFrame(
         {

@@ -8,46 +8,24 @@ import pytest
 from robotale.discovery.bpmn_net import process_net
 from robotale.discovery.conformance import check_conformance
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, MSG_ID, MSG_ROLE, ROBOT, TIMESTAMP
-
-# the BPMN parser, splitter and engine of robotale.fame_runtime
-Mission = pytest.importorskip("robotale.fame_runtime.mission").Mission
-from robotale.fame_runtime.library import Library, find_process  # noqa: E402
-from robotale.fame_runtime.parser import parse  # noqa: E402
-from robotale.fame_runtime.plan import signal_name  # noqa: E402
+from robotale.fame_runtime.library import Library, find_process
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.plan import signal_name
+from robotale.ingest.schema import ACTIVITY, CASE, ROBOT
 
 MODEL = Path(__file__).parent / "models" / "scout_workers.bpmn"
 
 
-def engine_log(case: str, robots: list[str], planned: int) -> pd.DataFrame:
-    """Run the mission on the in-process bus and turn its tags into an event log."""
-    tags = []
-    mission = Mission(
-        MODEL, robots=robots, tag_sink=tags.append, variables={"scout": {"planned": planned}}
-    )
-    mission.run(until=10_000)
-    return pd.DataFrame(
-        {
-            CASE: case,
-            TIMESTAMP: pd.to_datetime([t.stamp for t in tags], unit="s", utc=True),
-            ACTIVITY: [t.activity for t in tags],
-            LIFECYCLE: [t.lifecycle for t in tags],
-            ROBOT: [t.robot for t in tags],
-            MSG_ID: [t.msg_id or None for t in tags],
-            MSG_ROLE: [t.msg_role or None for t in tags],
-        }
-    )
-
-
 @pytest.fixture(scope="module")
-def runs() -> pd.DataFrame:
+def runs(engine_log) -> pd.DataFrame:
     """Three runs taking different paths: two finds with two workers, three finds with one,
     and one find with no worker at all, so the scout gives up waiting (its timer fires)."""
+    teams = {"1": ["scout", "worker_1", "worker_2"], "2": ["scout", "worker_1"], "3": ["scout"]}
+    planned = {"1": 2, "2": 3, "3": 1}
     return pd.concat(
         [
-            engine_log("1", ["scout", "worker_1", "worker_2"], planned=2),
-            engine_log("2", ["scout", "worker_1"], planned=3),
-            engine_log("3", ["scout"], planned=1),
+            engine_log(MODEL, case, robots=robots, variables={"scout": {"planned": planned[case]}})
+            for case, robots in teams.items()
         ],
         ignore_index=True,
     )
