@@ -1,10 +1,9 @@
-"""Fixtures for the discovery tests: the thesis log as a canonical event log."""
-
-from pathlib import Path
+"""Fixtures for the discovery tests: the thesis log, and logs the engine produces."""
 
 import pandas as pd
 import pytest
 
+from robotale.ingest.readers import read_log
 from robotale.ingest.schema import (
     ACTIVITY,
     CASE,
@@ -16,20 +15,10 @@ from robotale.ingest.schema import (
 )
 
 
-def read_thesis_log(path: Path) -> pd.DataFrame:
-    """The thesis CSV in canonical columns, one case (it has no case column)."""
-    table = pd.read_csv(path, dtype={"msg_id": "string", "field": "string"})
-    table = table.rename(
-        columns={"time": TIMESTAMP, "activity": ACTIVITY, "lifecycle": LIFECYCLE, "resource": ROBOT}
-    )
-    table[TIMESTAMP] = pd.to_datetime(table[TIMESTAMP])
-    table[CASE] = "1"
-    return table
-
-
 @pytest.fixture(scope="session")
 def thesis_log(thesis_csv) -> pd.DataFrame:
-    return read_thesis_log(thesis_csv)
+    """The thesis CSV read as robotale reads it: one case (it has no case column)."""
+    return read_log(thesis_csv)
 
 
 def tags_to_log(tags, case: str) -> pd.DataFrame:

@@ -5,21 +5,16 @@ from collections.abc import Callable
 import pandas as pd
 import pytest
 
-from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, TIMESTAMP
+from robotale.ingest.readers import read_log
+from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, TIMESTAMP
 
 BASE = pd.Timestamp("2024-01-01T10:00:00+00:00")
 
 
 @pytest.fixture(scope="session")
 def thesis_log(thesis_csv) -> pd.DataFrame:
-    """The thesis CSV in canonical columns, one case (it has no case column)."""
-    table = pd.read_csv(thesis_csv, dtype={"msg_id": "string", "field": "string"})
-    table = table.rename(
-        columns={"time": TIMESTAMP, "activity": ACTIVITY, "lifecycle": LIFECYCLE, "resource": ROBOT}
-    )
-    table[TIMESTAMP] = pd.to_datetime(table[TIMESTAMP])
-    table[CASE] = "1"
-    return table
+    """The thesis CSV read as robotale reads it: one case (it has no case column)."""
+    return read_log(thesis_csv)
 
 
 @pytest.fixture
