@@ -95,3 +95,15 @@ def discover_conformance(args: argparse.Namespace) -> int:
         print("\nDeviations:")
         print(report.deviations.to_string(index=False))
     return 0
+
+
+def discover_ekg(args: argparse.Namespace) -> int:
+    from robotale.discovery.ekg import discover_ekg as discover
+
+    if args.svg:
+        from robotale.discovery.render import require_dot
+
+        require_dot()
+    entities = values([args.entities]) if args.entities else None
+    graph = discover(args.log_name, args.aggregate, entities)
+    return emit_graph(graph, args)
