@@ -96,11 +96,19 @@ class _Builder:
         self.signal_name = signal_name
         self.counter = itertools.count()
         self.calling: list[str] = []  # call activities being expanded (stops recursion)
+        self.cancellations: list[tuple[list, Any, list]] = []  # drained after reduction
 
     def build(self, process):
         from pm4py.objects.petri_net.obj import Marking
+        from pm4py.objects.petri_net.utils.reduction import apply_simple_reduction
 
         self.scope(process, _Scope(done=None), entry=None)
+        # Silent steps that only pass a token on are merged away: every silent step is a
+        # state more for the alignment search, and the language stays the same. Drains come
+        # after, for the places that remain (a drain on a place would keep it from merging).
+        apply_simple_reduction(self.net)
+        for places, signal, after in self.cancellations:
+            self.drain([p for p in places if p in self.net.places], signal, after)
         return self.net, self.initial, Marking()
 
     # -- places, transitions, arcs -------------------------------------------------------------
@@ -161,7 +169,8 @@ class _Builder:
             else:
                 self.flow_node(node, scope, entry, ins, outs, conditional)
         if scope.cancel is not None:
-            self.drain(scope.places, scope.cancel, [scope.done] if scope.done else [])
+            after = [scope.done] if scope.done else []
+            self.cancellations.append((scope.places, scope.cancel, after))
 
     def event_subprocess(self, node, parent: _Scope) -> None:
         """An event sub-process starts (and is tagged with its own name) each time one of
@@ -248,7 +257,7 @@ class _Builder:
             if boundary.cancel_activity:
                 killed = self.place(scope, f"killed_{node.id}")
                 self.transition(name, boundary_label, [active], [*outs, killed])
-                self.drain([*inner.places, inner.done], killed, [])
+                self.cancellations.append(([*inner.places, inner.done], killed, []))
             else:
                 self.transition(name, boundary_label, [active], [active, *outs])
         scope.places.extend(inner.places)

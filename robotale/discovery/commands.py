@@ -94,6 +94,9 @@ def discover_conformance(args: argparse.Namespace) -> int:
     else:
         print("\nDeviations:")
         print(report.deviations.to_string(index=False))
+    if not report.outside.empty:
+        print("\nMessages the processes do not model (sent or received by skills), not replayed:")
+        print(report.outside.to_string(index=False))
     return 0
 
 

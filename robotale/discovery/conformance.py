@@ -22,7 +22,7 @@ from robotale.discovery.bpmn_net import process_net
 from robotale.discovery.graph import json_ready
 from robotale.discovery.instances import START_TIMESTAMP, activity_instances
 from robotale.errors import InputError, ModelError
-from robotale.ingest.schema import ACTIVITY, CASE, ROBOT, TIMESTAMP
+from robotale.ingest.schema import ACTIVITY, CASE, MSG_ROLE, ROBOT, TIMESTAMP, message_roles
 
 SKIP = ">>"  # pm4py's "no move" in an alignment
 
@@ -42,13 +42,18 @@ class ConformanceReport:
 
     ``robots``: robot, pool, runs, fitness (mean over its runs), fitting runs. ``runs``: case,
     robot, fitness, fits, method (alignment or token replay), deviations. ``deviations``:
-    robot, activity, kind (unexpected / missing), count, runs.
+    robot, activity, kind (unexpected / missing), count, runs. ``outside``: robot, activity,
+    instances of the messages a robot sent or received that its process does not model (a
+    skill publishing a signal), left out of the replay.
     """
 
     robots: pd.DataFrame
     runs: pd.DataFrame
     deviations: pd.DataFrame
     summary: dict[str, Any] = field(default_factory=dict)
+    outside: pd.DataFrame = field(
+        default_factory=lambda: pd.DataFrame(columns=["robot", "activity", "instances"])
+    )
 
     @property
     def figure(self):
@@ -65,6 +70,7 @@ class ConformanceReport:
                 "robots": self.robots.to_dict(orient="records"),
                 "runs": self.runs.to_dict(orient="records"),
                 "deviations": self.deviations.to_dict(orient="records"),
+                "outside": self.outside.to_dict(orient="records"),
             }
         )
 
@@ -72,8 +78,9 @@ class ConformanceReport:
 def robot_traces(log: pd.DataFrame) -> pd.DataFrame:
     """Every activity instance with its case and robot, in start order (the traces)."""
     instances = activity_instances(log)  # already in start order; keep it within each robot
-    order = instances.sort_values([CASE, ROBOT], kind="stable")
-    return order[[CASE, ROBOT, ACTIVITY, START_TIMESTAMP]].reset_index(drop=True)
+    order = instances.sort_values([CASE, ROBOT], kind="stable").reset_index(drop=True)
+    traces = order[[CASE, ROBOT, ACTIVITY, START_TIMESTAMP]]
+    return traces.assign(**{MSG_ROLE: message_roles(order).to_numpy()})
 
 
 def replay(
@@ -211,9 +218,24 @@ def check_conformance(
         observed = set(traces.loc[traces[ROBOT] == assignment.robot, ACTIVITY])
         net = process_net(assignment.process, observed, resolve, signal_name)
         models[assignment.robot] = RobotModel(assignment.robot_type, *net)
-    report = replay(traces, models, seconds_per_trace=seconds_per_trace)
+    outside = _outside_the_models(traces, models)
+    report = replay(traces[~outside], models, seconds_per_trace=seconds_per_trace)
+    report.outside = (
+        traces[outside].groupby([ROBOT, ACTIVITY]).size().rename("instances").reset_index()
+    ).rename(columns={ACTIVITY: "activity"})
     report.summary["model"] = str(model)
     return report
+
+
+def _outside_the_models(traces: pd.DataFrame, models: dict[str, RobotModel]) -> pd.Series:
+    """Message instances whose label the robot's net does not have: code the process calls,
+    such as a skill, sent or received them, so the process has nothing to say about them."""
+    labels = {robot: {t.label for t in m.net.transitions if t.label} for robot, m in models.items()}
+    known = [
+        activity in labels.get(robot, ())
+        for robot, activity in zip(traces[ROBOT], traces[ACTIVITY], strict=True)
+    ]
+    return traces[MSG_ROLE].notna() & ~pd.Series(known, index=traces.index)
 
 
 def _bind(definitions, robots: list[str]) -> list:

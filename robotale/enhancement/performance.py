@@ -1,9 +1,10 @@
 """Performance: activity durations, waiting between activities, slowest transitions, cases.
 
 Durations are those of activity instances (a start paired with its completion). Waiting is
-measured per robot: the time from one of its activities completing to its next one starting
-(zero when a robot runs two activities at once), because a robot waits for its own next step,
-not for another robot's.
+measured per robot: the time before one of its activities starts during which the robot had
+no activity running (its previous activities had all completed). A robot running a long
+activity while others come and go, such as a drone exploring while it reports weeds, is not
+waiting; and a robot waits for its own next step, not for another robot's.
 """
 
 from __future__ import annotations
@@ -60,18 +61,20 @@ def finished_instances(log: pd.DataFrame) -> pd.DataFrame:
 
 
 def robot_steps(instances: pd.DataFrame) -> pd.DataFrame:
-    """Each robot's consecutive activity instances within a case and the wait between them
-    (with the two instances' message ids when the log has them)."""
+    """Each robot's consecutive activity instances within a case and the time it was idle
+    between them (with the two instances' message ids when the log has them)."""
     keys = [CASE, ROBOT] if ROBOT in instances.columns else [CASE]
     ordered = instances.sort_values(keys, kind="stable")  # instances come in start order
-    following = ordered.groupby(keys, sort=False, dropna=False).shift(-1)
+    by_robot = ordered.groupby(keys, sort=False, dropna=False)
+    following = by_robot.shift(-1)
+    busy_until = by_robot[TIMESTAMP].cummax()  # the latest completion so far
     steps = pd.DataFrame(
         {
             CASE: ordered[CASE],
             ROBOT: ordered[ROBOT] if ROBOT in ordered.columns else None,
             "source": ordered[ACTIVITY],
             "target": following[ACTIVITY],
-            "source_end": ordered[TIMESTAMP],
+            "source_end": busy_until,
             "target_start": following[START_TIMESTAMP],
         }
     )
