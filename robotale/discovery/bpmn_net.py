@@ -100,13 +100,22 @@ class _Builder:
 
     def build(self, process):
         from pm4py.objects.petri_net.obj import Marking
+        from pm4py.objects.petri_net.utils.petri_utils import remove_transition
         from pm4py.objects.petri_net.utils.reduction import apply_simple_reduction
 
         self.scope(process, _Scope(done=None), entry=None)
         # Silent steps that only pass a token on are merged away: every silent step is a
         # state more for the alignment search, and the language stays the same. Drains come
-        # after, for the places that remain (a drain on a place would keep it from merging).
+        # after, for the places that remain (a drain on a place would keep it from merging);
+        # the places a cancellation ends in are held in place meanwhile.
+        holds = [
+            self.transition("hold", "hold", inputs=[place])
+            for _, _, after in self.cancellations
+            for place in after
+        ]
         apply_simple_reduction(self.net)
+        for hold in holds:
+            remove_transition(self.net, hold)
         for places, signal, after in self.cancellations:
             self.drain([p for p in places if p in self.net.places], signal, after)
         return self.net, self.initial, Marking()

@@ -40,11 +40,11 @@ class RobotModel(NamedTuple):
 class ConformanceReport:
     """Fitness per robot and per run, and the deviating activities.
 
-    ``robots``: robot, pool, runs, fitness (mean over its runs), fitting runs. ``runs``: case,
-    robot, fitness, fits, method (alignment or token replay), deviations. ``deviations``:
-    robot, activity, kind (unexpected / missing), count, runs. ``outside``: robot, activity,
-    instances of the messages a robot sent or received that its process does not model (a
-    skill publishing a signal), left out of the replay.
+    ``robots``: robot, pool, runs, fitness (mean over its runs), fitting runs, method.
+    ``runs``: case, robot, fitness, fits, method (alignment or token replay), deviations.
+    ``deviations``: robot, activity, kind (unexpected / missing), count, runs. ``outside``:
+    robot, activity, instances of the messages a robot sent or received that its process does
+    not model (a skill publishing a signal), left out of the replay.
     """
 
     robots: pd.DataFrame
@@ -180,9 +180,11 @@ def _robot_table(runs: pd.DataFrame, models: dict[str, RobotModel]) -> pd.DataFr
                 "runs": len(mine),
                 "fitness": float(mine["fitness"].mean()) if len(mine) else None,
                 "fitting_runs": int(mine["fits"].sum()),
+                "method": " + ".join(sorted(set(mine["method"]))),
             }
         )
-    return pd.DataFrame(rows, columns=["robot", "pool", "runs", "fitness", "fitting_runs"])
+    columns = ["robot", "pool", "runs", "fitness", "fitting_runs", "method"]
+    return pd.DataFrame(rows, columns=columns)
 
 
 def check_conformance(
