@@ -104,3 +104,23 @@ def test_agricultural_pools_carry_the_message_labels(fame_models):
     assert {"weed_position?", "tractor_position!", "closest_tractor?", "cut_grass"} <= labels[
         "Tractor"
     ]
+
+
+def test_the_thesis_log_against_the_thesis_model(thesis_log, fame_models):
+    # the authors tagged their ROS code by hand (move, cut_grass ...), so their log and their
+    # model disagree in places; the drone's single long run takes the token-replay fallback
+    folder = fame_models / "fame-ros"
+    report = check_conformance(
+        thesis_log, folder / "agri.bpmn", library=folder, seconds_per_trace=1
+    )
+    robots = report.robots.set_index("robot")
+    assert robots.loc["drone", "method"] == "token replay"
+    assert robots.loc["tractor_1", "method"] == "alignment"
+    assert all(0 < f < 1 for f in robots["fitness"])
+    assert ("tractor_1", "move", "unexpected") in {
+        (d["robot"], d["activity"], d["kind"]) for d in report.deviations.to_dict("records")
+    }
+    # select_closest_tractor carries msg_role send, and no element of the model sends it
+    assert report.outside.to_dict("records") == [
+        {"robot": "drone", "activity": "select_closest_tractor", "instances": 108}
+    ]
