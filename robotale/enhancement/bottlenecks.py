@@ -154,9 +154,7 @@ def _rank(excess: pd.DataFrame, cases: pd.DataFrame) -> pd.DataFrame:
     ).reset_index()
     table["delay_per_case"] = table["total"] / n_cases
     table["share"] = table["total"] / total_time
-    table["longer_by"] = [
-        _longer_by(cases, rows.groupby(CASE)["excess"].sum()) for _, rows in grouped
-    ]
+    table["longer_by"] = _longer_by(excess, cases, table[["kind", "activity", "robot"]])
     table = table.sort_values(["delay_per_case", "occurrences"], ascending=[False, False])
     table = table.reset_index(drop=True)
     table.insert(0, "rank", range(1, len(table) + 1))
@@ -164,15 +162,21 @@ def _rank(excess: pd.DataFrame, cases: pd.DataFrame) -> pd.DataFrame:
     return table
 
 
-def _longer_by(cases: pd.DataFrame, excess_per_case: pd.Series) -> float | None:
-    """How much longer the cases hit hardest (excess above the median case's) take than the
-    others; ``None`` when the candidate costs every case the same."""
-    excess = excess_per_case.reindex(cases[CASE]).fillna(0).to_numpy()
-    hit = excess > pd.Series(excess).median()
-    if not hit.any():
-        return None
+def _longer_by(excess: pd.DataFrame, cases: pd.DataFrame, candidates: pd.DataFrame) -> list:
+    """Per candidate, how much longer the cases it hits hardest (excess above the median
+    case's) take than the others; ``None`` when it costs every case the same."""
+    keys = ["kind", "activity", "robot"]
+    labelled = excess.assign(robot=excess["robot"].fillna("\x00"))
+    per_case = labelled.pivot_table(
+        index=keys, columns=CASE, values="excess", aggfunc="sum", fill_value=0.0
+    ).reindex(columns=cases[CASE], fill_value=0.0)
     durations = cases["duration"].to_numpy()
-    return float(durations[hit].mean() - durations[~hit].mean())
+    hit = per_case.to_numpy() > per_case.median(axis=1).to_numpy()[:, None]
+    results = {}
+    for key, row in zip(per_case.index, hit, strict=True):
+        results[key] = float(durations[row].mean() - durations[~row].mean()) if row.any() else None
+    lookup = candidates.assign(robot=candidates["robot"].fillna("\x00"))
+    return [results[tuple(key)] for key in lookup.itertuples(index=False, name=None)]
 
 
 def _explain(row: pd.Series) -> str:

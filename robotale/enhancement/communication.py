@@ -47,13 +47,13 @@ def communication_perspective(
     if activity is not None:
         messages = messages[messages[TYPE] == _type_of(activity)]
     if robot is not None:
-        messages = messages[messages["robots"].map(lambda robots: robot in robots)]
+        messages = messages[_involving(log, messages, robot)]
     if messages.empty:
         return no_data("communication", f"no message involves {focus_label(activity, robot)}.")
     types = _by_type(messages)
     return Perspective(
         name="communication",
-        tables={"message_types": types, "messages": messages.drop(columns="robots")},
+        tables={"message_types": types, "messages": messages},
         figures={"messages": _figure(types)},
         summary={
             "messages": len(messages),
@@ -84,7 +84,6 @@ def message_table(log: pd.DataFrame) -> pd.DataFrame:
     table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
     table["attempts"] = _attempts(sends, keys).reindex(table.index).fillna(0).astype(int)
     table["receivers"] = _distinct(receives, keys, ROBOT).reindex(table.index).fillna(0)
-    table["robots"] = _robot_sets(events, keys).reindex(table.index)
     table["sent"] = table["attempts"] > 0
     table["received"] = table["received_at"].notna()
     table["lost"] = table["sent"] & ~table["received"]
@@ -127,10 +126,16 @@ def _distinct(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
     return events.groupby(keys)[column].nunique()
 
 
-def _robot_sets(events: pd.DataFrame, keys: list[str]) -> pd.Series:
-    if ROBOT not in events.columns:
-        return events.groupby(keys)[TIMESTAMP].agg(lambda _: frozenset())
-    return events.groupby(keys)[ROBOT].agg(lambda robots: frozenset(robots.dropna()))
+def _involving(log: pd.DataFrame, messages: pd.DataFrame, robot: str) -> pd.Series:
+    """Which messages ``robot`` sent or received."""
+    if ROBOT not in log.columns:
+        return pd.Series(False, index=messages.index)
+    keys = [CASE, MSG_ID] if CASE in messages.columns else [MSG_ID]
+    mine = log.loc[log[ROBOT].astype("string").eq(robot).fillna(False).to_numpy(bool), keys]
+    involved = pd.MultiIndex.from_frame(mine.dropna().astype(str).drop_duplicates())
+    return pd.Series(
+        pd.MultiIndex.from_frame(messages[keys].astype(str)).isin(involved), index=messages.index
+    )
 
 
 def _attempts(sends: pd.DataFrame, keys: list[str]) -> pd.Series:

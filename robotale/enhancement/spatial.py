@@ -19,6 +19,10 @@ from robotale.enhancement.result import Perspective, focus_events, focus_label, 
 from robotale.errors import InputError
 from robotale.ingest.schema import ACTIVITY, CASE, ROBOT, TIMESTAMP, X, Y, Z
 
+#: the 3D scatter draws at most this many positions (a random sample beyond that): a browser
+#: stays responsive, and the tables and coverage always use every position
+SCATTER_POINTS = 20_000
+
 
 @dataclass(frozen=True, slots=True)
 class Field:
@@ -71,11 +75,14 @@ def spatial_perspective(
     if placed.empty:
         return no_data("spatial", f"no event of {focus_label(activity, robot)} has a position.")
     placed = placed.assign(**{Z: placed[Z] if Z in placed.columns else 0.0})
+    shown = (
+        placed.sample(SCATTER_POINTS, random_state=0) if len(placed) > SCATTER_POINTS else placed
+    )
     result = Perspective(
         name="spatial",
         tables={"occupancy": _occupancy(placed)},
-        figures={"scatter": _scatter(placed)},
-        summary={"positions": len(placed), "bounds": bounds(placed)},
+        figures={"scatter": _scatter(shown.sort_index())},
+        summary={"positions": len(placed), "plotted": len(shown), "bounds": bounds(placed)},
     )
     if field is not None:
         coverage = covered_cells(placed, field)
@@ -170,18 +177,41 @@ def _coverage_table(placed: pd.DataFrame, field: Field) -> pd.DataFrame:
     return pd.DataFrame(rows)
 
 
-def _scatter(placed: pd.DataFrame):
-    import plotly.express as px
+#: the marker symbols a 3D scatter offers, one per robot
+SYMBOLS = (
+    "circle",
+    "diamond",
+    "square",
+    "cross",
+    "x",
+    "circle-open",
+    "diamond-open",
+    "square-open",
+)
 
-    figure = px.scatter_3d(
-        placed.rename(columns={ACTIVITY: "activity"}),
-        x=X,
-        y=Y,
-        z=Z,
-        color="activity",
-        symbol=ROBOT if ROBOT in placed.columns else None,
-        hover_data=[c for c in (ROBOT, TIMESTAMP) if c in placed.columns],
-        title="Spatial occupancy by activity and robot",
+
+def _scatter(placed: pd.DataFrame):
+    """One trace per activity (its colour), one marker symbol per robot."""
+    import plotly.graph_objects as go
+
+    robots = placed[ROBOT].astype("string").fillna("") if ROBOT in placed.columns else None
+    names = sorted(set(robots)) if robots is not None else []
+    symbol_of = {r: SYMBOLS[i % len(SYMBOLS)] for i, r in enumerate(names)}
+    figure = go.Figure()
+    for activity, points in placed.groupby(ACTIVITY, sort=True):
+        who = robots.loc[points.index] if robots is not None else None
+        figure.add_scatter3d(
+            x=points[X],
+            y=points[Y],
+            z=points[Z],
+            mode="markers",
+            name=str(activity),
+            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).tolist()},
+            text=None if who is None else who.tolist(),
+            hovertemplate="%{text}<br>x %{x:.2f}, y %{y:.2f}, z %{z:.2f}",
+        )
+    figure.update_layout(
+        title="Spatial occupancy by activity (colour) and robot (symbol)",
+        scene={"xaxis_title": "x", "yaxis_title": "y", "zaxis_title": "z"},
     )
-    figure.update_traces(marker={"size": 3})
     return figure
