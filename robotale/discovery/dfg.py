@@ -34,7 +34,7 @@ def discover_dfg(log: pd.DataFrame, selection: LogFilter | None = None) -> Proce
     instances = activity_instances(events)
     finished = instances[instances[FINISHED]]
     if finished.empty:
-        raise InputError("the selected events contain no started or completed activity.")
+        raise InputError("the selected events contain no completed activity.")
     # pm4py orders a case's events by timestamp, stably: given the start times it keeps the
     # instances' own order, in which simultaneous starts follow the log
     by_start = finished[[CASE, ACTIVITY]].assign(**{TIMESTAMP: finished[START_TIMESTAMP]})
