@@ -282,7 +282,7 @@ class _Builder:
             return None
         return self.resolve(name)
 
-    # -- helpers -----------------------------------------------------------------------------------
+    # -- merges, splits, cancellations --------------------------------------------------------
 
     def merge(self, scope: _Scope, node_id: str, ins, entry):
         """One place holding a token for the node: its incoming flows merged (or the scope's

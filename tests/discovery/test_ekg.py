@@ -1,4 +1,4 @@
-"""EKG discovery against the real Neo4j of the test session."""
+"""EKG discovery against the real Neo4j the tests start."""
 
 import json
 import re
