@@ -7,8 +7,9 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.installed
 
 # Debian packages the test suite drives for real: Chromium for the browser tests,
-# docker-compose to validate docker-compose.yml (no Docker engine is needed for that).
-SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose
+# docker-compose to validate docker-compose.yml (no Docker engine is needed for that),
+# Graphviz to draw discovered process models as SVG.
+SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
 .PHONY: install system-deps test demo bench lint format constraints clean
 

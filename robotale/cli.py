@@ -34,6 +34,8 @@ def build_parser() -> argparse.ArgumentParser:
     _add_ingest(commands)
     _add_logs(commands)
     _add_demo(commands)
+    _add_discover(commands)
+    _add_perspectives(commands)
     return parser
 
 
@@ -355,6 +357,111 @@ def _add_simulate(commands) -> None:
     simulate.add_argument("--overwrite", action="store_true", help="replace runs already in --out")
     simulate.add_argument("--quiet", action="store_true", help="no progress bar")
     simulate.set_defaults(handler=_lazy("robotale.sim.commands.simulate_command"))
+
+
+def _add_log_source(parser: argparse.ArgumentParser, stored: bool = False) -> None:
+    """The event log a discovery or perspectives command reads."""
+    parser.add_argument("log", nargs="?", help="event log file (.csv or .xes)")
+    if stored:
+        parser.add_argument("--log", dest="log_name", metavar="NAME", help="a log stored in Neo4j")
+    parser.add_argument(
+        "--map",
+        action="append",
+        default=[],
+        metavar="COLUMN=FIELD",
+        help="read COLUMN as FIELD (time, activity, case, robot ...). Repeatable",
+    )
+    parser.add_argument(
+        "--case-column", metavar="COLUMN", help="the column telling runs apart (default: case)"
+    )
+
+
+def _add_discover(commands: argparse._SubParsersAction) -> None:
+    discover = commands.add_parser(
+        "discover",
+        help="process models from a log: DFG, aggregated EKG, conformance to a BPMN model",
+        description="Discover process models from an event log (thesis 7.1.2).",
+    )
+    actions = discover.add_subparsers(dest="action", metavar="ACTION", required=True)
+    graph_output = {
+        "--out": {"metavar": "JSON", "help": "write the graph as JSON (default: print it)"},
+        "--svg": {"metavar": "SVG", "help": "draw the graph (needs Graphviz's dot)"},
+    }
+
+    dfg = actions.add_parser("dfg", help="directly-follows graph (pm4py)")
+    _add_log_source(dfg)
+    for flag, text in (
+        ("--case", "keep these cases (runs)"),
+        ("--robot", "keep these robots"),
+        ("--robot-type", "keep these robot types (pools)"),
+        ("--activity", "keep these activities"),
+    ):
+        dfg.add_argument(flag, action="append", metavar="A,B", help=f"{text}. Repeatable")
+    dfg.add_argument("--since", metavar="TIME", help="keep events at or after this ISO time")
+    dfg.add_argument("--until", metavar="TIME", help="keep events at or before this ISO time")
+    _add_graph_output(dfg, graph_output)
+    dfg.set_defaults(handler=_lazy("robotale.discovery.commands.discover_dfg"))
+
+    ekg = actions.add_parser("ekg", help="aggregated event knowledge graph from Neo4j")
+    ekg.add_argument("--log", dest="log_name", required=True, metavar="NAME", help="stored log")
+    ekg.add_argument(
+        "--aggregate",
+        default="activity,robot",
+        metavar="KEYS",
+        help="event properties a class is made of (default: %(default)s)",
+    )
+    ekg.add_argument(
+        "--entities", metavar="TYPES", help="entity types whose DF_C edges to show (default: all)"
+    )
+    _add_graph_output(ekg, graph_output)
+    ekg.set_defaults(handler=_lazy("robotale.discovery.commands.discover_ekg"))
+
+    conformance = actions.add_parser(
+        "conformance", help="replay each robot against its pool of a BPMN collaboration"
+    )
+    _add_log_source(conformance)
+    conformance.add_argument("--model", required=True, type=Path, help="the .bpmn collaboration")
+    conformance.add_argument("--library", type=Path, metavar="DIR", help="building blocks")
+    conformance.add_argument("--json", metavar="FILE", help="also write the report as JSON")
+    conformance.set_defaults(handler=_lazy("robotale.discovery.commands.discover_conformance"))
+
+
+def _add_graph_output(parser: argparse.ArgumentParser, options: dict) -> None:
+    for flag, keywords in options.items():
+        parser.add_argument(flag, **keywords)
+    parser.add_argument(
+        "--labels",
+        choices=("frequency", "performance"),
+        default="frequency",
+        help="what the SVG's edges show (default: %(default)s)",
+    )
+
+
+def _add_perspectives(commands: argparse._SubParsersAction) -> None:
+    perspectives = commands.add_parser(
+        "perspectives",
+        help="spatial, communication, battery, performance perspectives and bottlenecks",
+        description="Enhance the process with the log's perspectives (thesis 6.2.2, 7.2.2): "
+        "an HTML report (works offline) and/or JSON.",
+    )
+    _add_log_source(perspectives, stored=True)
+    perspectives.add_argument("--out", metavar="HTML", help="write the report as HTML")
+    perspectives.add_argument("--json", metavar="JSON", help="write the report as JSON")
+    perspectives.add_argument("--activity", help="only this activity (drill-down)")
+    perspectives.add_argument("--robot", help="only this robot (drill-down)")
+    perspectives.add_argument(
+        "--field",
+        metavar="X0,X1,Y0,Y1[,CELL]",
+        help="the field to measure coverage of, e.g. 0,10,0,10 (cells of 1 m by default)",
+    )
+    perspectives.add_argument(
+        "--threshold",
+        type=float,
+        default=20.0,
+        metavar="PERCENT",
+        help="battery level counted as low (default: %(default)s)",
+    )
+    perspectives.set_defaults(handler=_lazy("robotale.enhancement.commands.perspectives"))
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -1,0 +1,209 @@
+"""Aggregated EKG models from Neo4j (thesis 7.1.2, EKG-discovery; figure 7.7).
+
+A stored log's events are aggregated into classes by a key (``activity``, ``activity,robot``,
+``activity,robot,msg_id`` ...; robotale.ekg builds the Class nodes and DF_C edges, here they
+are built on demand for a key the log was not ingested with). The model shows:
+
+- one node per class, labelled with its key values and the number of events it aggregates;
+- the DF_C edges of the chosen entity types (``robot``: each robot's own flow; ``msg_id``:
+  the flow of each message across robots), each edge naming its entity type;
+- ``COMM`` edges between the classes of a message's send and receive events, with the number
+  of messages and their latency;
+- an entry node per entity joined to the class of its first event; when a type has many
+  entities (messages), one entry node stands for all of them, with counts on its edges.
+
+Every query is a file ``cypher/discover_*.cypher``, run with parameters.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections import Counter
+from collections.abc import Sequence
+from typing import Any
+
+import pandas as pd
+
+from robotale.discovery.graph import Edge, Node, ProcessGraph
+from robotale.errors import InputError
+from robotale.ingest import schema
+
+COMM = "COMM"
+#: above this many entities of a type, one entry node stands for all of them
+ENTRY_NODES_PER_TYPE = 12
+
+
+def discover_ekg(
+    log: str,
+    aggregate: str | Sequence[str] = "activity,robot",
+    entities: Sequence[str] | None = None,
+    *,
+    driver: Any = None,
+) -> ProcessGraph:
+    """The class graph of the stored log ``log`` aggregated by ``aggregate``, with the DF_C
+    edges of the entity types ``entities`` (default: all the log has)."""
+    if driver is None:
+        from robotale.ekg.connection import session_driver
+
+        with session_driver() as connected:
+            return discover_ekg(log, aggregate, entities, driver=connected)
+    from robotale.ekg.aggregate import aggregate as build_classes
+    from robotale.ekg.aggregate import aggregation_key, class_type
+
+    info = _log_info(driver, log)
+    key = aggregation_key(aggregate)
+    kind = class_type(key)
+    if kind not in (info["classTypes"] or []):
+        build_classes(driver, log, key)
+    types = _entity_types(info, entities, log)
+    graph = ProcessGraph(
+        kind="ekg", info={"log": log, "aggregate": key, "class_type": kind, "entities": types}
+    )
+    graph.nodes = _class_nodes(_run(driver, "discover_classes", log=log, type=kind), key)
+    graph.edges = _df_c_edges(_run(driver, "discover_df_c", log=log, type=kind, entityTypes=types))
+    graph.edges += _comm_edges(_run(driver, "discover_comm_c", log=log, type=kind))
+    for entity_type in types:
+        rows = _run(driver, "discover_entry_nodes", log=log, type=kind, entityType=entity_type)
+        nodes, edges = _entry(entity_type, rows)
+        graph.nodes += nodes
+        graph.edges += edges
+    return graph
+
+
+def read_stored_log(log: str, *, driver: Any = None) -> pd.DataFrame:
+    """The events of a stored log as a canonical event log (pm4py column names)."""
+    if driver is None:
+        from robotale.ekg.connection import session_driver
+
+        with session_driver() as connected:
+            return read_stored_log(log, driver=connected)
+    _log_info(driver, log)
+    rows = _run(driver, "discover_events", log=log)
+    table = pd.DataFrame([row["properties"] for row in rows])
+    table = table.drop(columns=["timestamp", "log", "order"], errors="ignore")
+    stamps = pd.Series([row["seconds"] * 10**9 + row["nanos"] for row in rows], dtype="int64")
+    times = pd.to_datetime(stamps, unit="ns", utc=True)
+    zone = rows[0]["zone"] if rows else "UTC"
+    table[schema.TIMESTAMP] = times.dt.tz_convert(_zone(zone))
+    return table.rename(columns=_canonical_names(table.columns))
+
+
+def _log_info(driver: Any, log: str) -> dict[str, Any]:
+    info = _run(driver, "ekg_log_info", log=log)[0]
+    if info["name"] is None:
+        raise InputError(f"There is no log named {log!r} in Neo4j (see `robotale logs list`).")
+    return info
+
+
+def _run(driver: Any, query: str, **parameters: Any) -> list[dict[str, Any]]:
+    from robotale.ekg.connection import database
+    from robotale.ekg.queries import cypher
+
+    records, _, _ = driver.execute_query(cypher(query), parameters, database_=database())
+    return [record.data() for record in records]
+
+
+def _entity_types(info: dict[str, Any], chosen: Sequence[str] | None, log: str) -> list[str]:
+    known = list(info["entityTypes"] or [])
+    if chosen is None:
+        return known
+    unknown = [name for name in chosen if name not in known]
+    if unknown:
+        raise InputError(
+            f"Log {log!r} has no entity type {unknown[0]!r}; its entity types are "
+            f"{', '.join(known) or 'none'}."
+        )
+    return list(chosen)
+
+
+def _class_nodes(rows: list[dict[str, Any]], key: list[str]) -> list[Node]:
+    nodes = []
+    for row in rows:
+        values = {name: row["properties"].get(name) for name in key}
+        robots = sorted(str(r) for r in row["robots"] if r is not None)
+        robot = values.get("robot") if "robot" in values else None
+        nodes.append(
+            Node(
+                id=row["id"],
+                label=_class_label(values),
+                count=int(row["events"]),
+                robot=robot if robot is not None else (robots[0] if len(robots) == 1 else None),
+                robots=robots,
+                properties=values,
+            )
+        )
+    return nodes
+
+
+def _class_label(values: dict[str, Any]) -> str:
+    """``explore (drone)``: the activity, then the other key values."""
+    activity = values.get("activity")
+    others = [str(v) for k, v in values.items() if k != "activity" and v is not None]
+    head = str(activity) if activity is not None else " / ".join(others)
+    rest = others if activity is not None else []
+    return f"{head} ({', '.join(rest)})" if rest else head
+
+
+def _df_c_edges(rows: list[dict[str, Any]]) -> list[Edge]:
+    return [_edge(row, row["entityType"]) for row in rows]
+
+
+def _comm_edges(rows: list[dict[str, Any]]) -> list[Edge]:
+    return [_edge(row, COMM) for row in rows]
+
+
+def _edge(row: dict[str, Any], entity_type: str) -> Edge:
+    return Edge(
+        source=row["source"],
+        target=row["target"],
+        count=int(row["count"]),
+        label=str(int(row["count"])),
+        entity_type=entity_type,
+        durations={"mean": row["meanSeconds"], "median": row["medianSeconds"]},
+    )
+
+
+def _entry(entity_type: str, rows: list[dict[str, Any]]) -> tuple[list[Node], list[Edge]]:
+    """Entry nodes of one entity type: one per entity, or one for all when there are many."""
+    entities = sorted({row["entity"] for row in rows})
+    if len(entities) <= ENTRY_NODES_PER_TYPE:
+        nodes = [_entity_node(f"{entity_type}:{e}", str(e), 1, entity_type) for e in entities]
+        edges = [
+            Edge(f"{entity_type}:{row['entity']}", row["class"], 1, "", entity_type) for row in rows
+        ]
+        return nodes, edges
+    node_id = f"{entity_type}:*"
+    node = _entity_node(node_id, f"{entity_type} ({len(entities)})", len(entities), entity_type)
+    counts = Counter(row["class"] for row in rows)
+    edges = [Edge(node_id, c, n, str(n), entity_type) for c, n in sorted(counts.items())]
+    return [node], edges
+
+
+def _entity_node(node_id: str, label: str, count: int, entity_type: str) -> Node:
+    return Node(
+        id=node_id,
+        label=label,
+        count=count,
+        kind="entity",
+        properties={"entity_type": entity_type},
+    )
+
+
+def _canonical_names(properties) -> dict[str, str]:
+    """Event property -> canonical column (``activity`` -> ``concept:name`` ...)."""
+    from robotale.ekg.tables import EVENT_PROPERTIES
+
+    back = {prop: column for column, prop in EVENT_PROPERTIES.items()}
+    back |= {short: column for column, short in schema.CSV_NAMES.items() if short not in back}
+    return {p: back[p] for p in properties if p in back}
+
+
+def _zone(name: str) -> dt.tzinfo | str:
+    """A zone Neo4j reports (``Europe/Rome``, ``UTC``, ``+01:00``, ``Z``) for pandas."""
+    if name in ("Z", "UTC", "+00:00"):
+        return "UTC"
+    if name[:1] in "+-" and ":" in name:
+        hours, minutes = name[1:].split(":")
+        offset = dt.timedelta(hours=int(hours), minutes=int(minutes))
+        return dt.timezone(-offset if name[0] == "-" else offset)
+    return name

@@ -1,0 +1,154 @@
+"""Activity instances: a start event paired with its complete event.
+
+Tags mark where an activity starts and where it completes; control flow is about the activity
+instances those pairs delimit. Pairing follows pm4py's interval logs (first in, first out per
+activity), but per robot and per instance key (``execution_id`` or ``concept:instance`` when
+the log has one, otherwise ``msg_id``), because robots run at the same time within one case
+and a message activity's start and complete always share the message id. ``inprogress`` rows
+carry continuous data and are never instances; an instant event (lifecycle ``none``, such as a
+timer firing) is an instance that starts and completes at once.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import pandas as pd
+
+from robotale.ingest.schema import (
+    ACTIVITY,
+    CASE,
+    COMPLETE,
+    INPROGRESS,
+    LIFECYCLE,
+    MSG_ID,
+    ROBOT,
+    START,
+    STATE,
+    TIMESTAMP,
+)
+
+#: pm4py's column for the start of an interval event.
+START_TIMESTAMP = "start_timestamp"
+#: columns naming an activity instance (a start and its complete share the value), in the
+#: order they are looked for: robotale's own, XES's lifecycle instance, the message id.
+INSTANCE_KEYS = ("execution_id", "concept:instance", MSG_ID)
+DURATION = "duration"
+FINISHED = "finished"
+
+
+def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
+    """The start, complete and instant events of ``log`` (no ``inprogress`` rows)."""
+    lifecycle = _lifecycle(log)
+    keep = lifecycle.isin([START, COMPLETE, "none"])
+    if STATE in log.columns:
+        keep &= log[STATE].astype("string").fillna("").str.lower().ne(INPROGRESS).to_numpy(bool)
+    return log[keep.to_numpy(bool)]
+
+
+def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
+    """One row per activity instance, ordered by case and start (ties: the order in which
+    the start events appear in the log).
+
+    Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
+    completion), ``duration`` in seconds and ``finished``; for every column named in ``carry``
+    its value at the start as ``start_<column>`` (a battery level, say). A start that never
+    completes is an unfinished instance (no completion, no duration); a completion without a
+    start, and an instant event, starts when it completes.
+    """
+    events = control_flow_events(log)
+    if events.empty:
+        return _empty_instances(log)
+    events = events.assign(_order=np.arange(len(events)))
+    events = events.sort_values([TIMESTAMP, "_order"], kind="stable")
+    lifecycle = _lifecycle(events)
+    group = events.groupby(_pairing_keys(events), dropna=False, sort=False).ngroup()
+    starts = (lifecycle == START).to_numpy()
+    completes = (lifecycle == COMPLETE).to_numpy()
+    matched = _matched_completes(group.to_numpy(), starts, completes)
+    # the start event's position breaks ties between instances that start at the same time
+    from_start = {TIMESTAMP: START_TIMESTAMP, "_order": "_start_order"}
+    from_start |= {c: f"start_{c}" for c in carry}
+    paired_starts = _paired_starts(events, group.to_numpy(), starts, matched, list(from_start))
+
+    anchors = ~starts  # completes and instant events
+    finished = events[anchors].copy()
+    paired = matched[anchors]
+    for column, renamed in from_start.items():
+        finished[renamed] = finished[column]
+        values = paired_starts[column].set_axis(finished.index[paired])
+        finished.loc[paired, renamed] = values
+    finished[FINISHED] = True
+    unfinished = events[starts & ~_consumed_starts(group.to_numpy(), starts, matched)].copy()
+    for column, renamed in from_start.items():
+        unfinished[renamed] = unfinished[column]
+    unfinished[TIMESTAMP] = pd.Series(pd.NaT, index=unfinished.index, dtype=events[TIMESTAMP].dtype)
+    unfinished[FINISHED] = False
+
+    instances = pd.concat([finished, unfinished])
+    instances[DURATION] = (instances[TIMESTAMP] - instances[START_TIMESTAMP]).dt.total_seconds()
+    instances = instances.sort_values([CASE, START_TIMESTAMP, "_start_order"], kind="stable")
+    return instances.drop(columns=["_order", "_start_order"]).reset_index(drop=True)
+
+
+def _lifecycle(log: pd.DataFrame) -> pd.Series:
+    if LIFECYCLE not in log.columns:
+        return pd.Series(COMPLETE, index=log.index)
+    return log[LIFECYCLE].astype("string").fillna(COMPLETE).str.lower()
+
+
+def _pairing_keys(events: pd.DataFrame) -> list[str]:
+    keys = [column for column in (CASE, ROBOT, ACTIVITY) if column in events.columns]
+    for instance_key in INSTANCE_KEYS:
+        if instance_key in events.columns:
+            return [*keys, instance_key]
+    return keys
+
+
+def _matched_completes(group: np.ndarray, starts: np.ndarray, completes: np.ndarray) -> np.ndarray:
+    """Which completes find an open start of their group (events in time order).
+
+    The number of open starts follows q_i = max(q_(i-1) + d_i, 0) with d = +1 for a start and
+    -1 for a complete; its closed form S_i - min(0, min_(k<=i) S_k) over the running sum S
+    keeps the pairing vectorised. A complete is matched when a start was open before it.
+    """
+    step = pd.Series(starts.astype(int) - completes.astype(int))
+    by_group = step.groupby(group)
+    running = by_group.cumsum()
+    open_now = running - running.groupby(group).cummin().clip(upper=0)
+    open_before = open_now.groupby(group).shift(1, fill_value=0)
+    return completes & (open_before.to_numpy() > 0)
+
+
+def _paired_starts(
+    events: pd.DataFrame,
+    group: np.ndarray,
+    starts: np.ndarray,
+    matched: np.ndarray,
+    columns: list[str],
+) -> pd.DataFrame:
+    """The start events' ``columns`` for the matched completes: first in, first out within
+    each group, so the k-th matched complete of a group pairs with the group's k-th start."""
+    start_rank = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
+    match_rank = pd.Series(group[matched]).groupby(group[matched]).cumcount().to_numpy()
+    start_table = events.loc[starts, columns].reset_index(drop=True)
+    start_table = start_table.assign(_g=group[starts], _k=start_rank)
+    wanted = pd.DataFrame({"_g": group[matched], "_k": match_rank})
+    return wanted.merge(start_table, on=["_g", "_k"], how="left")
+
+
+def _consumed_starts(group: np.ndarray, starts: np.ndarray, matched: np.ndarray) -> np.ndarray:
+    """Which starts were paired: the first n starts of a group with n matched completes."""
+    n_matched = pd.Series(matched).groupby(group).transform("sum").to_numpy()
+    rank = np.zeros(len(group), dtype=int)
+    rank[starts] = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
+    return starts & (rank < n_matched)
+
+
+def _empty_instances(log: pd.DataFrame) -> pd.DataFrame:
+    empty = log.iloc[0:0].copy()
+    empty[START_TIMESTAMP] = pd.Series(dtype=log[TIMESTAMP].dtype)
+    empty[DURATION] = pd.Series(dtype=float)
+    empty[FINISHED] = pd.Series(dtype=bool)
+    return empty

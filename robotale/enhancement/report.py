@@ -1,0 +1,90 @@
+"""All perspectives of a log at once, and their report as one HTML page and/or JSON file."""
+
+from __future__ import annotations
+
+import html
+import json
+from pathlib import Path
+
+import pandas as pd
+
+from robotale.discovery.output import write_texts
+from robotale.enhancement.battery import battery_perspective
+from robotale.enhancement.bottlenecks import find_bottlenecks
+from robotale.enhancement.communication import communication_perspective
+from robotale.enhancement.performance import performance_perspective
+from robotale.enhancement.result import Perspective
+from robotale.enhancement.spatial import Field, spatial_perspective
+
+
+def all_perspectives(
+    log: pd.DataFrame,
+    *,
+    activity: str | None = None,
+    robot: str | None = None,
+    field: Field | None = None,
+    threshold: float = 20.0,
+) -> dict[str, Perspective]:
+    """Spatial, communication, battery, performance and bottlenecks, for the whole log or for
+    one activity and/or robot."""
+    focus = {"activity": activity, "robot": robot}
+    return {
+        "spatial": spatial_perspective(log, field=field, **focus),
+        "communication": communication_perspective(log, **focus),
+        "battery": battery_perspective(log, threshold=threshold, **focus),
+        "performance": performance_perspective(log, **focus),
+        "bottlenecks": find_bottlenecks(log, **focus),
+    }
+
+
+def report_json(perspectives: dict[str, Perspective]) -> str:
+    return json.dumps({name: p.to_dict() for name, p in perspectives.items()}, ensure_ascii=False)
+
+
+def report_html(perspectives: dict[str, Perspective], title: str = "robotale perspectives") -> str:
+    """One self-contained page (plotly's script inlined once, so it works offline)."""
+    sections = []
+    script_included = False
+    for name, perspective in perspectives.items():
+        parts = [f"<h2>{html.escape(name.capitalize())}</h2>"]
+        if not perspective.has_data:
+            parts.append(f"<p class='empty'>{html.escape(perspective.message or '')}</p>")
+        for figure in perspective.figures.values():
+            parts.append(figure.to_html(full_html=False, include_plotlyjs=not script_included))
+            script_included = True
+        for table_name, table in perspective.tables.items():
+            if not table.empty:
+                parts.append(f"<h3>{html.escape(table_name.replace('_', ' '))}</h3>")
+                parts.append(table.head(200).to_html(index=False, border=0, float_format="%.3f"))
+        sections.append("<section>" + "\n".join(parts) + "</section>")
+    return (
+        "<!DOCTYPE html><html><head><meta charset='utf-8'>"
+        f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head>"
+        f"<body><h1>{html.escape(title)}</h1>{''.join(sections)}</body></html>"
+    )
+
+
+def write_report(
+    perspectives: dict[str, Perspective],
+    *,
+    html_path: Path | None = None,
+    json_path: Path | None = None,
+    title: str = "robotale perspectives",
+) -> None:
+    """Write the HTML page and/or JSON file; either both appear complete or neither does."""
+    outputs = []
+    if html_path is not None:
+        outputs.append((Path(html_path), report_html(perspectives, title)))
+    if json_path is not None:
+        outputs.append((Path(json_path), report_json(perspectives)))
+    write_texts(outputs)
+
+
+_STYLE = """
+body { font-family: Helvetica, Arial, sans-serif; margin: 2em; color: #222; }
+section { margin-bottom: 3em; }
+table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
+th, td { padding: 0.25em 0.6em; border-bottom: 1px solid #ddd; text-align: right; }
+th { background: #f4f4f4; }
+.empty { color: #888; font-style: italic; }
+"""

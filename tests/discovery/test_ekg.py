@@ -1,0 +1,128 @@
+"""EKG discovery against the real Neo4j the tests start."""
+
+import json
+import re
+import uuid
+
+import pm4py
+import pytest
+
+from robotale.cli import main
+from robotale.discovery import discover_ekg
+from robotale.discovery.ekg import COMM, read_stored_log
+from robotale.ekg import build_ekg
+from robotale.ekg.logs import delete_log
+from robotale.errors import InputError
+from robotale.ingest.schema import ACTIVITY, MSG_ID, ROBOT, TIMESTAMP
+
+
+@pytest.fixture(scope="module")
+def stored(neo4j_driver, thesis_log):
+    """The thesis log stored once for this module, with the activity classes only."""
+    name = f"test_discovery_{uuid.uuid4().hex[:8]}"
+    build_ekg(
+        neo4j_driver, thesis_log, name, entities=["robot", "msg_id"], aggregate=["activity"],
+        progress=False,
+    )  # fmt: skip
+    yield name
+    delete_log(neo4j_driver, name)
+
+
+@pytest.fixture(scope="module")
+def by_robot(stored, neo4j_driver):
+    """activity+robot classes: built on demand, the log was stored with activity only."""
+    return discover_ekg(stored, "activity,robot", driver=neo4j_driver)
+
+
+def test_per_robot_df_counts_equal_pm4py(by_robot, thesis_log):
+    for robot, events in thesis_log.groupby(ROBOT):
+        expected, _, _ = pm4py.discover_dfg(events.assign(**{"case:concept:name": robot}))
+        activity = {n.id: n.properties.get("activity") for n in by_robot.nodes}
+        edges = {
+            (activity[e.source], activity[e.target]): e.count
+            for e in by_robot.edges
+            if e.entity_type == "robot" and by_robot.node(e.source).robot == robot
+        }
+        assert edges == dict(expected), robot
+
+
+def test_classes_count_their_events(by_robot, thesis_log):
+    expected = thesis_log.groupby([ACTIVITY, ROBOT]).size()
+    classes = [n for n in by_robot.nodes if n.kind == "activity"]
+    assert len(classes) == len(expected)
+    for node in classes:
+        assert node.count == expected[(node.properties["activity"], node.robot)]
+    assert by_robot.node("explore|drone").label == "explore (drone)"
+    assert by_robot.info["class_type"] == "activity+robot"
+
+
+def test_comm_edges_count_messages_between_classes(by_robot, thesis_log):
+    # the thesis' convention: "!" sends, "?" receives (select_closest_tractor carries the
+    # msg_id of the message it prepares without passing it on)
+    names = thesis_log[ACTIVITY]
+    columns = [MSG_ID, ACTIVITY, ROBOT]
+    sends = thesis_log[names.str.endswith("!")][columns].drop_duplicates()
+    receives = thesis_log[names.str.endswith("?")][columns].drop_duplicates()
+    pairs = sends.merge(receives, on=MSG_ID, suffixes=("_s", "_r"))
+    pairs["source"] = pairs[f"{ACTIVITY}_s"] + "|" + pairs[f"{ROBOT}_s"]
+    pairs["target"] = pairs[f"{ACTIVITY}_r"] + "|" + pairs[f"{ROBOT}_r"]
+    expected = pairs.groupby(["source", "target"])[MSG_ID].nunique().to_dict()
+    comm = {(e.source, e.target): e.count for e in by_robot.edges if e.entity_type == COMM}
+    assert comm == expected
+    assert comm[("weed_position!|drone", "weed_position?|tractor_1")] > 0
+
+
+def test_entry_nodes_join_each_robot_to_its_first_class(by_robot, thesis_log):
+    entries = {(e.source, e.target) for e in by_robot.edges if e.source.startswith("robot:")}
+    firsts = thesis_log.groupby(ROBOT).first()
+    assert entries == {(f"robot:{r}", f"{row[ACTIVITY]}|{r}") for r, row in firsts.iterrows()}
+    assert by_robot.node("robot:drone").kind == "entity"
+    # 421 messages: one entry node stands for all of them
+    messages = by_robot.node("msg_id:*")
+    assert messages.count == thesis_log[MSG_ID].nunique() == 421
+    into = sum(e.count for e in by_robot.edges if e.source == "msg_id:*")
+    assert into == 421
+
+
+def test_choose_the_entity_types_to_show(stored, neo4j_driver):
+    graph = discover_ekg(stored, "activity", ["msg_id"], driver=neo4j_driver)
+    assert {e.entity_type for e in graph.edges} == {"msg_id", COMM}
+    assert graph.node("explore").robot == "drone"  # one robot explores
+    assert graph.node("move").robot is None and graph.node("move").robots == [
+        "drone",
+        "tractor_1",
+        "tractor_2",
+    ]
+
+
+def test_bad_requests_name_what_is_wrong(stored, neo4j_driver):
+    with pytest.raises(InputError, match=r"no entity type 'case'.*robot, msg_id"):
+        discover_ekg(stored, "activity", ["case"], driver=neo4j_driver)
+    with pytest.raises(InputError, match="no log named 'nowhere'"):
+        discover_ekg("nowhere", driver=neo4j_driver)
+    with pytest.raises(InputError, match="no property 'colour'"):
+        discover_ekg(stored, "activity,colour", driver=neo4j_driver)
+
+
+def test_a_stored_log_reads_back_as_it_went_in(stored, neo4j_driver, thesis_log):
+    back = read_stored_log(stored, driver=neo4j_driver)
+    assert len(back) == len(thesis_log)
+    assert back[TIMESTAMP].equals(thesis_log[TIMESTAMP].astype(back[TIMESTAMP].dtype))
+    assert back[ACTIVITY].tolist() == thesis_log[ACTIVITY].tolist()
+    assert back[ROBOT].tolist() == thesis_log[ROBOT].tolist()
+    assert str(back[TIMESTAMP].dt.tz) == str(thesis_log[TIMESTAMP].dt.tz)
+
+
+def test_command_line_writes_json_and_svg(stored, neo4j_server, tmp_path, capsys):
+    out, svg = tmp_path / "agri_ekg.json", tmp_path / "agri_ekg.svg"
+    code = main([
+        "discover", "ekg", "--log", stored, "--aggregate", "activity,robot",
+        "--entities", "robot,msg_id", "--out", str(out), "--svg", str(svg),
+    ])  # fmt: skip
+    assert code == 0
+    data = json.loads(out.read_text())
+    assert data["kind"] == "ekg" and {"robot", "msg_id", COMM} <= {
+        e["entity_type"] for e in data["edges"]
+    }
+    assert "explore (drone)" in re.findall(r"<text[^>]*>(.*?)</text>", svg.read_text())
+    assert "EKG:" in capsys.readouterr().out

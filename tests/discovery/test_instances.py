@@ -1,0 +1,65 @@
+import pandas as pd
+
+from robotale.discovery.instances import activity_instances
+from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, STATE, TIMESTAMP
+
+T0 = pd.Timestamp("2024-01-01T10:00:00+00:00")
+
+
+def log_of(rows, **extra) -> pd.DataFrame:
+    log = pd.DataFrame(rows, columns=[ACTIVITY, LIFECYCLE, "t", *extra])
+    log[TIMESTAMP] = T0 + pd.to_timedelta(log.pop("t"), unit="s")
+    return log.assign(**{CASE: "1", ROBOT: "r"})
+
+
+def test_execution_ids_pair_overlapping_runs_of_one_activity():
+    # two scans overlap; the second finishes first: first in, first out would pair them wrongly
+    log = log_of(
+        [("scan", "start", 0, "a"), ("scan", "start", 1, "b"), ("scan", "complete", 3, "b"),
+         ("scan", "complete", 10, "a")],
+        execution_id=None,
+    )  # fmt: skip
+    instances = activity_instances(log).set_index("execution_id")
+    assert instances.loc["a", "duration"] == 10.0 and instances.loc["b", "duration"] == 2.0
+    fifo = activity_instances(log.drop(columns="execution_id"))
+    assert sorted(fifo["duration"]) == [3.0, 9.0]  # what pairing without ids gives
+
+
+def test_instants_lone_completions_and_open_starts():
+    log = log_of(
+        [
+            ("timer", "none", 0),
+            ("move", "complete", 2),  # its start was not recorded
+            ("cut", "start", 3),  # never completes
+        ]
+    )
+    instances = activity_instances(log).set_index(ACTIVITY)
+    assert instances.loc["timer", "duration"] == 0.0 and instances.loc["timer", "finished"]
+    assert instances.loc["move", "duration"] == 0.0
+    assert not instances.loc["cut", "finished"] and pd.isna(instances.loc["cut", "duration"])
+    assert list(instances.index) == ["timer", "move", "cut"]
+
+
+def test_start_values_are_carried_and_inprogress_rows_ignored():
+    log = log_of(
+        [("fly", "start", 0, 90.0, "none"), ("fly", "none", 5, 80.0, "inprogress"),
+         ("fly", "complete", 10, 70.0, "none")],
+        battery=None,
+        **{STATE: None},
+    )  # fmt: skip
+    instances = activity_instances(log, carry=["battery"])
+    assert len(instances) == 1
+    assert instances.loc[0, ["start_battery", "battery", "duration"]].tolist() == [90.0, 70.0, 10.0]
+
+
+def test_ties_keep_the_order_of_the_starts():
+    # everything at one instant (a simulated clock): the log's order decides
+    log = log_of(
+        [
+            ("go_home", "start", 0),
+            ("fly_back", "start", 0),
+            ("fly_back", "complete", 0),
+            ("go_home", "complete", 0),
+        ]
+    )
+    assert list(activity_instances(log)[ACTIVITY]) == ["go_home", "fly_back"]

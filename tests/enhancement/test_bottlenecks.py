@@ -1,0 +1,106 @@
+import pytest
+
+from robotale.enhancement import find_bottlenecks
+
+
+@pytest.fixture
+def known_bottleneck(events):
+    """20 runs of a robot doing a, b, c, d. b is long work (60 s, always). In runs 0-9 the robot
+    waits 100 + 10 i seconds before c; otherwise every wait is half a second. A second robot
+    scans for 120 s in every run."""
+    rows = []
+    for run in range(20):
+        t = 0.0
+        for activity, duration in (("a", 5), ("b", 60 + (run % 3) * 0.1), ("c", 2), ("d", 3)):
+            wait = 100 + 10 * run if activity == "c" and run < 10 else 0.5
+            t += wait
+            rows.append((run, "r1", activity, "start", t))
+            t += duration
+            rows.append((run, "r1", activity, "complete", t))
+        rows += [(run, "r2", "scan", "start", 0.0), (run, "r2", "scan", "complete", 120.0)]
+    return events(
+        *[
+            {"case": str(c), "robot": r, "activity": a, "lifecycle": lc, "t": t}
+            for c, r, a, lc, t in rows
+        ]
+    )
+
+
+def test_the_known_bottleneck_comes_first(known_bottleneck):
+    ranking = find_bottlenecks(known_bottleneck).table
+    first = ranking.iloc[0]
+    assert (first["kind"], first["activity"], first["robot"]) == ("waiting", "c", "r1")
+    # the excess it costs: all its waiting, averaged over the 20 runs
+    waits = [100 + 10 * run for run in range(10)] + [0.5] * 10
+    assert first["delay_per_case"] == pytest.approx(sum(waits) / 20)
+    # the runs with the long waits take longer than the others, by less than the waits
+    # themselves because r2's 120 s scan hides part of r1's time
+    times = known_bottleneck.groupby("case:concept:name")["time:timestamp"]
+    seconds = (times.max() - times.min()).dt.total_seconds()
+    long_runs = seconds.index.astype(int) < 10
+    expected = seconds[long_runs].mean() - seconds[~long_runs].mean()
+    assert first["longer_by"] == pytest.approx(expected)
+    assert 90 < expected < 100
+    assert "r1 waits" in first["explanation"] and "before c" in first["explanation"]
+
+
+def test_long_steady_work_is_not_a_bottleneck(known_bottleneck):
+    ranking = find_bottlenecks(known_bottleneck).table
+    scan = ranking[ranking["activity"] == "scan"]
+    assert scan.empty  # 120 s every time: nothing to gain
+    b = ranking[(ranking["activity"] == "b") & (ranking["kind"] == "delay")]
+    assert b["delay_per_case"].iloc[0] < 0.1  # 60 s of work, at most 0.2 s above its fastest
+
+
+def test_resends_are_rework_and_message_latency_is_queueing(events):
+    log = events(
+        {"case": "1", "robot": "d", "activity": "w!", "lifecycle": "start", "msg_id": "m", "t": 0},
+        {
+            "case": "1",
+            "robot": "d",
+            "activity": "w!",
+            "lifecycle": "complete",
+            "msg_id": "m",
+            "t": 1,
+        },
+        {"case": "1", "robot": "d", "activity": "w!", "lifecycle": "start", "msg_id": "m", "t": 11},
+        {
+            "case": "1",
+            "robot": "d",
+            "activity": "w!",
+            "lifecycle": "complete",
+            "msg_id": "m",
+            "t": 12,
+        },
+        {
+            "case": "1",
+            "robot": "t",
+            "activity": "w?",
+            "lifecycle": "start",
+            "msg_id": "m",
+            "t": 11.5,
+        },
+        {
+            "case": "1",
+            "robot": "t",
+            "activity": "w?",
+            "lifecycle": "complete",
+            "msg_id": "m",
+            "t": 12,
+        },
+    )
+    ranking = find_bottlenecks(log).table.set_index("kind")
+    assert ranking.loc["rework", "total"] == 10 + 1  # the wait before the resend and the resend
+    assert ranking.loc["queueing", "total"] == 11.5
+    assert "waiting" not in ranking.index  # the receiver idling for the message is not counted
+
+
+def test_drill_down_and_nothing_to_report(known_bottleneck, events):
+    only_d = find_bottlenecks(known_bottleneck, activity="d").table
+    assert set(only_d["activity"]) == {"d"}
+    steady = events(
+        {"case": "1", "robot": "r", "activity": "a", "lifecycle": "start", "t": 0},
+        {"case": "1", "robot": "r", "activity": "a", "lifecycle": "complete", "t": 5},
+    )
+    result = find_bottlenecks(steady)
+    assert not result.has_data and "nothing delays" in result.message
