@@ -55,9 +55,7 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="robotale-bench-") as scratch:
         synthetic(Path(scratch) / "synthetic", args.samples, args.tags)
         synthetic_batch(Path(scratch) / "batch", args.runs)
-        batch = args.batch or simulate(Path(scratch) / "agri", args.runs)
-        if batch is not None:
-            agri(batch)
+        agri(args.batch or simulate(Path(scratch) / "agri", args.runs))
     return 0
 
 
@@ -109,16 +107,10 @@ def batch(root: Path, target: bool) -> None:
         print(f"  target: {len(runs)} runs prepare in under 30 s: {verdict} ({seconds:.1f} s)")
 
 
-def simulate(out: Path, runs: int) -> Path | None:
-    """The agri batch from robotale's simulator, when it is installed."""
+def simulate(out: Path, runs: int) -> Path:
+    """The agri batch from robotale's simulator."""
     command = [sys.executable, "-m", "robotale", "simulate", "agri", "--runs", str(runs)]
-    command += ["--tractors", "2", "--seed", "1", "--out", str(out)]
-    available = subprocess.run(
-        [sys.executable, "-m", "robotale", "simulate", "--help"], capture_output=True
-    )
-    if available.returncode != 0:
-        print("agri batch: skipped, `robotale simulate` is not available (or pass --batch DIR)")
-        return None
+    command += ["--tractors", "2", "--seed", "1", "--quiet", "--out", str(out)]
     began = time.perf_counter()
     subprocess.run(command, check=True, stdout=subprocess.DEVNULL)
     print(f"agri batch: {runs} runs simulated in {time.perf_counter() - began:.0f} s")

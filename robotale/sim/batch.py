@@ -25,6 +25,7 @@ from typing import Any
 from tqdm import tqdm
 
 from robotale.errors import InputError
+from robotale.sim import scenarios
 from robotale.sim.run import CRASHED, MANIFEST, RunPlan, simulate_run
 
 SUMMARY = "robotale-batch.json"
@@ -172,8 +173,8 @@ def _summary(
     first = plans[0]
     return {
         "scenario": first.scenario,
-        "model": str(first.world.model),
-        "world": str(first.world.file),
+        "model": scenarios.describe(first.world.model),
+        "world": scenarios.describe(first.world.file),
         "seed": first.batch_seed,
         "runs": len(manifests),
         "workers": workers,

@@ -28,6 +28,7 @@ from robotale.fame_runtime.plan import error_name, signal_topic
 from robotale.fame_runtime.skills import Skill, load_skills
 from robotale.fame_runtime.tags import bus_sink
 from robotale.sim import faults as fault_model
+from robotale.sim import scenarios
 from robotale.sim.faults import Fault, Planned
 from robotale.sim.recorder import Recorder
 from robotale.sim.setup import Setup, draw, run_seed
@@ -217,8 +218,8 @@ def _manifest(
     manifest: dict[str, Any] = {
         "case": plan.case,
         "scenario": plan.scenario or world.file.stem,
-        "model": str(world.model),
-        "world": str(world.file),
+        "model": scenarios.describe(world.model),
+        "world": scenarios.describe(world.file),
         "seed": plan.seed,
         "batch_seed": plan.batch_seed,
         "index": plan.index,

@@ -1,7 +1,6 @@
 """Bags from robotale's own agri simulation prepare to the drone process of the thesis (fig. 7.4).
 
-Runs against the real simulator (``robotale simulate``); until it is installed the test is
-skipped with a reason, never faked.
+Runs the real simulator (``robotale simulate``), then the preparation on its bags.
 """
 
 from __future__ import annotations
@@ -16,18 +15,8 @@ from robotale.ingest.prepare import prepare
 pytestmark = pytest.mark.filterwarnings("ignore:Install the optional requirement:UserWarning")
 
 
-def has_command(name: str, capsys) -> bool:
-    """Whether ``robotale NAME`` exists (argparse exits 0 on its --help, 2 if it is unknown)."""
-    with pytest.raises(SystemExit) as exit_:
-        main([name, "--help"])
-    capsys.readouterr()
-    return exit_.value.code == 0
-
-
 @pytest.fixture
-def agri_runs(tmp_path, capsys):
-    if not has_command("simulate", capsys):
-        pytest.skip("robotale's simulator (robotale simulate) is not installed yet")
+def agri_runs(tmp_path):
     out = tmp_path / "agri"
     status = main(
         ["simulate", "agri", "--runs", "2", "--tractors", "2", "--seed", "1", "--out", str(out)]

@@ -8,7 +8,7 @@ import time
 from pathlib import Path
 
 import pytest
-from simbags import manifest
+from simbags import manifest, record
 
 from robotale.cli import main
 from robotale.errors import InputError
@@ -187,3 +187,10 @@ def test_a_model_and_world_of_ones_own_run_from_the_command_line(tmp_path, capsy
     error = capsys.readouterr().err
     assert "where (Get Position)" in error and "Teleport" in error
     assert not (tmp_path / "other").exists()
+
+
+def test_manifests_name_shipped_scenarios_the_same_on_every_machine(short_agri, tmp_path):
+    bag = record(short_agri, tmp_path / "runs")
+    written = manifest(bag)
+    assert written["model"] == "robotale/sim/scenarios/agri.bpmn"
+    assert written["world"] == "robotale/sim/scenarios/agri.yaml"

@@ -21,3 +21,13 @@ def world_file(name: str) -> Path | None:
     """The world file of a shipped scenario, or None."""
     path = FOLDER / f"{name}.yaml"
     return path if path.is_file() else None
+
+
+def describe(path: Path) -> str:
+    """How a manifest names a model or world file: shipped ones by their place in the package
+    (``robotale/sim/scenarios/agri.bpmn``) so a recording reads the same on every machine; a
+    user's own file by its full path."""
+    resolved = Path(path).resolve()
+    if resolved.is_relative_to(FOLDER):
+        return f"robotale/sim/scenarios/{resolved.relative_to(FOLDER).as_posix()}"
+    return str(resolved)
