@@ -33,6 +33,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_neo4j(commands)
     _add_ingest(commands)
     _add_logs(commands)
+    _add_serve(commands)
     _add_demo(commands)
     _add_discover(commands)
     _add_perspectives(commands)
@@ -69,6 +70,27 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
     stop.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_stop"))
     status = actions.add_parser("status", help="where the server is and whether it answers")
     status.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_status"))
+
+
+def _add_serve(commands: argparse._SubParsersAction) -> None:
+    serve = commands.add_parser(
+        "serve",
+        help="the dashboard at http://127.0.0.1:5000",
+        description="Serve the dashboard (logs, discovery, perspectives, model, Cypher console) "
+        "against the Neo4j robotale uses (NEO4J_URI, or the local server).",
+    )
+    serve.add_argument(
+        "--host", default="127.0.0.1", help="address to listen on (127.0.0.1: this machine only)"
+    )
+    serve.add_argument("--port", type=int, default=5000, help="port to listen on (5000)")
+    serve.set_defaults(handler=_serve)
+
+
+def _serve(args: argparse.Namespace) -> int:
+    from robotale.webapp.serve import serve
+
+    serve(host=args.host, port=args.port)
+    return 0
 
 
 def _add_fame(commands) -> None:

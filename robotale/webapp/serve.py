@@ -1,0 +1,94 @@
+"""Serve the dashboard: :func:`serve` in the foreground (``robotale serve``), or a
+:class:`Dashboard` in a background thread (tests, benchmarks, ``robotale demo``)."""
+
+from __future__ import annotations
+
+import errno
+import ipaddress
+import socket
+import sys
+import threading
+
+from flask import Flask
+from werkzeug.serving import BaseWSGIServer, make_server
+
+from robotale.errors import ServerError
+from robotale.webapp.settings import DEFAULT_HOST, DEFAULT_PORT
+
+
+class Dashboard:
+    """A running dashboard: ``url``, and ``stop()`` when done (or use it as a context)."""
+
+    def __init__(
+        self, app: Flask | None = None, host: str = DEFAULT_HOST, port: int = DEFAULT_PORT
+    ):
+        if app is None:
+            from robotale.webapp.app import create_app
+
+            app = create_app()
+        self.app = app
+        self.server = _bind(app, host, port)
+        self._thread: threading.Thread | None = None
+
+    @property
+    def url(self) -> str:
+        host = self.server.host
+        shown = f"[{host}]" if ":" in host else host
+        return f"http://{shown}:{self.server.port}"
+
+    def start(self) -> Dashboard:
+        self._thread = threading.Thread(target=self.server.serve_forever, daemon=True)
+        self._thread.start()
+        return self
+
+    def stop(self) -> None:
+        self.server.shutdown()
+        self.server.server_close()
+        if self._thread is not None:
+            self._thread.join(timeout=10)
+        from robotale.webapp.neo4j_access import close
+
+        close(self.app)
+
+    def __enter__(self) -> Dashboard:
+        return self.start()
+
+    def __exit__(self, *exc: object) -> None:
+        self.stop()
+
+
+def _bind(app: Flask, host: str, port: int) -> BaseWSGIServer:
+    # The socket is ours, so a port in use is our one sentence rather than werkzeug's exit.
+    family = socket.AF_INET6 if ":" in host else socket.AF_INET
+    try:
+        listening = socket.create_server((host, port), family=family)
+    except OSError as error:
+        if error.errno == errno.EADDRINUSE:
+            raise ServerError(
+                f"Port {port} on {host} is in use: choose another with --port."
+            ) from None
+        raise ServerError(f"Cannot serve the dashboard on {host}:{port} ({error}).") from None
+    with listening:
+        return make_server(host, port, app, threaded=True, fd=listening.fileno())
+
+
+def serve(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT) -> None:
+    """Serve the dashboard until Ctrl-C."""
+    dashboard = Dashboard(host=host, port=port)
+    print(f"robotale dashboard at {dashboard.url}  (Ctrl-C stops it)", file=sys.stderr)
+    if not _is_loopback(host):
+        print(
+            f"Listening on {host}: anyone who can reach this machine can read the logs.",
+            file=sys.stderr,
+        )
+    try:
+        dashboard.server.serve_forever()
+    finally:
+        dashboard.server.server_close()
+
+
+def _is_loopback(host: str) -> bool:
+    try:
+        return ipaddress.ip_address(host).is_loopback
+    except ValueError:
+        return host == "localhost"

@@ -1,0 +1,103 @@
+// Shared by every page: JSON calls with the CSRF token, error display, the log picker.
+"use strict";
+
+const robotale = (() => {
+  const csrf = document.querySelector('meta[name="csrf-token"]').content;
+  const errorBox = document.getElementById("error");
+
+  async function api(path, options = {}) {
+    const init = { method: options.method || "GET", headers: { Accept: "application/json" } };
+    if (options.body !== undefined) {
+      init.headers["Content-Type"] = "application/json";
+      init.body = JSON.stringify(options.body);
+    }
+    if (init.method !== "GET") init.headers["X-CSRFToken"] = csrf;
+    const response = await fetch(path, init);
+    const data = await response.json().catch(() => ({ error: response.statusText }));
+    if (!response.ok) {
+      const error = new Error(data.error || `${response.status} ${response.statusText}`);
+      error.hint = data.hint || "";
+      throw error;
+    }
+    return data;
+  }
+
+  function showError(error) {
+    errorBox.textContent = error.hint ? `${error.message} ${error.hint}` : String(error.message || error);
+    errorBox.hidden = false;
+  }
+
+  function clearError() {
+    errorBox.hidden = true;
+    errorBox.textContent = "";
+  }
+
+  function el(tag, attributes = {}, ...children) {
+    const node = document.createElement(tag);
+    for (const [key, value] of Object.entries(attributes)) {
+      if (key === "class") node.className = value;
+      else if (key === "text") node.textContent = value;
+      else node.setAttribute(key, value);
+    }
+    for (const child of children) node.append(child);
+    return node;
+  }
+
+  function table(columns, rows) {
+    const head = el("tr", {}, ...columns.map((c) => el("th", { text: c })));
+    const body = rows.map((row) =>
+      el("tr", {}, ...row.map((value) => {
+        const text = value === null ? "null" : typeof value === "object" ? JSON.stringify(value) : String(value);
+        return el("td", { class: typeof value === "number" ? "number" : "", text });
+      })));
+    return el("table", { class: "data" }, el("thead", {}, head), el("tbody", {}, ...body));
+  }
+
+  // The chosen log: the page's ?log=, else the last one chosen here, else the newest stored.
+  let logsPromise = null;
+  function logs() {
+    logsPromise = logsPromise || api("/api/logs").then((data) => data.logs);
+    return logsPromise;
+  }
+
+  async function currentLog() {
+    const asked = document.body.dataset.log;
+    if (asked) return asked;
+    const names = (await logs()).map((log) => log.name);
+    const remembered = localStorage.getItem("robotale.log");
+    if (names.includes(remembered)) return remembered;
+    return names.length ? names[names.length - 1] : "";
+  }
+
+  async function fillPicker() {
+    const picker = document.getElementById("log-picker");
+    if (!picker) return;
+    let names;
+    try {
+      names = (await logs()).map((log) => log.name);
+    } catch (error) {
+      return; // the page itself reports what is wrong
+    }
+    const chosen = await currentLog();
+    picker.replaceChildren(
+      ...(names.length ? names : [""]).map((name) =>
+        el("option", { value: name, text: name || "no logs yet" })));
+    picker.value = chosen;
+    if (chosen) localStorage.setItem("robotale.log", chosen);
+    picker.addEventListener("change", () => {
+      localStorage.setItem("robotale.log", picker.value);
+      const url = new URL(window.location.href);
+      url.search = "";
+      url.searchParams.set("log", picker.value);
+      window.location.assign(url);
+    });
+    for (const link of document.querySelectorAll("nav a[data-endpoint]")) {
+      if (chosen && link.dataset.endpoint !== "logs.page") {
+        link.href = `${link.pathname}?log=${encodeURIComponent(chosen)}`;
+      }
+    }
+  }
+
+  document.addEventListener("DOMContentLoaded", fillPicker);
+  return { api, showError, clearError, el, table, logs, currentLog };
+})();

@@ -1,0 +1,1 @@
+"""One blueprint per page; pages are HTML, their data comes from JSON endpoints under /api/."""
