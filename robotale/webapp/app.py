@@ -42,7 +42,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
 
 
 def _register_blueprints(app: Flask) -> None:
-    from robotale.webapp.views import assets, console
+    from robotale.webapp.views import assets, console, model
 
-    for module in (assets, console):
+    for module in (assets, console, model):
         app.register_blueprint(module.blueprint)

@@ -2,8 +2,10 @@
 
 ``ROBOTALE_UPLOAD_LIMIT_MB`` (default 500) caps one upload; uploads wait in
 ``$ROBOTALE_HOME/uploads`` (``ROBOTALE_UPLOAD_DIR``) under generated names until they are
-ingested, and are deleted then. ``ROBOTALE_SECRET_KEY`` signs sessions and CSRF tokens; without
-it every start picks a random one (forms of an earlier run then ask to be sent again).
+ingested, and are deleted then. BPMN models shown on the Model page are kept in
+``$ROBOTALE_HOME/models`` (``ROBOTALE_MODEL_DIR``). ``ROBOTALE_SECRET_KEY`` signs sessions
+and CSRF tokens; without it every start picks a random one (forms of an earlier run then ask
+to be sent again).
 """
 
 from __future__ import annotations
@@ -22,6 +24,7 @@ DEFAULT_PORT = 5000
 @dataclass(frozen=True)
 class WebSettings:
     upload_dir: Path
+    model_dir: Path
     upload_limit_mb: int = 500
     secret_key: str = ""
     #: rows the Cypher console shows at most (the rest is counted, not sent)
@@ -34,6 +37,7 @@ class WebSettings:
         env = os.environ
         return cls(
             upload_dir=Path(env.get("ROBOTALE_UPLOAD_DIR") or robotale_home() / "uploads"),
+            model_dir=Path(env.get("ROBOTALE_MODEL_DIR") or robotale_home() / "models"),
             upload_limit_mb=int(env.get("ROBOTALE_UPLOAD_LIMIT_MB") or cls.upload_limit_mb),
             secret_key=env.get("ROBOTALE_SECRET_KEY") or secrets.token_hex(32),
         )

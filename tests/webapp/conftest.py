@@ -34,7 +34,10 @@ def web_settings(tmp_path_factory: pytest.TempPathFactory):
     from robotale.webapp.settings import WebSettings
 
     return WebSettings(
-        upload_dir=tmp_path_factory.mktemp("uploads"), upload_limit_mb=50, secret_key="test"
+        upload_dir=tmp_path_factory.mktemp("uploads"),
+        model_dir=tmp_path_factory.mktemp("models"),
+        upload_limit_mb=50,
+        secret_key="test",
     )
 
 

@@ -23,3 +23,19 @@ def test_cypher_console_runs_an_example_and_refuses_a_write(page, screenshot, gr
     expect(page.locator("#error")).to_contain_text("The console only reads")
     expect(page.locator("#results table")).to_have_count(0)
     assert graph_counts() == before
+
+
+def test_model_page_draws_an_uploaded_collaboration(page, fame_models):
+    from robotale.fame_runtime.parser import parse
+
+    agri = fame_models / "fame-ros" / "agri.bpmn"
+    page.goto(page.base_url + "/model")
+    page.set_input_files("input[name=model]", str(agri))
+    page.click("form.inline-form button[type=submit]")
+    expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")
+    drawn = set(
+        page.eval_on_selector_all("[data-element-id]", "els => els.map(e => e.dataset.elementId)")
+    )
+    expected = {node.id for _, process in parse(agri).pools() for node in process.walk()}
+    assert expected and expected <= drawn
+    expect(page.locator("#model-picker option:checked")).to_contain_text("agri.bpmn")

@@ -1,0 +1,150 @@
+// Process graphs (DFGs and aggregated EKGs, robotale.discovery's ProcessGraph JSON) drawn with
+// cytoscape.js and the layered dagre layout: zoom and pan with the mouse, edge labels,
+// one colour per robot, a click on a node reports it to the page.
+"use strict";
+
+const robotaleGraph = (() => {
+  cytoscape.use(cytoscapeDagre);
+
+  // Colour-blind-safe palette (Okabe-Ito, then Tableau), assigned to robots in sorted order.
+  const PALETTE = ["#0072B2", "#009E73", "#E69F00", "#CC79A7", "#56B4E9", "#D55E00",
+    "#4E79A7", "#59A14F", "#B07AA1", "#9C755F", "#EDC948", "#76B7B2"];
+  const SHARED = "#8a94a6"; // nodes several robots perform
+  const ENTITY_EDGE = { COMM: "#D55E00", msg_id: "#D55E00" };
+
+  function robotColours(graph) {
+    const robots = new Set();
+    for (const node of graph.nodes) for (const robot of node.robots || []) robots.add(robot);
+    const colours = {};
+    [...robots].sort().forEach((robot, i) => { colours[robot] = PALETTE[i % PALETTE.length]; });
+    return colours;
+  }
+
+  function seconds(value) {
+    if (value === null || value === undefined) return "-";
+    if (value < 1) return `${Math.round(value * 1000)}ms`;
+    if (value < 60) return `${value.toFixed(1)}s`;
+    const minutes = Math.floor(value / 60);
+    if (minutes < 60) return `${minutes}m${String(Math.round(value % 60)).padStart(2, "0")}s`;
+    return `${Math.floor(minutes / 60)}h${String(minutes % 60).padStart(2, "0")}m`;
+  }
+
+  function nodeLabel(node, labels) {
+    if (node.kind === "start" || node.kind === "end") return node.label;
+    const figure = labels === "performance" ? seconds((node.durations || {}).mean) : node.count;
+    return `${node.label}\n${figure}`;
+  }
+
+  function edgeLabel(edge, labels) {
+    const figure = labels === "performance" ? seconds((edge.durations || {}).mean) : edge.count;
+    return edge.entity_type ? `${edge.entity_type}: ${figure}` : String(figure);
+  }
+
+  function elements(graph, colours, labels) {
+    const nodes = graph.nodes.map((node) => ({
+      group: "nodes",
+      data: {
+        id: node.id,
+        label: nodeLabel(node, labels),
+        kind: node.kind,
+        colour: node.robot ? colours[node.robot] : SHARED,
+        node,
+      },
+    }));
+    const edges = graph.edges.map((edge, i) => ({
+      group: "edges",
+      data: {
+        id: `e${i}`,
+        source: edge.source,
+        target: edge.target,
+        label: edgeLabel(edge, labels),
+        colour: ENTITY_EDGE[edge.entity_type] || "#4a5568",
+        width: 1 + Math.min(5, Math.log10(1 + edge.count)),
+        edge,
+      },
+    }));
+    return [...nodes, ...edges];
+  }
+
+  const STYLE = [
+    { selector: "node", style: {
+      shape: "round-rectangle", width: "label", height: "label", padding: "8px",
+      "background-color": "data(colour)", "background-opacity": 0.18,
+      "border-width": 2, "border-color": "data(colour)",
+      label: "data(label)", "text-wrap": "wrap", "text-valign": "center", "text-halign": "center",
+      "font-size": 12, color: "#1d2430" } },
+    { selector: "node[kind = 'start'], node[kind = 'end']", style: {
+      shape: "ellipse", width: 44, height: 44, padding: 0, "background-opacity": 1,
+      "background-color": "#1d2430", "border-color": "#1d2430", color: "white", "font-size": 10 } },
+    { selector: "node[kind = 'entity']", style: { shape: "diamond", padding: "14px", "font-size": 10 } },
+    { selector: "node:selected", style: { "border-width": 4, "border-color": "#1f6feb",
+      "background-opacity": 0.35 } },
+    { selector: "edge", style: {
+      "curve-style": "bezier", "target-arrow-shape": "triangle", width: "data(width)",
+      "line-color": "data(colour)", "target-arrow-color": "data(colour)",
+      label: "data(label)", "font-size": 10, color: "#364152",
+      "text-background-color": "white", "text-background-opacity": 0.85,
+      "text-background-padding": "2px", "text-rotation": "none" } },
+    { selector: "edge.dimmed, node.dimmed", style: { opacity: 0.25 } },
+  ];
+
+  function legend(box, colours) {
+    box.replaceChildren(...Object.entries(colours).map(([robot, colour]) => {
+      const swatch = document.createElement("span");
+      swatch.className = "swatch";
+      swatch.style.background = colour;
+      const item = document.createElement("span");
+      item.className = "legend-item";
+      item.append(swatch, robot);
+      return item;
+    }));
+  }
+
+  // Draws `graph` into `container`; options: labels ("frequency" | "performance"),
+  // onSelect(node | null), legend (an element for the robot colours). Returns the cytoscape
+  // instance; `container.dataset.drawn` holds how many nodes were drawn once the layout is done.
+  function draw(container, graph, options = {}) {
+    const labels = options.labels || "frequency";
+    const colours = robotColours(graph);
+    if (options.legend) legend(options.legend, colours);
+    if (container._cy) container._cy.destroy();
+    delete container.dataset.drawn;
+    const cy = cytoscape({
+      container,
+      elements: elements(graph, colours, labels),
+      style: STYLE,
+      wheelSensitivity: 0.3,
+      minZoom: 0.05,
+      maxZoom: 4,
+      layout: { name: "preset" },
+    });
+    container._cy = cy;
+    cy.on("tap", "node", (event) => {
+      const node = event.target;
+      cy.elements().addClass("dimmed");
+      node.closedNeighborhood().removeClass("dimmed");
+      if (options.onSelect) options.onSelect(node.data("node"));
+    });
+    cy.on("tap", (event) => {
+      if (event.target !== cy) return;
+      cy.elements().removeClass("dimmed");
+      if (options.onSelect) options.onSelect(null);
+    });
+    const layout = cy.layout({ name: "dagre", rankDir: "TB", nodeSep: 40, rankSep: 70,
+      edgeSep: 20, fit: true, padding: 20, animate: false });
+    layout.one("layoutstop", () => {
+      container.dataset.drawn = String(graph.nodes.length);
+      performance.mark("robotale-graph-drawn");
+    });
+    layout.run();
+    return cy;
+  }
+
+  function zoom(container, factor) {
+    const cy = container._cy;
+    if (!cy) return;
+    cy.zoom({ level: cy.zoom() * factor, renderedPosition: { x: cy.width() / 2, y: cy.height() / 2 } });
+  }
+
+  return { draw, zoom, seconds, robotColours };
+})();

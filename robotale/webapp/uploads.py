@@ -1,0 +1,167 @@
+"""Uploaded files: checked, stored under generated names, unpacked safely, deleted after use.
+
+An upload is kept as ``<token>.<kind>`` in the upload folder, never under the name the browser
+sent, and only if its content is what its extension says (a CSV with a header line, an XES
+document, a zip archive). A zipped bag folder is unpacked member by member: absolute paths,
+``..``, links and archives that unpack to more than a limit are refused.
+"""
+
+from __future__ import annotations
+
+import re
+import secrets
+import shutil
+import stat
+import time
+import zipfile
+from dataclasses import dataclass
+from pathlib import Path, PurePosixPath
+from typing import BinaryIO
+
+from robotale.errors import InputError
+
+#: extension -> kind of upload
+KINDS = {".csv": "csv", ".xes": "xes", ".zip": "zip"}
+_TOKEN = re.compile(r"[0-9a-f]{32}")
+_SNIFF = 64 * 1024
+#: uploads nobody ingested are removed after this many seconds
+STALE_AFTER = 24 * 3600
+
+
+@dataclass(frozen=True)
+class Upload:
+    token: str
+    path: Path
+    kind: str
+    filename: str  # as the user named it, for messages only
+
+    @property
+    def suggested_name(self) -> str:
+        """A log name from the file's name: ``robotic_data.csv`` -> ``robotic_data``."""
+        stem = PurePosixPath(self.filename.replace("\\", "/")).name
+        for suffix in KINDS:
+            stem = stem.removesuffix(suffix).removesuffix(suffix.upper())
+        return re.sub(r"[^\w.\- ]+", "_", stem).strip() or "log"
+
+
+def kind_of(filename: str) -> str:
+    """The kind of upload a file name announces; an :class:`InputError` for any other."""
+    suffix = PurePosixPath(filename.lower()).suffix
+    if suffix not in KINDS:
+        raise InputError(
+            f"{filename!r} is not an event log robotale reads: upload a .csv or .xes log, or a "
+            ".zip of a folder of rosbag2 recordings."
+        )
+    return KINDS[suffix]
+
+
+def save(stream: BinaryIO, filename: str, folder: Path) -> Upload:
+    """Store an uploaded file after checking that its content matches its extension."""
+    kind = kind_of(filename)
+    folder.mkdir(parents=True, exist_ok=True)
+    token = secrets.token_hex(16)
+    path = folder / f"{token}.{kind}"
+    partial = path.with_suffix(".part")
+    try:
+        with partial.open("wb") as out:
+            shutil.copyfileobj(stream, out, 1024 * 1024)
+        _check_content(partial, kind, filename)
+        partial.rename(path)
+    finally:
+        partial.unlink(missing_ok=True)
+    return Upload(token, path, kind, filename)
+
+
+def find(folder: Path, token: str, filename: str = "") -> Upload:
+    """The stored upload ``token`` names (a token that is not one of ours finds nothing)."""
+    if _TOKEN.fullmatch(token or ""):
+        for kind in KINDS.values():
+            path = folder / f"{token}.{kind}"
+            if path.is_file():
+                return Upload(token, path, kind, filename or path.name)
+    raise InputError("That upload is gone (it was ingested or is too old): upload the file again.")
+
+
+def discard(upload: Upload) -> None:
+    upload.path.unlink(missing_ok=True)
+
+
+def remove_stale(folder: Path, older_than: float = STALE_AFTER) -> int:
+    """Delete uploads and unpacked folders left behind longer than ``older_than`` seconds."""
+    if not folder.is_dir():
+        return 0
+    removed = 0
+    deadline = time.time() - older_than
+    for entry in folder.iterdir():
+        if _TOKEN.fullmatch(entry.name.split(".")[0]) and entry.stat().st_mtime < deadline:
+            if entry.is_dir():
+                shutil.rmtree(entry, ignore_errors=True)
+            else:
+                entry.unlink(missing_ok=True)
+            removed += 1
+    return removed
+
+
+def _check_content(path: Path, kind: str, filename: str) -> None:
+    with path.open("rb") as stream:
+        head = stream.read(_SNIFF)
+    if kind == "zip":
+        if not zipfile.is_zipfile(path):
+            raise InputError(f"{filename!r} is not a zip archive.")
+        return
+    if not head.strip():
+        raise InputError(f"{filename!r} is empty.")
+    if b"\0" in head:
+        raise InputError(f"{filename!r} is not a text file, so it is no {kind.upper()} event log.")
+    text = head.decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
+    if kind == "xes" and not (text.startswith("<?xml") or text.startswith("<log")):
+        raise InputError(f"{filename!r} is not an XES document: it does not start with XML.")
+    if kind == "csv" and ("," not in text.splitlines()[0] and ";" not in text.splitlines()[0]):
+        raise InputError(
+            f"{filename!r} does not start with a header line of comma-separated column names."
+        )
+
+
+def unpack(upload: Upload, limit_bytes: int) -> Path:
+    """Unpack a zip upload into a folder next to it; refuses unsafe or oversized archives."""
+    target = upload.path.with_suffix("")
+    target.mkdir(exist_ok=False)
+    try:
+        with zipfile.ZipFile(upload.path) as archive:
+            members = archive.infolist()
+            _check_members(members, upload.filename, limit_bytes)
+            for member in members:
+                _extract(archive, member, target)
+    except (zipfile.BadZipFile, EOFError) as error:
+        shutil.rmtree(target, ignore_errors=True)
+        raise InputError(f"{upload.filename!r} is a damaged zip archive ({error}).") from None
+    except BaseException:
+        shutil.rmtree(target, ignore_errors=True)
+        raise
+    return target
+
+
+def _check_members(members: list[zipfile.ZipInfo], filename: str, limit_bytes: int) -> None:
+    total = 0
+    for member in members:
+        name = PurePosixPath(member.filename)
+        if name.is_absolute() or ".." in name.parts or "\\" in member.filename:
+            raise InputError(f"{filename!r} holds an unsafe path {member.filename!r}.")
+        if stat.S_ISLNK(member.external_attr >> 16):
+            raise InputError(f"{filename!r} holds a link ({member.filename!r}); zip plain files.")
+        total += member.file_size
+    if total > limit_bytes:
+        raise InputError(
+            f"{filename!r} unpacks to {total // 2**20} MB, more than the limit of "
+            f"{limit_bytes // 2**20} MB."
+        )
+
+
+def _extract(archive: zipfile.ZipFile, member: zipfile.ZipInfo, target: Path) -> None:
+    destination = target.joinpath(*PurePosixPath(member.filename).parts)
+    if member.is_dir():
+        destination.mkdir(parents=True, exist_ok=True)
+        return
+    destination.parent.mkdir(parents=True, exist_ok=True)
+    with archive.open(member) as source, destination.open("wb") as out:
+        shutil.copyfileobj(source, out, 1024 * 1024)
