@@ -9,7 +9,7 @@ from flask import Flask, redirect, url_for
 from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
-from robotale.webapp import errors, neo4j_access
+from robotale.webapp import errors, jobs, neo4j_access, uploads
 from robotale.webapp.settings import WebSettings
 
 
@@ -30,6 +30,8 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
     app.json.sort_keys = False
     CSRFProtect(app)
     neo4j_access.init_app(app)
+    jobs.init_app(app)
+    uploads.remove_stale(settings.upload_dir)
     errors.init_app(app)
     _register_blueprints(app)
     app.jinja_env.globals.update(robotale_version=__version__, blueprints=app.blueprints)
@@ -42,7 +44,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
 
 
 def _register_blueprints(app: Flask) -> None:
-    from robotale.webapp.views import assets, console, model
+    from robotale.webapp.views import assets, console, discover, logs, model, perspectives
 
-    for module in (assets, console, model):
+    for module in (assets, logs, discover, perspectives, model, console):
         app.register_blueprint(module.blueprint)

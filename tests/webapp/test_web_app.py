@@ -38,7 +38,7 @@ def test_neo4j_down_shows_how_to_start_it(neo4j_down):
     assert "Neo4j is not reachable at bolt://127.0.0.1:" in page
     assert "robotale neo4j start" in page
     api = client.get("/api/logs")
-    assert api.status_code in (503, 404)
+    assert api.status_code == 503 and "robotale neo4j start" in api.json["hint"]
 
 
 def test_neo4j_down_for_json_endpoints_is_json(neo4j_down):

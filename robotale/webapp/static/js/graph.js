@@ -66,9 +66,14 @@ const robotaleGraph = (() => {
     return [...nodes, ...edges];
   }
 
+  // Node sizes follow their labels (cytoscape's own "label" size is deprecated).
+  const lines = (node) => String(node.data("label")).split("\n");
+  const labelWidth = (node) => 18 + 7.2 * Math.max(...lines(node).map((line) => line.length));
+  const labelHeight = (node) => 14 + 15 * lines(node).length;
+
   const STYLE = [
     { selector: "node", style: {
-      shape: "round-rectangle", width: "label", height: "label", padding: "8px",
+      shape: "round-rectangle", width: labelWidth, height: labelHeight,
       "background-color": "data(colour)", "background-opacity": 0.18,
       "border-width": 2, "border-color": "data(colour)",
       label: "data(label)", "text-wrap": "wrap", "text-valign": "center", "text-halign": "center",
@@ -76,7 +81,8 @@ const robotaleGraph = (() => {
     { selector: "node[kind = 'start'], node[kind = 'end']", style: {
       shape: "ellipse", width: 44, height: 44, padding: 0, "background-opacity": 1,
       "background-color": "#1d2430", "border-color": "#1d2430", color: "white", "font-size": 10 } },
-    { selector: "node[kind = 'entity']", style: { shape: "diamond", padding: "14px", "font-size": 10 } },
+    { selector: "node[kind = 'entity']", style: { shape: "diamond", "font-size": 10,
+      width: (node) => 1.6 * labelWidth(node), height: (node) => 1.8 * labelHeight(node) } },
     { selector: "node:selected", style: { "border-width": 4, "border-color": "#1f6feb",
       "background-opacity": 0.35 } },
     { selector: "edge", style: {
@@ -113,7 +119,6 @@ const robotaleGraph = (() => {
       container,
       elements: elements(graph, colours, labels),
       style: STYLE,
-      wheelSensitivity: 0.3,
       minZoom: 0.05,
       maxZoom: 4,
       layout: { name: "preset" },

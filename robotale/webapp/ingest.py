@@ -1,0 +1,225 @@
+"""From an uploaded file to a log in Neo4j, in the two steps of thesis figure 7.3.
+
+1. :func:`read_upload` turns the upload into the canonical event log (a CSV or XES log with
+   ``robotale.ingest.readers``, a zipped folder of rosbag2 recordings with
+   ``robotale.ingest.prepare``) and keeps it in memory as a :class:`Pending` log.
+2. The user picks the columns to store as event properties and those that are entities;
+   :func:`ingest` stores the log with :func:`robotale.ekg.build.build_ekg` and deletes the upload.
+"""
+
+from __future__ import annotations
+
+import shutil
+import threading
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+from neo4j import Driver
+
+from robotale.errors import InputError
+from robotale.ingest import schema
+from robotale.webapp import uploads
+from robotale.webapp.jobs import Job
+from robotale.webapp.models import ModelStore
+
+#: columns every stored log keeps, whatever the user unticks
+ALWAYS_STORED = (*schema.REQUIRED, schema.LIFECYCLE)
+#: entity columns ticked by default, where the log has them (as in thesis figure 7.3)
+DEFAULT_ENTITIES = ("robot", "msg_id")
+#: a zipped bag folder may unpack to this many times the upload limit
+UNPACK_FACTOR = 20
+
+
+@dataclass
+class Pending:
+    upload: uploads.Upload
+    log: pd.DataFrame | None = None
+    model_id: str | None = None
+    created: float = field(default_factory=time.time)
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of a pending log as the column-choice form shows it."""
+
+    name: str  # the short name, also the Event property it becomes
+    required: bool
+    store: bool
+    entity: bool
+    distinct: int
+    examples: list[str]
+
+
+class PendingLogs:
+    """Uploads read into logs, waiting for the user's column choice (one process, in memory)."""
+
+    def __init__(self) -> None:
+        self._items: dict[str, Pending] = {}
+        self._lock = threading.Lock()
+
+    def add(self, upload: uploads.Upload) -> Pending:
+        pending = Pending(upload)
+        with self._lock:
+            self._items[upload.token] = pending
+        return pending
+
+    def get(self, token: str) -> Pending:
+        with self._lock:
+            pending = self._items.get(token)
+        if pending is None or pending.log is None:
+            raise InputError("That upload is gone (it was ingested or is too old): upload again.")
+        return pending
+
+    def pop(self, token: str) -> Pending | None:
+        with self._lock:
+            return self._items.pop(token, None)
+
+
+def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job) -> None:
+    """Read ``pending.upload`` into ``pending.log``; a model inside a zip is stored too."""
+    upload = pending.upload
+    job.step("reading " + upload.filename)
+    try:
+        if upload.kind == "zip":
+            pending.log, pending.model_id = _read_bags(upload, limit_bytes, models, job)
+        else:
+            from robotale.ingest.readers import read_log
+
+            pending.log = read_log(upload.path)
+    except BaseException:
+        uploads.discard(upload)
+        raise
+    if pending.log.empty:
+        uploads.discard(upload)
+        raise InputError(f"{upload.filename!r} holds no events.")
+    job.step("read", len(pending.log), len(pending.log))
+
+
+def _read_bags(
+    upload: uploads.Upload, limit_bytes: int, models: ModelStore, job: Job
+) -> tuple[pd.DataFrame, str | None]:
+    from robotale.ingest.prepare import prepare
+
+    folder = uploads.unpack(upload, limit_bytes * UNPACK_FACTOR)
+    try:
+        job.step("preparing the recordings")
+        log = prepare(bag_root(folder))
+        model = next(iter(sorted(folder.rglob("*.bpmn"))), None)
+        model_id = models.add(model.read_bytes(), model.name).id if model else None
+        return log, model_id
+    finally:
+        shutil.rmtree(folder, ignore_errors=True)
+
+
+def bag_root(folder: Path) -> Path:
+    """The folder to prepare: the unpacked one, or the single folder a zip wraps its bags in."""
+    while not (folder / "metadata.yaml").is_file():
+        children = [c for c in folder.iterdir() if c.is_dir() and not c.name.startswith(".")]
+        if any((c / "metadata.yaml").is_file() for c in children) or len(children) != 1:
+            break
+        folder = children[0]
+    return folder
+
+
+def columns(log: pd.DataFrame) -> list[Column]:
+    """The log's columns with the default choice: store everything, robot and msg_id entities."""
+    found = []
+    for canonical in log.columns:
+        name = schema.CSV_NAMES.get(canonical, canonical)
+        values = log[canonical].dropna()
+        shown = values.astype(str).drop_duplicates().head(3).tolist()
+        found.append(
+            Column(
+                name=name,
+                required=canonical in ALWAYS_STORED,
+                store=True,
+                entity=name in DEFAULT_ENTITIES and values.nunique() > 0,
+                distinct=int(values.nunique()),
+                examples=shown,
+            )
+        )
+    return found
+
+
+def chosen_log(log: pd.DataFrame, store: list[str], entities: list[str]) -> pd.DataFrame:
+    """The log with only the columns to store (required ones and entities always kept)."""
+    short = {schema.CSV_NAMES.get(c, c): c for c in log.columns}
+    unknown = [name for name in [*store, *entities] if name not in short]
+    if unknown:
+        raise InputError(f"The log has no column {unknown[0]!r}.")
+    if not entities:
+        raise InputError("Tick at least one entity column (robot, for instance).")
+    keep = {short[n] for n in [*store, *entities]} | {c for c in ALWAYS_STORED if c in log}
+    return log[[c for c in log.columns if c in keep]]
+
+
+def ingest(
+    driver: Driver,
+    pending: Pending,
+    name: str,
+    entities: list[str],
+    replace: bool,
+    models: ModelStore,
+    job: Job,
+) -> dict[str, Any]:
+    """Store the pending log as ``name``; the upload is deleted whatever happens."""
+    from robotale.ekg.build import build_ekg
+
+    log = pending.log
+    if log is None:
+        raise InputError("That upload has not been read yet: wait for it, then choose again.")
+    try:
+        job.step("writing to Neo4j", 0, len(log))
+        with _ProgressWatch(driver, name, job, enabled=not replace):
+            summary = build_ekg(
+                driver,
+                log,
+                name,
+                entities=entities,
+                replace=replace,
+                source=pending.upload.filename,
+                progress=False,
+            )
+    finally:
+        uploads.discard(pending.upload)
+    if pending.model_id:
+        models.link(name, pending.model_id)
+    return {"log": summary.log, "events": summary.events, "seconds": round(summary.seconds, 2)}
+
+
+class _ProgressWatch:
+    """While a log is built, counts its events in Neo4j to report how far the build has come."""
+
+    def __init__(self, driver: Driver, log: str, job: Job, enabled: bool) -> None:
+        self.driver, self.log, self.job, self.enabled = driver, log, job, enabled
+        self._stop = threading.Event()
+        self._thread = threading.Thread(target=self._watch, daemon=True)
+
+    def __enter__(self) -> _ProgressWatch:
+        if self.enabled:
+            self._thread.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self._stop.set()
+        if self.enabled:
+            self._thread.join(timeout=5)
+
+    def _watch(self) -> None:
+        from robotale.ekg.connection import database
+        from robotale.ekg.queries import cypher
+
+        total = self.job.total
+        while not self._stop.wait(0.5):
+            try:
+                records, _, _ = self.driver.execute_query(
+                    cypher("webapp_build_progress"), log=self.log, database_=database()
+                )
+            except Exception:  # progress is a nicety; the build reports real failures
+                return
+            events = int(records[0]["events"])
+            stage = "writing events" if events < total else "linking events and aggregating"
+            self.job.step(stage, events, total)

@@ -1,0 +1,149 @@
+// The Discover page: the aggregated EKG (default) or the DFG of the chosen log, drawn as an
+// interactive graph; a click on a node shows its figures and its spatial perspective.
+"use strict";
+
+(() => {
+  const graphBox = document.getElementById("graph");
+  const status = document.getElementById("graph-status");
+  const labels = document.getElementById("labels");
+  const ekgForm = document.getElementById("ekg-form");
+  const dfgForm = document.getElementById("dfg-form");
+  const state = { log: "", view: "ekg", graph: null, robotFilter: [] };
+
+  function setView(view) {
+    state.view = view;
+    for (const tab of document.querySelectorAll(".tab")) tab.classList.toggle("active", tab.dataset.view === view);
+    for (const form of document.querySelectorAll(".view-form")) form.hidden = form.dataset.view !== view;
+  }
+
+  function selected(name) {
+    return [...dfgForm.elements[name].selectedOptions].map((option) => option.value);
+  }
+
+  function graphUrl() {
+    const params = new URLSearchParams({ log: state.log });
+    if (state.view === "ekg") {
+      for (const box of ekgForm.querySelectorAll("input[name=by]:checked")) params.append("by", box.value);
+      return `/api/discover/ekg?${params}`;
+    }
+    for (const name of ["case", "robot", "robot_type", "activity"]) {
+      for (const value of selected(name)) params.append(name, value);
+    }
+    return `/api/discover/dfg?${params}`;
+  }
+
+  async function discover() {
+    robotale.clearError();
+    status.textContent = "discovering…";
+    state.robotFilter = state.view === "dfg" ? selected("robot") : [];
+    try {
+      state.graph = await robotale.api(graphUrl());
+    } catch (error) {
+      status.textContent = "";
+      robotale.showError(error);
+      return;
+    }
+    draw();
+  }
+
+  function draw() {
+    const graph = state.graph;
+    const activities = graph.nodes.filter((n) => n.kind === "activity").length;
+    status.textContent = `${graph.kind.toUpperCase()}: ${activities} activities, ${graph.edges.length} edges`;
+    graphBox.dataset.kind = graph.kind;
+    showNode(null);
+    robotaleGraph.draw(graphBox, graph, {
+      labels: labels.value,
+      legend: document.getElementById("legend"),
+      onSelect: showNode,
+    });
+  }
+
+  function showNode(node) {
+    const details = document.getElementById("details");
+    const figureBox = document.getElementById("node-figure");
+    const focus = robotalePerspective.focusOf(node, state.robotFilter);
+    if (!node || !focus) {
+      details.hidden = true;
+      figureBox.hidden = true;
+      return;
+    }
+    document.getElementById("details-title").textContent = robotalePerspective.describe(focus);
+    const durations = node.durations || {};
+    const rows = [["count", node.count], ["robots", (node.robots || []).join(", ")],
+      ["mean duration", robotaleGraph.seconds(durations.mean)],
+      ["median duration", robotaleGraph.seconds(durations.median)]];
+    for (const [key, value] of Object.entries(node.properties || {})) {
+      if (key !== "activity" && key !== "robot") rows.push([key, value]);
+    }
+    document.getElementById("details-table").replaceChildren(
+      ...rows.map(([k, v]) => robotale.el("tr", {}, robotale.el("th", { text: k }), robotale.el("td", { text: String(v) }))));
+    document.getElementById("details-link").href =
+      `/perspectives?${robotalePerspective.query(state.log, focus)}`;
+    details.hidden = false;
+    showSpatial(focus);
+  }
+
+  async function showSpatial(focus) {
+    const figureBox = document.getElementById("node-figure");
+    const message = document.getElementById("node-figure-message");
+    const plotBox = document.getElementById("spatial-figure");
+    figureBox.hidden = false;
+    document.getElementById("node-figure-title").textContent =
+      `Where ${robotalePerspective.describe(focus)} happened`;
+    message.textContent = "loading…";
+    delete plotBox.dataset.plotted;
+    try {
+      const spatial = await robotalePerspective.load(state.log, "spatial", focus);
+      const figure = Object.values(spatial.figures)[0];
+      message.textContent = spatial.message || robotalePerspective.summaryText(spatial.summary);
+      if (figure) await robotalePerspective.plot(plotBox, figure);
+      else plotBox.replaceChildren();
+    } catch (error) {
+      message.textContent = "";
+      robotale.showError(error);
+    }
+  }
+
+  function fillSelectors(log, values) {
+    const aggregation = document.getElementById("aggregation");
+    for (const type of log.entityTypes || []) {
+      const box = robotale.el("input", { type: "checkbox", name: "by", value: type });
+      box.checked = type === "robot";
+      aggregation.append(robotale.el("label", { class: "check" }, box, ` ${type}`));
+    }
+    if (!values) return;
+    for (const [name, options] of Object.entries(values.filters)) {
+      const select = document.getElementById(`filter-${name}`);
+      select.replaceChildren(...options.map((v) => robotale.el("option", { value: v, text: v })));
+    }
+  }
+
+  async function start() {
+    state.log = await robotale.currentLog().catch((error) => { robotale.showError(error); return ""; });
+    if (!state.log) {
+      status.textContent = "No log yet: upload one on the Logs page.";
+      return;
+    }
+    const log = (await robotale.logs()).find((l) => l.name === state.log) || { entityTypes: [] };
+    fillSelectors(log, null);
+    await discover();
+    robotale.api(`/api/discover/values?log=${encodeURIComponent(state.log)}`)
+      .then((values) => fillSelectors({}, values))
+      .catch(robotale.showError);
+  }
+
+  for (const tab of document.querySelectorAll(".tab")) {
+    tab.addEventListener("click", () => { setView(tab.dataset.view); discover(); });
+  }
+  for (const form of [ekgForm, dfgForm]) {
+    form.addEventListener("submit", (event) => { event.preventDefault(); discover(); });
+  }
+  dfgForm.addEventListener("reset", () => setTimeout(discover, 0));
+  ekgForm.addEventListener("change", discover);
+  labels.addEventListener("change", () => state.graph && draw());
+  document.getElementById("zoom-in").addEventListener("click", () => robotaleGraph.zoom(graphBox, 1.25));
+  document.getElementById("zoom-out").addEventListener("click", () => robotaleGraph.zoom(graphBox, 0.8));
+  document.getElementById("fit").addEventListener("click", () => graphBox._cy && graphBox._cy.fit(undefined, 20));
+  start();
+})();

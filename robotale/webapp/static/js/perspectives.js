@@ -1,0 +1,81 @@
+// The Perspectives page: the four perspectives for the whole log or for the node clicked in
+// the process graph beside them (thesis figure 7.8).
+"use strict";
+
+(() => {
+  const section = document.getElementById("perspectives");
+  const graphBox = document.getElementById("graph");
+  const focusLabel = document.getElementById("focus-label");
+  const wholeLog = document.getElementById("whole-log");
+  let log = "";
+
+  function initialFocus() {
+    const { activity, robot } = section.dataset;
+    return activity ? { activity, robot: robot || null } : null;
+  }
+
+  async function showOne(article, focus) {
+    const name = article.dataset.name;
+    const summary = article.querySelector(".summary");
+    const figures = article.querySelector(".figures");
+    const tables = article.querySelector(".table-box");
+    summary.textContent = "loading…";
+    article.dataset.state = "loading";
+    try {
+      const result = await robotalePerspective.load(log, name, focus);
+      summary.textContent = result.message || robotalePerspective.summaryText(result.summary);
+      figures.replaceChildren();
+      for (const figure of Object.values(result.figures)) {
+        const box = robotale.el("div", { class: "figure" });
+        figures.append(box);
+        await robotalePerspective.plot(box, figure);
+      }
+      tables.replaceChildren();
+      for (const [title, rows] of Object.entries(result.tables)) {
+        if (!rows.length) continue;
+        const columns = Object.keys(rows[0]);
+        tables.append(robotale.el("h3", { text: title.replace(/_/g, " ") }),
+          robotale.table(columns, rows.slice(0, 50).map((row) => columns.map((c) => row[c]))));
+      }
+      article.dataset.state = result.message ? "empty" : "shown";
+    } catch (error) {
+      summary.textContent = "";
+      article.dataset.state = "failed";
+      robotale.showError(error);
+    }
+  }
+
+  function show(focus) {
+    focusLabel.textContent = robotalePerspective.describe(focus);
+    wholeLog.hidden = !focus;
+    const url = new URL(window.location.href);
+    url.search = robotalePerspective.query(log, focus);
+    window.history.replaceState(null, "", url);
+    return Promise.all([...section.querySelectorAll("article.perspective")].map((a) => showOne(a, focus)));
+  }
+
+  async function start() {
+    log = await robotale.currentLog().catch((error) => { robotale.showError(error); return ""; });
+    if (!log) {
+      focusLabel.textContent = "no log yet: upload one on the Logs page";
+      return;
+    }
+    const info = (await robotale.logs()).find((l) => l.name === log) || { entityTypes: [] };
+    const by = (info.entityTypes || []).includes("robot") ? "&by=robot" : "";
+    const focus = initialFocus();
+    const figures = show(focus);
+    try {
+      const graph = await robotale.api(`/api/discover/ekg?log=${encodeURIComponent(log)}${by}`);
+      robotaleGraph.draw(graphBox, graph, { onSelect: (node) => {
+        const chosen = robotalePerspective.focusOf(node);
+        if (chosen) show(chosen);
+      } });
+    } catch (error) {
+      robotale.showError(error);
+    }
+    await figures;
+  }
+
+  wholeLog.addEventListener("click", () => show(null));
+  start();
+})();

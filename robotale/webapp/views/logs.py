@@ -1,0 +1,133 @@
+"""The Logs page: upload a log, choose its properties and entities, ingest it; list, delete."""
+
+from __future__ import annotations
+
+from flask import (
+    Blueprint,
+    abort,
+    current_app,
+    flash,
+    jsonify,
+    redirect,
+    render_template,
+    request,
+    url_for,
+)
+
+from robotale.errors import InputError
+from robotale.webapp import ingest, pages, uploads
+from robotale.webapp.jobs import jobs
+from robotale.webapp.logdata import forget
+from robotale.webapp.neo4j_access import driver
+from robotale.webapp.views.model import store as model_store
+
+blueprint = Blueprint("logs", __name__)
+_PENDING = "robotale.pending"
+
+
+def pending_logs() -> ingest.PendingLogs:
+    return current_app.extensions.setdefault(_PENDING, ingest.PendingLogs())
+
+
+def settings():
+    return current_app.config["ROBOTALE"]
+
+
+def stored_logs() -> list[dict]:
+    connected = driver()
+    from robotale.ekg.logs import list_logs
+
+    return list_logs(connected)
+
+
+@blueprint.get("/logs")
+def page():
+    context = pages.context("logs.page")
+    return render_template("logs.html", logs=stored_logs(), **context)
+
+
+@blueprint.get("/api/logs")
+def api_logs():
+    return jsonify(logs=stored_logs())
+
+
+@blueprint.post("/logs/upload")
+def upload():
+    file = request.files.get("file")
+    if file is None or not file.filename:
+        raise InputError("Choose a CSV, XES or zipped bag folder to upload.")
+    saved = uploads.save(file.stream, file.filename, settings().upload_dir)
+    pending = pending_logs().add(saved)
+    limit = settings().upload_limit_mb * 1024 * 1024
+    models = model_store()
+    job = jobs().submit(
+        f"Reading {saved.filename}",
+        lambda job: ingest.read_upload(pending, limit, models, job) or {},
+    )
+    return redirect(url_for("logs.choose", token=saved.token, job=job.id))
+
+
+@blueprint.get("/logs/upload/<token>")
+def choose(token: str):
+    context = pages.context("logs.page")
+    job = jobs().get(request.args.get("job", ""))
+    if job is not None and not job.finished:
+        return render_template("logs_job.html", job=job, then="reload", **context)
+    if job is not None and job.error:
+        return render_template("logs_job.html", job=job, then="", **context)
+    pending = pending_logs().get(token)
+    return render_template(
+        "logs_columns.html",
+        token=token,
+        filename=pending.upload.filename,
+        name=pending.upload.suggested_name,
+        events=len(pending.log),
+        columns=ingest.columns(pending.log),
+        **context,
+    )
+
+
+@blueprint.post("/logs/upload/<token>")
+def start_ingest(token: str):
+    pending = pending_logs().get(token)
+    name = request.form.get("name", "").strip()
+    if not name:
+        raise InputError("Give the log a name.")
+    entities = request.form.getlist("entity")
+    log = ingest.chosen_log(pending.log, request.form.getlist("store"), entities)
+    pending.log = log
+    pending_logs().pop(token)
+    replace = request.form.get("replace") == "on"
+    connected, models = driver(), model_store()
+
+    def work(job):
+        forget(name)
+        return ingest.ingest(connected, pending, name, entities, replace, models, job)
+
+    job = jobs().submit(f"Storing {name}", work)
+    return redirect(url_for("logs.job_page", job_id=job.id, log=name))
+
+
+@blueprint.get("/logs/jobs/<job_id>")
+def job_page(job_id: str):
+    job = jobs().get(job_id) or abort(404, "That job is unknown (the dashboard was restarted?).")
+    return render_template("logs_job.html", job=job, then="", **pages.context("logs.page"))
+
+
+@blueprint.get("/api/jobs/<job_id>")
+def job_state(job_id: str):
+    job = jobs().get(job_id) or abort(404, "That job is unknown (the dashboard was restarted?).")
+    return jsonify(job.to_dict())
+
+
+@blueprint.post("/logs/delete")
+def delete():
+    from robotale.ekg.logs import delete_log
+
+    name = request.form.get("name", "")
+    if name not in {log["name"] for log in stored_logs()}:
+        raise InputError(f"There is no log named {name!r}.")
+    delete_log(driver(), name)
+    forget(name)
+    flash(f"Deleted the log {name!r}.", "success")
+    return redirect(url_for("logs.page"))
