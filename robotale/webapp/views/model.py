@@ -2,7 +2,18 @@
 
 from __future__ import annotations
 
-from flask import Blueprint, Response, current_app, redirect, render_template, request, url_for
+import threading
+
+from flask import (
+    Blueprint,
+    Response,
+    current_app,
+    jsonify,
+    redirect,
+    render_template,
+    request,
+    url_for,
+)
 
 from robotale.errors import InputError
 from robotale.webapp import pages
@@ -44,3 +55,41 @@ def upload():
 def xml(model_id: str):
     model = store().get(model_id)
     return Response(model.path.read_bytes(), mimetype="application/xml")
+
+
+@blueprint.get("/api/models/<model_id>/frequencies")
+def frequencies(model_id: str):
+    """How often the chosen log shows each element of the model."""
+    from robotale.webapp import overlay
+
+    return jsonify(elements=_cached("frequencies", model_id, overlay.frequencies))
+
+
+@blueprint.get("/api/models/<model_id>/deviations")
+def deviations(model_id: str):
+    """Where the chosen log deviates from the model (alignments: may take a while)."""
+    from robotale.webapp import overlay
+
+    return jsonify(_cached("deviations", model_id, overlay.deviations))
+
+
+def _cached(kind: str, model_id: str, compute):
+    from robotale.webapp.logdata import log_frame, log_info
+
+    model = store().get(model_id)
+    name = request.args.get("log", "")
+    key = (kind, model_id, name, str(log_info(name).get("created")))
+    with _lock:
+        if key in _results:
+            return _results[key]
+    result = compute(log_frame(name), model.path)
+    with _lock:
+        # the last result of each kind is enough: the page asks once per model and log
+        for old in [k for k in _results if k[0] == kind]:
+            del _results[old]
+        _results[key] = result
+    return result
+
+
+_results: dict[tuple[str, str, str, str], object] = {}
+_lock = threading.Lock()

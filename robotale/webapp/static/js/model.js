@@ -23,37 +23,47 @@
     return `rgb(${mix(255, 66)}, ${mix(255, 133)}, ${mix(255, 244)})`;
   }
 
-  function paint(overlay) {
+  function shapeOf(id) {
     const registry = viewer.get("elementRegistry");
-    const overlays = viewer.get("overlays");
-    const max = Math.max(0, ...Object.values(overlay.elements).map((e) => e.count));
-    for (const [id, facts] of Object.entries(overlay.elements)) {
-      const element = registry.get(id);
-      if (!element) continue;
-      const shape = registry.getGraphics(element).querySelector(".djs-visual > :first-child");
+    const element = registry.get(id);
+    return element ? registry.getGraphics(element).querySelector(".djs-visual > :first-child") : null;
+  }
+
+  function badge(id, text, title, deviating) {
+    const box = document.createElement("div");
+    box.className = deviating ? "count-badge deviating" : "count-badge";
+    box.textContent = text;
+    box.title = title;
+    box.dataset.element = id;
+    viewer.get("overlays").add(id, deviating ? "deviations" : "counts",
+      { position: deviating ? { bottom: 8, right: 12 } : { top: -12, right: 12 }, html: box });
+  }
+
+  function paintFrequencies(elements) {
+    const max = Math.max(0, ...Object.values(elements).map((e) => e.count));
+    for (const [id, facts] of Object.entries(elements)) {
+      const shape = shapeOf(id);
       if (shape) shape.style.fill = shade(facts.count, max);
-      const deviations = (facts.unexpected || 0) + (facts.missing || 0);
-      if (deviations) {
-        if (shape) { shape.style.stroke = "#b42318"; shape.style.strokeWidth = "4px"; }
-        viewer.get("canvas").addMarker(id, "deviating");
-      }
-      const badge = document.createElement("div");
-      badge.className = deviations ? "count-badge deviating" : "count-badge";
-      badge.textContent = deviations ? `${facts.count} · ${deviations} off` : String(facts.count);
-      badge.title = `${facts.count} times in the log` +
-        (facts.unexpected ? `, ${facts.unexpected} unexpected` : "") +
-        (facts.missing ? `, ${facts.missing} missing` : "");
-      badge.dataset.element = id;
-      overlays.add(id, { position: { top: -12, right: 12 }, html: badge });
+      if (facts.count) badge(id, String(facts.count), `${facts.count} times, by ${facts.robots.join(", ")}`, false);
     }
-    canvasBox.dataset.painted = String(Object.keys(overlay.elements).length);
-    if (overlay.robots && overlay.robots.length) {
-      summary.replaceChildren(
-        robotale.el("h2", { text: "Conformance per robot" }),
-        robotale.table(["robot", "pool", "runs", "fitness", "fitting runs"],
-          overlay.robots.map((r) => [r.robot, r.pool, r.runs,
-            r.fitness === null ? null : Number(r.fitness.toFixed(3)), r.fitting_runs])));
+    canvasBox.dataset.painted = String(Object.values(elements).filter((e) => e.count).length);
+  }
+
+  function paintDeviations(result) {
+    for (const [id, facts] of Object.entries(result.elements)) {
+      const shape = shapeOf(id);
+      if (shape) { shape.style.stroke = "#b42318"; shape.style.strokeWidth = "4px"; }
+      viewer.get("canvas").addMarker(id, "deviating");
+      const parts = [facts.unexpected ? `${facts.unexpected} unexpected` : "",
+        facts.missing ? `${facts.missing} missing` : ""].filter(Boolean);
+      badge(id, parts.join(", "), parts.join(", "), true);
     }
+    canvasBox.dataset.deviations = String(Object.keys(result.elements).length);
+    summary.replaceChildren(
+      robotale.el("h2", { text: "Conformance per robot" }),
+      robotale.table(["robot", "pool", "runs", "fitness", "fitting runs"],
+        result.robots.map((r) => [r.robot, r.pool, r.runs,
+          r.fitness === null ? null : Number(r.fitness.toFixed(3)), r.fitting_runs])));
   }
 
   async function show() {
@@ -66,11 +76,12 @@
       canvasBox.dataset.rendered = "1";
       const log = await robotale.currentLog().catch(() => "");
       if (!log) return;
-      status.textContent = `comparing with ${log}…`;
-      const overlay = await robotale.api(
-        `/api/models/${modelId}/overlay?log=${encodeURIComponent(log)}`);
-      paint(overlay);
-      status.textContent = overlay.message || `coloured by log ${log}`;
+      const query = `log=${encodeURIComponent(log)}`;
+      status.textContent = `counting ${log}…`;
+      paintFrequencies((await robotale.api(`/api/models/${modelId}/frequencies?${query}`)).elements);
+      status.textContent = `shaded by log ${log}; checking conformance…`;
+      paintDeviations(await robotale.api(`/api/models/${modelId}/deviations?${query}`));
+      status.textContent = `shaded by log ${log}; deviations outlined in red`;
     } catch (error) {
       status.textContent = "";
       robotale.showError(error);
