@@ -19,7 +19,7 @@ from typing import Any
 import pandas as pd
 from neo4j import Driver
 
-from robotale.errors import InputError
+from robotale.errors import InputError, RobotaleError
 from robotale.ingest import schema
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
@@ -36,6 +36,8 @@ UNPACK_FACTOR = 20
 @dataclass
 class Pending:
     upload: uploads.Upload
+    #: CSV / XES column -> canonical field, for logs whose columns have other names
+    mapping: dict[str, str] = field(default_factory=dict)
     log: pd.DataFrame | None = None
     model_id: str | None = None
     created: float = field(default_factory=time.time)
@@ -60,8 +62,8 @@ class PendingLogs:
         self._items: dict[str, Pending] = {}
         self._lock = threading.Lock()
 
-    def add(self, upload: uploads.Upload) -> Pending:
-        pending = Pending(upload)
+    def add(self, upload: uploads.Upload, mapping: dict[str, str]) -> Pending:
+        pending = Pending(upload, mapping)
         with self._lock:
             self._items[upload.token] = pending
         return pending
@@ -88,10 +90,13 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
         else:
             from robotale.ingest.readers import read_log
 
-            pending.log = read_log(upload.path)
-    except BaseException:
-        uploads.discard(upload)
-        raise
+            pending.log = read_log(upload.path, mapping=pending.mapping)
+    except RobotaleError as error:
+        # The message names our stored copy; the user knows the file by its own name.
+        raise type(error)(str(error).replace(str(upload.path), repr(upload.filename))) from None
+    finally:
+        if pending.log is None:
+            uploads.discard(upload)
     if pending.log.empty:
         uploads.discard(upload)
         raise InputError(f"{upload.filename!r} holds no events.")
@@ -179,6 +184,7 @@ def ingest(
                 log,
                 name,
                 entities=entities,
+                aggregate=aggregation_keys(entities),
                 replace=replace,
                 source=pending.upload.filename,
                 progress=False,
@@ -188,6 +194,12 @@ def ingest(
     if pending.model_id:
         models.link(name, pending.model_id)
     return {"log": summary.log, "events": summary.events, "seconds": round(summary.seconds, 2)}
+
+
+def aggregation_keys(entities: list[str]) -> list[str]:
+    """The class graphs built right away: by activity, and by activity and robot (the
+    Discover page's first view) when robots are entities; others are built when asked for."""
+    return ["activity", "activity,robot"] if "robot" in entities else ["activity"]
 
 
 class _ProgressWatch:

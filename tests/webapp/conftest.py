@@ -80,8 +80,10 @@ def chromium_path() -> str:
 @pytest.fixture(scope="session")
 def browser_context(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object]:
     """A headless Chromium with a fresh profile."""
-    from playwright.sync_api import sync_playwright
+    from playwright.sync_api import expect, sync_playwright
 
+    # The machine may be busy: wait for what the user would wait for, not for a fixed 5 s.
+    expect.set_options(timeout=60_000)
     with sync_playwright() as playwright:
         context = playwright.chromium.launch_persistent_context(
             tmp_path_factory.mktemp("chromium-profile"),
@@ -90,7 +92,7 @@ def browser_context(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object
             args=CHROMIUM_FLAGS,
             viewport={"width": 1400, "height": 900},
         )
-        context.set_default_timeout(30_000)
+        context.set_default_timeout(60_000)
         yield context
         context.close()
 

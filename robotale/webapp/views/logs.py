@@ -14,6 +14,7 @@ from flask import (
     url_for,
 )
 
+from robotale.ekg.log_commands import parse_mapping
 from robotale.errors import InputError
 from robotale.webapp import ingest, pages, uploads
 from robotale.webapp.jobs import jobs
@@ -56,8 +57,10 @@ def upload():
     file = request.files.get("file")
     if file is None or not file.filename:
         raise InputError("Choose a CSV, XES or zipped bag folder to upload.")
+    pairs = [pair for pair in request.form.get("mapping", "").split(",") if pair.strip()]
+    mapping = parse_mapping(pairs)
     saved = uploads.save(file.stream, file.filename, settings().upload_dir)
-    pending = pending_logs().add(saved)
+    pending = pending_logs().add(saved, mapping)
     limit = settings().upload_limit_mb * 1024 * 1024
     models = model_store()
     job = jobs().submit(

@@ -1,0 +1,229 @@
+"""The Logs page through the app: upload, column choice, ingest into the real Neo4j, delete."""
+
+from __future__ import annotations
+
+import csv
+import html
+import io
+import re
+import time
+
+import pytest
+
+from robotale.webapp import create_app
+
+
+def text(response) -> str:
+    return html.unescape(response.get_data(as_text=True))
+
+
+def upload(client, name: str, data: bytes, mapping: str = ""):
+    return client.post(
+        "/logs/upload",
+        data={"csrf_token": client.csrf, "file": (io.BytesIO(data), name), "mapping": mapping},
+        content_type="multipart/form-data",
+    )
+
+
+def wait(client, job_id: str, seen: list | None = None, timeout: float = 300) -> dict:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        job = client.get(f"/api/jobs/{job_id}").json
+        if seen is not None:
+            seen.append(job)
+        if job["finished"]:
+            return job
+        time.sleep(0.05)
+    raise AssertionError(f"job {job_id} did not finish in {timeout} s")
+
+
+def read_step(client, name: str, data: bytes, mapping: str = "") -> tuple[str, str]:
+    """Upload and wait until it is read: the upload's token and the column page."""
+    response = upload(client, name, data, mapping)
+    assert response.status_code == 302, text(response)
+    token, job_id = re.search(r"/logs/upload/(\w+)\?job=(\w+)", response.location).groups()
+    job = wait(client, job_id)
+    assert job["error"] is None, job["error"]
+    page = text(client.get(response.location))
+    return token, page
+
+
+def ingest(client, token: str, fields: dict) -> tuple[dict, list[dict]]:
+    response = client.post(f"/logs/upload/{token}", data={"csrf_token": client.csrf, **fields})
+    assert response.status_code == 302, text(response)
+    job_id = re.search(r"/logs/jobs/(\w+)", response.location).group(1)
+    seen: list[dict] = []
+    return wait(client, job_id, seen), seen
+
+
+def stored(client) -> dict[str, dict]:
+    return {log["name"]: log for log in client.get("/api/logs").json["logs"]}
+
+
+def test_thesis_csv_is_stored_with_the_chosen_columns(
+    client, thesis_csv, log_name, web_settings, neo4j_driver
+):
+    token, page = read_step(client, "robotic_data.csv", thesis_csv.read_bytes())
+    with thesis_csv.open() as stream:
+        rows = list(csv.DictReader(stream))
+    assert f"{len(rows)} events" in page
+    for column in ("time", "activity", "msg_id", "x", "field", "robot"):  # resource is the robot
+        assert f'data-column="{column}"' in page
+    assert re.search(r'value="robot" checked\s+aria-label="robot is an entity"', page)
+
+    kept = ["msg_id", "msg_role", "x", "y", "z", "robot", "event_id"]  # not: field, msg_payload
+    job, _ = ingest(client, token, {"name": log_name, "store": kept, "entity": ["robot", "msg_id"]})
+    assert job["error"] is None and job["stage"] == "done"
+    assert job["result"]["events"] == len(rows)
+
+    log = stored(client)[log_name]
+    assert log["events"] == len(rows) and log["status"] == "complete"
+    assert sorted(log["entityTypes"]) == ["msg_id", "robot"]
+    assert "activity+robot" in log["classTypes"]
+    records, _, _ = neo4j_driver.execute_query(
+        "MATCH (e:Event {log: $log}) UNWIND keys(e) AS key RETURN collect(DISTINCT key) AS keys",
+        log=log_name,
+    )
+    keys = set(records[0]["keys"])
+    assert {"activity", "timestamp", "lifecycle", "x", "robot", "msg_id"} <= keys
+    assert not keys & {"field", "msg_payload"}
+    robots, _, _ = neo4j_driver.execute_query(
+        "MATCH (n:Entity {log: $log, type: 'robot'}) RETURN collect(n.id) AS ids", log=log_name
+    )
+    assert sorted(robots[0]["ids"]) == sorted({row["resource"] for row in rows})
+    assert list(web_settings.upload_dir.iterdir()) == []  # the upload is gone
+
+
+def test_a_refused_choice_keeps_nothing_and_lets_the_user_choose_again(
+    client, thesis_csv, log_name, web_settings, graph_counts
+):
+    token, _ = read_step(client, "robotic_data.csv", thesis_csv.read_bytes())
+    before = graph_counts()
+    response = client.post(
+        f"/logs/upload/{token}",
+        data={"csrf_token": client.csrf, "name": log_name, "entity": ["no_such_column"]},
+    )
+    assert response.status_code == 400
+    assert "The log has no column 'no_such_column'" in text(response)
+    unnamed = client.post(
+        f"/logs/upload/{token}", data={"csrf_token": client.csrf, "name": " ", "entity": "robot"}
+    )
+    assert unnamed.status_code == 400 and "Give the log a name" in text(unnamed)
+    assert graph_counts() == before
+    # the upload is still there for a second try with a valid choice
+    job, _ = ingest(client, token, {"name": log_name, "store": [], "entity": ["robot"]})
+    assert job["error"] is None
+    assert list(web_settings.upload_dir.iterdir()) == []
+
+
+def test_an_existing_name_is_refused_unless_replaced(client, thesis_csv, log_name):
+    token, _ = read_step(client, "a.csv", thesis_csv.read_bytes())
+    ingest(client, token, {"name": log_name, "entity": ["robot"]})
+    first = stored(client)[log_name]
+
+    token, _ = read_step(client, "b.csv", thesis_csv.read_bytes())
+    job, _ = ingest(client, token, {"name": log_name, "entity": ["robot", "msg_id"]})
+    assert f"A log named {log_name!r} already exists" in job["error"]
+    assert stored(client)[log_name]["entityTypes"] == first["entityTypes"] == ["robot"]
+
+    token, _ = read_step(client, "c.csv", thesis_csv.read_bytes())
+    job, _ = ingest(
+        client, token, {"name": log_name, "entity": ["robot", "msg_id"], "replace": "on"}
+    )
+    assert job["error"] is None
+    assert sorted(stored(client)[log_name]["entityTypes"]) == ["msg_id", "robot"]
+
+
+def test_a_file_that_is_no_log_fails_while_reading_and_is_deleted(client, web_settings):
+    response = upload(client, "broken.csv", b"when,what\nyesterday,nothing\n")
+    job_id = re.search(r"job=(\w+)", response.location).group(1)
+    job = wait(client, job_id)
+    assert job["error"].startswith("'broken.csv' has no activity column")
+    assert str(web_settings.upload_dir) not in job["error"]
+    assert job["error"] in text(client.get(response.location))
+    assert list(web_settings.upload_dir.iterdir()) == []
+
+
+def test_columns_named_otherwise_are_mapped(client, log_name):
+    data = (
+        b"Zeit,Aktion,Roboter\n"
+        b"2023-05-16T10:00:00Z,explore,drone\n"
+        b"2023-05-16T10:00:05Z,land,drone\n"
+    )
+    token, page = read_step(
+        client, "german.csv", data, mapping="Zeit=time, Aktion=activity, Roboter=robot"
+    )
+    assert 'data-column="activity"' in page and 'data-column="robot"' in page
+    job, _ = ingest(client, token, {"name": log_name, "entity": ["robot"]})
+    assert job["error"] is None and job["result"]["events"] == 2
+    bad = upload(client, "german.csv", data, mapping="Zeit")
+    assert bad.status_code == 400 and "is not COLUMN=FIELD" in text(bad)
+
+
+def test_a_file_of_another_type_is_refused_at_once(client, web_settings):
+    response = upload(client, "notes.txt", b"hello")
+    assert response.status_code == 400
+    assert "is not an event log robotale reads" in text(response)
+    assert list(web_settings.upload_dir.iterdir()) == []
+
+
+def test_uploads_over_the_limit_are_refused(neo4j_server, web_settings, tmp_path):
+    import dataclasses
+
+    app = create_app(dataclasses.replace(web_settings, upload_dir=tmp_path, upload_limit_mb=1))
+    client = app.test_client()
+    page = client.get("/logs").get_data(as_text=True)
+    token = re.search(r'csrf-token" content="([^"]+)"', page).group(1)
+    big = b"time,activity\n" + b"2023-05-16T10:00:00Z,explore\n" * 40_000
+    response = client.post(
+        "/logs/upload",
+        data={"csrf_token": token, "file": (io.BytesIO(big), "big.csv")},
+        content_type="multipart/form-data",
+    )
+    assert response.status_code == 413
+    assert "larger than the limit of 1 MB" in text(response)
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_delete_removes_the_log_and_everything_built_from_it(
+    client, thesis_csv, log_name, graph_counts
+):
+    before = graph_counts()
+    token, _ = read_step(client, "robotic_data.csv", thesis_csv.read_bytes())
+    ingest(client, token, {"name": log_name, "entity": ["robot"]})
+    assert log_name in stored(client)
+    page = client.get("/logs").get_data(as_text=True)
+    assert f'data-log="{log_name}"' in page
+    response = client.post("/logs/delete", data={"csrf_token": client.csrf, "name": log_name})
+    assert response.status_code == 302
+    assert log_name not in stored(client)
+    assert graph_counts() == before
+    again = client.post("/logs/delete", data={"csrf_token": client.csrf, "name": log_name})
+    assert again.status_code == 400 and "There is no log named" in text(again)
+    no_token = client.post("/logs/delete", data={"name": log_name})
+    assert no_token.status_code == 400
+
+
+@pytest.mark.slow
+def test_progress_is_reported_while_a_large_log_is_written(client, thesis_csv, log_name):
+    # 8 runs of the thesis log as one file: large enough to watch the events arrive.
+    with thesis_csv.open() as stream:
+        rows = list(csv.DictReader(stream))
+    out = io.StringIO()
+    writer = csv.DictWriter(out, [*rows[0], "case"])
+    writer.writeheader()
+    body = [
+        {**row, "event_id": f"{run}_{row['event_id']}", "case": f"run_{run}"}
+        for run in range(8)
+        for row in rows
+    ]
+    writer.writerows(body)
+    data = out.getvalue().encode()
+    token, _ = read_step(client, "runs.csv", data)
+    job, seen = ingest(client, token, {"name": log_name, "entity": ["robot"]})
+    assert job["error"] is None and job["result"]["events"] == len(body)
+    partial = [s for s in seen if s["stage"] == "writing events" and 0 < s["done"] < s["total"]]
+    assert partial, [(s["stage"], s["done"]) for s in seen]
+    assert all(s["total"] == len(body) for s in partial)
+    done = [s["done"] for s in partial]
+    assert done == sorted(done)
