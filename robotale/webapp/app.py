@@ -10,6 +10,7 @@ from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
 from robotale.webapp import errors, jobs, neo4j_access, uploads
+from robotale.webapp.models import ModelStore
 from robotale.webapp.settings import WebSettings
 
 
@@ -32,6 +33,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
     neo4j_access.init_app(app)
     jobs.init_app(app)
     uploads.remove_stale(settings.upload_dir)
+    ModelStore(settings.model_dir).add_shipped()
     errors.init_app(app)
     _register_blueprints(app)
     app.jinja_env.globals.update(robotale_version=__version__, blueprints=app.blueprints)

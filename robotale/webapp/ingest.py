@@ -111,12 +111,24 @@ def _read_bags(
     folder = uploads.unpack(upload, limit_bytes * UNPACK_FACTOR)
     try:
         job.step("preparing the recordings")
-        log = prepare(bag_root(folder))
-        model = next(iter(sorted(folder.rglob("*.bpmn"))), None)
+        root = bag_root(folder)
+        log = prepare(root)
+        model = next(iter(sorted(folder.rglob("*.bpmn"))), None) or shipped_model(root)
         model_id = models.add(model.read_bytes(), model.name).id if model else None
         return log, model_id
     finally:
         shutil.rmtree(folder, ignore_errors=True)
+
+
+def shipped_model(root: Path) -> Path | None:
+    """The mission model of the shipped scenario the recordings' manifests name, if one."""
+    from robotale.ingest.prepare import find_runs, run_manifests
+    from robotale.sim import scenarios
+
+    names = {m.get("scenario") for m in run_manifests(find_runs(root)).values()}
+    if len(names) != 1 or (name := names.pop()) not in scenarios.names():
+        return None
+    return scenarios.FOLDER / f"{name}.bpmn"
 
 
 def bag_root(folder: Path) -> Path:

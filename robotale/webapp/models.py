@@ -68,6 +68,25 @@ class ModelStore:
         found = [self.get(p.stem) for p in self.folder.glob("*.bpmn") if _ID.fullmatch(p.stem)]
         return sorted(found, key=lambda model: model.name.lower())
 
+    def add_shipped(self) -> list[StoredModel]:
+        """Store the mission models of the scenarios robotale ships (agri, rexdingo)."""
+        from robotale.sim import scenarios
+
+        return [self.add(p.read_bytes(), p.name) for p in sorted(scenarios.FOLDER.glob("*.bpmn"))]
+
+    def matching(self, robots: list[str]) -> StoredModel | None:
+        """The first stored model whose pools bind all of ``robots`` (as the splitter would)."""
+        from robotale.fame_runtime.parser import parse
+        from robotale.fame_runtime.splitter import split
+
+        for model in self.all():
+            try:
+                split(parse(model.path), robots)
+            except ModelError:
+                continue
+            return model
+        return None
+
     def link(self, log: str, model_id: str) -> None:
         """Remember that ``model_id`` drove ``log``."""
         self.get(model_id)

@@ -6,7 +6,11 @@ import csv
 import html
 import io
 import re
+import subprocess
+import sys
 import time
+import zipfile
+from pathlib import Path
 
 import pytest
 
@@ -227,3 +231,42 @@ def test_progress_is_reported_while_a_large_log_is_written(client, thesis_csv, l
     assert all(s["total"] == len(body) for s in partial)
     done = [s["done"] for s in partial]
     assert done == sorted(done)
+
+
+@pytest.fixture(scope="module")
+def simulated_runs(tmp_path_factory) -> Path:
+    """Two short runs of the agri scenario, recorded by the simulator as rosbag2 folders."""
+    out = tmp_path_factory.mktemp("sim") / "agri"
+    command = [sys.executable, "-m", "robotale", "simulate", "agri", "--runs", "2"]
+    command += ["--weeds", "2", "--tractors", "2", "--out", str(out), "--workers", "0", "--quiet"]
+    subprocess.run(command, check=True, capture_output=True)
+    return out
+
+
+def zipped_folder(folder: Path) -> bytes:
+    buffer = io.BytesIO()
+    with zipfile.ZipFile(buffer, "w", zipfile.ZIP_DEFLATED) as archive:
+        for path in sorted(folder.rglob("*")):
+            archive.write(path, Path("agri") / path.relative_to(folder))
+    return buffer.getvalue()
+
+
+def test_a_zipped_bag_folder_is_prepared_and_linked_to_its_mission(
+    client, simulated_runs, log_name, web_settings
+):
+    from robotale.ingest.prepare import prepare
+    from robotale.sim import scenarios
+
+    expected = prepare(simulated_runs)
+    token, page = read_step(client, "agri.zip", zipped_folder(simulated_runs))
+    assert f"{len(expected)} events" in page
+    assert 'data-column="battery"' in page and 'data-column="robot_type"' in page
+    job, _ = ingest(client, token, {"name": log_name, "entity": ["robot", "msg_id"]})
+    assert job["error"] is None and job["result"]["events"] == len(expected)
+    assert stored(client)[log_name]["events"] == len(expected)
+    assert list(web_settings.upload_dir.iterdir()) == []  # zip and unpacked folder are gone
+
+    agri = (scenarios.FOLDER / "agri.bpmn").read_bytes()
+    model_page = text(client.get(f"/model?log={log_name}"))
+    model_id = re.search(r'data-model="(\w+)"', model_page).group(1)
+    assert client.get(f"/api/models/{model_id}.bpmn").data == agri

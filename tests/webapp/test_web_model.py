@@ -80,3 +80,19 @@ def test_upload_without_token_or_file_is_refused(client, agri):
     assert no_token.status_code == 400
     no_file = client.post("/model", data={"csrf_token": client.csrf})
     assert no_file.status_code == 400 and "Choose a .bpmn file" in no_file.get_data(as_text=True)
+
+
+def test_the_shipped_missions_are_offered_and_found_by_the_log_robots(tmp_path):
+    from robotale.sim import scenarios
+
+    store = ModelStore(tmp_path)
+    shipped = store.add_shipped()
+    assert sorted(m.name for m in shipped) == sorted(
+        p.name for p in scenarios.FOLDER.glob("*.bpmn")
+    )
+    by_name = {m.name: m for m in store.all()}
+    assert store.matching(["drone", "tractor_1", "tractor_2"]).id == by_name["agri.bpmn"].id
+    assert store.matching(["rex", "dingo"]).id == by_name["rexdingo.bpmn"].id
+    assert store.matching(["ufo"]) is None
+    assert store.add_shipped() == shipped  # stored once
+    assert len(store.all()) == len(shipped)

@@ -18,6 +18,7 @@ from flask import (
 from robotale.errors import InputError
 from robotale.webapp import pages
 from robotale.webapp.models import ModelStore
+from robotale.webapp.neo4j_access import driver
 
 blueprint = Blueprint("model", __name__)
 
@@ -32,11 +33,21 @@ def page():
     models = store().all()
     chosen = request.args.get("model") or ""
     if not chosen and context["log"]:
-        linked = store().linked(context["log"])
-        chosen = linked.id if linked else ""
+        found = store().linked(context["log"]) or store().matching(log_robots(context["log"]))
+        chosen = found.id if found else ""
     if not chosen and models:
         chosen = models[0].id
     return render_template("model.html", models=models, model=chosen, **context)
+
+
+def log_robots(log: str) -> list[str]:
+    from robotale.ekg.connection import database
+    from robotale.ekg.queries import cypher
+
+    records, _, _ = driver().execute_query(
+        cypher("webapp_log_robots"), log=log, database_=database()
+    )
+    return [str(robot) for robot in records[0]["robots"]]
 
 
 @blueprint.post("/model")
