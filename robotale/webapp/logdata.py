@@ -44,7 +44,7 @@ def log_frame(name: str) -> pd.DataFrame:
         if cached and cached[0] == version:
             _cache.move_to_end(name)
             return cached[1]
-    log = read_stored_log(name)
+    log = read_stored_log(name, driver=driver())
     with _lock:
         _cache[name] = (version, log)
         _cache.move_to_end(name)

@@ -8,6 +8,7 @@ from flask import Blueprint, jsonify, render_template, request
 from robotale.ingest import schema
 from robotale.webapp import pages
 from robotale.webapp.logdata import log_frame, log_info
+from robotale.webapp.neo4j_access import driver
 
 blueprint = Blueprint("discover", __name__)
 
@@ -59,3 +60,15 @@ def dfg():
         activities=request.args.getlist("activity"),
     )
     return jsonify(discover_dfg(log_frame(chosen_log()), selection).to_dict())
+
+
+@blueprint.get("/api/discover/ekg")
+def ekg():
+    """The class graph aggregated by activity and the entity types in ``by``, with the flow
+    of the entity types in ``edges`` (all of the log's when none is named)."""
+    from robotale.discovery import discover_ekg
+
+    key = ["activity", *request.args.getlist("by")]
+    edges = request.args.getlist("edges") or None
+    graph = discover_ekg(chosen_log(), key, edges, driver=driver())
+    return jsonify(graph.to_dict())

@@ -24,6 +24,7 @@
     const params = new URLSearchParams({ log: state.log });
     if (state.view === "ekg") {
       for (const box of ekgForm.querySelectorAll("input[name=by]:checked")) params.append("by", box.value);
+      for (const box of ekgForm.querySelectorAll("input[name=edges]:checked")) params.append("edges", box.value);
       return `/api/discover/ekg?${params}`;
     }
     for (const name of ["case", "robot", "robot_type", "activity"]) {
@@ -66,13 +67,17 @@
     if (!node || !focus) {
       details.hidden = true;
       figureBox.hidden = true;
+      if (graphBox._cy) graphBox._cy.resize();
       return;
     }
     document.getElementById("details-title").textContent = robotalePerspective.describe(focus);
     const durations = node.durations || {};
-    const rows = [["count", node.count], ["robots", (node.robots || []).join(", ")],
-      ["mean duration", robotaleGraph.seconds(durations.mean)],
-      ["median duration", robotaleGraph.seconds(durations.median)]];
+    const rows = [[state.graph.kind === "ekg" ? "events" : "instances", node.count],
+      ["robots", (node.robots || []).join(", ")]];
+    if (durations.mean !== undefined && durations.mean !== null) {
+      rows.push(["mean duration", robotaleGraph.seconds(durations.mean)],
+        ["median duration", robotaleGraph.seconds(durations.median)]);
+    }
     for (const [key, value] of Object.entries(node.properties || {})) {
       if (key !== "activity" && key !== "robot") rows.push([key, value]);
     }
@@ -88,7 +93,11 @@
     const figureBox = document.getElementById("node-figure");
     const message = document.getElementById("node-figure-message");
     const plotBox = document.getElementById("spatial-figure");
-    figureBox.hidden = false;
+    if (figureBox.hidden) {
+      figureBox.hidden = false;
+      graphBox._cy.resize(); // the graph just got narrower: keep all of it in view
+      graphBox._cy.fit(undefined, 20);
+    }
     document.getElementById("node-figure-title").textContent =
       `Where ${robotalePerspective.describe(focus)} happened`;
     message.textContent = "loading…";
@@ -106,11 +115,14 @@
   }
 
   function fillSelectors(log, values) {
-    const aggregation = document.getElementById("aggregation");
+    const rows = document.querySelector("#aggregation tbody");
     for (const type of log.entityTypes || []) {
-      const box = robotale.el("input", { type: "checkbox", name: "by", value: type });
-      box.checked = type === "robot";
-      aggregation.append(robotale.el("label", { class: "check" }, box, ` ${type}`));
+      const flow = robotale.el("input", { type: "checkbox", name: "edges", value: type, "aria-label": `flow of ${type}` });
+      const by = robotale.el("input", { type: "checkbox", name: "by", value: type, "aria-label": `aggregate by ${type}` });
+      flow.checked = true;
+      by.checked = type === "robot";
+      rows.append(robotale.el("tr", { "data-type": type }, robotale.el("td", { text: type }),
+        robotale.el("td", {}, flow), robotale.el("td", {}, by)));
     }
     if (!values) return;
     for (const [name, options] of Object.entries(values.filters)) {

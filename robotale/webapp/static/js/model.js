@@ -29,6 +29,12 @@
     return element ? registry.getGraphics(element).querySelector(".djs-visual > :first-child") : null;
   }
 
+  function isContainer(id) {
+    // an expanded sub-process: shade it lightly so what it holds stays readable
+    const element = viewer.get("elementRegistry").get(id);
+    return Boolean(element && element.children && element.children.length);
+  }
+
   function badge(id, text, title, deviating) {
     const box = document.createElement("div");
     box.className = deviating ? "count-badge deviating" : "count-badge";
@@ -43,7 +49,10 @@
     const max = Math.max(0, ...Object.values(elements).map((e) => e.count));
     for (const [id, facts] of Object.entries(elements)) {
       const shape = shapeOf(id);
-      if (shape) shape.style.fill = shade(facts.count, max);
+      if (shape) {
+        shape.style.fill = shade(facts.count, max);
+        if (isContainer(id)) shape.style.fillOpacity = "0.25";
+      }
       if (facts.count) badge(id, String(facts.count), `${facts.count} times, by ${facts.robots.join(", ")}`, false);
     }
     canvasBox.dataset.painted = String(Object.values(elements).filter((e) => e.count).length);
