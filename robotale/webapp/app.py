@@ -9,7 +9,7 @@ from flask import Flask, redirect, url_for
 from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
-from robotale.webapp import errors, jobs, neo4j_access, uploads
+from robotale.webapp import errors, jobs, neo4j_access, pages, uploads
 from robotale.webapp.models import ModelStore
 from robotale.webapp.settings import WebSettings
 
@@ -35,6 +35,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
     uploads.remove_stale(settings.upload_dir)
     ModelStore(settings.model_dir).add_shipped()
     errors.init_app(app)
+    pages.init_app(app)
     _register_blueprints(app)
     app.jinja_env.globals.update(robotale_version=__version__, blueprints=app.blueprints)
 

@@ -23,6 +23,7 @@ from robotale.errors import InputError, RobotaleError
 from robotale.ingest import schema
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
+from robotale.webapp.logdata import class_graph, first_key, forget
 from robotale.webapp.models import ModelStore
 
 #: columns every stored log keeps, whatever the user unticks
@@ -205,6 +206,9 @@ def ingest(
         uploads.discard(pending.upload)
     if pending.model_id:
         models.link(name, pending.model_id)
+    job.step("drawing its process")
+    forget(name)
+    class_graph(driver, name, first_key(entities))  # the Discover page's first view, ready
     return {"log": summary.log, "events": summary.events, "seconds": round(summary.seconds, 2)}
 
 

@@ -1,58 +1,113 @@
-"""Stored logs as event-log DataFrames, kept in memory between requests.
+"""Stored logs as the pages need them, kept in memory between requests.
 
-Discovery and the perspectives work on the canonical DataFrame; reading it back from Neo4j for
-every click would be slow, so the last few logs read stay cached. A cached log is used only
-while its Log node still has the same creation time, so a log rebuilt elsewhere (the command
-line, another dashboard) is read again.
+Discovery and the perspectives work on the canonical DataFrame, and the Discover page first
+shows the aggregated class graph; reading either from Neo4j on every click would be slow, so
+the last few stay cached. A cached result is used only while the log's Log node still has the
+same creation time, so a log rebuilt elsewhere (the command line, another dashboard) is read
+again. Concurrent requests for the same log wait for one read instead of reading it twice.
 """
 
 from __future__ import annotations
 
 import threading
 from collections import OrderedDict
+from collections.abc import Callable, Hashable, Sequence
+from typing import Any
 
 import pandas as pd
+from neo4j import Driver
 
 from robotale.errors import InputError
-from robotale.webapp.neo4j_access import driver
 
-#: how many logs stay in memory
+#: how many logs (and class graphs) stay in memory
 KEEP = 4
-_cache: OrderedDict[str, tuple[str, pd.DataFrame]] = OrderedDict()
-_lock = threading.Lock()
+#: the class graph the Discover page shows first
+DEFAULT_KEY = ("activity", "robot")
 
 
-def log_info(name: str) -> dict:
+class Cache:
+    """A small LRU cache of values keyed by tuples whose first item is the log's name."""
+
+    def __init__(self, size: int) -> None:
+        self.size = size
+        self.items: OrderedDict[Hashable, Any] = OrderedDict()
+        self.lock = threading.Lock()
+        self.loading: dict[Hashable, threading.Lock] = {}
+
+    def get(self, key: Hashable, load: Callable[[], Any]) -> Any:
+        with self.lock:
+            if key in self.items:
+                self.items.move_to_end(key)
+                return self.items[key]
+            loading = self.loading.setdefault(key, threading.Lock())
+        with loading:  # one read per key; the others wait for it
+            with self.lock:
+                if key in self.items:
+                    return self.items[key]
+            value = load()
+            with self.lock:
+                self.items[key] = value
+                self.loading.pop(key, None)
+                while len(self.items) > self.size:
+                    self.items.popitem(last=False)
+            return value
+
+    def forget(self, name: str) -> None:
+        with self.lock:
+            for key in [k for k in self.items if k[0] == name]:
+                del self.items[key]
+
+
+_frames = Cache(KEEP)
+_graphs = Cache(4 * KEEP)
+
+
+def log_info(driver: Driver, name: str) -> dict:
     """The Log node's description of ``name`` (an :class:`InputError` if there is none)."""
     from robotale.ekg.logs import list_logs
 
-    for log in list_logs(driver()):
+    if not name:
+        raise InputError("Choose a log first (upload one on the Logs page).")
+    for log in list_logs(driver):
         if log["name"] == name:
             return log
     raise InputError(f"There is no log named {name!r} in Neo4j: upload it on the Logs page.")
 
 
-def log_frame(name: str) -> pd.DataFrame:
+def log_frame(driver: Driver, name: str) -> pd.DataFrame:
     """The stored log ``name`` as a canonical event log."""
     from robotale.discovery.ekg import read_stored_log
 
-    if not name:
-        raise InputError("Choose a log first (upload one on the Logs page).")
-    version = str(log_info(name).get("created"))
-    with _lock:
-        cached = _cache.get(name)
-        if cached and cached[0] == version:
-            _cache.move_to_end(name)
-            return cached[1]
-    log = read_stored_log(name, driver=driver())
-    with _lock:
-        _cache[name] = (version, log)
-        _cache.move_to_end(name)
-        while len(_cache) > KEEP:
-            _cache.popitem(last=False)
-    return log
+    version = str(log_info(driver, name).get("created"))
+    return _frames.get((name, version), lambda: read_stored_log(name, driver=driver))
+
+
+def class_graph(
+    driver: Driver,
+    name: str,
+    key: Sequence[str] = DEFAULT_KEY,
+    entity_types: Sequence[str] | None = None,
+) -> dict[str, Any]:
+    """The aggregated EKG of ``name`` by ``key`` with the flow of ``entity_types`` (all the
+    log's when None), as :meth:`ProcessGraph.to_dict` gives it."""
+    from robotale.discovery import discover_ekg
+
+    info = log_info(driver, name)
+    if entity_types is not None and set(entity_types) == set(info.get("entityTypes") or []):
+        entity_types = None  # the same graph as "all", so the same cache entry
+    shown = tuple(entity_types) if entity_types is not None else None
+    version = str(info.get("created"))
+    return _graphs.get(
+        (name, version, tuple(key), shown),
+        lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
+    )
+
+
+def first_key(entity_types: Sequence[str]) -> tuple[str, ...]:
+    """The key of the class graph the Discover page shows first for a log."""
+    return DEFAULT_KEY if "robot" in entity_types else ("activity",)
 
 
 def forget(name: str) -> None:
-    with _lock:
-        _cache.pop(name, None)
+    _frames.forget(name)
+    _graphs.forget(name)

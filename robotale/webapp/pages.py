@@ -1,18 +1,41 @@
-"""What every page's template needs: the page's name for the menu and the chosen log.
+"""What every page's template needs: the menu, the stored logs and the chosen log, and static
+files under URLs that change with their content (so browsers keep them without asking again).
 
-Rendering a page first checks that Neo4j answers, so a server that is down shows the error page
-that says how to start it instead of a page whose data will never come.
+Rendering a page lists the stored logs first, so a Neo4j that is down shows the error page that
+says how to start it instead of a page whose data will never come; the list travels inside the
+page, so its scripts need not ask for it before they ask for their data.
 """
 
 from __future__ import annotations
 
+import hashlib
+from functools import cache
 from typing import Any
 
-from flask import request
+from flask import Flask, request, url_for
 
 from robotale.webapp.neo4j_access import driver
 
+#: how long browsers keep a static file; its URL changes when its content does
+STATIC_MAX_AGE = 365 * 24 * 3600
+
 
 def context(endpoint: str) -> dict[str, Any]:
-    driver().verify_connectivity()
-    return {"active": endpoint, "log": request.args.get("log", "")}
+    from robotale.ekg.logs import list_logs
+
+    return {"active": endpoint, "log": request.args.get("log", ""), "logs": list_logs(driver())}
+
+
+def init_app(app: Flask) -> None:
+    app.config["SEND_FILE_MAX_AGE_DEFAULT"] = STATIC_MAX_AGE
+    static = app.static_folder
+
+    @cache
+    def version(filename: str) -> str:
+        with open(f"{static}/{filename}", "rb") as stream:
+            return hashlib.sha256(stream.read()).hexdigest()[:12]
+
+    def asset(filename: str) -> str:
+        return url_for("static", filename=filename, v=version(filename))
+
+    app.jinja_env.globals["asset"] = asset

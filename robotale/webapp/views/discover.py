@@ -5,20 +5,14 @@ from __future__ import annotations
 
 from flask import Blueprint, jsonify, render_template, request
 
-from robotale.ingest import schema
 from robotale.webapp import pages
-from robotale.webapp.logdata import log_frame, log_info
+from robotale.webapp.logdata import class_graph, log_frame, log_info
 from robotale.webapp.neo4j_access import driver
 
 blueprint = Blueprint("discover", __name__)
 
-#: filter name in the query string -> column of the log
-FILTERS = {
-    "case": schema.CASE,
-    "robot": schema.ROBOT,
-    "robot_type": schema.ROBOT_TYPE,
-    "activity": schema.ACTIVITY,
-}
+#: the filters, named as in the query string and as Event properties
+FILTERS = ("case", "robot", "robot_type", "activity")
 
 
 @blueprint.get("/discover")
@@ -33,19 +27,21 @@ def chosen_log() -> str:
 @blueprint.get("/api/discover/values")
 def values():
     """What the filters and the aggregation selector offer for this log."""
+    from robotale.ekg.connection import database
+    from robotale.ekg.queries import cypher
+
     name = chosen_log()
-    log = log_frame(name)
-    offered = {
-        key: sorted(log[column].dropna().astype(str).unique().tolist())
-        for key, column in FILTERS.items()
-        if column in log.columns
-    }
-    info = log_info(name)
+    info = log_info(driver(), name)
+    records, _, _ = driver().execute_query(
+        cypher("webapp_filter_values"), log=name, database_=database()
+    )
+    found = records[0]
+    offered = {key: sorted(str(v) for v in found[key]) for key in FILTERS if found[key]}
     return jsonify(
         filters=offered,
         entity_types=info.get("entityTypes") or [],
         class_types=info.get("classTypes") or [],
-        events=len(log),
+        events=found["events"],
     )
 
 
@@ -59,16 +55,13 @@ def dfg():
         robot_types=request.args.getlist("robot_type"),
         activities=request.args.getlist("activity"),
     )
-    return jsonify(discover_dfg(log_frame(chosen_log()), selection).to_dict())
+    return jsonify(discover_dfg(log_frame(driver(), chosen_log()), selection).to_dict())
 
 
 @blueprint.get("/api/discover/ekg")
 def ekg():
     """The class graph aggregated by activity and the entity types in ``by``, with the flow
     of the entity types in ``edges`` (all of the log's when none is named)."""
-    from robotale.discovery import discover_ekg
-
     key = ["activity", *request.args.getlist("by")]
     edges = request.args.getlist("edges") or None
-    graph = discover_ekg(chosen_log(), key, edges, driver=driver())
-    return jsonify(graph.to_dict())
+    return jsonify(class_graph(driver(), chosen_log(), key, edges))

@@ -44,7 +44,7 @@ def stored_logs() -> list[dict]:
 @blueprint.get("/logs")
 def page():
     context = pages.context("logs.page")
-    return render_template("logs.html", logs=stored_logs(), **context)
+    return render_template("logs.html", **context)
 
 
 @blueprint.get("/api/logs")
@@ -104,7 +104,6 @@ def start_ingest(token: str):
     connected, models = driver(), model_store()
 
     def work(job):
-        forget(name)
         return ingest.ingest(connected, pending, name, entities, replace, models, job)
 
     job = jobs().submit(f"Storing {name}", work)

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import threading
-
 from flask import (
     Blueprint,
     Response,
@@ -17,6 +15,7 @@ from flask import (
 
 from robotale.errors import InputError
 from robotale.webapp import pages
+from robotale.webapp.logdata import Cache
 from robotale.webapp.models import ModelStore
 from robotale.webapp.neo4j_access import driver
 
@@ -89,18 +88,11 @@ def _cached(kind: str, model_id: str, compute):
 
     model = store().get(model_id)
     name = request.args.get("log", "")
-    key = (kind, model_id, name, str(log_info(name).get("created")))
-    with _lock:
-        if key in _results:
-            return _results[key]
-    result = compute(log_frame(name), model.path)
-    with _lock:
-        # the last result of each kind is enough: the page asks once per model and log
-        for old in [k for k in _results if k[0] == kind]:
-            del _results[old]
-        _results[key] = result
-    return result
+    version = str(log_info(driver(), name).get("created"))
+    return _results.get(
+        (name, version, kind, model_id), lambda: compute(log_frame(driver(), name), model.path)
+    )
 
 
-_results: dict[tuple[str, str, str, str], object] = {}
-_lock = threading.Lock()
+#: conformance results are not small: the last two (frequencies and deviations) are enough
+_results = Cache(2)

@@ -7,6 +7,7 @@ from flask import Blueprint, abort, jsonify, render_template, request
 
 from robotale.webapp import pages
 from robotale.webapp.logdata import log_frame
+from robotale.webapp.neo4j_access import driver
 
 blueprint = Blueprint("perspectives", __name__)
 
@@ -32,7 +33,7 @@ def perspective(name: str):
         abort(404, f"There is no {name!r} perspective; there are {', '.join(NAMES)}.")
     make = getattr(enhancement, f"{name}_perspective")
     result = make(
-        log_frame(request.args.get("log", "")),
+        log_frame(driver(), request.args.get("log", "")),
         activity=request.args.get("activity") or None,
         robot=request.args.get("robot") or None,
     )

@@ -53,12 +53,17 @@ const robotale = (() => {
     return el("table", { class: "data" }, el("thead", {}, head), el("tbody", {}, ...body));
   }
 
-  // The chosen log: the page's ?log=, else the last one chosen here, else the newest stored.
+  // The stored logs come inside the page (the server listed them anyway); else ask for them.
   let logsPromise = null;
   function logs() {
-    logsPromise = logsPromise || api("/api/logs").then((data) => data.logs);
+    const embedded = document.getElementById("logs-data");
+    logsPromise = logsPromise || (embedded
+      ? Promise.resolve(JSON.parse(embedded.textContent))
+      : api("/api/logs").then((data) => data.logs));
     return logsPromise;
   }
+
+  // The chosen log: the page's ?log=, else the last one chosen here, else the newest stored.
 
   async function currentLog() {
     const asked = document.body.dataset.log;

@@ -6,9 +6,13 @@
   const graphBox = document.getElementById("graph");
   const status = document.getElementById("graph-status");
   const labels = document.getElementById("labels");
+  const edgeLimit = document.getElementById("edge-limit");
+  // Above this many edges a graph is spaghetti to read and slow to lay out: draw the most
+  // frequent ones and let the user ask for more.
+  const DEFAULT_EDGES = 150;
   const ekgForm = document.getElementById("ekg-form");
   const dfgForm = document.getElementById("dfg-form");
-  const state = { log: "", view: "ekg", graph: null, robotFilter: [] };
+  const state = { log: "", view: "ekg", graph: null, robotFilter: [], edges: DEFAULT_EDGES };
 
   function setView(view) {
     state.view = view;
@@ -53,8 +57,15 @@
     status.textContent = `${graph.kind.toUpperCase()}: ${activities} activities, ${graph.edges.length} edges`;
     graphBox.dataset.kind = graph.kind;
     showNode(null);
+    const total = graph.edges.length;
+    edgeLimit.max = String(Math.max(10, Math.ceil(total / 10) * 10));
+    edgeLimit.value = String(Math.min(state.edges, Number(edgeLimit.max)));
+    const limit = state.edges >= total ? 0 : state.edges;
+    document.getElementById("edge-limit-value").textContent =
+      limit ? `the ${limit} most frequent of ${total}` : `all ${total}`;
     robotaleGraph.draw(graphBox, graph, {
       labels: labels.value,
+      maxEdges: limit,
       legend: document.getElementById("legend"),
       onSelect: showNode,
     });
@@ -154,6 +165,10 @@
   dfgForm.addEventListener("reset", () => setTimeout(discover, 0));
   ekgForm.addEventListener("change", discover);
   labels.addEventListener("change", () => state.graph && draw());
+  edgeLimit.addEventListener("change", () => {
+    state.edges = Number(edgeLimit.value);
+    if (state.graph) draw();
+  });
   document.getElementById("zoom-in").addEventListener("click", () => robotaleGraph.zoom(graphBox, 1.25));
   document.getElementById("zoom-out").addEventListener("click", () => robotaleGraph.zoom(graphBox, 0.8));
   document.getElementById("fit").addEventListener("click", () => graphBox._cy && graphBox._cy.fit(undefined, 20));

@@ -40,7 +40,23 @@ const robotaleGraph = (() => {
     return edge.entity_type ? `${edge.entity_type}: ${figure}` : String(figure);
   }
 
-  function elements(graph, colours, labels) {
+  // The edges worth drawing when there are too many to read (and to lay out quickly): the
+  // most frequent ones, plus each node's most frequent incoming edge so none is left alone.
+  function strongestEdges(edges, limit) {
+    if (!limit || edges.length <= limit) return edges;
+    const byCount = [...edges].sort((a, b) => b.count - a.count);
+    const kept = new Set(byCount.slice(0, limit));
+    const seen = new Set();
+    for (const edge of byCount) {
+      if (!seen.has(edge.target)) {
+        seen.add(edge.target);
+        kept.add(edge);
+      }
+    }
+    return edges.filter((edge) => kept.has(edge));
+  }
+
+  function elements(graph, colours, labels, limit) {
     const nodes = graph.nodes.map((node) => ({
       group: "nodes",
       data: {
@@ -51,7 +67,7 @@ const robotaleGraph = (() => {
         node,
       },
     }));
-    const edges = graph.edges.map((edge, i) => ({
+    const edges = strongestEdges(graph.edges, limit).map((edge, i) => ({
       group: "edges",
       data: {
         id: `e${i}`,
@@ -107,8 +123,10 @@ const robotaleGraph = (() => {
   }
 
   // Draws `graph` into `container`; options: labels ("frequency" | "performance"),
-  // onSelect(node | null), legend (an element for the robot colours). Returns the cytoscape
-  // instance; `container.dataset.drawn` holds how many nodes were drawn once the layout is done.
+  // onSelect(node | null), legend (an element for the robot colours), maxEdges (draw only the
+  // most frequent edges; 0: all). Returns the cytoscape instance; once the layout is done
+  // `container.dataset.drawn` holds how many nodes and `container.dataset.edges` how many
+  // edges were drawn.
   function draw(container, graph, options = {}) {
     const labels = options.labels || "frequency";
     const colours = robotColours(graph);
@@ -117,7 +135,7 @@ const robotaleGraph = (() => {
     delete container.dataset.drawn;
     const cy = cytoscape({
       container,
-      elements: elements(graph, colours, labels),
+      elements: elements(graph, colours, labels, options.maxEdges),
       style: STYLE,
       minZoom: 0.05,
       maxZoom: 4,
@@ -138,6 +156,7 @@ const robotaleGraph = (() => {
     const layout = cy.layout({ name: "dagre", rankDir: "TB", nodeSep: 40, rankSep: 70,
       edgeSep: 20, fit: true, padding: 20, animate: false });
     layout.one("layoutstop", () => {
+      container.dataset.edges = String(cy.edges().length);
       container.dataset.drawn = String(graph.nodes.length);
       performance.mark("robotale-graph-drawn");
     });

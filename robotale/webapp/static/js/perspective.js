@@ -3,6 +3,8 @@
 "use strict";
 
 const robotalePerspective = (() => {
+  const plotlyUrl = document.currentScript.dataset.plotly;
+  let plotlyPromise = null;
   // The activity / robot a node of a process graph stands for. An EKG class carries its key's
   // values; a DFG node is an activity, of one robot only when the graph was filtered to it.
   function focusOf(node, robotFilter = []) {
@@ -30,11 +32,17 @@ const robotalePerspective = (() => {
     return robotale.api(`/api/perspectives/${name}?${query(log, focus)}`);
   }
 
+  // plotly.js is 4.6 MB: fetched and parsed only when a figure is first drawn, so it never
+  // delays the process graph.
   function plotlyReady() {
-    return new Promise((resolve) => {
-      if (window.Plotly) resolve(window.Plotly);
-      else window.addEventListener("load", () => resolve(window.Plotly));
+    plotlyPromise = plotlyPromise || new Promise((resolve, reject) => {
+      const script = document.createElement("script");
+      script.src = plotlyUrl;
+      script.onload = () => resolve(window.Plotly);
+      script.onerror = () => reject(new Error("plotly.js could not be loaded."));
+      document.head.append(script);
     });
+    return plotlyPromise;
   }
 
   async function plot(box, figure) {

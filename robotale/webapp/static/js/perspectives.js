@@ -66,7 +66,7 @@
     const figures = show(focus);
     try {
       const graph = await robotale.api(`/api/discover/ekg?log=${encodeURIComponent(log)}${by}`);
-      robotaleGraph.draw(graphBox, graph, { onSelect: (node) => {
+      robotaleGraph.draw(graphBox, graph, { maxEdges: 150, onSelect: (node) => {
         const chosen = robotalePerspective.focusOf(node);
         if (chosen) show(chosen);
       } });
