@@ -24,8 +24,6 @@ Neo4j, then pm4py) is timed too, for reference.
 from __future__ import annotations
 
 import argparse
-import os
-import shutil
 import statistics
 import sys
 import tempfile
@@ -38,16 +36,6 @@ from ekg_build import private_neo4j, synthetic_log  # noqa: E402
 
 THESIS_CSV = BENCHMARKS.parent / "examples" / "thesis" / "robotic_data.csv"
 TARGETS = {10_000: 1.0, 100_000: 3.0}
-FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 DRAWN = "performance.getEntriesByName('robotale-graph-drawn').length > 0"
 
 
@@ -106,16 +94,14 @@ def measure_all(logs: dict, repeat: int) -> None:
     from playwright.sync_api import sync_playwright
 
     from robotale.webapp import create_app
+    from robotale.webapp.browser import launch
     from robotale.webapp.serve import Dashboard
 
     with tempfile.TemporaryDirectory(prefix="robotale-bench-web-") as scratch:
         folder = Path(scratch)
         app = create_app(upload_dir=folder / "uploads", model_dir=folder / "models")
         with Dashboard(app, port=0) as dashboard, sync_playwright() as playwright:
-            context = playwright.chromium.launch_persistent_context(
-                folder / "profile", executable_path=chromium(), headless=True, args=FLAGS,
-                viewport={"width": 1400, "height": 900},
-            )  # fmt: skip
+            context = launch(playwright, folder / "profile")
             page = context.new_page()
             page.goto(f"{dashboard.url}/cypher")  # warm the browser's cache of the scripts
             baseline_name, baseline_events = logs.pop("thesis")
@@ -161,13 +147,6 @@ def first_graph(
 
 
 _MARK = "performance.getEntriesByName('robotale-graph-drawn')[0].startTime"
-
-
-def chromium() -> str:
-    path = os.environ.get("ROBOTALE_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
-    if not Path(path).is_file():
-        sys.exit("This benchmark needs Debian's chromium (make system-deps) or ROBOTALE_CHROMIUM.")
-    return path
 
 
 if __name__ == "__main__":

@@ -10,23 +10,11 @@ from __future__ import annotations
 
 import os
 import re
-import shutil
 from collections.abc import Iterator
 from pathlib import Path
 from urllib.parse import urlsplit
 
 import pytest
-
-CHROMIUM_FLAGS = [
-    "--headless",
-    "--no-sandbox",
-    "--disable-gpu",
-    "--disable-quic",
-    "--no-first-run",
-    "--disable-background-networking",
-    "--disable-component-update",
-    "--disable-sync",
-]
 
 
 @pytest.fixture(scope="session")
@@ -67,16 +55,6 @@ def dashboard(app) -> Iterator[object]:
         yield running
 
 
-def chromium_path() -> str:
-    path = os.environ.get("ROBOTALE_CHROMIUM") or shutil.which("chromium") or "/usr/bin/chromium"
-    if not Path(path).is_file():
-        pytest.fail(
-            "The browser tests need Debian's chromium (make system-deps installs it) "
-            "or ROBOTALE_CHROMIUM naming a Chromium binary."
-        )
-    return path
-
-
 @pytest.fixture(scope="session")
 def browser_context(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object]:
     """A headless Chromium with a fresh profile."""
@@ -84,14 +62,15 @@ def browser_context(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object
 
     # The machine may be busy: wait for what the user would wait for, not for a fixed 5 s.
     expect.set_options(timeout=60_000)
-    with sync_playwright() as playwright:
-        context = playwright.chromium.launch_persistent_context(
-            tmp_path_factory.mktemp("chromium-profile"),
-            executable_path=chromium_path(),
-            headless=True,
-            args=CHROMIUM_FLAGS,
-            viewport={"width": 1400, "height": 900},
+    from robotale.webapp.browser import chromium_path, launch
+
+    if chromium_path() is None:
+        pytest.fail(
+            "The browser tests need Debian's chromium (make system-deps installs it) "
+            "or ROBOTALE_CHROMIUM naming a Chromium binary."
         )
+    with sync_playwright() as playwright:
+        context = launch(playwright, tmp_path_factory.mktemp("chromium-profile"))
         context.set_default_timeout(60_000)
         yield context
         context.close()
