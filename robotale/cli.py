@@ -83,13 +83,14 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
         "--host", default="127.0.0.1", help="address to listen on (127.0.0.1: this machine only)"
     )
     serve.add_argument("--port", type=int, default=5000, help="port to listen on (5000)")
+    serve.add_argument("--log", help="print the address of this stored log's Discover page")
     serve.set_defaults(handler=_serve)
 
 
 def _serve(args: argparse.Namespace) -> int:
     from robotale.webapp.serve import serve
 
-    serve(host=args.host, port=args.port)
+    serve(host=args.host, port=args.port, log=args.log)
     return 0
 
 

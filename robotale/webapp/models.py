@@ -116,3 +116,16 @@ def _write_atomically(path: Path, data: bytes) -> None:
     except BaseException:
         Path(partial).unlink(missing_ok=True)
         raise
+
+
+def attach_model(log: str, model: Path, folder: Path | None = None) -> StoredModel:
+    """Remember that the BPMN file ``model`` drove ``log``, for the Model page (scripts and
+    ``robotale demo`` call it after storing a log; ``folder`` defaults to the dashboard's)."""
+    if folder is None:
+        from robotale.webapp.settings import WebSettings
+
+        folder = WebSettings.from_env().model_dir
+    store = ModelStore(folder)
+    stored = store.add(Path(model).read_bytes(), Path(model).name)
+    store.link(log, stored.id)
+    return stored

@@ -8,6 +8,7 @@ import ipaddress
 import socket
 import sys
 import threading
+from urllib.parse import urlencode
 
 from flask import Flask
 from werkzeug.serving import BaseWSGIServer, make_server
@@ -72,10 +73,11 @@ def _bind(app: Flask, host: str, port: int) -> BaseWSGIServer:
         return make_server(host, port, app, threaded=True, fd=listening.fileno())
 
 
-def serve(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT) -> None:
-    """Serve the dashboard until Ctrl-C."""
+def serve(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT, log: str | None = None) -> None:
+    """Serve the dashboard until Ctrl-C; with ``log``, point at that log's Discover page."""
     dashboard = Dashboard(host=host, port=port)
-    print(f"robotale dashboard at {dashboard.url}  (Ctrl-C stops it)", file=sys.stderr)
+    where = f"{dashboard.url}/discover?{urlencode({'log': log})}" if log else dashboard.url
+    print(f"robotale dashboard at {where}  (Ctrl-C stops it)", file=sys.stderr)
     if not _is_loopback(host):
         print(
             f"Listening on {host}: anyone who can reach this machine can read the logs.",

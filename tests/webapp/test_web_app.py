@@ -130,7 +130,7 @@ def test_robotale_serve_answers(neo4j_server, tmp_path):
     import os
 
     process = subprocess.Popen(
-        [sys.executable, "-m", "robotale", "serve", "--port", str(port)],
+        [sys.executable, "-m", "robotale", "serve", "--port", str(port), "--log", "agri runs"],
         env={**os.environ, **env_home},
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
@@ -142,7 +142,7 @@ def test_robotale_serve_answers(neo4j_server, tmp_path):
     finally:
         process.terminate()
         _, stderr = process.communicate(timeout=20)
-    assert f"robotale dashboard at http://127.0.0.1:{port}" in stderr
+    assert f"robotale dashboard at http://127.0.0.1:{port}/discover?log=agri+runs" in stderr
 
 
 def _wait_for(url: str, process: subprocess.Popen, timeout: float = 60) -> str:

@@ -96,3 +96,12 @@ def test_the_shipped_missions_are_offered_and_found_by_the_log_robots(tmp_path):
     assert store.matching(["ufo"]) is None
     assert store.add_shipped() == shipped  # stored once
     assert len(store.all()) == len(shipped)
+
+
+def test_a_script_can_attach_the_mission_to_a_log(tmp_path, monkeypatch, agri):
+    from robotale.webapp.models import attach_model
+
+    monkeypatch.setenv("ROBOTALE_MODEL_DIR", str(tmp_path))
+    stored = attach_model("agri-runs", agri)
+    assert ModelStore(tmp_path).linked("agri-runs").id == stored.id
+    assert stored.path.read_bytes() == agri.read_bytes()
