@@ -66,8 +66,15 @@ class PendingLogs:
     def add(self, upload: uploads.Upload, mapping: dict[str, str]) -> Pending:
         pending = Pending(upload, mapping)
         with self._lock:
+            self._forget_stale()
             self._items[upload.token] = pending
         return pending
+
+    def _forget_stale(self) -> None:
+        # an upload read but never stored: its file and its log go after a day
+        limit = time.time() - uploads.STALE_AFTER
+        for token in [t for t, p in self._items.items() if p.created < limit]:
+            uploads.discard(self._items.pop(token).upload)
 
     def get(self, token: str) -> Pending:
         with self._lock:

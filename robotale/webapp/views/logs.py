@@ -59,6 +59,7 @@ def upload():
         raise InputError("Choose a CSV, XES or zipped bag folder to upload.")
     pairs = [pair for pair in request.form.get("mapping", "").split(",") if pair.strip()]
     mapping = parse_mapping(pairs)
+    uploads.remove_stale(settings().upload_dir)
     saved = uploads.save(file.stream, file.filename, settings().upload_dir)
     pending = pending_logs().add(saved, mapping)
     limit = settings().upload_limit_mb * 1024 * 1024

@@ -97,7 +97,11 @@
     document.getElementById("details-link").href =
       `/perspectives?${robotalePerspective.query(state.log, focus)}`;
     details.hidden = false;
-    showSpatial(focus);
+    showSpatial(focus); // shows the figure's panel at once, then loads the figure
+    // Bring the node and its neighbours into view; "fit" shows the whole graph again.
+    const cy = graphBox._cy;
+    cy.animate({ fit: { eles: cy.getElementById(node.id).closedNeighborhood(), padding: 30 } },
+      { duration: 250 });
   }
 
   async function showSpatial(focus) {
@@ -106,8 +110,7 @@
     const plotBox = document.getElementById("spatial-figure");
     if (figureBox.hidden) {
       figureBox.hidden = false;
-      graphBox._cy.resize(); // the graph just got narrower: keep all of it in view
-      graphBox._cy.fit(undefined, 20);
+      graphBox._cy.resize(); // the graph just got narrower
     }
     document.getElementById("node-figure-title").textContent =
       `Where ${robotalePerspective.describe(focus)} happened`;

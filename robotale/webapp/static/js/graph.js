@@ -11,6 +11,8 @@ const robotaleGraph = (() => {
     "#4E79A7", "#59A14F", "#B07AA1", "#9C755F", "#EDC948", "#76B7B2"];
   const SHARED = "#8a94a6"; // nodes several robots perform
   const ENTITY_EDGE = { COMM: "#D55E00", msg_id: "#D55E00" };
+  // Edge types that join different robots' classes rather than follow one robot's process.
+  const ACROSS = new Set(["COMM", "msg_id"]);
 
   function robotColours(graph) {
     const robots = new Set();
@@ -56,8 +58,14 @@ const robotaleGraph = (() => {
     return edges.filter((edge) => kept.has(edge));
   }
 
+  // Where a node goes in the element list: dagre breaks cycles by a depth-first search in
+  // that order, so starting from the start (and entity) nodes puts them on top and makes the
+  // loops (the next run's takeoff after a landing) the edges that point upwards.
+  const ORDER = { start: 0, entity: 1, activity: 2, end: 3 };
+
   function elements(graph, colours, labels, limit) {
-    const nodes = graph.nodes.map((node) => ({
+    const ordered = [...graph.nodes].sort((a, b) => (ORDER[a.kind] ?? 2) - (ORDER[b.kind] ?? 2));
+    const nodes = ordered.map((node) => ({
       group: "nodes",
       data: {
         id: node.id,
@@ -84,8 +92,8 @@ const robotaleGraph = (() => {
 
   // Node sizes follow their labels (cytoscape's own "label" size is deprecated).
   const lines = (node) => String(node.data("label")).split("\n");
-  const labelWidth = (node) => 18 + 7.2 * Math.max(...lines(node).map((line) => line.length));
-  const labelHeight = (node) => 14 + 15 * lines(node).length;
+  const labelWidth = (node) => 18 + 8.4 * Math.max(...lines(node).map((line) => line.length));
+  const labelHeight = (node) => 12 + 17 * lines(node).length;
 
   const STYLE = [
     { selector: "node", style: {
@@ -93,7 +101,7 @@ const robotaleGraph = (() => {
       "background-color": "data(colour)", "background-opacity": 0.18,
       "border-width": 2, "border-color": "data(colour)",
       label: "data(label)", "text-wrap": "wrap", "text-valign": "center", "text-halign": "center",
-      "font-size": 12, color: "#1d2430" } },
+      "font-size": 14, color: "#1d2430" } },
     { selector: "node[kind = 'start'], node[kind = 'end']", style: {
       shape: "ellipse", width: 44, height: 44, padding: 0, "background-opacity": 1,
       "background-color": "#1d2430", "border-color": "#1d2430", color: "white", "font-size": 10 } },
@@ -104,7 +112,7 @@ const robotaleGraph = (() => {
     { selector: "edge", style: {
       "curve-style": "bezier", "target-arrow-shape": "triangle", width: "data(width)",
       "line-color": "data(colour)", "target-arrow-color": "data(colour)",
-      label: "data(label)", "font-size": 10, color: "#364152",
+      label: "data(label)", "font-size": 12, color: "#364152",
       "text-background-color": "white", "text-background-opacity": 0.85,
       "text-background-padding": "2px", "text-rotation": "none" } },
     { selector: "edge.dimmed, node.dimmed", style: { opacity: 0.25 } },
@@ -153,8 +161,12 @@ const robotaleGraph = (() => {
       cy.elements().removeClass("dimmed");
       if (options.onSelect) options.onSelect(null);
     });
-    const layout = cy.layout({ name: "dagre", rankDir: "TB", nodeSep: 40, rankSep: 70,
-      edgeSep: 20, fit: true, padding: 20, animate: false });
+    // Ranks follow each robot's own flow (and the DFG's): message edges between robots are
+    // left out of the layout, so every robot's process reads top to bottom, side by side,
+    // with the messages drawn across.
+    const across = cy.edges().filter((edge) => ACROSS.has(edge.data("edge").entity_type));
+    const layout = cy.elements().difference(across).layout({ name: "dagre", rankDir: "TB",
+      nodeSep: 30, rankSep: 45, edgeSep: 15, fit: true, padding: 15, animate: false });
     layout.one("layoutstop", () => {
       container.dataset.edges = String(cy.edges().length);
       container.dataset.drawn = String(graph.nodes.length);
