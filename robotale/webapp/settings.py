@@ -16,6 +16,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from robotale.config import robotale_home
+from robotale.errors import InputError
 
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 5000
@@ -38,6 +39,16 @@ class WebSettings:
         return cls(
             upload_dir=Path(env.get("ROBOTALE_UPLOAD_DIR") or robotale_home() / "uploads"),
             model_dir=Path(env.get("ROBOTALE_MODEL_DIR") or robotale_home() / "models"),
-            upload_limit_mb=int(env.get("ROBOTALE_UPLOAD_LIMIT_MB") or cls.upload_limit_mb),
+            upload_limit_mb=_megabytes(env.get("ROBOTALE_UPLOAD_LIMIT_MB"), cls.upload_limit_mb),
             secret_key=env.get("ROBOTALE_SECRET_KEY") or secrets.token_hex(32),
         )
+
+
+def _megabytes(value: str | None, default: int) -> int:
+    if not value:
+        return default
+    if not value.strip().isdigit() or int(value) < 1:
+        raise InputError(
+            f"ROBOTALE_UPLOAD_LIMIT_MB is {value!r}: give a whole number of megabytes."
+        )
+    return int(value)

@@ -155,3 +155,18 @@ def _wait_for(url: str, process: subprocess.Popen, timeout: float = 60) -> str:
         except (urllib.error.URLError, ConnectionError):
             time.sleep(0.3)
     raise AssertionError(f"{url} did not answer within {timeout} s")
+
+
+def test_settings_come_from_the_environment(monkeypatch, tmp_path):
+    from robotale.errors import InputError
+    from robotale.webapp.settings import WebSettings
+
+    monkeypatch.setenv("ROBOTALE_HOME", str(tmp_path))
+    monkeypatch.delenv("ROBOTALE_UPLOAD_DIR", raising=False)
+    monkeypatch.setenv("ROBOTALE_UPLOAD_LIMIT_MB", "20")
+    settings = WebSettings.from_env()
+    assert settings.upload_dir == tmp_path / "uploads" and settings.upload_limit_mb == 20
+    assert len(settings.secret_key) == 64
+    monkeypatch.setenv("ROBOTALE_UPLOAD_LIMIT_MB", "lots")
+    with pytest.raises(InputError, match="ROBOTALE_UPLOAD_LIMIT_MB is 'lots'"):
+        WebSettings.from_env()
