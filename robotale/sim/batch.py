@@ -2,10 +2,10 @@
 
 :func:`simulate_batch` writes ``<out>/run_0001/`` ... (each a bag with its
 ``robotale-run.json``) and ``<out>/robotale-batch.json``, the batch's summary. A run is
-recorded into a hidden ``.run_0001.partial`` folder and renamed when complete, so ``<out>``
-never holds half a bag. A run that raises is recorded as crashed and the batch goes on; a run
-that kills its worker process is retried alone once, then recorded as crashed (a manifest
-without a bag).
+recorded inside a hidden ``.run_0001.partial`` folder and moved into place when complete, so
+``<out>`` never holds half a bag (and the bag's files carry the run's own name). A run that
+raises is recorded as crashed and the batch goes on; a run that kills its worker process is
+retried alone once, then recorded as crashed (a manifest without a bag).
 """
 
 from __future__ import annotations
@@ -82,14 +82,16 @@ def run_into(
     plan: RunPlan, out: Path, *, gui: bool = False, pace: float | None = None
 ) -> dict[str, Any]:
     """One run recorded into ``out/<case>`` (through a hidden partial folder)."""
+    # rosbag2 names its storage files after the bag's folder, so the bag is written under its
+    # final name inside the hidden folder and only the folder is moved.
     partial, final = out / f".{plan.case}.partial", out / plan.case
     shutil.rmtree(partial, ignore_errors=True)
+    partial.mkdir(parents=True)
     try:
-        manifest = simulate_run(plan, partial, gui=gui, pace=pace)
-    except BaseException:
+        manifest = simulate_run(plan, partial / plan.case, gui=gui, pace=pace)
+        (partial / plan.case).rename(final)
+    finally:
         shutil.rmtree(partial, ignore_errors=True)
-        raise
-    partial.rename(final)
     return manifest
 
 

@@ -101,3 +101,13 @@ def test_more_robot_topics_are_recorded_when_asked_and_sensors_read_the_world(sh
     assert all(0 < r <= 2.0 for r in tractor)
     forward = [m.linear.x for _, _, m in messages(bag, {"/tractor_1/cmd_vel"})]
     assert max(forward) > 0 and forward[-1] == 0.0  # it drove, and stopped
+
+
+def test_a_runs_storage_file_carries_the_runs_name(short_agri, tmp_path):
+    bag = record(short_agri, tmp_path / "runs")
+    assert sorted(p.name for p in bag.iterdir()) == [
+        "metadata.yaml",
+        "robotale-run.json",
+        "run_0001.db3",
+    ]
+    assert not list((tmp_path / "runs").glob(".*")), "no hidden partial folder is left behind"
