@@ -19,8 +19,9 @@ def ingest(args: argparse.Namespace) -> int:
     path = Path(args.path)
     if path.is_dir():
         raise InputError(f"{path} is a directory; give an event log file (.csv or .xes).")
+    mapping = parse_mapping(args.map)
     with session_driver() as driver:
-        log = read_log(path, parse_mapping(args.map), args.case)
+        log = read_log(path, mapping, args.case)
         summary = build_ekg(
             driver,
             log,

@@ -1,0 +1,104 @@
+"""`robotale ingest`, `logs` and `demo` against the session's Neo4j."""
+
+from __future__ import annotations
+
+import pandas as pd
+import pytest
+
+from robotale.cli import main
+from robotale.ekg.logs import delete_log, list_logs, log_summary
+
+
+def run(capsys, *args: str) -> tuple[int, str, str]:
+    code = main(list(args))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_ingest_list_show_delete(tmp_path, capsys, neo4j_driver, log_name, thesis_csv):
+    code, out, err = run(
+        capsys,
+        "ingest",
+        str(thesis_csv),
+        "--log",
+        log_name,
+        "--entities",
+        "robot,msg_id",
+        "--aggregate",
+        "activity,robot",
+    )
+    assert code == 0, err
+    assert f"Log '{log_name}': 3,648 events" in out
+    assert "DF_C      activity+robot 93" in out
+
+    code, out, _ = run(capsys, "logs", "list")
+    line = next(line for line in out.splitlines() if line.startswith(log_name))
+    assert "[complete]  3,648 events  entities: robot, msg_id  classes: activity+robot" in line
+
+    code, out, _ = run(capsys, "logs", "show", log_name)
+    assert code == 0 and f"from {thesis_csv}" in out
+    shown = {" ".join(line.split()[:-1]): line.split()[-1] for line in out.splitlines()[1:]}
+    assert shown["events"] == "3,648" and shown["entities:robot"] == "3"
+
+    code, out, _ = run(capsys, "logs", "delete", log_name)
+    assert code == 0 and log_name not in {log["name"] for log in list_logs(neo4j_driver)}
+    code, _, err = run(capsys, "logs", "delete", log_name)
+    assert code == 1 and f"There is no log named '{log_name}'" in err
+
+
+def test_ingest_maps_columns_and_picks_the_case(tmp_path, capsys, neo4j_driver, log_name):
+    path = tmp_path / "shift.csv"
+    pd.DataFrame(
+        {
+            "Zeit": [
+                "2024-01-01T08:00:00+01:00",
+                "2024-01-01T08:01:00+01:00",
+                "2024-01-01T08:02:00+01:00",
+            ],
+            "Tätigkeit": ["load", "drive", "unload"],
+            "wer": ["truck, crane", "truck", "truck, crane"],
+            "schicht": ["s1", "s1", "s2"],
+        }
+    ).to_csv(path, index=False)
+    code, _, err = run(
+        capsys,
+        "ingest",
+        str(path),
+        "--log",
+        log_name,
+        "--map",
+        "Zeit=time",
+        "--map",
+        "Tätigkeit=activity",
+        "--map",
+        "wer=robot",
+        "--case",
+        "schicht",
+    )
+    assert code == 0, err
+    counts = log_summary(neo4j_driver, log_name)["counts"]
+    assert counts["cases"] == 2
+    assert counts["entities:robot"] == 2
+    assert counts["CORR:robot"] == 5
+    assert counts["DF:robot"] == 3  # truck: 2 edges, crane: 1 edge
+
+
+def test_bad_map_option(capsys, tmp_path):
+    code, _, err = run(capsys, "ingest", str(tmp_path / "x.csv"), "--map", "Zeit")
+    assert code == 1 and "--map 'Zeit' is not COLUMN=FIELD" in err
+
+
+@pytest.mark.slow
+def test_demo_ingests_the_thesis_log(capsys, neo4j_driver):
+    try:
+        code, out, err = run(capsys, "demo")
+        assert code == 0, err
+        assert "Log 'thesis': 3,648 events" in out
+        assert "MATCH (c:Class {log: 'thesis', type: 'activity+robot'})" in out
+        counts = log_summary(neo4j_driver, "thesis")["counts"]
+        assert counts["classes:activity+robot"] == 24
+        # Running it again replaces the log instead of refusing it.
+        assert run(capsys, "demo")[0] == 0
+        assert log_summary(neo4j_driver, "thesis")["counts"] == counts
+    finally:
+        delete_log(neo4j_driver, "thesis")

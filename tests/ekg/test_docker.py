@@ -1,0 +1,73 @@
+"""docker-compose.yml and the Dockerfile, checked without a Docker engine."""
+
+from __future__ import annotations
+
+import fnmatch
+import os
+import re
+import shutil
+import subprocess
+from pathlib import Path
+
+import yaml
+
+REPO = Path(__file__).resolve().parents[2]
+
+
+def compose_config(**env: str) -> dict:
+    assert shutil.which("docker-compose"), "install the Debian package docker-compose"
+    environment = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")} | env
+    result = subprocess.run(
+        ["docker-compose", "-f", str(REPO / "docker-compose.yml"), "config"],
+        capture_output=True,
+        text=True,
+        env=environment,
+        cwd=REPO,
+    )
+    assert result.returncode == 0, result.stderr
+    return yaml.safe_load(result.stdout)
+
+
+def test_compose_runs_neo4j_and_the_dashboard_against_it():
+    config = compose_config(NEO4J_PASSWORD="a-secret-1")
+    neo4j, dashboard = config["services"]["neo4j"], config["services"]["dashboard"]
+    assert neo4j["image"] == "neo4j:5.26-community"
+    assert neo4j["environment"]["NEO4J_AUTH"] == "neo4j/a-secret-1"
+    assert "neo4j-data:/data:rw" in neo4j["volumes"]
+    assert "cypher-shell" in " ".join(neo4j["healthcheck"]["test"])
+    assert dashboard["environment"] == {
+        "NEO4J_URI": "bolt://neo4j:7687",
+        "NEO4J_USER": "neo4j",
+        "NEO4J_PASSWORD": "a-secret-1",
+    }
+    assert dashboard["depends_on"] == {"neo4j": {"condition": "service_healthy"}}
+    assert dashboard["command"][:4] == ["robotale", "serve", "--host", "0.0.0.0"]
+    assert Path(dashboard["build"]["context"]) == REPO
+    ports = neo4j["ports"] + dashboard["ports"]
+    assert all(str(port).startswith("127.0.0.1:") for port in ports), "this machine only"
+
+
+def test_compose_has_a_local_default_password():
+    config = compose_config()
+    assert config["services"]["neo4j"]["environment"]["NEO4J_AUTH"] == "neo4j/robotale-local"
+    dashboard = config["services"]["dashboard"]["environment"]
+    assert dashboard["NEO4J_PASSWORD"] == "robotale-local"
+
+
+def test_dockerfile_copies_only_what_exists_and_is_not_ignored():
+    dockerfile = (REPO / "Dockerfile").read_text()
+    ignored = [
+        line.strip()
+        for line in (REPO / ".dockerignore").read_text().splitlines()
+        if line.strip() and not line.startswith("#")
+    ]
+    sources = []
+    for line in dockerfile.splitlines():
+        if line.startswith("COPY") and "--from=" not in line:
+            sources += [s for s in line.split()[1:-1] if not s.startswith("--")]
+    assert {"robotale", "cypher", "setup.py", "pyproject.toml", "examples"} <= set(sources)
+    for source in sources:
+        assert (REPO / source).exists(), source
+        assert not any(fnmatch.fnmatch(source, pattern) for pattern in ignored), source
+    command = re.search(r"^CMD \[(.*)\]$", dockerfile, re.M).group(1)
+    assert command.replace('"', "").split(", ")[:2] == ["robotale", "serve"]
