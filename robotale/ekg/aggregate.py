@@ -53,13 +53,25 @@ def aggregate(driver: Driver, log: str, key: str | Sequence[str]) -> int:
 
 def aggregate_unchecked(driver: Driver, log: str, key: list[str]) -> int:
     """:func:`aggregate` for a key already checked against the log's properties."""
+    kind = create_classes(driver, log, key)
+    edges = create_df_c(driver, log, kind)
+    driver.execute_query(cypher("ekg_log_add_class_type"), log=log, type=kind, database_=database())
+    return edges
+
+
+def create_classes(driver: Driver, log: str, key: list[str]) -> str:
+    """Class nodes and OBSERVED edges for ``key`` (replacing earlier ones); the class type."""
     kind = class_type(key)
     with driver.session(database=database()) as session:
         for statement in statements("ekg_delete_classes"):
             session.run(statement, log=log, type=kind).consume()
         session.run(cypher("ekg_aggregate_classes"), log=log, type=kind, key=key).consume()
+    return kind
+
+
+def create_df_c(driver: Driver, log: str, kind: str) -> int:
+    """DF_C edges between the classes of type ``kind``; how many."""
     records, _, _ = driver.execute_query(
         cypher("ekg_aggregate_df_c"), log=log, type=kind, database_=database()
     )
-    driver.execute_query(cypher("ekg_log_add_class_type"), log=log, type=kind, database_=database())
     return int(records[0]["edges"])

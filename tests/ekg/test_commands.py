@@ -102,3 +102,25 @@ def test_demo_ingests_the_thesis_log(capsys, neo4j_driver):
         assert log_summary(neo4j_driver, "thesis")["counts"] == counts
     finally:
         delete_log(neo4j_driver, "thesis")
+
+
+def test_xes_log_with_a_named_time_zone(tmp_path, capsys, neo4j_driver, log_name):
+    from robotale.ekg.queries import cypher
+
+    path = tmp_path / "zones.xes"
+    path.write_text(
+        """<log xmlns="http://www.xes-standard.org/"><trace><string key="concept:name" value="r1"/>
+        <event><string key="concept:name" value="a"/><date key="time:timestamp"
+          value="2024-03-31T01:30:00+01:00"/><string key="org:resource" value="rex"/></event>
+        <event><string key="concept:name" value="b"/><date key="time:timestamp"
+          value="2024-03-31T01:45:00+01:00"/><string key="org:resource" value="rex"/></event>
+        </trace></log>"""
+    )
+    code, _, err = run(capsys, "ingest", str(path), "--log", log_name)
+    assert code == 0, err
+    records, _, _ = neo4j_driver.execute_query(cypher("ekg_event"), log=log_name, id="1")
+    event = records[0]["e"]
+    assert event["case"] == "r1" and event["robot"] == "rex" and event["activity"] == "b"
+    assert event["timestamp"].iso_format() == "2024-03-31T01:45:00.000000000+01:00"
+    counts = log_summary(neo4j_driver, log_name)["counts"]
+    assert counts["DF:robot"] == 1 and counts["DF_C:activity / robot"] == 1

@@ -125,3 +125,13 @@ def test_with_the_naming_convention_names_decide():
 def test_logs_that_cannot_be_stored(change, message):
     with pytest.raises(InputError, match=message):
         graph_tables(change(log([(1, "a", "r"), (2, "b", "r")])), ["robot"])
+
+
+def test_a_named_zone_is_kept_and_offsets_are_written_as_such():
+    from robotale.ekg.load import timezone_name
+
+    rome = pd.Series(pd.to_datetime(["2024-03-31T01:30:00"]).tz_localize("Europe/Rome"))
+    assert timezone_name(rome) == "Europe/Rome"
+    fixed = pd.Series(pd.to_datetime(["2024-03-31T01:30:00-03:30"]))
+    assert timezone_name(fixed) == "-03:30"
+    assert timezone_name(pd.Series(pd.to_datetime(["2024-03-31T01:30:00Z"]))) == "+00:00"
