@@ -13,7 +13,7 @@ import dataclasses
 import itertools
 import time
 import uuid
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -24,6 +24,7 @@ from tqdm import tqdm
 
 from robotale.ekg.aggregate import aggregate_unchecked, aggregation_key, class_type
 from robotale.ekg.connection import database
+from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.load import Loader
 from robotale.ekg.logs import delete_log, log_exists
 from robotale.ekg.queries import cypher, statements
@@ -82,8 +83,7 @@ def build_ekg(
     target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
     summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress))
     if existing:
-        delete_log(driver, name)
-        _rename(driver, target, name)
+        _swap(driver, target, name)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
 
 
@@ -121,7 +121,8 @@ class _Job:
 def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
     target = job.target
     try:
-        return _write(driver, job)
+        with DeferredInterrupt() as interrupt:
+            return _write(driver, job, interrupt.check)
     except BaseException as error:
         try:
             delete_log(driver, target)
@@ -137,7 +138,7 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
         raise
 
 
-def _write(driver: Driver, job: _Job) -> BuildSummary:
+def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> BuildSummary:
     tables, target = job.tables, job.target
     events, entities = tables.events, tables.entities
     driver.execute_query(
@@ -156,8 +157,12 @@ def _write(driver: Driver, job: _Job) -> BuildSummary:
         disable=None if job.progress else True,
         leave=False,
     ) as bar:
-        _write_graph(Loader(driver, target, bar), tables)
-    df_c = {class_type(key): aggregate_unchecked(driver, target, key) for key in job.keys}
+        _write_graph(Loader(driver, target, bar, between_batches), tables)
+    df_c = {}
+    for key in job.keys:
+        between_batches()
+        df_c[class_type(key)] = aggregate_unchecked(driver, target, key)
+    between_batches()
     driver.execute_query(
         cypher("ekg_log_finish"), log=target, events=len(events), database_=database()
     )
@@ -214,7 +219,15 @@ def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> lis
     return [nodes[start:end] for start, end in itertools.pairwise(bounds)]
 
 
-def _rename(driver: Driver, old: str, new: str) -> None:
-    with driver.session(database=database()) as session:
-        for statement in statements("ekg_rename_log"):
-            session.run(statement, log=old, name=new).consume()
+def _swap(driver: Driver, new: str, name: str) -> None:
+    """Replace the log ``name`` by the complete log stored as ``new``."""
+    try:
+        delete_log(driver, name)
+        with driver.session(database=database()) as session:
+            for statement in statements("ekg_rename_log"):
+                session.run(statement, log=new, name=name).consume()
+    except (Neo4jError, DriverError, OSError) as error:
+        raise ServerError(
+            f"The rebuilt log is complete as {new!r} but replacing {name!r} by it failed "
+            f"({error}); delete {name!r} and ingest again."
+        ) from error

@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import datetime as dt
 import math
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from typing import Any
 
 import numpy as np
@@ -27,10 +27,17 @@ BATCH = 10_000
 class Loader:
     """Runs the batched writes of one build and shows their progress."""
 
-    def __init__(self, driver: Driver, log: str, progress: tqdm | None = None) -> None:
+    def __init__(
+        self,
+        driver: Driver,
+        log: str,
+        progress: tqdm | None = None,
+        between_batches: Callable[[], None] = lambda: None,
+    ) -> None:
         self.driver = driver
         self.log = log
         self.progress = progress
+        self.between_batches = between_batches  # e.g. DeferredInterrupt.check
 
     def run(
         self,
@@ -48,6 +55,7 @@ class Loader:
         size = len(next(iter(columns.values())))
 
         def write(start: int) -> list[int]:
+            self.between_batches()
             params = {name: _slice(values, start) for name, values in columns.items()}
             for name, columns_of_map in (maps or {}).items():
                 params[name] = {k: _slice(v, start) for k, v in columns_of_map.items()}
