@@ -128,7 +128,7 @@ class LocalServer:
         options = options or ServerOptions.from_env()
         for port, flag in ((options.bolt_port, "bolt"), (options.http_port, "http")):
             _require_free(port, flag)
-        java = _java()
+        java = java_executable()
         lib = ensure_jars()
         self._write_config(options)
         self._ensure_password(java, lib)
@@ -197,7 +197,8 @@ class LocalServer:
             _write_private(self.password_file, password)
         env = {**os.environ, "NEO4J_HOME": str(self.home), "NEO4J_CONF": str(self.home / "conf")}
         result = subprocess.run(
-            [java, "-cp", f"{lib}/*", _ADMIN_TOOL, "dbms", "set-initial-password", password],
+            # "--": a password may begin with "-" (token_urlsafe's do, now and then).
+            [java, "-cp", f"{lib}/*", _ADMIN_TOOL, "dbms", "set-initial-password", "--", password],
             env=env,
             capture_output=True,
             text=True,
@@ -260,7 +261,7 @@ def _http_answers(state: RunningServer) -> bool:
         return False
 
 
-def _java() -> str:
+def java_executable() -> str:
     java_home = os.environ.get("JAVA_HOME")
     java = str(Path(java_home) / "bin" / "java") if java_home else shutil.which("java")
     if not java or not Path(java).is_file():

@@ -20,7 +20,7 @@ from typing import ClassVar
 import pytest
 
 from robotale.ekg import connection, jars
-from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port
+from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port, java_executable
 from robotale.errors import ServerError
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
@@ -173,6 +173,15 @@ def test_start_refuses_a_port_in_use(tmp_path):
         with pytest.raises(PortInUse, match=rf"bolt port {port} on 127\.0\.0\.1 is in use"):
             server.start(ServerOptions(bolt_port=port, http_port=free_port()))
     assert server.running() is None
+
+
+def test_a_password_that_looks_like_an_option_is_set(tmp_path, monkeypatch):
+    monkeypatch.setenv("NEO4J_PASSWORD", "-looks-like-an-option")
+    server = LocalServer(tmp_path)
+    server._write_config(ServerOptions(free_port(), free_port()))
+    server._ensure_password(java_executable(), jars.ensure_jars())
+    assert server.password() == "-looks-like-an-option"
+    assert (server.home / "data" / "dbms" / "auth.ini").read_text().startswith("neo4j:")
 
 
 def test_a_stale_record_is_not_a_running_server(tmp_path):
