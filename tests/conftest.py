@@ -25,8 +25,14 @@ import re
 import uuid
 from collections.abc import Callable, Iterator
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pytest
+
+if TYPE_CHECKING:
+    from neo4j import Driver
+
+    from robotale.ekg.connection import Settings
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLES = REPO / "examples"
@@ -45,7 +51,7 @@ def fame_models() -> Path:
 
 
 @pytest.fixture(scope="session")
-def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object]:
+def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Settings]:
     """The Neo4j server of this test session (see the module docstring)."""
     from robotale.ekg.connection import settings
 
@@ -75,7 +81,7 @@ def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object]:
 
 
 @pytest.fixture(scope="session")
-def neo4j_driver(neo4j_server: object) -> Iterator[object]:
+def neo4j_driver(neo4j_server: Settings) -> Iterator[Driver]:
     """A driver connected to the session's Neo4j server."""
     from robotale.ekg.connection import connect
 
@@ -85,7 +91,7 @@ def neo4j_driver(neo4j_server: object) -> Iterator[object]:
 
 
 @pytest.fixture
-def log_name(request: pytest.FixtureRequest, neo4j_driver: object) -> Iterator[str]:
+def log_name(request: pytest.FixtureRequest, neo4j_driver: Driver) -> Iterator[str]:
     """A fresh log name for this test; its data is deleted afterwards."""
     from robotale.ekg.logs import delete_log
 
@@ -96,7 +102,7 @@ def log_name(request: pytest.FixtureRequest, neo4j_driver: object) -> Iterator[s
 
 
 @pytest.fixture
-def graph_counts(neo4j_driver: object) -> Callable[[], dict[str, int]]:
+def graph_counts(neo4j_driver: Driver) -> Callable[[], dict[str, int]]:
     """Counts of nodes per label and relationships per type in the whole database."""
     from robotale.ekg.logs import graph_counts
 
