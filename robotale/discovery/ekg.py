@@ -164,12 +164,18 @@ def _edge(row: dict[str, Any], entity_type: str) -> Edge:
 
 
 def _entry(entity_type: str, rows: list[dict[str, Any]]) -> tuple[list[Node], list[Edge]]:
-    """Entry nodes of one entity type: one per entity, or one for all when there are many."""
+    """Entry nodes of one entity type: one per entity, or one for all when there are many.
+
+    An entity begins once per case it appears in (directly-follows never crosses a case), so
+    an edge counts the cases in which the entity began at that class.
+    """
     entities = sorted({row["entity"] for row in rows})
     if len(entities) <= ENTRY_NODES_PER_TYPE:
         nodes = [_entity_node(f"{entity_type}:{e}", str(e), 1, entity_type) for e in entities]
+        starts = Counter((row["entity"], row["class"]) for row in rows)
         edges = [
-            Edge(f"{entity_type}:{row['entity']}", row["class"], 1, "", entity_type) for row in rows
+            Edge(f"{entity_type}:{e}", c, n, str(n) if n > 1 else "", entity_type)
+            for (e, c), n in sorted(starts.items())
         ]
         return nodes, edges
     node_id = f"{entity_type}:*"

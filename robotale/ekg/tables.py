@@ -8,9 +8,13 @@ stored is refused before the database is touched, and the writes are plain batch
 - ``entities``: ``type``, ``id`` of every entity the chosen entity columns mention.
 - ``corr``: ``event``, ``entity`` (row positions) for each CORR edge.
 - ``df``: ``source``, ``target`` (event positions), ``entityType``, ``entityId``: consecutive
-  events of one entity, ordered by time and then by their order in the log.
+  events of one entity in one case, ordered by time and then by their order in the log.
 - ``comm``: ``source``, ``target``, ``msgId``: from each send event to each receive event of
-  the same message.
+  the same message in the same case.
+
+A case is one run of the robots: directly-follows and messages never cross from one run to
+another, even where runs reuse message ids or overlap in time (simulated runs all start at
+the same instant).
 """
 
 from __future__ import annotations
@@ -177,13 +181,15 @@ def _correlations(events: pd.DataFrame, types: list[str]) -> pd.DataFrame:
 
 def _directly_follows(events: pd.DataFrame, corr: pd.DataFrame) -> pd.DataFrame:
     times = events["timestamp"].dt.tz_convert("UTC")
-    ordered = corr.assign(time=times.to_numpy()[corr["event"].to_numpy()])
-    # Sorting by event position last makes the log order break ties between equal times.
-    ordered = ordered.sort_values(["type", "id", "time", "event"], kind="stable")
-    same = (ordered["type"].shift(-1) == ordered["type"]) & (
-        ordered["id"].shift(-1) == ordered["id"]
+    at = corr["event"].to_numpy()
+    ordered = corr.assign(
+        time=times.to_numpy()[at], case=events["case"].astype("string").to_numpy()[at]
     )
-    same = same.fillna(False).to_numpy(bool)
+    # Sorting by event position last makes the log order break ties between equal times.
+    ordered = ordered.sort_values(["type", "id", "case", "time", "event"], kind="stable")
+    same = np.ones(len(ordered), dtype=bool)
+    for key in ("type", "id", "case"):
+        same &= (ordered[key].shift(-1) == ordered[key]).fillna(False).to_numpy(bool)
     following = ordered["event"].shift(-1)[same]
     sources = ordered[same]
     return pd.DataFrame(
@@ -216,10 +222,18 @@ def _communication(events: pd.DataFrame) -> pd.DataFrame:
         return pd.DataFrame(columns=["source", "target", "msgId"])
     ids = entity_ids(events[schema.MSG_ID])
     roles = communication_roles(events)[ids.index.to_numpy()]
-    messages = pd.DataFrame({"event": ids.index.to_numpy(), "msgId": ids.to_numpy(), "role": roles})
+    at = ids.index.to_numpy()
+    messages = pd.DataFrame(
+        {
+            "event": at,
+            "msgId": ids.to_numpy(),
+            "case": events["case"].astype("string").to_numpy()[at],
+            "role": roles,
+        }
+    )
     sends = messages[messages["role"] == schema.SEND]
     receives = messages[messages["role"] == schema.RECEIVE]
-    pairs = sends.merge(receives, on="msgId", suffixes=("_send", "_receive"))
+    pairs = sends.merge(receives, on=["case", "msgId"], suffixes=("_send", "_receive"))
     return pd.DataFrame(
         {
             "source": pairs["event_send"].to_numpy(),

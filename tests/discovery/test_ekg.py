@@ -4,6 +4,7 @@ import json
 import re
 import uuid
 
+import pandas as pd
 import pm4py
 import pytest
 
@@ -13,7 +14,7 @@ from robotale.discovery.ekg import COMM, read_stored_log
 from robotale.ekg import build_ekg
 from robotale.ekg.logs import delete_log
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, MSG_ID, ROBOT, TIMESTAMP
+from robotale.ingest.schema import ACTIVITY, CASE, EVENT_ID, MSG_ID, ROBOT, TIMESTAMP
 
 
 @pytest.fixture(scope="module")
@@ -82,6 +83,18 @@ def test_entry_nodes_join_each_robot_to_its_first_class(by_robot, thesis_log):
     assert messages.count == thesis_log[MSG_ID].nunique() == 421
     into = sum(e.count for e in by_robot.edges if e.source == "msg_id:*")
     assert into == 421
+
+
+def test_each_run_begins_an_entity_anew(neo4j_driver, thesis_log, log_name):
+    # The thesis log twice, as two runs: each robot begins once per run.
+    twice = pd.concat([thesis_log.assign(case="r1"), thesis_log.assign(case="r2")])
+    twice = twice.drop(columns=CASE).rename(columns={"case": CASE})
+    twice[EVENT_ID] = [f"e{i}" for i in range(len(twice))]
+    build_ekg(neo4j_driver, twice, log_name, entities=["robot"], progress=False)
+    graph = discover_ekg(log_name, "activity,robot", ["robot"], driver=neo4j_driver)
+    entries = {(e.source, e.target): e.count for e in graph.edges if e.source.startswith("robot:")}
+    firsts = thesis_log.groupby(ROBOT).first()
+    assert entries == {(f"robot:{r}", f"{row[ACTIVITY]}|{r}"): 2 for r, row in firsts.iterrows()}
 
 
 def test_choose_the_entity_types_to_show(stored, neo4j_driver):

@@ -88,6 +88,29 @@ def test_comm_joins_every_send_to_every_receive_of_a_message():
     ]
 
 
+def test_df_and_comm_never_cross_a_case():
+    # Two simulated runs: both start at the same instant and both number their messages m_1.
+    table = log(
+        [
+            (0, "take_off", "drone"),
+            (1, "weed_position!", "tractor_1"),
+            (2, "weed_position?", "drone"),
+            (0, "take_off", "drone"),
+            (1, "weed_position!", "tractor_1"),
+            (3, "weed_position?", "drone"),
+        ],
+        {schema.MSG_ID: [None, "m_1", "m_1", None, "m_1", "m_1"]},
+    )
+    table[schema.CASE] = ["run_1"] * 3 + ["run_2"] * 3
+    tables = graph_tables(table, ["robot", "msg_id"])
+    assert sorted(pairs(tables, "robot")) == [(0, 2), (3, 5)]
+    assert sorted(pairs(tables, "msg_id")) == [(1, 2), (4, 5)]
+    assert sorted(zip(tables.comm["source"], tables.comm["target"], strict=True)) == [
+        (1, 2),
+        (4, 5),
+    ]
+
+
 def test_without_the_naming_convention_msg_role_decides():
     table = log(
         [(1, "send", "a"), (2, "get", "b"), (3, "other", "c")],
