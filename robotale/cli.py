@@ -187,10 +187,16 @@ def _add_prepare(commands) -> None:
     )
     prepare.add_argument("--xes", metavar="FILE", help="also write IEEE XES")
     prepare.add_argument("--ocel", metavar="FILE", help="also write OCEL 2.0 JSON")
-    prepare.add_argument(
+    _add_preparation_options(prepare)
+    prepare.set_defaults(handler=_lazy("robotale.ingest.commands.prepare_command"))
+
+
+def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
+    """How recordings become an event log; shared by ``prepare`` and ``ingest``."""
+    parser.add_argument(
         "--tags", default="/*/tag", metavar="GLOB", help="the tag topics (default: %(default)s)"
     )
-    prepare.add_argument(
+    parser.add_argument(
         "--tag-field",
         action="append",
         default=[],
@@ -198,84 +204,46 @@ def _add_prepare(commands) -> None:
         help="the tag message field holding KEY (activity, lifecycle, robot, msg_id, msg_role, "
         "payload); FIELD empty if there is none. Repeatable",
     )
-    prepare.add_argument(
+    parser.add_argument(
         "--perspectives",
         default="odom,battery",
         metavar="LIST",
         help="comma-separated: odom, battery, NAME=/TOPIC_GLOB:FIELD (default: %(default)s)",
     )
-    prepare.add_argument(
+    parser.add_argument(
         "--rate",
         type=float,
         default=1.0,
         metavar="HZ",
         help="inprogress events per second of an activity, 0 for none (default: %(default)s)",
     )
-    prepare.add_argument(
+    parser.add_argument(
         "--msg",
         action="append",
         default=[],
         metavar="PATH",
         help="a .msg/.idl file or a folder of them, for types the bags do not define. Repeatable",
     )
-    prepare.add_argument(
+    parser.add_argument(
         "--bag-time",
         action="store_true",
         help="time events by when the bag recorded them, not by their message stamps",
     )
-    prepare.set_defaults(handler=_prepare)
-
-
-def _prepare(args: argparse.Namespace) -> int:
-    import warnings
-    from pathlib import Path
-
-    from robotale.ingest import writers
-    from robotale.ingest.enrich import PreparationWarning
-    from robotale.ingest.prepare import TagFields, find_runs, prepare, run_manifests
-
-    source = Path(args.source)
-    out = args.out or (None if args.xes or args.ocel else f"{source.resolve().name}.csv")
-    perspectives = [p for p in args.perspectives.split(",") if p.strip()]
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", PreparationWarning)
-        log = prepare(
-            source,
-            tags=args.tags,
-            tag_fields=TagFields.parse(args.tag_field),
-            perspectives=perspectives,
-            rate=args.rate,
-            msg_files=args.msg,
-            bag_time=args.bag_time,
-            progress=True,
-        )
-    for warning in caught:
-        if issubclass(warning.category, PreparationWarning):
-            print(f"robotale: warning: {warning.message}", file=sys.stderr)
-    written = []
-    if out:
-        writers.write_csv(log, out)
-        written.append(out)
-    if args.xes:
-        writers.write_xes(log, args.xes, name=source.resolve().name)
-        written.append(args.xes)
-    if args.ocel:
-        writers.write_ocel(log, args.ocel, runs=run_manifests(find_runs(source)))
-        written.append(args.ocel)
-    cases = log["case:concept:name"].nunique()
-    print(f"{len(log)} events from {cases} run(s) written to {', '.join(written)}")
-    return 0
 
 
 def _add_ingest(commands: argparse._SubParsersAction) -> None:
     ingest = commands.add_parser(
         "ingest",
-        help="load an event log (CSV or XES) into Neo4j as an event knowledge graph",
-        description="Read an event log and store it in Neo4j: Event, Entity and Class nodes, "
-        "CORR, DF, COMM, OBSERVED and DF_C edges. Nothing is written if the log is refused, "
-        "and a failed ingest leaves the database as it was.",
+        help="load an event log (CSV, XES or rosbag2 recordings) into Neo4j as an event "
+        "knowledge graph",
+        description="Read an event log, or prepare one from rosbag2 recordings as `robotale "
+        "prepare` does, and store it in Neo4j: Event, Entity and Class nodes, CORR, DF, COMM, "
+        "OBSERVED and DF_C edges. Nothing is written if the log is refused, and a failed ingest "
+        "leaves the database as it was.",
     )
-    ingest.add_argument("path", help="the event log: a .csv or .xes file")
+    ingest.add_argument(
+        "path", help="a .csv or .xes event log, a rosbag2 directory or a folder of runs"
+    )
     ingest.add_argument("--log", help="name of the log in Neo4j (default: the file's name)")
     ingest.add_argument(
         "--entities",
@@ -299,6 +267,7 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
     )
     ingest.add_argument("--case", metavar="COLUMN", help="the column that tells cases apart")
     ingest.add_argument("--replace", action="store_true", help="rebuild a log that exists")
+    _add_preparation_options(ingest.add_argument_group("recordings (rosbag2 directories)"))
     ingest.set_defaults(handler=_lazy("robotale.ekg.log_commands.ingest"))
 
 

@@ -17,15 +17,16 @@ THESIS_LOG = Path("examples") / "thesis" / "robotic_data.csv"
 
 def ingest(args: argparse.Namespace) -> int:
     path = Path(args.path)
-    if path.is_dir():
-        raise InputError(f"{path} is a directory; give an event log file (.csv or .xes).")
-    mapping = parse_mapping(args.map)
+    log = (
+        read_recordings(path, args)
+        if path.is_dir()
+        else read_log(path, parse_mapping(args.map), args.case)
+    )
     with session_driver() as driver:
-        log = read_log(path, mapping, args.case)
         summary = build_ekg(
             driver,
             log,
-            args.log or path.stem,
+            args.log or log_name(path),
             entities=split_names(args.entities) if args.entities else None,
             aggregate=args.aggregate or ["activity"],
             replace=args.replace,
@@ -33,6 +34,23 @@ def ingest(args: argparse.Namespace) -> int:
         )
     print(describe(summary))
     return 0
+
+
+def log_name(path: Path) -> str:
+    """A log's default name: the file's stem, or the folder's name (also for ``.``)."""
+    return path.resolve().name if path.is_dir() else path.stem
+
+
+def read_recordings(path: Path, args: argparse.Namespace):
+    """The event log of a rosbag2 directory or a folder of runs, prepared as ``prepare`` does."""
+    from robotale.ingest.commands import prepare_recordings
+
+    if args.map or args.case:
+        raise InputError(
+            f"{path} holds recordings: --map and --case apply to CSV and XES files "
+            "(each run of a recording is its own case)."
+        )
+    return prepare_recordings(path, args)
 
 
 def logs_list(args: argparse.Namespace) -> int:

@@ -126,3 +126,55 @@ def test_xes_log_with_a_named_time_zone(tmp_path, capsys, neo4j_driver, log_name
     assert event["timestamp"].iso_format() == "2024-03-31T01:45:00.000000000+01:00"
     counts = log_summary(neo4j_driver, log_name)["counts"]
     assert counts["DF:robot"] == 1 and counts["DF_C:activity / robot"] == 1
+
+
+@pytest.fixture
+def agri_recordings(tmp_path):
+    out = tmp_path / "agri"
+    assert main(["simulate", "agri", "--runs", "2", "--seed", "3", "--out", str(out)]) == 0
+    return out
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:Install the optional requirement:UserWarning")
+def test_ingest_prepares_a_folder_of_recordings(capsys, neo4j_driver, log_name, agri_recordings):
+    from robotale.ingest import schema
+    from robotale.ingest.prepare import prepare
+
+    capsys.readouterr()
+    code, out, err = run(
+        capsys, "ingest", str(agri_recordings), "--log", log_name, "--entities", "robot,msg_id"
+    )
+    assert code == 0, err
+    # the graph holds exactly what `robotale prepare` makes of the same bags
+    log = prepare(agri_recordings)
+    counts = log_summary(neo4j_driver, log_name)["counts"]
+    assert counts["events"] == len(log) and f"{len(log):,} events" in out
+    assert counts["cases"] == 2
+    assert counts["entities:robot"] == log[schema.ROBOT].nunique()
+    assert counts["entities:msg_id"] == log[schema.MSG_ID].dropna().nunique()
+
+
+def test_ingest_refuses_case_and_map_for_recordings(
+    capsys, neo4j_driver, log_name, agri_recordings
+):
+    capsys.readouterr()
+    code, _, err = run(capsys, "ingest", str(agri_recordings), "--log", log_name, "--case", "x")
+    assert code == 1
+    assert err.strip() == (
+        f"robotale: {agri_recordings} holds recordings: --map and --case apply to CSV and XES "
+        "files (each run of a recording is its own case)."
+    )
+    assert log_name not in {log["name"] for log in list_logs(neo4j_driver)}
+
+
+def test_ingest_names_the_log_after_the_folder(capsys, neo4j_driver, agri_recordings, monkeypatch):
+    monkeypatch.chdir(agri_recordings)
+    delete_log(neo4j_driver, "agri")
+    capsys.readouterr()
+    try:
+        code, out, err = run(capsys, "ingest", ".", "--rate", "0")
+        assert code == 0, err
+        assert out.startswith("Log 'agri': ")
+    finally:
+        delete_log(neo4j_driver, "agri")
