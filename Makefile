@@ -38,8 +38,11 @@ test: install system-deps
 	$(BIN)/ruff check .
 	$(BIN)/pytest
 
+# DEMO_ARGS passes options on (`make demo DEMO_ARGS="--port 5001"`); ROBOTALE_DEMO_RUNS
+# shortens the simulation (20 runs by default).
+DEMO_ARGS ?=
 demo: install
-	$(BIN)/robotale demo
+	$(BIN)/robotale demo $(DEMO_ARGS)
 
 bench: install
 	@for b in benchmarks/*.py; do echo "== $$b"; $(BIN)/python $$b || exit 1; done

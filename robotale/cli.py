@@ -288,12 +288,27 @@ def _add_logs(commands: argparse._SubParsersAction) -> None:
 def _add_demo(commands: argparse._SubParsersAction) -> None:
     demo = commands.add_parser(
         "demo",
-        help="start Neo4j, load the thesis' event log and show what came out",
-        description="Starts the local Neo4j (unless NEO4J_URI names a server), ingests "
-        "examples/thesis/robotic_data.csv as the log 'thesis' (replacing an earlier one) and "
-        "prints a summary.",
+        help="the whole mission end to end: simulate, prepare, ingest, serve the dashboard",
+        description="Starts the local Neo4j (unless NEO4J_URI names a server), simulates the "
+        "agri mission (drone + two tractors), prepares its bags into an event log, ingests it "
+        "as the log 'agri' and the thesis' own log as 'thesis' (replacing earlier ones), "
+        "attaches the BPMN models and serves the dashboard until Ctrl-C.",
     )
-    demo.set_defaults(handler=_lazy("robotale.ekg.log_commands.demo"))
+    demo.add_argument(
+        "--runs",
+        type=int,
+        metavar="N",
+        help="runs to simulate (default: $ROBOTALE_DEMO_RUNS, else 20)",
+    )
+    demo.add_argument("--seed", type=int, default=1, help="seed of the runs (default: 1)")
+    demo.add_argument(
+        "--out", metavar="DIR", help="folder for the bags and the CSV (default: ~/.robotale/demo)"
+    )
+    demo.add_argument("--port", type=int, default=5000, help="the dashboard's port (5000)")
+    demo.add_argument(
+        "--no-serve", action="store_true", help="stop after ingesting instead of serving"
+    )
+    demo.set_defaults(handler=_lazy("robotale.demo.demo"))
 
 
 def _add_simulate(commands) -> None:

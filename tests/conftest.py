@@ -40,7 +40,7 @@ EXAMPLES = REPO / "examples"
 
 @pytest.fixture(scope="session")
 def thesis_csv() -> Path:
-    """The event log the thesis' authors recorded from their running scenario (70 runs)."""
+    """The event log the thesis' authors recorded from their running scenario (five of its runs)."""
     return EXAMPLES / "thesis" / "robotic_data.csv"
 
 

@@ -1,9 +1,8 @@
-"""Handlers of the ``ingest``, ``logs`` and ``demo`` commands (parsers in :mod:`robotale.cli`)."""
+"""Handlers of the ``ingest`` and ``logs`` commands (parsers in :mod:`robotale.cli`)."""
 
 from __future__ import annotations
 
 import argparse
-import os
 from pathlib import Path
 
 from robotale.ekg.build import BuildSummary, build_ekg
@@ -11,8 +10,6 @@ from robotale.ekg.connection import session_driver
 from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
 from robotale.errors import InputError
 from robotale.ingest.readers import read_log
-
-THESIS_LOG = Path("examples") / "thesis" / "robotic_data.csv"
 
 
 def ingest(args: argparse.Namespace) -> int:
@@ -84,41 +81,6 @@ def logs_delete(args: argparse.Namespace) -> int:
         delete_log(driver, args.name)
     print(f"Deleted the log {args.name!r}.")
     return 0
-
-
-def demo(args: argparse.Namespace) -> int:
-    from robotale.ekg.server import LocalServer, ServerOptions
-
-    if not os.environ.get("NEO4J_URI"):
-        running = LocalServer().start(ServerOptions.from_env())
-        print(f"Neo4j is running at {running.bolt_uri}; Neo4j Browser: {running.browser_url}")
-    path = thesis_log()
-    with session_driver() as driver:
-        log = read_log(path)
-        summary = build_ekg(
-            driver,
-            log,
-            "thesis",
-            entities=["robot", "msg_id"],
-            aggregate=["activity", "activity,robot"],
-            replace=True,
-            source=str(path),
-        )
-    print(describe(summary))
-    print(
-        "See it in Neo4j Browser:\n"
-        "  MATCH (c:Class {log: 'thesis', type: 'activity+robot'})-[r:DF_C]->(d) "
-        "RETURN c, r, d"
-    )
-    return 0
-
-
-def thesis_log() -> Path:
-    """The thesis' event log in a source checkout (or below the current directory)."""
-    for root in (Path(__file__).resolve().parents[2], Path.cwd()):
-        if (root / THESIS_LOG).is_file():
-            return root / THESIS_LOG
-    raise InputError(f"{THESIS_LOG} was not found; run the demo from robotale's source tree.")
 
 
 def parse_mapping(items: list[str]) -> dict[str, str]:

@@ -90,22 +90,6 @@ def test_bad_map_option(capsys, tmp_path):
     assert code == 1 and "--map 'Zeit' is not COLUMN=FIELD" in err
 
 
-@pytest.mark.slow
-def test_demo_ingests_the_thesis_log(capsys, neo4j_driver):
-    try:
-        code, out, err = run(capsys, "demo")
-        assert code == 0, err
-        assert "Log 'thesis': 3,648 events" in out
-        assert "MATCH (c:Class {log: 'thesis', type: 'activity+robot'})" in out
-        counts = log_summary(neo4j_driver, "thesis")["counts"]
-        assert counts["classes:activity+robot"] == 24
-        # Running it again replaces the log instead of refusing it.
-        assert run(capsys, "demo")[0] == 0
-        assert log_summary(neo4j_driver, "thesis")["counts"] == counts
-    finally:
-        delete_log(neo4j_driver, "thesis")
-
-
 def test_xes_log_with_a_named_time_zone(tmp_path, capsys, neo4j_driver, log_name):
     from robotale.ekg.queries import cypher
 

@@ -23,6 +23,11 @@ def world_file(name: str) -> Path | None:
     return path if path.is_file() else None
 
 
+def model_file(name: str) -> Path:
+    """The mission model of a shipped scenario."""
+    return FOLDER / f"{name}.bpmn"
+
+
 def describe(path: Path) -> str:
     """How a manifest names a model or world file: shipped ones by their place in the package
     (``robotale/sim/scenarios/agri.bpmn``) so a recording reads the same on every machine; a
