@@ -169,16 +169,8 @@ def _dashboard(port: int):
 
 
 def _serve(dashboard) -> None:
-    from urllib.parse import urlencode
+    from robotale.webapp.serve import serve_until_interrupted
 
-    print(
-        f"\nThe dashboard: {dashboard.url}/discover?{urlencode({'log': AGRI_LOG})}"
-        "  (Ctrl-C stops it)",
-        flush=True,
-    )
-    # werkzeug's serve_forever returns on Ctrl-C: that is how a demo ends, not a failure.
-    try:
-        dashboard.server.serve_forever()
-    finally:
-        dashboard.server.server_close()
+    print("\nThe dashboard is up; open the address below.", flush=True)
+    serve_until_interrupted(dashboard, AGRI_LOG)
     print("Dashboard stopped; the logs stay in Neo4j (`robotale serve` shows them again).")

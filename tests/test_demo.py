@@ -60,12 +60,12 @@ def test_make_demo_serves_the_dashboard_with_the_ingested_logs(tmp_path, neo4j_d
         cwd=REPO,
         env=environment,
         stdout=subprocess.PIPE,
-        stderr=subprocess.DEVNULL,
+        stderr=subprocess.STDOUT,
         text=True,
         start_new_session=True,
     )
     try:
-        printed = "".join(wait_for_line(process, "The dashboard: ", 600))
+        printed = "".join(wait_for_line(process, "robotale dashboard at ", 600))
         page = urllib.request.urlopen(f"http://127.0.0.1:{port}/logs", timeout=30).read()
         for name in DEMO_LOGS:
             assert f">{name}<".encode() in page, name

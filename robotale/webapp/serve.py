@@ -1,5 +1,5 @@
-"""Serve the dashboard: :func:`serve` in the foreground (``robotale serve``), or a
-:class:`Dashboard` in a background thread (tests, benchmarks, ``robotale demo``)."""
+"""Serve the dashboard: :func:`serve` in the foreground (``robotale serve``, ``robotale
+demo``), or a :class:`Dashboard` in a background thread (tests, benchmarks)."""
 
 from __future__ import annotations
 
@@ -75,12 +75,19 @@ def _bind(app: Flask, host: str, port: int) -> BaseWSGIServer:
 
 def serve(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT, log: str | None = None) -> None:
     """Serve the dashboard until Ctrl-C; with ``log``, point at that log's Discover page."""
-    dashboard = Dashboard(host=host, port=port)
-    where = f"{dashboard.url}/discover?{urlencode({'log': log})}" if log else dashboard.url
-    print(f"robotale dashboard at {where}  (Ctrl-C stops it)", file=sys.stderr)
-    if not _is_loopback(host):
+    serve_until_interrupted(Dashboard(host=host, port=port), log)
+
+
+def serve_until_interrupted(dashboard: Dashboard, log: str | None = None) -> None:
+    """Serve a dashboard bound earlier in this thread until Ctrl-C (which werkzeug turns into
+    a normal return)."""
+    url = dashboard.url
+    where = f"{url}/discover?{urlencode({'log': log})}" if log else url
+    print(f"robotale dashboard at {where}  (Ctrl-C stops it)", file=sys.stderr, flush=True)
+    if not _is_loopback(dashboard.server.host):
         print(
-            f"Listening on {host}: anyone who can reach this machine can read the logs.",
+            f"Listening on {dashboard.server.host}: anyone who can reach this machine can read "
+            "the logs.",
             file=sys.stderr,
         )
     try:
