@@ -3,6 +3,9 @@
 Each part keeps its own fixtures in ``tests/<part>/conftest.py``; only what several parts use
 lives here.
 
+Every test runs with ``ROBOTALE_HOME`` set to a temporary directory of the session (the
+download cache stays the user's), so nothing is written into the user's robotale home.
+
 Neo4j (always a real server, never a mock):
 
 - ``neo4j_server`` (session): the :class:`robotale.ekg.connection.Settings` of the server the
@@ -36,6 +39,22 @@ if TYPE_CHECKING:
 
 REPO = Path(__file__).resolve().parent.parent
 EXAMPLES = REPO / "examples"
+
+
+@pytest.fixture(scope="session", autouse=True)
+def robotale_home(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
+    """A robotale home of this session's own, so no test writes into the user's (uploads,
+    models, demo runs); the download cache stays the user's, so the Neo4j jars are reused."""
+    from robotale.config import cache_dir
+
+    environment = pytest.MonkeyPatch()
+    environment.setenv("ROBOTALE_CACHE", str(cache_dir()))
+    home = tmp_path_factory.mktemp("home")
+    environment.setenv("ROBOTALE_HOME", str(home))
+    try:
+        yield home
+    finally:
+        environment.undo()
 
 
 @pytest.fixture(scope="session")
