@@ -22,6 +22,7 @@ from collections import Counter
 from collections.abc import Sequence
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from robotale.discovery.graph import Edge, Node, ProcessGraph
@@ -78,12 +79,13 @@ def read_stored_log(log: str, *, driver: Any = None) -> pd.DataFrame:
         with session_driver() as connected:
             return read_stored_log(log, driver=connected)
     _log_info(driver, log)
-    rows = _run(driver, "discover_events", log=log)
-    table = pd.DataFrame([row["properties"] for row in rows])
+    chunks = _run(driver, "discover_events", log=log)
+    table = pd.DataFrame([event for chunk in chunks for event in chunk["properties"]])
     table = table.drop(columns=["timestamp", "log", "order"], errors="ignore")
-    stamps = pd.Series([row["seconds"] * 10**9 + row["nanos"] for row in rows], dtype="int64")
-    times = pd.to_datetime(stamps, unit="ns", utc=True)
-    zone = rows[0]["zone"] if rows else "UTC"
+    seconds = np.array([s for chunk in chunks for s in chunk["seconds"]], dtype="int64")
+    nanos = np.array([n for chunk in chunks for n in chunk["nanos"]], dtype="int64")
+    times = pd.to_datetime(pd.Series(seconds * 10**9 + nanos), unit="ns", utc=True)
+    zone = chunks[0]["zones"][0] if chunks else "UTC"
     table[schema.TIMESTAMP] = times.dt.tz_convert(_zone(zone))
     return table.rename(columns=_canonical_names(table.columns))
 
