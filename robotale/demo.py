@@ -90,6 +90,9 @@ def _step(title: str) -> None:
 
 def _neo4j_up() -> None:
     if os.environ.get("NEO4J_URI"):
+        from robotale.ekg.connection import connect
+
+        connect().close()  # a server that is down should stop the demo before the simulation
         print(f"Using the Neo4j at {os.environ['NEO4J_URI']} (NEO4J_URI)")
         return
     from robotale.ekg.server import LocalServer, ServerOptions

@@ -86,3 +86,30 @@ def test_make_demo_serves_the_dashboard_with_the_ingested_logs(tmp_path, neo4j_d
         if process.poll() is None:
             os.killpg(process.pid, signal.SIGKILL)
             process.wait()
+
+
+def test_a_server_that_is_down_stops_the_demo_before_the_work(tmp_path, monkeypatch, capsys):
+    from robotale.cli import main
+
+    uri = f"bolt://127.0.0.1:{free_port()}"
+    monkeypatch.setenv("NEO4J_URI", uri)
+    assert main(["demo", "--no-serve", "--out", str(tmp_path / "demo")]) == 1
+    error = capsys.readouterr().err.strip()
+    assert error == (
+        f"robotale: Neo4j is not reachable at {uri} (NEO4J_URI): start that server, or unset "
+        "NEO4J_URI and run `robotale neo4j start`."
+    )
+    assert not (tmp_path / "demo").exists()
+
+
+def test_a_port_in_use_stops_the_demo_before_the_work(tmp_path, capsys):
+    from robotale.cli import main
+
+    with socket.socket() as taken:
+        taken.bind(("127.0.0.1", 0))
+        taken.listen()
+        port = taken.getsockname()[1]
+        assert main(["demo", "--port", str(port), "--out", str(tmp_path / "demo")]) == 1
+    error = capsys.readouterr().err.strip()
+    assert error == f"robotale: Port {port} on 127.0.0.1 is in use: choose another with --port."
+    assert not (tmp_path / "demo").exists()
