@@ -24,6 +24,7 @@ Neo4j, then pm4py) is timed too, for reference.
 from __future__ import annotations
 
 import argparse
+import logging
 import statistics
 import sys
 import tempfile
@@ -100,6 +101,7 @@ def measure_all(logs: dict, repeat: int) -> None:
     with tempfile.TemporaryDirectory(prefix="robotale-bench-web-") as scratch:
         folder = Path(scratch)
         app = create_app(upload_dir=folder / "uploads", model_dir=folder / "models")
+        logging.getLogger("werkzeug").setLevel(logging.WARNING)  # one line per request otherwise
         with Dashboard(app, port=0) as dashboard, sync_playwright() as playwright:
             context = launch(playwright, folder / "profile")
             page = context.new_page()
