@@ -244,7 +244,9 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
     ingest.add_argument(
         "path", help="a .csv or .xes event log, a rosbag2 directory or a folder of runs"
     )
-    ingest.add_argument("--log", help="name of the log in Neo4j (default: the file's name)")
+    ingest.add_argument(
+        "--log", help="name of the log in Neo4j (default: the file's or folder's name)"
+    )
     ingest.add_argument(
         "--entities",
         help="comma-separated columns whose values are entities (default: robot,msg_id "

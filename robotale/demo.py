@@ -18,6 +18,7 @@ import pandas as pd
 
 from robotale.config import robotale_home
 from robotale.errors import InputError
+from robotale.ingest.readers import read_log
 
 DEFAULT_RUNS = 20
 AGRI_LOG = "agri"
@@ -68,7 +69,7 @@ def demo(args: argparse.Namespace) -> int:
     log = _prepare(bags, options.folder / "agri.csv")
     _step("Building the event knowledge graphs")
     _ingest(log, AGRI_LOG, bags)
-    _ingest(_read(thesis), THESIS_LOG_NAME, thesis)
+    _ingest(read_log(thesis), THESIS_LOG_NAME, thesis)
     _attach_models(thesis)
     _explain()
     if dashboard is not None:
@@ -97,8 +98,10 @@ def _neo4j_up() -> None:
         return
     from robotale.ekg.server import LocalServer, ServerOptions
 
-    running = LocalServer().start(ServerOptions.from_env())
+    server = LocalServer()
+    running = server.start(ServerOptions.from_env())
     print(f"Neo4j is running at {running.bolt_uri}; Neo4j Browser: {running.browser_url}")
+    print(f"  user neo4j, password in {server.password_file}")
 
 
 def _simulate(options: DemoOptions) -> Path:
@@ -115,19 +118,13 @@ def _simulate(options: DemoOptions) -> Path:
 
 
 def _prepare(bags: Path, csv: Path) -> pd.DataFrame:
-    from robotale.ingest.prepare import prepare
+    from robotale.ingest.commands import prepare_reporting
     from robotale.ingest.writers import write_csv
 
-    log = prepare(bags, progress=True)
+    log = prepare_reporting(bags)
     write_csv(log, csv)
     print(f"{len(log):,} events from {log['case:concept:name'].nunique()} run(s) in {csv}")
     return log
-
-
-def _read(path: Path) -> pd.DataFrame:
-    from robotale.ingest.readers import read_log
-
-    return read_log(path)
 
 
 def _ingest(log: pd.DataFrame, name: str, source: Path) -> None:

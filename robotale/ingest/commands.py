@@ -7,6 +7,7 @@ import argparse
 import sys
 import warnings
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -35,21 +36,25 @@ def prepare_command(args: argparse.Namespace) -> int:
 
 
 def prepare_recordings(source: Path, args: argparse.Namespace) -> pd.DataFrame:
-    """The event log of the recordings at ``source`` with the preparation options of ``args``;
-    the warnings of the preparation (completes without a start ...) go to stderr, one line
-    each."""
+    """The event log of the recordings at ``source`` with the preparation options of ``args``
+    (see :func:`prepare_reporting`)."""
+    return prepare_reporting(
+        source,
+        tags=args.tags,
+        tag_fields=TagFields.parse(args.tag_field),
+        perspectives=[p for p in args.perspectives.split(",") if p.strip()],
+        rate=args.rate,
+        msg_files=args.msg,
+        bag_time=args.bag_time,
+    )
+
+
+def prepare_reporting(source: Path, **options: Any) -> pd.DataFrame:
+    """:func:`~robotale.ingest.prepare.prepare` with a progress bar, its warnings (completes
+    without a start ...) on stderr as one ``robotale: warning:`` line each."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PreparationWarning)
-        log = prepare(
-            source,
-            tags=args.tags,
-            tag_fields=TagFields.parse(args.tag_field),
-            perspectives=[p for p in args.perspectives.split(",") if p.strip()],
-            rate=args.rate,
-            msg_files=args.msg,
-            bag_time=args.bag_time,
-            progress=True,
-        )
+        log = prepare(source, progress=True, **options)
     for warning in caught:
         if issubclass(warning.category, PreparationWarning):
             print(f"robotale: warning: {warning.message}", file=sys.stderr)
