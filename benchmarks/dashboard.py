@@ -56,7 +56,7 @@ def main() -> int:
 
 
 def thesis_log():
-    from robotale.ingest.readers import read_log
+    from robotale.eventlog.readers import read_log
 
     return read_log(THESIS_CSV)
 
@@ -65,7 +65,7 @@ def thesis_runs(events: int):
     """The thesis log's runs repeated, a week apart, until the log has ``events`` events."""
     import pandas as pd
 
-    from robotale.ingest import schema
+    from robotale.eventlog import schema
 
     thesis = thesis_log()
     copies = []
@@ -95,8 +95,11 @@ def measure_all(logs: dict, repeat: int) -> None:
     from playwright.sync_api import sync_playwright
 
     from robotale.webapp import create_app
-    from robotale.webapp.browser import launch
     from robotale.webapp.serve import Dashboard
+
+    # The headless Chromium of the browser tests: one place drives it for both.
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests" / "webapp"))
+    from browser import launch
 
     with tempfile.TemporaryDirectory(prefix="robotale-bench-web-") as scratch:
         folder = Path(scratch)

@@ -24,7 +24,7 @@ import warnings
 import numpy as np
 import pandas as pd
 
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 #: above this size pm4py's interval route (Python objects per event) is left out: minutes
 INTERVAL_ROUTE_LIMIT = 200_000

@@ -29,7 +29,7 @@ from pathlib import Path
 import numpy as np
 import pandas as pd
 
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 ACTIVITIES = ["explore", "move", "cut_grass", "scan", "charge", "wait", "dock", "report"]
 MESSAGES = ["weed_position", "tractor_position", "closest_tractor"]

@@ -34,10 +34,10 @@ import pandas as pd
 from rosbags.rosbag2 import Reader, Writer
 from rosbags.typesys import Stores, get_typestore
 
+from robotale.eventlog import schema
+from robotale.eventlog.prepare import prepare
+from robotale.eventlog.rosbag import Bag
 from robotale.fame_runtime.tags import TAG_TYPE, register_tag_type
-from robotale.ingest import schema
-from robotale.ingest.prepare import prepare
-from robotale.ingest.rosbag import Bag
 
 ROBOTS = ("drone", "tractor_1", "tractor_2", "tractor_3", "tractor_4")
 START = 1_700_000_000 * 10**9
@@ -153,7 +153,7 @@ def report_prepare(seconds: float, log: pd.DataFrame, messages: int, decode: flo
 
 def compare_with_search(path: Path, searched: int = 2000) -> None:
     """The sorted join against a search per event over that robot's samples."""
-    from robotale.ingest.enrich import upper_closest
+    from robotale.eventlog.enrich import upper_closest
 
     samples = _odometry(path)
     events = _odometry(path, tags=True)

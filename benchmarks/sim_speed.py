@@ -22,7 +22,7 @@ from pathlib import Path
 
 from robotale.sim import scenarios
 from robotale.sim.batch import run_into, simulate_batch
-from robotale.sim.commands import adjust, plans
+from robotale.sim.plans import adjust, plans
 from robotale.sim.worldspec import load_world
 
 SINGLE_TARGET = 50.0  # x real time

@@ -1,7 +1,7 @@
 """robotale: understand what a team of robots actually did.
 
 BPMN collaborations drive the robots (``robotale.fame_runtime``), simulated robots carry the
-missions out (``robotale.sim``), tagged events become event logs (``robotale.ingest``) and an
+missions out (``robotale.sim``), tagged events become event logs (``robotale.eventlog``) and an
 Event Knowledge Graph in Neo4j (``robotale.ekg``), which ``robotale.discovery`` and
 ``robotale.enhancement`` turn into process models and perspectives for ``robotale.webapp``.
 """

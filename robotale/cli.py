@@ -1,9 +1,11 @@
 """The ``robotale`` command.
 
-Thin by design: each ``_add_*`` function declares one command group's arguments and its handler
-imports the part that does the work only when the command runs, so ``robotale --help`` stays
-fast. A :class:`~robotale.errors.RobotaleError` ends the command with its one-sentence message
-and exit status 1.
+Declarations only: each ``_add_*`` function declares one command group's arguments, with
+``dest`` names equal to the keyword arguments of its handler in :mod:`robotale.commands`. The
+handler's module is imported only when its command runs, so ``robotale --help`` stays fast. An
+option the user did not give is not passed at all (its default is ``None`` here), so the
+handler, or the library below it, owns the default. A :class:`~robotale.errors.RobotaleError`
+ends the command with its one-sentence message and exit status 1.
 """
 
 from __future__ import annotations
@@ -11,11 +13,14 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from pathlib import Path
 
 from robotale import __version__
 from robotale.errors import RobotaleError
+
+#: the namespace key holding the handler's dotted name; subparser keys begin with "_" too
+_HANDLER = "_handler"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -24,7 +29,7 @@ def build_parser() -> argparse.ArgumentParser:
         description="Understand what a team of robots did: missions, event logs, EKGs.",
     )
     parser.add_argument("--version", action="version", version=f"robotale {__version__}")
-    commands = parser.add_subparsers(dest="command", metavar="COMMAND")
+    commands = parser.add_subparsers(dest="_command", metavar="COMMAND")
     commands.required = True
     # One line per command group, in the order of the data flow (see DESIGN.md).
     _add_fame(commands)
@@ -40,14 +45,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _lazy(target: str) -> Callable[[argparse.Namespace], int]:
-    """A handler that imports ``module.function`` only when its command runs."""
-    module, _, name = target.rpartition(".")
+def _handled_by(parser: argparse.ArgumentParser, target: str) -> None:
+    """``target`` (``module.function`` below ``robotale.commands``) handles ``parser``."""
+    parser.set_defaults(**{_HANDLER: f"robotale.commands.{target}"})
 
-    def handler(args: argparse.Namespace) -> int:
-        return int(getattr(importlib.import_module(module), name)(args) or 0)
 
-    return handler
+def run_handler(args: argparse.Namespace) -> int:
+    """Import the command's handler and call it with the arguments the user gave."""
+    module, _, name = getattr(args, _HANDLER).rpartition(".")
+    handler = getattr(importlib.import_module(module), name)
+    given = {k: v for k, v in vars(args).items() if not k.startswith("_") and v is not None}
+    return int(handler(**given) or 0)
 
 
 def _add_neo4j(commands: argparse._SubParsersAction) -> None:
@@ -58,18 +66,18 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
         "home ($ROBOTALE_HOME, default ~/.robotale). With NEO4J_URI set, robotale uses that "
         "server instead.",
     )
-    actions = neo4j.add_subparsers(dest="action", metavar="ACTION", required=True)
+    actions = neo4j.add_subparsers(dest="_action", metavar="ACTION", required=True)
     start = actions.add_parser("start", help="start the server in the background and wait for it")
     start.add_argument("--bolt-port", type=int, help="Bolt port (ROBOTALE_NEO4J_BOLT_PORT, 7687)")
     start.add_argument("--http-port", type=int, help="HTTP port (ROBOTALE_NEO4J_HTTP_PORT, 7474)")
     start.add_argument("--heap", help="JVM heap, e.g. 2g (ROBOTALE_NEO4J_HEAP, 1g)")
     start.add_argument("--pagecache", help="page cache, e.g. 1g (ROBOTALE_NEO4J_PAGECACHE, 512m)")
-    start.add_argument("--timeout", type=float, default=180, help="seconds to wait (180)")
-    start.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_start"))
+    start.add_argument("--timeout", type=float, help="seconds to wait (180)")
+    _handled_by(start, "neo4j.neo4j_start")
     stop = actions.add_parser("stop", help="stop the server cleanly")
-    stop.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_stop"))
+    _handled_by(stop, "neo4j.neo4j_stop")
     status = actions.add_parser("status", help="where the server is and whether it answers")
-    status.set_defaults(handler=_lazy("robotale.ekg.commands.neo4j_status"))
+    _handled_by(status, "neo4j.neo4j_status")
 
 
 def _add_serve(commands: argparse._SubParsersAction) -> None:
@@ -79,28 +87,19 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
         description="Serve the dashboard (logs, discovery, perspectives, model, Cypher console) "
         "against the Neo4j robotale uses (NEO4J_URI, or the local server).",
     )
-    serve.add_argument(
-        "--host", default="127.0.0.1", help="address to listen on (127.0.0.1: this machine only)"
-    )
-    serve.add_argument("--port", type=int, default=5000, help="port to listen on (5000)")
+    serve.add_argument("--host", help="address to listen on (127.0.0.1: this machine only)")
+    serve.add_argument("--port", type=int, help="port to listen on (5000)")
     serve.add_argument("--log", help="print the address of this stored log's Discover page")
-    serve.set_defaults(handler=_serve)
+    _handled_by(serve, "serve.serve_command")
 
 
-def _serve(args: argparse.Namespace) -> int:
-    from robotale.webapp.serve import serve
-
-    serve(host=args.host, port=args.port, log=args.log)
-    return 0
-
-
-def _add_fame(commands) -> None:
+def _add_fame(commands: argparse._SubParsersAction) -> None:
     fame = commands.add_parser(
         "fame",
         help="BPMN missions: check, split and run collaborations",
         description="Missions as BPMN collaborations (FAME): one pool per robot, one engine each.",
     )
-    sub = fame.add_subparsers(dest="fame_command", metavar="COMMAND")
+    sub = fame.add_subparsers(dest="_fame_command", metavar="COMMAND")
     sub.required = True
     library = {"type": Path, "metavar": "DIR", "help": "folder of .bpmn building blocks"}
     skills = {"metavar": "MODULE", "help": "Python module (or .py file) with a SKILLS mapping"}
@@ -110,13 +109,15 @@ def _add_fame(commands) -> None:
     check.add_argument("model", type=Path, help="the .bpmn collaboration")
     check.add_argument("--library", **library)
     check.add_argument("--skills", **skills)
-    check.set_defaults(handler=_fame_check)
+    _handled_by(check, "fame.check_command")
 
     split = sub.add_parser("split", help="one process per robot")
     split.add_argument("model", type=Path, help="the .bpmn collaboration")
     split.add_argument("--robots", **robots)
-    split.add_argument("--out", type=Path, metavar="DIR", help="write <robot>.bpmn files here")
-    split.set_defaults(handler=_fame_split)
+    split.add_argument(
+        "--out", dest="out_dir", type=Path, metavar="DIR", help="write <robot>.bpmn files here"
+    )
+    _handled_by(split, "fame.split_command")
 
     run = sub.add_parser("run", help="run in process on a simulated clock, printing tags")
     run.add_argument("model", type=Path, help="the .bpmn collaboration")
@@ -126,54 +127,26 @@ def _add_fame(commands) -> None:
     run.add_argument(
         "--until",
         type=float,
-        default=3600.0,
         metavar="SECONDS",
         help="stop at this simulated time at the latest (default 3600)",
     )
     run.add_argument(
         "--latency",
         type=float,
-        default=0.0,
         metavar="SECONDS",
         help="message delivery delay on the bus (default 0)",
     )
     run.add_argument(
         "--set",
+        dest="assignments",
         action="append",
-        default=[],
         metavar="ROBOT.NAME=VALUE",
         help="an initial variable, e.g. drone.delay=10 (repeatable)",
     )
-    run.set_defaults(handler=_fame_run)
+    _handled_by(run, "fame.run_command")
 
 
-def _fame_check(args: argparse.Namespace) -> int:
-    from robotale.fame_runtime.commands import check_command
-
-    return check_command(args.model, library=args.library, skills=args.skills)
-
-
-def _fame_split(args: argparse.Namespace) -> int:
-    from robotale.fame_runtime.commands import split_command
-
-    return split_command(args.model, robots=args.robots, out_dir=args.out)
-
-
-def _fame_run(args: argparse.Namespace) -> int:
-    from robotale.fame_runtime.commands import run_command
-
-    return run_command(
-        args.model,
-        robots=args.robots,
-        skills=args.skills,
-        library=args.library,
-        until=args.until,
-        latency=args.latency,
-        assignments=args.set,
-    )
-
-
-def _add_prepare(commands) -> None:
+def _add_prepare(commands: argparse._SubParsersAction) -> None:
     prepare = commands.add_parser(
         "prepare",
         help="turn rosbag2 recordings into a multi-perspective event log (CSV, XES, OCEL 2.0)",
@@ -181,52 +154,54 @@ def _add_prepare(commands) -> None:
         "multi-perspective event log: every tag becomes an event enriched with the robot's "
         "position and battery, with inprogress events between each start and complete.",
     )
-    prepare.add_argument("source", help="a rosbag2 directory or a folder of run directories")
     prepare.add_argument(
-        "--out", metavar="CSV", help="CSV file (default: SOURCE_NAME.csv if no other output)"
+        "source", type=Path, help="a rosbag2 directory or a folder of run directories"
     )
-    prepare.add_argument("--xes", metavar="FILE", help="also write IEEE XES")
-    prepare.add_argument("--ocel", metavar="FILE", help="also write OCEL 2.0 JSON")
+    prepare.add_argument(
+        "--out",
+        type=Path,
+        metavar="CSV",
+        help="CSV file (default: SOURCE_NAME.csv if no other output)",
+    )
+    prepare.add_argument("--xes", type=Path, metavar="FILE", help="also write IEEE XES")
+    prepare.add_argument("--ocel", type=Path, metavar="FILE", help="also write OCEL 2.0 JSON")
     _add_preparation_options(prepare)
-    prepare.set_defaults(handler=_lazy("robotale.ingest.commands.prepare_command"))
+    _handled_by(prepare, "prepare.prepare_command")
 
 
 def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
     """How recordings become an event log; shared by ``prepare`` and ``ingest``."""
-    parser.add_argument(
-        "--tags", default="/*/tag", metavar="GLOB", help="the tag topics (default: %(default)s)"
-    )
+    parser.add_argument("--tags", metavar="GLOB", help="the tag topics (default: /*/tag)")
     parser.add_argument(
         "--tag-field",
+        dest="tag_fields",
         action="append",
-        default=[],
         metavar="KEY=FIELD",
         help="the tag message field holding KEY (activity, lifecycle, robot, msg_id, msg_role, "
         "payload); FIELD empty if there is none. Repeatable",
     )
     parser.add_argument(
         "--perspectives",
-        default="odom,battery",
         metavar="LIST",
-        help="comma-separated: odom, battery, NAME=/TOPIC_GLOB:FIELD (default: %(default)s)",
+        help="comma-separated: odom, battery, NAME=/TOPIC_GLOB:FIELD (default: odom,battery)",
     )
     parser.add_argument(
         "--rate",
         type=float,
-        default=1.0,
         metavar="HZ",
-        help="inprogress events per second of an activity, 0 for none (default: %(default)s)",
+        help="inprogress events per second of an activity, 0 for none (default: 1.0)",
     )
     parser.add_argument(
         "--msg",
+        dest="msg_files",
         action="append",
-        default=[],
         metavar="PATH",
         help="a .msg/.idl file or a folder of them, for types the bags do not define. Repeatable",
     )
     parser.add_argument(
         "--bag-time",
         action="store_true",
+        default=None,
         help="time events by when the bag recorded them, not by their message stamps",
     )
 
@@ -242,7 +217,7 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
         "leaves the database as it was.",
     )
     ingest.add_argument(
-        "path", help="a .csv or .xes event log, a rosbag2 directory or a folder of runs"
+        "path", type=Path, help="a .csv or .xes event log, a rosbag2 directory or a folder of runs"
     )
     ingest.add_argument(
         "--log", help="name of the log in Neo4j (default: the file's or folder's name)"
@@ -259,32 +234,36 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
         help="an aggregation key: activity, or activity plus entity columns such as "
         "activity,robot; repeat for several (default: activity)",
     )
+    _add_mapping(ingest)
+    ingest.add_argument("--case", metavar="COLUMN", help="the column that tells cases apart")
     ingest.add_argument(
+        "--replace", action="store_true", default=None, help="rebuild a log that exists"
+    )
+    _add_preparation_options(ingest.add_argument_group("recordings (rosbag2 directories)"))
+    _handled_by(ingest, "ingest.ingest_command")
+
+
+def _add_mapping(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
         "--map",
+        dest="mapping",
         action="append",
-        default=[],
         metavar="COLUMN=FIELD",
         help="read COLUMN as FIELD (time, activity, case, robot, lifecycle, msg_id ...); "
         "repeatable",
     )
-    ingest.add_argument("--case", metavar="COLUMN", help="the column that tells cases apart")
-    ingest.add_argument("--replace", action="store_true", help="rebuild a log that exists")
-    _add_preparation_options(ingest.add_argument_group("recordings (rosbag2 directories)"))
-    ingest.set_defaults(handler=_lazy("robotale.ekg.log_commands.ingest"))
 
 
 def _add_logs(commands: argparse._SubParsersAction) -> None:
     logs = commands.add_parser("logs", help="the event logs stored in Neo4j")
-    actions = logs.add_subparsers(dest="action", metavar="ACTION", required=True)
-    actions.add_parser("list", help="every stored log").set_defaults(
-        handler=_lazy("robotale.ekg.log_commands.logs_list")
-    )
+    actions = logs.add_subparsers(dest="_action", metavar="ACTION", required=True)
+    _handled_by(actions.add_parser("list", help="every stored log"), "ingest.logs_list")
     show = actions.add_parser("show", help="what one log holds, counted in the graph")
     show.add_argument("name")
-    show.set_defaults(handler=_lazy("robotale.ekg.log_commands.logs_show"))
+    _handled_by(show, "ingest.logs_show")
     delete = actions.add_parser("delete", help="remove a log and everything of it")
     delete.add_argument("name")
-    delete.set_defaults(handler=_lazy("robotale.ekg.log_commands.logs_delete"))
+    _handled_by(delete, "ingest.logs_delete")
 
 
 def _add_demo(commands: argparse._SubParsersAction) -> None:
@@ -302,18 +281,25 @@ def _add_demo(commands: argparse._SubParsersAction) -> None:
         metavar="N",
         help="runs to simulate (default: $ROBOTALE_DEMO_RUNS, else 20)",
     )
-    demo.add_argument("--seed", type=int, default=1, help="seed of the runs (default: 1)")
+    demo.add_argument("--seed", type=int, help="seed of the runs (default: 1)")
     demo.add_argument(
-        "--out", metavar="DIR", help="folder for the bags and the CSV (default: ~/.robotale/demo)"
+        "--out",
+        type=Path,
+        metavar="DIR",
+        help="folder for the bags and the CSV (default: ~/.robotale/demo)",
     )
-    demo.add_argument("--port", type=int, default=5000, help="the dashboard's port (5000)")
+    demo.add_argument("--port", type=int, help="the dashboard's port (5000)")
     demo.add_argument(
-        "--no-serve", action="store_true", help="stop after ingesting instead of serving"
+        "--no-serve",
+        dest="serve",
+        action="store_false",
+        default=None,
+        help="stop after ingesting instead of serving",
     )
-    demo.set_defaults(handler=_lazy("robotale.demo.demo"))
+    _handled_by(demo, "demo.demo_command")
 
 
-def _add_simulate(commands) -> None:
+def _add_simulate(commands: argparse._SubParsersAction) -> None:
     simulate = commands.add_parser(
         "simulate",
         help="run missions with simulated robots (pybullet), one rosbag2 per run",
@@ -325,32 +311,34 @@ def _add_simulate(commands) -> None:
     simulate.add_argument("scenario", nargs="?", help="agri or rexdingo (or omit with --world)")
     simulate.add_argument("--model", type=Path, metavar="BPMN", help="the mission to run instead")
     simulate.add_argument("--world", type=Path, metavar="YAML", help="a world file of your own")
-    simulate.add_argument("--runs", type=int, default=1, metavar="N", help="how many runs (1)")
-    simulate.add_argument("--seed", type=int, default=1, help="the batch's seed (1)")
+    simulate.add_argument("--runs", type=int, metavar="N", help="how many runs (1)")
+    simulate.add_argument("--seed", type=int, help="the batch's seed (1)")
+    simulate.add_argument("--first", type=int, metavar="N", help="number of the first run (1)")
     simulate.add_argument(
-        "--first", type=int, default=1, metavar="N", help="number of the first run (1)"
+        "--out",
+        dest="out_dir",
+        type=Path,
+        metavar="DIR",
+        help="where the runs go (runs/<scenario>)",
     )
-    simulate.add_argument("--out", metavar="DIR", help="where the runs go (runs/<scenario>)")
     simulate.add_argument("--tractors", type=int, metavar="N", help="agri: how many tractors")
     simulate.add_argument(
         "--count",
+        dest="counts",
         action="append",
-        default=[],
         metavar="GROUP=N",
         help="robots of a group, e.g. tractor=3 (repeatable)",
     )
     simulate.add_argument("--weeds", metavar="N|LOW-HIGH", help="weeds per run, e.g. 2 or 3-6")
     simulate.add_argument(
         "--fault",
+        dest="faults",
         action="append",
-        default=[],
         metavar="SPEC",
         help="die:ROBOT@T, drop:/TOPIC[,to=ROBOT][,nth=N], battery:ROBOT@T[,rate=R][,for=S]; "
         "@FROM-TO and ,p=P vary it per run (repeatable)",
     )
-    simulate.add_argument(
-        "--storage", choices=("sqlite3", "mcap"), default="sqlite3", help="bag storage (sqlite3)"
-    )
+    simulate.add_argument("--storage", choices=("sqlite3", "mcap"), help="bag storage (sqlite3)")
     simulate.add_argument(
         "--rate", type=float, metavar="HZ", help="odometry and battery samples a second (2)"
     )
@@ -359,27 +347,25 @@ def _add_simulate(commands) -> None:
     simulate.add_argument(
         "--workers", type=int, metavar="N", help="worker processes (one per CPU); 0: none"
     )
-    simulate.add_argument("--gui", action="store_true", help="watch in pybullet's window")
+    simulate.add_argument(
+        "--gui", action="store_true", default=None, help="watch in pybullet's window"
+    )
     simulate.add_argument(
         "--pace", type=float, metavar="X", help="simulated seconds per wall second (--gui: 1)"
     )
-    simulate.add_argument("--overwrite", action="store_true", help="replace runs already in --out")
-    simulate.add_argument("--quiet", action="store_true", help="no progress bar")
-    simulate.set_defaults(handler=_lazy("robotale.sim.commands.simulate_command"))
+    simulate.add_argument(
+        "--overwrite", action="store_true", default=None, help="replace runs already in --out"
+    )
+    simulate.add_argument("--quiet", action="store_true", default=None, help="no progress bar")
+    _handled_by(simulate, "simulate.simulate_command")
 
 
 def _add_log_source(parser: argparse.ArgumentParser, stored: bool = False) -> None:
     """The event log a discovery or perspectives command reads."""
-    parser.add_argument("log", nargs="?", help="event log file (.csv or .xes)")
+    parser.add_argument("log", nargs="?", type=Path, help="event log file (.csv or .xes)")
     if stored:
         parser.add_argument("--log", dest="log_name", metavar="NAME", help="a log stored in Neo4j")
-    parser.add_argument(
-        "--map",
-        action="append",
-        default=[],
-        metavar="COLUMN=FIELD",
-        help="read COLUMN as FIELD (time, activity, case, robot ...). Repeatable",
-    )
+    _add_mapping(parser)
     parser.add_argument(
         "--case-column", metavar="COLUMN", help="the column telling runs apart (default: case)"
     )
@@ -391,39 +377,36 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
         help="process models from a log: DFG, aggregated EKG, conformance to a BPMN model",
         description="Discover process models from an event log (thesis 7.1.2).",
     )
-    actions = discover.add_subparsers(dest="action", metavar="ACTION", required=True)
-    graph_output = {
-        "--out": {"metavar": "JSON", "help": "write the graph as JSON (default: print it)"},
-        "--svg": {"metavar": "SVG", "help": "draw the graph (needs Graphviz's dot)"},
-    }
+    actions = discover.add_subparsers(dest="_action", metavar="ACTION", required=True)
 
     dfg = actions.add_parser("dfg", help="directly-follows graph (pm4py)")
     _add_log_source(dfg)
-    for flag, text in (
-        ("--case", "keep these cases (runs)"),
-        ("--robot", "keep these robots"),
-        ("--robot-type", "keep these robot types (pools)"),
-        ("--activity", "keep these activities"),
+    for flag, dest, text in (
+        ("--case", "cases", "keep these cases (runs)"),
+        ("--robot", "robots", "keep these robots"),
+        ("--robot-type", "robot_types", "keep these robot types (pools)"),
+        ("--activity", "activities", "keep these activities"),
     ):
-        dfg.add_argument(flag, action="append", metavar="A,B", help=f"{text}. Repeatable")
+        dfg.add_argument(
+            flag, dest=dest, action="append", metavar="A,B", help=f"{text}. Repeatable"
+        )
     dfg.add_argument("--since", metavar="TIME", help="keep events at or after this ISO time")
     dfg.add_argument("--until", metavar="TIME", help="keep events at or before this ISO time")
-    _add_graph_output(dfg, graph_output)
-    dfg.set_defaults(handler=_lazy("robotale.discovery.commands.discover_dfg"))
+    _add_graph_output(dfg)
+    _handled_by(dfg, "discover.dfg_command")
 
     ekg = actions.add_parser("ekg", help="aggregated event knowledge graph from Neo4j")
     ekg.add_argument("--log", dest="log_name", required=True, metavar="NAME", help="stored log")
     ekg.add_argument(
         "--aggregate",
-        default="activity,robot",
         metavar="KEYS",
-        help="event properties a class is made of (default: %(default)s)",
+        help="event properties a class is made of (default: activity,robot)",
     )
     ekg.add_argument(
         "--entities", metavar="TYPES", help="entity types whose DF_C edges to show (default: all)"
     )
-    _add_graph_output(ekg, graph_output)
-    ekg.set_defaults(handler=_lazy("robotale.discovery.commands.discover_ekg"))
+    _add_graph_output(ekg)
+    _handled_by(ekg, "discover.ekg_command")
 
     conformance = actions.add_parser(
         "conformance", help="replay each robot against its pool of a BPMN collaboration"
@@ -431,18 +414,21 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
     _add_log_source(conformance)
     conformance.add_argument("--model", required=True, type=Path, help="the .bpmn collaboration")
     conformance.add_argument("--library", type=Path, metavar="DIR", help="building blocks")
-    conformance.add_argument("--json", metavar="FILE", help="also write the report as JSON")
-    conformance.set_defaults(handler=_lazy("robotale.discovery.commands.discover_conformance"))
+    conformance.add_argument(
+        "--json", dest="json_out", type=Path, metavar="FILE", help="also write the report as JSON"
+    )
+    _handled_by(conformance, "discover.conformance_command")
 
 
-def _add_graph_output(parser: argparse.ArgumentParser, options: dict) -> None:
-    for flag, keywords in options.items():
-        parser.add_argument(flag, **keywords)
+def _add_graph_output(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--out", type=Path, metavar="JSON", help="write the graph as JSON (default: print it)"
+    )
+    parser.add_argument("--svg", type=Path, metavar="SVG", help="draw the graph (needs dot)")
     parser.add_argument(
         "--labels",
         choices=("frequency", "performance"),
-        default="frequency",
-        help="what the SVG's edges show (default: %(default)s)",
+        help="what the SVG's edges show (default: frequency)",
     )
 
 
@@ -454,8 +440,10 @@ def _add_perspectives(commands: argparse._SubParsersAction) -> None:
         "an HTML report (works offline) and/or JSON.",
     )
     _add_log_source(perspectives, stored=True)
-    perspectives.add_argument("--out", metavar="HTML", help="write the report as HTML")
-    perspectives.add_argument("--json", metavar="JSON", help="write the report as JSON")
+    perspectives.add_argument("--out", type=Path, metavar="HTML", help="write the report as HTML")
+    perspectives.add_argument(
+        "--json", dest="json_out", type=Path, metavar="JSON", help="write the report as JSON"
+    )
     perspectives.add_argument("--activity", help="only this activity (drill-down)")
     perspectives.add_argument("--robot", help="only this robot (drill-down)")
     perspectives.add_argument(
@@ -466,17 +454,16 @@ def _add_perspectives(commands: argparse._SubParsersAction) -> None:
     perspectives.add_argument(
         "--threshold",
         type=float,
-        default=20.0,
         metavar="PERCENT",
-        help="battery level counted as low (default: %(default)s)",
+        help="battery level counted as low (default: 20)",
     )
-    perspectives.set_defaults(handler=_lazy("robotale.enhancement.commands.perspectives"))
+    _handled_by(perspectives, "perspectives.perspectives_command")
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     args = build_parser().parse_args(argv)
     try:
-        return int(args.handler(args) or 0)
+        return run_handler(args)
     except RobotaleError as error:
         print(f"robotale: {error}", file=sys.stderr)
         return 1

@@ -22,7 +22,7 @@ from robotale.discovery.bpmn_net import process_net
 from robotale.discovery.graph import json_ready
 from robotale.discovery.instances import START_TIMESTAMP, activity_instances
 from robotale.errors import InputError, ModelError
-from robotale.ingest.schema import ACTIVITY, CASE, MSG_ROLE, ROBOT, TIMESTAMP, message_roles
+from robotale.eventlog.schema import ACTIVITY, CASE, MSG_ROLE, ROBOT, TIMESTAMP, message_roles
 
 SKIP = ">>"  # pm4py's "no move" in an alignment
 

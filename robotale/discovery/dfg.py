@@ -17,7 +17,7 @@ from robotale.discovery.filters import LogFilter, filter_log
 from robotale.discovery.graph import END_NODE, START_NODE, Edge, Node, ProcessGraph, duration_stats
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, CASE, REQUIRED, ROBOT, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, CASE, REQUIRED, ROBOT, TIMESTAMP
 
 
 def discover_dfg(log: pd.DataFrame, selection: LogFilter | None = None) -> ProcessGraph:

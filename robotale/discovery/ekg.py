@@ -26,8 +26,9 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.graph import Edge, Node, ProcessGraph
+from robotale.ekg.keys import DISCOVERY_KEY
 from robotale.errors import InputError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 COMM = "COMM"
 #: above this many entities of a type, one entry node stands for all of them
@@ -36,13 +37,14 @@ ENTRY_NODES_PER_TYPE = 12
 
 def discover_ekg(
     log: str,
-    aggregate: str | Sequence[str] = "activity,robot",
+    aggregate: str | Sequence[str] | None = None,
     entities: Sequence[str] | None = None,
     *,
     driver: Any = None,
 ) -> ProcessGraph:
-    """The class graph of the stored log ``log`` aggregated by ``aggregate``, with the DF_C
-    edges of the entity types ``entities`` (default: all the log has)."""
+    """The class graph of the stored log ``log`` aggregated by ``aggregate`` (default:
+    activity and robot), with the DF_C edges of the entity types ``entities`` (default: all
+    the log has)."""
     if driver is None:
         from robotale.ekg.connection import session_driver
 
@@ -52,7 +54,7 @@ def discover_ekg(
     from robotale.ekg.aggregate import aggregation_key, class_type
 
     info = _log_info(driver, log)
-    key = aggregation_key(aggregate)
+    key = aggregation_key(aggregate or DISCOVERY_KEY)
     kind = class_type(key)
     if kind not in (info["classTypes"] or []):
         build_classes(driver, log, key)

@@ -8,7 +8,7 @@ from dataclasses import dataclass, field
 import pandas as pd
 
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, CASE, ROBOT, ROBOT_TYPE, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, ROBOT_TYPE, TIMESTAMP
 
 
 @dataclass(frozen=True, slots=True)

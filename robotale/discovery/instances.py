@@ -16,7 +16,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
-from robotale.ingest.schema import (
+from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
     COMPLETE,

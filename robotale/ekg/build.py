@@ -25,16 +25,12 @@ from tqdm import tqdm
 from robotale.ekg.aggregate import aggregate_unchecked, aggregation_key, class_type
 from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
+from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
 from robotale.ekg.load import Loader
 from robotale.ekg.logs import delete_log, log_exists
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import GraphTables, entity_types, graph_tables
 from robotale.errors import InputError, ServerError
-from robotale.ingest import schema
-
-#: entity columns used when none are named: those of these the log has.
-DEFAULT_ENTITIES = ("robot", "msg_id")
-DEFAULT_AGGREGATE = (("activity",),)
 
 
 @dataclass(frozen=True)
@@ -70,7 +66,7 @@ def build_ekg(
     """
     started = time.perf_counter()
     check_log_name(name)
-    tables = graph_tables(log, default_entities(log) if entities is None else entities)
+    tables = graph_tables(log, default_entities(log.columns) if entities is None else entities)
     keys = [aggregation_key(key) for key in aggregate]
     _check_keys(tables.events, keys)
     ensure_schema(driver)
@@ -85,11 +81,6 @@ def build_ekg(
     if existing:
         _swap(driver, target, name)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
-
-
-def default_entities(log: pd.DataFrame) -> list[str]:
-    present = [e for e in DEFAULT_ENTITIES if e in log.columns]
-    return present or [schema.CSV_NAMES[schema.CASE]]
 
 
 def check_log_name(name: object) -> str:

@@ -26,7 +26,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.errors import InputError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 #: canonical column -> Neo4j property of an Event (other columns keep their names).
 EVENT_PROPERTIES: dict[str, str] = {

@@ -11,7 +11,7 @@ import pandas as pd
 
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
-from robotale.ingest.schema import ACTIVITY, BATTERY, CASE, LIFECYCLE, ROBOT, START, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, LIFECYCLE, ROBOT, START, TIMESTAMP
 
 LOW_ACTIVITY = "low_battery"
 

@@ -29,7 +29,7 @@ from robotale.discovery.instances import DURATION
 from robotale.enhancement.communication import TYPE, message_table
 from robotale.enhancement.performance import WAIT, case_durations, finished_instances, robot_steps
 from robotale.enhancement.result import Perspective, focus_label, no_data
-from robotale.ingest.schema import ACTIVITY, CASE, RECEIVE, ROBOT, message_roles
+from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, message_roles
 
 KINDS = ("waiting", "rework", "delay", "queueing")
 

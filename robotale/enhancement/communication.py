@@ -16,7 +16,7 @@ from __future__ import annotations
 import pandas as pd
 
 from robotale.enhancement.result import Perspective, focus_label, no_data
-from robotale.ingest.schema import (
+from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
     COMPLETE,

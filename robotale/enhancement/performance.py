@@ -13,7 +13,7 @@ import pandas as pd
 
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.result import Perspective, focus_label, no_data
-from robotale.ingest.schema import ACTIVITY, CASE, MSG_ID, ROBOT, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, CASE, MSG_ID, ROBOT, TIMESTAMP
 
 WAIT = "wait"
 

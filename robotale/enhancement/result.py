@@ -9,7 +9,7 @@ from typing import Any
 import pandas as pd
 
 from robotale.discovery.graph import json_ready
-from robotale.ingest.schema import ACTIVITY, CSV_NAMES, ROBOT
+from robotale.eventlog.schema import ACTIVITY, CSV_NAMES, ROBOT
 
 
 @dataclass(slots=True)

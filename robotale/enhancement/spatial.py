@@ -17,7 +17,7 @@ import pandas as pd
 
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, CASE, ROBOT, TIMESTAMP, X, Y, Z
+from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, TIMESTAMP, X, Y, Z
 
 #: the 3D scatter draws at most this many positions (a random sample beyond that): a browser
 #: stays responsive, and the tables and coverage always use every position

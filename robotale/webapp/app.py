@@ -10,7 +10,7 @@ from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
 from robotale.webapp import errors, jobs, neo4j_access, pages, uploads
-from robotale.webapp.models import ModelStore
+from robotale.webapp.model_store import ModelStore
 from robotale.webapp.settings import WebSettings
 
 

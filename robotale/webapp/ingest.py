@@ -1,8 +1,8 @@
 """From an uploaded file to a log in Neo4j, in the two steps of thesis figure 7.3.
 
 1. :func:`read_upload` turns the upload into the canonical event log (a CSV or XES log with
-   ``robotale.ingest.readers``, a zipped folder of rosbag2 recordings with
-   ``robotale.ingest.prepare``) and keeps it in memory as a :class:`Pending` log.
+   ``robotale.eventlog.readers``, a zipped folder of rosbag2 recordings with
+   ``robotale.eventlog.prepare``) and keeps it in memory as a :class:`Pending` log.
 2. The user picks the columns to store as event properties and those that are entities;
    :func:`ingest` stores the log with :func:`robotale.ekg.build.build_ekg` and deletes the upload.
 """
@@ -20,11 +20,11 @@ import pandas as pd
 from neo4j import Driver
 
 from robotale.errors import InputError, RobotaleError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
 from robotale.webapp.logdata import class_graph, first_key, forget
-from robotale.webapp.models import ModelStore
+from robotale.webapp.model_store import ModelStore
 
 #: columns every stored log keeps, whatever the user unticks
 ALWAYS_STORED = (*schema.REQUIRED, schema.LIFECYCLE)
@@ -96,7 +96,7 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
         if upload.kind == "zip":
             pending.log, pending.model_id = _read_bags(upload, limit_bytes, models, job)
         else:
-            from robotale.ingest.readers import read_log
+            from robotale.eventlog.readers import read_log
 
             pending.log = read_log(upload.path, mapping=pending.mapping)
     except RobotaleError as error:
@@ -114,7 +114,7 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
 def _read_bags(
     upload: uploads.Upload, limit_bytes: int, models: ModelStore, job: Job
 ) -> tuple[pd.DataFrame, str | None]:
-    from robotale.ingest.prepare import prepare
+    from robotale.eventlog.prepare import prepare
 
     folder = uploads.unpack(upload, limit_bytes * UNPACK_FACTOR)
     try:
@@ -130,7 +130,7 @@ def _read_bags(
 
 def shipped_model(root: Path) -> Path | None:
     """The mission model of the shipped scenario the recordings' manifests name, if one."""
-    from robotale.ingest.prepare import find_runs, run_manifests
+    from robotale.eventlog.prepare import find_runs, run_manifests
     from robotale.sim import scenarios
 
     names = {m.get("scenario") for m in run_manifests(find_runs(root)).values()}

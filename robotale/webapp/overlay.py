@@ -17,10 +17,10 @@ from typing import Any
 import pandas as pd
 
 from robotale.errors import InputError, ModelError
+from robotale.eventlog.schema import ACTIVITY, ROBOT
 from robotale.fame_runtime.model import Node
 from robotale.fame_runtime.plan import error_name, signal_name
 from robotale.fame_runtime.tags import activity_label
-from robotale.ingest.schema import ACTIVITY, ROBOT
 
 _CATCHING = ("startEvent", "intermediateCatchEvent", "boundaryEvent")
 

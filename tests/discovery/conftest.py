@@ -3,8 +3,8 @@
 import pandas as pd
 import pytest
 
-from robotale.ingest.readers import read_log
-from robotale.ingest.schema import (
+from robotale.eventlog.readers import read_log
+from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
     LIFECYCLE,

@@ -3,7 +3,7 @@ import pm4py
 import pytest
 
 from robotale.discovery.conformance import RobotModel, replay
-from robotale.ingest.schema import ACTIVITY, CASE, ROBOT
+from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT
 
 T0 = pd.Timestamp("2024-01-01T10:00:00+00:00")
 

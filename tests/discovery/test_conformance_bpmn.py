@@ -8,10 +8,10 @@ import pytest
 from robotale.discovery.bpmn_net import process_net
 from robotale.discovery.conformance import check_conformance
 from robotale.errors import InputError
+from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT
 from robotale.fame_runtime.library import Library, find_process
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.plan import signal_name
-from robotale.ingest.schema import ACTIVITY, CASE, ROBOT
 
 MODEL = Path(__file__).parent / "models" / "scout_workers.bpmn"
 

@@ -8,7 +8,7 @@ from pm4py.objects.log.util import interval_lifecycle
 from robotale.discovery import LogFilter, ProcessGraph, discover_dfg
 from robotale.discovery.graph import END_NODE, START_NODE
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, ROBOT_TYPE, STATE, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, ROBOT_TYPE, STATE, TIMESTAMP
 
 
 def pm4py_interval_dfg(log: pd.DataFrame):

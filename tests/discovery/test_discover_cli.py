@@ -47,7 +47,7 @@ def test_missing_graphviz_is_reported_before_any_output(thesis_csv, tmp_path, ca
 def test_conformance_command(engine_log, tmp_path, capsys):
     from pathlib import Path
 
-    from robotale.ingest.schema import to_csv_names
+    from robotale.eventlog.schema import to_csv_names
 
     model = Path(__file__).parent / "models" / "scout_workers.bpmn"
     log = engine_log(model, robots=["scout", "worker_1"], variables={"scout": {"planned": 2}})

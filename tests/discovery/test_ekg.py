@@ -14,7 +14,7 @@ from robotale.discovery.ekg import COMM, read_stored_log
 from robotale.ekg import build_ekg
 from robotale.ekg.logs import delete_log
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, CASE, EVENT_ID, MSG_ID, ROBOT, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, CASE, EVENT_ID, MSG_ID, ROBOT, TIMESTAMP
 
 
 @pytest.fixture(scope="module")

@@ -1,7 +1,7 @@
 import pandas as pd
 
 from robotale.discovery.instances import activity_instances
-from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, STATE, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, STATE, TIMESTAMP
 
 T0 = pd.Timestamp("2024-01-01T10:00:00+00:00")
 

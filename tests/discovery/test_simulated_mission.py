@@ -10,7 +10,7 @@ import pytest
 from robotale.cli import main
 from robotale.discovery import LogFilter, check_conformance, discover_dfg
 from robotale.enhancement import all_perspectives
-from robotale.ingest.readers import read_log
+from robotale.eventlog.readers import read_log
 
 pytestmark = [
     pytest.mark.slow,

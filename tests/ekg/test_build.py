@@ -14,8 +14,8 @@ from robotale.ekg.connection import database
 from robotale.ekg.logs import delete_log, list_logs, log_summary
 from robotale.ekg.queries import cypher
 from robotale.errors import InputError
-from robotale.ingest import schema
-from robotale.ingest.readers import read_csv
+from robotale.eventlog import schema
+from robotale.eventlog.readers import read_csv
 
 
 @pytest.fixture(scope="module")

@@ -122,8 +122,8 @@ def agri_recordings(tmp_path):
 @pytest.mark.slow
 @pytest.mark.filterwarnings("ignore:Install the optional requirement:UserWarning")
 def test_ingest_prepares_a_folder_of_recordings(capsys, neo4j_driver, log_name, agri_recordings):
-    from robotale.ingest import schema
-    from robotale.ingest.prepare import prepare
+    from robotale.eventlog import schema
+    from robotale.eventlog.prepare import prepare
 
     capsys.readouterr()
     code, out, err = run(

@@ -7,7 +7,7 @@ import pytest
 
 from robotale.ekg.tables import communication_roles, graph_tables
 from robotale.errors import InputError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 
 def log(rows: list[tuple], extra: dict | None = None) -> pd.DataFrame:

@@ -5,8 +5,8 @@ from collections.abc import Callable
 import pandas as pd
 import pytest
 
-from robotale.ingest.readers import read_log
-from robotale.ingest.schema import ACTIVITY, CASE, LIFECYCLE, TIMESTAMP
+from robotale.eventlog.readers import read_log
+from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, TIMESTAMP
 
 BASE = pd.Timestamp("2024-01-01T10:00:00+00:00")
 

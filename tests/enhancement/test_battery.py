@@ -1,7 +1,7 @@
 import pytest
 
 from robotale.enhancement import battery_perspective, low_battery_events
-from robotale.ingest.schema import ACTIVITY, LIFECYCLE
+from robotale.eventlog.schema import ACTIVITY, LIFECYCLE
 
 
 @pytest.fixture

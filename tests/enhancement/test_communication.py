@@ -2,7 +2,7 @@ import pandas as pd
 import pytest
 
 from robotale.enhancement import communication_perspective
-from robotale.ingest.schema import ACTIVITY, LIFECYCLE, ROBOT, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, LIFECYCLE, ROBOT, TIMESTAMP
 
 
 def by_hand(log: pd.DataFrame) -> pd.DataFrame:

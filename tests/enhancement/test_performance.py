@@ -4,7 +4,7 @@ import pytest
 from pm4py.objects.log.util import interval_lifecycle
 
 from robotale.enhancement import performance_perspective
-from robotale.ingest.schema import ROBOT
+from robotale.eventlog.schema import ROBOT
 
 
 @pytest.fixture

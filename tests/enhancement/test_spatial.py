@@ -3,7 +3,7 @@ import pytest
 
 from robotale.enhancement import Field, spatial_perspective
 from robotale.errors import InputError
-from robotale.ingest.schema import ACTIVITY, ROBOT
+from robotale.eventlog.schema import ACTIVITY, ROBOT
 
 
 def test_bounds_match_the_data(thesis_log):

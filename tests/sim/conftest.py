@@ -7,7 +7,7 @@ import pytest
 from simbags import full_batteries
 
 from robotale.sim import scenarios
-from robotale.sim.commands import adjust
+from robotale.sim.plans import adjust
 from robotale.sim.worldspec import World, load_world
 
 

@@ -8,8 +8,8 @@ import math
 
 from simbags import manifest, messages, record, seconds, tags
 
-from robotale.sim.commands import adjust
 from robotale.sim.faults import parse_fault
+from robotale.sim.plans import adjust
 
 
 def test_a_short_agri_run_cuts_every_weed_and_its_tags_follow_the_model(short_agri, tmp_path):

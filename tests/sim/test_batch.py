@@ -13,7 +13,7 @@ from simbags import manifest, record
 from robotale.cli import main
 from robotale.errors import InputError
 from robotale.sim.batch import SUMMARY, simulate_batch
-from robotale.sim.commands import plans
+from robotale.sim.plans import plans
 from robotale.sim.worldspec import load_world
 
 ROVER = """<?xml version="1.0" encoding="UTF-8"?>

@@ -10,8 +10,8 @@ import pytest
 from simbags import manifest, messages, record, seconds, tags
 
 from robotale.errors import InputError
-from robotale.sim.commands import adjust
 from robotale.sim.faults import parse_fault
+from robotale.sim.plans import adjust
 
 ROBOTS = ["drone", "tractor_1", "tractor_2"]
 

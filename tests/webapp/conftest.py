@@ -62,7 +62,7 @@ def browser_context(tmp_path_factory: pytest.TempPathFactory) -> Iterator[object
 
     # The machine may be busy: wait for what the user would wait for, not for a fixed 5 s.
     expect.set_options(timeout=60_000)
-    from robotale.webapp.browser import chromium_path, launch
+    from browser import chromium_path, launch
 
     if chromium_path() is None:
         pytest.fail(

@@ -175,7 +175,7 @@ def crashed_drone_log(neo4j_driver, tmp_path):
     """Two agri runs in which the drone dies after 20 s, stored as the log ``agri_test``."""
     from robotale.ekg.build import build_ekg
     from robotale.ekg.logs import delete_log
-    from robotale.ingest.prepare import prepare
+    from robotale.eventlog.prepare import prepare
 
     out = tmp_path / "agri"
     command = [sys.executable, "-m", "robotale", "simulate", "agri", "--runs", "2", "--weeds", "3"]

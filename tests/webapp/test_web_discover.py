@@ -22,7 +22,7 @@ def stored_thesis(neo4j_driver, thesis_csv):
     """The thesis log stored once for this module, as the dashboard stores it."""
     from robotale.ekg.build import build_ekg
     from robotale.ekg.logs import delete_log
-    from robotale.ingest.readers import read_log
+    from robotale.eventlog.readers import read_log
     from robotale.webapp.ingest import aggregation_keys
 
     name = f"test_discover_{uuid.uuid4().hex[:8]}"

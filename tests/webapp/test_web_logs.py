@@ -254,7 +254,7 @@ def zipped_folder(folder: Path) -> bytes:
 def test_a_zipped_bag_folder_is_prepared_and_linked_to_its_mission(
     client, simulated_runs, log_name, web_settings
 ):
-    from robotale.ingest.prepare import prepare
+    from robotale.eventlog.prepare import prepare
     from robotale.sim import scenarios
 
     expected = prepare(simulated_runs)

@@ -7,7 +7,7 @@ import io
 import pytest
 
 from robotale.errors import InputError
-from robotale.webapp.models import ModelStore
+from robotale.webapp.model_store import ModelStore
 
 
 @pytest.fixture
@@ -99,7 +99,7 @@ def test_the_shipped_missions_are_offered_and_found_by_the_log_robots(tmp_path):
 
 
 def test_a_script_can_attach_the_mission_to_a_log(tmp_path, monkeypatch, agri):
-    from robotale.webapp.models import attach_model
+    from robotale.webapp.model_store import attach_model
 
     monkeypatch.setenv("ROBOTALE_MODEL_DIR", str(tmp_path))
     stored = attach_model("agri-runs", agri)

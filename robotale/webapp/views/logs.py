@@ -14,8 +14,8 @@ from flask import (
     url_for,
 )
 
-from robotale.ekg.log_commands import parse_mapping
 from robotale.errors import InputError
+from robotale.eventlog.readers import parse_mapping
 from robotale.webapp import ingest, pages, uploads
 from robotale.webapp.jobs import jobs
 from robotale.webapp.logdata import forget

@@ -16,7 +16,7 @@ from flask import (
 from robotale.errors import InputError
 from robotale.webapp import pages
 from robotale.webapp.logdata import Cache
-from robotale.webapp.models import ModelStore
+from robotale.webapp.model_store import ModelStore
 from robotale.webapp.neo4j_access import driver
 
 blueprint = Blueprint("model", __name__)

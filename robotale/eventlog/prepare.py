@@ -2,8 +2,8 @@
 
 :func:`prepare` is the one function to call. It takes one rosbag2 directory or a folder of them
 (a batch of runs: ``runs/agri/run_0001/`` ...), reads each bag's tag topics and the topics of
-the chosen perspectives, and enriches the tags (:mod:`robotale.ingest.enrich`). Every bag is one
-case, named after its directory. The result is the DataFrame of :mod:`robotale.ingest.schema`,
+the chosen perspectives, and enriches the tags (:mod:`robotale.eventlog.enrich`). Every bag is one
+case, named after its directory. The result is the DataFrame of :mod:`robotale.eventlog.schema`,
 ready for the writers, pm4py or the EKG.
 
 Bags recorded on real ROS 2 robots work too: the tag topics are a glob and the tag message's
@@ -27,8 +27,8 @@ import yaml
 from tqdm import tqdm
 
 from robotale.errors import InputError
-from robotale.ingest import schema
-from robotale.ingest.enrich import (
+from robotale.eventlog import schema
+from robotale.eventlog.enrich import (
     BUILTIN,
     Perspective,
     PreparationWarning,
@@ -36,7 +36,7 @@ from robotale.ingest.enrich import (
     parse_perspective,
     robots_without_samples,
 )
-from robotale.ingest.rosbag import TIME, Bag, is_bag, message_types, namespace
+from robotale.eventlog.rosbag import TIME, Bag, is_bag, message_types, namespace
 
 TAG_TOPICS = "/*/tag"
 MANIFEST = "robotale-run.json"

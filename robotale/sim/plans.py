@@ -1,13 +1,13 @@
-"""What ``robotale simulate`` does; :mod:`robotale.cli` only parses the arguments."""
+"""A batch of simulated runs, planned: the world a scenario or a world file names, the
+command line's overrides applied, checked before any run starts, and one :class:`RunPlan` per
+run."""
 
 from __future__ import annotations
 
-import os
-import sys
 from collections.abc import Sequence
 from dataclasses import replace
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any
 
 from robotale.errors import InputError, ModelError
 from robotale.fame_runtime.bus import InProcessBus
@@ -15,7 +15,6 @@ from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.parser import parse
 from robotale.sim import messages, scenarios
-from robotale.sim.batch import simulate_batch
 from robotale.sim.faults import Fault, parse_fault
 from robotale.sim.run import RunPlan, model_topics, skills_of
 from robotale.sim.setup import draw
@@ -121,100 +120,3 @@ def plans(
         )
         for index in range(first, first + runs)
     ]
-
-
-def simulate_command(args: Any, out: TextIO | None = None) -> int:
-    """``robotale simulate``: a batch (or one run in pybullet's window with --gui)."""
-    out = out or sys.stdout
-    world, scenario = resolve_world(args.scenario, args.model, args.world)
-    counts = dict(_count(text) for text in args.count)
-    if args.tractors is not None:
-        counts["tractor"] = args.tractors
-    world = adjust(
-        world,
-        counts=counts,
-        weeds=_weeds(args.weeds) if args.weeds else None,
-        time_limit=args.time_limit,
-        rate=args.rate,
-    )
-    check(world)
-    batch = plans(
-        world,
-        scenario,
-        runs=args.runs,
-        seed=args.seed,
-        first=args.first,
-        faults=args.fault,
-        storage=args.storage,
-        extra_topics=_topics(args.topics),
-        settings=_overrides(args),
-    )
-    target = Path(args.out) if args.out else Path("runs") / scenario
-    if args.gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-        raise InputError("--gui needs a display (DISPLAY is not set); run without --gui")
-    watching = args.gui or bool(args.pace)
-    summary = simulate_batch(
-        batch,
-        target,
-        workers=args.workers,
-        overwrite=args.overwrite,
-        progress=not (args.quiet or watching),
-        gui=args.gui,
-        pace=(args.pace or 1.0) if watching else None,
-    )
-    print_summary(summary, target, out)
-    return 0
-
-
-def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
-    outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
-    runs, workers = summary["runs"], summary["workers"]
-    where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
-    print(
-        f"{runs} run{'s' if runs != 1 else ''} of {summary['scenario']} "
-        f"in {summary['wall_time']:.1f} s ({where}): {outcomes}",
-        file=out,
-    )
-    for case in summary["cases"]:
-        if case["status"] != "ended":
-            reason = f": {case['reason']}" if case["reason"] else ""
-            print(f"  {case['case']} {case['status']}{reason}", file=out)
-    for kind, verb in (("weeds", "cut"), ("targets", "destroyed")):
-        totals = [c[kind] for c in summary["cases"] if kind in c]
-        if totals:
-            done = sum(t[verb] for t in totals)
-            print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
-    print(f"recorded in {target} (summary: {target / 'robotale-batch.json'})", file=out)
-
-
-def _overrides(args: Any) -> dict[str, Any]:
-    """The command line's changes to the world, for the manifests."""
-    given = {
-        "counts": dict(_count(text) for text in args.count) or None,
-        "tractors": args.tractors,
-        "weeds": args.weeds,
-        "faults": list(args.fault) or None,
-        "extra_topics": _topics(args.topics) or None,
-    }
-    return {key: value for key, value in given.items() if value is not None}
-
-
-def _count(text: str) -> tuple[str, int]:
-    group, sep, number = text.partition("=")
-    if not sep or not number.strip().isdigit():
-        raise InputError(f"--count {text!r} must be GROUP=N, e.g. tractor=3")
-    return group.strip(), int(number)
-
-
-def _weeds(text: str) -> tuple[int, int]:
-    low, _, high = text.partition("-")
-    if not low.strip().isdigit() or (high and not high.strip().isdigit()):
-        raise InputError(f"--weeds {text!r} must be a number or LOW-HIGH, e.g. 2 or 3-6")
-    bounds = (int(low), int(high or low))
-    if bounds[1] < bounds[0]:
-        raise InputError(f"--weeds {text!r}: the range ends before it starts")
-    return bounds
-
-
-def _topics(text: str | None) -> list[str]:
-    return [t.strip().strip("/") for t in text.split(",") if t.strip()] if text else []

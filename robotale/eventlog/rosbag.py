@@ -36,8 +36,8 @@ from rosbags.typesys import (
 from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
+from robotale.eventlog.cdrlayout import Layout, columns
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
-from robotale.ingest.cdrlayout import Layout, columns
 
 TIME = "time"
 HEADER_TYPE = "std_msgs/msg/Header"
@@ -247,7 +247,7 @@ class _TopicRows:
     """The recording times and field values of one topic's messages.
 
     Numeric fields are read in bulk from the raw bytes of every message that shares the first
-    message's layout (:mod:`robotale.ingest.cdrlayout`); other messages, and other fields, are
+    message's layout (:mod:`robotale.eventlog.cdrlayout`); other messages, and other fields, are
     decoded one by one with rosbags.
     """
 

@@ -11,10 +11,10 @@ from bagbuilder import agri_like, at
 from rosbags.rosbag2 import Writer
 
 from robotale.errors import InputError
+from robotale.eventlog import schema
+from robotale.eventlog.enrich import PreparationWarning
+from robotale.eventlog.prepare import TagFields, find_runs, is_recording, prepare, robot_type
 from robotale.fame_runtime.tags import TAG_TYPE
-from robotale.ingest import schema
-from robotale.ingest.enrich import PreparationWarning
-from robotale.ingest.prepare import TagFields, find_runs, is_recording, prepare, robot_type
 
 COLUMNS = [
     schema.CASE,

@@ -11,9 +11,9 @@ import pytest
 from bagbuilder import agri_like
 
 from robotale.errors import InputError
-from robotale.ingest import schema
-from robotale.ingest.prepare import prepare
-from robotale.ingest.writers import write_csv, write_ocel, write_xes
+from robotale.eventlog import schema
+from robotale.eventlog.prepare import prepare
+from robotale.eventlog.writers import write_csv, write_ocel, write_xes
 
 CASE, TIME, ACTIVITY = schema.CASE, schema.TIMESTAMP, schema.ACTIVITY
 pytestmark = pytest.mark.filterwarnings("ignore:Install the optional requirement:UserWarning")

@@ -9,8 +9,8 @@ import pm4py
 import pytest
 
 from robotale.cli import main
-from robotale.ingest import schema
-from robotale.ingest.prepare import prepare
+from robotale.eventlog import schema
+from robotale.eventlog.prepare import prepare
 
 pytestmark = pytest.mark.filterwarnings("ignore:Install the optional requirement:UserWarning")
 

@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
-from robotale.ingest.cdrlayout import Layout, columns
-from robotale.ingest.rosbag import Bag
+from robotale.eventlog.cdrlayout import Layout, columns
+from robotale.eventlog.rosbag import Bag
 
 MIXED = "mixed_msgs/msg/Mixed"
 MIXED_MSG = """\

@@ -1,4 +1,4 @@
-"""Debian's Chromium, headless, for the dashboard's browser tests and its benchmark.
+"""Debian's Chromium, headless, for the dashboard's browser tests and its benchmark (test-only).
 
 Playwright (a development dependency) drives the system's Chromium (``/usr/bin/chromium``, or
 ``ROBOTALE_CHROMIUM``) rather than a browser it downloads. The flags keep Chromium from

@@ -10,8 +10,8 @@ import yaml
 from bagbuilder import at, nanos
 
 from robotale.errors import InputError
-from robotale.ingest.prepare import TagFields, prepare
-from robotale.ingest.rosbag import Bag, read_bag
+from robotale.eventlog.prepare import TagFields, prepare
+from robotale.eventlog.rosbag import Bag, read_bag
 
 EVENT_TYPE = "turtle_msgs/msg/Event"
 EVENT_MSG = "builtin_interfaces/Time stamp\nstring action\nstring status\n"

@@ -3,7 +3,7 @@
 Each writer writes to a temporary file next to the target and renames it into place, so a
 failure never leaves a partial file behind. Timestamps are written in UTC with microseconds.
 
-- CSV: the short column names of :mod:`robotale.ingest.schema`, one row per event.
+- CSV: the short column names of :mod:`robotale.eventlog.schema`, one row per event.
 - XES: one trace per case; every event carries ``concept:name``, ``time:timestamp``,
   ``lifecycle:transition`` and ``lifecycle:state`` and the other columns as typed attributes
   (``float`` for x, y, z and battery ...), as in the thesis' listing 6.1. Empty values are left
@@ -29,7 +29,7 @@ import pandas as pd
 from lxml import etree
 
 from robotale.errors import InputError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 CASE, TIME, ACTIVITY = schema.CASE, schema.TIMESTAMP, schema.ACTIVITY
 _TIME_FORMAT = "%Y-%m-%dT%H:%M:%S.%f+00:00"

@@ -8,7 +8,6 @@ drove them attached for the Model page, and the dashboard served until Ctrl-C.
 
 from __future__ import annotations
 
-import argparse
 import os
 import sys
 from dataclasses import dataclass
@@ -16,9 +15,22 @@ from pathlib import Path
 
 import pandas as pd
 
+from robotale.commands.ingest import store
+from robotale.commands.prepare import prepare_reporting
+from robotale.commands.simulate import print_summary
 from robotale.config import robotale_home
+from robotale.ekg.connection import connect
+from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
+from robotale.ekg.server import LocalServer, ServerOptions
 from robotale.errors import InputError
-from robotale.ingest.readers import read_log
+from robotale.eventlog.readers import read_log
+from robotale.eventlog.writers import write_csv
+from robotale.sim import scenarios
+from robotale.sim.batch import simulate_batch
+from robotale.sim.plans import check, plans, resolve_world
+from robotale.webapp.model_store import attach_model
+from robotale.webapp.serve import Dashboard, serve_until_interrupted
+from robotale.webapp.settings import DEFAULT_PORT
 
 DEFAULT_RUNS = 20
 AGRI_LOG = "agri"
@@ -26,8 +38,7 @@ THESIS_LOG_NAME = "thesis"
 THESIS_DIR = Path("examples") / "thesis"
 THESIS_LOG = THESIS_DIR / "robotic_data.csv"
 THESIS_MODEL = THESIS_DIR / "fame-models" / "fame-ros" / "agri.bpmn"
-ENTITIES = ["robot", "msg_id"]
-AGGREGATE = ["activity", "activity,robot"]
+ENTITIES = list(DEFAULT_ENTITIES)
 
 
 @dataclass(frozen=True)
@@ -39,12 +50,14 @@ class DemoOptions:
     serve: bool
 
     @classmethod
-    def from_args(cls, args: argparse.Namespace) -> DemoOptions:
-        runs = args.runs if args.runs is not None else _runs_from_env()
+    def given(
+        cls, runs: int | None, seed: int | None, out: Path | None, port: int | None, serve: bool
+    ) -> DemoOptions:
+        runs = runs if runs is not None else _runs_from_env()
         if runs < 1:
             raise InputError(f"--runs is {runs}: the demo needs at least one run.")
-        folder = Path(args.out) if args.out else robotale_home() / "demo"
-        return cls(runs, args.seed, folder, args.port, not args.no_serve)
+        folder = out or robotale_home() / "demo"
+        return cls(runs, 1 if seed is None else seed, folder, port or DEFAULT_PORT, serve)
 
 
 def _runs_from_env() -> int:
@@ -56,8 +69,16 @@ def _runs_from_env() -> int:
     return int(value)
 
 
-def demo(args: argparse.Namespace) -> int:
-    options = DemoOptions.from_args(args)
+def demo_command(
+    *,
+    runs: int | None = None,
+    seed: int | None = None,
+    out: Path | None = None,
+    port: int | None = None,
+    serve: bool = True,
+) -> int:
+    """The whole mission end to end; ``serve`` keeps the dashboard up until Ctrl-C."""
+    options = DemoOptions.given(runs, seed, out, port, serve)
     thesis = source_file(THESIS_LOG)
     # Bind the dashboard's port first: a port in use should stop the demo before the work.
     dashboard = _dashboard(options.port) if options.serve else None
@@ -79,7 +100,7 @@ def demo(args: argparse.Namespace) -> int:
 
 def source_file(relative: Path) -> Path:
     """A file of robotale's source checkout (or below the current directory)."""
-    for root in (Path(__file__).resolve().parents[1], Path.cwd()):
+    for root in (Path(__file__).resolve().parents[2], Path.cwd()):
         if (root / relative).is_file():
             return root / relative
     raise InputError(f"{relative} was not found; run the demo from robotale's source tree.")
@@ -91,13 +112,9 @@ def _step(title: str) -> None:
 
 def _neo4j_up() -> None:
     if os.environ.get("NEO4J_URI"):
-        from robotale.ekg.connection import connect
-
         connect().close()  # a server that is down should stop the demo before the simulation
         print(f"Using the Neo4j at {os.environ['NEO4J_URI']} (NEO4J_URI)")
         return
-    from robotale.ekg.server import LocalServer, ServerOptions
-
     server = LocalServer()
     running = server.start(ServerOptions.from_env())
     print(f"Neo4j is running at {running.bolt_uri}; Neo4j Browser: {running.browser_url}")
@@ -105,22 +122,16 @@ def _neo4j_up() -> None:
 
 
 def _simulate(options: DemoOptions) -> Path:
-    from robotale.sim import commands
-    from robotale.sim.batch import simulate_batch
-
-    world, scenario = commands.resolve_world("agri")
-    commands.check(world)
-    plans = commands.plans(world, scenario, runs=options.runs, seed=options.seed)
+    world, scenario = resolve_world("agri")
+    check(world)
+    batch = plans(world, scenario, runs=options.runs, seed=options.seed)
     target = options.folder / "runs"
-    summary = simulate_batch(plans, target, overwrite=True, progress=True)
-    commands.print_summary(summary, target, sys.stdout)
+    summary = simulate_batch(batch, target, overwrite=True, progress=True)
+    print_summary(summary, target, sys.stdout)
     return target
 
 
 def _prepare(bags: Path, csv: Path) -> pd.DataFrame:
-    from robotale.ingest.commands import prepare_reporting
-    from robotale.ingest.writers import write_csv
-
     log = prepare_reporting(bags)
     write_csv(log, csv)
     print(f"{len(log):,} events from {log['case:concept:name'].nunique()} run(s) in {csv}")
@@ -128,27 +139,10 @@ def _prepare(bags: Path, csv: Path) -> pd.DataFrame:
 
 
 def _ingest(log: pd.DataFrame, name: str, source: Path) -> None:
-    from robotale.ekg.build import build_ekg
-    from robotale.ekg.connection import session_driver
-    from robotale.ekg.log_commands import describe
-
-    with session_driver() as driver:
-        summary = build_ekg(
-            driver,
-            log,
-            name,
-            entities=ENTITIES,
-            aggregate=AGGREGATE,
-            replace=True,
-            source=str(source),
-        )
-    print(describe(summary))
+    store(log, name, source, entities=ENTITIES, aggregate=built_keys(ENTITIES))
 
 
 def _attach_models(thesis: Path) -> None:
-    from robotale.sim import scenarios
-    from robotale.webapp.models import attach_model
-
     attach_model(AGRI_LOG, scenarios.model_file("agri"))
     attach_model(THESIS_LOG_NAME, source_file(THESIS_MODEL))
 
@@ -162,15 +156,11 @@ def _explain() -> None:
     )
 
 
-def _dashboard(port: int):
-    from robotale.webapp.serve import Dashboard
-
+def _dashboard(port: int) -> Dashboard:
     return Dashboard(port=port)
 
 
-def _serve(dashboard) -> None:
-    from robotale.webapp.serve import serve_until_interrupted
-
+def _serve(dashboard: Dashboard) -> None:
     print("\nThe dashboard is up; open the address below.", flush=True)
     serve_until_interrupted(dashboard, AGRI_LOG)
     print("Dashboard stopped; the logs stay in Neo4j (`robotale serve` shows them again).")

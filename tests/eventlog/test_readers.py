@@ -9,8 +9,8 @@ import pm4py
 import pytest
 
 from robotale.errors import InputError
-from robotale.ingest import schema
-from robotale.ingest.readers import read_csv, read_log, read_xes
+from robotale.eventlog import schema
+from robotale.eventlog.readers import read_csv, read_log, read_xes
 
 XES = """<?xml version="1.0" encoding="UTF-8"?>
 <log xes.version="1.0" xmlns="http://www.xes-standard.org/">

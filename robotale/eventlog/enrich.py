@@ -22,7 +22,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.errors import InputError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 CASE, TIME, ROBOT, ACTIVITY = schema.CASE, schema.TIMESTAMP, schema.ROBOT, schema.ACTIVITY
 LIFECYCLE, STATE = schema.LIFECYCLE, schema.STATE

@@ -1,4 +1,4 @@
-"""What ``robotale fame check|split|run`` do; :mod:`robotale.cli` only parses arguments."""
+"""``robotale fame check|split|run``: BPMN missions checked, split per robot and run."""
 
 from __future__ import annotations
 
@@ -26,7 +26,11 @@ def robot_list(text: str | None) -> list[str] | None:
 
 
 def check_command(
-    model: Path, *, library: Path | None, skills: str | None, out: TextIO | None = None
+    model: Path,
+    *,
+    library: Path | None = None,
+    skills: str | None = None,
+    out: TextIO | None = None,
 ) -> int:
     """Print the structure and QoS report; 1 when something is wrong."""
     out = out or sys.stdout
@@ -58,7 +62,11 @@ def print_report(report: Report, out: TextIO) -> None:
 
 
 def split_command(
-    model: Path, *, robots: str | None, out_dir: Path | None, out: TextIO | None = None
+    model: Path,
+    *,
+    robots: str | None = None,
+    out_dir: Path | None = None,
+    out: TextIO | None = None,
 ) -> int:
     """Print which robot runs which pool's process; with ``out_dir`` write one file each."""
     out = out or sys.stdout
@@ -77,11 +85,11 @@ def split_command(
 def run_command(
     model: Path,
     *,
-    robots: str | None,
-    skills: str | None,
-    library: Path | None,
-    until: float,
-    latency: float,
+    robots: str | None = None,
+    skills: str | None = None,
+    library: Path | None = None,
+    until: float = 3600.0,
+    latency: float = 0.0,
     assignments: Sequence[str] = (),
     out: TextIO | None = None,
     err: TextIO | None = None,

@@ -15,13 +15,13 @@ from __future__ import annotations
 
 import io
 import re
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
 
 from robotale.errors import InputError
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 #: canonical column -> names it is recognised by (compared ignoring case, blanks, "_" and "-").
 SYNONYMS: dict[str, tuple[str, ...]] = {
@@ -57,6 +57,17 @@ TEXT_COLUMNS = (
     schema.EXECUTION_ID,
 )
 SINGLE_CASE = "1"
+
+
+def parse_mapping(items: Sequence[str]) -> dict[str, str]:
+    """``--map`` options (``["Zeit=time", ...]``) as ``{"Zeit": "time"}``."""
+    mapping = {}
+    for item in items:
+        column, sep, field = item.partition("=")
+        if not sep or not column.strip() or not field.strip():
+            raise InputError(f"--map {item!r} is not COLUMN=FIELD (e.g. --map Zeit=time).")
+        mapping[column.strip()] = field.strip()
+    return mapping
 
 
 def read_log(

@@ -8,8 +8,8 @@ import pytest
 from bagbuilder import at
 
 from robotale.errors import InputError
-from robotale.ingest import schema
-from robotale.ingest.enrich import (
+from robotale.eventlog import schema
+from robotale.eventlog.enrich import (
     BATTERY,
     ODOM,
     Perspective,

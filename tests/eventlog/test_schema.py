@@ -1,6 +1,6 @@
 import pandas as pd
 
-from robotale.ingest import schema
+from robotale.eventlog import schema
 
 
 def test_csv_names_round_trip_keeps_values_and_orders_known_columns_first():

@@ -1,0 +1,6 @@
+"""Every ``robotale`` command's handler, one module per command (group).
+
+A handler takes typed keyword arguments (never an argparse namespace), prints what the user
+asked for and returns the exit status; :mod:`robotale.cli` only declares the arguments and
+calls it. The parts below (``fame_runtime`` ... ``webapp``) never import this package.
+"""

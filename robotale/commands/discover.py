@@ -1,0 +1,110 @@
+"""``robotale discover dfg|ekg|conformance``: process models from an event log."""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+from robotale.commands.logsource import read_event_log, values
+from robotale.discovery.conformance import check_conformance
+from robotale.discovery.dfg import discover_dfg
+from robotale.discovery.ekg import discover_ekg
+from robotale.discovery.filters import LogFilter
+from robotale.discovery.graph import ProcessGraph
+from robotale.discovery.output import write_texts
+from robotale.discovery.render import graph_to_svg, require_dot
+
+
+def dfg_command(
+    log: Path | None = None,
+    *,
+    log_name: str | None = None,
+    mapping: Sequence[str] = (),
+    case_column: str | None = None,
+    cases: Sequence[str] | None = None,
+    robots: Sequence[str] | None = None,
+    robot_types: Sequence[str] | None = None,
+    activities: Sequence[str] | None = None,
+    since: str | None = None,
+    until: str | None = None,
+    out: Path | None = None,
+    svg: Path | None = None,
+    labels: str = "frequency",
+) -> int:
+    """The directly-follows graph of a log, filtered; JSON to ``out`` (else printed), SVG."""
+    if svg:
+        require_dot()  # before any work, so a missing Graphviz costs nothing
+    selection = LogFilter(
+        cases=values(cases),
+        robots=values(robots),
+        robot_types=values(robot_types),
+        activities=values(activities),
+        start=since,
+        end=until,
+    )
+    events = read_event_log(log, log_name=log_name, mapping=mapping, case_column=case_column)
+    return emit_graph(discover_dfg(events, selection), out=out, svg=svg, labels=labels)
+
+
+def ekg_command(
+    log_name: str,
+    *,
+    aggregate: str | None = None,
+    entities: str | None = None,
+    out: Path | None = None,
+    svg: Path | None = None,
+    labels: str = "frequency",
+) -> int:
+    """The class graph Neo4j aggregates for the stored log ``log_name``."""
+    if svg:
+        require_dot()
+    types = values([entities]) if entities else None
+    graph = discover_ekg(log_name, aggregate, types)
+    return emit_graph(graph, out=out, svg=svg, labels=labels)
+
+
+def conformance_command(
+    log: Path | None = None,
+    *,
+    model: Path,
+    library: Path | None = None,
+    json_out: Path | None = None,
+    log_name: str | None = None,
+    mapping: Sequence[str] = (),
+    case_column: str | None = None,
+) -> int:
+    """Each robot's runs replayed against its pool of the BPMN collaboration ``model``."""
+    events = read_event_log(log, log_name=log_name, mapping=mapping, case_column=case_column)
+    report = check_conformance(events, model, library=library)
+    if json_out:
+        write_texts([(json_out, json.dumps(report.to_dict(), indent=2))])
+    print(report.robots.to_string(index=False, float_format=lambda v: f"{v:.3f}"))
+    if report.deviations.empty:
+        print("No deviations: every robot did what its process allows.")
+    else:
+        print("\nDeviations:")
+        print(report.deviations.to_string(index=False))
+    if not report.outside.empty:
+        print("\nMessages the processes do not model (sent or received by skills), not replayed:")
+        print(report.outside.to_string(index=False))
+    return 0
+
+
+def emit_graph(
+    graph: ProcessGraph, *, out: Path | None, svg: Path | None, labels: str = "frequency"
+) -> int:
+    """Write the graph as JSON (``out``, else to standard output) and SVG (``svg``)."""
+    outputs = []
+    if out:
+        outputs.append((out, graph.to_json()))
+    if svg:
+        outputs.append((svg, graph_to_svg(graph, labels=labels)))
+    write_texts(outputs)
+    if not out:
+        print(graph.to_json())
+        return 0
+    activities = sum(1 for node in graph.nodes if node.kind == "activity")
+    written = " and ".join(str(path) for path, _ in outputs)
+    print(f"{graph.kind.upper()}: {activities} activities, {len(graph.edges)} edges -> {written}")
+    return 0

@@ -1,0 +1,128 @@
+"""``robotale ingest`` (an event log or recordings into the graph) and ``robotale logs``."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from robotale.commands.prepare import prepare_recordings
+from robotale.ekg.build import BuildSummary, build_ekg
+from robotale.ekg.connection import session_driver
+from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
+from robotale.errors import InputError
+from robotale.eventlog.readers import parse_mapping, read_log
+
+
+def ingest_command(
+    path: Path,
+    *,
+    log: str | None = None,
+    entities: str | None = None,
+    aggregate: Sequence[str] | None = None,
+    mapping: Sequence[str] = (),
+    case: str | None = None,
+    replace: bool = False,
+    tags: str | None = None,
+    tag_fields: Sequence[str] = (),
+    perspectives: str | None = None,
+    rate: float | None = None,
+    msg_files: Sequence[str] = (),
+    bag_time: bool = False,
+) -> int:
+    """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
+    Neo4j as ``log`` (default: the file's or folder's name)."""
+    if path.is_dir():
+        if mapping or case:
+            raise InputError(
+                f"{path} holds recordings: --map and --case apply to CSV and XES files "
+                "(each run of a recording is its own case)."
+            )
+        events = prepare_recordings(
+            path,
+            tags=tags,
+            tag_fields=tag_fields,
+            perspectives=perspectives,
+            rate=rate,
+            msg_files=msg_files,
+            bag_time=bag_time,
+        )
+    else:
+        events = read_log(path, parse_mapping(mapping), case)
+    with session_driver() as driver:
+        summary = build_ekg(
+            driver,
+            events,
+            log or log_name(path),
+            entities=split_names(entities) if entities else None,
+            aggregate=aggregate or ["activity"],
+            replace=replace,
+            source=str(path),
+        )
+    print(describe(summary))
+    return 0
+
+
+def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> None:
+    """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
+    with session_driver() as driver:
+        summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
+    print(describe(summary))
+
+
+def log_name(path: Path) -> str:
+    """A log's default name: the file's stem, or the folder's name (also for ``.``)."""
+    return path.resolve().name if path.is_dir() else path.stem
+
+
+def logs_list() -> int:
+    with session_driver() as driver:
+        logs = list_logs(driver)
+    if not logs:
+        print("No event logs in Neo4j yet: load one with `robotale ingest FILE`.")
+    for log in logs:
+        events = f"{log['events']:,} events" if log["events"] is not None else "no events yet"
+        print(
+            f"{log['name']}  [{log['status']}]  {events}  "
+            f"entities: {', '.join(log['entityTypes'] or []) or '-'}  "
+            f"classes: {', '.join(log['classTypes'] or []) or '-'}  created {log['created']}"
+        )
+    return 0
+
+
+def logs_show(name: str) -> int:
+    with session_driver() as driver:
+        summary = log_summary(driver, name)
+    print(f"{summary['name']}  [{summary['status']}]  from {summary['source'] or '-'}")
+    for what, count in summary["counts"].items():
+        print(f"  {what:<40} {count:>10,}")
+    return 0
+
+
+def logs_delete(name: str) -> int:
+    with session_driver() as driver:
+        if not log_exists(driver, name):
+            raise InputError(f"There is no log named {name!r} in Neo4j.")
+        delete_log(driver, name)
+    print(f"Deleted the log {name!r}.")
+    return 0
+
+
+def split_names(text: str) -> list[str]:
+    return [name.strip() for name in text.split(",") if name.strip()]
+
+
+def describe(summary: BuildSummary) -> str:
+    def counts(values: dict[str, int]) -> str:
+        return ", ".join(f"{k} {v:,}" for k, v in sorted(values.items())) or "-"
+
+    return "\n".join(
+        [
+            f"Log {summary.log!r}: {summary.events:,} events in {summary.seconds:.1f} s",
+            f"  entities  {counts(summary.entities)} (CORR {summary.corr:,})",
+            f"  DF        {counts(summary.df)}",
+            f"  COMM      {summary.comm:,}",
+            f"  DF_C      {counts(summary.df_c)}",
+        ]
+    )

@@ -1,0 +1,33 @@
+"""The event log a ``discover`` or ``perspectives`` command reads: a file or a stored log."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+import pandas as pd
+
+from robotale.discovery.ekg import read_stored_log
+from robotale.errors import InputError
+from robotale.eventlog.readers import parse_mapping, read_log
+
+
+def read_event_log(
+    log: Path | None = None,
+    *,
+    log_name: str | None = None,
+    mapping: Sequence[str] = (),
+    case_column: str | None = None,
+) -> pd.DataFrame:
+    """A CSV/XES file (``log``, read with the ``--map`` items and ``case_column``) or, with
+    ``log_name``, a log stored in Neo4j."""
+    if log_name:
+        return read_stored_log(log_name)
+    if not log:
+        raise InputError("name an event log: a CSV or XES file, or --log NAME for a stored one.")
+    return read_log(log, mapping=parse_mapping(mapping), case=case_column)
+
+
+def values(lists: Sequence[str] | None) -> tuple[str, ...]:
+    """Repeated and comma-separated option values as one tuple."""
+    return tuple(v.strip() for item in lists or [] for v in item.split(",") if v.strip())

@@ -1,0 +1,55 @@
+"""``robotale perspectives``: spatial, communication, battery and performance perspectives."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from robotale.commands.logsource import read_event_log
+from robotale.enhancement.report import all_perspectives, write_report
+from robotale.enhancement.spatial import Field
+from robotale.errors import InputError
+
+
+def perspectives_command(
+    log: Path | None = None,
+    *,
+    log_name: str | None = None,
+    mapping: Sequence[str] = (),
+    case_column: str | None = None,
+    out: Path | None = None,
+    json_out: Path | None = None,
+    activity: str | None = None,
+    robot: str | None = None,
+    field: str | None = None,
+    threshold: float | None = None,
+) -> int:
+    """The perspectives of a log (a file or ``log_name``) as HTML (``out``) and/or JSON."""
+    if not out and not json_out:
+        raise InputError("say where the report goes: --out report.html and/or --json report.json.")
+    area = Field.parse(field) if field else None
+    events = read_event_log(log, log_name=log_name, mapping=mapping, case_column=case_column)
+    options = {} if threshold is None else {"threshold": threshold}
+    results = all_perspectives(events, activity=activity, robot=robot, field=area, **options)
+    title = f"robotale perspectives: {log_name or Path(log or '').name}"
+    write_report(results, html_path=out, json_path=json_out, title=title)
+    for name, result in results.items():
+        print(f"{name:>13}: {result.message or _headline(name, result.summary)}")
+    return 0
+
+
+def _headline(name: str, summary: dict) -> str:
+    if name == "spatial":
+        covered = summary.get("field", {}).get("covered_fraction")
+        field = f", {covered:.0%} of the field covered" if covered is not None else ""
+        return f"{summary['positions']} positions{field}"
+    if name == "communication":
+        return (
+            f"{summary['messages']} messages, {summary['received']} received, "
+            f"{summary['lost']} lost, {summary['resends']} resends"
+        )
+    if name == "battery":
+        return f"{summary['low_battery_events']} low-battery events"
+    if name == "performance":
+        return f"{summary['cases']} cases, slowest transition {summary['slowest_transition']}"
+    return f"first: {summary['first']}"

@@ -1,0 +1,96 @@
+"""``robotale prepare``: rosbag2 recordings into an event log; also the preparation that
+``ingest`` and ``demo`` run on recordings."""
+
+from __future__ import annotations
+
+import sys
+import warnings
+from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
+
+import pandas as pd
+
+from robotale.eventlog import writers
+from robotale.eventlog.enrich import PreparationWarning
+from robotale.eventlog.prepare import TagFields, find_runs, prepare, run_manifests
+
+
+def prepare_command(
+    source: Path,
+    *,
+    out: Path | None = None,
+    xes: Path | None = None,
+    ocel: Path | None = None,
+    tags: str | None = None,
+    tag_fields: Sequence[str] = (),
+    perspectives: str | None = None,
+    rate: float | None = None,
+    msg_files: Sequence[str] = (),
+    bag_time: bool = False,
+) -> int:
+    """Write the event log of the recordings at ``source`` as CSV (``out``, by default
+    ``<source name>.csv`` when no other output is asked for), XES and/or OCEL 2.0."""
+    csv = out or (None if xes or ocel else Path(f"{source.resolve().name}.csv"))
+    log = prepare_recordings(
+        source,
+        tags=tags,
+        tag_fields=tag_fields,
+        perspectives=perspectives,
+        rate=rate,
+        msg_files=msg_files,
+        bag_time=bag_time,
+    )
+    written = []
+    if csv:
+        writers.write_csv(log, csv)
+        written.append(csv)
+    if xes:
+        writers.write_xes(log, xes, name=source.resolve().name)
+        written.append(xes)
+    if ocel:
+        writers.write_ocel(log, ocel, runs=run_manifests(find_runs(source)))
+        written.append(ocel)
+    cases = log["case:concept:name"].nunique()
+    print(f"{len(log)} events from {cases} run(s) written to {', '.join(map(str, written))}")
+    return 0
+
+
+def prepare_recordings(
+    source: Path,
+    *,
+    tags: str | None = None,
+    tag_fields: Sequence[str] = (),
+    perspectives: str | None = None,
+    rate: float | None = None,
+    msg_files: Sequence[str] = (),
+    bag_time: bool = False,
+) -> pd.DataFrame:
+    """The event log of the recordings at ``source``; an option left ``None`` takes
+    :func:`~robotale.eventlog.prepare.prepare`'s default."""
+    given: dict[str, Any] = {
+        "tags": tags,
+        "perspectives": (
+            None if perspectives is None else [p for p in perspectives.split(",") if p.strip()]
+        ),
+        "rate": rate,
+    }
+    return prepare_reporting(
+        source,
+        tag_fields=TagFields.parse(tag_fields),
+        msg_files=msg_files,
+        bag_time=bag_time,
+        **{key: value for key, value in given.items() if value is not None},
+    )
+
+
+def prepare_reporting(source: Path, **options: Any) -> pd.DataFrame:
+    """:func:`~robotale.eventlog.prepare.prepare` with a progress bar, its warnings (completes
+    without a start ...) on stderr as one ``robotale: warning:`` line each."""
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PreparationWarning)
+        log = prepare(source, progress=True, **options)
+    for warning in caught:
+        if issubclass(warning.category, PreparationWarning):
+            print(f"robotale: warning: {warning.message}", file=sys.stderr)
+    return log

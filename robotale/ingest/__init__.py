@@ -1,2 +1,0 @@
-"""Ingest: event logs from CSV, XES and rosbag2 (TALE preparation) into the canonical
-DataFrame of :mod:`robotale.ingest.schema`, and writers for CSV, XES and OCEL 2.0."""
