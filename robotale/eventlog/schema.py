@@ -23,6 +23,10 @@ ROBOT_TYPE = "robot_type"
 MSG_ID = "msg_id"
 MSG_ROLE = "msg_role"
 MSG_PAYLOAD = "msg_payload"
+#: the robots a message goes from and to, where the log says so (else the robots of its
+#: send and receive events tell)
+MSG_SENDER = "msg_sender"
+MSG_RECEIVER = "msg_receiver"
 EVENT_ID = "event_id"
 #: names one activity instance: the start and the complete event of one execution share it.
 EXECUTION_ID = "execution_id"
@@ -41,6 +45,8 @@ CSV_NAMES: dict[str, str] = {
     MSG_ID: "msg_id",
     MSG_ROLE: "msg_role",
     MSG_PAYLOAD: "msg_payload",
+    MSG_SENDER: "msg_sender",
+    MSG_RECEIVER: "msg_receiver",
     X: "x",
     Y: "y",
     Z: "z",
