@@ -1,4 +1,4 @@
-"""The canonical event log: the contract between ingest, ekg, discovery and enhancement.
+"""The canonical event log: the contract between eventlog, ekg, discovery and enhancement.
 
 An event log is a pandas DataFrame with pm4py's column names, so pm4py functions take it as it
 is. On disk (CSV) the columns carry the short names on the right. ``time:timestamp`` is always
