@@ -94,7 +94,7 @@ class FlowPlan:
 @dataclass(slots=True, eq=False)
 class NodePlan:
     node: Node
-    behaviour: str  # how the engine runs it; see Engine._enter
+    behaviour: str  # how the engine runs it; see Engine._BEHAVIOURS
     label: str
     scope: ScopePlan
     outgoing: list[FlowPlan] = field(default_factory=list)
