@@ -86,8 +86,16 @@ def process_net(
 
 class _Builder:
     def __init__(self, observed, resolve: Resolver) -> None:
+        # pm4py is imported here, when a net is built, not with the module: importing it takes
+        # over 2 s and prints a banner, and whatever imports robotale.discovery (commands, the
+        # dashboard) imports this module. Its parts are kept for the methods below.
         from pm4py.objects.petri_net.obj import Marking, PetriNet
+        from pm4py.objects.petri_net.utils.petri_utils import add_arc_from_to, remove_transition
+        from pm4py.objects.petri_net.utils.reduction import apply_simple_reduction
 
+        self.Place, self.Transition, self.Marking = PetriNet.Place, PetriNet.Transition, Marking
+        self.add_arc, self.remove_transition = add_arc_from_to, remove_transition
+        self.reduce = apply_simple_reduction
         self.net = PetriNet("process")
         self.initial = Marking()
         self.observed = set(observed)
@@ -97,10 +105,6 @@ class _Builder:
         self.cancellations: list[tuple[list, Any, list]] = []  # drained after reduction
 
     def build(self, process):
-        from pm4py.objects.petri_net.obj import Marking
-        from pm4py.objects.petri_net.utils.petri_utils import remove_transition
-        from pm4py.objects.petri_net.utils.reduction import apply_simple_reduction
-
         self.scope(process, _Scope(done=None), entry=None)
         # Silent steps that only pass a token on are merged away: every silent step is a
         # state more for the alignment search, and the language stays the same. Drains come
@@ -111,33 +115,28 @@ class _Builder:
             for _, _, after in self.cancellations
             for place in after
         ]
-        apply_simple_reduction(self.net)
+        self.reduce(self.net)
         for hold in holds:
-            remove_transition(self.net, hold)
+            self.remove_transition(self.net, hold)
         for places, signal, after in self.cancellations:
             self.drain([p for p in places if p in self.net.places], signal, after)
-        return self.net, self.initial, Marking()
+        return self.net, self.initial, self.Marking()
 
     # -- places, transitions, arcs -------------------------------------------------------------
 
     def place(self, scope: _Scope, name: str):
-        from pm4py.objects.petri_net.obj import PetriNet
-
-        place = PetriNet.Place(f"{name}#{next(self.counter)}")
+        place = self.Place(f"{name}#{next(self.counter)}")
         self.net.places.add(place)
         scope.places.append(place)
         return place
 
     def transition(self, name: str, label: str | None, inputs=(), outputs=()):
-        from pm4py.objects.petri_net.obj import PetriNet
-        from pm4py.objects.petri_net.utils.petri_utils import add_arc_from_to
-
-        transition = PetriNet.Transition(f"{name}#{next(self.counter)}", label)
+        transition = self.Transition(f"{name}#{next(self.counter)}", label)
         self.net.transitions.add(transition)
         for place in inputs:
-            add_arc_from_to(place, transition, self.net)
+            self.add_arc(place, transition, self.net)
         for place in outputs:
-            add_arc_from_to(transition, place, self.net)
+            self.add_arc(transition, place, self.net)
         return transition
 
     # -- scopes ----------------------------------------------------------------------------------
