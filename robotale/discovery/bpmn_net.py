@@ -1,9 +1,10 @@
 """A robot's BPMN process as a Petri net whose labels are the activities its tags carry.
 
-Labels follow the engine's tags: an activity is tagged with ``activity_label(name, id)``, a
-signal throw with ``<signal>!`` and a catch with ``<signal>?``, an error with its name. Events
-of other kinds (timers, conditions, none events) are tagged by some sources and not by others,
-so they are visible only when the robot's log contains their label; otherwise they are silent.
+Labels are the engine's tags (:func:`robotale.fame_runtime.labels.element_label`): an activity
+is tagged with its name, a signal throw with ``<signal>!`` and a catch with ``<signal>?``, an
+error with its name. Events of other kinds (timers, conditions, none events) are tagged by
+some sources and not by others, so they are visible only when the robot's log contains their
+label; otherwise they are silent.
 
 The translation follows BPMN's token semantics where a place/transition net can:
 
@@ -34,7 +35,7 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
-from robotale.fame_runtime.tags import activity_label
+from robotale.fame_runtime.labels import element_label
 
 ACTIVITY_KINDS = frozenset(
     {
@@ -73,36 +74,37 @@ def process_net(
     process: Any,
     observed: set[str] | frozenset[str] = frozenset(),
     resolve: Resolver | None = None,
-    signal_name: Callable[[Any], str] | None = None,
 ) -> tuple[Any, Any, Any]:
     """The Petri net, initial marking and (empty) final marking of ``process``.
 
     ``observed`` are the activity labels in the robot's log (they decide which events are
-    visible); ``resolve`` finds the process a call activity calls; ``signal_name`` names a
-    signal event's topic (by default its name without ``!``/``?``, else its signal's name).
+    visible); ``resolve`` finds the process a call activity calls.
     """
-    builder = _Builder(observed, resolve or (lambda _name: None), signal_name or _signal_name)
+    builder = _Builder(observed, resolve or (lambda _name: None))
     return builder.build(process)
 
 
 class _Builder:
-    def __init__(self, observed, resolve: Resolver, signal_name: Callable[[Any], str]) -> None:
+    def __init__(self, observed, resolve: Resolver) -> None:
+        # pm4py is imported here, when a net is built, not with the module: importing it takes
+        # over 2 s and prints a banner, and whatever imports robotale.discovery (commands, the
+        # dashboard) imports this module. Its parts are kept for the methods below.
         from pm4py.objects.petri_net.obj import Marking, PetriNet
+        from pm4py.objects.petri_net.utils.petri_utils import add_arc_from_to, remove_transition
+        from pm4py.objects.petri_net.utils.reduction import apply_simple_reduction
 
+        self.Place, self.Transition, self.Marking = PetriNet.Place, PetriNet.Transition, Marking
+        self.add_arc, self.remove_transition = add_arc_from_to, remove_transition
+        self.reduce = apply_simple_reduction
         self.net = PetriNet("process")
         self.initial = Marking()
         self.observed = set(observed)
         self.resolve = resolve
-        self.signal_name = signal_name
         self.counter = itertools.count()
         self.calling: list[str] = []  # call activities being expanded (stops recursion)
         self.cancellations: list[tuple[list, Any, list]] = []  # drained after reduction
 
     def build(self, process):
-        from pm4py.objects.petri_net.obj import Marking
-        from pm4py.objects.petri_net.utils.petri_utils import remove_transition
-        from pm4py.objects.petri_net.utils.reduction import apply_simple_reduction
-
         self.scope(process, _Scope(done=None), entry=None)
         # Silent steps that only pass a token on are merged away: every silent step is a
         # state more for the alignment search, and the language stays the same. Drains come
@@ -113,33 +115,28 @@ class _Builder:
             for _, _, after in self.cancellations
             for place in after
         ]
-        apply_simple_reduction(self.net)
+        self.reduce(self.net)
         for hold in holds:
-            remove_transition(self.net, hold)
+            self.remove_transition(self.net, hold)
         for places, signal, after in self.cancellations:
             self.drain([p for p in places if p in self.net.places], signal, after)
-        return self.net, self.initial, Marking()
+        return self.net, self.initial, self.Marking()
 
     # -- places, transitions, arcs -------------------------------------------------------------
 
     def place(self, scope: _Scope, name: str):
-        from pm4py.objects.petri_net.obj import PetriNet
-
-        place = PetriNet.Place(f"{name}#{next(self.counter)}")
+        place = self.Place(f"{name}#{next(self.counter)}")
         self.net.places.add(place)
         scope.places.append(place)
         return place
 
     def transition(self, name: str, label: str | None, inputs=(), outputs=()):
-        from pm4py.objects.petri_net.obj import PetriNet
-        from pm4py.objects.petri_net.utils.petri_utils import add_arc_from_to
-
-        transition = PetriNet.Transition(f"{name}#{next(self.counter)}", label)
+        transition = self.Transition(f"{name}#{next(self.counter)}", label)
         self.net.transitions.add(transition)
         for place in inputs:
-            add_arc_from_to(place, transition, self.net)
+            self.add_arc(place, transition, self.net)
         for place in outputs:
-            add_arc_from_to(transition, place, self.net)
+            self.add_arc(transition, place, self.net)
         return transition
 
     # -- scopes ----------------------------------------------------------------------------------
@@ -189,7 +186,7 @@ class _Builder:
         for start in (n for n in node.scope.nodes.values() if n.kind == "startEvent"):
             entries[start.id] = self.place(inner, f"triggered_{start.id}")
             cancels = [self.cancel(parent)] if start.interrupting else []
-            label = activity_label(node.name, node.id)
+            label = element_label(node)
             self.transition(f"esp_{node.id}", label, [], [entries[start.id], *cancels])
         self.scope(node.scope, inner, entry=None, entries=entries)
 
@@ -228,7 +225,7 @@ class _Builder:
             # a triggered process start: one more instance each time its trigger fires. It
             # stays visible even if never tagged: a silent transition that can always fire
             # would let the alignment search wander without end.
-            label = label or activity_label(node.name, node.id)
+            label = label or element_label(node)
             self.transition(f"start_{node.id}", label, [], outs)
 
     def end(self, node, scope: _Scope, ins) -> None:
@@ -242,7 +239,7 @@ class _Builder:
     def activity(self, node, scope: _Scope, ready, boundaries):
         """The activity's own visible transition, its content (sub-process, resolved call) and
         its boundary events; returns the place holding the token once it is done."""
-        label = activity_label(node.name, node.id)
+        label = element_label(node)
         done = self.place(scope, f"done_{node.id}")
         content = self.content(node)
         if content is None:
@@ -319,15 +316,11 @@ class _Builder:
         self.transition("drained", None, [signal], after)
 
     def event_label(self, node) -> str | None:
-        kind = node.event_kind
-        if kind == "signal":
-            catching = node.kind in ("startEvent", "intermediateCatchEvent", "boundaryEvent")
-            return activity_label(f"{self.signal_name(node)}{'?' if catching else '!'}", node.id)
-        if kind == "error":
-            event = node.event
-            return activity_label((event.ref_name if event else "") or node.name, node.id)
-        label = activity_label(node.name, node.id)
-        return label if label in self.observed else None
+        """Signal and error events are always visible; other events only when tagged."""
+        label = element_label(node)
+        if node.event_kind in ("signal", "error") or label in self.observed:
+            return label
+        return None
 
 
 _EVENT_AND_GATEWAY_KINDS = frozenset(
@@ -342,12 +335,6 @@ _EVENT_AND_GATEWAY_KINDS = frozenset(
         *SUBSET_GATEWAYS,
     }
 )
-
-
-def _signal_name(node) -> str:
-    event = node.event
-    name = (node.name or (event.ref_name if event else "")).strip().rstrip("!?")
-    return "_".join(name.split())
 
 
 def _by(items, attribute: str) -> dict[str, list]:

@@ -203,7 +203,6 @@ def check_conformance(
     """
     from robotale.fame_runtime.library import Library, find_process
     from robotale.fame_runtime.parser import parse
-    from robotale.fame_runtime.plan import signal_name
 
     if ROBOT not in log.columns:
         raise InputError("conformance needs the robot of every event; the log has no robot column.")
@@ -218,7 +217,7 @@ def check_conformance(
     models = {}
     for assignment in assignments:
         observed = set(traces.loc[traces[ROBOT] == assignment.robot, ACTIVITY])
-        net = process_net(assignment.process, observed, resolve, signal_name)
+        net = process_net(assignment.process, observed, resolve)
         models[assignment.robot] = RobotModel(assignment.robot_type, *net)
     outside = _outside_the_models(traces, models)
     report = replay(traces[~outside], models, seconds_per_trace=seconds_per_trace)

@@ -13,13 +13,11 @@ from collections import defaultdict
 from collections.abc import Collection
 from dataclasses import dataclass, field
 
+from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Node, Process
-from robotale.fame_runtime.plan import problems, signal_topic
+from robotale.fame_runtime.plan import problems
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, incompatibilities
-
-_CATCHING = ("startEvent", "intermediateCatchEvent", "boundaryEvent")
-_THROWING = ("intermediateThrowEvent", "endEvent")
 
 
 @dataclass(frozen=True, slots=True)
@@ -78,9 +76,9 @@ def check(
         ]
         for node, owner in _signal_events(process, skills, library):
             endpoint = _endpoint(pool.name, owner, node)
-            if node.kind in _THROWING:
+            if node.kind in THROWING:
                 publishers[endpoint.topic].append(endpoint)
-            elif node.kind in _CATCHING:
+            elif catches(node):
                 subscribers[endpoint.topic].append(endpoint)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [

@@ -17,7 +17,7 @@ import types
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Bus, Envelope
@@ -34,6 +34,10 @@ from robotale.fame_runtime.triggers import Triggers
 
 #: steps one engine may take without its clock moving on: more means a loop with no wait
 MAX_STEPS = 1_000_000
+
+#: runs a token at a node (engine, token, node) and returns where it goes next (None: it waits
+#: or is gone)
+Behaviour = Callable[["Engine", "_Token", NodePlan], "NodePlan | None"]
 
 #: values a script leaves behind that are not variables (``import math``, functions it defines)
 _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
@@ -119,11 +123,6 @@ class Engine:
         self._inclusive: set[_Scope] = set()
         self._when_idle: list[Callable[[], Any]] = []
         self._starting = 0  # none-start instances scheduled but not begun
-        self._behaviours = {
-            name.removeprefix("_run_"): getattr(self, name)
-            for name in dir(self)
-            if name.startswith("_run_")
-        }
         self.started = False
         self.stopped = False
         self.completed = 0  # process instances that ended
@@ -255,6 +254,7 @@ class Engine:
 
     def _advance(self, token: _Token, node: NodePlan | None) -> None:
         """Move ``token`` from ``node`` on until it has to wait."""
+        behaviours = self._BEHAVIOURS  # a local: this loop is the engine's hot path
         while node is not None and token.alive:
             token.node = node
             self._steps += 1
@@ -263,7 +263,7 @@ class Engine:
                     f"robot {self.robot.name}: {node.node.kind} {node.node.describe()} is in a "
                     f"loop that ran {MAX_STEPS} steps without waiting for anything"
                 )
-            node = self._behaviours[node.behaviour](token, node)
+            node = behaviours[node.behaviour](self, token, node)
 
     # -- tokens and scopes ---------------------------------------------------------------------
 
@@ -493,8 +493,6 @@ class Engine:
             self._close(child)
         return None
 
-    _run_subprocess = _run_call
-
     def _activity_done(self, token: _Token, outputs: Mapping[str, Any] | None = None) -> None:
         """A waiting activity (skill, call, sub-process, event sub-process) completed."""
         node = token.node
@@ -534,7 +532,7 @@ class Engine:
         token.node = node
         self._go_on(token, node)
 
-    def _run_exclusiveGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+    def _run_exclusive_gateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
         return self._split(token, node, first=True)
 
     def _split(self, token: _Token, node: NodePlan, *, first: bool) -> NodePlan | None:
@@ -547,19 +545,19 @@ class Engine:
             )
         return self._follow(token, flows)
 
-    def _run_parallelGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+    def _run_parallel_gateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
         if len(node.incoming) > 1 and not self._joined(token, node):
             return None
         return self._follow(token, list(node.outgoing))
 
-    def _run_inclusiveGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+    def _run_inclusive_gateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
         if len(node.incoming) > 1:
             token.scope.joins.setdefault(node.id, []).append(token)
             self._inclusive.add(token.scope)
             return None
         return self._split(token, node, first=False)
 
-    def _run_eventBasedGateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
+    def _run_event_based_gateway(self, token: _Token, node: NodePlan) -> NodePlan | None:
         for flow in node.outgoing:
             target = flow.target
             if target.trigger is not None:
@@ -618,6 +616,26 @@ class Engine:
 
     def _run_event_subprocess(self, token: _Token, node: NodePlan) -> NodePlan | None:
         return None  # never entered by a sequence flow; _event_subprocess starts it
+
+    #: how a node runs, by the behaviour the deployer gave it (``NodePlan.behaviour``)
+    _BEHAVIOURS: ClassVar[dict[str, Behaviour]] = {
+        "start": _run_start,
+        "catch": _run_catch,
+        "boundary": _run_boundary,
+        "pass": _run_pass,
+        "end": _run_end,
+        "terminate": _run_terminate,
+        "task": _run_task,
+        "script": _run_script,
+        "skill": _run_skill,
+        "call": _run_call,
+        "subprocess": _run_call,  # its content runs like a called process
+        "event_subprocess": _run_event_subprocess,
+        "exclusiveGateway": _run_exclusive_gateway,
+        "parallelGateway": _run_parallel_gateway,
+        "inclusiveGateway": _run_inclusive_gateway,
+        "eventBasedGateway": _run_event_based_gateway,
+    }
 
     # -- boundary events and event sub-processes -----------------------------------------------
 

@@ -183,9 +183,9 @@ class _Reader:
             elif kind == "dataObjectReference":
                 data_object = self.data_object(child, element)
                 process.data_objects[data_object.id] = data_object
-        self.check_flows(scope, element)
+        self.check_flows(scope)
 
-    def check_flows(self, scope: Scope, element: etree._Element) -> None:
+    def check_flows(self, scope: Scope) -> None:
         for flow in scope.flows.values():
             for end, ref in (("source", flow.source), ("target", flow.target)):
                 if ref not in scope.nodes:
@@ -224,7 +224,7 @@ class _Reader:
             triggered_by_event=element.get("triggeredByEvent") == "true",
         )
         node.events = [self.event_definition(d, node) for d in element if _is_definition(d)]
-        self.data_associations(element, node, process)
+        self.data_associations(element, node)
         self.markers(element, node)
         extensions = _Extensions(element.find(f"{_B}extensionElements"))
         node.inputs, node.outputs = extensions.inputs, extensions.outputs
@@ -246,7 +246,7 @@ class _Reader:
         if element.get("isForCompensation") == "true":
             node.quirks.append("is a compensation activity")
 
-    def data_associations(self, element: etree._Element, node: Node, process: Process) -> None:
+    def data_associations(self, element: etree._Element, node: Node) -> None:
         for assoc in _bpmn_children(element, "dataInputAssociation"):
             node.data_inputs += [_text(r) for r in _bpmn_children(assoc, "sourceRef")]
         for assoc in _bpmn_children(element, "dataOutputAssociation"):

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
+from robotale.fame_runtime.labels import catches, element_label, error_name, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import DataObject, Node, Process, RosMessage, Scope
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
-from robotale.fame_runtime.tags import activity_label
 from robotale.fame_runtime.timers import TimerSpec
 
 EMPTY_MSGTYPE = "std_msgs/msg/Empty"
@@ -94,7 +94,7 @@ class FlowPlan:
 @dataclass(slots=True, eq=False)
 class NodePlan:
     node: Node
-    behaviour: str  # how the engine runs it; see Engine._enter
+    behaviour: str  # how the engine runs it; see Engine._BEHAVIOURS
     label: str
     scope: ScopePlan
     outgoing: list[FlowPlan] = field(default_factory=list)
@@ -153,26 +153,6 @@ def problems(
     planner = _Planner(skills, library)
     planner.process(process, top=True)
     return planner.problems
-
-
-def signal_name(node: Node) -> str:
-    """The topic name of a signal event: the event's name (the thesis correlates by it), else
-    the referenced signal's; without the thesis' ``!``/``?`` suffix."""
-    name = (node.name or (node.event.ref_name if node.event else "")).strip().rstrip("!?")
-    return "_".join(name.split())
-
-
-def signal_topic(node: Node) -> str:
-    name = signal_name(node)
-    return name if name.startswith("/") or not name else f"/{name}"
-
-
-def error_name(node: Node) -> str:
-    """The error an error event throws or catches ("" catches any): the referenced error's
-    name, else the event's name."""
-    event = node.event
-    name = (event.ref_name if event else "") or node.name
-    return "_".join(name.strip().split())
 
 
 def reachable_flows(node: NodePlan) -> frozenset[str]:
@@ -267,7 +247,7 @@ class _Planner:
 
     def node(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
-        plan.label = activity_label(node.name, node.id)
+        plan.label = element_label(node)
         plan.data_inputs = [scope.process.data_objects[r] for r in node.data_inputs]
         plan.data_outputs = [scope.process.data_objects[r] for r in node.data_outputs]
         for quirk in node.quirks:
@@ -345,7 +325,7 @@ class _Planner:
                 node, f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run{hint}"
             )
             return
-        if node.kind in ("startEvent", "intermediateCatchEvent", "boundaryEvent"):
+        if catches(node):
             self.catching(plan, scope)
         else:
             self.throwing(plan)
@@ -378,11 +358,10 @@ class _Planner:
             topic = signal_topic(node)
             if not topic:
                 self.refuse(node, "names no signal (give the event or its signal a name)")
-            label = activity_label(f"{signal_name(node)}?", node.id)
-            return Trigger("signal", label, topic, message.msgtype, message.qos)
+            return Trigger("signal", plan.label, topic, message.msgtype, message.qos)
         if kind == "error":
             name = error_name(node)
-            return Trigger("error", activity_label(name, node.id), name, EMPTY_MSGTYPE, message.qos)
+            return Trigger("error", plan.label, name, EMPTY_MSGTYPE, message.qos)
         if kind == "timer":
             timer = node.event.timer if node.event else None
             if timer is None:
@@ -415,8 +394,6 @@ class _Planner:
             if not topic:
                 self.refuse(node, "names no signal (give the event or its signal a name)")
             msgtype = message.msgtype or EMPTY_MSGTYPE
-            label = activity_label(f"{signal_name(node)}!", node.id)
-            plan.throw = Throw("signal", label, topic, msgtype, message.payload, message.qos)
+            plan.throw = Throw("signal", plan.label, topic, msgtype, message.payload, message.qos)
         elif kind == "error":
-            name = error_name(node)
-            plan.throw = Throw("error", activity_label(name, node.id), name)
+            plan.throw = Throw("error", plan.label, error_name(node))

@@ -54,8 +54,9 @@ def policy_name(name: str) -> str | None:
     return key if key in POLICIES else None
 
 
-def qos_from_policies(policies: Mapping[str, str], base: QoS = DEFAULT_QOS) -> QoS:
-    """A profile from ``name -> value`` text as written in a model; ValueError names a bad one.
+def qos_from_policies(policies: Mapping[str, str]) -> QoS:
+    """A profile from ``name -> value`` text as written in a model, the ROS defaults for the
+    policies it leaves out; ValueError names a bad one.
 
     Values are case and spacing tolerant (``Best Effort``); durations are seconds or ISO 8601
     (``PT2S``); ``infinite`` or an empty value keeps the ROS default.
@@ -66,7 +67,7 @@ def qos_from_policies(policies: Mapping[str, str], base: QoS = DEFAULT_QOS) -> Q
         if key is None:
             raise ValueError(f"{name!r} is not a QoS policy ({', '.join(POLICIES)})")
         fields[key] = _policy_value(key, text)
-    return replace(base, **fields)
+    return replace(DEFAULT_QOS, **fields)
 
 
 def _policy_value(key: str, text: str) -> object:

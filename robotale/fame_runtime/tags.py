@@ -9,7 +9,6 @@ adds it to a rosbags type store so bags can be written and read without a ROS in
 from __future__ import annotations
 
 import json
-import re
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -48,21 +47,6 @@ class Tag:
 
 #: where engines deliver tags: a recorder, a list's ``append``, a printer ...
 TagSink = Callable[[Tag], None]
-
-
-def activity_label(name: str | None, element_id: str = "") -> str:
-    """The activity name a BPMN element is tagged with (and looked up by in conformance).
-
-    Lower snake case of the element's name, camel case split and the message suffix kept:
-    ``Take Off`` -> ``take_off``, ``ReturnToBase`` -> ``return_to_base``, ``weed_position!``
-    stays. An element without a name is tagged with its id.
-    """
-    text = (name or "").strip()
-    if not text:
-        return element_id
-    suffix = text[-1] if text[-1] in "!?" else ""
-    words = re.sub(r"([a-z0-9])([A-Z])", r"\1_\2", text.rstrip("!?"))
-    return re.sub(r"[^0-9a-zA-Z]+", "_", words).strip("_").lower() + suffix
 
 
 class Tagger:
@@ -115,6 +99,8 @@ def bus_sink(bus) -> TagSink:
 
 def register_tag_type(typestore) -> None:
     """Add ``robotale_msgs/msg/Tag`` to a rosbags type store (idempotent)."""
+    # rosbags is imported here, by those who read or write bags, not with the module: every
+    # engine imports this module, and rosbags would add a fifth (about 30 ms) to its import
     from rosbags.typesys import get_types_from_msg
 
     if TAG_TYPE not in typestore.fielddefs:

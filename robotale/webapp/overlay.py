@@ -18,21 +18,8 @@ import pandas as pd
 
 from robotale.errors import InputError, ModelError
 from robotale.eventlog.schema import ACTIVITY, ROBOT
+from robotale.fame_runtime.labels import element_label
 from robotale.fame_runtime.model import Node
-from robotale.fame_runtime.plan import error_name, signal_name
-from robotale.fame_runtime.tags import activity_label
-
-_CATCHING = ("startEvent", "intermediateCatchEvent", "boundaryEvent")
-
-
-def element_label(node: Node) -> str:
-    """The activity the engine tags ``node`` with (as :mod:`robotale.fame_runtime.plan` does)."""
-    if node.event_kind == "signal":
-        suffix = "?" if node.kind in _CATCHING else "!"
-        return activity_label(f"{signal_name(node)}{suffix}", node.id)
-    if node.event_kind == "error":
-        return activity_label(error_name(node), node.id)
-    return activity_label(node.name, node.id)
 
 
 def frequencies(log: pd.DataFrame, model: Path) -> dict[str, dict[str, Any]]:

@@ -11,7 +11,6 @@ from robotale.errors import InputError
 from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT
 from robotale.fame_runtime.library import Library, find_process
 from robotale.fame_runtime.parser import parse
-from robotale.fame_runtime.plan import signal_name
 
 MODEL = Path(__file__).parent / "models" / "scout_workers.bpmn"
 
@@ -87,7 +86,7 @@ def test_every_thesis_model_becomes_a_net(fame_models):
             def resolve(name, definitions=definitions):
                 return find_process(definitions, name) or library.find(name)
 
-            net, _, _ = process_net(process, set(), resolve, signal_name)
+            net, _, _ = process_net(process, set(), resolve)
             assert net.transitions, f"{path.name}: pool {pool.name} has no transition"
 
 
@@ -96,7 +95,7 @@ def test_agricultural_pools_carry_the_message_labels(fame_models):
     library = Library(fame_models / "fame-ros")
     labels = {}
     for pool, process in definitions.pools():
-        net, _, _ = process_net(process, set(), library.find, signal_name)
+        net, _, _ = process_net(process, set(), library.find)
         labels[pool.name] = {t.label for t in net.transitions if t.label}
     assert {"weed_position!", "tractor_position?", "closest_tractor!", "weed_found?"} <= labels[
         "Drone"

@@ -1,0 +1,78 @@
+"""What a BPMN element is called in a log: the one place that decides it.
+
+The engine tags every element it runs with :func:`element_label`; conformance labels its
+Petri net transitions with it and the Model page finds elements in a log by it, so a log made
+by the engines and the model always agree. The facts the label is made of live here too:
+which element kinds catch (:data:`CATCHING`) and throw (:data:`THROWING`), the topic a signal
+event uses (:func:`signal_name`, :func:`signal_topic`) and the error an error event names
+(:func:`error_name`).
+"""
+
+from __future__ import annotations
+
+import re
+
+from robotale.fame_runtime.model import Node
+
+#: element kinds whose event definition waits for something (a signal catch is a subscriber)
+CATCHING = frozenset({"startEvent", "intermediateCatchEvent", "boundaryEvent"})
+#: element kinds whose event definition is thrown (a signal throw is a publisher)
+THROWING = frozenset({"intermediateThrowEvent", "endEvent"})
+
+#: how a message event's label ends, as in the thesis' logs: ``!`` sends, ``?`` receives
+SEND, RECEIVE = "!", "?"
+
+_CAMEL = re.compile(r"([a-z0-9])([A-Z])")
+_NOT_WORD = re.compile(r"[^0-9a-zA-Z]+")
+
+
+def activity_label(name: str | None, element_id: str = "") -> str:
+    """The activity a name is tagged as (and looked up by in conformance).
+
+    Lower snake case of the name, camel case split and the message suffix kept:
+    ``Take Off`` -> ``take_off``, ``ReturnToBase`` -> ``return_to_base``, ``weed_position!``
+    stays. An element without a name is tagged with its id.
+    """
+    text = (name or "").strip()
+    if not text:
+        return element_id
+    suffix = text[-1] if text[-1] in SEND + RECEIVE else ""
+    words = _CAMEL.sub(r"\1_\2", text.rstrip(SEND + RECEIVE))
+    return _NOT_WORD.sub("_", words).strip("_").lower() + suffix
+
+
+def catches(node: Node) -> bool:
+    """Whether ``node``'s event definition waits for something rather than being thrown."""
+    return node.kind in CATCHING
+
+
+def signal_name(node: Node) -> str:
+    """The topic name of a signal event: the event's name (the thesis correlates by it), else
+    the referenced signal's; without the thesis' ``!``/``?`` suffix."""
+    name = (node.name or (node.event.ref_name if node.event else "")).strip()
+    return "_".join(name.rstrip(SEND + RECEIVE).split())
+
+
+def signal_topic(node: Node) -> str:
+    """The topic a signal event publishes or subscribes to ("" when it names no signal)."""
+    name = signal_name(node)
+    return name if name.startswith("/") or not name else f"/{name}"
+
+
+def error_name(node: Node) -> str:
+    """The error an error event throws or catches ("" catches any): the referenced error's
+    name, else the event's name."""
+    event = node.event
+    name = (event.ref_name if event else "") or node.name
+    return "_".join(name.strip().split())
+
+
+def element_label(node: Node) -> str:
+    """The activity the engine tags ``node`` with: a signal event is its signal with ``!``
+    (thrown) or ``?`` (caught), an error event its error, anything else its name."""
+    if node.event_kind == "signal":
+        suffix = RECEIVE if catches(node) else SEND
+        return activity_label(signal_name(node) + suffix, node.id)
+    if node.event_kind == "error":
+        return activity_label(error_name(node), node.id)
+    return activity_label(node.name, node.id)
