@@ -24,8 +24,9 @@ from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock
 from robotale.fame_runtime.data import Data
 from robotale.fame_runtime.expressions import BpmnError, Compiled
+from robotale.fame_runtime.javascript import JavaScript, ScriptFailure
 from robotale.fame_runtime.library import Library
-from robotale.fame_runtime.model import Process
+from robotale.fame_runtime.model import JAVASCRIPT, Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, reachable_flows
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
@@ -80,7 +81,9 @@ class Engine:
     ``process`` is a parsed :class:`~robotale.fame_runtime.model.Process` (or an already
     deployed plan); ``skills`` maps called-element names to Python skills; ``library`` is a
     folder of .bpmn building blocks for call activities; ``variables`` are initial variables
-    (they win over the data objects' literal values); ``tag_sink`` receives every tag.
+    (they win over the data objects' literal values); ``tag_sink`` receives every tag;
+    ``output`` prints what JavaScript scripts ``console.log`` (default: standard output, each
+    line prefixed with the robot's name).
     """
 
     def __init__(
@@ -95,6 +98,7 @@ class Engine:
         tag_sink: TagSink | None = None,
         library: Library | str | Path | None = None,
         variables: Mapping[str, Any] | None = None,
+        output: Callable[[str], None] | None = None,
     ) -> None:
         self.skills = dict(skills or {})
         if library is not None and not isinstance(library, Library):
@@ -127,6 +131,8 @@ class Engine:
         self.stopped = False
         self.completed = 0  # process instances that ended
         self.failures: list[str] = []  # BPMN errors nobody caught
+        self.output = output or (lambda line: print(f"[{robot}] {line}", flush=True))
+        self._javascript: JavaScript | None = None  # made when a first script needs it
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -206,6 +212,8 @@ class Engine:
         def restart() -> None:
             self.plan = plan
             self.robot.close()
+            if self._javascript is not None:
+                self._javascript.close()
             self.start()
 
         self.stop(safe=True, then=restart)
@@ -368,11 +376,32 @@ class Engine:
             taken.append(node.default)
         return taken
 
+    @property
+    def javascript(self) -> JavaScript:
+        """This robot's JavaScript runtime (its variables are the robot's)."""
+        if self._javascript is None:
+            self._javascript = JavaScript(
+                self.robot.name,
+                self.bus,
+                self.variables,
+                schedule=self._call,
+                changed=self._changed,
+                output=self.output,
+            )
+        return self._javascript
+
     def _condition(self, condition: Compiled, where: str) -> bool:
         try:
+            if condition.language == JAVASCRIPT:
+                return bool(self.javascript.condition(condition.source))
             return bool(eval(condition.code, self.env, self.variables))
         except BpmnError:
             raise
+        except ScriptFailure as failure:
+            raise ModelError(
+                f"robot {self.robot.name}: the JavaScript condition of {where} failed: "
+                f"{failure.text}"
+            ) from None
         except Exception as error:
             raise ModelError(
                 f"robot {self.robot.name}: the condition of {where} ({condition.source}) "
@@ -383,6 +412,8 @@ class Engine:
         """A conditional event's condition; one reading a variable nobody set yet is false
         (it cannot have become true), unlike a gateway's, where that is a model error."""
         try:
+            if condition.language == JAVASCRIPT:
+                return self._condition(condition, "a conditional event")
             return eval(condition.code, self.env, self.variables)
         except NameError:
             return False
@@ -422,6 +453,8 @@ class Engine:
     def _run_script(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")
         self.data.inputs(node)
+        if node.script is not None and node.script.language == JAVASCRIPT:
+            return self._run_javascript(token, node)
         if node.script is not None:
             try:
                 self._exec(node)
@@ -447,6 +480,22 @@ class Engine:
             if isinstance(self.variables.get(name), _NOT_VARIABLES):
                 del self.variables[name]
         self._changed(script.writes)
+
+    def _run_javascript(self, token: _Token, node: NodePlan) -> None:
+        """A JavaScript script task completes when it calls ``next`` -- now or later, from a
+        callback -- so its token waits like a skill's (and its boundary events are armed)."""
+        self._arm_boundaries(token, node)
+        generation = token.generation
+
+        def done(error: str | None, _value: Any) -> None:
+            outcome = None if error is None else BpmnError(error)
+            self._call(lambda: self._skill_done(token, generation, outcome))
+
+        try:
+            self.javascript.run_script(node.script.source, done)
+        except ScriptFailure as failure:
+            self._throw_error(token, f"script task {node.node.describe()}: {failure.text}")
+        return None
 
     def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")

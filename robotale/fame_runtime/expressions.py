@@ -1,15 +1,11 @@
 """Scripts, conditions and ``${...}`` templates, compiled once when a process is deployed.
 
-Scripts and conditions are Python. They run with the robot's variables as their local names
-(an assignment in a script sets a variable) and ``robot`` (the robot handle) and
-``BpmnError`` as globals. Models are trusted code, exactly like FAME's JavaScript: a model can
-do anything the Python process can.
-
-The thesis' JavaScript is accepted in its two plain forms, translated to Python here:
-conditions ``next(null, <comparison>)`` over ``this.environment.variables.<name>``, literals,
-``.length``, ``! && || === !==``; and scripts made only of
-``this.environment.variables.<name> = <expression>;`` statements and ``next();``. Anything
-else in JavaScript is refused when the process is deployed.
+Python scripts and conditions run with the robot's variables as their local names (an
+assignment in a script sets a variable) and ``robot`` (the robot handle) and ``BpmnError`` as
+globals. JavaScript ones (FAME's language) run in the embedded engine of
+:mod:`robotale.fame_runtime.javascript`; here they are only checked for syntax. Models are
+trusted code: a Python script can do anything the Python process can, a JavaScript one only
+what FAME's runtime API offers.
 """
 
 from __future__ import annotations
@@ -24,6 +20,7 @@ from functools import lru_cache
 from types import CodeType
 from typing import Any
 
+from robotale.fame_runtime.javascript import function_source, member_names, syntax_error
 from robotale.fame_runtime.model import JAVASCRIPT, PYTHON, Expression
 
 
@@ -40,32 +37,47 @@ class Compiled:
     """A compiled condition (``eval``) or script (``exec``) and the variable names it reads
     and assigns, which conditional events and data associations need."""
 
-    code: CodeType
-    source: str  # the Python text, after translation from JavaScript
+    code: CodeType | None  # None for JavaScript, which its own engine compiles
+    source: str  # Python text, or the JavaScript ``function (next) {...}`` source
     reads: frozenset[str]
-    writes: frozenset[str]
+    writes: frozenset[str]  # JavaScript's are known only when it runs
+    language: str = PYTHON
+
+
+#: what ``language`` / ``scriptFormat`` values robotale evaluates, for the messages
+EVALUATED = "python or javascript"
+
+
+def _javascript(expression: Expression, *, condition: bool) -> Compiled:
+    source = function_source(expression.text, condition=condition)
+    error = syntax_error(source)
+    if error is not None:
+        raise ValueError(error)
+    return Compiled(None, source, member_names(expression.text), frozenset(), JAVASCRIPT)
 
 
 def compile_condition(expression: Expression) -> Compiled:
     """A condition as Python ``eval`` code; ValueError explains what cannot be compiled."""
-    text = expression.text.strip()
     if expression.language == JAVASCRIPT:
-        text = js_condition(text)
-    elif expression.language != PYTHON:
-        raise ValueError(f"conditions in {expression.language} are not supported")
-    text = _unwrap_placeholder(text)
+        return _javascript(expression, condition=True)
+    if expression.language != PYTHON:
+        raise ValueError(
+            f"it is in {expression.language!r}, an expression language robotale does not "
+            f"evaluate (it evaluates {EVALUATED})"
+        )
+    text = _unwrap_placeholder(expression.text.strip())
     return _compile(text, "eval", expression.element_id)
 
 
 def compile_script(expression: Expression) -> Compiled:
     """A script task's body as Python ``exec`` code; ValueError explains what cannot."""
     if expression.language == JAVASCRIPT:
-        text = js_script(expression.text)
-    elif expression.language == PYTHON:
-        text = textwrap.dedent(expression.text.strip("\n"))
-    else:
-        raise ValueError(f"scripts in {expression.language!r} are not supported (use python)")
-    return _compile(text, "exec", expression.element_id)
+        return _javascript(expression, condition=False)
+    if expression.language != PYTHON:
+        raise ValueError(
+            f"scripts in {expression.language!r} are not supported (robotale runs {EVALUATED})"
+        )
+    return _compile(textwrap.dedent(expression.text.strip("\n")), "exec", expression.element_id)
 
 
 def _unwrap_placeholder(text: str) -> str:
@@ -98,132 +110,6 @@ def _stores(code: CodeType) -> set[str]:
     # Only the top level: names assigned inside comprehensions or functions are their own.
     stores = ("STORE_NAME", "DELETE_NAME")
     return {i.argval for i in dis.get_instructions(code) if i.opname in stores}
-
-
-# -- the thesis' JavaScript --------------------------------------------------------------------
-
-_NEXT = re.compile(r"next\s*\(\s*null\s*,(?P<expr>.*)\)\s*;?", re.DOTALL)
-_TOKEN = re.compile(
-    r"""\s*(?:
-        (?P<num>\d+(?:\.\d*)?(?:[eE][+-]?\d+)?|\.\d+)
-      | (?P<str>"(?:[^"\\]|\\.)*"|'(?:[^'\\]|\\.)*')
-      | (?P<name>[A-Za-z_$][\w$]*(?:\s*\.\s*[A-Za-z_$][\w$]*)*)
-      | (?P<op>===|!==|==|!=|<=|>=|&&|\|\||[-+*/%<>!(),])
-    )""",
-    re.VERBOSE,
-)
-_VARIABLE_PREFIXES = ("this.environment.variables.", "environment.variables.")
-_JS_WORDS = {"null": "None", "undefined": "None", "true": "True", "false": "False"}
-_JS_OPS = {"===": "==", "!==": "!=", "&&": "and", "||": "or"}
-
-
-def js_condition(text: str) -> str:
-    """``next(null, <expr>)`` (or a bare JavaScript expression) as a Python expression."""
-    match = _NEXT.fullmatch(text.strip())
-    return js_expression(match.group("expr") if match else text)
-
-
-def js_script(text: str) -> str:
-    """A JavaScript script of variable assignments and ``next()`` as Python statements."""
-    lines = []
-    for statement in re.split(r"[;\n]", re.sub(r"//[^\n]*", "", text)):
-        statement = statement.strip()
-        if not statement or re.fullmatch(r"next\s*\(\s*(null)?\s*\)", statement):
-            continue
-        target, equals, value = statement.partition("=")
-        name = _variable(target.strip())
-        if not equals or value.startswith("=") or name is None:
-            raise ValueError(
-                f"the JavaScript statement {statement!r} is not an assignment to "
-                "this.environment.variables.<name>; write the script in Python"
-            )
-        lines.append(f"{name} = {js_expression(value)}")
-    return "\n".join(lines)
-
-
-def _variable(dotted: str) -> str | None:
-    compact = re.sub(r"\s+", "", dotted)
-    for prefix in _VARIABLE_PREFIXES:
-        if compact.startswith(prefix) and compact[len(prefix) :].isidentifier():
-            return compact[len(prefix) :]
-    return None
-
-
-def js_expression(text: str) -> str:
-    """A plain JavaScript expression (comparisons, ``!``, ``&&``, ``||``, arithmetic,
-    variables, literals, ``.length``) as Python; ValueError for anything else."""
-    return _js_tokens(_tokens(text))
-
-
-def _tokens(text: str) -> list[tuple[str, str]]:
-    tokens, position, text = [], 0, text.strip().rstrip(";")
-    while position < len(text):
-        match = _TOKEN.match(text, position)
-        if not match or match.end() == position:
-            raise ValueError(
-                f"cannot translate the JavaScript {text!r} (at {text[position:]!r}); only "
-                "variables, literals, comparisons and ! && || are translated: write it in Python"
-            )
-        kind = match.lastgroup or ""
-        tokens.append((kind, match.group(kind)))
-        position = match.end()
-        while position < len(text) and text[position].isspace():
-            position += 1
-    return tokens
-
-
-def _js_term(tokens: list[tuple[str, str]], position: int) -> tuple[str, int]:
-    kind, value = tokens[position]
-    if kind == "op" and value == "!":
-        operand, position = _js_operand(tokens, position + 1)
-        return f"(not {operand})", position
-    if kind == "name":
-        if position + 1 < len(tokens) and tokens[position + 1] == ("op", "("):
-            raise ValueError(
-                f"cannot translate the JavaScript call {value}(...): write it in Python"
-            )
-        return _js_name(value), position + 1
-    if kind == "op":
-        return _JS_OPS.get(value, value), position + 1
-    return value, position + 1
-
-
-def _js_operand(tokens: list[tuple[str, str]], position: int) -> tuple[str, int]:
-    if position >= len(tokens):
-        raise ValueError("a JavaScript '!' has nothing to negate")
-    if tokens[position] != ("op", "("):
-        return _js_term(tokens, position)
-    depth, pieces = 0, []
-    while position < len(tokens):
-        kind, value = tokens[position]
-        depth += (value == "(") - (value == ")") if kind == "op" else 0
-        if depth == 0:
-            inner = _js_tokens(pieces[1:])
-            return f"({inner})", position + 1
-        pieces.append(tokens[position])
-        position += 1
-    raise ValueError("unbalanced parentheses in a JavaScript condition")
-
-
-def _js_tokens(tokens: list[tuple[str, str]]) -> str:
-    out, position = [], 0
-    while position < len(tokens):
-        piece, position = _js_term(tokens, position)
-        out.append(piece)
-    return " ".join(out)
-
-
-def _js_name(dotted: str) -> str:
-    compact = re.sub(r"\s+", "", dotted)
-    if compact in _JS_WORDS:
-        return _JS_WORDS[compact]
-    for prefix in _VARIABLE_PREFIXES:
-        compact = compact.removeprefix(prefix)
-    length = compact.endswith(".length")
-    compact = compact.removesuffix(".length")
-    if not compact.isidentifier():
-        raise ValueError(f"cannot translate the JavaScript name {dotted!r}")
-    return f"len({compact})" if length else compact
 
 
 # -- ${...} templates --------------------------------------------------------------------------

@@ -15,6 +15,7 @@ from pathlib import Path
 from lxml import etree
 
 from robotale.errors import ModelError
+from robotale.fame_runtime.javascript import looks_like_javascript
 from robotale.fame_runtime.model import (
     JAVASCRIPT,
     PYTHON,
@@ -283,7 +284,7 @@ class _Reader:
 
     def expression(self, element: etree._Element, text: str, element_id: str) -> Expression:
         language = (element.get("language") or "").lower()
-        if "javascript" in language or language == "js" or text.startswith("next("):
+        if _is_javascript(language) or (not language and looks_like_javascript(text)):
             language = JAVASCRIPT
         return Expression(text, language or PYTHON, element_id, element.sourceline or 0)
 
@@ -304,10 +305,10 @@ class _Reader:
         body = element.find(f"{_B}script")
         text = body.text if body is not None and body.text else ""
         script_format = (element.get("scriptFormat") or "").strip().lower()
-        if not script_format or script_format in ("python", "py", "python3"):
-            language = PYTHON
-        elif script_format.startswith("javascript") or script_format in ("js", "ecmascript"):
+        if _is_javascript(script_format) or (not script_format and looks_like_javascript(text)):
             language = JAVASCRIPT
+        elif not script_format or script_format in ("python", "py", "python3"):
+            language = PYTHON
         else:
             language = script_format
         return Expression(text, language, node.id, body.sourceline if body is not None else 0)
@@ -424,3 +425,9 @@ def _parameter_value(element: etree._Element) -> object:
         if kind == "script":
             return _text(child)
     return _text(element)
+
+
+def _is_javascript(language: str) -> bool:
+    """``javascript``, ``text/javascript``, ``js``, ``ecmascript`` and the like."""
+    language = language.rsplit("/", 1)[-1]
+    return language.startswith(("javascript", "ecmascript")) or language in ("js", "es6")

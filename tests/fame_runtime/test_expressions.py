@@ -5,59 +5,69 @@ import pytest
 from robotale.fame_runtime.expressions import (
     compile_condition,
     compile_script,
-    js_condition,
-    js_script,
     render_json,
     substitute,
 )
+from robotale.fame_runtime.javascript import JavaScript
 from robotale.fame_runtime.model import Expression
 
 
+def javascript_value(text: str, variables: dict) -> object:
+    """What a JavaScript condition passes to ``next`` with these variables."""
+    compiled = compile_condition(Expression(text, "javascript", "f"))
+    runtime = JavaScript(
+        "drone", None, dict(variables), schedule=None, changed=lambda _: None, output=print
+    )
+    return runtime.condition(compiled.source)
+
+
 @pytest.mark.parametrize(
-    ("javascript", "python"),
+    ("javascript", "variables", "value"),
     [
         # The conditions of the authors' own models.
         (
             "next(null, this.environment.variables.closest_tractor != null);",
-            "closest_tractor != None",
+            {"closest_tractor": "tractor_1"},
+            True,
         ),
-        ("next(null,!this.environment.variables.reached);", "(not reached)"),
-        ("next(null,this.environment.variables.map_points.length <= 0);", "len(map_points) <= 0"),
-        ("next(null, this.environment.variables.sara == 0);", "sara == 0"),
-        ("next(null, !(a && b) || c === 'x');", "(not (a and b)) or c == 'x'"),
-        # Listing 5.5 of the thesis.
-        ("next(null, variable_2 > 10);", "variable_2 > 10"),
+        ("next(null, this.environment.variables.closest_tractor != null);", {}, False),
+        ("next(null,!this.environment.variables.reached);", {"reached": False}, True),
+        ("next(null,this.environment.variables.map_points.length <= 0);", {"map_points": []}, True),
+        ("next(null, this.environment.variables.sara == 0);", {"sara": 0}, True),
+        ("next(null, !(a && b) || c === 'x');", {}, "reference"),
+        # Listing 5.5 of the thesis: a bare name is a global, not a variable, in JavaScript.
+        ("next(null, this.environment.variables.variable_2 > 10);", {"variable_2": 11}, True),
     ],
 )
-def test_thesis_javascript_conditions_become_python(javascript, python):
-    assert js_condition(javascript) == python
+def test_thesis_javascript_conditions_evaluate_in_the_engine(javascript, variables, value):
+    if value == "reference":  # undeclared globals throw in JavaScript, as in FAME
+        with pytest.raises(Exception, match="ReferenceError: a is not defined"):
+            javascript_value(javascript, variables)
+        return
+    assert javascript_value(javascript, variables) is value
 
 
 def test_javascript_conditions_evaluate_like_javascript():
-    code = compile_condition(Expression("next(null, !(x > 1) || y === true);", "javascript", "f"))
-    assert eval(code.code, {}, {"x": 0, "y": False}) is True
-    assert eval(code.code, {}, {"x": 5, "y": False}) is False
-    assert code.reads == {"x", "y"}
+    text = "next(null, !(environment.variables.x > 1) || environment.variables.y === true);"
+    assert javascript_value(text, {"x": 0, "y": False}) is True
+    assert javascript_value(text, {"x": 5, "y": False}) is False
+    assert {"x", "y"} <= compile_condition(Expression(text, "javascript", "f")).reads
 
 
-def test_javascript_beyond_plain_comparisons_is_refused():
-    with pytest.raises(ValueError, match="cannot translate"):
-        js_condition(
+def test_the_javascript_the_translator_refused_now_compiles():
+    compile_condition(
+        Expression(
             "next(null, this.environment.variables.tractor === "
-            "this.environment.variables.node.namespace().replace('/', ''));"
+            "this.environment.variables.node.namespace().replace('/', ''));",
+            "javascript",
+            "f",
         )
-    with pytest.raises(ValueError, match="not an assignment"):
-        js_script("var node = this.environment.variables.ros_node;\nnext();")
-
-
-def test_javascript_assignment_scripts_become_python():
-    # data.bpmn's "Set Value" script task of the authors' tests.
-    text = (
-        "this.environment.variables.variable_name = 5;\n"
-        "this.environment.variables.loop = 0;\nnext();"
     )
-    assert js_script(text) == "variable_name = 5\nloop = 0"
-    assert js_script("next();") == ""
+    compile_script(
+        Expression("var node = this.environment.variables.ros_node;\nnext();", "javascript", "s")
+    )
+    with pytest.raises(ValueError, match="JavaScript syntax error on line 2"):
+        compile_script(Expression("var a = 1;\nvar = 2;", "javascript", "s"))
 
 
 def test_python_scripts_report_what_they_assign_and_conditions_what_they_read():

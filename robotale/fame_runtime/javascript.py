@@ -1,0 +1,480 @@
+"""JavaScript scripts and conditions in an embedded QuickJS engine, with FAME's runtime API.
+
+What a FAME script sees (thesis chapter 5, bpmn-engine's script context):
+
+- ``this.environment.variables`` (also the global ``environment.variables``): the robot's
+  process variables, shared with Python scripts, skills and data associations;
+- ``next()`` / ``next(err, value)``: the script task completes when ``next`` is called (maybe
+  later, from a subscription's callback); ``next(err)`` throws a BPMN error; a condition's
+  value is the ``value`` it passes to ``next`` (or the value of a bare expression);
+- ``console.log``: a line of the run's output, prefixed with the robot;
+- ``this.environment.variables.node`` / ``.ros_node``: a shim of the rclnodejs node API onto
+  robotale's bus: ``createPublisher(type, topic).publish(msg)``,
+  ``createSubscription(type, topic, [options], callback)``, ``destroySubscription(s)``,
+  ``createClient(type, service)`` with ``waitForService()`` (a promise) and
+  ``sendRequest(request, callback)``, ``namespace()``, ``name()`` and ``getLogger()``.
+  Topics without a leading ``/`` are in the robot's namespace. A service call is a request
+  published on ``<service>/request`` and the first message on ``<service>/response`` after it.
+
+Why effects go through an outbox: the embedding refuses calls from JavaScript into Python
+while a time limit is set, and a script without a time limit could hang a robot. So the
+JavaScript side only records what a script does (publish, subscribe, log, ``next``) and the
+variables it wrote; Python applies that after each call. The bus is used only through its
+public ``publish``/``subscribe``, so the same shim works on every bus.
+
+QuickJS (``quickjs-ng`` on PyPI) is the embedding: no file, network or process access exists
+in it at all, and each runtime has a CPU-time and a memory limit.
+"""
+
+from __future__ import annotations
+
+import json
+import re
+import threading
+from collections.abc import Callable, Iterable
+from typing import Any
+
+import quickjs
+
+from robotale.errors import ModelError
+from robotale.fame_runtime.bus import Bus, Envelope, Subscription
+
+#: CPU seconds one call into JavaScript may take (a script, a condition, a callback)
+TIME_LIMIT = 2.0
+#: bytes one robot's JavaScript runtime may allocate
+MEMORY_LIMIT = 64 * 1024 * 1024
+
+#: variables that hold the rclnodejs shim, never copied to Python
+NODE_NAMES = ("node", "ros_node")
+
+#: the runtime every robot's context starts with; every function of it is named ``fame_*``
+#: so that an error's stack can be cut down to the script's own lines
+_PRELUDE = r"""
+var __fame = (function () {
+  var out = [], dirty = {}, store = {}, subs = {}, calls = {}, ids = 0;
+  var hidden = {node: true, ros_node: true};
+  var variables = new Proxy(store, {
+    get: function fame_get(t, k) {
+      var v = t[k];
+      // an object read may be changed in place (points.shift()): copy it back too
+      if (typeof k === 'string' && v !== null && typeof v === 'object' && !hidden[k]) dirty[k] = 1;
+      return v;
+    },
+    set: function fame_set(t, k, v) { t[k] = v; if (!hidden[k]) dirty[k] = 1; return true; },
+    deleteProperty: function fame_delete(t, k) { delete t[k]; dirty[k] = 1; return true; }
+  });
+  var environment = {variables: variables, services: {}, output: {}, settings: {}};
+  var context = {environment: environment};
+  function fame_text(args) {
+    return Array.prototype.map.call(args, function fame_one(a) {
+      return typeof a === 'string' ? a : JSON.stringify(a);
+    }).join(' ');
+  }
+  function fame_log() { out.push(['log', fame_text(arguments)]); }
+  var console = {log: fame_log, info: fame_log, warn: fame_log, error: fame_log, debug: fame_log};
+  function fame_node(name) {
+    return {
+      name: function fame_name() { return name; },
+      namespace: function fame_namespace() { return '/' + name; },
+      getLogger: function fame_logger() { return console; },
+      createPublisher: function fame_publisher(type, topic) {
+        return {topic: topic, publish: function fame_publish(msg) {
+          out.push(['pub', topic, type, msg]); }};
+      },
+      createSubscription: function fame_subscription(type, topic, options, callback) {
+        var id = ++ids;
+        subs[id] = typeof options === 'function' ? options : callback;
+        out.push(['sub', id, topic, type]);
+        return {id: id, topic: topic};
+      },
+      destroySubscription: function fame_destroy(s) {
+        if (s && subs[s.id]) { delete subs[s.id]; out.push(['unsub', s.id]); }
+      },
+      createClient: function fame_client(type, service) {
+        return {
+          waitForService: function fame_wait() { return Promise.resolve(true); },
+          isServiceServerAvailable: function fame_available() { return true; },
+          sendRequest: function fame_request(request, callback) {
+            var id = ++ids;
+            calls[id] = callback;
+            out.push(['req', id, service, type, request]);
+          }
+        };
+      }
+    };
+  }
+  function fame_hide(name, value) {
+    Object.defineProperty(store, name, {value: value, enumerable: false, writable: true});
+  }
+  function fame_absorb(push) {
+    if (!push) return;
+    var p = JSON.parse(push), k;
+    for (k in p.set) store[k] = p.set[k];
+    for (var i = 0; i < p.del.length; i++) delete store[p.del[i]];
+  }
+  function fame_drain() {
+    var w = {}, d = [], k, n = 0;
+    for (k in dirty) {
+      n++;
+      if (store[k] === undefined) d.push(k); else w[k] = store[k];
+    }
+    dirty = {};
+    if (!n && !out.length) return '';
+    var e = out;
+    out = [];
+    return JSON.stringify({w: w, d: d, e: e});
+  }
+  function fame_next(run) {
+    var settled = false;
+    return function next(err, value) {
+      if (settled) return;
+      settled = true;
+      out.push(['next', run, err == null ? null : String(err && err.message || err),
+                value === undefined ? null : value]);
+    };
+  }
+  function fame_fail(run, e) {
+    var text = e instanceof Error ? e.name + ': ' + e.message : String(e);
+    out.push(['throw', run, text, e instanceof Error ? String(e.stack) : '']);
+  }
+  function fame_run(fn, run, push) {
+    fame_absorb(push);
+    try { fn.call(context, fame_next(run)); } catch (e) { fame_fail(run, e); }
+    return fame_drain();
+  }
+  function fame_deliver(table, id, msg, push, once) {
+    fame_absorb(push);
+    var callback = table[id];
+    if (once) delete table[id];
+    if (callback) {
+      try { callback(JSON.parse(msg)); } catch (e) { fame_fail(0, e); }
+    }
+    return fame_drain();
+  }
+  return {
+    context: context, console: console, environment: environment, node: fame_node,
+    hide: fame_hide, run: fame_run, drain: fame_drain,
+    message: function fame_message(id, msg, push) {
+      return fame_deliver(subs, id, msg, push, false);
+    },
+    response: function fame_response(id, msg, push) {
+      return fame_deliver(calls, id, msg, push, true);
+    }
+  };
+})();
+var console = __fame.console, environment = __fame.environment;
+"""
+
+_FRAME = re.compile(r"at (?P<name>\S+) \(<input>:(?P<line>\d+)")
+_NEXT_CALL = re.compile(r"\bnext\s*\(")
+_MEMBER = re.compile(r"\.\s*([A-Za-z_$][\w$]*)|\[\s*[\"']([^\"']+)[\"']\s*\]")
+_WRAP = "(function (next) {\n%s\n})"  # the body's line n is the wrapper's line n + 1
+
+
+def function_source(text: str, *, condition: bool) -> str:
+    """A script or condition as the source of ``function (next) {...}``.
+
+    A condition written as a bare expression (``x > 1``, ``${x > 1}``) returns its value
+    through ``next`` like FAME's ``next(null, x > 1)``."""
+    body = text.strip()
+    if condition and not _NEXT_CALL.search(body):
+        if body.startswith("${") and body.endswith("}"):
+            body = body[2:-1]
+        body = f"next(null, ({body.strip().rstrip(';')}));"
+    return _WRAP % body
+
+
+_LOOKS_LIKE_JAVASCRIPT = re.compile(
+    r"\bnext\s*\(|\bthis\.environment\b|\benvironment\.variables\b"
+    r"|\b(?:var|let|const)\s+[A-Za-z_$]|=>|===|!==|&&|\|\||;\s*$",
+    re.MULTILINE,
+)
+
+
+def looks_like_javascript(text: str) -> bool:
+    """A script or condition without a language is JavaScript when it uses what Python
+    cannot (``next(``, ``this.environment``, ``var``/``let``/``const``, ``=>``, ``===``,
+    ``&&``, a statement ending in ``;``), as FAME's models do; otherwise it is Python."""
+    return bool(_LOOKS_LIKE_JAVASCRIPT.search(text))
+
+
+def member_names(text: str) -> frozenset[str]:
+    """Every ``.name`` and ``["name"]`` in ``text``: a superset of the variables a condition
+    reads, so a conditional event is re-evaluated when one of them changes."""
+    return frozenset(a or b for a, b in _MEMBER.findall(text))
+
+
+_checker_lock = threading.Lock()
+_checker: list[quickjs.Context] = []
+
+
+def syntax_error(source: str) -> str | None:
+    """Why ``source`` (from :func:`function_source`) is not valid JavaScript, or None."""
+    with _checker_lock:
+        if not _checker:
+            _checker.append(quickjs.Context())
+        try:
+            _checker[0].eval(f"(function () {{ return {source}; }})")
+        except quickjs.JSException as error:
+            message, line = _first_line(str(error)), _script_line(str(error))
+            return f"JavaScript syntax error on line {line}: {message}" if line else message
+    return None
+
+
+def _first_line(text: str) -> str:
+    return text.strip().splitlines()[0] if text.strip() else "unknown error"
+
+
+def _script_line(stack: str) -> int:
+    """The line, counted in the script's own text, of the innermost frame that is the
+    script's (the runtime's own functions are ``fame_*``); 0 when there is none."""
+    for match in _FRAME.finditer(stack):
+        if not match.group("name").startswith("fame_"):
+            return max(int(match.group("line")) - 1, 1)
+    match = re.search(r"<input>:(\d+)", stack)
+    return max(int(match.group(1)) - 1, 1) if match else 0
+
+
+class ScriptFailure(Exception):
+    """A script threw, called ``next(err)`` or ran out of time: ``text`` says what and
+    where; the engine throws it as a BPMN error of the script's activity."""
+
+    def __init__(self, text: str) -> None:
+        super().__init__(text)
+        self.text = text
+
+
+#: called when a script calls ``next(err, value)``: err is None or the error's text
+Completion = Callable[[str | None, Any], None]
+
+
+class JavaScript:
+    """One robot's JavaScript runtime: its variables mirror the robot's, its node shim
+    publishes and subscribes on the robot's bus.
+
+    ``schedule`` queues work on the robot's engine (deliveries run there, never inside the
+    bus); ``changed`` tells the engine which variables a callback wrote; ``output`` prints a
+    ``console.log`` line.
+    """
+
+    def __init__(
+        self,
+        robot: str,
+        bus: Bus,
+        variables: dict[str, Any],
+        *,
+        schedule: Callable[[Callable[[], Any]], None],
+        changed: Callable[[Iterable[str]], None],
+        output: Callable[[str], None],
+        time_limit: float = TIME_LIMIT,
+        memory_limit: int = MEMORY_LIMIT,
+    ) -> None:
+        self.robot, self.bus, self.variables = robot, bus, variables
+        self.schedule, self.changed, self.output = schedule, changed, output
+        self.time_limit = time_limit
+        self.context = quickjs.Context()
+        self.context.set_memory_limit(memory_limit)
+        self.context.eval(_PRELUDE)
+        js = self.context.eval
+        self._run, self._message, self._response = (
+            js("__fame.run"),
+            js("__fame.message"),
+            js("__fame.response"),
+        )
+        self._drain = js("__fame.drain")
+        node, hide = js("__fame.node")(robot), js("__fame.hide")
+        for name in NODE_NAMES:
+            hide(name, node)
+        self.context.set_time_limit(time_limit)
+        self._functions: dict[str, Any] = {}
+        self._mirror: dict[str, Any] = {}  # what the JavaScript side holds, by identity
+        self._runs: dict[int, Completion] = {}
+        self._run_ids = 0
+        self._subscriptions: dict[int, Subscription] = {}
+        self._calls: dict[int, tuple[Subscription, str]] = {}
+
+    # -- running ---------------------------------------------------------------------------
+
+    def run_script(self, source: str, done: Completion) -> None:
+        """Run a script task's body; ``done`` is called when it calls ``next`` (maybe now).
+        ScriptFailure when it throws."""
+        self._run_ids += 1
+        run = self._run_ids
+        self._runs[run] = done
+        try:
+            self._apply(self._call(self._run, self._function(source), run), run)
+        except ScriptFailure:
+            self._runs.pop(run, None)
+            raise
+
+    def condition(self, source: str) -> Any:
+        """The value a condition passes to ``next`` (None when it never calls it)."""
+        values: list[Any] = []
+
+        def done(error: str | None, value: Any) -> None:
+            if error is not None:
+                raise ScriptFailure(f"the condition called next with the error {error!r}")
+            values.append(value)
+
+        self.run_script(source, done)
+        self._runs.pop(self._run_ids, None)  # a condition that never called next is false
+        return values[0] if values else None
+
+    def close(self) -> None:
+        """Drop the subscriptions scripts made (the engine stops or restarts)."""
+        for subscription in (*self._subscriptions.values(), *(s for s, _ in self._calls.values())):
+            subscription.unsubscribe()
+        self._subscriptions.clear()
+        self._calls.clear()
+        self._runs.clear()
+
+    def _function(self, source: str) -> Any:
+        function = self._functions.get(source)
+        if function is None:
+            function = self._functions[source] = self.context.eval(source)
+        return function
+
+    def _call(self, function: Any, *args: Any) -> str:
+        """Call into JavaScript with the variables Python changed; its pending promise jobs
+        run before its effects are collected."""
+        try:
+            result = function(*args, self._push())
+            if self.context.execute_pending_job():
+                while self.context.execute_pending_job():
+                    pass
+                tail = self._drain()
+                result = _merge(result, tail)
+            return result
+        except quickjs.JSException as error:
+            text = str(error)
+            if "interrupted" in text:
+                raise ScriptFailure(
+                    f"the script ran longer than its time limit of {self.time_limit:g} s of "
+                    "CPU time and was stopped"
+                ) from None
+            if "out of memory" in text:
+                raise ModelError(
+                    f"robot {self.robot}: JavaScript ran out of its {MEMORY_LIMIT >> 20} MiB "
+                    "of memory"
+                ) from None
+            raise ScriptFailure(f"{_first_line(text)} (line {_script_line(text)})") from None
+
+    def _push(self) -> str:
+        """The variables that changed in Python since JavaScript last saw them, as JSON."""
+        mirror, variables = self._mirror, self.variables
+        changed = {
+            k: v
+            for k, v in variables.items()
+            if k not in NODE_NAMES and (k not in mirror or mirror[k] is not v)
+        }
+        gone = [k for k in mirror if k not in variables]
+        if not changed and not gone:
+            return ""
+        for name in gone:
+            del mirror[name]
+        sendable = {}
+        for name, value in changed.items():
+            try:
+                json.dumps(value)
+            except (TypeError, ValueError):
+                continue  # a Python-only value (an object a skill left): JavaScript lacks it
+            sendable[name] = value
+            mirror[name] = value
+        return json.dumps({"set": sendable, "del": gone})
+
+    # -- effects -------------------------------------------------------------------------------
+
+    def _apply(self, result: str, run: int = 0) -> None:
+        if not result:
+            return
+        outcome = json.loads(result)
+        written = self._take_writes(outcome)
+        for effect in outcome["e"]:
+            self._effect(effect, run)
+        if written:
+            self.changed(written)
+
+    def _take_writes(self, outcome: dict[str, Any]) -> list[str]:
+        mirror, variables = self._mirror, self.variables
+        for name, value in outcome["w"].items():
+            variables[name] = mirror[name] = value
+        for name in outcome["d"]:
+            variables.pop(name, None)
+            mirror.pop(name, None)
+        return [*outcome["w"], *outcome["d"]]
+
+    def _effect(self, effect: list[Any], run: int) -> None:
+        kind = effect[0]
+        if kind == "log":
+            self.output(effect[1])
+        elif kind == "next":
+            done = self._runs.pop(effect[1], None)
+            if done is not None:
+                done(effect[2], effect[3])
+        elif kind == "throw":
+            self._runs.pop(effect[1], None)
+            raise ScriptFailure(f"{_first_line(effect[2])} (line {_script_line(effect[3])})")
+        elif kind == "pub":
+            self.bus.publish(
+                self._topic(effect[1]), effect[3], msgtype=effect[2], sender=self.robot
+            )
+        elif kind == "sub":
+            self._subscribe(effect[1], effect[2], effect[3])
+        elif kind == "unsub":
+            subscription = self._subscriptions.pop(effect[1], None)
+            if subscription is not None:
+                subscription.unsubscribe()
+        elif kind == "req":
+            self._request(effect[1], effect[2], effect[3], effect[4])
+
+    def _topic(self, name: str) -> str:
+        return name if name.startswith("/") else f"/{self.robot}/{name}"
+
+    def _subscribe(self, sub_id: int, topic: str, msgtype: str) -> None:
+        def deliver(envelope: Envelope) -> None:
+            self.schedule(lambda: self._deliver(self._message, sub_id, envelope))
+
+        self._subscriptions[sub_id] = self.bus.subscribe(
+            self._topic(topic), deliver, msgtype=msgtype, owner=self.robot
+        )
+
+    def _request(self, call_id: int, service: str, msgtype: str, request: Any) -> None:
+        topic = self._topic(service)
+
+        def deliver(envelope: Envelope) -> None:
+            entry = self._calls.pop(call_id, None)
+            if entry is not None:
+                entry[0].unsubscribe()
+                self.schedule(lambda: self._deliver(self._response, call_id, envelope))
+
+        subscription = self.bus.subscribe(
+            f"{topic}/response", deliver, msgtype=msgtype, owner=self.robot
+        )
+        self._calls[call_id] = (subscription, topic)
+        self.bus.publish(f"{topic}/request", request, msgtype=msgtype, sender=self.robot)
+
+    def _deliver(self, function: Any, callback_id: int, envelope: Envelope) -> None:
+        try:
+            message = json.dumps(envelope.data)
+        except (TypeError, ValueError):
+            return  # not a ROS message (a tag): nothing a rclnodejs callback could read
+        try:
+            self._apply(self._call(function, callback_id, message))
+        except ScriptFailure as failure:
+            raise ModelError(
+                f"robot {self.robot}: a JavaScript callback on {envelope.topic} failed: "
+                f"{failure.text}"
+            ) from None
+
+
+def _merge(first: str, second: str) -> str:
+    """Two drained outboxes (before and after promise jobs) as one."""
+    if not second:
+        return first
+    if not first:
+        return second
+    a, b = json.loads(first), json.loads(second)
+    a["w"].update(b["w"])
+    a["d"] = [d for d in a["d"] if d not in b["w"]] + b["d"]
+    a["e"] += b["e"]
+    return json.dumps(a)
