@@ -59,6 +59,8 @@ def print_report(report: Report, out: TextIO) -> None:
         )
     for note in report.notes:
         print(f"note: {note}", file=out)
+    for warning in report.warnings:
+        print(f"warning: {warning}", file=out)
 
 
 def split_command(

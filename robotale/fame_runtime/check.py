@@ -56,6 +56,7 @@ class Report:
     problems: list[str] = field(default_factory=list)  # "<pool>: <element> <why>"
     pairs: list[Pairing] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)  # silent choices of the parser
 
     @property
     def ok(self) -> bool:
@@ -66,7 +67,7 @@ def check(
     definitions: Definitions, *, skills: Collection[str] = (), library: Library | None = None
 ) -> Report:
     """Structure (what the engine would refuse) and QoS compatibility of a collaboration."""
-    report = Report(str(definitions.file))
+    report = Report(str(definitions.file), warnings=list(definitions.warnings))
     publishers: dict[str, list[Endpoint]] = defaultdict(list)
     subscribers: dict[str, list[Endpoint]] = defaultdict(list)
     for pool, process in definitions.pools():

@@ -171,6 +171,8 @@ class Definitions:
     signals: dict[str, str] = field(default_factory=dict)  # id -> name
     errors: dict[str, str] = field(default_factory=dict)  # id -> name (or errorCode)
     message_flows: list[tuple[str, str, str]] = field(default_factory=list)
+    #: silent choices made visible: "<file>:<line>: <element> <what happens>"
+    warnings: list[str] = field(default_factory=list)
 
     def pools(self) -> list[tuple[Participant, Process]]:
         """Every pool with the process it holds; a file without a collaboration has one pool

@@ -45,6 +45,35 @@ ACTIVITIES += ("manualTask", "businessRuleTask")
 GATEWAYS = ("exclusiveGateway", "parallelGateway", "inclusiveGateway", "eventBasedGateway")
 GATEWAYS += ("complexGateway",)
 FLOW_NODES = frozenset(EVENTS + ACTIVITIES + GATEWAYS)
+
+#: what a data association may also point at in valid BPMN; the engine moves no data there
+_NOT_DATA_OBJECTS = frozenset(
+    ("dataStoreReference", "dataStore", "dataInput", "dataOutput", "property")
+)
+
+#: the children of extensionElements the engine reads (anything else is reported, not run)
+_READ_EXTENSIONS = frozenset(
+    (
+        "properties",
+        "property",
+        "parameters",
+        "parameter",
+        "payload",
+        "policies",
+        "policy",
+        "message",
+        "process",
+        "inputOutput",
+        "inputParameter",
+        "outputParameter",
+        "list",
+        "value",
+        "map",
+        "entry",
+        "script",
+        "qos",
+    )
+)
 SCOPES = frozenset(("subProcess", "transaction", "adHocSubProcess"))
 
 
@@ -100,9 +129,18 @@ class _Reader:
         self.file = file
         self.signals: dict[str, str] = {}
         self.errors: dict[str, str] = {}
+        self.problems: list[str] = []  # every problem of the file, reported together
+        self.warnings: list[str] = []
+        self.language = ""  # the file's expressionLanguage, when it declares one
 
     def fail(self, element: etree._Element, message: str) -> ModelError:
         return ModelError(f"{self.file}:{element.sourceline}: {message}")
+
+    def problem(self, line: int | None, message: str) -> None:
+        self.problems.append(f"{self.file}:{line or 0}: {message}")
+
+    def warn(self, line: int | None, message: str) -> None:
+        self.warnings.append(f"{self.file}:{line or 0}: {message}")
 
     def definitions(self, root: etree._Element) -> Definitions:
         # Signals and errors first: the authors' models reference them before declaring them.
@@ -111,6 +149,7 @@ class _Reader:
             e.get("id", ""): e.get("name") or e.get("errorCode") or ""
             for e in root.iter(f"{_B}error")
         }
+        self.language = (root.get("expressionLanguage") or "").strip().lower()
         definitions = Definitions(self.file, root.get("id", ""), signals=dict(self.signals))
         definitions.errors = dict(self.errors)
         for element in _bpmn_children(root, "process"):
@@ -119,7 +158,28 @@ class _Reader:
             definitions.processes[process.id] = process
         for collaboration in _bpmn_children(root, "collaboration"):
             self.collaboration(collaboration, definitions)
+        self.outside_pools(definitions)
+        if len(self.problems) == 1:
+            raise ModelError(self.problems[0])
+        if self.problems:
+            raise ModelError(
+                f"{self.file}: {len(self.problems)} problems:\n" + "\n".join(self.problems)
+            )
+        definitions.warnings = self.warnings
         return definitions
+
+    def outside_pools(self, definitions: Definitions) -> None:
+        """With pools, a process that is in none is not run: say so."""
+        if not definitions.participants:
+            return
+        pooled = {p.process_ref for p in definitions.participants}
+        for process in definitions.processes.values():
+            if process.id not in pooled:
+                self.warn(
+                    process.line,
+                    f"process {process.describe()} is in no pool: it is not run (only a call "
+                    "activity can call it)",
+                )
 
     def collaboration(self, element: etree._Element, definitions: Definitions) -> None:
         for pool in _bpmn_children(element, "participant"):
@@ -127,9 +187,12 @@ class _Reader:
             if not ref:
                 continue  # a black-box pool: nobody runs it
             if ref not in definitions.processes:
-                raise self.fail(
-                    pool, f"pool {pool.get('id')} refers to process {ref}, which is not in the file"
+                self.problem(
+                    pool.sourceline,
+                    f"pool {pool.get('id')} refers to process {ref}, which is not in the file "
+                    f"(processes: {', '.join(definitions.processes) or 'none'})",
                 )
+                continue
             definitions.participants.append(self.participant(pool, definitions.processes[ref]))
         for flow in _bpmn_children(element, "messageFlow"):
             definitions.message_flows.append(
@@ -162,6 +225,11 @@ class _Reader:
             line=element.sourceline or 0,
             file=self.file,
         )
+        self.not_data_objects = {
+            e.get("id", "")
+            for e in element.iter()
+            if isinstance(e.tag, str) and _local(e) in _NOT_DATA_OBJECTS
+        }
         self.scope(element, process, process)
         self.check_data_associations(process)
         return process
@@ -169,7 +237,8 @@ class _Reader:
     def required_id(self, element: etree._Element) -> str:
         identifier = element.get("id")
         if not identifier:
-            raise self.fail(element, f"a bpmn:{_local(element)} has no id")
+            identifier = f"<{_local(element)} on line {element.sourceline}>"
+            self.problem(element.sourceline, f"a bpmn:{_local(element)} has no id (add one)")
         return identifier
 
     def scope(self, element: etree._Element, scope: Scope, process: Process) -> None:
@@ -191,24 +260,53 @@ class _Reader:
             for end, ref in (("source", flow.source), ("target", flow.target)):
                 if ref not in scope.nodes:
                     where = f" ({ref})" if ref else ""
-                    raise ModelError(
-                        f"{self.file}:{flow.line}: sequence flow {flow.id} is dangling: its "
-                        f"{end}{where} is not an element of the same process or sub-process"
+                    self.problem(
+                        flow.line,
+                        f"sequence flow {flow.id} is dangling: its {end}{where} is not an "
+                        "element of the same process or sub-process",
                     )
+        for flow_id in [f.id for f in scope.flows.values() if not _joined(f, scope)]:
+            del scope.flows[flow_id]  # reported above; the rest of the file is still read
         for node in scope.nodes.values():
             if node.kind == "boundaryEvent" and node.attached_to not in scope.nodes:
-                raise ModelError(
-                    f"{self.file}:{node.line}: boundary event {node.id} is attached to "
-                    f"{node.attached_to or 'nothing'}, which is not in the same process"
+                self.problem(
+                    node.line,
+                    f"boundary event {node.id} is attached to {node.attached_to or 'nothing'}, "
+                    "which is not in the same process",
+                )
+        self.unconditioned_choices(scope)
+
+    def unconditioned_choices(self, scope: Scope) -> None:
+        """An exclusive gateway with several unconditioned flows takes the first: say so."""
+        for node in scope.nodes.values():
+            if node.kind != "exclusiveGateway":
+                continue
+            bare = [
+                f.id
+                for f in scope.flows.values()
+                if f.source == node.id and f.condition is None and f.id != node.default_flow
+            ]
+            if len(bare) > 1:
+                self.warn(
+                    node.line,
+                    f"exclusiveGateway {node.describe()} has {len(bare)} outgoing flows without "
+                    f"a condition ({', '.join(bare)}): the engine takes the first, {bare[0]}",
                 )
 
     def check_data_associations(self, process: Process) -> None:
         for node in process.walk():
-            for ref in (*node.data_inputs, *node.data_outputs):
-                if ref not in process.data_objects:
-                    raise ModelError(
-                        f"{self.file}:{node.line}: {node.kind} {node.id} has a data association "
-                        f"with {ref}, which is not a data object of process {process.id}"
+            for refs in (node.data_inputs, node.data_outputs):
+                for ref in list(refs):
+                    if ref in process.data_objects:
+                        continue
+                    refs.remove(ref)
+                    if ref in self.not_data_objects:
+                        continue  # a data store, an input/output or a property: valid BPMN
+                    self.problem(
+                        node.line,
+                        f"{node.kind} {node.id} has a data association with {ref or 'nothing'}, "
+                        "which is no data object, data store, input, output or property of "
+                        f"process {process.id}",
                     )
 
     def node(self, element: etree._Element, kind: str, process: Process) -> Node:
@@ -228,6 +326,8 @@ class _Reader:
         self.data_associations(element, node)
         self.markers(element, node)
         extensions = _Extensions(element.find(f"{_B}extensionElements"))
+        for ignored in extensions.ignored:
+            self.warn(node.line, f"{kind} {node.describe()}: {ignored} is ignored (not run)")
         node.inputs, node.outputs = extensions.inputs, extensions.outputs
         if kind in EVENTS and node.events and node.events[0].kind in ("signal", "error"):
             node.message = self.ros_message(extensions, element, node)
@@ -273,17 +373,18 @@ class _Reader:
     def timer(self, element: etree._Element, node: Node):
         for child in element:
             if _local(child) in TIMER_KINDS:
+                if not _text(child):
+                    continue  # an empty <timeDate/>: a gap the deployer reports as such
                 try:
                     return parse_timer(_local(child), _text(child))
                 except ValueError as error:
-                    raise ModelError(
-                        f"{self.file}:{child.sourceline}: timer event {node.describe()} is "
-                        f"malformed: {error}"
-                    ) from None
+                    self.problem(
+                        child.sourceline, f"timer event {node.describe()} is malformed: {error}"
+                    )
         return None
 
     def expression(self, element: etree._Element, text: str, element_id: str) -> Expression:
-        language = (element.get("language") or "").lower()
+        language = (element.get("language") or self.language).lower()
         if _is_javascript(language) or (not language and looks_like_javascript(text)):
             language = JAVASCRIPT
         return Expression(text, language or PYTHON, element_id, element.sourceline or 0)
@@ -367,6 +468,10 @@ def _is_definition(element: etree._Element) -> bool:
     return _local(element).endswith("EventDefinition") and isinstance(element.tag, str)
 
 
+def _joined(flow: Flow, scope: Scope) -> bool:
+    return flow.source in scope.nodes and flow.target in scope.nodes
+
+
 def _int_or_none(text: str | None) -> int | None:
     return int(text) if text and text.strip().isdigit() else None
 
@@ -383,9 +488,15 @@ class _Extensions:
         self.payload: dict[str, str] | None = None
         self.msgtype = ""
         self.embedded_process = ""
+        self.ignored: list[str] = []  # extensions the engine does not run, as prefix:name
         if element is not None:
             for child in element.iter():
                 self.read(child)
+            self.ignored = [
+                f"{child.prefix or 'extension'}:{_local(child)}"
+                for child in element
+                if isinstance(child.tag, str) and _local(child) not in _READ_EXTENSIONS
+            ]
 
     def read(self, child: etree._Element) -> None:
         kind, parent = _local(child), _local(child.getparent())

@@ -1,0 +1,186 @@
+"""Valid BPMN 2.0 as different modellers write it: ``fame check`` reads every file, reports
+every problem of a file at once, names each correctly and never crashes."""
+
+from pathlib import Path
+
+import pytest
+
+from robotale.cli import main
+
+HEAD = (
+    '<?xml version="1.0" encoding="UTF-8"?>\n'
+    '<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL"\n'
+    '    xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"\n'
+    '    xmlns:camunda="http://camunda.org/schema/1.0/bpmn" id="d"{attributes}>\n'
+)
+
+#: one process per modeller habit; each runs once its quirk is read
+FILES = {
+    # Signavio/Bizagi style: a data store and ioSpecification inputs and outputs in
+    # associations, a property as the target of an input association.
+    "data_store.bpmn": """
+  <bpmn:process id="shop" isExecutable="true">
+    <bpmn:ioSpecification id="io">
+      <bpmn:dataInput id="order_in" /><bpmn:dataOutput id="receipt_out" />
+      <bpmn:inputSet id="is"><bpmn:dataInputRefs>order_in</bpmn:dataInputRefs></bpmn:inputSet>
+      <bpmn:outputSet id="os"><bpmn:dataOutputRefs>receipt_out</bpmn:dataOutputRefs>
+      </bpmn:outputSet>
+    </bpmn:ioSpecification>
+    <bpmn:dataStore id="stock_store" name="Stock" />
+    <bpmn:dataStoreReference id="stock" dataStoreRef="stock_store" />
+    <bpmn:startEvent id="start" />
+    <bpmn:task id="pick" name="Pick">
+      <bpmn:property id="pick_in" name="__targetRef_placeholder" />
+      <bpmn:dataInputAssociation id="a1"><bpmn:sourceRef>stock</bpmn:sourceRef>
+        <bpmn:targetRef>pick_in</bpmn:targetRef></bpmn:dataInputAssociation>
+      <bpmn:dataInputAssociation id="a2"><bpmn:sourceRef>order_in</bpmn:sourceRef>
+        <bpmn:targetRef>pick_in</bpmn:targetRef></bpmn:dataInputAssociation>
+      <bpmn:dataOutputAssociation id="a3"><bpmn:targetRef>receipt_out</bpmn:targetRef>
+      </bpmn:dataOutputAssociation>
+    </bpmn:task>
+    <bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="pick" />
+    <bpmn:sequenceFlow id="f2" sourceRef="pick" targetRef="end" />
+  </bpmn:process>""",
+    # Lanes, two pools, a message flow between them, and a process in no pool.
+    "pools.bpmn": """
+  <bpmn:collaboration id="c">
+    <bpmn:participant id="p1" name="Rover" processRef="rover" />
+    <bpmn:participant id="p2" name="Base" processRef="base" />
+    <bpmn:messageFlow id="m1" sourceRef="send" targetRef="base_start" />
+  </bpmn:collaboration>
+  <bpmn:process id="rover" isExecutable="true">
+    <bpmn:laneSet id="ls"><bpmn:lane id="l1" name="Arm">
+      <bpmn:flowNodeRef>start</bpmn:flowNodeRef><bpmn:flowNodeRef>send</bpmn:flowNodeRef>
+    </bpmn:lane></bpmn:laneSet>
+    <bpmn:startEvent id="start" /><bpmn:task id="send" name="Send" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="send" />
+  </bpmn:process>
+  <bpmn:process id="base" isExecutable="true">
+    <bpmn:startEvent id="base_start" /><bpmn:endEvent id="base_end" />
+    <bpmn:sequenceFlow id="f2" sourceRef="base_start" targetRef="base_end" />
+  </bpmn:process>
+  <bpmn:process id="spare" isExecutable="false">
+    <bpmn:startEvent id="s" />
+  </bpmn:process>""",
+    # Camunda: an execution listener and two unconditioned flows out of an exclusive gateway.
+    "listener.bpmn": """
+  <bpmn:process id="cam" isExecutable="true">
+    <bpmn:startEvent id="start" />
+    <bpmn:task id="work" name="Work">
+      <bpmn:extensionElements>
+        <camunda:executionListener class="org.example.Audit" event="start" />
+      </bpmn:extensionElements>
+    </bpmn:task>
+    <bpmn:exclusiveGateway id="choice" />
+    <bpmn:endEvent id="e1" /><bpmn:endEvent id="e2" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="work" />
+    <bpmn:sequenceFlow id="f2" sourceRef="work" targetRef="choice" />
+    <bpmn:sequenceFlow id="f3" sourceRef="choice" targetRef="e1" />
+    <bpmn:sequenceFlow id="f4" sourceRef="choice" targetRef="e2" />
+  </bpmn:process>""",
+}
+
+#: files with gaps robotale must name, all of them at once
+GAPS = {
+    # An empty timeDate, a FEEL condition and an XPath condition (the file's language).
+    "gaps.bpmn": (
+        ' expressionLanguage="http://www.w3.org/1999/XPath"',
+        """
+  <bpmn:process id="gappy" isExecutable="true">
+    <bpmn:startEvent id="start" />
+    <bpmn:intermediateCatchEvent id="wait" name="Wait">
+      <bpmn:timerEventDefinition id="t"><bpmn:timeDate xsi:type="bpmn:tFormalExpression" />
+      </bpmn:timerEventDefinition>
+    </bpmn:intermediateCatchEvent>
+    <bpmn:exclusiveGateway id="choice" default="f5" />
+    <bpmn:endEvent id="e1" /><bpmn:endEvent id="e2" /><bpmn:endEvent id="e3" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="wait" />
+    <bpmn:sequenceFlow id="f2" sourceRef="wait" targetRef="choice" />
+    <bpmn:sequenceFlow id="f3" sourceRef="choice" targetRef="e1">
+      <bpmn:conditionExpression xsi:type="bpmn:tFormalExpression"
+        language="https://www.omg.org/spec/DMN/20191111/FEEL/"
+        >amount &gt; 10</bpmn:conditionExpression>
+    </bpmn:sequenceFlow>
+    <bpmn:sequenceFlow id="f4" sourceRef="choice" targetRef="e2">
+      <bpmn:conditionExpression xsi:type="bpmn:tFormalExpression"
+        >count(//item) &gt; 1</bpmn:conditionExpression>
+    </bpmn:sequenceFlow>
+    <bpmn:sequenceFlow id="f5" sourceRef="choice" targetRef="e3" />
+  </bpmn:process>""",
+    ),
+}
+
+
+def write(folder: Path, name: str, body: str, attributes: str = "") -> Path:
+    path = folder / name
+    path.write_text(HEAD.format(attributes=attributes) + body + "\n</bpmn:definitions>\n")
+    return path
+
+
+@pytest.mark.parametrize("name", sorted(FILES))
+def test_valid_files_pass_the_check(tmp_path, capsys, name):
+    path = write(tmp_path, name, FILES[name])
+    code = main(["fame", "check", str(path)])
+    out = capsys.readouterr().out
+    assert code == 0, out
+    assert "structure: ok" in out
+
+
+def test_processes_outside_pools_are_named_as_not_run(tmp_path, capsys):
+    path = write(tmp_path, "pools.bpmn", FILES["pools.bpmn"])
+    main(["fame", "check", str(path)])
+    out = capsys.readouterr().out
+    assert "pools Rover, Base" in out
+    assert f"warning: {path}:22: process spare is in no pool: it is not run" in out
+
+
+def test_silent_choices_are_warnings(tmp_path, capsys):
+    path = write(tmp_path, "listener.bpmn", FILES["listener.bpmn"])
+    main(["fame", "check", str(path)])
+    warnings = [line for line in capsys.readouterr().out.splitlines() if "warning" in line]
+    assert warnings == [
+        f"warning: {path}:8: task work (Work): camunda:executionListener is ignored (not run)",
+        f"warning: {path}:13: exclusiveGateway choice has 2 outgoing flows without a "
+        "condition (f3, f4): the engine takes the first, f3",
+    ]
+
+
+def test_every_gap_of_a_file_is_named_at_once(tmp_path, capsys):
+    attributes, body = GAPS["gaps.bpmn"]
+    path = write(tmp_path, "gaps.bpmn", body, attributes)
+    assert main(["fame", "check", str(path)]) == 1
+    out = capsys.readouterr().out
+    problems = [line.strip() for line in out.splitlines() if line.startswith("  gappy")]
+    assert problems == [
+        "gappy: intermediateCatchEvent wait (Wait) is a timer without a date, duration or cycle",
+        "gappy: sequence flow f3 has a condition the engine cannot run: it is in "
+        "'https://www.omg.org/spec/dmn/20191111/feel/', an expression language robotale does "
+        "not evaluate (it evaluates python or javascript)",
+        "gappy: sequence flow f4 has a condition the engine cannot run: it is in "
+        "'http://www.w3.org/1999/xpath', an expression language robotale does not evaluate "
+        "(it evaluates python or javascript)",
+    ]
+    assert "Python syntax error" not in out
+
+
+def test_several_broken_references_are_reported_together(tmp_path, capsys):
+    body = """
+  <bpmn:collaboration id="c"><bpmn:participant id="p" processRef="ghost" /></bpmn:collaboration>
+  <bpmn:process id="real">
+    <bpmn:startEvent id="start" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="nowhere" />
+    <bpmn:task id="t"><bpmn:dataInputAssociation id="a">
+      <bpmn:sourceRef>missing</bpmn:sourceRef></bpmn:dataInputAssociation></bpmn:task>
+  </bpmn:process>"""
+    path = write(tmp_path, "broken.bpmn", body)
+    assert main(["fame", "check", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert err.splitlines() == [
+        f"robotale: {path}: 3 problems:",
+        f"{path}:9: sequence flow f1 is dangling: its target (nowhere) is not an element of "
+        "the same process or sub-process",
+        f"{path}:10: task t has a data association with missing, which is no data object, "
+        "data store, input, output or property of process real",
+        f"{path}:6: pool p refers to process ghost, which is not in the file (processes: real)",
+    ]
