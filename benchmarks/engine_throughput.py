@@ -4,7 +4,9 @@ Both engines run the same .bpmn files (written to a temporary folder): a sequenc
 tasks, and a parallel split of 10 script-task branches joined again. For each, the process is
 parsed once and then instantiated and run to completion again and again; the figures are
 process instances and flow nodes per second, and robotale's throughput as a multiple of
-SpiffWorkflow's measured in the same run (target: at least 10x).
+SpiffWorkflow's measured in the same run (target: at least 10x). The sequence runs a second
+time with the same scripts in JavaScript (FAME's ``this.environment.variables.value_<i> = <i>
+* 2; next();``) in the embedded engine (target: at least half the Python throughput).
 
 Then the latency of a signal: one engine throws ``ping`` once a simulated second, another
 catches it; the wall time from the throw to the catching token moving, on the in-process bus
@@ -42,10 +44,17 @@ FOOTER = '<bpmn:endEvent id="end" />\n</bpmn:process>\n</bpmn:definitions>\n'
 TASKS = 10
 
 
-def script_task(i: int) -> str:
+#: the same assignment in each script language
+SCRIPTS = {
+    "python": "value_{i} = {i} * 2",
+    "javascript": "this.environment.variables.value_{i} = {i} * 2; next();",
+}
+
+
+def script_task(i: int, language: str = "python") -> str:
     return (
-        f'<bpmn:scriptTask id="task_{i}" name="Task {i}" scriptFormat="python">'
-        f"<bpmn:script>value_{i} = {i} * 2</bpmn:script></bpmn:scriptTask>\n"
+        f'<bpmn:scriptTask id="task_{i}" name="Task {i}" scriptFormat="{language}">'
+        f"<bpmn:script>{SCRIPTS[language].format(i=i)}</bpmn:script></bpmn:scriptTask>\n"
     )
 
 
@@ -56,9 +65,9 @@ def flow(source: str, target: str) -> str:
     )
 
 
-def sequential() -> str:
+def sequential(language: str = "python") -> str:
     chain = ["start", *[f"task_{i}" for i in range(TASKS)], "end"]
-    body = "".join(script_task(i) for i in range(TASKS))
+    body = "".join(script_task(i, language) for i in range(TASKS))
     return HEADER + body + "".join(flow(a, b) for a, b in itertools.pairwise(chain)) + FOOTER
 
 
@@ -184,6 +193,7 @@ def main() -> int:
         models = {"sequential, 10 script tasks": (sequential(), TASKS + 2)}
         models["parallel split of 10 branches"] = (parallel(), TASKS + 4)
         print(f"{'model':32} {'engine':12} {'instances/s':>12} {'nodes/s':>12} {'ratio':>7}")
+        python = 0.0
         for label, (text, nodes) in tqdm(
             models.items(), desc="throughput", file=sys.stderr, leave=False
         ):
@@ -191,9 +201,17 @@ def main() -> int:
             path.write_text(text)
             ours = rate(robotale_runner(path), options.seconds)
             spiff = rate(spiff_runner(path), options.seconds)
+            python = python or ours
             for engine, value in (("robotale", ours), ("SpiffWorkflow", spiff)):
                 ratio = value / spiff
                 print(f"{label:32} {engine:12} {value:12.0f} {value * nodes:12.0f} {ratio:6.1f}x")
+        path = Path(folder) / "bench_js.bpmn"
+        path.write_text(sequential("javascript"))
+        js = rate(robotale_runner(path), options.seconds)
+        print(
+            f"{'sequential, JavaScript':32} {'robotale':12} {js:12.0f} {js * (TASKS + 2):12.0f} "
+            f"{js / python:6.2f}x of Python (target >= 0.5)"
+        )
         ping = Path(folder) / "ping.bpmn"
         ping.write_text(PING)
         latencies = signal_latencies(ping, options.messages)

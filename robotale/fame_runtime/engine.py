@@ -481,13 +481,18 @@ class Engine:
                 del self.variables[name]
         self._changed(script.writes)
 
-    def _run_javascript(self, token: _Token, node: NodePlan) -> None:
-        """A JavaScript script task completes when it calls ``next`` -- now or later, from a
-        callback -- so its token waits like a skill's (and its boundary events are armed)."""
-        self._arm_boundaries(token, node)
+    def _run_javascript(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        """A JavaScript script task completes when it calls ``next``: at once, like a Python
+        script, or later from a callback, its token waiting like a skill's meanwhile (with its
+        boundary events armed)."""
         generation = token.generation
+        now: list[str | None] = []  # next() called during the run: its error (or None)
+        running = True
 
         def done(error: str | None, _value: Any) -> None:
+            if running:
+                now.append(error)
+                return
             outcome = None if error is None else BpmnError(error)
             self._call(lambda: self._skill_done(token, generation, outcome))
 
@@ -495,7 +500,18 @@ class Engine:
             self.javascript.run_script(node.script.source, done)
         except ScriptFailure as failure:
             self._throw_error(token, f"script task {node.node.describe()}: {failure.text}")
-        return None
+            return None
+        finally:
+            running = False
+        if not now:
+            self._arm_boundaries(token, node)
+            return None
+        if now[0] is not None:
+            self._throw_error(token, now[0])
+            return None
+        self._tag(node.label, "complete")
+        self.data.outputs(node, {})
+        return self._follow(token, self._taken(node, first=False))
 
     def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")
