@@ -55,10 +55,10 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     the start events appear in the log).
 
     Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
-    completion), ``duration`` in seconds, ``finished`` and ``start_known``; for every column named in ``carry``
-    its value at the start as ``start_<column>`` (a battery level, say). A start that never
-    completes is an unfinished instance (no completion, no duration); a completion without a
-    start, and an instant event, starts when it completes.
+    completion), ``duration`` in seconds, ``finished`` and ``start_known``; for every column
+    named in ``carry`` its value at the start as ``start_<column>`` (a battery level, say). A
+    start that never completes is an unfinished instance (no completion, no duration); a
+    completion without a start, and an instant event, starts when it completes.
     """
     events = control_flow_events(log)
     if events.empty:

@@ -302,12 +302,16 @@ def _steady_rows(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
         return pd.DataFrame()
     excess = excess.assign(_id=excess.groupby(KEY, dropna=False, sort=False).ngroup())
     grouped = excess.groupby("_id")
-    table = grouped[KEY].first().join(
-        grouped.agg(
-            occurrences=("excess", "size"),
-            cases=(CASE, "nunique"),
-            total=("excess", "sum"),
-            mean=("excess", "mean"),
+    table = (
+        grouped[KEY]
+        .first()
+        .join(
+            grouped.agg(
+                occurrences=("excess", "size"),
+                cases=(CASE, "nunique"),
+                total=("excess", "sum"),
+                mean=("excess", "mean"),
+            )
         )
     )
     table["delay_per_case"] = table["total"] / len(cases)
@@ -407,12 +411,14 @@ def _figure(ranking: pd.DataFrame):
     import plotly.express as px
 
     shown = ranking.head(15).assign(
-        candidate=lambda t: t["kind"]
-        + ": "
-        + t["activity"].astype(str).map(lambda a: _short(a, 40))
-        + " ("
-        + t["robot"].fillna("-").astype(str)
-        + ")"
+        candidate=lambda t: (
+            t["kind"]
+            + ": "
+            + t["activity"].astype(str).map(lambda a: _short(a, 40))
+            + " ("
+            + t["robot"].fillna("-").astype(str)
+            + ")"
+        )
     )
     return px.bar(
         shown,

@@ -196,9 +196,11 @@ def _deliveries(
 ) -> pd.DataFrame:
     """One row per message and receiver, with the first receive by that receiver."""
     base = table[[*keys, TYPE, "sender", "sent_at"]]
-    if ROBOT in receives.columns and not receives.empty:
-        seen = receives.dropna(subset=[ROBOT]).groupby([*keys, ROBOT])[TIMESTAMP].min()
-        seen = seen.rename("received_at").reset_index().rename(columns={ROBOT: "receiver"})
+    receiver = _receiving_robot(receives)
+    if receiver is not None and not receives.empty:
+        receives = receives.assign(receiver=receiver).dropna(subset=["receiver"])
+        seen = receives.groupby([*keys, "receiver"])[TIMESTAMP].min()
+        seen = seen.rename("received_at").reset_index()
     else:
         seen = pd.DataFrame(columns=[*keys, "receiver", "received_at"])
     reached = base.merge(seen, on=keys)
@@ -211,6 +213,15 @@ def _deliveries(
     deliveries["received"] = deliveries["received_at"].notna()
     deliveries["lost"] = deliveries["sent_at"].notna() & ~deliveries["received"]
     return deliveries
+
+
+def _receiving_robot(receives: pd.DataFrame) -> pd.Series | None:
+    """Per receive event, who received: ``msg_receiver`` where set, else the event's robot."""
+    stated = receives[MSG_RECEIVER].astype(object) if MSG_RECEIVER in receives.columns else None
+    robot = receives[ROBOT].astype(object) if ROBOT in receives.columns else None
+    if stated is None or robot is None:
+        return stated if robot is None else robot
+    return stated.combine_first(robot)
 
 
 def _meant_for(missing, events, reached, keys) -> np.ndarray:

@@ -55,7 +55,10 @@ def performance_perspective(
     if activity is not None or robot is not None:
         steps = steps[_touches(steps, activity, robot)]
         in_focus = cases[CASE].isin(chosen[CASE])
-        cases, case_variants = cases[in_focus], case_variants[case_variants[CASE].isin(chosen[CASE])]
+        cases, case_variants = (
+            cases[in_focus],
+            case_variants[case_variants[CASE].isin(chosen[CASE])],
+        )
         robot_variants = _robot_focus(robot_variants, chosen)
         robots = robots[robots[CASE].isin(chosen[CASE])]
     waiting = transition_waits(steps)
