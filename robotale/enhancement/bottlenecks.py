@@ -238,22 +238,55 @@ def _waiting(steps: pd.DataFrame, instances: pd.DataFrame, receives: set[str]):
 
 def _resource_overlap(waits: pd.DataFrame, instances: pd.DataFrame) -> pd.Series:
     """Per wait, the seconds during which another robot of the case did the activity waited
-    for (at most the wait itself)."""
+    for. The waiting robot runs nothing while it waits, so the time the activity was busy at
+    all (the union of its instances in the case) during the wait is the queueing."""
     shared = instances.groupby([CASE, ACTIVITY], dropna=False)[ROBOT].transform("nunique") > 1
-    busy = instances.loc[shared, [CASE, ACTIVITY, ROBOT, START_TIMESTAMP, TIMESTAMP]]
-    candidates = waits[waits["target"].isin(busy[ACTIVITY].unique())]
-    if busy.empty or candidates.empty:
+    busy = instances.loc[shared, [CASE, ACTIVITY, START_TIMESTAMP, TIMESTAMP]]
+    if busy.empty or waits.empty:
         return pd.Series(0.0, index=waits.index)
-    pairs = candidates[[CASE, ROBOT, "target", "source_end", "target_start"]].reset_index()
-    pairs = pairs.merge(
-        busy.rename(columns={ACTIVITY: "target", ROBOT: "_other"}), on=[CASE, "target"]
+    origin = busy[START_TIMESTAMP].min()
+    groups = pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)).unique()
+    busy_group = groups.get_indexer(pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)))
+    wait_group = groups.get_indexer(
+        pd.MultiIndex.from_arrays([waits[CASE].astype(str), waits["target"].astype(str)])
     )
-    pairs = pairs[pairs[ROBOT] != pairs["_other"]]
-    begin = np.maximum(pairs["source_end"], pairs[START_TIMESTAMP])
-    end = np.minimum(pairs["target_start"], pairs[TIMESTAMP])
-    overlap = (end - begin).dt.total_seconds().clip(lower=0)
-    total = overlap.groupby(pairs["index"]).sum().reindex(waits.index, fill_value=0.0)
-    return np.minimum(total, waits[WAIT])
+    span = float((busy[TIMESTAMP].max() - origin).total_seconds()) + 1.0
+    starts, lengths, cumulative = _busy_union(
+        busy_group, _seconds(busy[START_TIMESTAMP], origin), _seconds(busy[TIMESTAMP], origin), span
+    )
+    known = wait_group >= 0
+    offset = wait_group[known] * span
+
+    def busy_until(times: pd.Series) -> np.ndarray:
+        at = _seconds(times[known], origin) + offset
+        k = np.searchsorted(starts, at, side="right") - 1
+        inside = np.clip(at - starts[np.maximum(k, 0)], 0, lengths[np.maximum(k, 0)])
+        return np.where(k >= 0, cumulative[np.maximum(k, 0)] + inside, 0.0)
+
+    overlap = np.zeros(len(waits))
+    overlap[known] = busy_until(waits["target_start"]) - busy_until(waits["source_end"])
+    return pd.Series(np.minimum(overlap, waits[WAIT].to_numpy()), index=waits.index)
+
+
+def _seconds(times: pd.Series, origin: pd.Timestamp) -> np.ndarray:
+    return (times - origin).dt.total_seconds().to_numpy(float)
+
+
+def _busy_union(group: np.ndarray, begin: np.ndarray, end: np.ndarray, span: float):
+    """The union of each group's intervals on one axis (group g shifted by g * span): sorted
+    starts, lengths, and the busy time before each (a running total across groups)."""
+    begin, end = begin + group * span, end + group * span
+    order = np.argsort(begin, kind="stable")
+    begin, end = begin[order], end[order]
+    reach = np.maximum.accumulate(end)
+    new = np.ones(len(begin), dtype=bool)
+    new[1:] = begin[1:] > reach[:-1]
+    block = np.cumsum(new) - 1
+    starts = begin[new]
+    stops = pd.Series(end).groupby(block).max().to_numpy()
+    lengths = stops - starts
+    cumulative = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
+    return starts, lengths, cumulative
 
 
 def _rework(steps: pd.DataFrame, instances: pd.DataFrame) -> pd.DataFrame:

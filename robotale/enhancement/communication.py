@@ -313,7 +313,16 @@ def _distinct(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
 
 
 def _joined(deliveries: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
-    return deliveries.groupby(keys)[column].agg(lambda r: ", ".join(sorted(map(str, set(r)))))
+    """Per message, its distinct ``column`` values joined (most messages have one)."""
+    values = deliveries[[*keys, column]].astype({column: str}).drop_duplicates()
+    values = values.sort_values(column, kind="stable")
+    grouped = values.groupby(keys)[column]
+    joined = grouped.first()
+    several = grouped.size() > 1
+    if several.any():
+        many = values[_in(values, several[several].reset_index(), keys)]
+        joined.update(many.groupby(keys)[column].agg(", ".join))
+    return joined
 
 
 def _lookup(frame: pd.DataFrame, keys: list[str], values: pd.Series) -> pd.Series:

@@ -125,7 +125,7 @@ def robot_times(instances: pd.DataFrame, steps: pd.DataFrame) -> pd.DataFrame:
     table = grouped.agg(
         start=(START_TIMESTAMP, "min"), end=(TIMESTAMP, "max"), activities=(ACTIVITY, "size")
     )
-    table[VARIANT] = grouped[ACTIVITY].agg(lambda names: ARROW.join(map(str, names)))
+    table[VARIANT] = _paths(instances, keys)
     table["span"] = (table["end"] - table["start"]).dt.total_seconds()
     idle = steps.groupby(keys, sort=False, dropna=False)[[WAIT, GAP]].sum()
     table = table.join(idle)
@@ -156,9 +156,17 @@ def case_variant_table(instances: pd.DataFrame) -> pd.DataFrame:
     """Per case: its variant (every robot's activities in start order) and duration."""
     grouped = instances.groupby(CASE, sort=True)
     table = grouped.agg(start=(START_TIMESTAMP, "min"), end=(TIMESTAMP, "max"))
-    table[VARIANT] = grouped[ACTIVITY].agg(lambda names: ARROW.join(map(str, names)))
+    table[VARIANT] = _paths(instances, [CASE])
     table["duration"] = (table["end"] - table["start"]).dt.total_seconds()
     return table.reset_index()
+
+
+def _paths(instances: pd.DataFrame, keys: list[str]) -> pd.Series:
+    """Per group, its activities in start order joined by arrows (summing the strings keeps
+    the join vectorised)."""
+    names = instances[ACTIVITY].astype(str) + ARROW
+    joined = names.groupby([instances[k] for k in keys], sort=True, dropna=False).sum()
+    return joined.str.slice(stop=-len(ARROW))
 
 
 def robot_variant_table(robots: pd.DataFrame) -> pd.DataFrame:
@@ -252,14 +260,20 @@ def _transition_name(row: pd.Series) -> str:
 
 
 def _durations_figure(instances: pd.DataFrame):
-    import plotly.express as px
+    """Box plots of working time per activity, one colour per robot (plain traces: plotly
+    express spends seconds preparing a large frame)."""
+    import plotly.graph_objects as go
 
-    return px.box(
-        instances.rename(columns={ACTIVITY: "activity"}),
-        x="activity",
-        y=DURATION,
-        color=ROBOT if ROBOT in instances.columns else None,
-        title="Activity durations: working time (s)",
+    figure = go.Figure()
+    robots = (
+        instances.groupby(ROBOT, sort=True) if ROBOT in instances.columns else [("", instances)]
+    )
+    for robot, mine in robots:
+        figure.add_box(
+            x=mine[ACTIVITY].astype(str).to_numpy(), y=mine[DURATION].to_numpy(), name=str(robot)
+        )
+    return figure.update_layout(
+        boxmode="group", title="Activity durations: working time (s)", yaxis_title=DURATION
     )
 
 
