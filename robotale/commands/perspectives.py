@@ -46,10 +46,19 @@ def _headline(name: str, summary: dict) -> str:
     if name == "communication":
         return (
             f"{summary['messages']} messages, {summary['received']} received, "
-            f"{summary['lost']} lost, {summary['resends']} resends"
+            f"{summary['lost']} lost, {summary['resends']} resends "
+            f"({summary.get('resends_new_id', 0)} under a new id), "
+            f"{summary.get('delayed', 0)} delayed, {summary.get('channels', 0)} channels"
         )
     if name == "battery":
-        return f"{summary['low_battery_events']} low-battery events"
+        energy = summary.get("energy_per_case_mean")
+        used = summary.get("battery_levels") if energy is None else f"{energy:.1f}% used per case"
+        return f"{summary['low_battery_events']} low-battery events; {used}"
     if name == "performance":
-        return f"{summary['cases']} cases, slowest transition {summary['slowest_transition']}"
+        share = summary.get("waiting_share")
+        waiting = "" if share is None else f", robots wait {share:.0%} of their time"
+        return (
+            f"{summary['cases']} cases, {summary.get('variants', 0)} variants{waiting}, "
+            f"slowest transition {summary['slowest_transition']}"
+        )
     return f"first: {summary['first']}"

@@ -36,6 +36,9 @@ START_TIMESTAMP = "start_timestamp"
 INSTANCE_KEYS = ("execution_id", "concept:instance", MSG_ID)
 DURATION = "duration"
 FINISHED = "finished"
+#: False for a completion whose start the log does not have: its duration is unknown (0 here),
+#: so the time before it mixes the activity's own work with any wait.
+START_KNOWN = "start_known"
 
 
 def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
@@ -52,10 +55,10 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     the start events appear in the log).
 
     Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
-    completion), ``duration`` in seconds and ``finished``; for every column named in ``carry``
-    its value at the start as ``start_<column>`` (a battery level, say). A start that never
-    completes is an unfinished instance (no completion, no duration); a completion without a
-    start, and an instant event, starts when it completes.
+    completion), ``duration`` in seconds, ``finished`` and ``start_known``; for every column
+    named in ``carry`` its value at the start as ``start_<column>`` (a battery level, say). A
+    start that never completes is an unfinished instance (no completion, no duration); a
+    completion without a start, and an instant event, starts when it completes.
     """
     events = control_flow_events(log)
     if events.empty:
@@ -80,11 +83,13 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
         values = paired_starts[column].set_axis(finished.index[paired])
         finished.loc[paired, renamed] = values
     finished[FINISHED] = True
+    finished[START_KNOWN] = paired | (lifecycle[anchors] == "none").to_numpy()
     unfinished = events[starts & ~_consumed_starts(group.to_numpy(), starts, matched)].copy()
     for column, renamed in from_start.items():
         unfinished[renamed] = unfinished[column]
     unfinished[TIMESTAMP] = pd.Series(pd.NaT, index=unfinished.index, dtype=events[TIMESTAMP].dtype)
     unfinished[FINISHED] = False
+    unfinished[START_KNOWN] = True
 
     instances = pd.concat([finished, unfinished])
     instances[DURATION] = (instances[TIMESTAMP] - instances[START_TIMESTAMP]).dt.total_seconds()
@@ -151,4 +156,5 @@ def _empty_instances(log: pd.DataFrame) -> pd.DataFrame:
     empty[START_TIMESTAMP] = pd.Series(dtype=log[TIMESTAMP].dtype)
     empty[DURATION] = pd.Series(dtype=float)
     empty[FINISHED] = pd.Series(dtype=bool)
+    empty[START_KNOWN] = pd.Series(dtype=bool)
     return empty

@@ -1,19 +1,31 @@
-"""Battery: level over time per robot, consumption per activity, low-battery events.
+"""Battery: level over time per robot, what each activity drains, low-battery events and what
+they caused, energy per case.
 
-``battery`` is a percentage (0-100). A low-battery event is the moment a robot's level falls
-below the threshold (once per fall, per case), or an event of the activity that tags it, such
-as the thesis' ``low_battery``. For each the perspective lists what the robot did next.
+``battery`` is a percentage (0-100). An activity's use is its working time only: the level at
+its start minus the level at its completion (the events' own levels, else the robot's last
+sample before). What a robot uses while it waits between activities is its ``waiting`` row, so
+idle drain never lands on the activity that follows. A low-battery event is the moment a
+robot's level falls below the threshold (once per fall, per case), or an event of the activity
+that tags it, such as the thesis' ``low_battery``; for each the perspective lists what the
+robot did next. Energy per case: per robot, the percentage points it used (every fall of its
+level added up) and charged (every rise). A log without battery levels says so; its figures
+are missing, never 0.
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
+from robotale.enhancement.performance import WAIT, robot_steps
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, LIFECYCLE, ROBOT, START, TIMESTAMP
 
 LOW_ACTIVITY = "low_battery"
+NO_LEVELS = "no battery levels"
+#: the row of the consumption table for what a robot uses between its activities
+IDLE = "(waiting)"
 
 
 def battery_perspective(
@@ -30,7 +42,7 @@ def battery_perspective(
     levels = _levels(log)
     lows = low_battery_events(log, threshold=threshold, low_activity=low_activity)
     if levels.empty and lows.empty:
-        return no_data("battery", "the log has no battery levels and no low-battery events.")
+        return no_data("battery", f"the log has {NO_LEVELS} and no low-battery events.")
     lows = _with_what_followed(lows, log, following)
     focused = focus_events(levels, activity, robot) if not levels.empty else levels
     if activity is not None or robot is not None:
@@ -38,14 +50,21 @@ def battery_perspective(
         if focused.empty and lows.empty:
             return no_data("battery", f"no battery data for {focus_label(activity, robot)}.")
     consumption = activity_consumption(log, activity=activity, robot=robot)
+    energy = case_energy(focused)
     return Perspective(
         name="battery",
-        tables={"consumption": consumption, "low_battery": lows, "levels": _level_table(focused)},
+        tables={
+            "consumption": consumption,
+            "low_battery": lows,
+            "energy": energy,
+            "levels": _level_table(focused),
+        },
         figures={"levels": _levels_figure(focused, lows)},
         summary={
             "robots": sorted(focused[ROBOT].dropna().unique()) if ROBOT in focused else [],
             "low_battery_events": len(lows),
             "threshold": threshold,
+            **_energy_summary(consumption, energy),
         },
     )
 
@@ -68,28 +87,125 @@ def low_battery_events(
 def activity_consumption(
     log: pd.DataFrame, *, activity: str | None = None, robot: str | None = None
 ) -> pd.DataFrame:
-    """Per activity and robot: the battery percentage points its instances used, in total,
-    per instance and per minute (from the level at its start to the level at its end)."""
-    if BATTERY not in log.columns or log[BATTERY].isna().all():
+    """Per activity and robot: the battery percentage points its instances used over their
+    working time, in total, per instance and per minute, and the level at their starts; a
+    ``(waiting)`` row per robot for what it used while idle between activities."""
+    levels = _levels(log)
+    if levels.empty:
         return pd.DataFrame()
-    instances = activity_instances(focus_events(log, activity, robot), carry=[BATTERY])
-    instances = instances[instances[FINISHED]].dropna(subset=[BATTERY, f"start_{BATTERY}"])
-    if instances.empty:
+    instances = activity_instances(log, carry=[BATTERY])
+    instances = instances[instances[FINISHED]]
+    instances = _fill_levels(instances, levels)
+    idle = _idle_use(instances, levels)
+    chosen = focus_events(instances, activity, robot).dropna(subset=[BATTERY, f"start_{BATTERY}"])
+    if chosen.empty:
         return pd.DataFrame()
-    instances = instances.assign(used=instances[f"start_{BATTERY}"] - instances[BATTERY])
-    keys = [ACTIVITY] + ([ROBOT] if ROBOT in instances.columns else [])
-    table = instances.groupby(keys, sort=True).agg(
-        instances=("used", "size"), used=("used", "sum"), seconds=(DURATION, "sum")
+    chosen = chosen.assign(used=chosen[f"start_{BATTERY}"] - chosen[BATTERY])
+    keys = [ACTIVITY] + ([ROBOT] if ROBOT in chosen.columns else [])
+    table = chosen.groupby(keys, sort=True).agg(
+        instances=("used", "size"),
+        used=("used", "sum"),
+        seconds=(DURATION, "sum"),
+        start_level_mean=(f"start_{BATTERY}", "mean"),
+        start_level_min=(f"start_{BATTERY}", "min"),
     )
+    table = table.reset_index()
+    if activity is None and not idle.empty:
+        mine = idle if robot is None or ROBOT not in idle.columns else idle[idle[ROBOT] == robot]
+        table = pd.concat([table, mine], ignore_index=True)
     table["used_per_instance"] = table["used"] / table["instances"]
     table["used_per_minute"] = table["used"] / (table["seconds"] / 60).where(table["seconds"] > 0)
-    return table.reset_index().rename(columns={ACTIVITY: "activity"})
+    return table.rename(columns={ACTIVITY: "activity"})
+
+
+def case_energy(levels: pd.DataFrame) -> pd.DataFrame:
+    """Per case and robot: levels at its first and last sample, lowest level, percentage
+    points used (falls added up) and charged (rises added up)."""
+    keys = [k for k in (CASE, ROBOT) if k in levels.columns]
+    if levels.empty or not keys:
+        return pd.DataFrame()
+    change = levels.groupby(keys, sort=False)[BATTERY].diff()
+    grouped = levels.assign(_fall=(-change).clip(lower=0), _rise=change.clip(lower=0)).groupby(
+        keys, sort=True
+    )
+    return grouped.agg(
+        first_level=(BATTERY, "first"),
+        last_level=(BATTERY, "last"),
+        lowest_level=(BATTERY, "min"),
+        used=("_fall", "sum"),
+        charged=("_rise", "sum"),
+    ).reset_index()
+
+
+def _fill_levels(instances: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
+    """Levels at an instance's start and completion where its events carry none: the robot's
+    last sample at or before that time."""
+    keys = [k for k in (CASE, ROBOT) if k in instances.columns and k in levels.columns]
+    samples = levels[[*keys, TIMESTAMP, BATTERY]].dropna().sort_values(TIMESTAMP, kind="stable")
+    filled = instances.copy()
+    for when, column in ((START_TIMESTAMP, f"start_{BATTERY}"), (TIMESTAMP, BATTERY)):
+        missing = filled[column].isna() & filled[when].notna()
+        if not missing.any():
+            continue
+        wanted = filled.loc[missing, [*keys, when]].rename(columns={when: TIMESTAMP})
+        wanted = wanted.reset_index().sort_values(TIMESTAMP, kind="stable")
+        found = pd.merge_asof(wanted, samples, on=TIMESTAMP, by=keys or None)
+        filled.loc[found["index"], column] = found[BATTERY].to_numpy()
+    return filled
+
+
+def _idle_use(instances: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
+    """Per robot, what it used between its activities: the level at one activity's completion
+    minus the level at the next one's start, over the waits between them."""
+    if ROBOT not in instances.columns:
+        return pd.DataFrame()
+    steps = robot_steps(instances).dropna(subset=[WAIT])
+    steps = steps[steps[WAIT] > 0]
+    if steps.empty:
+        return pd.DataFrame()
+    probe = pd.DataFrame(
+        {
+            CASE: steps[CASE],
+            ROBOT: steps[ROBOT],
+            START_TIMESTAMP: steps["source_end"],
+            TIMESTAMP: steps["target_start"],
+            f"start_{BATTERY}": np.nan,
+            BATTERY: np.nan,
+        }
+    )
+    probe = _fill_levels(probe, levels).dropna(subset=[BATTERY, f"start_{BATTERY}"])
+    probe = probe.assign(used=probe[f"start_{BATTERY}"] - probe[BATTERY], seconds=steps[WAIT])
+    table = probe.groupby(ROBOT, sort=True).agg(
+        instances=("used", "size"), used=("used", "sum"), seconds=("seconds", "sum")
+    )
+    return table.reset_index().assign(**{ACTIVITY: IDLE})
+
+
+def _energy_summary(consumption: pd.DataFrame, energy: pd.DataFrame) -> dict:
+    if energy.empty:
+        return {"battery_levels": f"the log has {NO_LEVELS}"}
+    per_case = energy.groupby(CASE)["used"].sum() if CASE in energy.columns else energy["used"]
+    summary = {
+        "energy_used": float(energy["used"].sum()),
+        "energy_per_case_mean": float(per_case.mean()),
+    }
+    if not consumption.empty:
+        idle = consumption["activity"] == IDLE
+        work = consumption[~idle].sort_values("used", ascending=False)
+        summary["most_used_by"] = None if work.empty else str(work["activity"].iloc[0])
+        summary["used_while_waiting"] = float(consumption.loc[idle, "used"].sum())
+    return summary
 
 
 def _levels(log: pd.DataFrame) -> pd.DataFrame:
+    """The rows with a battery level (samples included), in time order; none when the column
+    is missing, empty or 0 throughout (a reader's filler, not a robot running on empty)."""
     if BATTERY not in log.columns:
         return log.iloc[0:0]
-    return log.dropna(subset=[BATTERY]).sort_values(TIMESTAMP, kind="stable")
+    levels = log.dropna(subset=[BATTERY])
+    if levels.empty or levels[BATTERY].eq(0).all():
+        return log.iloc[0:0]
+    return levels.sort_values(TIMESTAMP, kind="stable")
 
 
 def _threshold_crossings(levels: pd.DataFrame, threshold: float) -> pd.DataFrame:

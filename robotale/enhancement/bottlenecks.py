@@ -1,37 +1,64 @@
-"""Bottlenecks: what makes cases slower than they need to be, ranked by the time it costs them.
+"""Bottlenecks: what makes cases slower, ranked by the seconds it adds per case.
 
-Long work is not a bottleneck when it always takes as long as it must; what costs time is the
-part that need not be there. Each candidate is an activity of a robot (a class of the
-activity+robot model), with its excess time per occurrence:
+Two sorts of candidate, one ranking (``delay_per_case``: how much longer, on average over all
+cases, the cases take because of it):
+
+Effects, measured by comparing the cases with a thing against the cases without it: an
+activity of a robot (a class of the activity+robot model), a transition (a robot going from
+one activity to the next), a rework loop (a robot doing an activity more than once in a case)
+and a variant (a robot's whole path through a case; a case's path when several cases share
+one). Its cost is the extra mean duration of the cases with it times the share of cases with
+it. Nothing is special-cased by its name: an optional activity that only waits ranks high
+because the cases with it take longer, and an activity found in every case, however long,
+has no effect to measure. Candidates found in exactly the same cases are one row (the
+simplest one named, the others in ``also``).
+
+Steady costs, time that need not be there in any case that has it:
 
 - waiting: the robot idles before the activity (its previous activity completed, this one has
-  not started); no wait is needed, so all of it is excess. Waiting to receive a message is
-  not counted: the receiver is idle until another robot sends, and what holds the sender up
-  shows among the sender's own candidates (and the message's queueing);
+  not started). Never its own duration, and not waiting to receive a message: the receiver is
+  idle until another robot sends, and what holds the sender up shows among its own candidates;
+- resource: the part of that wait during which another robot of the case was doing the same
+  activity (queueing for a shared resource, such as one charging station);
 - rework: the robot does the activity again right after doing it, for the same message if it
-  is a message activity (a resend, a retry): the repeat and the wait before it are excess;
-- delay: the activity took longer than it can take, i.e. than its fastest runs (the
-  ``baseline_quantile`` of its durations, 10% by default);
+  is a message activity (a resend, a retry): the repeat and the wait before it;
+- delay: the activity took longer than its fastest runs (the ``baseline_quantile`` of its
+  durations, 10% by default);
 - queueing: a message waited from its first send to its first receive.
 
-A candidate's cost is its excess summed over the cases and divided by the number of cases:
-how much longer, on average, the cases take because of it (candidates may overlap: a resent
-message is rework for its sender and queueing for the message). The table also gives how much
-longer the cases in which it happens take than the others (``longer_by``) when both exist.
+Their cost is their excess summed over the cases and divided by the number of cases. For every
+row ``longer_by`` / ``extra_median`` say how much longer (mean / median) the cases with it (for
+a steady cost: the cases it hits hardest, above its median case) take than the others, and
+``p_value`` how sure that is (Mann-Whitney U, see :mod:`robotale.enhancement.effects`).
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
 from robotale.discovery.graph import format_seconds
-from robotale.discovery.instances import DURATION
+from robotale.discovery.instances import DURATION, START_TIMESTAMP
 from robotale.enhancement.communication import TYPE, message_table
-from robotale.enhancement.performance import WAIT, case_durations, finished_instances, robot_steps
+from robotale.enhancement.effects import compare_cases
+from robotale.enhancement.performance import (
+    ARROW,
+    VARIANT,
+    WAIT,
+    case_durations,
+    case_variant_table,
+    finished_instances,
+    robot_steps,
+    robot_times,
+)
 from robotale.enhancement.result import Perspective, focus_label, no_data
-from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, message_roles
+from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP, message_roles
 
-KINDS = ("waiting", "rework", "delay", "queueing")
+#: effect candidates, simplest first (the one named when several share their cases)
+EFFECTS = ("activity", "loop", "transition", "variant")
+STEADY = ("waiting", "resource", "rework", "delay", "queueing")
+KINDS = EFFECTS + STEADY
+KEY = ["kind", "activity", "robot"]
 
 
 def find_bottlenecks(
@@ -40,42 +67,150 @@ def find_bottlenecks(
     activity: str | None = None,
     robot: str | None = None,
     baseline_quantile: float = 0.1,
+    min_variant_cases: int = 2,
     top: int | None = None,
 ) -> Perspective:
     """Bottlenecks ranked by how much longer they make the cases (seconds per case), largest
-    first; ``activity`` / ``robot`` keep the candidates of one activity or class."""
+    first; ``activity`` / ``robot`` keep the candidates of one activity or class. A variant is
+    a candidate when at least ``min_variant_cases`` cases follow it."""
     instances = finished_instances(log)
     if instances.empty:
         return no_data("bottlenecks", "the log has no completed activity.")
     if ROBOT not in instances.columns:
         instances = instances.assign(**{ROBOT: None})
     steps = robot_steps(instances)
-    excess = pd.concat(
-        [
-            _waiting(steps, _receive_activities(instances)),
-            _rework(steps, instances),
-            _delays(instances, baseline_quantile),
-            _queueing(log),
-        ]
-    )
-    excess = excess[excess["excess"] > 0]
-    if activity is not None:
-        excess = excess[excess["activity"] == activity]
-    if robot is not None:
-        excess = excess[excess["robot"] == robot]
-    if excess.empty:
+    cases = case_durations(instances).set_index(CASE)["duration"]
+    presence = _keep(_presence(instances, steps, min_variant_cases), activity, robot)
+    excess = _keep(_steady_excess(log, instances, steps, baseline_quantile), activity, robot)
+    parts = [_effect_rows(presence, cases), _steady_rows(excess, cases)]
+    parts = [part for part in parts if not part.empty]
+    ranking = pd.concat(parts) if parts else pd.DataFrame({"delay_per_case": []})
+    if not (ranking["delay_per_case"] > 0).any():
         return no_data(
             "bottlenecks", f"nothing delays the cases of {focus_label(activity, robot)}."
         )
-    ranking = _rank(excess, case_durations(instances))
+    ranking = _order(ranking[ranking["delay_per_case"] > 0], float(cases.sum()))
     if top is not None:
         ranking = ranking.head(top)
+    first = ranking.iloc[0]
     return Perspective(
         name="bottlenecks",
         tables={"bottlenecks": ranking},
         figures={"bottlenecks": _figure(ranking)},
-        summary={"first": ranking.iloc[0]["explanation"], "candidates": len(ranking)},
+        summary={
+            "first": first["explanation"],
+            "first_kind": first["kind"],
+            "first_delay_per_case": float(first["delay_per_case"]),
+            "candidates": len(ranking),
+            "cases": len(cases),
+        },
     )
+
+
+def _keep(rows: pd.DataFrame, activity: str | None, robot: str | None) -> pd.DataFrame:
+    if activity is not None:
+        rows = rows[rows["activity"] == activity]
+    if robot is not None:
+        rows = rows[rows["robot"] == robot]
+    return rows
+
+
+# -- effects: the cases with a thing against the cases without it ----------------------------
+
+
+def _presence(instances: pd.DataFrame, steps: pd.DataFrame, min_variant_cases: int):
+    """Rows of kind, activity, robot, case and occurrences: where each effect candidate is."""
+    per_class = instances.groupby([ACTIVITY, ROBOT, CASE], dropna=False, sort=False).size()
+    activities = _labelled(per_class, "activity")
+    loops = _labelled(per_class[per_class > 1] - 1, "loop")
+    moves = steps.groupby(["source", "target", ROBOT, CASE], dropna=False, sort=False).size()
+    moves = moves.reset_index(name="occurrences")
+    transitions = pd.DataFrame(
+        {
+            "kind": "transition",
+            "activity": moves["source"].astype(str) + ARROW + moves["target"].astype(str),
+            "robot": moves[ROBOT],
+            CASE: moves[CASE],
+            "occurrences": moves["occurrences"],
+        }
+    )
+    paths = robot_times(instances, steps)[[ROBOT, CASE, VARIANT]]
+    if paths[CASE].duplicated().any():  # several robots: their own paths and the case's
+        paths = pd.concat([paths, case_variant_table(instances).assign(**{ROBOT: None})])
+    paths = paths[[ROBOT, CASE, VARIANT]]
+    common = paths.groupby([VARIANT, ROBOT], dropna=False)[CASE].transform("size")
+    paths = paths[common >= min_variant_cases]
+    variants = pd.DataFrame(
+        {
+            "kind": "variant",
+            "activity": paths[VARIANT],
+            "robot": paths[ROBOT],
+            CASE: paths[CASE],
+            "occurrences": 1,
+        }
+    )
+    return pd.concat([activities, loops, transitions, variants], ignore_index=True)
+
+
+def _labelled(counts: pd.Series, kind: str) -> pd.DataFrame:
+    table = counts.reset_index(name="occurrences").rename(columns={ACTIVITY: "activity"})
+    return table.rename(columns={ROBOT: "robot"}).assign(kind=kind)
+
+
+def _effect_rows(presence: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
+    if presence.empty:
+        return pd.DataFrame()
+    presence = presence.assign(_id=presence.groupby(KEY, dropna=False, sort=False).ngroup())
+    stats = compare_cases(presence, "_id", cases)
+    stats = stats[(stats["cases_without"] > 0) & (stats["extra_mean"] > 0)]
+    if stats.empty:
+        return pd.DataFrame()
+    chosen = presence[presence["_id"].isin(stats.index)]
+    names = chosen.groupby("_id")[KEY].first()
+    table = names.join(stats).join(chosen.groupby("_id")["occurrences"].sum())
+    table = table.join(_same_cases(chosen, table))
+    table = table[table["_keep"]].drop(columns="_keep")
+    table["cases"] = table["cases_with"]
+    table["total"] = table["extra_mean"] * table["cases_with"]
+    table["mean"] = table["extra_mean"]
+    table["delay_per_case"] = table["total"] / len(cases)
+    return table.reset_index(drop=True)
+
+
+def _same_cases(chosen: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
+    """Candidates found in exactly the same cases are one: the simplest kind (then the shortest
+    name) is kept, and names the others in ``also``."""
+    signature = chosen.sort_values(CASE).groupby("_id")[CASE].agg(lambda c: hash(tuple(c)))
+    order = table.assign(
+        _sig=signature,
+        _kind=table["kind"].map(EFFECTS.index),
+        _len=table["activity"].astype(str).str.len(),
+    ).sort_values(["_sig", "_kind", "_len"], kind="stable")
+    first = ~order["_sig"].duplicated()
+    robots = order["robot"].map(lambda r: f" ({r})" if isinstance(r, str) else "")
+    label = order["kind"] + " " + order["activity"].astype(str) + robots
+    others = label[~first].groupby(order.loc[~first, "_sig"]).agg("; ".join)
+    also = order["_sig"].map(others).where(first)
+    return pd.DataFrame({"_keep": first, "also": also}).reindex(table.index)
+
+
+# -- steady costs: time that need not be there --------------------------------------------------
+
+
+def _steady_excess(log, instances, steps, baseline_quantile: float) -> pd.DataFrame:
+    waiting, resource = _waiting(steps, instances, _receive_activities(instances))
+    parts = [
+        waiting,
+        resource,
+        _rework(steps, instances),
+        _delays(instances, baseline_quantile),
+        _queueing(log),
+    ]
+    parts = [part for part in parts if not part.empty]
+    if not parts:
+        return pd.DataFrame(columns=[*KEY, CASE, "excess"])
+    excess = pd.concat(parts)
+    return excess[excess["excess"] > 0]
 
 
 def _receive_activities(instances: pd.DataFrame) -> set[str]:
@@ -91,23 +226,76 @@ def _repeats(steps: pd.DataFrame) -> pd.Series:
     return same.astype(bool)
 
 
-def _waiting(steps: pd.DataFrame, receives: set[str]) -> pd.DataFrame:
-    waits = steps[~_repeats(steps) & ~steps["target"].isin(receives)]
-    return _excess_rows(waits, "waiting", waits["target"], waits[WAIT])
+def _waiting(steps: pd.DataFrame, instances: pd.DataFrame, receives: set[str]):
+    """Idle time before an activity, split into plain waiting and queueing for a resource."""
+    waits = steps[~_repeats(steps) & ~steps["target"].isin(receives) & (steps[WAIT] > 0)]
+    queued = _resource_overlap(waits, instances)
+    return (
+        _excess_rows(waits, "waiting", waits["target"], waits[WAIT] - queued),
+        _excess_rows(waits, "resource", waits["target"], queued),
+    )
+
+
+def _resource_overlap(waits: pd.DataFrame, instances: pd.DataFrame) -> pd.Series:
+    """Per wait, the seconds during which another robot of the case did the activity waited
+    for. The waiting robot runs nothing while it waits, so the time the activity was busy at
+    all (the union of its instances in the case) during the wait is the queueing."""
+    shared = instances.groupby([CASE, ACTIVITY], dropna=False)[ROBOT].transform("nunique") > 1
+    busy = instances.loc[shared, [CASE, ACTIVITY, START_TIMESTAMP, TIMESTAMP]]
+    if busy.empty or waits.empty:
+        return pd.Series(0.0, index=waits.index)
+    origin = busy[START_TIMESTAMP].min()
+    groups = pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)).unique()
+    busy_group = groups.get_indexer(pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)))
+    wait_group = groups.get_indexer(
+        pd.MultiIndex.from_arrays([waits[CASE].astype(str), waits["target"].astype(str)])
+    )
+    span = float((busy[TIMESTAMP].max() - origin).total_seconds()) + 1.0
+    starts, lengths, cumulative = _busy_union(
+        busy_group, _seconds(busy[START_TIMESTAMP], origin), _seconds(busy[TIMESTAMP], origin), span
+    )
+    known = wait_group >= 0
+    offset = wait_group[known] * span
+
+    def busy_until(times: pd.Series) -> np.ndarray:
+        at = _seconds(times[known], origin) + offset
+        k = np.searchsorted(starts, at, side="right") - 1
+        inside = np.clip(at - starts[np.maximum(k, 0)], 0, lengths[np.maximum(k, 0)])
+        return np.where(k >= 0, cumulative[np.maximum(k, 0)] + inside, 0.0)
+
+    overlap = np.zeros(len(waits))
+    overlap[known] = busy_until(waits["target_start"]) - busy_until(waits["source_end"])
+    return pd.Series(np.minimum(overlap, waits[WAIT].to_numpy()), index=waits.index)
+
+
+def _seconds(times: pd.Series, origin: pd.Timestamp) -> np.ndarray:
+    return (times - origin).dt.total_seconds().to_numpy(float)
+
+
+def _busy_union(group: np.ndarray, begin: np.ndarray, end: np.ndarray, span: float):
+    """The union of each group's intervals on one axis (group g shifted by g * span): sorted
+    starts, lengths, and the busy time before each (a running total across groups)."""
+    begin, end = begin + group * span, end + group * span
+    order = np.argsort(begin, kind="stable")
+    begin, end = begin[order], end[order]
+    reach = np.maximum.accumulate(end)
+    new = np.ones(len(begin), dtype=bool)
+    new[1:] = begin[1:] > reach[:-1]
+    block = np.cumsum(new) - 1
+    starts = begin[new]
+    stops = pd.Series(end).groupby(block).max().to_numpy()
+    lengths = stops - starts
+    cumulative = np.concatenate([[0.0], np.cumsum(lengths)[:-1]])
+    return starts, lengths, cumulative
 
 
 def _rework(steps: pd.DataFrame, instances: pd.DataFrame) -> pd.DataFrame:
     repeats = steps[_repeats(steps)]
     # the repeated instance: the one that starts at this step's target start
-    durations = instances.set_index([CASE, ROBOT, ACTIVITY, "start_timestamp"])[DURATION]
+    durations = instances.set_index([CASE, ROBOT, ACTIVITY, START_TIMESTAMP])[DURATION]
     durations = durations[~durations.index.duplicated()]
     keys = pd.MultiIndex.from_arrays(
-        [
-            repeats[CASE],
-            repeats[ROBOT],
-            repeats["target"],
-            repeats["target_start"],
-        ]
+        [repeats[CASE], repeats[ROBOT], repeats["target"], repeats["target_start"]]
     )
     repeat_time = durations.reindex(keys).fillna(0).to_numpy()
     return _excess_rows(repeats, "rework", repeats["target"], repeats[WAIT] + repeat_time)
@@ -137,46 +325,82 @@ def _excess_rows(rows: pd.DataFrame, kind: str, activity: pd.Series, excess: pd.
             "activity": activity.to_numpy(),
             "robot": rows[ROBOT].to_numpy(),
             CASE: rows[CASE].to_numpy(),
-            "excess": excess.to_numpy(dtype=float),
+            "excess": np.asarray(excess, dtype=float),
         }
     )
 
 
-def _rank(excess: pd.DataFrame, cases: pd.DataFrame) -> pd.DataFrame:
-    n_cases = len(cases)
-    total_time = float(cases["duration"].sum()) or float("nan")
-    grouped = excess.groupby(["kind", "activity", "robot"], dropna=False, sort=False)
-    table = grouped.agg(
-        occurrences=("excess", "size"),
-        cases=(CASE, "nunique"),
-        total=("excess", "sum"),
-        mean=("excess", "mean"),
-    ).reset_index()
-    table["delay_per_case"] = table["total"] / n_cases
-    table["share"] = table["total"] / total_time
-    table["longer_by"] = _longer_by(excess, cases, table[["kind", "activity", "robot"]])
-    table = table.sort_values(["delay_per_case", "occurrences"], ascending=[False, False])
-    table = table.reset_index(drop=True)
-    table.insert(0, "rank", range(1, len(table) + 1))
-    table["explanation"] = table.apply(_explain, axis=1)
-    return table
+def _steady_rows(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
+    if excess.empty:
+        return pd.DataFrame()
+    excess = excess.assign(_id=excess.groupby(KEY, dropna=False, sort=False).ngroup())
+    grouped = excess.groupby("_id")
+    table = (
+        grouped[KEY]
+        .first()
+        .join(
+            grouped.agg(
+                occurrences=("excess", "size"),
+                cases=(CASE, "nunique"),
+                total=("excess", "sum"),
+                mean=("excess", "mean"),
+            )
+        )
+    )
+    table["delay_per_case"] = table["total"] / len(cases)
+    stats = compare_cases(_hardest_hit(excess, cases), "_id", cases)
+    table = table.join(stats[["cases_without", "extra_mean", "extra_median", "p_value"]])
+    return table.reset_index(drop=True)
 
 
-def _longer_by(excess: pd.DataFrame, cases: pd.DataFrame, candidates: pd.DataFrame) -> list:
-    """Per candidate, how much longer the cases it hits hardest (excess above the median
-    case's) take than the others; ``None`` when it costs every case the same."""
-    keys = ["kind", "activity", "robot"]
-    labelled = excess.assign(robot=excess["robot"].fillna("\x00"))
-    per_case = labelled.pivot_table(
-        index=keys, columns=CASE, values="excess", aggfunc="sum", fill_value=0.0
-    ).reindex(columns=cases[CASE], fill_value=0.0)
-    durations = cases["duration"].to_numpy()
-    hit = per_case.to_numpy() > per_case.median(axis=1).to_numpy()[:, None]
-    results = {}
-    for key, row in zip(per_case.index, hit, strict=True):
-        results[key] = float(durations[row].mean() - durations[~row].mean()) if row.any() else None
-    lookup = candidates.assign(robot=candidates["robot"].fillna("\x00"))
-    return [results[tuple(key)] for key in lookup.itertuples(index=False, name=None)]
+def _hardest_hit(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
+    """Per steady candidate, the cases whose excess is above its median case's (cases without
+    any of it counting as 0): the cases it hits hardest."""
+    per_case = excess.groupby(["_id", CASE], sort=False)["excess"].sum()
+    width = len(cases)
+    medians = per_case.groupby(level="_id").agg(lambda values: _median_with_zeros(values, width))
+    above = per_case > medians.reindex(per_case.index.get_level_values("_id")).to_numpy()
+    return per_case[above].reset_index()[["_id", CASE]]
+
+
+def _median_with_zeros(values: pd.Series, width: int) -> float:
+    """The median of ``values`` padded with zeros to ``width`` values."""
+    return float(np.median(np.pad(values.to_numpy(float), (0, max(width - len(values), 0)))))
+
+
+# -- the ranking -------------------------------------------------------------------------------
+
+
+def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
+    ranking = ranking.assign(
+        share=ranking["total"] / (total_time or float("nan")),
+        longer_by=ranking["extra_mean"],
+        _kind=ranking["kind"].map(KINDS.index),
+    )
+    ranking = ranking.sort_values(
+        ["delay_per_case", "_kind", "occurrences"], ascending=[False, True, False], kind="stable"
+    ).reset_index(drop=True)
+    ranking.insert(0, "rank", range(1, len(ranking) + 1))
+    ranking["explanation"] = ranking.apply(_explain, axis=1)
+    if "also" not in ranking.columns:
+        ranking["also"] = None
+    columns = [
+        "rank",
+        *KEY,
+        "occurrences",
+        "cases",
+        "cases_without",
+        "total",
+        "mean",
+        "delay_per_case",
+        "share",
+        "longer_by",
+        "extra_median",
+        "p_value",
+        "also",
+        "explanation",
+    ]
+    return ranking[columns]
 
 
 def _explain(row: pd.Series) -> str:
@@ -184,20 +408,50 @@ def _explain(row: pd.Series) -> str:
     each = format_seconds(row["mean"])
     per_case = format_seconds(row["delay_per_case"])
     times = "once" if row["occurrences"] == 1 else f"{row['occurrences']} times"
-    sentences = {
-        "waiting": f"{who} waits {each} on average before {row['activity']} ({times})",
-        "rework": f"{who} repeats {row['activity']} {times}, {each} each",
-        "delay": f"{row['activity']} by {who} runs {each} longer than its fastest runs ({times})",
-        "queueing": f"{row['activity']} messages wait {each} from send to receipt ({times})",
-    }
-    return f"{sentences[row['kind']]}: {per_case} per case"
+    name = _short(str(row["activity"]))
+    if row["kind"] in EFFECTS:
+        whose = f"{row['robot']}'s" if isinstance(row["robot"], str) else "the"
+        subject = {
+            "activity": f"cases with {name} by {who}",
+            "loop": f"cases where {who} repeats {name}",
+            "transition": f"cases where {who} goes {name}",
+            "variant": f"cases where {whose} path is {name}",
+        }[row["kind"]]
+        sentence = (
+            f"{subject} take {each} longer than the others "
+            f"({row['cases']} of {int(row['cases'] + row['cases_without'])} cases{_sure(row)})"
+        )
+    else:
+        sentence = {
+            "waiting": f"{who} waits {each} on average before {name} ({times})",
+            "resource": f"{who} queues {each} for {name} while another robot does it ({times})",
+            "rework": f"{who} repeats {name} {times}, {each} each",
+            "delay": f"{name} by {who} runs {each} longer than its fastest runs ({times})",
+            "queueing": f"{name} messages wait {each} from send to receipt ({times})",
+        }[row["kind"]]
+    return f"{sentence}: {per_case} per case"
+
+
+def _sure(row: pd.Series) -> str:
+    return "" if pd.isna(row["p_value"]) else f", p = {row['p_value']:.2g}"
+
+
+def _short(text: str, limit: int = 80) -> str:
+    return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
 def _figure(ranking: pd.DataFrame):
     import plotly.express as px
 
     shown = ranking.head(15).assign(
-        candidate=lambda t: t["kind"] + ": " + t["activity"] + " (" + t["robot"].fillna("-") + ")"
+        candidate=lambda t: (
+            t["kind"]
+            + ": "
+            + t["activity"].astype(str).map(lambda a: _short(a, 40))
+            + " ("
+            + t["robot"].fillna("-").astype(str)
+            + ")"
+        )
     )
     return px.bar(
         shown,

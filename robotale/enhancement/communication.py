@@ -1,20 +1,36 @@
-"""Inter-robot communication: messages sent, received, lost, latency and resends (thesis 7.2.2).
+"""Inter-robot communication: who talks to whom, what got lost, delayed or resent (thesis 7.2.2).
 
-A message is one ``msg_id``. Its sends are the events whose role is send (``msg_role`` or an
-activity ending in ``!``), its receives those whose role is receive (or ``?``). A message type
-is named after its send activity (a message nobody was seen sending is named after its receive
-activity with ``?`` turned into ``!``). Per message:
+A message is one ``msg_id`` in a case. Its sends are the events whose role is send
+(``msg_role`` or an activity ending in ``!``), its receives those whose role is receive (or
+``?``). A message type is named after its send activity (a message nobody was seen sending is
+named after its receive activity with ``?`` turned into ``!``). Its sender is ``msg_sender``
+where the log has it, else the robot of its sends; its receivers the robots of its receives,
+else ``msg_receiver``, else the one robot that received every other message of its sender and
+type, else ``unknown``. A channel is a sender -> receiver pair. Per message:
 
 - sent: it has at least one send; received: at least one receive; lost: sent, never received;
-- attempts: how many times it was sent (the send activity's starts, or its events when the log
-  has no lifecycle), resends = attempts - 1;
-- latency: from its first send to its first receive, resends included.
+- attempts: how many times it was sent under its id (the send activity's starts, or its events
+  when the log has no lifecycle);
+- resends: attempts - 1 (``resends_same_id``), plus one when the sender sent it again under a
+  new id (``resends_new_id``): the next message of the same sender, type and channel in the
+  case, sent before this one was received (or when it never was), and with the same payload
+  when the log has ``msg_payload`` (a different payload is news, not a resend);
+- latency: from its first send to its first receive (per receiver on the channels);
+- delayed: a latency above ``delay_threshold`` seconds if given, else above the channel's own
+  95th percentile (for channels with at least ``MIN_FOR_P95`` received messages).
+
+For every lost message the ``lost`` table says what its sender did next, whether it was resent
+and got through, and how much later its case ended than the median case without a lost message.
 """
 
 from __future__ import annotations
 
+import numpy as np
 import pandas as pd
 
+from robotale.discovery.instances import START_TIMESTAMP
+from robotale.enhancement.effects import compare_cases
+from robotale.enhancement.performance import case_durations, finished_instances
 from robotale.enhancement.result import Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
@@ -22,6 +38,9 @@ from robotale.eventlog.schema import (
     COMPLETE,
     LIFECYCLE,
     MSG_ID,
+    MSG_PAYLOAD,
+    MSG_RECEIVER,
+    MSG_SENDER,
     RECEIVE,
     ROBOT,
     SEND,
@@ -31,66 +50,123 @@ from robotale.eventlog.schema import (
 )
 
 TYPE = "message_type"
+UNKNOWN = "unknown"
+#: the fewest received messages on a channel for its own 95th percentile to mean anything
+MIN_FOR_P95 = 20
+CHANNEL = ["sender", "receiver", TYPE]
 
 
 def communication_perspective(
-    log: pd.DataFrame, *, activity: str | None = None, robot: str | None = None
+    log: pd.DataFrame,
+    *,
+    activity: str | None = None,
+    robot: str | None = None,
+    delay_threshold: float | None = None,
+    following: int = 3,
 ) -> Perspective:
-    """Per message type: sent, received, lost, resends and latency; with a bar chart.
+    """Per message type and per channel: sent, received, lost, delayed, resent and latency;
+    every message; every lost message with its consequence; with a bar chart.
 
     With ``activity`` (a send ``x!`` or receive ``x?`` activity) only the messages of that
     type; with ``robot`` only the messages that robot sent or received.
     """
-    messages = message_table(log)
+    messages, deliveries = message_tables(log, delay_threshold)
     if messages.empty:
         return no_data("communication", "the log has no messages (no events with a msg_id).")
+    keep = pd.Series(True, index=messages.index)
     if activity is not None:
-        messages = messages[messages[TYPE] == _type_of(activity)]
+        keep &= messages[TYPE] == _type_of(activity)
     if robot is not None:
-        messages = messages[_involving(log, messages, robot)]
-    if messages.empty:
+        keep &= _involving(log, messages, robot)
+    if not keep.any():
         return no_data("communication", f"no message involves {focus_label(activity, robot)}.")
-    types = _by_type(messages)
+    lost, lost_effect = lost_messages(log, messages, following)
+    messages = messages[keep]
+    deliveries = deliveries.merge(messages[_keys(messages)], on=_keys(messages))
+    lost = lost.merge(messages[_keys(messages)], on=_keys(messages))
+    types, channels = _by_type(messages, deliveries), _by_channel(deliveries)
     return Perspective(
         name="communication",
-        tables={"message_types": types, "messages": messages},
+        tables={"message_types": types, "channels": channels, "messages": messages, "lost": lost},
         figures={"messages": _figure(types)},
-        summary={
-            "messages": len(messages),
-            "sent": int(messages["sent"].sum()),
-            "received": int(messages["received"].sum()),
-            "lost": int(messages["lost"].sum()),
-            "resends": int(messages["resends"].sum()),
-        },
+        summary=_summary(messages, channels, lost_effect),
     )
 
 
 def message_table(log: pd.DataFrame) -> pd.DataFrame:
-    """One row per message: type, sender, attempts, receivers, first send and receive, latency."""
-    if MSG_ID not in log.columns:
-        return pd.DataFrame()
-    roles = message_roles(log)
-    events = log.assign(_role=roles)[roles.notna().to_numpy(bool) & log[MSG_ID].notna()]
+    """One row per message: type, sender, receiver(s), attempts, first send and receive,
+    latency, whether it was lost, delayed or resent."""
+    return message_tables(log)[0]
+
+
+def message_tables(
+    log: pd.DataFrame, delay_threshold: float | None = None
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The messages, and their deliveries: one row per message and receiver (a message nobody
+    received has one, to the receiver it was meant for or ``unknown``)."""
+    events = _message_events(log)
     if events.empty:
-        return pd.DataFrame()
-    keys = [CASE, MSG_ID] if CASE in events.columns else [MSG_ID]
+        return pd.DataFrame(), pd.DataFrame()
+    keys = _keys(events)
     sends = events[events["_role"] == SEND]
     receives = events[events["_role"] == RECEIVE]
     table = events.groupby(keys, sort=True).agg(first_event=(TIMESTAMP, "min"))
     table[TYPE] = _types(sends, receives, keys).reindex(table.index)
     sends = _sends_of_type(sends, table[TYPE], keys)
-    table["sender"] = _first(sends, keys, ROBOT).reindex(table.index)
+    table["sender"] = _sender(events, sends, keys).reindex(table.index)
+    if MSG_PAYLOAD in events.columns:
+        table["payload"] = _first(events, keys, MSG_PAYLOAD).reindex(table.index)
     table["sent_at"] = sends.groupby(keys)[TIMESTAMP].min().reindex(table.index)
     table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
     table["attempts"] = _attempts(sends, keys).reindex(table.index).fillna(0).astype(int)
     table["receivers"] = _distinct(receives, keys, ROBOT).reindex(table.index).fillna(0)
+    table["receivers"] = table["receivers"].astype(int)
     table["sent"] = table["attempts"] > 0
     table["received"] = table["received_at"].notna()
     table["lost"] = table["sent"] & ~table["received"]
-    table["resends"] = (table["attempts"] - 1).clip(lower=0)
     table["latency"] = (table["received_at"] - table["sent_at"]).dt.total_seconds()
-    table["receivers"] = table["receivers"].astype(int)
-    return table.drop(columns="first_event").reset_index()
+    table = table.drop(columns="first_event").reset_index()
+    deliveries = _deliveries(table, events, receives, keys)
+    table["receiver"] = _lookup(table, keys, _joined(deliveries, keys, "receiver"))
+    deliveries["delayed"] = _delayed(deliveries, delay_threshold)
+    delayed = deliveries.groupby(keys)["delayed"].any()
+    table["delayed"] = _lookup(table, keys, delayed).fillna(False).astype(bool)
+    return _with_resends(table, keys), deliveries
+
+
+def lost_messages(
+    log: pd.DataFrame, messages: pd.DataFrame, following: int = 3
+) -> tuple[pd.DataFrame, dict]:
+    """Every lost message with what its sender did next (``then``), whether it was resent and
+    the resend got through, seconds from its send to its case's end, and how much later its
+    case ended than the median case without a lost message (``ended_later_by``). With them,
+    how much longer the cases with a lost message take than the others (mean, p-value)."""
+    lost = messages[messages["lost"]]
+    columns = [*_keys(messages), TYPE, "sender", "receiver", "sent_at", "resent_as", "recovered"]
+    lost = lost[[c for c in columns if c in lost.columns]].reset_index(drop=True)
+    instances = finished_instances(log)
+    if lost.empty or instances.empty or CASE not in lost.columns:
+        return lost.assign(then=pd.Series(dtype=object)), {}
+    lost["then"] = _what_followed(lost, instances, following)
+    cases = case_durations(instances).set_index(CASE)
+    ends = cases["end"].reindex(lost[CASE]).to_numpy()
+    lost["until_end"] = (pd.Series(ends) - lost["sent_at"]).dt.total_seconds()
+    calm = cases.loc[~cases.index.isin(lost[CASE]), "duration"]
+    duration = cases["duration"].reindex(lost[CASE]).to_numpy()
+    lost["ended_later_by"] = duration - (calm.median() if len(calm) else np.nan)
+    effect = compare_cases(lost.assign(_lost=True), "_lost", cases["duration"])
+    return lost, _lost_effect(effect)
+
+
+def _message_events(log: pd.DataFrame) -> pd.DataFrame:
+    if MSG_ID not in log.columns:
+        return pd.DataFrame()
+    roles = message_roles(log)
+    return log.assign(_role=roles)[roles.notna().to_numpy(bool) & log[MSG_ID].notna()]
+
+
+def _keys(frame: pd.DataFrame) -> list[str]:
+    return [CASE, MSG_ID] if CASE in frame.columns else [MSG_ID]
 
 
 def _types(sends: pd.DataFrame, receives: pd.DataFrame, keys: list[str]) -> pd.Series:
@@ -107,6 +183,116 @@ def _sends_of_type(sends: pd.DataFrame, types: pd.Series, keys: list[str]) -> pd
     named = types.rename("_type").reset_index()
     joined = sends.merge(named, on=keys, how="left")
     return joined[joined[ACTIVITY].astype(object) == joined["_type"].astype(object)]
+
+
+def _sender(events: pd.DataFrame, sends: pd.DataFrame, keys: list[str]) -> pd.Series:
+    stated = _first(events, keys, MSG_SENDER) if MSG_SENDER in events.columns else None
+    seen = _first(sends, keys, ROBOT)
+    return seen if stated is None else stated.combine_first(seen)
+
+
+def _deliveries(
+    table: pd.DataFrame, events: pd.DataFrame, receives: pd.DataFrame, keys: list[str]
+) -> pd.DataFrame:
+    """One row per message and receiver, with the first receive by that receiver."""
+    base = table[[*keys, TYPE, "sender", "sent_at"]]
+    receiver = _receiving_robot(receives)
+    if receiver is not None and not receives.empty:
+        receives = receives.assign(receiver=receiver).dropna(subset=["receiver"])
+        seen = receives.groupby([*keys, "receiver"])[TIMESTAMP].min()
+        seen = seen.rename("received_at").reset_index()
+    else:
+        seen = pd.DataFrame(columns=[*keys, "receiver", "received_at"])
+    reached = base.merge(seen, on=keys)
+    missing = base[~_in(base, reached, keys)].assign(received_at=pd.NaT)
+    missing["receiver"] = _meant_for(missing, events, reached, keys)
+    deliveries = pd.concat([reached, missing], ignore_index=True)
+    deliveries["received_at"] = pd.to_datetime(deliveries["received_at"], utc=True)
+    latency = deliveries["received_at"] - deliveries["sent_at"]
+    deliveries["latency"] = latency.dt.total_seconds()
+    deliveries["received"] = deliveries["received_at"].notna()
+    deliveries["lost"] = deliveries["sent_at"].notna() & ~deliveries["received"]
+    return deliveries
+
+
+def _receiving_robot(receives: pd.DataFrame) -> pd.Series | None:
+    """Per receive event, who received: ``msg_receiver`` where set, else the event's robot."""
+    stated = receives[MSG_RECEIVER].astype(object) if MSG_RECEIVER in receives.columns else None
+    robot = receives[ROBOT].astype(object) if ROBOT in receives.columns else None
+    if stated is None or robot is None:
+        return stated if robot is None else robot
+    return stated.combine_first(robot)
+
+
+def _meant_for(missing, events, reached, keys) -> np.ndarray:
+    """Who an unreceived message was for: ``msg_receiver``, else the one robot that received
+    every other message of its sender and type, else ``unknown``."""
+    if missing.empty:
+        return np.array([], dtype=object)
+    stated = pd.Series(np.nan, index=missing.index, dtype=object)
+    if MSG_RECEIVER in events.columns:
+        stated = _lookup(missing, keys, _first(events, keys, MSG_RECEIVER))
+    usual = reached.groupby(["sender", TYPE])["receiver"].agg(
+        lambda r: r.iloc[0] if r.nunique() == 1 else np.nan
+    )
+    guessed = pd.Series(
+        usual.reindex(pd.MultiIndex.from_frame(missing[["sender", TYPE]])).to_numpy(),
+        index=missing.index,
+    )
+    return stated.combine_first(guessed).fillna(UNKNOWN).to_numpy(object)
+
+
+def _delayed(deliveries: pd.DataFrame, threshold: float | None) -> pd.Series:
+    latency = deliveries["latency"]
+    if threshold is not None:
+        return latency.gt(threshold)
+    channel = deliveries.groupby(CHANNEL, dropna=False)["latency"]
+    p95 = channel.transform("quantile", 0.95)
+    enough = channel.transform("count") >= MIN_FOR_P95
+    return latency.gt(p95) & enough
+
+
+def _with_resends(table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
+    """Adds which messages were sent again under a new id (``resent_as``), the resends by id
+    reuse and by new id, and ``recovered``: lost, but a resend got through."""
+    group = [k for k in (CASE, "sender", TYPE, "payload") if k in table.columns]
+    ordered = table.sort_values([*group, "sent_at"], kind="stable")
+    following = ordered.groupby(group, dropna=False, sort=False)[
+        [MSG_ID, "sent_at", "receiver", "received"]
+    ].shift(-1)
+    unanswered = ordered["received_at"].isna() | (following["sent_at"] < ordered["received_at"])
+    same_channel = ordered["receiver"].isin([UNKNOWN]) | (
+        ordered["receiver"] == following["receiver"]
+    )
+    again = following[MSG_ID].notna() & ordered["sent"] & unanswered & same_channel
+    table["resent_as"] = following[MSG_ID].where(again).reindex(table.index)
+    table["resends_same_id"] = (table["attempts"] - 1).clip(lower=0)
+    table["resends_new_id"] = table["resent_as"].notna().astype(int)
+    table["resends"] = table["resends_same_id"] + table["resends_new_id"]
+    got_through = following["received"].where(again).reindex(table.index)
+    table["recovered"] = table["lost"] & got_through.fillna(False).astype(bool)
+    return table
+
+
+def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) -> list[str]:
+    """The sender's next activities (started after the message was first sent)."""
+    mine = instances[[CASE, ROBOT, ACTIVITY, START_TIMESTAMP]].rename(columns={ROBOT: "sender"})
+    later = lost[[CASE, "sender", "sent_at"]].reset_index().merge(mine, on=[CASE, "sender"])
+    later = later[later[START_TIMESTAMP] > later["sent_at"]]
+    later = later.sort_values(["index", START_TIMESTAMP], kind="stable")
+    names = later.groupby("index").head(following).groupby("index")[ACTIVITY]
+    joined = names.agg(lambda a: " -> ".join(map(str, a)))
+    return joined.reindex(lost.index).fillna("").tolist()
+
+
+def _lost_effect(effect: pd.DataFrame) -> dict:
+    if effect.empty or effect["cases_without"].iloc[0] == 0:
+        return {}
+    row = effect.iloc[0]
+    return {
+        "lost_cases_longer_by": float(row["extra_mean"]),
+        "lost_cases_p_value": None if pd.isna(row["p_value"]) else float(row["p_value"]),
+    }
 
 
 def _type_of(activity: str) -> str:
@@ -126,11 +312,35 @@ def _distinct(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
     return events.groupby(keys)[column].nunique()
 
 
+def _joined(deliveries: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
+    """Per message, its distinct ``column`` values joined (most messages have one)."""
+    values = deliveries[[*keys, column]].astype({column: str}).drop_duplicates()
+    values = values.sort_values(column, kind="stable")
+    grouped = values.groupby(keys)[column]
+    joined = grouped.first()
+    several = grouped.size() > 1
+    if several.any():
+        many = values[_in(values, several[several].reset_index(), keys)]
+        joined.update(many.groupby(keys)[column].agg(", ".join))
+    return joined
+
+
+def _lookup(frame: pd.DataFrame, keys: list[str], values: pd.Series) -> pd.Series:
+    index = pd.MultiIndex.from_frame(frame[keys]) if len(keys) > 1 else frame[keys[0]]
+    return pd.Series(values.reindex(index).to_numpy(), index=frame.index)
+
+
+def _in(frame: pd.DataFrame, other: pd.DataFrame, keys: list[str]) -> np.ndarray:
+    if len(keys) == 1:
+        return frame[keys[0]].isin(other[keys[0]]).to_numpy()
+    return pd.MultiIndex.from_frame(frame[keys]).isin(pd.MultiIndex.from_frame(other[keys]))
+
+
 def _involving(log: pd.DataFrame, messages: pd.DataFrame, robot: str) -> pd.Series:
     """Which messages ``robot`` sent or received."""
     if ROBOT not in log.columns:
         return pd.Series(False, index=messages.index)
-    keys = [CASE, MSG_ID] if CASE in messages.columns else [MSG_ID]
+    keys = _keys(messages)
     mine = log.loc[log[ROBOT].astype("string").eq(robot).fillna(False).to_numpy(bool), keys]
     involved = pd.MultiIndex.from_frame(mine.dropna().astype(str).drop_duplicates())
     return pd.Series(
@@ -158,20 +368,63 @@ def _attempts(sends: pd.DataFrame, keys: list[str]) -> pd.Series:
     return counts[["start", "complete"]].max(axis=1) + counts["instant"]
 
 
-def _by_type(messages: pd.DataFrame) -> pd.DataFrame:
+def _latency_figures(grouped) -> pd.DataFrame:
+    return grouped["latency"].agg(
+        latency_mean="mean",
+        latency_median="median",
+        latency_p95=lambda x: x.quantile(0.95),
+        latency_max="max",
+    )
+
+
+def _by_type(messages: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:
     grouped = messages.groupby(TYPE, sort=True)
     table = grouped.agg(
         sent=("sent", "sum"),
         received=("received", "sum"),
         lost=("lost", "sum"),
+        delayed=("delayed", "sum"),
         resends=("resends", "sum"),
-        latency_mean=("latency", "mean"),
-        latency_median=("latency", "median"),
-        latency_max=("latency", "max"),
+        resends_same_id=("resends_same_id", "sum"),
+        resends_new_id=("resends_new_id", "sum"),
+        recovered=("recovered", "sum"),
         receivers_mean=("receivers", "mean"),
     )
+    table = table.join(_latency_figures(grouped))
     table["loss_rate"] = table["lost"] / table["sent"].where(table["sent"] > 0)
+    table["channels"] = deliveries.groupby(TYPE)[["sender", "receiver"]].apply(
+        lambda pairs: len(pairs.drop_duplicates())
+    )
     return table.reset_index()
+
+
+def _by_channel(deliveries: pd.DataFrame) -> pd.DataFrame:
+    grouped = deliveries.groupby(CHANNEL, sort=True, dropna=False)
+    table = grouped.agg(
+        sent=("sent_at", "count"),
+        received=("received", "sum"),
+        lost=("lost", "sum"),
+        delayed=("delayed", "sum"),
+    )
+    return table.join(_latency_figures(grouped)).reset_index()
+
+
+def _summary(messages: pd.DataFrame, channels: pd.DataFrame, lost_effect: dict) -> dict:
+    totals = {
+        column: int(messages[column].sum())
+        for column in (
+            "sent",
+            "received",
+            "lost",
+            "delayed",
+            "resends",
+            "resends_same_id",
+            "resends_new_id",
+            "recovered",
+        )
+    }
+    pairs = channels[["sender", "receiver"]].drop_duplicates()
+    return {"messages": len(messages), **totals, "channels": len(pairs), **lost_effect}
 
 
 def _figure(types: pd.DataFrame):
@@ -180,11 +433,16 @@ def _figure(types: pd.DataFrame):
     figure = make_subplots(
         rows=1, cols=2, subplot_titles=("Messages", "Latency, first send to first receive (s)")
     )
-    for column, colour in (("received", "#2ca02c"), ("lost", "#d62728"), ("resends", "#ff7f0e")):
+    for column, colour in (
+        ("received", "#2ca02c"),
+        ("lost", "#d62728"),
+        ("resends", "#ff7f0e"),
+        ("delayed", "#8c564b"),
+    ):
         figure.add_bar(
             x=types[TYPE], y=types[column], name=column, marker_color=colour, row=1, col=1
         )
-    for column, colour in (("latency_mean", "#1f77b4"), ("latency_median", "#9467bd")):
+    for column, colour in (("latency_mean", "#1f77b4"), ("latency_p95", "#9467bd")):
         figure.add_bar(
             x=types[TYPE],
             y=types[column],

@@ -49,6 +49,8 @@ def report_html(perspectives: dict[str, Perspective], title: str = "robotale per
         parts = [f"<h2>{html.escape(name.capitalize())}</h2>"]
         if not perspective.has_data:
             parts.append(f"<p class='empty'>{html.escape(perspective.message or '')}</p>")
+        else:
+            parts.append(_summary_list(perspective.summary))
         for figure in perspective.figures.values():
             parts.append(figure.to_html(full_html=False, include_plotlyjs=not script_included))
             script_included = True
@@ -62,6 +64,18 @@ def report_html(perspectives: dict[str, Perspective], title: str = "robotale per
         f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head>"
         f"<body><h1>{html.escape(title)}</h1>{''.join(sections)}</body></html>"
     )
+
+
+def _summary_list(summary: dict) -> str:
+    """The headline figures as a definition list (lists and nested figures left to the
+    tables)."""
+    items = []
+    for key, value in summary.items():
+        if isinstance(value, dict | list):
+            continue
+        shown = f"{value:.3g}" if isinstance(value, float) else str(value)
+        items.append(f"<dt>{html.escape(key.replace('_', ' '))}</dt><dd>{html.escape(shown)}</dd>")
+    return f"<dl class='summary'>{''.join(items)}</dl>"
 
 
 def write_report(
@@ -87,4 +101,7 @@ table { border-collapse: collapse; font-size: 0.85em; margin: 0.5em 0 1.5em; }
 th, td { padding: 0.25em 0.6em; border-bottom: 1px solid #ddd; text-align: right; }
 th { background: #f4f4f4; }
 .empty { color: #888; font-style: italic; }
+dl.summary { display: grid; grid-template-columns: max-content auto; gap: 0.2em 1em; }
+dl.summary dt { color: #555; }
+dl.summary dd { margin: 0; }
 """

@@ -71,3 +71,77 @@ def test_a_log_without_battery_data_says_so(events):
 def test_drill_down_to_a_robot_without_data(drained):
     result = battery_perspective(drained, robot="tractor_9")
     assert not result.has_data and "robot tractor_9" in result.message
+
+
+@pytest.fixture
+def idle_drain(events):
+    """Two missions of a rover: its tag events carry no level, samples (inprogress rows) do.
+    It drains 1 %/min while idle between drive and dig and much faster while working."""
+    rows = []
+    for case, level in (("1", 90.0), ("2", 80.0)):
+        tags = [("drive", "start", 0), ("drive", "complete", 60), ("dig", "start", 660)]
+        tags += [("dig", "complete", 720)]
+        samples = [(0, level), (60, level - 10), (660, level - 20), (720, level - 35)]
+        rows += [(case, a, lc, t, None, None) for a, lc, t in tags]
+        rows += [
+            (case, "drive" if t <= 60 else "dig", "none", t, b, "inprogress") for t, b in samples
+        ]
+    return events(
+        *[
+            {"case": c, "robot": "rover", "activity": a, "lifecycle": lc, "t": t, "battery": b,
+             "lifecycle:state": state}
+            for c, a, lc, t, b, state in rows
+        ]
+    )  # fmt: skip
+
+
+def test_battery_use_per_activity_counts_working_time_only(idle_drain):
+    result = battery_perspective(idle_drain)
+    table = result.tables["consumption"].set_index("activity")
+    samples = idle_drain.dropna(subset=["battery"]).set_index(
+        ["case:concept:name", "time:timestamp"]
+    )
+    level = samples["battery"].droplevel(1).groupby(level=0).agg(list)  # [start, 60, 660, 720]
+    drive = sum(levels[0] - levels[1] for levels in level)
+    dig = sum(levels[2] - levels[3] for levels in level)
+    idle = sum(levels[1] - levels[2] for levels in level)
+    assert table.loc["drive", "used"] == drive == 20
+    assert table.loc["dig", "used"] == dig == 30  # not the 10 points lost while waiting
+    assert table.loc["(waiting)", "used"] == idle and table.loc["(waiting)", "seconds"] == 1200
+    assert table.loc["dig", "used_per_minute"] == pytest.approx(dig / 2)
+    assert table.loc["dig", "start_level_mean"] == pytest.approx((70 + 60) / 2)
+    assert result.summary["most_used_by"] == "dig"
+
+
+def test_energy_per_case_by_hand(idle_drain, drained):
+    energy = battery_perspective(idle_drain).tables["energy"].set_index("case")
+    levels = idle_drain.dropna(subset=["battery"]).groupby("case:concept:name")["battery"]
+    assert energy["used"].to_dict() == (levels.first() - levels.last()).to_dict()
+    assert battery_perspective(idle_drain).summary["energy_per_case_mean"] == 35.0
+    # the drone's battery only falls: used = first - last level, charged nothing
+    drone = battery_perspective(drained).tables["energy"].iloc[0]
+    assert drone["used"] == drained["battery"].iloc[0] - drained["battery"].iloc[-1]
+    assert drone["charged"] == 0
+
+
+def test_a_battery_column_of_zeros_is_no_battery_data(events):
+    log = events(
+        {"case": "1", "robot": "a", "activity": "go", "lifecycle": "start", "t": 0, "battery": 0},
+        {
+            "case": "1",
+            "robot": "a",
+            "activity": "go",
+            "lifecycle": "complete",
+            "t": 5,
+            "battery": 0,
+        },
+    )
+    result = battery_perspective(log)
+    assert not result.has_data and result.message.count(".") == 1
+    assert "no battery levels" in result.message
+
+
+def test_low_battery_tags_without_levels_say_so(thesis_log):
+    summary = battery_perspective(thesis_log).summary
+    assert summary["battery_levels"] == "the log has no battery levels"
+    assert "energy_used" not in summary

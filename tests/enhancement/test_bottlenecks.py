@@ -104,3 +104,75 @@ def test_drill_down_and_nothing_to_report(known_bottleneck, events):
     )
     result = find_bottlenecks(steady)
     assert not result.has_data and "nothing delays" in result.message
+
+
+@pytest.fixture
+def optional_wait(events):
+    """30 missions of r1: plan, navigate (300-320 s, in every mission), deliver. In every third
+    mission it also holds position for 150 s after navigating; r2 scans for 60 s throughout."""
+    rows = []
+    for case in range(30):
+        t = 0.0
+        steps = [("plan", 10 + case % 4), ("navigate", 300 + (case * 7) % 20)]
+        steps += [("hold_position", 150)] if case % 3 == 0 else []
+        steps += [("deliver", 20 + case % 2)]
+        for activity, seconds in steps:
+            t += 1
+            rows += [
+                (case, "r1", activity, "start", t),
+                (case, "r1", activity, "complete", t + seconds),
+            ]
+            t += seconds
+        rows += [(case, "r2", "scan", "start", 0), (case, "r2", "scan", "complete", 60)]
+    return events(
+        *[
+            {"case": str(c), "robot": r, "activity": a, "lifecycle": lc, "t": t}
+            for c, r, a, lc, t in rows
+        ]
+    )
+
+
+def test_an_optional_waiting_activity_ranks_first_by_its_effect(optional_wait):
+    from scipy.stats import mannwhitneyu
+
+    ranking = find_bottlenecks(optional_wait).table
+    first = ranking.iloc[0]
+    assert (first["kind"], first["activity"], first["robot"]) == ("activity", "hold_position", "r1")
+    # the cases with it against the cases without it, counted here with pandas and scipy
+    times = optional_wait.groupby("case:concept:name")["time:timestamp"]
+    seconds = (times.max() - times.min()).dt.total_seconds()
+    has = optional_wait.groupby("case:concept:name")["concept:name"].agg(
+        lambda names: "hold_position" in set(names)
+    )
+    with_it, without = seconds[has], seconds[~has]
+    assert (first["cases"], first["cases_without"]) == (len(with_it), len(without)) == (10, 20)
+    assert first["longer_by"] == pytest.approx(with_it.mean() - without.mean())
+    assert first["extra_median"] == pytest.approx(with_it.median() - without.median())
+    assert first["delay_per_case"] == pytest.approx((with_it.mean() - without.mean()) / 3)
+    expected_p = mannwhitneyu(with_it, without, method="asymptotic").pvalue
+    assert first["p_value"] == pytest.approx(expected_p)
+    # the transitions and path that come with it are the same cases: named, not ranked again
+    assert "transition navigate -> hold_position (r1)" in first["also"]
+    assert "2m" in first["explanation"] and "10 of 30 cases" in first["explanation"]
+    # navigate is long but in every case: it has no effect to measure, and its own duration
+    # is never reported as waiting before it
+    navigate = ranking[ranking["activity"] == "navigate"]
+    assert set(navigate["kind"]) <= {"delay", "waiting"}
+    assert navigate.loc[navigate["kind"] == "waiting", "mean"].max() == pytest.approx(1.0)
+    assert ranking.loc[ranking["activity"] == "scan", "kind"].tolist() == []
+
+
+def test_queueing_for_an_activity_another_robot_is_doing(events):
+    # two robots, one charger: r2 waits 20 s for r1 to finish charging, 5 s of it before
+    log = events(
+        {"case": "1", "robot": "r1", "activity": "charge", "lifecycle": "start", "t": 0},
+        {"case": "1", "robot": "r1", "activity": "charge", "lifecycle": "complete", "t": 30},
+        {"case": "1", "robot": "r2", "activity": "drive", "lifecycle": "start", "t": 0},
+        {"case": "1", "robot": "r2", "activity": "drive", "lifecycle": "complete", "t": 5},
+        {"case": "1", "robot": "r2", "activity": "charge", "lifecycle": "start", "t": 30},
+        {"case": "1", "robot": "r2", "activity": "charge", "lifecycle": "complete", "t": 40},
+    )
+    ranking = find_bottlenecks(log).table.set_index(["kind", "robot"])
+    assert ranking.loc[("resource", "r2"), "total"] == 30 - 5  # r1 charged all the while
+    assert ("waiting", "r2") not in ranking.index
+    assert "queues" in ranking.loc[("resource", "r2"), "explanation"]

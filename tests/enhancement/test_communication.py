@@ -1,3 +1,5 @@
+import itertools
+
 import pandas as pd
 import pytest
 
@@ -30,6 +32,25 @@ def by_hand(log: pd.DataFrame) -> pd.DataFrame:
     )
 
 
+def new_id_resends(log: pd.DataFrame) -> pd.Series:
+    """Per message type: messages the sender sent again under another id (same type and
+    payload) before they were received, counted with a plain loop."""
+    found: dict[str, int] = {}
+    with_id = log.dropna(subset=["msg_id"])
+    sends = with_id[with_id[ACTIVITY].str.endswith("!")]
+    firsts = sends.groupby("msg_id").agg(
+        type=(ACTIVITY, "first"), payload=("msg_payload", "first"), sent=(TIMESTAMP, "min")
+    )
+    receives = with_id[with_id[ACTIVITY].str.endswith("?")].groupby("msg_id")[TIMESTAMP].min()
+    firsts["received"] = receives.reindex(firsts.index)
+    for (kind, _), same in firsts.sort_values("sent").groupby(["type", "payload"]):
+        rows = list(same.itertuples())
+        for this, after in itertools.pairwise(rows):
+            if pd.isna(this.received) or after.sent < this.received:
+                found[kind] = found.get(kind, 0) + 1
+    return pd.Series(found, dtype=int)
+
+
 def test_thesis_message_counts_equal_a_count_by_hand(thesis_log):
     expected = by_hand(thesis_log)
     table = communication_perspective(thesis_log).table.set_index("message_type")
@@ -39,11 +60,17 @@ def test_thesis_message_counts_equal_a_count_by_hand(thesis_log):
         assert table.loc[name, "sent"] == row["sent"]
         assert table.loc[name, "received"] == row["received"]
         assert table.loc[name, "lost"] == row["sent"] - row["received"]
-        assert table.loc[name, "resends"] == row["resends"]
+        # resends: by id reuse (the same id sent again) plus under a new id
+        assert table.loc[name, "resends_same_id"] == row["resends"]
+        new_ids = new_id_resends(thesis_log).get(name, 0)
+        assert table.loc[name, "resends_new_id"] == new_ids
+        assert table.loc[name, "resends"] == row["resends"] + new_ids
         assert table.loc[name, "latency_mean"] == pytest.approx(row["latency_mean"])
     # as in the thesis, only weed_position! messages get lost
     assert table.loc["weed_position!", "lost"] > 0
     assert table.loc[["closest_tractor!", "tractor_position!"], "lost"].sum() == 0
+    # the drone resends lost weed positions under new ids (the same weed, a new message)
+    assert table.loc["weed_position!", "resends_new_id"] > 0
 
 
 def test_drill_down_to_a_receive_activity_and_a_robot(thesis_log):
@@ -132,3 +159,106 @@ def test_figure_shows_received_and_lost_per_type(thesis_log):
     figure = communication_perspective(thesis_log).figure
     lost = next(trace for trace in figure.data if trace.name == "lost")
     assert dict(zip(lost.x, lost.y, strict=True))["weed_position!"] > 0
+
+
+@pytest.fixture
+def recoveries(events):
+    """Case 1: the base asks r1 to go (m1, sent twice under its id, received); r1 reports done
+    under m2, no answer, so again under m3 (same payload, new id, received 40 s after sending);
+    then status m4 under a different payload. Case 2: m2 reports once and is received. The
+    columns msg_sender / msg_receiver name the channel; the robot column is the logger's."""
+
+    def message(case, msg, activity, t, payload, sender, receiver):
+        return {
+            "case": case,
+            "robot": "logger",
+            "activity": activity,
+            "msg_id": msg,
+            "msg_payload": payload,
+            "msg_sender": sender,
+            "msg_receiver": receiver,
+            "t": t,
+        }
+
+    return events(
+        message("1", "m1", "go!", 0, "go", "base", "r1"),
+        message("1", "m1", "go!", 5, "go", "base", "r1"),
+        message("1", "m1", "go?", 6, "go", "base", "r1"),
+        message("1", "m2", "done!", 10, "done", "r1", "base"),
+        message("1", "m3", "done!", 30, "done", "r1", "base"),
+        message("1", "m3", "done?", 70, "done", "r1", "base"),
+        message("1", "m4", "done!", 80, "status", "r1", "base"),
+        message("1", "m4", "done?", 81, "status", "r1", "base"),
+        message("2", "m2", "done!", 0, "done", "r1", "base"),
+        message("2", "m2", "done?", 1, "done", "r1", "base"),
+    )
+
+
+def test_resends_by_id_reuse_and_by_a_new_id(recoveries):
+    result = communication_perspective(recoveries)
+    messages = result.tables["messages"].set_index(["case", "msg_id"])
+    assert messages.loc[("1", "m1"), "resends_same_id"] == 1  # go! sent at 0 and 5
+    assert messages.loc[("1", "m2"), "resent_as"] == "m3"  # unanswered, same payload, new id
+    assert bool(messages.loc[("1", "m2"), "lost"]) and bool(messages.loc[("1", "m2"), "recovered"])
+    assert messages.loc[("1", "m3"), "resends"] == 0  # m4 carries other news
+    sends = recoveries[recoveries["concept:name"].str.endswith("!")]
+    attempts = sends.groupby(["case:concept:name", "msg_id"]).size()
+    assert result.summary["resends_same_id"] == (attempts - 1).sum() == 1
+    assert result.summary["resends_new_id"] == 1 and result.summary["resends"] == 2
+    assert result.summary["messages"] == len(attempts) == 5
+
+
+def test_channels_come_from_msg_sender_and_msg_receiver(recoveries):
+    channels = communication_perspective(recoveries, delay_threshold=30).tables["channels"]
+    table = channels.set_index(["sender", "receiver", "message_type"])
+    expected = (
+        recoveries.drop_duplicates(["case:concept:name", "msg_id"])
+        .groupby(["msg_sender", "msg_receiver", "concept:name"])
+        .size()
+    )
+    assert table["sent"].to_dict() == expected.to_dict()
+    assert table.loc[("r1", "base", "done!"), "lost"] == 1
+    # m3 took 40 s, above the 30 s threshold
+    assert table.loc[("r1", "base", "done!"), "delayed"] == 1
+    assert table.loc[("base", "r1", "go!"), "latency_max"] == 6.0
+
+
+def test_a_lost_message_and_what_it_caused(events):
+    """Three missions of a drone reporting to a tractor; in mission 1 the report is lost and
+    the drone searches again before landing."""
+    rows = []
+    for case, lost in (("1", True), ("2", False), ("3", False)):
+        rows += [
+            ("drone", "report!", "start", 10, "m"),
+            ("drone", "report!", "complete", 11, "m"),
+        ]
+        if not lost:
+            rows += [
+                ("tractor", "report?", "start", 12, "m"),
+                ("tractor", "report?", "complete", 12, "m"),
+            ]
+            rows += [("drone", "land", "start", 20 + int(case), None)]
+            rows += [("drone", "land", "complete", 30 + int(case), None)]
+        else:
+            rows += [
+                ("drone", "search", "start", 15, None),
+                ("drone", "search", "complete", 75, None),
+            ]
+            rows += [("drone", "land", "start", 80, None), ("drone", "land", "complete", 90, None)]
+        rows = [(case, *row) if len(row) == 5 else row for row in rows]
+    log = events(
+        *[
+            {"case": c, "robot": r, "activity": a, "lifecycle": lc, "t": t, "msg_id": m}
+            for c, r, a, lc, t, m in rows
+        ]
+    )
+    result = communication_perspective(log)
+    lost = result.tables["lost"]
+    assert len(lost) == 1 and lost.iloc[0]["case"] == "1"
+    assert lost.iloc[0]["then"] == "search -> land"
+    times = log.groupby("case:concept:name")["time:timestamp"]
+    seconds = (times.max() - times.min()).dt.total_seconds()
+    assert lost.iloc[0]["ended_later_by"] == seconds["1"] - seconds[["2", "3"]].median()
+    assert lost.iloc[0]["until_end"] == 90 - 10
+    assert lost.iloc[0]["receiver"] == "tractor"  # every other report went to the tractor
+    assert result.summary["lost_cases_longer_by"] == seconds["1"] - seconds[["2", "3"]].mean()

@@ -68,3 +68,71 @@ def test_figures_and_json(two_cases):
     data = result.to_dict()
     assert data["tables"]["cases"][0]["start"].startswith("2024-01-01T10:00:00")
     assert isinstance(pd.Timestamp(data["tables"]["cases"][0]["end"]), pd.Timestamp)
+
+
+def test_working_and_waiting_time_are_kept_apart(two_cases):
+    robots = performance_perspective(two_cases).tables["robots"].set_index(["case", "robot"])
+    # by hand from the fixture: r1 works 10 + 6 s and waits 4 s in case 1; r2 works 25 s
+    log = two_cases.assign(t=(two_cases["time:timestamp"] - two_cases["time:timestamp"].min()))
+    seconds = log.pivot_table(
+        index=["case:concept:name", "robot", "concept:name"],
+        columns="lifecycle:transition",
+        values="t",
+        aggfunc="first",
+    ).apply(lambda col: col.dt.total_seconds())
+    work = (seconds["complete"] - seconds["start"]).groupby(level=[0, 1]).sum()
+    assert robots["working"].to_dict() == work.to_dict()
+    assert robots.loc[("1", "r1"), "waiting"] == seconds.loc[("1", "r1", "b"), "start"] - 10
+    assert robots["waiting"].sum() == 4.0
+    cases = performance_perspective(two_cases).tables["cases"].set_index("case")
+    assert cases.loc["1", "working"] + cases.loc["1", "waiting"] == 10 + 6 + 25 + 4
+
+
+def test_a_completion_without_its_start_is_never_waiting(events):
+    # only completions: the 300 s before navigate completes is its own work, not a wait
+    log = events(
+        {"case": "1", "robot": "r", "activity": "plan", "lifecycle": "complete", "t": 10},
+        {"case": "1", "robot": "r", "activity": "navigate", "lifecycle": "complete", "t": 310},
+    )
+    result = performance_perspective(log)
+    assert result.tables["waiting"].empty and result.summary["slowest_transition"] is None
+    robot = result.tables["robots"].iloc[0]
+    assert (robot["waiting"], robot["unsplit"]) == (0.0, 300.0)
+
+
+@pytest.fixture
+def paths(events):
+    """Nine cases: r1 does a, b, c (six cases) or a, c (three); r2 does x in the first four."""
+    rows = []
+    for case in range(9):
+        t = 0
+        for activity in ("a", "b", "c") if case % 3 else ("a", "c"):
+            rows += [(case, "r1", activity, "start", t), (case, "r1", activity, "complete", t + 5)]
+            t += 5 + case
+        if case < 4:
+            rows += [(case, "r2", "x", "start", 1), (case, "r2", "x", "complete", 2)]
+    return events(
+        *[
+            {"case": str(c), "robot": r, "activity": a, "lifecycle": lc, "t": t}
+            for c, r, a, lc, t in rows
+        ]
+    )
+
+
+def test_variants_per_case_and_per_robot_equal_pm4py(paths):
+    starts = paths[paths["lifecycle:transition"] == "start"]
+    starts = starts.sort_values(["case:concept:name", "time:timestamp"], kind="stable")
+    expected = pm4py.get_variants(starts)  # pm4py's own variants of the start events
+    result = performance_perspective(paths)
+    variants = result.tables["variants"]
+    assert dict(
+        zip(variants["variant"].str.split(" -> ").map(tuple), variants["cases"], strict=True)
+    ) == {variant: count for variant, count in expected.items()}
+    per_robot = starts.assign(**{"case:concept:name": starts["case:concept:name"] + starts[ROBOT]})
+    per_robot = per_robot.sort_values(["case:concept:name", "time:timestamp"], kind="stable")
+    robot_variants = result.tables["robot_variants"]
+    assert sorted(robot_variants["cases"]) == sorted(pm4py.get_variants(per_robot).values())
+    ordered = paths.sort_values(["case:concept:name", "time:timestamp"], kind="stable")
+    durations = pm4py.get_all_case_durations(ordered)  # first to last event of each case
+    assert sorted(result.tables["cases"]["duration"]) == pytest.approx(sorted(durations))
+    assert result.summary["variants"] == len(expected)
