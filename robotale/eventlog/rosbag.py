@@ -636,5 +636,11 @@ def stamp_path(msgtype: str, typestore: Typestore) -> str | None:
 
 
 def namespace(topic: str) -> str:
-    """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``."""
+    """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``.
+
+    An action's topics are in the namespace of the action, not in the action's own:
+    ``/r1/navigate_to_pose/_action/feedback`` -> ``r1``.
+    """
+    if "/_action/" in topic:
+        topic = topic.rsplit("/_action/", 1)[0]
     return topic.strip("/").rpartition("/")[0]
