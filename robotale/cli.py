@@ -381,6 +381,13 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
     )
     simulate.add_argument("--storage", choices=("sqlite3", "mcap"), help="bag storage (sqlite3)")
     simulate.add_argument(
+        "--distro",
+        choices=("humble", "iron", "jazzy"),
+        default=None,
+        help="write the bag metadata that this ROS 2 distribution's `ros2 bag` reads (humble, "
+        "which every supported distribution reads)",
+    )
+    simulate.add_argument(
         "--rate", type=float, metavar="HZ", help="odometry and battery samples a second (2)"
     )
     simulate.add_argument("--topics", metavar="A,B", help="also record these robot topics")
