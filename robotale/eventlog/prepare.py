@@ -400,6 +400,8 @@ def _without_empty_activities(
 def _lifecycles(rows: pd.DataFrame, topic: str, run: Path, mode: str | None) -> pd.Series:
     """The tags' lifecycles: their field's, or ``complete`` for tags that are single events."""
     if schema.LIFECYCLE not in rows or mode == "events":
+        if mode == "implicit":
+            return pd.Series(schema.START, index=rows.index, dtype=object)
         if mode is None:
             warnings.warn(
                 f"{run}: the tags on {topic} have no lifecycle, so each is a single event; "

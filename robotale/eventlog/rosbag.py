@@ -243,7 +243,7 @@ class Bag:
                 raise InputError(
                     f"{self.path}: a message on {topic} cannot be decoded as {msgtype} "
                     f"({error or type(error).__name__}); the definition registered for it does "
-                    "not match the recording."
+                    "not match the recording (give the right one with --msg or --distro)."
                 ) from None
 
         return decode
@@ -412,7 +412,8 @@ def _definitions(reader: Reader, extra: Mapping, distro: Mapping, unparsed: dict
         try:
             embedded = _embedded_types(connection)
         except TypesysError as error:
-            unparsed[connection.topic] = " ".join(str(error).split())
+            reason = " ".join(str(error).split())
+            unparsed[connection.topic] = reason if len(reason) < 160 else f"{reason[:157]}..."
             continue
         typs.update({name: spec for name, spec in embedded.items() if name not in extra})
     for source in (distro, get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
