@@ -270,3 +270,45 @@ def test_a_defaulted_robot_and_an_empty_activity_are_warnings(tmp_path):
     assert rows(log) == [(at(6), "dock", "complete", "robot")]
     assert any("--tag-field robot=FIELD" in w for w in warned)
     assert any("1 tag(s) on /events have an empty activity" in w for w in warned)
+
+
+BT_CHANGE = "nav2_msgs/msg/BehaviorTreeStatusChange"
+BT_LOG = "nav2_msgs/msg/BehaviorTreeLog"
+
+
+def test_behaviour_tree_transitions_become_activities(tmp_path):
+    b = Nav2Bag()
+    b.store.register(
+        {
+            **get_types_from_msg(
+                "builtin_interfaces/Time timestamp\nstring node_name\nstring previous_status\n"
+                "string current_status\n",
+                BT_CHANGE,
+            ),
+            **get_types_from_msg(
+                "builtin_interfaces/Time timestamp\nBehaviorTreeStatusChange[] event_log\n", BT_LOG
+            ),
+        }
+    )
+    change = b.t[BT_CHANGE]
+    for t, changes in (
+        (1, [("ComputePath", "IDLE", "RUNNING"), ("Spin", "IDLE", "RUNNING")]),
+        (2, [("ComputePath", "RUNNING", "SUCCESS"), ("Spin", "RUNNING", "IDLE")]),
+        (3, [("ComputePath", "SUCCESS", "IDLE"), ("GoalReached", "IDLE", "FAILURE")]),
+    ):
+        log = [change(timestamp=b.time(t), node_name=n, previous_status=p, current_status=c)
+               for n, p, c in changes]  # fmt: skip
+        b.add(t, "/r1/behavior_tree_log", BT_LOG, b.t[BT_LOG](timestamp=b.time(t), event_log=log))
+    bag = b.write(tmp_path / "nav")
+    log, _ = quiet_prepare(bag, tags="/none", bt_logs="/*/behavior_tree_log")
+    assert rows(log) == [
+        (at(1), "ComputePath", "start", "r1"),
+        (at(1), "Spin", "start", "r1"),
+        (at(2), "ComputePath", "complete", "r1"),
+        (at(2), "Spin", "cancelled", "r1"),  # halted
+        (at(3), "GoalReached", "start", "r1"),  # failed at once: an instant activity
+        (at(3), "GoalReached", "aborted", "r1"),
+    ]
+    said = []
+    quiet_prepare(bag, tags="/none", auto=True, report=said.append)
+    assert "--bt-log /r1/behavior_tree_log" in said[0]
