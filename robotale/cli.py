@@ -204,6 +204,47 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         default=None,
         help="time events by when the bag recorded them, not by their message stamps",
     )
+    parser.add_argument(
+        "--lifecycle",
+        choices=("explicit", "implicit", "events"),
+        default=None,
+        help="how tags end activities: their lifecycle field (explicit), the robot's next tag "
+        "(implicit), or not at all (events); default: explicit, events for tags without one",
+    )
+    parser.add_argument(
+        "--actions",
+        metavar="GLOB",
+        default=None,
+        help="ROS 2 action status topics whose goals are activities, e.g. /*/_action/status",
+    )
+    parser.add_argument(
+        "--state-topic",
+        dest="state_topics",
+        action="append",
+        default=None,
+        metavar="GLOB[:FIELD]",
+        help="a string or enum topic whose values are activities, e.g. /*/mode. Repeatable",
+    )
+    parser.add_argument(
+        "--bt-log",
+        metavar="GLOB",
+        default=None,
+        help="behaviour-tree transition logs whose nodes are activities, e.g. /behavior_tree_log",
+    )
+    parser.add_argument(
+        "--auto",
+        action="store_true",
+        default=None,
+        help="also take activities from whatever actions, state topics and BT logs a bag holds, "
+        "and say what was chosen",
+    )
+    parser.add_argument(
+        "--distro",
+        choices=("humble", "iron", "jazzy"),
+        default=None,
+        help="the ROS 2 distribution whose standard message types fill in those the bags do "
+        "not define (default: the one a bag names, else humble)",
+    )
 
 
 def _add_ingest(commands: argparse._SubParsersAction) -> None:
@@ -339,6 +380,13 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
         "@FROM-TO and ,p=P vary it per run (repeatable)",
     )
     simulate.add_argument("--storage", choices=("sqlite3", "mcap"), help="bag storage (sqlite3)")
+    simulate.add_argument(
+        "--distro",
+        choices=("humble", "iron", "jazzy"),
+        default=None,
+        help="write the bag metadata that this ROS 2 distribution's `ros2 bag` reads (humble, "
+        "which every supported distribution reads)",
+    )
     simulate.add_argument(
         "--rate", type=float, metavar="HZ", help="odometry and battery samples a second (2)"
     )

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
+from typing import Any
 
 import pandas as pd
 
@@ -30,9 +31,11 @@ def ingest_command(
     rate: float | None = None,
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
+    **recording: Any,
 ) -> int:
     """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
-    Neo4j as ``log`` (default: the file's or folder's name)."""
+    Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the other
+    options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto ...)."""
     if path.is_dir():
         if mapping or case:
             raise InputError(
@@ -47,6 +50,7 @@ def ingest_command(
             rate=rate,
             msg_files=msg_files,
             bag_time=bag_time,
+            **recording,
         )
     else:
         events = read_log(path, parse_mapping(mapping), case)

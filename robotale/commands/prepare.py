@@ -28,6 +28,12 @@ def prepare_command(
     rate: float | None = None,
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
+    lifecycle: str | None = None,
+    actions: str | None = None,
+    state_topics: Sequence[str] = (),
+    bt_log: str | None = None,
+    auto: bool = False,
+    distro: str | None = None,
 ) -> int:
     """Write the event log of the recordings at ``source`` as CSV (``out``, by default
     ``<source name>.csv`` when no other output is asked for), XES and/or OCEL 2.0."""
@@ -40,6 +46,12 @@ def prepare_command(
         rate=rate,
         msg_files=msg_files,
         bag_time=bag_time,
+        lifecycle=lifecycle,
+        actions=actions,
+        state_topics=state_topics,
+        bt_log=bt_log,
+        auto=auto,
+        distro=distro,
     )
     written = []
     if csv:
@@ -65,6 +77,12 @@ def prepare_recordings(
     rate: float | None = None,
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
+    lifecycle: str | None = None,
+    actions: str | None = None,
+    state_topics: Sequence[str] = (),
+    bt_log: str | None = None,
+    auto: bool = False,
+    distro: str | None = None,
 ) -> pd.DataFrame:
     """The event log of the recordings at ``source``; an option left ``None`` takes
     :func:`~robotale.eventlog.prepare.prepare`'s default."""
@@ -80,6 +98,12 @@ def prepare_recordings(
         tag_fields=TagFields.parse(tag_fields),
         msg_files=msg_files,
         bag_time=bag_time,
+        lifecycle=lifecycle,
+        actions=actions,
+        states=list(state_topics or ()),
+        bt_logs=bt_log,
+        auto=bool(auto),
+        distro=distro,
         **{key: value for key, value in given.items() if value is not None},
     )
 
@@ -89,8 +113,13 @@ def prepare_reporting(source: Path, **options: Any) -> pd.DataFrame:
     without a start ...) on stderr as one ``robotale: warning:`` line each."""
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PreparationWarning)
-        log = prepare(source, progress=True, **options)
+        log = prepare(source, progress=True, report=_report, **options)
     for warning in caught:
         if issubclass(warning.category, PreparationWarning):
             print(f"robotale: warning: {warning.message}", file=sys.stderr)
     return log
+
+
+def _report(text: str) -> None:
+    """What the preparation chose (``--auto``), on stderr so that stdout stays the summary."""
+    print(f"robotale: {text}", file=sys.stderr)

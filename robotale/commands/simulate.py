@@ -27,6 +27,7 @@ def simulate_command(
     weeds: str | None = None,
     faults: Sequence[str] = (),
     storage: str = "sqlite3",
+    distro: str = "humble",
     rate: float | None = None,
     topics: str | None = None,
     time_limit: float | None = None,
@@ -69,6 +70,7 @@ def simulate_command(
         storage=storage,
         extra_topics=_topics(topics),
         settings={key: value for key, value in overrides.items() if value is not None},
+        distro=distro,
     )
     target = out_dir or Path("runs") / scenario
     if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):

@@ -29,6 +29,8 @@ LIFECYCLE, STATE = schema.LIFECYCLE, schema.STATE
 KEYS = [CASE, ROBOT]
 #: the order of events that share a timestamp: tags as recorded, then inprogress rows.
 _ORDER = "_order"
+#: lifecycles that end an activity: its completion, or an outcome such as an aborted goal
+_CLOSING = frozenset({schema.COMPLETE, schema.ABORTED, schema.CANCELLED})
 
 
 class PreparationWarning(UserWarning):
@@ -123,9 +125,10 @@ def _ordered(events: pd.DataFrame) -> pd.DataFrame:
 
 
 def pair_activities(events: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Row positions of each activity's start and its completion, and of unpaired completions.
+    """Row positions of each activity's start and its end, and of unpaired ends.
 
-    Within a case, a robot and an activity name, each completion closes the earliest start still
+    An activity ends by completing, or by being aborted or cancelled. Within a case, a robot and
+    an activity name, each end closes the earliest start still
     open (events must be in time order). One pass over the tags, none over the samples.
     """
     open_starts: defaultdict[tuple, deque[int]] = defaultdict(deque)
@@ -134,7 +137,7 @@ def pair_activities(events: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.nd
     for position, (key, lifecycle) in enumerate(zip(keys, events[LIFECYCLE], strict=True)):
         if lifecycle == schema.START:
             open_starts[key].append(position)
-        elif lifecycle == schema.COMPLETE:
+        elif lifecycle in _CLOSING:
             if open_starts[key]:
                 starts.append(open_starts[key].popleft())
                 completes.append(position)

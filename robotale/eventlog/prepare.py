@@ -8,7 +8,10 @@ ready for the writers, pm4py or the EKG.
 
 Bags recorded on real ROS 2 robots work too: the tag topics are a glob and the tag message's
 field names are configurable (:class:`TagFields`); robotale's ``robotale_msgs/msg/Tag`` is the
-default.
+default. Tags without a lifecycle are single events, or with ``lifecycle="implicit"``
+activities that the robot's next tag ends. Without any tags, what robots already publish says
+what they did (:mod:`robotale.eventlog.sources`): action goals, state topics, behaviour-tree
+logs; ``auto`` picks those a bag holds.
 """
 
 from __future__ import annotations
@@ -16,7 +19,7 @@ from __future__ import annotations
 import json
 import re
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields, replace
 from fnmatch import fnmatchcase
 from pathlib import Path
@@ -27,7 +30,7 @@ import yaml
 from tqdm import tqdm
 
 from robotale.errors import InputError
-from robotale.eventlog import schema
+from robotale.eventlog import activities, schema, sources
 from robotale.eventlog.enrich import (
     BUILTIN,
     Perspective,
@@ -36,7 +39,15 @@ from robotale.eventlog.enrich import (
     parse_perspective,
     robots_without_samples,
 )
-from robotale.eventlog.rosbag import TIME, Bag, is_bag, message_types, namespace
+from robotale.eventlog.rosbag import (
+    TIME,
+    Bag,
+    check_distro,
+    is_bag,
+    message_types,
+    namespace,
+)
+from robotale.eventlog.sources import Sources
 
 TAG_TOPICS = "/*/tag"
 MANIFEST = "robotale-run.json"
@@ -49,8 +60,9 @@ DEFAULT_ROBOT = "robot"
 class TagFields:
     """Which field of the tag message holds what; an empty name means the message has none.
 
-    ``activity`` and ``lifecycle`` are required. Without a ``robot`` field (or when it is empty)
-    the robot is the tag topic's namespace.
+    ``activity`` is required. Without a ``lifecycle`` field each tag is one event (or, with
+    ``lifecycle="implicit"``, an activity until the robot's next tag). Without a ``robot`` field
+    (or when it is empty) the robot is the tag topic's namespace.
     """
 
     activity: str = "activity"
@@ -83,7 +95,23 @@ _TAG_COLUMNS = {
     "msg_role": schema.MSG_ROLE,
     "payload": schema.MSG_PAYLOAD,
 }
-_LIFECYCLES = {schema.START, schema.COMPLETE, schema.NONE}
+_LIFECYCLES = {schema.START, schema.COMPLETE, schema.NONE, schema.ABORTED, schema.CANCELLED}
+#: how tags say when an activity ends: their lifecycle field (``explicit``), the robot's next
+#: tag (``implicit``), or not at all: each tag one event (``events``)
+LIFECYCLE_MODES = ("explicit", "implicit", "events")
+
+
+@dataclass(frozen=True)
+class _Reading:
+    """What every bag of a preparation is read for."""
+
+    tags: str
+    tag_fields: TagFields
+    lifecycle: str | None
+    sources: Sources
+    auto: bool
+    perspectives: Sequence[Perspective]
+    bag_time: bool
 
 
 def prepare(
@@ -96,6 +124,13 @@ def prepare(
     msg_files: Sequence[str | Path] = (),
     bag_time: bool = False,
     progress: bool = False,
+    lifecycle: str | None = None,
+    actions: str | None = None,
+    states: Sequence[str] = (),
+    bt_logs: str | None = None,
+    auto: bool = False,
+    distro: str | None = None,
+    report: Callable[[str], None] | None = None,
 ) -> pd.DataFrame:
     """The multi-perspective event log of a rosbag2 directory or of a folder of them.
 
@@ -104,10 +139,28 @@ def prepare(
     the number of ``inprogress`` events per second of an activity (0: none); ``msg_files`` are
     ``.msg`` / ``.idl`` files (or folders) for types the bags do not define; ``bag_time`` uses
     recording times instead of message stamps; ``progress`` shows a bar on stderr.
+
+    ``lifecycle`` is one of :data:`LIFECYCLE_MODES` (default: ``explicit`` when the tags have a
+    lifecycle field, else ``events``). Activities also come from ``actions`` (a glob of
+    ``<action>/_action/status`` topics), ``states`` (``GLOB[:FIELD]`` state topics) and
+    ``bt_logs`` (a glob of behaviour-tree logs); ``auto`` adds whatever of those each bag
+    holds and tells ``report`` what it chose. ``distro`` names the ROS 2 distribution whose
+    standard types fill in those a bag does not define.
     """
     chosen = [p if isinstance(p, Perspective) else parse_perspective(p) for p in perspectives]
-    fields_ = tag_fields or TagFields()
+    if lifecycle is not None and lifecycle not in LIFECYCLE_MODES:
+        raise InputError(f"Unknown lifecycle mode {lifecycle!r}: use {', '.join(LIFECYCLE_MODES)}.")
+    reading = _Reading(
+        tags,
+        tag_fields or TagFields(),
+        lifecycle,
+        Sources(actions, tuple(states), bt_logs),
+        auto,
+        chosen,
+        bag_time,
+    )
     extra_types = message_types([Path(p) for p in msg_files])
+    distro = check_distro(distro)
     runs = find_runs(Path(source))
     globs = [tags, *(glob for p in chosen for glob in p.topic.split("|"))]
     with tqdm(
@@ -117,10 +170,14 @@ def prepare(
         disable=not progress,
         leave=False,
     ) as bar:
-        parts = [_read_run(run, extra_types, tags, fields_, chosen, bag_time, bar) for run in runs]
+        told: set[tuple[str, ...]] = set()
+        parts = [
+            _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
+            for run in runs
+        ]
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
     if tag_rows.empty:
-        raise InputError(f"{source} has no tags: its topics matching {tags!r} hold no messages.")
+        raise InputError(_nothing_found(source, reading))
     samples = {
         p.name: pd.concat([sample_parts[p.name] for _, sample_parts in parts], ignore_index=True)
         for p in chosen
@@ -181,39 +238,103 @@ def robot_type(robot: str) -> str:
 
 
 def _read_run(
-    run: Path,
-    extra_types: Mapping,
-    tag_glob: str,
-    tag_fields: TagFields,
-    perspectives: Sequence[Perspective],
-    bag_time: bool,
-    bar: tqdm,
+    opened: Bag, reading: _Reading, bar: tqdm, report: Callable[[str], None]
 ) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
-    with Bag(run, extra_types) as bag:
-        tag_topics = [t for t in bag.topics if fnmatchcase(t, tag_glob)]
-        if not tag_topics:
+    run = opened.path
+    with opened as bag:
+        tag_topics = [t for t in bag.topics if fnmatchcase(t, reading.tags)]
+        chosen = _sources(bag, reading, report)
+        if not tag_topics and not chosen:
             raise InputError(
-                f"{run} has no tag topic matching {tag_glob!r}; its topics are "
+                f"{run} has no tag topic matching {reading.tags!r}; its topics are "
                 f"{', '.join(bag.topics) or 'none'} (name the tag topics with --tags)."
             )
-        columns = {topic: _tag_columns(bag, topic, tag_fields) for topic in tag_topics}
+        columns = {t: _tag_columns(bag, t, reading.tag_fields) for t in tag_topics}
+        for topic, wanted in sources.columns(bag, chosen).items():
+            columns[topic] = {**columns.get(topic, {}), **wanted}
         sample_topics = {
             p.name: [t for t in bag.topics if p.matches(t) and t not in columns]
-            for p in perspectives
+            for p in reading.perspectives
         }
-        for p in perspectives:
+        for p in reading.perspectives:
             for topic in sample_topics[p.name]:
                 columns[topic] = {**columns.get(topic, {}), **p.columns}
-        tables = bag.tables(columns, bag_time=bag_time, progress=bar)
-    tag_rows = pd.concat(
-        [_tag_rows(tables[topic], topic, run) for topic in tag_topics], ignore_index=True
-    )
+        tables = bag.tables(columns, bag_time=reading.bag_time, progress=bar)
+        tables = {topic: sources.numbered(table) for topic, table in tables.items()}
+        end = pd.Timestamp(max(bag.reader.end_time - 1, 0), unit="ns", tz="UTC")
+        _warn_foreign(bag, columns)
+        parts = [_tag_rows(tables[t], t, run, reading, bag.topics[t]) for t in tag_topics]
+        if reading.lifecycle == "implicit" and parts:
+            parts = [activities.implicit(pd.concat(parts, ignore_index=True), {run.name: end})]
+        parts += sources.activity_rows(bag, tables, chosen, run.name, end)
+    tag_rows = pd.concat(parts, ignore_index=True)
     robots = sorted(set(tag_rows[schema.ROBOT]))
     samples = {
         p.name: _samples(run, [(t, tables[t]) for t in sample_topics[p.name]], p, robots)
-        for p in perspectives
+        for p in reading.perspectives
     }
     return tag_rows, samples
+
+
+def _sources(bag: Bag, reading: _Reading, report: Callable[[str], None]) -> Sources:
+    """The non-tag sources for a bag: those asked for, and with ``auto`` those it holds."""
+    if not reading.auto:
+        return reading.sources
+    found = sources.propose(bag)
+    chosen = Sources(
+        reading.sources.actions or found.actions,
+        tuple(dict.fromkeys([*reading.sources.states, *found.states])),
+        reading.sources.bt_logs or found.bt_logs,
+    )
+    tags = [t for t, n in bag.reader.topics.items() if fnmatchcase(t, reading.tags) and n.msgcount]
+    said = [f"--tags {reading.tags}"] if tags else []
+    report(
+        f"{bag.name}: activities from "
+        + (", ".join(said + chosen.describe()) or "nothing (no tags, actions, states or BT logs)")
+    )
+    return chosen
+
+
+def _once(report: Callable[[str], None] | None, told: set) -> Callable[[str], None]:
+    """``report`` that says each choice once (a batch's runs usually all choose the same)."""
+
+    def say(text: str) -> None:
+        key = text.partition(": ")[2]
+        if report is not None and key not in told:
+            told.add(key)
+            report(text)
+
+    return say
+
+
+def _nothing_found(source: Path | str, reading: _Reading) -> str:
+    if reading.sources or reading.auto:
+        return (
+            f"{source} has no activities: neither its tags ({reading.tags!r}) nor its action, "
+            "state or behaviour-tree topics hold any."
+        )
+    return f"{source} has no tags: its topics matching {reading.tags!r} hold no messages."
+
+
+def _warn_foreign(bag: Bag, columns: Mapping[str, Mapping[str, str]]) -> None:
+    """What the preparation read around in a bag robotale did not write."""
+    skipped = [t for t in bag.unparsed if t not in columns]
+    if skipped:
+        warnings.warn(
+            f"{bag.path}: the message definitions stored for {', '.join(skipped)} cannot be "
+            "parsed; those topics were not read.",
+            PreparationWarning,
+            stacklevel=4,
+        )
+    mismatched = [t for t in bag.qos_mismatch if t in columns]
+    if mismatched:
+        warnings.warn(
+            f"{bag.path}: metadata.yaml describes {', '.join(mismatched)} with other QoS "
+            "profiles (or type hashes) than its storage does; their messages were read from the "
+            "storage.",
+            PreparationWarning,
+            stacklevel=4,
+        )
 
 
 def _tag_columns(bag: Bag, topic: str, tag_fields: TagFields) -> dict[str, str]:
@@ -223,34 +344,82 @@ def _tag_columns(bag: Bag, topic: str, tag_fields: TagFields) -> dict[str, str]:
         field = getattr(tag_fields, key)
         if field in available:
             columns[column] = field
-        elif key in ("activity", "lifecycle"):
+        elif key == "activity" or (key == "lifecycle" and field):
             raise InputError(
                 f"{bag.path}: the tags on {topic} ({bag.topics[topic]}) have no field "
                 f"{field!r} for the {key}; name it with --tag-field {key}=FIELD (its fields are "
-                f"{', '.join(sorted(available))})."
+                f"{', '.join(sorted(available))}"
+                + ("; --tag-field lifecycle= if it has none)." if key == "lifecycle" else ").")
             )
     return columns
 
 
-def _tag_rows(table: pd.DataFrame, topic: str, run: Path) -> pd.DataFrame:
-    rows = table.rename(columns={TIME: schema.TIMESTAMP})
+def _tag_rows(
+    table: pd.DataFrame, topic: str, run: Path, reading: _Reading, msgtype: str
+) -> pd.DataFrame:
+    rows = table.rename(columns={TIME: schema.TIMESTAMP, sources.INDEX: schema.SOURCE_INDEX})
     rows.insert(0, schema.CASE, run.name)
-    given = rows[schema.LIFECYCLE].astype(str)
-    rows[schema.LIFECYCLE] = given.str.strip().str.lower().replace("", schema.NONE)
-    bad = ~rows[schema.LIFECYCLE].isin(_LIFECYCLES)
-    if bad.any():
-        at = rows.loc[bad, schema.TIMESTAMP].iloc[0].isoformat()
-        raise InputError(
-            f"{run}: a tag on {topic} at {at} has lifecycle {given[bad].iloc[0]!r}; "
-            "expected start, complete or none."
-        )
-    fallback = namespace(topic) or DEFAULT_ROBOT
+    rows[schema.SOURCE_TOPIC] = topic
+    rows = _without_empty_activities(rows, topic, run, reading.tag_fields)
+    rows[schema.LIFECYCLE] = _lifecycles(rows, topic, run, reading.lifecycle)
+    fallback = namespace(topic)
     robot = rows[schema.ROBOT].astype(str).str.strip() if schema.ROBOT in rows else None
+    defaulted = robot is None or (robot == "").any()
+    if not fallback and defaulted and len(rows):
+        fallback = DEFAULT_ROBOT
+        warnings.warn(
+            f"{run}: tags on {topic} ({msgtype}) name no robot and the topic has no namespace, "
+            f"so their robot is {DEFAULT_ROBOT!r}; name the field holding it with --tag-field "
+            "robot=FIELD, or record the tags as /<robot>/tag.",
+            PreparationWarning,
+            stacklevel=4,
+        )
     rows[schema.ROBOT] = fallback if robot is None else robot.replace("", fallback)
     for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
         if column in rows:
             rows[column] = rows[column].astype(object).replace("", None)
     return rows
+
+
+def _without_empty_activities(
+    rows: pd.DataFrame, topic: str, run: Path, tag_fields: TagFields
+) -> pd.DataFrame:
+    """The tags that name an activity; the others are left out with a warning."""
+    empty = rows[schema.ACTIVITY].astype(str).str.strip() == ""
+    if empty.any():
+        warnings.warn(
+            f"{run}: {int(empty.sum())} tag(s) on {topic} have an empty activity (field "
+            f"{tag_fields.activity!r}) and were left out; name the field holding the activity "
+            "with --tag-field activity=FIELD.",
+            PreparationWarning,
+            stacklevel=5,
+        )
+    return rows[~empty].reset_index(drop=True)
+
+
+def _lifecycles(rows: pd.DataFrame, topic: str, run: Path, mode: str | None) -> pd.Series:
+    """The tags' lifecycles: their field's, or ``complete`` for tags that are single events."""
+    if schema.LIFECYCLE not in rows or mode == "events":
+        if mode == "implicit":
+            return pd.Series(schema.START, index=rows.index, dtype=object)
+        if mode is None:
+            warnings.warn(
+                f"{run}: the tags on {topic} have no lifecycle, so each is a single event; "
+                "--lifecycle implicit makes each an activity that the robot's next tag ends.",
+                PreparationWarning,
+                stacklevel=5,
+            )
+        return pd.Series(schema.COMPLETE, index=rows.index, dtype=object)
+    given = rows[schema.LIFECYCLE].astype(str)
+    lifecycles = given.str.strip().str.lower().replace("", schema.NONE)
+    bad = ~lifecycles.isin(_LIFECYCLES)
+    if bad.any():
+        at = rows.loc[bad, schema.TIMESTAMP].iloc[0].isoformat()
+        raise InputError(
+            f"{run}: a tag on {topic} at {at} has lifecycle {given[bad].iloc[0]!r}; "
+            "expected start, complete or none (or an outcome: aborted, cancelled)."
+        )
+    return lifecycles
 
 
 def _samples(
@@ -357,6 +526,7 @@ def _message_count(run: Path, globs: Sequence[str]) -> int:
 __all__ = [
     "BUILTIN",
     "DEFAULT_PERSPECTIVES",
+    "LIFECYCLE_MODES",
     "TAG_TOPICS",
     "TagFields",
     "find_runs",

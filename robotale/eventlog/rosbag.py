@@ -1,10 +1,16 @@
 """rosbag2 recordings as tables: one pandas DataFrame per topic.
 
 A recording is read with ``rosbags`` (sqlite3 or MCAP storage, any ROS 2 distribution) without a
-ROS installation. Message types come, in this order of precedence, from the definitions the bag
-carries (Iron and later embed them), from ``.msg`` / ``.idl`` files the user names, from the ROS 2
-distribution the bag was recorded with (Humble when the bag does not say), and robotale's own
-``robotale_msgs/msg/Tag``.
+ROS installation. Message types come, in this order of precedence, from ``.msg`` / ``.idl`` files
+the user names, from the definitions the bag carries (Iron and later embed them), from the ROS 2
+distribution the user names or the bag was recorded with (Humble when neither says), and
+robotale's own ``robotale_msgs/msg/Tag``.
+
+Bags robotale did not write are read defensively: a stored definition that cannot be parsed
+only matters for the topics asked for (a service-event topic nobody reads does not stop the
+preparation); messages are read from the storage files by topic and type, so a metadata.yaml
+whose QoS differs from its storage's does not hide them; and each topic's first message is
+checked against its definition, so a wrong stored definition is named instead of trusted.
 
 Every table has a ``time`` column (tz-aware UTC): the message's own stamp (``header.stamp`` or a
 top-level ``stamp``) when it has a non-zero one, else the time the bag recorded it. The other
@@ -91,16 +97,25 @@ def _types_from_file(file: Path) -> dict:
 class Bag:
     """An open rosbag2 directory; use as a context manager.
 
+    ``distro`` names the ROS 2 distribution whose standard types complete what the bag does not
+    define (default: the one the bag names, else Humble).
+
     ``topics`` maps each topic to its message type; :meth:`tables` decodes the chosen topics'
     fields in one pass over the recording.
     """
 
     path: Path
     extra_types: Mapping = field(default_factory=dict)
+    #: the ROS 2 distribution whose standard types fill in what the bag does not define
+    distro: str | None = None
     _reader: Reader | None = field(default=None, init=False, repr=False)
     typestore: Typestore | None = field(default=None, init=False, repr=False)
     _definitions: Mapping = field(default_factory=dict, init=False, repr=False)
     _topics: dict[str, str] = field(default_factory=dict, init=False, repr=False)
+    #: topic -> why its stored definition cannot be used (reported only if it is read)
+    unparsed: dict[str, str] = field(default_factory=dict, init=False, repr=False)
+    #: topics whose QoS in metadata.yaml differs from their storage's (read from the storage)
+    qos_mismatch: list[str] = field(default_factory=list, init=False, repr=False)
 
     def __enter__(self) -> Bag:
         if not self.path.exists():
@@ -116,9 +131,11 @@ class Bag:
         self._reader = reader
         self._topics = {n: i.msgtype or "" for n, i in sorted(reader.topics.items())}
         try:
-            self._definitions = _definitions(reader, self.extra_types, self.path)
-            roots = {c.msgtype for c in reader.connections}
+            distro = _distribution(self.distro or reader.ros_distro)
+            self._definitions = _definitions(reader, self.extra_types, distro, self.unparsed)
+            roots = {c.msgtype for c in reader.connections if c.topic not in self.unparsed}
             self.typestore = _typestore(self._definitions, roots, self.path)
+            self.qos_mismatch = _qos_mismatches(reader)
         except BaseException:
             self.__exit__()
             raise
@@ -181,7 +198,8 @@ class Bag:
     def _rows(self, topic: str, paths: Mapping[str, str]) -> _TopicRows:
         msgtype = self._decodable(self.topics[topic], topic)
         field_paths, stamped = self._field_paths(topic, paths)
-        return _TopicRows(msgtype, field_paths, stamped, self.typestore, self._decoder(topic))
+        decode, check = self._decoder(topic), self._checker(topic)
+        return _TopicRows(msgtype, field_paths, stamped, self.typestore, decode, check)
 
     def _field_paths(self, topic: str, paths: Mapping[str, str]) -> tuple[list[str], bool]:
         """The field paths to read from a topic's messages, and whether they lead with a stamp."""
@@ -199,6 +217,11 @@ class Bag:
         return [*stamp_paths, *paths.values()], bool(stamp)
 
     def _decodable(self, msgtype: str, topic: str) -> str:
+        if topic in self.unparsed:
+            raise InputError(
+                f"{self.path}: the definition of {msgtype} stored in the bag for {topic} cannot "
+                f"be parsed ({self.unparsed[topic]}); give it with --msg (a .msg or .idl file)."
+            )
         if msgtype not in self.typestore.fielddefs:
             missing = _missing(self._definitions, msgtype) or msgtype
             package, _, name = missing.rpartition("/msg/")
@@ -220,17 +243,38 @@ class Bag:
                 raise InputError(
                     f"{self.path}: a message on {topic} cannot be decoded as {msgtype} "
                     f"({error or type(error).__name__}); the definition registered for it does "
-                    "not match the recording."
+                    "not match the recording (give the right one with --msg or --distro)."
                 ) from None
 
         return decode
+
+    def _checker(self, topic: str):
+        """A check of a topic's first message against the definition it is decoded with.
+
+        Decoding alone trusts too much: a definition shorter than the message (a stored
+        ``uint8 level`` for a whole ``rcl_interfaces/msg/Log``) decodes without an error. The
+        decoded message written back must take the bytes it was read from, up to CDR's final
+        alignment padding.
+        """
+        msgtype, store = self.topics[topic], self.typestore
+
+        def check(raw: bytes, message: object) -> None:
+            again = len(store.serialize_cdr(message, msgtype))
+            if abs(len(raw) - again) > 3:  # CDR pads a message to a multiple of 4 bytes
+                raise InputError(
+                    f"{self.path}: the messages on {topic} do not match the definition of "
+                    f"{msgtype} they are read with ({len(raw)} bytes, the definition accounts "
+                    f"for {again}); give the right one with --msg or --distro."
+                )
+
+        return check
 
     def _raw_messages(
         self, connections: list[Connection], progress
     ) -> Iterator[tuple[str, int, bytes]]:
         last = -1
         try:
-            for connection, recorded, raw in self.reader.messages(connections=connections):
+            for connection, recorded, raw in _storage_messages(self.reader, connections):
                 if recorded < last:
                     raise InputError(
                         _out_of_order(self.reader, self.path, connection.topic, recorded, last)
@@ -251,9 +295,9 @@ class _TopicRows:
     decoded one by one with rosbags.
     """
 
-    def __init__(self, msgtype, paths: list[str], stamped: bool, typestore, decode) -> None:
+    def __init__(self, msgtype, paths: list[str], stamped: bool, typestore, decode, check) -> None:
         self.msgtype, self.paths, self.stamped = msgtype, paths, stamped
-        self.typestore, self.decode = typestore, decode
+        self.typestore, self.decode, self.check = typestore, decode, check
         self.extract = _extractor(paths)
         self.layout: Layout | None = None
         self.recorded: list[int] = []
@@ -263,8 +307,10 @@ class _TopicRows:
         self.one_by_one_at: list[int] = []
 
     def add(self, recorded: int, raw: bytes) -> None:
-        if not self.recorded and self.paths:
-            self.layout = self._checked_layout(raw)
+        if not self.recorded:
+            self.check(raw, self.decode(raw))
+            if self.paths:
+                self.layout = self._checked_layout(raw)
         position = len(self.recorded)
         self.recorded.append(recorded)
         if not self.paths:
@@ -309,9 +355,10 @@ def read_bag(
     *,
     msg_files: Sequence[Path] = (),
     bag_time: bool = False,
+    distro: str | None = None,
 ) -> dict[str, pd.DataFrame]:
     """Every scalar field of every topic (or of ``topics``), one DataFrame per topic."""
-    with Bag(Path(path), message_types(msg_files)) as bag:
+    with Bag(Path(path), message_types(msg_files), check_distro(distro)) as bag:
         chosen = list(bag.topics) if topics is None else list(topics)
         columns = {topic: {f: f for f in bag.fields(topic)} for topic in chosen}
         return bag.tables(columns, bag_time=bag_time)
@@ -354,12 +401,22 @@ def _storage_files(reader: Reader) -> list[str]:
     return []
 
 
-def _definitions(reader: Reader, extra: Mapping, path: Path) -> dict:
-    """The types the bag carries, then the user's, then the distribution's, then robotale's."""
-    typs: dict = {}
+def _definitions(reader: Reader, extra: Mapping, distro: Mapping, unparsed: dict) -> dict:
+    """The user's types, then the bag's, then the distribution's, then robotale's.
+
+    The user's come first: they are given to correct or complete what the bag says. A stored
+    definition that cannot be parsed is noted in ``unparsed`` (topic -> reason) and left out.
+    """
+    typs: dict = dict(extra)
     for connection in reader.connections:
-        typs.update(_embedded_types(connection, path))
-    for source in (extra, _distribution_types(reader), get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
+        try:
+            embedded = _embedded_types(connection)
+        except TypesysError as error:
+            reason = " ".join(str(error).split())
+            unparsed[connection.topic] = reason if len(reason) < 160 else f"{reason[:157]}..."
+            continue
+        typs.update({name: spec for name, spec in embedded.items() if name not in extra})
+    for source in (distro, get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
         typs.update({name: spec for name, spec in source.items() if name not in typs})
     return typs
 
@@ -424,16 +481,12 @@ def _references(desc: tuple) -> list[str]:
     return []
 
 
-def _embedded_types(connection: Connection, path: Path) -> dict:
+def _embedded_types(connection: Connection) -> dict:
     definition = connection.msgdef
     try:
         return dict(_parsed(definition.format, definition.data, connection.msgtype))
-    except TypesysError as error:
-        reason = " ".join(str(error).split())
-        raise InputError(
-            f"{path}: the definition of {connection.msgtype} stored in the bag cannot be parsed: "
-            f"{reason}"
-        ) from None
+    except (KeyError, IndexError, ValueError) as error:  # malformed IDL the parser trips on
+        raise TypesysError(f"{type(error).__name__}: {error}") from None
 
 
 @functools.lru_cache(maxsize=256)
@@ -452,10 +505,85 @@ def _parsed(kind: MessageDefinitionFormat, data: str, msgtype: str) -> tuple:
     return ()
 
 
-def _distribution_types(reader: Reader) -> Mapping:
-    distro = (reader.ros_distro or "humble").lower()
-    store = getattr(Stores, f"ROS2_{distro.upper()}", Stores.ROS2_HUMBLE)
+#: the distributions whose standard types rosbags provides, by the name users give them
+DISTROS = {
+    name.removeprefix("ROS2_").lower(): store
+    for name, store in Stores.__members__.items()
+    if name.startswith("ROS2_")
+}
+DEFAULT_DISTRO = "humble"
+
+
+def _distribution(name: str | None) -> Mapping:
+    """The standard types of a ROS 2 distribution (Humble's for a bag that names none)."""
+    store = DISTROS.get((name or DEFAULT_DISTRO).lower(), DISTROS[DEFAULT_DISTRO])
     return get_typestore(store).fielddefs
+
+
+def check_distro(name: str | None) -> str | None:
+    """``name`` if rosbags knows the distribution, else an error listing those it knows."""
+    if name is not None and name.lower() not in DISTROS:
+        raise InputError(
+            f"Unknown ROS 2 distribution {name!r}: use one of {', '.join(sorted(DISTROS))}."
+        )
+    return name and name.lower()
+
+
+def _qos_mismatches(reader: Reader) -> list[str]:
+    """Topics whose QoS (or type hash) in metadata.yaml differs from what their storage says.
+
+    rosbags pairs metadata and storage connections on those too, so it would read no message
+    of such a topic; :func:`_storage_messages` pairs them on topic and type only.
+    """
+    storage_ext = {
+        (c.topic, c.msgtype): (c.ext, c.digest)
+        for storage in _storages(reader)
+        for c in storage.connections
+    }
+    mismatched = set()
+    for c in reader.connections:
+        ext, digest = storage_ext.get((c.topic, c.msgtype), (c.ext, c.digest))
+        if ext != c.ext or (digest and c.digest and digest != c.digest):
+            mismatched.add(c.topic)
+    return sorted(mismatched)
+
+
+def _storages(reader: Reader) -> list:
+    with contextlib.suppress(AttributeError):
+        return list(reader.storage.storages)
+    return []
+
+
+def _storage_messages(
+    reader: Reader, connections: list[Connection]
+) -> Iterator[tuple[Connection, int, bytes]]:
+    """The messages of ``connections``, read from each storage file by topic and type."""
+    storages = _storages(reader)
+    if not storages:  # not a directory reader: rosbags' own pairing is all there is
+        yield from reader.messages(connections=connections)
+        return
+    wanted = {(c.topic, c.msgtype): c for c in connections}
+    compressed = reader.compression_mode == "message"
+    for storage in storages:
+        mine = {
+            c.id: wanted[(c.topic, c.msgtype)]
+            for c in storage.connections
+            if (c.topic, c.msgtype) in wanted
+        }
+        own = [c for c in storage.connections if c.id in mine]
+        if not own:
+            continue
+        for connection, recorded, raw in storage.messages(own, None, None):
+            yield mine[connection.id], recorded, _decompressed(raw) if compressed else raw
+
+
+def _decompressed(raw: bytes) -> bytes:
+    # rosbags' own zstd (the standard library's from Python 3.14 on)
+    try:
+        from compression import zstd
+    except ImportError:
+        from backports import zstd
+    return zstd.decompress(raw)
 
 
 def all_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
@@ -509,5 +637,11 @@ def stamp_path(msgtype: str, typestore: Typestore) -> str | None:
 
 
 def namespace(topic: str) -> str:
-    """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``."""
+    """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``.
+
+    An action's topics are in the namespace of the action, not in the action's own:
+    ``/r1/navigate_to_pose/_action/feedback`` -> ``r1``.
+    """
+    if "/_action/" in topic:
+        topic = topic.rsplit("/_action/", 1)[0]
     return topic.strip("/").rpartition("/")[0]

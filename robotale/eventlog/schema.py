@@ -27,6 +27,9 @@ MSG_PAYLOAD = "msg_payload"
 #: send and receive events tell)
 MSG_SENDER = "msg_sender"
 MSG_RECEIVER = "msg_receiver"
+#: where an event came from in its recording: the topic and the message's position on it
+SOURCE_TOPIC = "source_topic"
+SOURCE_INDEX = "source_index"
 EVENT_ID = "event_id"
 #: names one activity instance: the start and the complete event of one execution share it.
 EXECUTION_ID = "execution_id"
@@ -47,6 +50,8 @@ CSV_NAMES: dict[str, str] = {
     MSG_PAYLOAD: "msg_payload",
     MSG_SENDER: "msg_sender",
     MSG_RECEIVER: "msg_receiver",
+    SOURCE_TOPIC: "source_topic",
+    SOURCE_INDEX: "source_index",
     X: "x",
     Y: "y",
     Z: "z",
@@ -71,6 +76,8 @@ REQUIRED = (CASE, ACTIVITY, TIMESTAMP)
 # Lifecycle values: a tag marks an activity's start or completion; TALE's enrichment adds
 # ``inprogress`` rows (transition "none", state "inprogress") that carry continuous data.
 START, COMPLETE, NONE = "start", "complete", "none"
+#: outcomes other than success that end an activity (a ROS 2 action's aborted or cancelled goal)
+ABORTED, CANCELLED = "aborted", "cancelled"
 INPROGRESS = "inprogress"
 SEND, RECEIVE = "send", "receive"
 

@@ -101,6 +101,7 @@ def plans(
     storage: str = "sqlite3",
     extra_topics: Sequence[str] = (),
     settings: dict[str, Any] | None = None,
+    distro: str = "humble",
 ) -> list[RunPlan]:
     if runs < 1 or first < 1:
         raise InputError("--runs and --first must be at least 1")
@@ -117,6 +118,7 @@ def plans(
             storage,
             tuple(extra_topics),
             dict(settings or {}),
+            distro,
         )
         for index in range(first, first + runs)
     ]

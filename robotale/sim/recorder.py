@@ -12,7 +12,10 @@ is still in the bag, as ``ros2 bag record`` on the sender's side would have it).
 - any other robot topic named in ``extra`` (``range``, ``cmd_vel`` ...), at ``rate``.
 
 The connections of the topics the mission is known to use are announced when the bag opens;
-others are added when their first message arrives. Message timestamps are simulated time.
+others are added when their first message arrives. Message timestamps are simulated time. Each
+topic offers rclcpp's default QoS, and the metadata is written as the chosen ROS 2
+distribution's ``ros2 bag`` writes it (:mod:`robotale.sim.bagmeta`; Humble's by default, which
+every supported distribution reads).
 """
 
 from __future__ import annotations
@@ -25,7 +28,7 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope
 from robotale.fame_runtime.tags import TAG_TYPE
-from robotale.sim import messages
+from robotale.sim import bagmeta, messages
 from robotale.sim.robots import BATTERY, ODOM
 
 STORAGES = {"sqlite3": StoragePlugin.SQLITE3, "mcap": StoragePlugin.MCAP}
@@ -45,9 +48,13 @@ class Recorder:
         rate: float = 2.0,
         errors: Iterable[str] = (),
         extra: Iterable[str] = (),
+        distro: str = bagmeta.DEFAULT_DISTRO,
     ) -> None:
         if storage not in STORAGES:
             raise InputError(f"storage {storage!r} is not one of {', '.join(STORAGES)}")
+        if distro not in bagmeta.VERSIONS:
+            raise InputError(f"distro {distro!r} is not one of {', '.join(bagmeta.VERSIONS)}")
+        self.path, self.distro = Path(path), distro
         self.robots = frozenset(robots)
         self.period = 1.0 / rate
         self.errors = frozenset(errors)
@@ -57,7 +64,9 @@ class Recorder:
         self.types: dict[str, str] = {}
         self._due: dict[str, float] = {}
         self._connections: dict[tuple[str, str], object] = {}
-        self._writer = Writer(path, version=9, storage_plugin=STORAGES[storage])
+        self._writer = Writer(
+            path, version=bagmeta.writer_version(distro), storage_plugin=STORAGES[storage]
+        )
         self._writer.open()
         for robot in sorted(self.robots):
             self._connect(f"/{robot}/tag", TAG_TYPE)
@@ -70,7 +79,10 @@ class Recorder:
         key = (topic, msgtype)
         if key not in self._connections:
             self._connections[key] = self._writer.add_connection(
-                topic, msgtype, typestore=messages.typestore()
+                topic,
+                msgtype,
+                typestore=messages.typestore(),
+                offered_qos_profiles=[bagmeta.DEFAULT_QOS],
             )
             self.types.setdefault(topic, msgtype)
             self.counts.setdefault(topic, 0)
@@ -104,6 +116,7 @@ class Recorder:
 
     def close(self) -> None:
         self._writer.close()
+        bagmeta.for_distro(self.path, self.distro)
 
     def topics(self) -> dict[str, dict[str, object]]:
         """Each recorded topic's type and message count (what the bag announces)."""

@@ -52,6 +52,7 @@ class RunPlan:
     storage: str = "sqlite3"
     extra_topics: tuple[str, ...] = ()
     settings: Mapping[str, Any] = field(default_factory=dict)  # as given, for the manifest
+    distro: str = "humble"  # the ROS 2 distribution whose `ros2 bag` the metadata is written for
 
     @property
     def case(self) -> str:
@@ -97,6 +98,7 @@ def simulate_run(
             rate=world.record_rate,
             errors=errors,
             extra=plan.extra_topics,
+            distro=plan.distro,
         )
         bus.tap(recorder.tap)
         sim = SimWorld(world, setup, clock=clock, bus=bus, gui=gui)

@@ -1,0 +1,221 @@
+"""Activities from what ROS 2 robots already publish, for bags without hand-placed tags.
+
+Each source becomes tag rows (case, time, activity, lifecycle, robot, and where each event came
+from: ``source_topic`` and ``source_index``, the message's position on its topic), which the
+TALE enrichment then treats as it treats tags:
+
+- ROS 2 actions: an ``<action>/_action/status`` topic (``action_msgs/msg/GoalStatusArray``)
+  lists every goal with its status. Each goal is one activity instance named after the action,
+  of the robot of the action's namespace: it starts when the server accepted it and ends with
+  its outcome as the lifecycle (``complete``, ``aborted``, ``cancelled``), when the first status
+  message says so.
+- State topics: a string or enum field (``/*/mode``): each value is an activity from the
+  message where it appears until the one where the next value does (a new activity ends the
+  previous one); the last ends with the recording.
+- Behaviour-tree transition logs (Nav2's ``nav2_msgs/msg/BehaviorTreeLog`` or any message with
+  ``node_name``, ``previous_status`` and ``current_status``): a node is an activity from RUNNING
+  until SUCCESS (complete), FAILURE (aborted) or IDLE (halted: cancelled).
+- Tags with only starts, or plain events (:func:`implicit`): each tag starts an activity that
+  the robot's next tag ends.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+
+import numpy as np
+import pandas as pd
+
+from robotale.eventlog import schema
+from robotale.eventlog.rosbag import TIME
+
+SOURCE_TOPIC, SOURCE_INDEX = schema.SOURCE_TOPIC, schema.SOURCE_INDEX
+#: the column of a topic's table that numbers its messages (added by the preparation)
+INDEX = "_index"
+ACTION_STATUS = "/*/_action/status"
+STATUS_TYPE = "action_msgs/msg/GoalStatusArray"
+#: action_msgs/msg/GoalStatus codes -> the lifecycle of the goal's activity they end it with
+_GOAL_OUTCOMES = {4: schema.COMPLETE, 5: schema.CANCELLED, 6: schema.ABORTED}
+_BT_OUTCOMES = {"SUCCESS": schema.COMPLETE, "FAILURE": schema.ABORTED, "IDLE": schema.CANCELLED}
+BT_FIELDS = ("node_name", "previous_status", "current_status")
+COLUMNS = [
+    schema.CASE,
+    schema.TIMESTAMP,
+    schema.ACTIVITY,
+    schema.LIFECYCLE,
+    schema.ROBOT,
+    schema.EXECUTION_ID,
+    SOURCE_TOPIC,
+    SOURCE_INDEX,
+]
+
+
+@dataclass(frozen=True)
+class Event:
+    """One activity event before it becomes a row."""
+
+    time: pd.Timestamp
+    activity: str
+    lifecycle: str
+    index: int
+    execution: str | None = None
+
+
+def action_of(topic: str) -> tuple[str, str]:
+    """``/r1/navigate_to_pose/_action/status`` -> (``r1``, ``navigate_to_pose``)."""
+    before = topic.rsplit("/_action/", 1)[0].strip("/")
+    robot, _, action = before.rpartition("/")
+    return robot, action
+
+
+def goal_events(table: pd.DataFrame, topic: str, column: str = "status_list") -> list[Event]:
+    """One start and one outcome per goal of an action's status topic, in message order."""
+    _, action = action_of(topic)
+    started: set[str] = set()
+    ended: set[str] = set()
+    events = []
+    for time, index, statuses in zip(table[TIME], table[INDEX], table[column], strict=True):
+        for status in statuses:
+            goal = bytes(np.asarray(status.goal_info.goal_id.uuid, dtype=np.uint8)).hex()
+            if goal not in started:
+                started.add(goal)
+                accepted = _stamp(status.goal_info.stamp) or time
+                events.append(Event(min(accepted, time), action, schema.START, index, goal))
+            outcome = _GOAL_OUTCOMES.get(int(status.status))
+            if outcome and goal not in ended:
+                ended.add(goal)
+                events.append(Event(time, action, outcome, index, goal))
+    return events
+
+
+def _stamp(stamp) -> pd.Timestamp | None:
+    nanos = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+    return pd.Timestamp(nanos, unit="ns", tz="UTC") if nanos > 0 else None
+
+
+def state_events(
+    table: pd.DataFrame, column: str, end: pd.Timestamp, names: dict | None = None
+) -> list[Event]:
+    """Each value of a state field an activity until the next value; the last until ``end``.
+
+    ``names`` maps enum values to their constants' names (``2`` -> ``DOCKING``). An empty value
+    is no activity: it only ends the previous one.
+    """
+    events: list[Event] = []
+    current = None
+    for time, index, value in zip(table[TIME], table[INDEX], table[column], strict=True):
+        value = str((names or {}).get(value, value)).strip()
+        if value == current:
+            continue
+        if current:
+            events.append(Event(time, current, schema.COMPLETE, index))
+        if value:
+            events.append(Event(time, value, schema.START, index))
+        current = value
+    if current:
+        events.append(Event(max(end, events[-1].time), current, schema.COMPLETE, events[-1].index))
+    return events
+
+
+def bt_events(changes: Iterable[tuple[pd.Timestamp, int, object]]) -> list[Event]:
+    """Behaviour-tree nodes as activities, from (time, index, status change) in order.
+
+    A change's own ``timestamp`` wins over the message time when it has one. A node that
+    succeeds or fails without having been RUNNING is an instant activity; a reset to IDLE after
+    an outcome is no event.
+    """
+    events = []
+    for time, index, change in changes:
+        stamp = getattr(change, "timestamp", None)
+        when = (_stamp(stamp) if stamp is not None else None) or time
+        node = str(change.node_name)
+        before, after = (str(getattr(change, name)).upper() for name in BT_FIELDS[1:])
+        if after == before:
+            continue
+        if after == "RUNNING" or (after in ("SUCCESS", "FAILURE") and before != "RUNNING"):
+            events.append(Event(when, node, schema.START, index))
+        if after in ("SUCCESS", "FAILURE") or (after == "IDLE" and before == "RUNNING"):
+            events.append(Event(when, node, _BT_OUTCOMES[after], index))
+    return events
+
+
+def bt_changes(table: pd.DataFrame, column: str | None) -> list[tuple[pd.Timestamp, int, object]]:
+    """(time, index, change) of a log topic: ``column`` holds a sequence of changes per message,
+    or each message is one change (``column`` None, its fields as columns)."""
+    if column is not None:
+        return [
+            (time, index, change)
+            for time, index, changes in zip(table[TIME], table[INDEX], table[column], strict=True)
+            for change in changes
+        ]
+    fields = zip(*(table[name] for name in BT_FIELDS), strict=True)
+    return [
+        (time, index, _Change(*values))
+        for time, index, values in zip(table[TIME], table[INDEX], fields, strict=True)
+    ]
+
+
+@dataclass(frozen=True)
+class _Change:
+    node_name: str
+    previous_status: str
+    current_status: str
+
+
+def rows(events: Sequence[Event], case: str, robot: str, topic: str) -> pd.DataFrame:
+    """Tag rows of ``events``."""
+    return pd.DataFrame(
+        {
+            schema.CASE: case,
+            schema.TIMESTAMP: pd.to_datetime([e.time for e in events], utc=True),
+            schema.ACTIVITY: [e.activity for e in events],
+            schema.LIFECYCLE: [e.lifecycle for e in events],
+            schema.ROBOT: robot,
+            schema.EXECUTION_ID: [e.execution for e in events],
+            SOURCE_TOPIC: topic,
+            SOURCE_INDEX: np.array([e.index for e in events], dtype=np.int64),
+        },
+        columns=COLUMNS,
+    )
+
+
+def implicit(tags: pd.DataFrame, ends: dict[str, pd.Timestamp]) -> pd.DataFrame:
+    """Tags whose activities end when the robot's next one starts.
+
+    Every tag that is not a ``complete`` (or another outcome) starts an activity; one that its
+    robot does not complete before its next tag is completed at that tag's time, the robot's last
+    at the end of its run (``ends``: case -> time). The added completes keep their start's
+    source.
+    """
+    closing = {schema.COMPLETE, schema.ABORTED, schema.CANCELLED}
+    tags = tags.sort_values([schema.CASE, schema.ROBOT, schema.TIMESTAMP], kind="stable")
+    tags = tags.assign(**{schema.LIFECYCLE: tags[schema.LIFECYCLE].where(
+        tags[schema.LIFECYCLE].isin(closing), schema.START
+    )})  # fmt: skip
+    added = []
+    for (case, _), group in tags.groupby([schema.CASE, schema.ROBOT], sort=False):
+        records = group.to_dict("records")
+        for k, tag in enumerate(records):
+            if tag[schema.LIFECYCLE] != schema.START:
+                continue
+            after = records[k + 1] if k + 1 < len(records) else None
+            if after is not None and (
+                after[schema.LIFECYCLE] in closing
+                and after[schema.ACTIVITY] == tag[schema.ACTIVITY]
+            ):
+                continue
+            close = dict(tag, **{schema.LIFECYCLE: schema.COMPLETE})
+            close[schema.TIMESTAMP] = after[schema.TIMESTAMP] if after else ends[case]
+            for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
+                close.pop(column, None)
+            added.append((tag, close))
+    return _with_closes(tags, added)
+
+
+def _with_closes(tags: pd.DataFrame, added: list[tuple[dict, dict]]) -> pd.DataFrame:
+    """``tags`` in time order, each added complete before any tag at its time (it ends the
+    previous activity that a tag at the same time follows)."""
+    closes = pd.DataFrame([close for _, close in added], columns=tags.columns)
+    merged = pd.concat([closes, tags], ignore_index=True) if len(closes) else tags
+    return merged.sort_values([schema.CASE, schema.TIMESTAMP], kind="stable", ignore_index=True)

@@ -1,0 +1,140 @@
+"""robotale's own bags, read back without robotale or rosbags, for each ROS 2 distribution.
+
+What each distribution's reader requires of metadata.yaml is written here from rosbag2's
+``rosbag2_storage`` YAML decoding (``metadata_io.cpp`` on the humble branch,
+``include/rosbag2_storage/yaml.hpp`` on iron and jazzy; branches as of October 2024): the keys it
+reads for the version it finds, and the YAML kind each must have.
+"""
+
+from __future__ import annotations
+
+import sqlite3
+
+import pytest
+import yaml
+from mcap.reader import make_reader
+
+from robotale.fame_runtime.bus import Envelope
+from robotale.fame_runtime.tags import TAG_TYPE, Tag
+from robotale.sim.recorder import Recorder
+
+#: distribution -> (metadata version its rosbag2 writes, newest version whose fields it decodes)
+WRITES = {"humble": 5, "iron": 7, "jazzy": 9}
+#: keys every reader decodes (version >= 5), and the YAML kind of each
+BAG_KEYS = {
+    "version": int,
+    "storage_identifier": str,
+    "duration": dict,
+    "starting_time": dict,
+    "message_count": int,
+    "topics_with_message_count": list,
+    "relative_file_paths": list,
+    "compression_format": str,
+    "compression_mode": str,
+    "files": list,
+}
+FILE_KEYS = {"path": str, "starting_time": dict, "duration": dict, "message_count": int}
+
+
+def required(distro: str, version: int) -> tuple[dict, dict]:
+    """(bag keys, topic_metadata keys) ``distro``'s reader decodes from a file of ``version``."""
+    bag = dict(BAG_KEYS)
+    topic = {"name": str, "type": str, "serialization_format": str}
+    # all three read offered_qos_profiles as a string up to version 8; only Jazzy knows 9's list
+    topic["offered_qos_profiles"] = list if version >= 9 else str
+    if distro != "humble":
+        if version >= 6:
+            bag["custom_data"] = (dict, type(None))  # an empty map is written as null
+        if version >= 7:
+            topic["type_description_hash"] = str
+    if distro == "jazzy" and version >= 8:
+        bag["ros_distro"] = str
+    return bag, topic
+
+
+def assert_kinds(mapping: dict, kinds: dict, where: str) -> None:
+    for key, kind in kinds.items():
+        assert key in mapping, f"{where} lacks {key}"
+        assert isinstance(mapping[key], kind), f"{where}: {key} is {mapping[key]!r}"
+
+
+def record(path, storage: str, distro: str) -> dict[str, int]:
+    """A short recording of two tags; how many messages each topic got."""
+    recorder = Recorder(path, robots=["drone"], announced={}, storage=storage, distro=distro)
+    for stamp, lifecycle in ((1.0, "start"), (2.5, "complete")):
+        tag = Tag(stamp, "drone", "take_off", lifecycle)
+        recorder.tap(Envelope("/drone/tag", tag, TAG_TYPE, stamp))
+    recorder.close()
+    return {"/drone/tag": 2}
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+@pytest.mark.parametrize("distro", ["humble", "iron", "jazzy"])
+def test_the_written_metadata_is_what_each_distribution_reads(tmp_path, storage, distro):
+    bag = tmp_path / "run"
+    record(bag, storage, distro)
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert info["version"] == WRITES[distro]
+    # every distribution at least as new as the one chosen reads it
+    for reader in [d for d in WRITES if WRITES[d] >= WRITES[distro]]:
+        bag_keys, topic_keys = required(reader, info["version"])
+        assert_kinds(info, bag_keys, f"{reader}: metadata")
+        for entry in info["topics_with_message_count"]:
+            assert_kinds(entry["topic_metadata"], topic_keys, f"{reader}: {entry}")
+        for file in info["files"]:
+            assert_kinds(file, FILE_KEYS, f"{reader}: files")
+    qos = info["topics_with_message_count"][0]["topic_metadata"]["offered_qos_profiles"]
+    profiles = yaml.safe_load(qos) if isinstance(qos, str) else qos
+    assert profiles and profiles[0]["depth"] == 10  # a real profile, not an empty list
+
+
+def test_older_distributions_cannot_read_what_jazzy_writes(tmp_path):
+    """The check above can fail: Jazzy's QoS list is not the string Humble and Iron read."""
+    record(tmp_path / "run", "sqlite3", "jazzy")
+    info = yaml.safe_load((tmp_path / "run" / "metadata.yaml").read_text())
+    info = info["rosbag2_bagfile_information"]
+    for reader in ("humble", "iron"):
+        _, topic_keys = required(reader, 8)  # what they expect below their own version
+        with pytest.raises(AssertionError):
+            assert_kinds(info["topics_with_message_count"][0]["topic_metadata"], topic_keys, "")
+
+
+@pytest.mark.parametrize("distro", ["humble", "iron", "jazzy"])
+def test_sqlite3_bags_read_back_with_sqlite(tmp_path, distro):
+    counts = record(tmp_path / "run", "sqlite3", distro)
+    info = yaml.safe_load((tmp_path / "run" / "metadata.yaml").read_text())
+    info = info["rosbag2_bagfile_information"]
+    database = tmp_path / "run" / info["relative_file_paths"][0]
+    with sqlite3.connect(database) as connection:
+        rows = connection.execute(
+            "SELECT topics.name, topics.type, COUNT(*) FROM messages "
+            "JOIN topics ON topics.id = messages.topic_id GROUP BY topics.name"
+        ).fetchall()
+        stored = connection.execute("SELECT metadata_version FROM metadata").fetchone()[0]
+    connection.close()
+    assert {name: n for name, _, n in rows} == counts
+    assert {kind for _, kind, _ in rows} == {TAG_TYPE}
+    assert stored == WRITES[distro]
+    listed = {
+        e["topic_metadata"]["name"]: e["message_count"] for e in info["topics_with_message_count"]
+    }
+    assert {t: n for t, n in listed.items() if n} == counts
+
+
+@pytest.mark.parametrize("distro", ["humble", "iron", "jazzy"])
+def test_mcap_bags_read_back_with_the_mcap_reader(tmp_path, distro):
+    counts = record(tmp_path / "run", "mcap", distro)
+    info = yaml.safe_load((tmp_path / "run" / "metadata.yaml").read_text())
+    info = info["rosbag2_bagfile_information"]
+    with open(tmp_path / "run" / info["relative_file_paths"][0], "rb") as stream:
+        messages = list(make_reader(stream).iter_messages())
+    seen: dict[str, int] = {}
+    for schema, channel, _ in messages:
+        assert (schema.name, schema.encoding, channel.message_encoding) == (
+            TAG_TYPE,
+            "ros2msg",
+            "cdr",
+        )
+        seen[channel.topic] = seen.get(channel.topic, 0) + 1
+    assert seen == counts
+    assert info["message_count"] == sum(counts.values())
