@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -12,7 +13,8 @@ from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
 from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
 from robotale.errors import InputError
-from robotale.eventlog.readers import parse_mapping, read_log
+from robotale.eventlog.readers import parse_mapping, read_log_with_reading
+from robotale.eventlog.reading import format_reading
 
 
 def ingest_command(
@@ -23,6 +25,7 @@ def ingest_command(
     aggregate: Sequence[str] | None = None,
     mapping: Sequence[str] = (),
     case: str | None = None,
+    case_gap: str | None = None,
     replace: bool = False,
     tags: str | None = None,
     tag_fields: Sequence[str] = (),
@@ -34,10 +37,10 @@ def ingest_command(
     """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
     Neo4j as ``log`` (default: the file's or folder's name)."""
     if path.is_dir():
-        if mapping or case:
+        if mapping or case or case_gap:
             raise InputError(
-                f"{path} holds recordings: --map and --case apply to CSV and XES files "
-                "(each run of a recording is its own case)."
+                f"{path} holds recordings: --map, --case and --case-gap apply to CSV and XES "
+                "files (each run of a recording is its own case)."
             )
         events = prepare_recordings(
             path,
@@ -49,7 +52,8 @@ def ingest_command(
             bag_time=bag_time,
         )
     else:
-        events = read_log(path, parse_mapping(mapping), case)
+        events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
+        print(format_reading(reading, short=True), file=sys.stderr)
     with session_driver() as driver:
         summary = build_ekg(
             driver,

@@ -505,14 +505,16 @@ def format_reading(reading: Reading, *, short: bool = False) -> str:
 
 
 def _details(reading: Reading) -> list[str]:
-    columns = ", ".join(f"{column} -> {role}" for column, role in reading.columns.items())
+    width = max((len(column) for column in reading.columns), default=0)
+    columns = [f"    {column:<{width}} -> {role}" for column, role in reading.columns.items()]
     robots = ", ".join(
         robot if kind is None else f"{robot} ({kind})" for robot, kind in reading.robots.items()
     )
     events = ", ".join(f"{reading.events[kind]:,} {kind}" for kind in KINDS)
     missing = ", ".join(f"{column} {count:,}" for column, count in reading.missing.items())
     return [
-        f"  columns:   {columns}",
+        "  columns:",
+        *columns,
         f"  cases:     {reading.cases:,} ({reading.case})",
         f"  robots:    {robots or '-'}",
         f"  events:    {events}",
