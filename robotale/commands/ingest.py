@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -37,10 +36,15 @@ def ingest_command(
     """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
     Neo4j as ``log`` (default: the file's or folder's name)."""
     if path.is_dir():
-        if mapping or case or case_gap:
+        if mapping or case:
             raise InputError(
-                f"{path} holds recordings: --map, --case and --case-gap apply to CSV and XES "
-                "files (each run of a recording is its own case)."
+                f"{path} holds recordings: --map and --case apply to CSV and XES files "
+                "(each run of a recording is its own case)."
+            )
+        if case_gap:
+            raise InputError(
+                f"{path} holds recordings: --case-gap applies to CSV and XES files "
+                "(each run of a recording is its own case)."
             )
         events = prepare_recordings(
             path,
@@ -53,7 +57,8 @@ def ingest_command(
         )
     else:
         events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
-        print(format_reading(reading, short=True), file=sys.stderr)
+        # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
+        print(format_reading(reading, short=True))
     with session_driver() as driver:
         summary = build_ekg(
             driver,

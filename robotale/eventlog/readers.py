@@ -246,7 +246,7 @@ def canonical_log(
         cases=int(log[schema.CASE].nunique()),
         robots=robots,
         events={kind: int((kinds == kind).sum()) for kind in reading.KINDS},
-        pairing=reading.pairing_description(log),
+        pairing=reading.pairing_description(log, renames),
         rows=len(table),
         missing=dict(missing or {}),
         dropped=dropped,

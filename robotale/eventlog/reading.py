@@ -304,7 +304,7 @@ def dropped_rows(kinds: pd.Series, lines: pd.Series) -> dict[str, list[int]]:
     }
 
 
-def pairing_description(log: pd.DataFrame) -> str:
+def pairing_description(log: pd.DataFrame, renames: Mapping[str, str]) -> str:
     """How a start finds its completion (the keys robotale's activity instances use)."""
     keys = [
         name
@@ -312,10 +312,12 @@ def pairing_description(log: pd.DataFrame) -> str:
         if column in log.columns
     ]
     within = ", ".join([*keys, "activity"])
+    source = {canonical: column for column, canonical in renames.items()}
     if schema.EXECUTION_ID in log.columns:
-        return f"by {schema.EXECUTION_ID} within {within}"
+        return f"by {source.get(schema.EXECUTION_ID, schema.EXECUTION_ID)} within {within}"
     if schema.MSG_ID in log.columns:
-        return f"by msg_id within {within} (first in, first out where there is none)"
+        key = source.get(schema.MSG_ID, schema.MSG_ID)
+        return f"by {key} within {within} (first in, first out where there is none)"
     return f"first in, first out within {within}"
 
 
@@ -408,16 +410,9 @@ def robot_types(log: pd.DataFrame) -> tuple[dict[str, str | None], list[str]]:
     return found, warnings
 
 
-#: canonical columns that name entities: one value over the whole log tells nothing apart.
-ENTITY_COLUMNS = (
-    schema.CASE,
-    schema.ROBOT,
-    schema.ROBOT_TYPE,
-    schema.EXECUTION_ID,
-    schema.MSG_ID,
-    schema.MSG_SENDER,
-    schema.MSG_RECEIVER,
-)
+#: canonical columns that name entities: one value over the whole log tells nothing apart
+#: (robot types, senders and receivers may well have one: a team of one kind, one sender).
+ENTITY_COLUMNS = (schema.CASE, schema.ROBOT, schema.EXECUTION_ID, schema.MSG_ID)
 
 
 def single_value_warnings(log: pd.DataFrame, renames: Mapping[str, str]) -> list[str]:
