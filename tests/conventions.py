@@ -89,9 +89,7 @@ class GroundTruth:
 
     def instance_table(self) -> pd.DataFrame:
         """case, robot, activity, start, end, seconds: one row per instance, sorted."""
-        rows = [
-            (i.case, i.robot, i.activity, i.start, i.end, i.seconds) for i in self.instances
-        ]
+        rows = [(i.case, i.robot, i.activity, i.start, i.end, i.seconds) for i in self.instances]
         columns = ["case", "robot", "activity", "start", "end", "seconds"]
         return pd.DataFrame(rows, columns=columns).sort_values(columns).reset_index(drop=True)
 
@@ -154,9 +152,7 @@ def _one_run(truth: GroundTruth, case: str, begin: pd.Timestamp) -> None:
 
     def instance(robot: str, activity: str, start: float, end: float, msg_id=None) -> None:
         key = f"{case}-{len(truth.instances) + 1}"
-        truth.instances.append(
-            Instance(case, robot, activity, at(start), at(end), key, msg_id)
-        )
+        truth.instances.append(Instance(case, robot, activity, at(start), at(end), key, msg_id))
 
     def message(number: int, to: str, sent: float, received: float | None, resend_of=None):
         msg_id = f"{case}-m{number}"

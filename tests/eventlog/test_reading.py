@@ -159,7 +159,8 @@ def test_inprogress_samples_keep_their_battery(tmp_path):
     flow = len(log) - len(TRUTH.samples)
     assert reading.missing == {
         "execution_id": len(TRUTH.samples),
-        "msg_id": len(log) - sum(i.msg_id is not None for i in TRUTH.instances)
+        "msg_id": len(log)
+        - sum(i.msg_id is not None for i in TRUTH.instances)
         - sum(i.msg_id is not None and not i.instant for i in TRUTH.instances),
         "battery": flow,
     }
@@ -184,8 +185,9 @@ def test_robot_id_csv_markers_and_roles(tmp_path):
         "msg_receiver": len(raw) - message_events,
         "battery": expected.count(None),
     }
-    assert reading.notes == [f"{message_events} message events take their role from "
-                             "msg_sender / msg_receiver."]
+    assert reading.notes == [
+        f"{message_events} message events take their role from msg_sender / msg_receiver."
+    ]
     sends = sum(1 for i in TRUTH.instances if i.msg_id and i.activity.endswith("!")) * 2
     assert (log[schema.MSG_ROLE] == "send").sum() == sends
 
@@ -225,12 +227,10 @@ def test_lifecycle_wins_over_state_and_only_untransitioned_rows_are_samples(tmp_
         "2024-01-01T10:00:05Z,c,,done\n",
     )
     log, reading = read_log_with_reading(path)
-    assert log[schema.LIFECYCLE].tolist() == ["start", "none", "none", "complete", "none"] + [
-        "complete"
-    ]
-    assert log[schema.STATE].tolist() == ["none", "inprogress", "inprogress", "none", "none"] + [
-        "none"
-    ]
+    lifecycles = ["start", "none", "none", "complete", "none", "complete"]
+    states = ["none", "inprogress", "inprogress", "none", "none", "none"]
+    assert log[schema.LIFECYCLE].tolist() == lifecycles
+    assert log[schema.STATE].tolist() == states
     assert reading.events == {"start": 1, "complete": 2, "instant": 1, "sample": 2}
     assert "1 start and 1 complete rows say the state is in progress" in reading.notes[0]
 
@@ -297,7 +297,7 @@ def test_org_resource_alone_is_the_robot(tmp_path):
         "org.csv",
         "time,activity,org:resource,org:role\n2024-01-01T10:00:00Z,a,drone,Drone\n",
     )
-    log, reading = read_log_with_reading(path)
+    _, reading = read_log_with_reading(path)
     assert reading.columns == {
         "time": "time",
         "activity": "activity",
