@@ -100,3 +100,13 @@ def test_perspectives_show_the_reading_on_stderr(tmp_path, capsys):
     lost = sum(m.received is None for m in TRUTH.messages)
     assert (summary["messages"], summary["lost"]) == (len(TRUTH.messages), lost)
     assert summary["received"] == len(TRUTH.messages) - lost
+
+
+def test_ingest_splits_the_thesis_log_by_case_gap(thesis_csv, capsys, neo4j_driver, log_name):
+    from robotale.ekg.logs import log_summary
+
+    days = pd.to_datetime(pd.read_csv(thesis_csv)["time"], format="ISO8601").dt.date.nunique()
+    code, out, err = run(capsys, "ingest", str(thesis_csv), "--log", log_name, "--case-gap", "1h")
+    assert code == 0, err
+    assert out.startswith(f"Read robotic_data.csv: 3,648 of 3,648 rows kept, {days} cases")
+    assert log_summary(neo4j_driver, log_name)["counts"]["cases"] == days
