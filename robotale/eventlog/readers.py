@@ -99,16 +99,35 @@ def _read_csv(
     text_columns = [src for src, canonical in renames.items() if canonical in TEXT_COLUMNS]
     if case is not None:
         text_columns.append(case)
-    try:
-        # every cell as text, so the missing markers are ours to decide (pandas' own list
-        # would take "NA" for missing and leave "-" as a value)
-        table = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
-    except (pd.errors.ParserError, ValueError) as error:
-        raise InputError(f"{path} is not a readable CSV file: {error}") from None
-    missing = reading.mark_missing(table)
-    table = reading.typed_columns(table, text_columns)
+    table, missing = _csv_table(path, text, text_columns)
     lines = pd.Series(range(2, len(table) + 2), index=table.index)  # line 1 is the header
     return canonical_log(path, table, renames, lines, case, case_gap, missing)
+
+
+def _csv_table(
+    path: Path, text: str, text_columns: list[str]
+) -> tuple[pd.DataFrame, dict[str, int]]:
+    """The CSV's cells with the missing markers cleared, and how many per column.
+
+    The markers are ours to decide, not pandas' (its own list takes "NA" for missing and
+    leaves "-" as a value). Markers as whole cells are cleared by pandas' parser itself;
+    only a file with blanks around a marker is read as text and cleared cell by cell.
+    """
+    try:
+        if reading.has_padded_markers(text):
+            table = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
+            missing = reading.mark_missing(table)
+            return reading.typed_columns(table, text_columns), missing
+        table = pd.read_csv(
+            io.StringIO(text),
+            dtype=dict.fromkeys(text_columns, str),
+            keep_default_na=False,
+            na_values=sorted(reading.MISSING_MARKERS),
+        )
+    except (pd.errors.ParserError, ValueError) as error:
+        raise InputError(f"{path} is not a readable CSV file: {error}") from None
+    counts = table.isna().sum()  # every NaN is a marker: no other value reads as one
+    return table, {str(column): int(n) for column, n in counts.items() if n}
 
 
 def _read_xes(
@@ -224,7 +243,7 @@ def canonical_log(
     _require_values(path, log, schema.ACTIVITY, lines)
     kinds = reading.event_kinds(log)
     dropped = reading.dropped_rows(kinds, lines)
-    keep = ~kinds.str.startswith("?").to_numpy(bool)
+    keep = reading.understood(kinds).to_numpy(bool)
     if not keep.any():
         raise InputError(f"{path}: no row is an event ({next(iter(dropped))}).")
     log, kinds = log[keep].copy(), kinds[keep]

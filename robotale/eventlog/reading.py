@@ -216,6 +216,23 @@ def listing(columns: list[str]) -> str:
 # -- missing values ----------------------------------------------------------------------------
 
 
+_MARKER = "|".join(re.escape(m) for m in sorted(MISSING_MARKERS, key=len, reverse=True) if m)
+#: a CSV cell holding a marker or nothing, with blanks around it
+_PADDED = re.compile(rf"(?:^|,)(?:[ \t]+(?:{_MARKER})?[ \t]*|(?:{_MARKER})[ \t]+)(?=,|\r?$)", re.M)
+
+
+def has_padded_markers(text: str) -> bool:
+    """Whether a CSV text may hold a marker (or nothing) with blanks around it, which only
+    :func:`mark_missing` recognises; one regular expression over the text, so files without
+    any (nearly all) are read at the speed of pandas' own parser."""
+    # a blank next to a delimiter or a line's end is rare, and plain substring tests are fast
+    blanks = (", ", ",\t", " ,", "\t,", "\n ", "\n\t", " \n", "\t\n", " \r", "\t\r")
+    edges = text[:1] + text.rstrip("\r\n")[-1:]
+    if not any(blank in text for blank in blanks) and not edges.isspace():
+        return False
+    return _PADDED.search(text) is not None
+
+
 def mark_missing(table: pd.DataFrame) -> dict[str, int]:
     """Replace the :data:`MISSING_MARKERS` of every text cell by NaN, in place; the count of
     cells replaced per column (columns without any are left out)."""
@@ -257,14 +274,20 @@ def event_kinds(log: pd.DataFrame) -> pd.Series:
         meaning = pd.Series(None, index=log.index, dtype=object)
     in_progress = _in_progress(log)
     absent = raw.isna().to_numpy(bool)
-    kinds = pd.Series("?" + raw.fillna(""), index=log.index, dtype=object)
+    kinds = pd.Series("instant", index=log.index, dtype=object)
     kinds[(meaning == schema.START).to_numpy(bool)] = "start"
     kinds[(meaning == schema.COMPLETE).to_numpy(bool)] = "complete"
     no_transition = absent | (meaning == schema.NONE).to_numpy(bool)
-    kinds[no_transition] = "instant"
     kinds[absent & ~in_progress] = "complete"  # pm4py's default: a recorded completion
     kinds[no_transition & in_progress] = "sample"
+    unknown = (~absent) & meaning.isna().to_numpy(bool)
+    kinds[unknown] = "?" + raw[unknown]
     return kinds
+
+
+def understood(kinds: pd.Series) -> pd.Series:
+    """Which rows :func:`event_kinds` could read (the others are dropped)."""
+    return kinds.isin(KINDS)
 
 
 def _in_progress(log: pd.DataFrame) -> pd.Series:
@@ -297,7 +320,7 @@ def lifecycle_columns(log: pd.DataFrame, kinds: pd.Series) -> list[str]:
 
 def dropped_rows(kinds: pd.Series, lines: pd.Series) -> dict[str, list[int]]:
     """Reason -> file lines of the rows whose lifecycle is not understood."""
-    unknown = kinds[kinds.str.startswith("?")]
+    unknown = kinds[~understood(kinds)]
     return {
         f"lifecycle {value[1:]!r} is not start, complete or none": lines[group.index].tolist()
         for value, group in unknown.groupby(unknown, sort=True)
@@ -385,7 +408,8 @@ def cases_by_gap(times: pd.Series, gap: pd.Timedelta) -> pd.Series:
 
 def days_spanned(times: pd.Series) -> list[str]:
     """The calendar days (in the log's own offset) its events fall on."""
-    return sorted({str(day) for day in times.dt.date.unique()})
+    days = times.dt.normalize().drop_duplicates()  # in the log's own offset
+    return sorted(day.strftime("%Y-%m-%d") for day in days)
 
 
 # -- what the reading finds --------------------------------------------------------------------
