@@ -36,6 +36,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_simulate(commands)
     _add_prepare(commands)
     _add_neo4j(commands)
+    _add_inspect(commands)
     _add_ingest(commands)
     _add_logs(commands)
     _add_serve(commands)
@@ -277,6 +278,7 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
     )
     _add_mapping(ingest)
     ingest.add_argument("--case", metavar="COLUMN", help="the column that tells cases apart")
+    _add_case_gap(ingest)
     ingest.add_argument(
         "--replace", action="store_true", default=None, help="rebuild a log that exists"
     )
@@ -414,9 +416,38 @@ def _add_log_source(parser: argparse.ArgumentParser, stored: bool = False) -> No
     if stored:
         parser.add_argument("--log", dest="log_name", metavar="NAME", help="a log stored in Neo4j")
     _add_mapping(parser)
+    _add_case_options(parser)
+
+
+def _add_case_options(parser: argparse.ArgumentParser) -> None:
+    """How a log file's events fall into cases."""
     parser.add_argument(
         "--case-column", metavar="COLUMN", help="the column telling runs apart (default: case)"
     )
+    _add_case_gap(parser)
+
+
+def _add_case_gap(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--case-gap",
+        metavar="DURATION",
+        help="without a case column, start a new case after every pause this long between "
+        "events, e.g. 1h, 90s, 30min",
+    )
+
+
+def _add_inspect(commands: argparse._SubParsersAction) -> None:
+    inspect = commands.add_parser(
+        "inspect",
+        help="how an event log (CSV or XES) is read: columns, cases, robots, dropped rows",
+        description="Show how robotale reads an event log before anything is built on it: "
+        "which column is the case, the robot and its type, the lifecycle and the pairing key, "
+        "which cells are missing, how many rows were kept or dropped and why, and warnings.",
+    )
+    inspect.add_argument("log", type=Path, help="event log file (.csv or .xes)")
+    _add_mapping(inspect)
+    _add_case_options(inspect)
+    _handled_by(inspect, "inspect.inspect_command")
 
 
 def _add_discover(commands: argparse._SubParsersAction) -> None:

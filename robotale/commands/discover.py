@@ -22,6 +22,7 @@ def dfg_command(
     log_name: str | None = None,
     mapping: Sequence[str] = (),
     case_column: str | None = None,
+    case_gap: str | None = None,
     cases: Sequence[str] | None = None,
     robots: Sequence[str] | None = None,
     robot_types: Sequence[str] | None = None,
@@ -43,7 +44,9 @@ def dfg_command(
         start=since,
         end=until,
     )
-    events = read_event_log(log, log_name=log_name, mapping=mapping, case_column=case_column)
+    events = read_event_log(
+        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
+    )
     return emit_graph(discover_dfg(events, selection), out=out, svg=svg, labels=labels)
 
 
@@ -73,9 +76,12 @@ def conformance_command(
     log_name: str | None = None,
     mapping: Sequence[str] = (),
     case_column: str | None = None,
+    case_gap: str | None = None,
 ) -> int:
     """Each robot's runs replayed against its pool of the BPMN collaboration ``model``."""
-    events = read_event_log(log, log_name=log_name, mapping=mapping, case_column=case_column)
+    events = read_event_log(
+        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
+    )
     report = check_conformance(events, model, library=library)
     if json_out:
         write_texts([(json_out, json.dumps(report.to_dict(), indent=2))])

@@ -13,7 +13,8 @@ from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
 from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
 from robotale.errors import InputError
-from robotale.eventlog.readers import parse_mapping, read_log
+from robotale.eventlog.readers import parse_mapping, read_log_with_reading
+from robotale.eventlog.reading import format_reading
 
 
 def ingest_command(
@@ -24,6 +25,7 @@ def ingest_command(
     aggregate: Sequence[str] | None = None,
     mapping: Sequence[str] = (),
     case: str | None = None,
+    case_gap: str | None = None,
     replace: bool = False,
     tags: str | None = None,
     tag_fields: Sequence[str] = (),
@@ -42,6 +44,11 @@ def ingest_command(
                 f"{path} holds recordings: --map and --case apply to CSV and XES files "
                 "(each run of a recording is its own case)."
             )
+        if case_gap:
+            raise InputError(
+                f"{path} holds recordings: --case-gap applies to CSV and XES files "
+                "(each run of a recording is its own case)."
+            )
         events = prepare_recordings(
             path,
             tags=tags,
@@ -53,7 +60,9 @@ def ingest_command(
             **recording,
         )
     else:
-        events = read_log(path, parse_mapping(mapping), case)
+        events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
+        # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
+        print(format_reading(reading, short=True))
     with session_driver() as driver:
         summary = build_ekg(
             driver,

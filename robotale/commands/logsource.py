@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 from collections.abc import Sequence
 from pathlib import Path
 
@@ -9,7 +10,8 @@ import pandas as pd
 
 from robotale.discovery.ekg import read_stored_log
 from robotale.errors import InputError
-from robotale.eventlog.readers import parse_mapping, read_log
+from robotale.eventlog.readers import parse_mapping, read_log_with_reading
+from robotale.eventlog.reading import Reading, format_reading
 
 
 def read_event_log(
@@ -18,14 +20,25 @@ def read_event_log(
     log_name: str | None = None,
     mapping: Sequence[str] = (),
     case_column: str | None = None,
+    case_gap: str | None = None,
 ) -> pd.DataFrame:
-    """A CSV/XES file (``log``, read with the ``--map`` items and ``case_column``) or, with
-    ``log_name``, a log stored in Neo4j."""
+    """A CSV/XES file (``log``, read with the ``--map`` items, ``case_column`` and
+    ``case_gap``; how it was read goes to stderr) or, with ``log_name``, a log stored in
+    Neo4j."""
     if log_name:
         return read_stored_log(log_name)
     if not log:
         raise InputError("name an event log: a CSV or XES file, or --log NAME for a stored one.")
-    return read_log(log, mapping=parse_mapping(mapping), case=case_column)
+    events, reading = read_log_with_reading(
+        log, parse_mapping(mapping), case=case_column, case_gap=case_gap
+    )
+    report_reading(reading)
+    return events
+
+
+def report_reading(reading: Reading) -> None:
+    """The short form of how a file was read, on stderr so it never mixes with the output."""
+    print(format_reading(reading, short=True), file=sys.stderr)
 
 
 def values(lists: Sequence[str] | None) -> tuple[str, ...]:

@@ -17,6 +17,7 @@ def perspectives_command(
     log_name: str | None = None,
     mapping: Sequence[str] = (),
     case_column: str | None = None,
+    case_gap: str | None = None,
     out: Path | None = None,
     json_out: Path | None = None,
     activity: str | None = None,
@@ -28,7 +29,9 @@ def perspectives_command(
     if not out and not json_out:
         raise InputError("say where the report goes: --out report.html and/or --json report.json.")
     area = Field.parse(field) if field else None
-    events = read_event_log(log, log_name=log_name, mapping=mapping, case_column=case_column)
+    events = read_event_log(
+        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
+    )
     options = {} if threshold is None else {"threshold": threshold}
     results = all_perspectives(events, activity=activity, robot=robot, field=area, **options)
     title = f"robotale perspectives: {log_name or Path(log or '').name}"

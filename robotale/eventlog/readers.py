@@ -1,11 +1,14 @@
 """Read an event log from CSV or XES into the canonical DataFrame of :mod:`.schema`.
 
-Columns are recognised by their usual names (``time``, ``timestamp``, ``time:timestamp``;
-``activity``, ``concept:name``; ``resource``, ``robot_id``, ``org:resource`` for the robot ...;
-see :data:`SYNONYMS`), or mapped explicitly with ``mapping={"Zeit": "time"}`` (the command
-line's ``--map Zeit=time``). Without a case column the whole log is one case (``"1"``), unless
-``case=`` names the column that tells cases apart. In XES the trace's name is the case. Rows
-keep their order in the file, which breaks ties between equal timestamps later on.
+How a log is read (which column is the case, the robot, its type, the lifecycle, which cells
+mean "missing", which rows are samples) is decided in :mod:`.reading`, which also describes the
+decisions: :func:`read_log_with_reading` returns that :class:`~.reading.Reading` next to the
+log. Columns are recognised by their usual names (see :data:`.reading.SYNONYMS`) or mapped
+explicitly with ``mapping={"Zeit": "time"}`` (the command line's ``--map Zeit=time``). Without a
+case column the whole log is one case (``"1"``), unless ``case=`` names the column that tells
+cases apart or ``case_gap=`` starts a new case after every pause that long. In XES the trace's
+name is the case. Rows keep their order in the file, which breaks ties between equal timestamps
+later on.
 
 Every problem is one :class:`~robotale.errors.InputError` naming the file and, where there is
 one, the line.
@@ -14,49 +17,18 @@ one, the line.
 from __future__ import annotations
 
 import io
-import re
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
 import pandas as pd
 
 from robotale.errors import InputError
-from robotale.eventlog import schema
+from robotale.eventlog import reading, schema
+from robotale.eventlog.reading import SYNONYMS, TEXT_COLUMNS, Reading, column_mapping, listing
 
-#: canonical column -> names it is recognised by (compared ignoring case, blanks, "_" and "-").
-SYNONYMS: dict[str, tuple[str, ...]] = {
-    schema.CASE: ("case", "case:concept:name", "case_id", "trace", "trace_id"),
-    schema.ACTIVITY: ("activity", "concept:name", "activity_name", "task"),
-    schema.TIMESTAMP: ("time", "timestamp", "time:timestamp", "datetime"),
-    schema.LIFECYCLE: ("lifecycle", "lifecycle:transition", "transition"),
-    schema.STATE: ("state", "lifecycle:state"),
-    schema.ROBOT: ("robot", "resource", "robot_id", "org:resource", "agent"),
-    schema.ROBOT_TYPE: ("robot_type", "org:role"),
-    schema.MSG_ID: ("msg_id", "message_id"),
-    schema.MSG_ROLE: ("msg_role", "message_role"),
-    schema.MSG_PAYLOAD: ("msg_payload", "payload", "message_payload"),
-    schema.EVENT_ID: ("event_id", "id"),
-    schema.EXECUTION_ID: ("execution_id", "concept:instance", "activity_instance"),
-    schema.X: ("x",),
-    schema.Y: ("y",),
-    schema.Z: ("z",),
-    schema.BATTERY: ("battery",),
-}
-#: columns whose values are names, never numbers ("38" stays the case "38").
-TEXT_COLUMNS = (
-    schema.CASE,
-    schema.ACTIVITY,
-    schema.LIFECYCLE,
-    schema.STATE,
-    schema.ROBOT,
-    schema.ROBOT_TYPE,
-    schema.MSG_ID,
-    schema.MSG_ROLE,
-    schema.MSG_PAYLOAD,
-    schema.EVENT_ID,
-    schema.EXECUTION_ID,
-)
 SINGLE_CASE = "1"
+#: a duration such as ``pd.Timedelta("1h")`` or the text ``"1h"``
+Gap = pd.Timedelta | str | None
 
 
 def parse_mapping(items: Sequence[str]) -> dict[str, str]:
@@ -71,43 +43,102 @@ def parse_mapping(items: Sequence[str]) -> dict[str, str]:
 
 
 def read_log(
-    path: str | Path, mapping: Mapping[str, str] | None = None, case: str | None = None
+    path: str | Path,
+    mapping: Mapping[str, str] | None = None,
+    case: str | None = None,
+    case_gap: Gap = None,
 ) -> pd.DataFrame:
     """Read a ``.csv`` or ``.xes`` event log (chosen by the file's extension)."""
+    return read_log_with_reading(path, mapping, case, case_gap)[0]
+
+
+def read_log_with_reading(
+    path: str | Path,
+    mapping: Mapping[str, str] | None = None,
+    case: str | None = None,
+    case_gap: Gap = None,
+) -> tuple[pd.DataFrame, Reading]:
+    """The log and how it was read.
+
+    The reading travels next to the DataFrame, not in ``DataFrame.attrs``: pandas copies
+    ``attrs`` into some derived frames and not others, so a reading there would silently
+    follow a filtered or merged log it no longer describes.
+    """
     path = Path(path)
     if path.suffix.lower() == ".xes":
-        return read_xes(path, mapping, case)
-    return read_csv(path, mapping, case)
+        return _read_xes(path, mapping, case, case_gap)
+    return _read_csv(path, mapping, case, case_gap)
 
 
 def read_csv(
-    path: str | Path, mapping: Mapping[str, str] | None = None, case: str | None = None
+    path: str | Path,
+    mapping: Mapping[str, str] | None = None,
+    case: str | None = None,
+    case_gap: Gap = None,
 ) -> pd.DataFrame:
     """Read a CSV event log (UTF-8, a header line, comma-separated)."""
-    path = Path(path)
+    return _read_csv(Path(path), mapping, case, case_gap)[0]
+
+
+def read_xes(
+    path: str | Path,
+    mapping: Mapping[str, str] | None = None,
+    case: str | None = None,
+    case_gap: Gap = None,
+) -> pd.DataFrame:
+    """Read an XES event log; trace attributes become ``case:<key>`` columns."""
+    return _read_xes(Path(path), mapping, case, case_gap)[0]
+
+
+def _read_csv(
+    path: Path, mapping: Mapping[str, str] | None, case: str | None, case_gap: Gap
+) -> tuple[pd.DataFrame, Reading]:
     text = _read_text(path)
     header = pd.read_csv(io.StringIO(text), nrows=0).columns
     renames = column_mapping(path, list(header), mapping)
     text_columns = [src for src, canonical in renames.items() if canonical in TEXT_COLUMNS]
     if case is not None:
         text_columns.append(case)
+    table, missing = _csv_table(path, text, text_columns)
+    lines = pd.Series(range(2, len(table) + 2), index=table.index)  # line 1 is the header
+    return canonical_log(path, table, renames, lines, case, case_gap, missing)
+
+
+def _csv_table(
+    path: Path, text: str, text_columns: list[str]
+) -> tuple[pd.DataFrame, dict[str, int]]:
+    """The CSV's cells with the missing markers cleared, and how many per column.
+
+    The markers are ours to decide, not pandas' (its own list takes "NA" for missing and
+    leaves "-" as a value). Markers as whole cells are cleared by pandas' parser itself;
+    only a file with blanks around a marker is read as text and cleared cell by cell.
+    """
     try:
-        table = pd.read_csv(io.StringIO(text), dtype=dict.fromkeys(text_columns, str))
+        if reading.has_padded_markers(text):
+            table = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
+            missing = reading.mark_missing(table)
+            return reading.typed_columns(table, text_columns), missing
+        table = pd.read_csv(
+            io.StringIO(text),
+            dtype=dict.fromkeys(text_columns, str),
+            keep_default_na=False,
+            na_values=sorted(reading.MISSING_MARKERS),
+        )
     except (pd.errors.ParserError, ValueError) as error:
         raise InputError(f"{path} is not a readable CSV file: {error}") from None
-    lines = pd.Series(range(2, len(table) + 2), index=table.index)  # line 1 is the header
-    return canonical_log(path, table, renames, lines, case)
+    counts = table.isna().sum()  # every NaN is a marker: no other value reads as one
+    return table, {str(column): int(n) for column, n in counts.items() if n}
 
 
-def read_xes(
-    path: str | Path, mapping: Mapping[str, str] | None = None, case: str | None = None
-) -> pd.DataFrame:
-    """Read an XES event log; trace attributes become ``case:<key>`` columns."""
-    path = Path(path)
+def _read_xes(
+    path: Path, mapping: Mapping[str, str] | None, case: str | None, case_gap: Gap
+) -> tuple[pd.DataFrame, Reading]:
     _require_content(path)
     table, lines = _parse_xes(path)
+    missing = reading.mark_missing(table)
+    table = table.infer_objects()  # an int column whose markers were text is numbers again
     renames = column_mapping(path, list(table.columns), mapping)
-    return canonical_log(path, table, renames, lines, case)
+    return canonical_log(path, table, renames, lines, case, case_gap, missing, traces=True)
 
 
 # -- XES -------------------------------------------------------------------------------------
@@ -160,8 +191,12 @@ def _xes_attributes(path: Path, element: object) -> dict[str, object]:
         key = child.get("key")
         if convert is None or key is None:
             continue
+        raw = child.get("value", "")
+        if raw.strip() in reading.MISSING_MARKERS:
+            values[key] = raw  # a missing marker: counted and cleared with the CSV's
+            continue
         try:
-            values[key] = convert(child.get("value", ""))
+            values[key] = convert(raw)
         except ValueError:
             raise InputError(
                 f"{path} line {child.sourceline}: the {kind} attribute {key!r} has the value "
@@ -177,60 +212,95 @@ def etree_localname(tag: object) -> str:
 # -- steps shared by both formats --------------------------------------------------------------
 
 
-def column_mapping(
-    path: Path, columns: list[str], explicit: Mapping[str, str] | None = None
-) -> dict[str, str]:
-    """Source column -> canonical column, explicit entries first, then :data:`SYNONYMS`."""
-    explicit = dict(explicit or {})
-    for source in explicit:
-        if source not in columns:
-            raise InputError(
-                f"{path} has no column {source!r} to map; its columns are {_listing(columns)}."
-            )
-    renames = {source: _canonical_name(target) for source, target in explicit.items()}
-    taken = set(renames.values())
-    for canonical, names in SYNONYMS.items():
-        if canonical in taken:
-            continue
-        wanted = [_normalised(name) for name in names]
-        found = [c for c in columns if c not in renames and _normalised(c) in wanted]
-        if found:
-            renames[min(found, key=lambda c: wanted.index(_normalised(c)))] = canonical
-            taken.add(canonical)
-    return renames
-
-
 def canonical_log(
     path: Path,
     table: pd.DataFrame,
     renames: Mapping[str, str],
     lines: pd.Series,
     case: str | None = None,
-) -> pd.DataFrame:
-    """Rename, check and normalise a raw table into the canonical event log."""
+    case_gap: Gap = None,
+    missing: Mapping[str, int] | None = None,
+    traces: bool = False,
+) -> tuple[pd.DataFrame, Reading]:
+    """Rename, check and normalise a raw table into the canonical event log, and say how.
+
+    ``missing`` counts the cells already cleared as missing; ``traces`` says the cases are XES
+    traces.
+    """
     if table.empty:
         raise InputError(f"{path} has no events, only a header.")
     if case is not None and case not in table.columns:
         raise InputError(
             f"{path} has no column {case!r} for --case; its columns are "
-            f"{_listing(list(table.columns))}."
+            f"{listing(list(table.columns))}."
         )
+    gap = reading.parse_duration(case_gap) if case_gap is not None else None
     log = table.rename(columns=dict(renames))
     if case is not None:
         log[schema.CASE] = table[case].astype("string")
     _check_columns(path, log, renames)
     log[schema.TIMESTAMP] = parse_timestamps(path, log[schema.TIMESTAMP], lines)
     _require_values(path, log, schema.ACTIVITY, lines)
-    if schema.CASE not in log.columns:
-        log[schema.CASE] = SINGLE_CASE
-    log[schema.LIFECYCLE] = _lifecycle(log)
+    kinds = reading.event_kinds(log)
+    dropped = reading.dropped_rows(kinds, lines)
+    keep = reading.understood(kinds).to_numpy(bool)
+    if not keep.any():
+        raise InputError(f"{path}: no row is an event ({next(iter(dropped))}).")
+    log, kinds = log[keep].copy(), kinds[keep]
+    notes = reading.lifecycle_columns(log, kinds)
+    case_text, warnings = _cases(path, log, renames, case, gap, traces)
     if schema.MSG_ROLE in log.columns:
         log[schema.MSG_ROLE] = log[schema.MSG_ROLE].str.strip().str.lower()
+    notes += reading.message_roles_from_ends(log)
     log[schema.EVENT_ID] = _event_ids(path, log, lines)
     for column in TEXT_COLUMNS:
         if column in log.columns:
             log[column] = log[column].astype("string")
-    return log.reset_index(drop=True)
+    log = log.reset_index(drop=True)
+    robots, robot_warnings = reading.robot_types(log)
+    found = Reading(
+        source=path.name,
+        columns=reading.column_roles(list(table.columns), renames, case),
+        case=case_text,
+        cases=int(log[schema.CASE].nunique()),
+        robots=robots,
+        events={kind: int((kinds == kind).sum()) for kind in reading.KINDS},
+        pairing=reading.pairing_description(log, renames),
+        rows=len(table),
+        missing=dict(missing or {}),
+        dropped=dropped,
+        notes=notes,
+        warnings=warnings
+        + robot_warnings
+        + reading.single_value_warnings(log, renames)
+        + reading.no_pairs_warning(log),
+    )
+    return log, found
+
+
+def _cases(
+    path: Path,
+    log: pd.DataFrame,
+    renames: Mapping[str, str],
+    case: str | None,
+    gap: pd.Timedelta | None,
+    traces: bool,
+) -> tuple[str, list[str]]:
+    """Fill the case column where the log has none; how cases are told apart, and warnings."""
+    if schema.CASE in log.columns:
+        column = case or next((c for c, r in renames.items() if r == schema.CASE), None)
+        told_by = "its XES traces" if traces and case is None else f"the column {column!r}"
+        if gap is not None:
+            raise InputError(
+                f"{path} tells its cases apart by {told_by}; --case-gap splits only a log "
+                "without a case column."
+            )
+        return told_by, []
+    if gap is not None:
+        log[schema.CASE] = reading.cases_by_gap(log[schema.TIMESTAMP], gap)
+        return f"a new case after every pause of {reading.duration_text(gap)} or more", []
+    log[schema.CASE] = SINGLE_CASE
+    return "no case column: one case", reading.days_warning(path, log)
 
 
 def parse_timestamps(path: Path, values: pd.Series, lines: pd.Series) -> pd.Series:
@@ -293,17 +363,10 @@ def _require_values(path: Path, log: pd.DataFrame, column: str, lines: pd.Series
         )
 
 
-def _lifecycle(log: pd.DataFrame) -> pd.Series:
-    # A log without lifecycle information records completed activities (pm4py's default).
-    if schema.LIFECYCLE not in log.columns:
-        return pd.Series(schema.COMPLETE, index=log.index, dtype="string")
-    values = log[schema.LIFECYCLE].astype("string").str.strip().str.lower()
-    return values.fillna(schema.COMPLETE)
-
-
 def _event_ids(path: Path, log: pd.DataFrame, lines: pd.Series) -> pd.Series:
     if schema.EVENT_ID not in log.columns:
-        return pd.Series([str(i) for i in range(len(log))], index=log.index, dtype="string")
+        # the row's position in the file, so ids stay put when rows are dropped
+        return pd.Series(log.index.astype(str), index=log.index, dtype="string")
     ids = log[schema.EVENT_ID].astype("string").str.strip()
     missing = ids.isna() | (ids == "")
     if missing.any():
@@ -317,20 +380,6 @@ def _event_ids(path: Path, log: pd.DataFrame, lines: pd.Series) -> pd.Series:
             f"{where[1]}); event ids must be unique."
         )
     return ids
-
-
-def _canonical_name(target: str) -> str:
-    """``time`` -> ``time:timestamp`` etc.; any other target is kept as the new name."""
-    short_to_long = {short: long for long, short in schema.CSV_NAMES.items()}
-    return short_to_long.get(target, target)
-
-
-def _normalised(name: str) -> str:
-    return re.sub(r"[\s_\-]", "", str(name)).lower()
-
-
-def _listing(columns: list[str]) -> str:
-    return ", ".join(repr(c) for c in columns[:20]) + (" ..." if len(columns) > 20 else "")
 
 
 def _require_content(path: Path) -> bytes:

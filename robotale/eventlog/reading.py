@@ -1,0 +1,544 @@
+"""How one event log is read: which column plays which role, and what became of every row.
+
+Logs come from many tools, each with its own conventions. This module is the one place that
+decides how a log is read, and :class:`Reading` reports the decisions so a user can check them
+(``robotale inspect LOG``) before trusting a single figure. The rules (docs/reading.md):
+
+- **Columns** are recognised by their usual names (:data:`SYNONYMS`) unless ``--map`` names
+  them. ``org:resource`` is the robot when it is the only robot column; next to an
+  instance-like column (``robot``, ``robot_id``, ``resource`` ...) it is the robot's type.
+- **Missing**: the markers of :data:`MISSING_MARKERS` mean "no value" in every column; they are
+  counted per column.
+- **Lifecycle**: a row whose lifecycle is start or complete (or a synonym such as ``begin``,
+  ``end``) is a control-flow event, whatever its state says. Only a row whose lifecycle is
+  ``none`` or missing and whose state says in-progress is a sample (continuous data between a
+  start and its completion). Other rows without a lifecycle are completions (pm4py's default);
+  ``none`` alone is an instant event. A row with any other lifecycle (``schedule``,
+  ``suspend`` ...) is dropped, counted and named.
+- **Cases**: the case column, else the XES trace, else one case, or with a case gap a new case
+  after every pause of at least that long.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import re
+from collections.abc import Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+from robotale.errors import InputError
+from robotale.eventlog import schema
+
+#: canonical column -> names it is recognised by (compared ignoring case, blanks, "_" and "-"),
+#: best first. ``org:resource`` comes last for the robot, so an instance-like column wins and
+#: ``org:resource`` is then read as the robot type.
+SYNONYMS: dict[str, tuple[str, ...]] = {
+    schema.CASE: ("case", "case:concept:name", "case_id", "trace", "trace_id"),
+    schema.ACTIVITY: ("activity", "concept:name", "activity_name", "task"),
+    schema.TIMESTAMP: ("time", "timestamp", "time:timestamp", "datetime"),
+    schema.LIFECYCLE: ("lifecycle", "lifecycle:transition", "transition"),
+    schema.STATE: ("state", "lifecycle:state"),
+    schema.ROBOT: ("robot", "robot_id", "robot_name", "resource", "agent", "org:resource"),
+    schema.ROBOT_TYPE: ("robot_type", "org:role", "org:resource"),
+    schema.MSG_ID: ("msg_id", "message_id"),
+    schema.MSG_ROLE: ("msg_role", "message_role"),
+    schema.MSG_PAYLOAD: ("msg_payload", "payload", "message_payload"),
+    schema.MSG_SENDER: ("msg_sender", "message_sender", "sender"),
+    schema.MSG_RECEIVER: ("msg_receiver", "message_receiver", "receiver"),
+    schema.EVENT_ID: ("event_id", "id"),
+    schema.EXECUTION_ID: ("execution_id", "concept:instance", "activity_instance"),
+    schema.X: ("x",),
+    schema.Y: ("y",),
+    schema.Z: ("z",),
+    schema.BATTERY: ("battery",),
+}
+#: columns whose values are names, never numbers ("38" stays the case "38").
+TEXT_COLUMNS = (
+    schema.CASE,
+    schema.ACTIVITY,
+    schema.LIFECYCLE,
+    schema.STATE,
+    schema.ROBOT,
+    schema.ROBOT_TYPE,
+    schema.MSG_ID,
+    schema.MSG_ROLE,
+    schema.MSG_PAYLOAD,
+    schema.MSG_SENDER,
+    schema.MSG_RECEIVER,
+    schema.EVENT_ID,
+    schema.EXECUTION_ID,
+)
+#: cell values that mean "no value" in every column (compared after stripping blanks). Case
+#: matters: the lowercase lifecycle ``none`` is an instant event, not a missing value.
+MISSING_MARKERS = frozenset({"", "null", "NULL", "None", "NaN", "nan", "-", "N/A", "n/a"})
+#: lifecycle values (lowercased) and what they mean.
+LIFECYCLE_VALUES: dict[str, str] = {
+    "start": schema.START,
+    "begin": schema.START,
+    "started": schema.START,
+    "complete": schema.COMPLETE,
+    "completed": schema.COMPLETE,
+    "end": schema.COMPLETE,
+    "ended": schema.COMPLETE,
+    "done": schema.COMPLETE,
+    "finish": schema.COMPLETE,
+    "finished": schema.COMPLETE,
+    "none": schema.NONE,
+    "instant": schema.NONE,
+}
+#: a state says in-progress when, lowercased without blanks, "_" and "-", it is this.
+INPROGRESS_STATE = "inprogress"
+#: what a source column is for, in words, by its canonical name.
+ROLE_NAMES: dict[str, str] = {
+    schema.CASE: "case",
+    schema.ACTIVITY: "activity",
+    schema.TIMESTAMP: "time",
+    schema.LIFECYCLE: "lifecycle",
+    schema.STATE: "state",
+    schema.ROBOT: "robot",
+    schema.ROBOT_TYPE: "robot type",
+    schema.MSG_ID: "message id",
+    schema.MSG_ROLE: "message role",
+    schema.MSG_PAYLOAD: "message payload",
+    schema.MSG_SENDER: "message sender",
+    schema.MSG_RECEIVER: "message receiver",
+    schema.EVENT_ID: "event id",
+    schema.EXECUTION_ID: "pairing key",
+    schema.X: "perspective (x)",
+    schema.Y: "perspective (y)",
+    schema.Z: "perspective (z)",
+    schema.BATTERY: "perspective (battery)",
+}
+#: event kinds of :func:`event_kinds`, in the order a reading lists them.
+KINDS = ("start", "complete", "instant", "sample")
+#: a dropped row's lines are listed up to this many.
+SHOWN_LINES = 5
+
+
+@dataclass
+class Reading:
+    """How a log was read: returned next to the DataFrame (see ``read_log_with_reading``)."""
+
+    source: str
+    #: source column -> its role in words ("robot", "robot type", "perspective" ...)
+    columns: dict[str, str]
+    #: how cases are told apart, in words
+    case: str
+    cases: int
+    #: robot instance -> its type (None where the log gives none)
+    robots: dict[str, str | None]
+    #: events by kind: start, complete, instant, sample
+    events: dict[str, int]
+    #: how a start finds its completion, in words
+    pairing: str
+    rows: int
+    #: source column -> cells read as missing
+    missing: dict[str, int] = field(default_factory=dict)
+    #: reason -> the file lines of the rows dropped for it
+    dropped: dict[str, list[int]] = field(default_factory=dict)
+    #: decisions worth knowing that are not problems
+    notes: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+
+    @property
+    def kept(self) -> int:
+        return self.rows - sum(len(lines) for lines in self.dropped.values())
+
+    @property
+    def lifecycle(self) -> str:
+        """The lifecycle model in words."""
+        parts = []
+        if self.events["start"] and self.events["complete"]:
+            parts.append("start/complete pairs")
+        elif self.events["complete"] or self.events["instant"]:
+            parts.append("instant events")
+        if self.events["sample"]:
+            parts.append("in-progress samples")
+        return " with ".join(parts) or "no control-flow events"
+
+
+# -- columns -----------------------------------------------------------------------------------
+
+
+def column_mapping(
+    path: Path, columns: list[str], explicit: Mapping[str, str] | None = None
+) -> dict[str, str]:
+    """Source column -> canonical column, explicit entries first, then :data:`SYNONYMS`."""
+    explicit = dict(explicit or {})
+    for source in explicit:
+        if source not in columns:
+            raise InputError(
+                f"{path} has no column {source!r} to map; its columns are {listing(columns)}."
+            )
+    renames = {source: canonical_name(target) for source, target in explicit.items()}
+    taken = set(renames.values())
+    for canonical, names in SYNONYMS.items():
+        if canonical in taken:
+            continue
+        wanted = [normalised(name) for name in names]
+        found = [c for c in columns if c not in renames and normalised(c) in wanted]
+        if found:
+            renames[min(found, key=lambda c: wanted.index(normalised(c)))] = canonical
+            taken.add(canonical)
+    return renames
+
+
+def column_roles(
+    columns: list[str], renames: Mapping[str, str], case: str | None
+) -> dict[str, str]:
+    """Every source column's role in words; unrecognised columns are perspectives."""
+    roles = {}
+    for column in columns:
+        canonical = renames.get(column, column)
+        roles[column] = ROLE_NAMES.get(canonical, "perspective")
+    if case is not None:
+        roles[case] = "case"
+    return roles
+
+
+def canonical_name(target: str) -> str:
+    """``time`` -> ``time:timestamp`` etc.; any other target is kept as the new name."""
+    short_to_long = {short: long for long, short in schema.CSV_NAMES.items()}
+    return short_to_long.get(target, target)
+
+
+def normalised(name: str) -> str:
+    return re.sub(r"[\s_\-]", "", str(name)).lower()
+
+
+def listing(columns: list[str]) -> str:
+    return ", ".join(repr(c) for c in columns[:20]) + (" ..." if len(columns) > 20 else "")
+
+
+# -- missing values ----------------------------------------------------------------------------
+
+
+_MARKER = "|".join(re.escape(m) for m in sorted(MISSING_MARKERS, key=len, reverse=True) if m)
+#: a CSV cell holding a marker or nothing, with blanks around it
+_PADDED = re.compile(rf"(?:^|,)(?:[ \t]+(?:{_MARKER})?[ \t]*|(?:{_MARKER})[ \t]+)(?=,|\r?$)", re.M)
+
+
+def has_padded_markers(text: str) -> bool:
+    """Whether a CSV text may hold a marker (or nothing) with blanks around it, which only
+    :func:`mark_missing` recognises; one regular expression over the text, so files without
+    any (nearly all) are read at the speed of pandas' own parser."""
+    # a blank next to a delimiter or a line's end is rare, and plain substring tests are fast
+    blanks = (", ", ",\t", " ,", "\t,", "\n ", "\n\t", " \n", "\t\n", " \r", "\t\r")
+    edges = text[:1] + text.rstrip("\r\n")[-1:]
+    if not any(blank in text for blank in blanks) and not edges.isspace():
+        return False
+    return _PADDED.search(text) is not None
+
+
+def mark_missing(table: pd.DataFrame) -> dict[str, int]:
+    """Replace the :data:`MISSING_MARKERS` of every text cell by NaN, in place; the count of
+    cells replaced per column (columns without any are left out)."""
+    counts = {}
+    for column in table.columns:
+        values = table[column]
+        if not (pd.api.types.is_object_dtype(values) or pd.api.types.is_string_dtype(values)):
+            continue
+        # numbers and booleans (XES) never print as a marker, so all cells can go as text
+        marked = values.astype("string").str.strip().isin(MISSING_MARKERS)
+        marked = marked.fillna(False).astype(bool)
+        if marked.any():
+            table[column] = values.mask(marked)
+            counts[str(column)] = int(marked.sum())
+    return counts
+
+
+def typed_columns(table: pd.DataFrame, text: list[str]) -> pd.DataFrame:
+    """Columns read as text made numbers where every value is one (``text`` columns stay)."""
+    for column in table.columns:
+        if column in text:
+            continue
+        with contextlib.suppress(ValueError, TypeError):  # names or mixed values stay text
+            table[column] = pd.to_numeric(table[column])
+    return table
+
+
+# -- lifecycle ---------------------------------------------------------------------------------
+
+
+def event_kinds(log: pd.DataFrame) -> pd.Series:
+    """Each row's kind: start, complete, instant, sample, or ``?<value>`` for a lifecycle value
+    that is none of these (such rows are dropped)."""
+    if schema.LIFECYCLE in log.columns:
+        raw = log[schema.LIFECYCLE].astype("string").str.strip()
+        meaning = raw.str.lower().map(LIFECYCLE_VALUES)
+    else:
+        raw = pd.Series(pd.NA, index=log.index, dtype="string")
+        meaning = pd.Series(None, index=log.index, dtype=object)
+    in_progress = _in_progress(log)
+    absent = raw.isna().to_numpy(bool)
+    kinds = pd.Series("instant", index=log.index, dtype=object)
+    kinds[(meaning == schema.START).to_numpy(bool)] = "start"
+    kinds[(meaning == schema.COMPLETE).to_numpy(bool)] = "complete"
+    no_transition = absent | (meaning == schema.NONE).to_numpy(bool)
+    kinds[absent & ~in_progress] = "complete"  # pm4py's default: a recorded completion
+    kinds[no_transition & in_progress] = "sample"
+    unknown = (~absent) & meaning.isna().to_numpy(bool)
+    kinds[unknown] = "?" + raw[unknown]
+    return kinds
+
+
+def understood(kinds: pd.Series) -> pd.Series:
+    """Which rows :func:`event_kinds` could read (the others are dropped)."""
+    return kinds.isin(KINDS)
+
+
+def _in_progress(log: pd.DataFrame) -> pd.Series:
+    if schema.STATE not in log.columns:
+        return pd.Series(False, index=log.index).to_numpy(bool)
+    states = log[schema.STATE].astype("string").map(normalised, na_action="ignore")
+    return (states == INPROGRESS_STATE).fillna(False).to_numpy(bool)
+
+
+def lifecycle_columns(log: pd.DataFrame, kinds: pd.Series) -> list[str]:
+    """Set the canonical lifecycle (and state, where the log has one) from each row's kind;
+    notes on rows whose state the lifecycle overruled."""
+    notes = []
+    if schema.STATE in log.columns:
+        overruled = kinds.isin(["start", "complete"]).to_numpy(bool) & _in_progress(log)
+        if overruled.any():
+            counts = kinds[overruled].value_counts()
+            said = " and ".join(f"{counts[k]:,} {k}" for k in ("start", "complete") if k in counts)
+            notes.append(
+                f"{said} rows say the state is in progress: read as control-flow events "
+                "(the lifecycle wins over the state)."
+            )
+        samples = (kinds == "sample").to_numpy(bool)
+        log[schema.STATE] = pd.Series(schema.NONE, index=log.index, dtype="string")
+        log.loc[samples, schema.STATE] = schema.INPROGRESS
+    transitions = {"start": schema.START, "complete": schema.COMPLETE}
+    log[schema.LIFECYCLE] = kinds.map(transitions).fillna(schema.NONE).astype("string")
+    return notes
+
+
+def dropped_rows(kinds: pd.Series, lines: pd.Series) -> dict[str, list[int]]:
+    """Reason -> file lines of the rows whose lifecycle is not understood."""
+    unknown = kinds[~understood(kinds)]
+    return {
+        f"lifecycle {value[1:]!r} is not start, complete or none": lines[group.index].tolist()
+        for value, group in unknown.groupby(unknown, sort=True)
+    }
+
+
+def pairing_description(log: pd.DataFrame, renames: Mapping[str, str]) -> str:
+    """How a start finds its completion (the keys robotale's activity instances use)."""
+    keys = [
+        name
+        for column, name in ((schema.CASE, "case"), (schema.ROBOT, "robot"))
+        if column in log.columns
+    ]
+    within = ", ".join([*keys, "activity"])
+    source = {canonical: column for column, canonical in renames.items()}
+    if schema.EXECUTION_ID in log.columns:
+        return f"by {source.get(schema.EXECUTION_ID, schema.EXECUTION_ID)} within {within}"
+    if schema.MSG_ID in log.columns:
+        key = source.get(schema.MSG_ID, schema.MSG_ID)
+        return f"by {key} within {within} (first in, first out where there is none)"
+    return f"first in, first out within {within}"
+
+
+# -- messages ----------------------------------------------------------------------------------
+
+
+def message_roles_from_ends(log: pd.DataFrame) -> list[str]:
+    """Where a message event has no role, its robot being the message's sender or receiver
+    tells; notes on how many roles were so derived."""
+    ends = (schema.MSG_ID, schema.ROBOT, schema.MSG_SENDER, schema.MSG_RECEIVER)
+    if not all(column in log.columns for column in ends):
+        return []
+    if schema.MSG_ROLE not in log.columns:
+        log[schema.MSG_ROLE] = pd.Series(pd.NA, index=log.index, dtype="string")
+    open_role = log[schema.MSG_ROLE].isna() & log[schema.MSG_ID].notna()
+    robot = log[schema.ROBOT].astype("string")
+    derived = 0
+    for role, column in ((schema.SEND, schema.MSG_SENDER), (schema.RECEIVE, schema.MSG_RECEIVER)):
+        match = (open_role & (robot == log[column].astype("string"))).fillna(False).astype(bool)
+        log.loc[match, schema.MSG_ROLE] = role
+        open_role &= ~match
+        derived += int(match.sum())
+    if not derived:
+        return []
+    return [f"{derived:,} message events take their role from msg_sender / msg_receiver."]
+
+
+# -- cases -------------------------------------------------------------------------------------
+
+
+_DURATION = re.compile(r"^\s*(\d+(?:\.\d+)?)\s*(ms|s|sec|min|m|h|d)\s*$", re.IGNORECASE)
+_UNITS = {"ms": "ms", "s": "s", "sec": "s", "min": "min", "m": "min", "h": "h", "d": "D"}
+
+
+def parse_duration(text: str | pd.Timedelta) -> pd.Timedelta:
+    """``1h``, ``90s``, ``30min``, ``2d``, ``500ms`` as a positive duration."""
+    if isinstance(text, pd.Timedelta):
+        duration = text
+    else:
+        match = _DURATION.match(str(text))
+        if not match:
+            raise InputError(f"--case-gap {text!r} is not a duration such as 1h, 90s, 30min or 2d.")
+        duration = pd.Timedelta(float(match.group(1)), unit=_UNITS[match.group(2).lower()])
+    if duration <= pd.Timedelta(0):
+        raise InputError(f"--case-gap {text!r} must be longer than nothing.")
+    return duration
+
+
+def duration_text(duration: pd.Timedelta) -> str:
+    """``1h``, ``90s``, ``30min``: the largest unit that says the duration exactly."""
+    seconds = duration.total_seconds()
+    for unit, size in (("d", 86400), ("h", 3600), ("min", 60), ("s", 1)):
+        if seconds >= size and seconds % size == 0:
+            return f"{int(seconds // size)}{unit}"
+    return f"{seconds:g}s"
+
+
+def cases_by_gap(times: pd.Series, gap: pd.Timedelta) -> pd.Series:
+    """Case ids ``"1"``, ``"2"`` ...: a new case after every pause of at least ``gap`` between
+    consecutive events of the whole log (in time order; ties keep the file's order)."""
+    ordered = times.sort_values(kind="stable")
+    number = (ordered.diff() >= gap).cumsum() + 1
+    return number.astype(str).astype("string").reindex(times.index)
+
+
+def days_spanned(times: pd.Series) -> list[str]:
+    """The calendar days (in the log's own offset) its events fall on."""
+    days = times.dt.normalize().drop_duplicates()  # in the log's own offset
+    return sorted(day.strftime("%Y-%m-%d") for day in days)
+
+
+# -- what the reading finds --------------------------------------------------------------------
+
+
+def robot_types(log: pd.DataFrame) -> tuple[dict[str, str | None], list[str]]:
+    """Robot instance -> its type; warnings for robots with more than one type."""
+    if schema.ROBOT not in log.columns:
+        return {}, []
+    robots = log[schema.ROBOT].dropna().astype(str)
+    if schema.ROBOT_TYPE not in log.columns:
+        return dict.fromkeys(sorted(robots.unique())), []
+    types = log.loc[robots.index, schema.ROBOT_TYPE].astype("string")
+    pairs = pd.DataFrame({"robot": robots, "type": types}).dropna().drop_duplicates()
+    found: dict[str, str | None] = dict.fromkeys(sorted(robots.unique()))
+    warnings = []
+    for robot, group in pairs.groupby("robot", sort=True):
+        found[str(robot)] = str(group["type"].iloc[0])
+        if len(group) > 1:
+            names = ", ".join(sorted(group["type"]))
+            warnings.append(f"The robot {robot!r} has {len(group)} types ({names}).")
+    return found, warnings
+
+
+#: canonical columns that name entities: one value over the whole log tells nothing apart
+#: (robot types, senders and receivers may well have one: a team of one kind, one sender).
+ENTITY_COLUMNS = (schema.CASE, schema.ROBOT, schema.EXECUTION_ID, schema.MSG_ID)
+
+
+def single_value_warnings(log: pd.DataFrame, renames: Mapping[str, str]) -> list[str]:
+    """A column that looks like an entity (a robot, a case, an id ...) but has one value."""
+    source = {canonical: column for column, canonical in renames.items()}
+    candidates = [c for c in ENTITY_COLUMNS if c in source]
+    candidates += [c for c in log.columns if c not in schema.CSV_NAMES and _looks_like_id(c)]
+    warnings = []
+    for column in candidates:
+        values = log[column].dropna().unique()
+        if len(values) == 1 and log[column].notna().sum() > 1:
+            name = source.get(column, column)
+            warnings.append(
+                f"The column {name!r} ({ROLE_NAMES.get(column, 'an id')}) has one value, "
+                f"{str(values[0])!r}, on every row that has one: it tells nothing apart."
+            )
+    return warnings
+
+
+def _looks_like_id(column: str) -> bool:
+    name = normalised(column)
+    return name.endswith("id") and len(name) > 2 and not name.startswith("case:")
+
+
+def pairs_found(log: pd.DataFrame) -> bool:
+    """Whether some start has a complete of the same case, robot, activity and pairing key."""
+    keys = [c for c in (schema.CASE, schema.ROBOT, schema.ACTIVITY) if c in log.columns]
+    if schema.EXECUTION_ID in log.columns:
+        keys.append(schema.EXECUTION_ID)
+    lifecycle = log[schema.LIFECYCLE]
+    flags = pd.DataFrame(
+        {"start": lifecycle == schema.START, "complete": lifecycle == schema.COMPLETE}
+    )
+    both = flags.groupby([log[k].fillna("") for k in keys]).any()
+    return bool((both["start"] & both["complete"]).any())
+
+
+def no_pairs_warning(log: pd.DataFrame) -> list[str]:
+    if pairs_found(log):
+        return []
+    return [
+        "No start/complete pairs found: every activity lasts 0 s (map the column that says "
+        "start and complete with --map COLUMN=lifecycle if there is one)."
+    ]
+
+
+def days_warning(path: Path, log: pd.DataFrame) -> list[str]:
+    days = days_spanned(log[schema.TIMESTAMP])
+    if len(days) < 2:
+        return []
+    return [
+        f"{path.name} has no case column and spans {len(days)} days ({days[0]} to {days[-1]}), "
+        "so it is read as one case: --case-gap 1h starts a new case after every pause of an "
+        "hour or more (or name the column that tells runs apart)."
+    ]
+
+
+def dropped_note(dropped: Mapping[str, list[int]]) -> list[str]:
+    lines = []
+    for reason, where in dropped.items():
+        shown = ", ".join(str(line) for line in where[:SHOWN_LINES])
+        more = " ..." if len(where) > SHOWN_LINES else ""
+        lines.append(f"{len(where):,} dropped: {reason} (line {shown}{more})")
+    return lines
+
+
+# -- as text -----------------------------------------------------------------------------------
+
+
+def format_reading(reading: Reading, *, short: bool = False) -> str:
+    """The reading as plain lines: all of it, or (``short``) what a command shows before it
+    works on the log: events kept and dropped, cases, robots, notes and warnings."""
+    lines = [
+        f"Read {reading.source}: {reading.kept:,} of {reading.rows:,} rows kept, "
+        f"{reading.cases:,} case{'s' if reading.cases != 1 else ''} ({reading.case}), "
+        f"{len(reading.robots):,} robot{'s' if len(reading.robots) != 1 else ''}, "
+        f"{reading.lifecycle}."
+    ]
+    if not short:
+        lines += _details(reading)
+    lines += [f"  {line}" for line in dropped_note(reading.dropped)]
+    lines += [f"  note: {note}" for note in reading.notes]
+    lines += [f"  warning: {warning}" for warning in reading.warnings]
+    return "\n".join(lines)
+
+
+def _details(reading: Reading) -> list[str]:
+    width = max((len(column) for column in reading.columns), default=0)
+    columns = [f"    {column:<{width}} -> {role}" for column, role in reading.columns.items()]
+    robots = ", ".join(
+        robot if kind is None else f"{robot} ({kind})" for robot, kind in reading.robots.items()
+    )
+    events = ", ".join(f"{reading.events[kind]:,} {kind}" for kind in KINDS)
+    missing = ", ".join(f"{column} {count:,}" for column, count in reading.missing.items())
+    return [
+        "  columns:",
+        *columns,
+        f"  cases:     {reading.cases:,} ({reading.case})",
+        f"  robots:    {robots or '-'}",
+        f"  events:    {events}",
+        f"  lifecycle: {reading.lifecycle}; pairs {reading.pairing}",
+        f"  missing:   {missing or '-'}",
+        f"  rows:      {reading.rows:,} read, {reading.kept:,} kept, "
+        f"{reading.rows - reading.kept:,} dropped",
+    ]
