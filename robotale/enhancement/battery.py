@@ -20,7 +20,7 @@ import pandas as pd
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.performance import WAIT, robot_steps
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
-from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, LIFECYCLE, ROBOT, START, TIMESTAMP
+from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, ROBOT, TIMESTAMP
 
 LOW_ACTIVITY = "low_battery"
 NO_LEVELS = "no battery levels"
@@ -76,8 +76,7 @@ def low_battery_events(
     found = [_threshold_crossings(_levels(log), threshold)]
     if low_activity is not None:
         tagged = log[log[ACTIVITY].astype("string").eq(low_activity).fillna(False)]
-        tagged = tagged[_is_start_or_instant(tagged)]
-        found.append(_low_rows(tagged, f"activity {low_activity}"))
+        found.append(_low_rows(_tagged_moments(tagged), f"activity {low_activity}"))
     found = [f for f in found if not f.empty]
     if not found:
         return pd.DataFrame(columns=[CASE, ROBOT, TIMESTAMP, BATTERY, "source"])
@@ -222,11 +221,15 @@ def _low_rows(events: pd.DataFrame, source: str) -> pd.DataFrame:
     return events[columns].assign(source=source)
 
 
-def _is_start_or_instant(events: pd.DataFrame) -> pd.Series:
-    if LIFECYCLE not in events.columns:
-        return pd.Series(True, index=events.index)
-    lifecycle = events[LIFECYCLE].astype("string").fillna("none").str.lower()
-    return lifecycle.isin([START, "none"])
+def _tagged_moments(events: pd.DataFrame) -> pd.DataFrame:
+    """One row per instance of a tagged activity, at its start with the level then: a tool may
+    write such a moment as a start/complete pair, an instant event or a lone completion."""
+    carry = [BATTERY] if BATTERY in events.columns else []
+    instances = activity_instances(events, carry=carry)
+    moments = instances.assign(**{TIMESTAMP: instances[START_TIMESTAMP]})
+    if f"start_{BATTERY}" in moments.columns:  # absent when no instance was found
+        moments[BATTERY] = moments[f"start_{BATTERY}"].fillna(moments[BATTERY])
+    return moments
 
 
 def _with_what_followed(lows: pd.DataFrame, log: pd.DataFrame, following: int) -> pd.DataFrame:
