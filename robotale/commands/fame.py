@@ -99,9 +99,12 @@ def run_command(
     """Run the mission on the in-process bus and a simulated clock, printing every tag as it
     happens; 1 when a BPMN error went uncaught."""
     out, err = out or sys.stdout, err or sys.stderr
+    definitions = parse(model)
+    for warning in definitions.warnings:  # as fame check prints them, before anything runs
+        print(f"# warning: {warning}", file=err)
     clock = SimClock()
     mission = Mission(
-        parse(model),
+        definitions,
         robots=robot_list(robots),
         clock=clock,
         bus=InProcessBus(clock, latency=latency),
