@@ -100,8 +100,6 @@ def run_command(
     happens; 1 when a BPMN error went uncaught."""
     out, err = out or sys.stdout, err or sys.stderr
     definitions = parse(model)
-    for warning in definitions.warnings:  # as fame check prints them, before anything runs
-        print(f"# warning: {warning}", file=err)
     clock = SimClock()
     mission = Mission(
         definitions,
@@ -113,6 +111,8 @@ def run_command(
         tag_sink=lambda tag: print(tag_line(tag), file=out),
         variables=parse_assignments(assignments),
     )
+    for warning in definitions.warnings:  # as fame check prints them, before anything runs
+        print(f"# warning: {warning}", file=err)
     reached = mission.run(until=until)
     state = "done" if mission.done else "still running"
     counts = ", ".join(f"{r} {e.completed}" for r, e in mission.engines.items())
