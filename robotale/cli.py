@@ -110,6 +110,12 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
     check.add_argument("model", type=Path, help="the .bpmn collaboration")
     check.add_argument("--library", **library)
     check.add_argument("--skills", **skills)
+    check.add_argument(
+        "--world",
+        type=Path,
+        metavar="YAML",
+        help="a simulation's world file: also list what its robots do not provide",
+    )
     _handled_by(check, "fame.check_command")
 
     split = sub.add_parser("split", help="one process per robot")
@@ -354,6 +360,12 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
     simulate.add_argument("scenario", nargs="?", help="agri or rexdingo (or omit with --world)")
     simulate.add_argument("--model", type=Path, metavar="BPMN", help="the mission to run instead")
     simulate.add_argument("--world", type=Path, metavar="YAML", help="a world file of your own")
+    simulate.add_argument(
+        "--library",
+        type=Path,
+        metavar="DIR",
+        help="building blocks (.bpmn) for call activities; they replace the simulator's skills",
+    )
     simulate.add_argument("--runs", type=int, metavar="N", help="how many runs (1)")
     simulate.add_argument("--seed", type=int, help="the batch's seed (1)")
     simulate.add_argument("--first", type=int, metavar="N", help="number of the first run (1)")

@@ -30,14 +30,35 @@ def check_command(
     *,
     library: Path | None = None,
     skills: str | None = None,
+    world: Path | None = None,
     out: TextIO | None = None,
 ) -> int:
-    """Print the structure and QoS report; 1 when something is wrong."""
+    """Print the structure and QoS report; with ``world`` (a simulation's world file) also
+    what the model needs that the world's robots do not provide. 1 when something is wrong."""
     out = out or sys.stdout
     names = load_skills(skills) if skills else {}
-    report = check(parse(model), skills=names, library=Library(library) if library else None)
+    definitions = parse(model)
+    blocks = Library(library) if library else None
+    report = check(definitions, skills=names, library=blocks)
+    missing = _simulation_lacks(definitions, model, world, blocks) if world is not None else []
     print_report(report, out)
-    return 0 if report.ok else 1
+    print_lacks(missing, out)
+    return 0 if report.ok and not missing else 1
+
+
+def _simulation_lacks(definitions, model: Path, world: Path, library: Library | None):
+    from robotale.sim.provides import lacks  # the simulator only when a world is named
+    from robotale.sim.worldspec import load_world
+
+    return lacks(definitions, load_world(world, model), library)
+
+
+def print_lacks(missing: Sequence[str], out: TextIO) -> None:
+    """The "simulation lacks" section: every need of the model the robots do not meet."""
+    if missing:
+        print(f"simulation lacks: {len(missing)}", file=out)
+        for sentence in missing:
+            print(f"  {sentence}", file=out)
 
 
 def print_report(report: Report, out: TextIO) -> None:
@@ -99,9 +120,10 @@ def run_command(
     """Run the mission on the in-process bus and a simulated clock, printing every tag as it
     happens; 1 when a BPMN error went uncaught."""
     out, err = out or sys.stdout, err or sys.stderr
+    definitions = parse(model)
     clock = SimClock()
     mission = Mission(
-        parse(model),
+        definitions,
         robots=robot_list(robots),
         clock=clock,
         bus=InProcessBus(clock, latency=latency),
@@ -110,6 +132,8 @@ def run_command(
         tag_sink=lambda tag: print(tag_line(tag), file=out),
         variables=parse_assignments(assignments),
     )
+    for warning in definitions.warnings:  # as fame check prints them, before anything runs
+        print(f"# warning: {warning}", file=err)
     reached = mission.run(until=until)
     state = "done" if mission.done else "still running"
     counts = ", ".join(f"{r} {e.completed}" for r, e in mission.engines.items())

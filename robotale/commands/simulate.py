@@ -18,6 +18,7 @@ def simulate_command(
     *,
     model: Path | None = None,
     world: Path | None = None,
+    library: Path | None = None,
     runs: int = 1,
     seed: int = 1,
     first: int = 1,
@@ -41,7 +42,7 @@ def simulate_command(
     """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second."""
     out = out or sys.stdout
-    loaded, scenario = resolve_world(scenario, model, world)
+    loaded, scenario = resolve_world(scenario, model, world, library)
     group_counts = dict(_count(text) for text in counts)
     if tractors is not None:
         group_counts["tractor"] = tractors
@@ -52,7 +53,11 @@ def simulate_command(
         time_limit=time_limit,
         rate=rate,
     )
-    check(loaded)
+    missing = check(loaded)
+    if missing:  # before anything runs, like fame check --world
+        print(f"simulation lacks: {len(missing)}", file=out)
+        for sentence in missing:
+            print(f"  {sentence}", file=out)
     overrides = {
         "counts": dict(_count(text) for text in counts) or None,
         "tractors": tractors,

@@ -8,6 +8,9 @@
   with the activity's outputs or the message's fields in scope.
 - A caught message becomes the variable named after its signal.
 - A thrown signal's payload template is filled in from the variables.
+- In a process written in FAME's JavaScript dialect, a ``${name}`` of a variable nobody set
+  stays as written in a variable and is null in a payload, as FAME's engine leaves it
+  (``keep_unset``); elsewhere it is a model error naming the data object.
 """
 
 from __future__ import annotations
@@ -36,6 +39,7 @@ class Data:
         self.env = env  # the globals scripts and ${...} see (robot, BpmnError)
         self.changed = changed  # conditional events re-evaluate
         self.given = frozenset(variables)  # set by the caller: data objects do not override
+        self.keep_unset = False  # FAME's dialect: see the module's docstring
 
     def declare(self, data_objects: Iterable[DataObject]) -> None:
         """A process starts: literal values become variables, ``${name}`` declares ``name``."""
@@ -82,11 +86,14 @@ class Data:
         try:
             if isinstance(template, dict):
                 return _nest(
-                    {k: substitute(v, self.variables, self.env) for k, v in template.items()}
+                    {
+                        k: substitute(v, self.variables, self.env, keep_unset=self.keep_unset)
+                        for k, v in template.items()
+                    }
                 )
             if not template or not template.strip():
                 return {}
-            value = render_json(template, self.variables, self.env)
+            value = render_json(template, self.variables, self.env, keep_unset=self.keep_unset)
         except Exception as error:
             raise ModelError(
                 f"robot {self.robot}: the payload of signal event {node.node.describe()} "
@@ -105,7 +112,7 @@ class Data:
         for data_object in data_objects:
             for name, text in data_object.parameters.items():
                 try:
-                    values[name] = substitute(text, names, self.env)
+                    values[name] = substitute(text, names, self.env, keep_unset=self.keep_unset)
                 except Exception as error:
                     raise ModelError(
                         f"robot {self.robot}: data object {data_object.id} "
@@ -116,7 +123,7 @@ class Data:
 
     def _parameter(self, value: Any, names: Mapping[str, Any]) -> Any:
         if isinstance(value, str):
-            return substitute(value, names, self.env)
+            return substitute(value, names, self.env, keep_unset=self.keep_unset)
         if isinstance(value, list):
             return [self._parameter(v, names) for v in value]
         if isinstance(value, dict):

@@ -27,7 +27,14 @@ from robotale.fame_runtime.expressions import BpmnError, Compiled
 from robotale.fame_runtime.javascript import JavaScript, ScriptFailure
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import JAVASCRIPT, Process
-from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, reachable_flows
+from robotale.fame_runtime.plan import (
+    FlowPlan,
+    NodePlan,
+    ScopePlan,
+    deploy,
+    reachable_flows,
+    speaks_javascript,
+)
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.tags import Tagger, TagSink, payload_text
@@ -115,6 +122,7 @@ class Engine:
             "BpmnError": BpmnError,
         }
         self.data = Data(robot, self.variables, self.env, self._changed)
+        self.data.keep_unset = speaks_javascript(self.plan)
         self._tag = Tagger(robot, clock, tag_sink, bus)
         self.triggers = Triggers(
             robot, bus, clock, self._call, self._value, self.env, self.variables
@@ -211,6 +219,7 @@ class Engine:
 
         def restart() -> None:
             self.plan = plan
+            self.data.keep_unset = speaks_javascript(plan)
             self.robot.close()
             if self._javascript is not None:
                 self._javascript.close()

@@ -145,26 +145,53 @@ def literal(text: str) -> Any:
         return text
 
 
-def substitute(text: str, names: Mapping[str, Any], env: dict[str, Any]) -> Any:
+def unset(expression: str, names: Mapping[str, Any], env: Mapping[str, Any]) -> bool:
+    """Whether ``expression`` is a bare name that no variable or global has."""
+    name = expression.strip()
+    return name.isidentifier() and name not in names and name not in env
+
+
+def substitute(
+    text: str, names: Mapping[str, Any], env: dict[str, Any], *, keep_unset: bool = False
+) -> Any:
     """A parameter's value: ``${expr}`` alone gives the value itself, ``${...}`` inside text is
-    formatted into it, anything else is a literal."""
+    formatted into it, anything else is a literal. With ``keep_unset`` a ``${name}`` of a
+    variable nobody set stays as written (FAME's engine assigns data objects' properties as
+    written; robotale does so for processes in its JavaScript dialect)."""
     whole = _PLACEHOLDER.fullmatch(text.strip())
     if whole:
+        if keep_unset and unset(whole.group(1), names, env):
+            return text.strip()
         return evaluate(whole.group(1), names, env)
     if "${" not in text:
         return literal(text)
-    return _PLACEHOLDER.sub(lambda m: str(evaluate(m.group(1), names, env)), text)
+
+    def fill(match: re.Match) -> str:
+        if keep_unset and unset(match.group(1), names, env):
+            return match.group(0)
+        return str(evaluate(match.group(1), names, env))
+
+    return _PLACEHOLDER.sub(fill, text)
 
 
-def render_json(template: str, names: Mapping[str, Any], env: dict[str, Any]) -> Any:
+def render_json(
+    template: str, names: Mapping[str, Any], env: dict[str, Any], *, keep_unset: bool = False
+) -> Any:
     """A JSON payload template with ``${...}`` filled in: inside a JSON string the value is
-    formatted as text, elsewhere it is written as JSON (``{"x": ${x}}`` -> ``{"x": 1.5}``)."""
+    formatted as text, elsewhere it is written as JSON (``{"x": ${x}}`` -> ``{"x": 1.5}``).
+    With ``keep_unset`` a ``${name}`` of a variable nobody set is null (JSON's nearest to
+    JavaScript's undefined) outside a string and stays as written inside one."""
     out, inside, position = [], False, 0
     while position < len(template):
         char = template[position]
         if template.startswith("${", position):
             end = template.index("}", position)
-            value = evaluate(template[position + 2 : end], names, env)
+            expression = template[position + 2 : end]
+            if keep_unset and unset(expression, names, env):
+                out.append(template[position : end + 1] if inside else "null")
+                position = end + 1
+                continue
+            value = evaluate(expression, names, env)
             out.append(json.dumps(str(value))[1:-1] if inside else json.dumps(value))
             position = end + 1
             continue
@@ -176,4 +203,4 @@ def render_json(template: str, names: Mapping[str, Any], env: dict[str, Any]) ->
     try:
         return json.loads(text)
     except ValueError:
-        return substitute(template, names, env)
+        return substitute(template, names, env, keep_unset=keep_unset)

@@ -16,7 +16,14 @@ from robotale.errors import ModelError
 from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
 from robotale.fame_runtime.labels import catches, element_label, error_name, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
-from robotale.fame_runtime.model import DataObject, Node, Process, RosMessage, Scope
+from robotale.fame_runtime.model import (
+    JAVASCRIPT,
+    DataObject,
+    Node,
+    Process,
+    RosMessage,
+    Scope,
+)
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.timers import TimerSpec
 
@@ -153,6 +160,29 @@ def problems(
     planner = _Planner(skills, library)
     planner.process(process, top=True)
     return planner.problems
+
+
+def speaks_javascript(plan: ScopePlan) -> bool:
+    """Whether a script or condition of ``plan`` (its sub-processes and the processes it
+    calls included) is JavaScript: the process is written in FAME's dialect."""
+    seen: set[int] = set()
+
+    def scope(current: ScopePlan) -> bool:
+        if id(current) in seen:
+            return False
+        seen.add(id(current))
+        nodes = [*current.nodes.values(), *current.event_subprocesses]
+        return any(node_speaks(node) for node in nodes)
+
+    def node_speaks(node: NodePlan) -> bool:
+        compiled = [node.script, *(f.condition for f in node.outgoing)]
+        if node.trigger is not None:
+            compiled.append(node.trigger.condition)
+        if any(c is not None and c.language == JAVASCRIPT for c in compiled):
+            return True
+        return node.child is not None and scope(node.child)
+
+    return scope(plan)
 
 
 def reachable_flows(node: NodePlan) -> frozenset[str]:

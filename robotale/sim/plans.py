@@ -12,20 +12,34 @@ from typing import Any
 from robotale.errors import InputError, ModelError
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.parser import parse
 from robotale.sim import messages, scenarios
 from robotale.sim.faults import Fault, parse_fault
+from robotale.sim.provides import lacks
 from robotale.sim.run import RunPlan, model_topics, skills_of
 from robotale.sim.setup import draw
 from robotale.sim.worldspec import World, load_world
 
 
 def resolve_world(
-    scenario: str | None, model: Path | None = None, world: Path | None = None
+    scenario: str | None,
+    model: Path | None = None,
+    world: Path | None = None,
+    library: Path | None = None,
 ) -> tuple[World, str]:
     """The world to simulate and the scenario's name: a shipped scenario, or a world file;
-    ``model`` replaces the world's mission model."""
+    ``model`` replaces the world's mission model, ``library`` its building blocks."""
+    loaded, name = _world(scenario, model, world)
+    if library is not None:
+        if not Path(library).is_dir():
+            raise InputError(f"--library {library}: there is no such folder")
+        loaded = replace(loaded, library=Path(library))
+    return loaded, name
+
+
+def _world(scenario: str | None, model: Path | None, world: Path | None) -> tuple[World, str]:
     if world is not None:
         loaded = load_world(world, model)
         return loaded, scenario or Path(world).stem
@@ -64,10 +78,11 @@ def adjust(
     return world
 
 
-def check(world: World) -> None:
+def check(world: World) -> list[str]:
     """Refuse, before any run starts, what would make every run fail: a model the engine
     cannot run or that the robots do not fit, message types unknown to ROS 2, a world with no
-    room for its objects."""
+    room for its objects. Returns what the model needs that the robots do not provide (runs
+    go on without it: a script waits for a topic nobody publishes)."""
     if not world.model.is_file():
         raise InputError(f"{world.file}: the mission model {world.model} does not exist")
     definitions = parse(world.model)
@@ -88,6 +103,8 @@ def check(world: World) -> None:
                 "not a ROS 2 Humble type the recorder can write"
             )
     draw(world, 0)
+    library = Library(world.library) if world.library else None
+    return lacks(definitions, world, library)
 
 
 def plans(

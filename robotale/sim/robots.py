@@ -6,6 +6,9 @@ forward speed (``linear.x``) and turn rate (``angular.z``). A drone takes off on
 altitude, and while flying obeys ``cmd_vel`` in its body frame like the Tello of the thesis.
 Each control step the pose is integrated from the commands, clipped to the robot's limits, and
 set on its pybullet body; a robot whose battery is empty stops (a drone drops to the ground).
+A drone also serves the Tello driver's ``tello_action`` service the thesis' scripts call,
+as the topics ``/<robot>/tello_action/request`` (``cmd``: ``takeoff``, ``land``) and
+``/<robot>/tello_action/response`` (``rc``: 1 done, 3 busy or unknown).
 Actuators: ``/<robot>/blade_force`` (``std_msgs/msg/Float64``, > 0 cuts) and ``/<robot>/led``
 (``std_msgs/msg/ColorRGBA``).
 """
@@ -28,6 +31,8 @@ TWIST = "geometry_msgs/msg/Twist"
 EMPTY = "std_msgs/msg/Empty"
 FLOAT64 = "std_msgs/msg/Float64"
 COLOR = "std_msgs/msg/ColorRGBA"
+TELLO_ACTION = "tello_msgs/srv/TelloAction"
+TELLO_OK, TELLO_BUSY = 1, 3  # tello_msgs/srv/TelloAction response codes
 
 LANDED, CLIMBING, FLYING, DESCENDING = "landed", "climbing", "flying", "descending"
 CHARGER_REACH = 0.5  # metres from its charging spot a robot still charges
@@ -75,6 +80,7 @@ class SimRobot:
         if self.flies:
             wanted["takeoff"] = (EMPTY, self._takeoff)
             wanted["land"] = (EMPTY, self._land)
+            wanted["tello_action/request"] = (TELLO_ACTION, lambda e: self._tello(bus, e))
         if self.spec.blade:
             wanted["blade_force"] = (FLOAT64, self._blade)
         if self.spec.led:
@@ -106,6 +112,18 @@ class SimRobot:
         if self.flight in (CLIMBING, FLYING):
             self.flight = DESCENDING
             self._command = (0.0, 0.0, 0.0)
+
+    def _tello(self, bus: Bus, envelope: Envelope) -> None:
+        """The Tello driver's action service: ``takeoff`` and ``land`` do what the topics do;
+        anything else (``rc`` commands, flips) is answered busy, as the driver does."""
+        command = str((envelope.data or {}).get("cmd", "")).strip().lower()
+        actions = {"takeoff": self._takeoff, "land": self._land}
+        if command in actions:
+            actions[command](envelope)
+        rc = TELLO_OK if command in actions else TELLO_BUSY
+        bus.publish(
+            self.topic("tello_action/response"), {"rc": rc}, msgtype=TELLO_ACTION, sender=self.name
+        )
 
     def _blade(self, envelope: Envelope) -> None:
         self.blade = float((envelope.data or {}).get("data", 0.0))

@@ -21,6 +21,7 @@ from typing import Any
 
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.model import Definitions
 from robotale.fame_runtime.parser import parse
@@ -70,8 +71,12 @@ class RunPlan:
 
 
 def skills_of(world: World) -> dict[str, Skill]:
-    """The simulator's skills, and the world's own skills module over them."""
-    return {**SKILLS, **(load_skills(world.skills) if world.skills else {})}
+    """The simulator's skills, and the world's own skills module over them. A building block
+    of the world's library replaces the simulator's skill of its name (the thesis' own
+    ``GoTo.bpmn`` runs instead of robotale's GoTo), never a skill of the world's module."""
+    library = Library(world.library) if world.library else None
+    simulator = {n: s for n, s in SKILLS.items() if library is None or library.find(n) is None}
+    return {**simulator, **(load_skills(world.skills) if world.skills else {})}
 
 
 def simulate_run(
@@ -101,7 +106,9 @@ def simulate_run(
             distro=plan.distro,
         )
         bus.tap(recorder.tap)
-        sim = SimWorld(world, setup, clock=clock, bus=bus, gui=gui)
+        sim = SimWorld(
+            world, setup, clock=clock, bus=bus, gui=gui, silent=skill_signals(definitions)
+        )
         mission.start()
         sim.start()
         _schedule(planned, clock, start, sim, mission)
@@ -185,6 +192,16 @@ def model_topics(definitions: Definitions) -> tuple[dict[str, str], set[str]]:
                 signals[topic] = msgtype
             signals.setdefault(topic, "std_msgs/msg/Empty")
     return signals, errors
+
+
+def skill_signals(definitions: Definitions) -> frozenset[str]:
+    """The signals call activities ask a skill to throw (Explore's ``signal`` input)."""
+    return frozenset(
+        str(node.inputs["signal"]).strip("/")
+        for _, process in definitions.pools()
+        for node in process.walk()
+        if node.kind == "callActivity" and isinstance(node.inputs.get("signal"), str)
+    )
 
 
 def _schedule(planned: list[Planned], clock: SimClock, start, sim: SimWorld, mission: Mission):

@@ -12,6 +12,7 @@ topic                      type                               when
 ``/<robot>/low_battery``   ``std_msgs/msg/Empty``             below the threshold, repeated
 ``/<robot>/range``         ``sensor_msgs/msg/Range``          every control step (if fitted)
 ``/<robot>/detection``     ``geometry_msgs/msg/PointStamped`` each step an object is seen
+``/<camera signal>``       ``geometry_msgs/msg/Vector3``      once per new object (if named)
 =========================  =================================  ==============================
 
 A tractor's blade cuts the weeds within its radius while ``blade_force`` > 0; a robot whose
@@ -35,6 +36,7 @@ from robotale.sim.robots import BATTERY, EMPTY, ODOM, Pose, SimRobot, place
 from robotale.sim.setup import Placed, RobotStart, Setup
 from robotale.sim.worldspec import ObjectsSpec, RobotSpec, World
 
+VECTOR3 = "geometry_msgs/msg/Vector3"
 FIRE_RANGE = 1.5  # metres
 BATTERY_PERIOD = 1.0  # seconds between battery messages
 FIELD_COLOR = (0.55, 0.45, 0.3, 1.0)
@@ -64,9 +66,20 @@ class Thing:
 
 class SimWorld:
     def __init__(
-        self, world: World, setup: Setup, *, clock: SimClock, bus: Bus, gui: bool = False
+        self,
+        world: World,
+        setup: Setup,
+        *,
+        clock: SimClock,
+        bus: Bus,
+        gui: bool = False,
+        silent: frozenset[str] = frozenset(),
     ) -> None:
+        """``silent``: camera signals the mission's skills throw themselves (so the world
+        does not throw them a second time)."""
         self.spec, self.setup = world, setup
+        self.silent = silent
+        self._signalled: set[tuple[str, int]] = set()  # (robot, object) a signal announced
         self.clock, self.bus = clock, bus
         self.dt = 1.0 / world.control_rate
         self.physics = Physics(gui=gui)
@@ -180,6 +193,21 @@ class SimWorld:
         if spec.camera is not None:
             seen = sensors.camera_view(self.physics, robot, spec.camera)
             self._detected(robot, seen, spec.camera.detects, now)
+            if spec.camera.signal and spec.camera.signal not in self.silent:
+                self._announce(robot, seen, spec.camera)
+
+    def _announce(self, robot: SimRobot, bodies: set[int], camera) -> None:
+        """The detector's signal, once per object this robot sees (the thesis' drone tells
+        the mission ``weed_found`` with where the weed is)."""
+        for body in sorted(bodies):
+            thing = self.things.get(body)
+            if thing is None or thing.kind != camera.detects or thing.state != "present":
+                continue
+            if (robot.name, body) in self._signalled:
+                continue
+            self._signalled.add((robot.name, body))
+            point = {"x": round(thing.x, 4), "y": round(thing.y, 4), "z": 0.0}
+            self.bus.publish(f"/{camera.signal}", point, msgtype=VECTOR3, sender=robot.name)
 
     def _detected(self, robot: SimRobot, bodies: set[int], kind: str, now: float) -> None:
         for body in sorted(bodies):

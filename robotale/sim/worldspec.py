@@ -48,6 +48,9 @@ class BatterySpec:
 class CameraSpec:
     fov: float = 90.0  # degrees, a square footprint under the robot
     detects: str = "weed"
+    # a global signal the robot's detector publishes once per new object (``weed_found``),
+    # as the thesis' drone does, unless a skill of the mission throws that signal itself
+    signal: str = ""
 
 
 @dataclass(frozen=True)
@@ -281,10 +284,11 @@ class _Reader:
         if data is None:
             return None
         data = self.mapping(data, where)
-        self.known(data, where, {"fov", "detects"})
+        self.known(data, where, {"fov", "detects", "signal"})
         return CameraSpec(
             fov=self.number(data.get("fov", 90.0), f"{where}.fov", positive=True),
             detects=str(data.get("detects", "weed")),
+            signal=str(data.get("signal") or "").strip("/"),
         )
 
     def range_sensor(self, data: Any, where: str) -> RangeSpec | None:

@@ -99,3 +99,22 @@ def test_templates_fill_values_as_json_outside_strings_and_as_text_inside():
     assert substitute("${x * 2}", names, {}) == 3.0
     assert substitute("at ${x} m", names, {}) == "at 1.5 m"
     assert substitute("50", {}, {}) == 50 and substitute("paperino", {}, {}) == "paperino"
+
+
+def test_an_unset_name_stays_as_written_only_in_fames_dialect():
+    # FAME's engine assigns data object properties as written and leaves unset payload
+    # values undefined: robotale keeps the text, and writes null where JSON needs a value
+    names = {"x": 1.5}
+    assert substitute("${tractor_name}", names, {}, keep_unset=True) == "${tractor_name}"
+    assert substitute("at ${y} m", names, {}, keep_unset=True) == "at ${y} m"
+    assert substitute("${x}", names, {}, keep_unset=True) == 1.5
+    assert render_json('{"x": ${x}, "y": ${y}, "n": "${n}"}', names, {}, keep_unset=True) == {
+        "x": 1.5,
+        "y": None,
+        "n": "${n}",
+    }
+    assert substitute("${len([x])}", names, {"len": len}, keep_unset=True) == 1
+    with pytest.raises(NameError):  # robotale's own (Python) dialect still names the mistake
+        substitute("${tractor_name}", names, {})
+    with pytest.raises(NameError):
+        render_json('{"y": ${y}}', names, {})

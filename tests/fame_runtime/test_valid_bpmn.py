@@ -184,3 +184,14 @@ def test_several_broken_references_are_reported_together(tmp_path, capsys):
         "data store, input, output or property of process real",
         f"{path}:6: pool p refers to process ghost, which is not in the file (processes: real)",
     ]
+
+
+def test_run_prints_the_warnings_before_the_tags(tmp_path, capsys):
+    # the same warnings fame check prints, on standard error before the run's first line
+    path = write(tmp_path, "listener.bpmn", FILES["listener.bpmn"])
+    main(["fame", "check", str(path)])
+    checked = [line for line in capsys.readouterr().out.splitlines() if line.startswith("warn")]
+    main(["fame", "run", str(path), "--until", "1"])
+    err = capsys.readouterr().err.splitlines()
+    assert len(checked) == 2
+    assert err[: len(checked)] == [f"# {line}" for line in checked]
