@@ -10,13 +10,12 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from robotale.errors import InputError, ModelError
+from robotale.files import write_file
 
 _ID = re.compile(r"[0-9a-f]{16}")
 _LINKS = "links.json"
@@ -50,9 +49,9 @@ class ModelStore:
             raise InputError(f"{name!r} holds no process to show.")
         model_id = hashlib.sha256(data).hexdigest()[:16]
         self.folder.mkdir(parents=True, exist_ok=True)
-        _write_atomically(self.folder / f"{model_id}.bpmn", data)
+        write_file(self.folder / f"{model_id}.bpmn", data)
         meta = {"name": name, "pools": pools}
-        _write_atomically(self.folder / f"{model_id}.json", json.dumps(meta).encode())
+        write_file(self.folder / f"{model_id}.json", json.dumps(meta).encode())
         return StoredModel(model_id, name, self.folder / f"{model_id}.bpmn", pools)
 
     def get(self, model_id: str) -> StoredModel:
@@ -93,7 +92,7 @@ class ModelStore:
         links = self._links()
         links[log] = model_id
         self.folder.mkdir(parents=True, exist_ok=True)
-        _write_atomically(self.folder / _LINKS, json.dumps(links, indent=1).encode())
+        write_file(self.folder / _LINKS, json.dumps(links, indent=1).encode())
 
     def linked(self, log: str) -> StoredModel | None:
         model_id = self._links().get(log)
@@ -105,17 +104,6 @@ class ModelStore:
     def _links(self) -> dict[str, str]:
         path = self.folder / _LINKS
         return json.loads(path.read_text()) if path.is_file() else {}
-
-
-def _write_atomically(path: Path, data: bytes) -> None:
-    handle, partial = tempfile.mkstemp(dir=path.parent, prefix=".", suffix=".part")
-    try:
-        with os.fdopen(handle, "wb") as out:
-            out.write(data)
-        os.replace(partial, path)
-    except BaseException:
-        Path(partial).unlink(missing_ok=True)
-        raise
 
 
 def attach_model(log: str, model: Path, folder: Path | None = None) -> StoredModel:
