@@ -10,7 +10,6 @@ with the reason; whatever was recorded until then stays in the bag.
 from __future__ import annotations
 
 import datetime as dt
-import json
 import math
 import time
 import traceback
@@ -21,6 +20,7 @@ from typing import Any
 
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.manifest import RunManifest, write_manifest
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.model import Definitions
 from robotale.fame_runtime.parser import parse
@@ -36,7 +36,6 @@ from robotale.sim.skills import SKILLS
 from robotale.sim.world import SimWorld, WindowClosed
 from robotale.sim.worldspec import World
 
-MANIFEST = "robotale-run.json"
 ENDED, TIME_LIMIT, CRASHED = "ended", "time limit", "crashed"
 
 
@@ -75,7 +74,7 @@ def skills_of(world: World) -> dict[str, Skill]:
 
 def simulate_run(
     plan: RunPlan, folder: Path, *, gui: bool = False, pace: float | None = None
-) -> dict[str, Any]:
+) -> RunManifest:
     """Simulate and record one run into ``folder`` (created); returns its manifest."""
     began = time.perf_counter()
     world, start = plan.world, plan.start
@@ -119,7 +118,7 @@ def simulate_run(
     manifest.update(_what_happened(mission, sim, recorder, start))
     manifest["wall_time"] = round(time.perf_counter() - began, 3)
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    write_manifest(folder, manifest)
     return manifest
 
 
@@ -213,9 +212,9 @@ def _manifest(
     status: str,
     reason: str,
     detail: str,
-) -> dict[str, Any]:
+) -> RunManifest:
     world = plan.world
-    manifest: dict[str, Any] = {
+    manifest: RunManifest = {
         "case": plan.case,
         "scenario": plan.scenario or world.file.stem,
         "model": scenarios.describe(world.model),

@@ -21,6 +21,7 @@ from neo4j import Driver
 
 from robotale.errors import InputError, RobotaleError
 from robotale.eventlog import schema
+from robotale.fame_runtime.manifest import read_manifests
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
 from robotale.webapp.logdata import class_graph, first_key, forget
@@ -130,10 +131,10 @@ def _read_bags(
 
 def shipped_model(root: Path) -> Path | None:
     """The mission model of the shipped scenario the recordings' manifests name, if one."""
-    from robotale.eventlog.prepare import find_runs, run_manifests
+    from robotale.eventlog.prepare import find_runs
     from robotale.sim import scenarios
 
-    names = {m.get("scenario") for m in run_manifests(find_runs(root)).values()}
+    names = {m.get("scenario") for m in read_manifests(find_runs(root)).values()}
     if len(names) != 1 or (name := names.pop()) not in scenarios.names():
         return None
     return scenarios.FOLDER / f"{name}.bpmn"
