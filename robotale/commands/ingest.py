@@ -10,7 +10,7 @@ import pandas as pd
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
-from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
+from robotale.ekg.logs import delete_log, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping, read_log
 
@@ -102,8 +102,7 @@ def logs_show(name: str) -> int:
 
 def logs_delete(name: str) -> int:
     with session_driver() as driver:
-        if not log_exists(driver, name):
-            raise InputError(f"There is no log named {name!r} in Neo4j.")
+        require_log(driver, name)
         delete_log(driver, name)
     print(f"Deleted the log {name!r}.")
     return 0
