@@ -53,7 +53,7 @@ def test_several_files_change_together_or_not_at_all(tmp_path):
     first = tmp_path / "graph.dot"
     first.write_text("old\n")
     missing = tmp_path / "no such folder" / "graph.svg"
-    with pytest.raises(InputError, match="no such folder/graph.svg"):
+    with pytest.raises(InputError, match=r"no such folder/graph\.svg"):
         write_files([(first, "new\n"), (missing, "<svg/>")])
     assert first.read_text() == "old\n"
     assert [p.name for p in tmp_path.iterdir()] == ["graph.dot"]

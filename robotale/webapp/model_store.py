@@ -15,7 +15,11 @@ from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from robotale.errors import InputError, ModelError
+from robotale.fame_runtime.parser import parse, parse_bytes
+from robotale.fame_runtime.splitter import split
 from robotale.files import write_file
+from robotale.sim import scenarios
+from robotale.webapp.settings import WebSettings
 
 _ID = re.compile(r"[0-9a-f]{16}")
 _LINKS = "links.json"
@@ -35,8 +39,6 @@ class ModelStore:
 
     def add(self, data: bytes, filename: str) -> StoredModel:
         """Check ``data`` with the FAME parser and store it; a ``ModelError`` if it is no model."""
-        from robotale.fame_runtime.parser import parse_bytes
-
         name = PurePosixPath(filename.replace("\\", "/")).name or "model.bpmn"
         if not name.lower().endswith(".bpmn"):
             raise InputError(f"{name!r} is not a .bpmn file.")
@@ -69,15 +71,10 @@ class ModelStore:
 
     def add_shipped(self) -> list[StoredModel]:
         """Store the mission models of the scenarios robotale ships (agri, rexdingo)."""
-        from robotale.sim import scenarios
-
         return [self.add(p.read_bytes(), p.name) for p in sorted(scenarios.FOLDER.glob("*.bpmn"))]
 
     def matching(self, robots: list[str]) -> StoredModel | None:
         """The first stored model whose pools bind all of ``robots`` (as the splitter would)."""
-        from robotale.fame_runtime.parser import parse
-        from robotale.fame_runtime.splitter import split
-
         for model in self.all():
             try:
                 split(parse(model.path), robots)
@@ -110,8 +107,6 @@ def attach_model(log: str, model: Path, folder: Path | None = None) -> StoredMod
     """Remember that the BPMN file ``model`` drove ``log``, for the Model page (scripts and
     ``robotale demo`` call it after storing a log; ``folder`` defaults to the dashboard's)."""
     if folder is None:
-        from robotale.webapp.settings import WebSettings
-
         folder = WebSettings.from_env().model_dir
     store = ModelStore(folder)
     stored = store.add(Path(model).read_bytes(), Path(model).name)
