@@ -10,6 +10,7 @@ import pandas as pd
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
+from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import delete_log, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping, read_log
@@ -56,7 +57,7 @@ def ingest_command(
             events,
             log or log_name(path),
             entities=split_names(entities) if entities else None,
-            aggregate=aggregate or ["activity"],
+            aggregate=aggregate or DEFAULT_AGGREGATE,
             replace=replace,
             source=str(path),
         )
