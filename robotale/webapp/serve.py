@@ -26,7 +26,7 @@ class Dashboard:
         self, app: Flask | None = None, host: str = DEFAULT_HOST, port: int = DEFAULT_PORT
     ):
         self.app = app if app is not None else create_app()
-        self.server = _bind(app, host, port)
+        self.server = _bind(self.app, host, port)
         self._thread: threading.Thread | None = None
 
     @property
