@@ -125,7 +125,7 @@ def job_state(job_id: str):
 @blueprint.post("/logs/delete")
 def delete():
     name = request.form.get("name", "")
-    require_log(driver(), name, "was it deleted already? The list shows the stored logs")
+    require_log(driver(), name, "the Logs page lists those stored")
     delete_log(driver(), name)
     state().logs.forget(name)
     flash(f"Deleted the log {name!r}.", "success")
