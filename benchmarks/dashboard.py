@@ -83,10 +83,10 @@ def thesis_runs(events: int):
 
 def store(driver, name: str, log) -> tuple[str, int]:
     from robotale.ekg.build import build_ekg
-    from robotale.webapp.ingest import aggregation_keys
+    from robotale.ekg.keys import built_keys
 
     entities = ["robot", "msg_id"]
-    build_ekg(driver, log, name, entities=entities, aggregate=aggregation_keys(entities),
+    build_ekg(driver, log, name, entities=entities, aggregate=built_keys(entities),
               replace=True, progress=False)  # fmt: skip
     return name, len(log)
 
@@ -110,34 +110,35 @@ def measure_all(logs: dict, repeat: int) -> None:
             page = context.new_page()
             page.goto(f"{dashboard.url}/cypher")  # warm the browser's cache of the scripts
             baseline_name, baseline_events = logs.pop("thesis")
-            baseline = first_graph(page, dashboard.url, baseline_name, repeat, cold=True)
+            baseline = first_graph(page, dashboard, baseline_name, repeat, cold=True)
             print(f"baseline: thesis log, {baseline_events:,} events: first graph in "
                   f"{baseline:.2f} s")  # fmt: skip
             for (size, kind), (name, events) in logs.items():
                 target = TARGETS.get(size)
                 for cold in (True, False):
-                    seconds = first_graph(page, dashboard.url, name, repeat, cold=cold)
+                    seconds = first_graph(page, dashboard, name, repeat, cold=cold)
                     verdict = f"target < {target:.0f} s: {'met' if seconds < target else 'MISSED'}"
                     print(f"{events:>9,} events ({kind}, {'cold' if cold else 'warm'}): first "
                           f"graph in {seconds:.2f} s ({seconds / baseline:.2f}x the baseline; "
                           f"{verdict if target else 'no target'})")  # fmt: skip
-                dfg = first_graph(page, dashboard.url, name, 1, tab="#tab-dfg")
+                dfg = first_graph(page, dashboard, name, 1, tab="#tab-dfg")
                 print(f"{'':>9}  DFG tab (log read from Neo4j, pm4py): {dfg:.2f} s "
                       f"({dfg / baseline:.2f}x the baseline)")  # fmt: skip
             context.close()
 
 
 def first_graph(
-    page, url: str, log: str, repeat: int, tab: str | None = None, cold: bool = False
+    page, dashboard, log: str, repeat: int, tab: str | None = None, cold: bool = False
 ) -> float:
     """Median seconds from navigation start to the drawn graph (of the DFG tab, if ``tab``);
     ``cold``: with the dashboard's caches of this log emptied first."""
-    from robotale.webapp.logdata import forget
+    from robotale.webapp.state import state
 
+    url = dashboard.url
     timings = []
     for _ in range(repeat):
         if cold:
-            forget(log)
+            state(dashboard.app).logs.forget(log)
         page.goto(f"{url}/discover?log={log}")
         page.wait_for_function(DRAWN, timeout=300_000)
         if tab is None:

@@ -1,4 +1,6 @@
-// What the Log node of $log records (null fields when there is no such log).
-OPTIONAL MATCH (l:Log {name: $log})
-RETURN l.name AS name, l.status AS status, l.properties AS properties,
-       l.entityTypes AS entityTypes, l.classTypes AS classTypes
+// What the Log node of $log records (no row when there is no such log): its status, source,
+// entity and class types, the event properties it stores, and when it was created.
+MATCH (l:Log {name: $log})
+RETURN l.name AS name, l.status AS status, l.events AS events, l.source AS source,
+       l.entityTypes AS entityTypes, l.classTypes AS classTypes,
+       toString(l.created) AS created, l.properties AS properties

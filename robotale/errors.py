@@ -20,3 +20,11 @@ class ModelError(RobotaleError):
 
 class ServerError(RobotaleError):
     """Neo4j (or another server robotale needs) cannot be reached or started."""
+
+
+class LogNotFound(InputError):
+    """No event log of that name is stored in Neo4j; ``hint`` says where to find or get one."""
+
+    def __init__(self, name: str, hint: str | None = None) -> None:
+        self.name, self.hint = name, hint or "see `robotale logs list`"
+        super().__init__(f"There is no log named {name!r} in Neo4j ({self.hint}).")

@@ -11,7 +11,8 @@ import pandas as pd
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
-from robotale.ekg.logs import delete_log, list_logs, log_exists, log_summary
+from robotale.ekg.keys import DEFAULT_AGGREGATE
+from robotale.ekg.logs import delete_log, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping, read_log_with_reading
 from robotale.eventlog.reading import format_reading
@@ -69,7 +70,7 @@ def ingest_command(
             events,
             log or log_name(path),
             entities=split_names(entities) if entities else None,
-            aggregate=aggregate or ["activity"],
+            aggregate=aggregate or DEFAULT_AGGREGATE,
             replace=replace,
             source=str(path),
         )
@@ -115,8 +116,7 @@ def logs_show(name: str) -> int:
 
 def logs_delete(name: str) -> int:
     with session_driver() as driver:
-        if not log_exists(driver, name):
-            raise InputError(f"There is no log named {name!r} in Neo4j.")
+        require_log(driver, name)
         delete_log(driver, name)
     print(f"Deleted the log {name!r}.")
     return 0

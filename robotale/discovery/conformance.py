@@ -17,12 +17,16 @@ from pathlib import Path
 from typing import Any, NamedTuple
 
 import pandas as pd
+from tqdm import tqdm
 
 from robotale.discovery.bpmn_net import process_net
 from robotale.discovery.graph import json_ready
 from robotale.discovery.instances import START_TIMESTAMP, activity_instances
 from robotale.errors import InputError, ModelError
 from robotale.eventlog.schema import ACTIVITY, CASE, MSG_ROLE, ROBOT, TIMESTAMP, message_roles
+from robotale.fame_runtime.library import Library, find_process
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.splitter import split
 
 SKIP = ">>"  # pm4py's "no move" in an alignment
 
@@ -57,7 +61,7 @@ class ConformanceReport:
 
     @property
     def figure(self):
-        import plotly.express as px
+        import plotly.express as px  # 0.7 s to import: only a figure needs it
 
         return px.bar(
             self.robots, x="robot", y="fitness", range_y=[0, 1], title="Fitness per robot"
@@ -87,8 +91,6 @@ def replay(
     traces: pd.DataFrame, models: dict[str, RobotModel], *, seconds_per_trace: float = 10.0
 ) -> ConformanceReport:
     """Align each robot's traces with its model (``models`` maps robot -> model)."""
-    from tqdm import tqdm
-
     runs = []
     for robot, model in tqdm(sorted(models.items()), desc="replaying robots", leave=False):
         mine = traces[traces[ROBOT] == robot]
@@ -113,6 +115,7 @@ def replay(
 
 
 def _replay_robot(robot: str, model: RobotModel, traces: pd.DataFrame, seconds: float):
+    # pm4py takes 2 s to import and prints a banner: only a replay loads it.
     import pm4py
     from pm4py.algo.conformance.alignments.petri_net import algorithm as alignments
     from pm4py.algo.conformance.tokenreplay import algorithm as token_replay
@@ -201,9 +204,6 @@ def check_conformance(
     expanded when the called process is in the same file or in the ``library`` folder of
     building blocks, as the engine would run them.
     """
-    from robotale.fame_runtime.library import Library, find_process
-    from robotale.fame_runtime.parser import parse
-
     if ROBOT not in log.columns:
         raise InputError("conformance needs the robot of every event; the log has no robot column.")
     definitions = parse(model)
@@ -240,8 +240,6 @@ def _outside_the_models(traces: pd.DataFrame, models: dict[str, RobotModel]) -> 
 
 
 def _bind(definitions, robots: list[str]) -> list:
-    from robotale.fame_runtime.splitter import split
-
     try:
         return split(definitions, robots)
     except ModelError as error:

@@ -26,7 +26,13 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.graph import Edge, Node, ProcessGraph
+from robotale.ekg.aggregate import aggregate as build_classes
+from robotale.ekg.aggregate import aggregation_key, class_type
+from robotale.ekg.connection import database, session_driver
 from robotale.ekg.keys import DISCOVERY_KEY
+from robotale.ekg.logs import log_info
+from robotale.ekg.queries import cypher
+from robotale.ekg.tables import EVENT_PROPERTIES
 from robotale.errors import InputError
 from robotale.eventlog import schema
 
@@ -46,14 +52,9 @@ def discover_ekg(
     activity and robot), with the DF_C edges of the entity types ``entities`` (default: all
     the log has)."""
     if driver is None:
-        from robotale.ekg.connection import session_driver
-
         with session_driver() as connected:
             return discover_ekg(log, aggregate, entities, driver=connected)
-    from robotale.ekg.aggregate import aggregate as build_classes
-    from robotale.ekg.aggregate import aggregation_key, class_type
-
-    info = _log_info(driver, log)
+    info = log_info(driver, log)
     key = aggregation_key(aggregate or DISCOVERY_KEY)
     kind = class_type(key)
     if kind not in (info["classTypes"] or []):
@@ -76,11 +77,9 @@ def discover_ekg(
 def read_stored_log(log: str, *, driver: Any = None) -> pd.DataFrame:
     """The events of a stored log as a canonical event log (pm4py column names)."""
     if driver is None:
-        from robotale.ekg.connection import session_driver
-
         with session_driver() as connected:
             return read_stored_log(log, driver=connected)
-    _log_info(driver, log)
+    log_info(driver, log)
     chunks = _run(driver, "discover_events", log=log)
     table = pd.DataFrame([event for chunk in chunks for event in chunk["properties"]])
     table = table.drop(columns=["timestamp", "log", "order"], errors="ignore")
@@ -92,17 +91,7 @@ def read_stored_log(log: str, *, driver: Any = None) -> pd.DataFrame:
     return table.rename(columns=_canonical_names(table.columns))
 
 
-def _log_info(driver: Any, log: str) -> dict[str, Any]:
-    info = _run(driver, "ekg_log_info", log=log)[0]
-    if info["name"] is None:
-        raise InputError(f"There is no log named {log!r} in Neo4j (see `robotale logs list`).")
-    return info
-
-
 def _run(driver: Any, query: str, **parameters: Any) -> list[dict[str, Any]]:
-    from robotale.ekg.connection import database
-    from robotale.ekg.queries import cypher
-
     records, _, _ = driver.execute_query(cypher(query), parameters, database_=database())
     return [record.data() for record in records]
 
@@ -201,8 +190,6 @@ def _entity_node(node_id: str, label: str, count: int, entity_type: str) -> Node
 
 def _canonical_names(properties) -> dict[str, str]:
     """Event property -> canonical column (``activity`` -> ``concept:name`` ...)."""
-    from robotale.ekg.tables import EVENT_PROPERTIES
-
     back = {prop: column for column, prop in EVENT_PROPERTIES.items()}
     back |= {short: column for column, short in schema.CSV_NAMES.items() if short not in back}
     return {p: back[p] for p in properties if p in back}

@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import shutil
 
+import graphviz
+
 from robotale.discovery.graph import Edge, Node, ProcessGraph, format_seconds
 from robotale.errors import RobotaleError
 
@@ -27,8 +29,6 @@ def graph_to_svg(graph: ProcessGraph, labels: str = "frequency") -> str:
     ``labels`` chooses what edges show: ``frequency`` (how often) or ``performance`` (mean
     time between the two activities, with the count in brackets).
     """
-    import graphviz
-
     if labels not in LABELS:
         raise RobotaleError(f"unknown edge labels {labels!r}; choose one of {', '.join(LABELS)}.")
     require_dot()
@@ -54,8 +54,6 @@ def graph_to_svg(graph: ProcessGraph, labels: str = "frequency") -> str:
 
 
 def _node_style(node: Node, robot_colours: dict[str, str]) -> dict[str, str]:
-    import graphviz
-
     label = graphviz.escape(node.label)  # a backslash in a name is text, not a Graphviz escape
     if node.kind in ("start", "end"):
         fill = "#8fd18f" if node.kind == "start" else "#f08080"
@@ -73,8 +71,6 @@ def _node_style(node: Node, robot_colours: dict[str, str]) -> dict[str, str]:
 
 
 def _edge_label(edge: Edge, labels: str) -> str:
-    import graphviz
-
     prefix = f"{graphviz.escape(edge.entity_type)}: " if edge.entity_type else ""
     if labels == "performance" and edge.durations.get("mean") is not None:
         return f"{prefix}{format_seconds(edge.durations['mean'])} ({edge.count})"

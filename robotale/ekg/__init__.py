@@ -20,7 +20,7 @@ __all__ = sorted(_EXPORTS)
 
 
 def __getattr__(name: str) -> Any:
-    # Imported on first use, so `robotale neo4j status` does not load pandas.
+    # Imported on first use, so `robotale neo4j status` does not load pandas (half a second).
     if name in _EXPORTS:
         import importlib
 

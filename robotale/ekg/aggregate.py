@@ -12,6 +12,7 @@ from collections.abc import Sequence
 from neo4j import Driver
 
 from robotale.ekg.connection import database
+from robotale.ekg.logs import log_info
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import check_name, property_name
 from robotale.errors import InputError
@@ -34,14 +35,11 @@ def class_type(key: Sequence[str]) -> str:
 def aggregate(driver: Driver, log: str, key: str | Sequence[str]) -> int:
     """(Re)build the classes of ``key`` for the stored log ``log``; returns the DF_C count.
 
-    Raises :class:`InputError` when there is no complete log of that name or its events lack
-    one of the key's properties.
+    Raises :class:`LogNotFound` when there is no log of that name and :class:`InputError`
+    when its events lack one of the key's properties.
     """
     properties = aggregation_key(key)
-    records, _, _ = driver.execute_query(cypher("ekg_log_info"), log=log, database_=database())
-    info = records[0]
-    if info["name"] is None:
-        raise InputError(f"There is no log named {log!r} in Neo4j (see `robotale logs list`).")
+    info = log_info(driver, log)
     missing = [p for p in properties if p not in (info["properties"] or [])]
     if missing:
         raise InputError(

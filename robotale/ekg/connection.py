@@ -20,6 +20,7 @@ from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.ekg.queries import cypher
 from robotale.ekg.server import HOST, USER, LocalServer, ServerOptions
+from robotale.ekg.server import bolt_answers as bolt_answers  # re-exported: the server owns it
 from robotale.errors import ServerError
 
 # The driver logs every refused connection attempt as a warning; robotale turns the failure
@@ -93,20 +94,6 @@ def unreachable_message(where: Settings) -> str:
         f"Neo4j is not running at {where.uri}: start it with `robotale neo4j start`, "
         "or set NEO4J_URI to a running server."
     )
-
-
-def bolt_answers(uri: str, auth: tuple[str, str]) -> bool:
-    """True when a Bolt server answers at ``uri`` (even if it refuses these credentials)."""
-    driver = GraphDatabase.driver(uri, auth=auth, connection_timeout=2)
-    try:
-        driver.verify_connectivity()
-        return True
-    except AuthError:
-        return True
-    except (ServiceUnavailable, OSError):
-        return False
-    finally:
-        driver.close()
 
 
 def server_version(driver: Driver) -> dict[str, Any]:

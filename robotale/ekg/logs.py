@@ -1,4 +1,9 @@
-"""The event logs stored in Neo4j: list, show, delete."""
+"""The event logs stored in Neo4j: list them, read one log, delete one.
+
+Every read of one stored log goes through here, each query a file of ``cypher/``, and a name
+under which nothing is stored raises :class:`~robotale.errors.LogNotFound` (whose ``hint``
+lets each caller say where logs come from: the command line, the dashboard's Logs page).
+"""
 
 from __future__ import annotations
 
@@ -8,37 +13,63 @@ from neo4j import Driver
 
 from robotale.ekg.connection import database
 from robotale.ekg.queries import cypher, statements
-from robotale.errors import InputError
+from robotale.errors import LogNotFound
 
 
 def list_logs(driver: Driver) -> list[dict[str, Any]]:
     """Every stored log as its Log node describes it, by name."""
-    records, _, _ = driver.execute_query(cypher("ekg_list_logs"), log=None, database_=database())
-    return [record.data() for record in records]
+    return _rows(driver, "ekg_list_logs", log=None)
 
 
-def log_summary(driver: Driver, name: str) -> dict[str, Any]:
-    """The Log node's description of ``name`` plus counts taken from the graph.
+def log_info(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
+    """What the Log node of ``name`` records: ``status``, ``events``, ``source``,
+    ``entityTypes``, ``classTypes``, ``created`` (text) and the event ``properties``."""
+    rows = _rows(driver, "ekg_log_info", log=name)
+    if not rows:
+        raise LogNotFound(name, hint)
+    return rows[0]
+
+
+def log_summary(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
+    """:func:`log_info` plus counts taken from the graph.
 
     ``counts`` maps ``"events"``, ``"entities:robot"``, ``"DF:robot"``,
     ``"DF_C:activity / robot"`` ... to numbers.
     """
-    records, _, _ = driver.execute_query(cypher("ekg_list_logs"), log=name, database_=database())
-    if not records:
-        raise InputError(f"There is no log named {name!r} in Neo4j (see `robotale logs list`).")
-    counted, _, _ = driver.execute_query(cypher("ekg_log_counts"), log=name, database_=database())
+    info = log_info(driver, name, hint)
     counts = {
         r["what"] if r["type"] is None else f"{r['what']}:{r['type']}": r["count"]
-        for r in counted
+        for r in _rows(driver, "ekg_log_counts", log=name)
         if r["count"]
     }
-    return records[0].data() | {"counts": counts}
+    return info | {"counts": counts}
 
 
 def log_exists(driver: Driver, name: str) -> bool:
     """Whether anything (a Log node or events) is stored under ``name``."""
-    records, _, _ = driver.execute_query(cypher("ekg_log_exists"), log=name, database_=database())
-    return bool(records[0]["exists"])
+    return bool(_rows(driver, "ekg_log_exists", log=name)[0]["exists"])
+
+
+def require_log(driver: Driver, name: str, hint: str | None = None) -> None:
+    """A :class:`LogNotFound` unless something is stored under ``name``."""
+    if not log_exists(driver, name):
+        raise LogNotFound(name, hint)
+
+
+def log_values(driver: Driver, name: str) -> dict[str, Any]:
+    """The distinct ``case``, ``robot``, ``robot_type`` and ``activity`` values of the log's
+    events (lists) and their number, ``events``."""
+    return _rows(driver, "ekg_log_values", log=name)[0]
+
+
+def log_robots(driver: Driver, name: str) -> list[str]:
+    """The robots the log's events name."""
+    return [str(robot) for robot in _rows(driver, "ekg_log_robots", log=name)[0]["robots"]]
+
+
+def stored_events(driver: Driver, name: str) -> int:
+    """How many events of ``name`` are stored so far (also while it is being built)."""
+    return int(_rows(driver, "ekg_log_event_count", log=name)[0]["events"])
 
 
 def delete_log(driver: Driver, name: str) -> None:
@@ -53,3 +84,8 @@ def graph_counts(driver: Driver) -> dict[str, int]:
     with driver.session(database=database()) as session:
         result = session.run(cypher("ekg_graph_counts"))
         return {f"{r['kind']}:{r['name']}": r["count"] for r in result if r["count"]}
+
+
+def _rows(driver: Driver, query: str, **parameters: Any) -> list[dict[str, Any]]:
+    records, _, _ = driver.execute_query(cypher(query), parameters, database_=database())
+    return [record.data() for record in records]

@@ -1,10 +1,21 @@
-"""Load the Cypher files of ``cypher/`` (installed as the package ``robotale.cypher``)."""
+"""Load the Cypher files of ``cypher/`` (installed as the package ``robotale.cypher``) and split
+text into statements, the one way robotale does (its own files, the dashboard's console)."""
 
 from __future__ import annotations
 
 import re
+from collections.abc import Iterator
 from functools import cache
 from importlib.resources import files
+
+#: one piece of Cypher text: a quoted string or name, a comment, a ``;``, or other code
+_PIECE = re.compile(
+    r"""(?P<quoted>'(?:\\.?|[^'\\])*(?:'|$)|"(?:\\.?|[^"\\])*(?:"|$)|`[^`]*(?:`|$))
+      | (?P<comment>//[^\n]*|/\*.*?(?:\*/|$))
+      | (?P<end>;)
+      | (?P<code>[^'"`/;]+|/)""",
+    re.VERBOSE | re.DOTALL,
+)
 
 
 @cache
@@ -14,8 +25,33 @@ def cypher(name: str) -> str:
 
 
 def statements(name: str) -> list[str]:
-    """The statements of a file that holds several, each ending in ``;`` at the end of a line."""
-    text = "\n".join(
-        line for line in cypher(name).splitlines() if not line.lstrip().startswith("//")
-    )
-    return [part.strip() for part in re.split(r";[ \t]*(?:\n|$)", text) if part.strip()]
+    """The statements of a file that holds several, without their comments."""
+    return split_statements(cypher(name), comments=False)
+
+
+def split_statements(text: str, *, comments: bool = True) -> list[str]:
+    """The statements of ``text``: split at each ``;`` outside strings, quoted names and
+    comments, each stripped; statements of nothing but comments are dropped. Without
+    ``comments`` the comments are taken out of the statements too."""
+    found: list[str] = []
+    parts: list[str] = []
+    has_code = False
+    for kind, piece in _pieces(text):
+        if kind == "end":
+            if has_code:
+                found.append("".join(parts).strip())
+            parts, has_code = [], False
+            continue
+        if kind == "comment" and not comments:
+            piece = " " if piece.startswith("/*") else ""  # a block comment still separates
+        parts.append(piece)
+        has_code = has_code or (kind != "comment" and bool(piece.strip()))
+    if has_code:
+        found.append("".join(parts).strip())
+    return found
+
+
+def _pieces(text: str) -> Iterator[tuple[str, str]]:
+    # An unterminated string or comment runs to the end of the text, as Neo4j reads it.
+    for match in _PIECE.finditer(text):
+        yield str(match.lastgroup), match.group()

@@ -21,6 +21,9 @@ import urllib.request
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
+from neo4j import GraphDatabase
+from neo4j.exceptions import AuthError, ServiceUnavailable
+
 from robotale.config import robotale_home
 from robotale.ekg.jars import ensure_jars
 from robotale.errors import ServerError
@@ -234,8 +237,6 @@ class LocalServer:
     def _wait_until_answering(
         self, process: subprocess.Popen, state: RunningServer, timeout: float
     ) -> None:
-        from robotale.ekg.connection import bolt_answers
-
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if process.poll() is not None:
@@ -251,6 +252,20 @@ class LocalServer:
         if "Address already in use" in tail:
             raise PortInUse(f"{what}: a port it needs is in use; see {self.log_file}.")
         raise ServerError(f"{what}; the last lines of {self.log_file}:\n{tail}")
+
+
+def bolt_answers(uri: str, auth: tuple[str, str]) -> bool:
+    """True when a Bolt server answers at ``uri`` (even if it refuses these credentials)."""
+    driver = GraphDatabase.driver(uri, auth=auth, connection_timeout=2)
+    try:
+        driver.verify_connectivity()
+        return True
+    except AuthError:
+        return True
+    except (ServiceUnavailable, OSError):
+        return False
+    finally:
+        driver.close()
 
 
 def _http_answers(state: RunningServer) -> bool:

@@ -16,7 +16,6 @@ logs; ``auto`` picks those a bag holds.
 
 from __future__ import annotations
 
-import json
 import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
@@ -48,10 +47,13 @@ from robotale.eventlog.rosbag import (
     namespace,
 )
 from robotale.eventlog.sources import Sources
+from robotale.fame_runtime.manifest import RunManifest, read_manifests
 
 TAG_TOPICS = "/*/tag"
-MANIFEST = "robotale-run.json"
 DEFAULT_PERSPECTIVES = ("odom", "battery")
+#: each run's manifest by case id (the name ``robotale prepare`` imports; the manifest module
+#: owns the file)
+run_manifests = read_manifests
 #: the robot of tags that name none, on a topic without a namespace (a single-robot bag).
 DEFAULT_ROBOT = "robot"
 
@@ -183,7 +185,7 @@ def prepare(
         for p in chosen
     }
     _warn_missing_samples(tag_rows, samples, chosen)
-    tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, run_manifests(runs))
+    tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, read_manifests(runs))
     log = enrich(tag_rows, samples, rate=rate)
     return _canonical(log, chosen)
 
@@ -216,19 +218,6 @@ def find_runs(source: Path) -> list[Path]:
             f"{source} is not a rosbag2 directory (it has no metadata.yaml) and holds none."
         )
     return runs
-
-
-def run_manifests(runs: Sequence[Path]) -> dict[str, dict]:
-    """Each run's ``robotale-run.json`` (seed, settings, outcome, robots), by case id."""
-    manifests = {}
-    for run in runs:
-        path = run / MANIFEST
-        if path.is_file():
-            try:
-                manifests[run.name] = json.loads(path.read_text(encoding="utf-8"))
-            except (ValueError, UnicodeDecodeError) as error:
-                raise InputError(f"{path} is not valid JSON: {error}.") from None
-    return manifests
 
 
 def robot_type(robot: str) -> str:
@@ -453,7 +442,7 @@ def _only_robot(run: Path, topic: str, robots: Sequence[str]) -> str:
     )
 
 
-def _robot_types(tags: pd.DataFrame, manifests: Mapping[str, dict]) -> np.ndarray:
+def _robot_types(tags: pd.DataFrame, manifests: Mapping[str, RunManifest]) -> np.ndarray:
     """From each run's manifest (``robots``: name -> pool), else from the robot's name."""
     declared = {
         (case, name): _declared_type(value)

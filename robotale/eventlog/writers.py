@@ -14,15 +14,11 @@ failure never leaves a partial file behind. Timestamps are written in UTC with m
 
 from __future__ import annotations
 
-import contextlib
 import itertools
 import json
 import math
-import os
-import tempfile
-from collections.abc import Iterator, Mapping
+from collections.abc import Mapping
 from pathlib import Path
-from typing import IO
 
 import numpy as np
 import pandas as pd
@@ -30,6 +26,8 @@ from lxml import etree
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
+from robotale.fame_runtime.manifest import RunManifest
+from robotale.files import atomic_file
 
 CASE, TIME, ACTIVITY = schema.CASE, schema.TIMESTAMP, schema.ACTIVITY
 _TIME_FORMAT = "%Y-%m-%dT%H:%M:%S.%f+00:00"
@@ -43,32 +41,14 @@ _XES_EXTENSIONS = (
 _EPOCH = "1970-01-01T00:00:00+00:00"
 
 
-@contextlib.contextmanager
-def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO]:
-    """A file opened for writing that appears at ``path`` only once it is complete."""
+def _target(path: str | Path) -> Path:
+    """``path``, with its folder created if need be."""
     path = Path(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
-        handle, temporary = tempfile.mkstemp(
-            dir=path.parent, prefix=f".{path.name}.", suffix=".tmp"
-        )
     except OSError as error:
         raise InputError(f"Cannot write {path}: {error.strerror or error}.") from None
-    try:
-        with os.fdopen(handle, mode, **({} if "b" in mode else {"encoding": "utf-8"})) as file:
-            yield file
-        os.chmod(temporary, 0o666 & ~_umask())
-        os.replace(temporary, path)
-    except BaseException:
-        with contextlib.suppress(OSError):
-            os.unlink(temporary)
-        raise
-
-
-def _umask() -> int:
-    current = os.umask(0)
-    os.umask(current)
-    return current
+    return path
 
 
 def _utc_text(times: pd.Series) -> pd.Series:
@@ -79,7 +59,7 @@ def write_csv(log: pd.DataFrame, path: str | Path) -> None:
     """The log as CSV with the short column names (``case``, ``time``, ``activity`` ...)."""
     table = schema.to_csv_names(log)
     table["time"] = _utc_text(log[TIME]).to_numpy()
-    with atomic_file(path) as file:
+    with atomic_file(_target(path)) as file:
         table.to_csv(file, index=False, lineterminator="\n")
 
 
@@ -127,7 +107,7 @@ def write_xes(log: pd.DataFrame, path: str | Path, name: str | None = None) -> N
         attributes.append((column, kind, _xes_values(log[column], kind)))
     cases = log[CASE].astype(str).to_numpy(object)
     bounds = [0, *(np.flatnonzero(cases[1:] != cases[:-1]) + 1).tolist(), len(log)]
-    with atomic_file(path, "wb") as file, etree.xmlfile(file, encoding="utf-8") as xml:
+    with atomic_file(_target(path), "wb") as file, etree.xmlfile(file, encoding="utf-8") as xml:
         xml.write_declaration()
         with xml.element("log", {"xes.version": "1849-2016"}, nsmap={None: _XES_NS}):
             xml.write("\n")
@@ -206,7 +186,7 @@ _OCEL_MESSAGE = {schema.MSG_ID, schema.MSG_PAYLOAD}
 
 
 def write_ocel(
-    log: pd.DataFrame, path: str | Path, runs: Mapping[str, Mapping] | None = None
+    log: pd.DataFrame, path: str | Path, runs: Mapping[str, RunManifest] | None = None
 ) -> None:
     """The log as OCEL 2.0 JSON with objects ``robot``, ``message`` and ``run``.
 
@@ -222,7 +202,7 @@ def write_ocel(
         "objects": _ocel_robots(log) + _ocel_messages(log) + _ocel_runs(log, runs or {}),
         "events": events,
     }
-    with atomic_file(path) as file:
+    with atomic_file(_target(path)) as file:
         json.dump(document, file, ensure_ascii=False, allow_nan=False)
 
 
@@ -284,7 +264,7 @@ def _json_values(series: pd.Series, kind: str) -> list:
     return [None if v is None else bool(v) for v in values]
 
 
-def _ocel_object_types(log: pd.DataFrame, runs: Mapping[str, Mapping]) -> list[dict]:
+def _ocel_object_types(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> list[dict]:
     run_attributes = sorted({key for manifest in runs.values() for key in _flat(manifest)})
     string = lambda names: [{"name": n, "type": "string"} for n in names]  # noqa: E731
     return [
@@ -342,7 +322,7 @@ def _ocel_messages(log: pd.DataFrame) -> list[dict]:
     return objects
 
 
-def _ocel_runs(log: pd.DataFrame, runs: Mapping[str, Mapping]) -> list[dict]:
+def _ocel_runs(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> list[dict]:
     objects = []
     for case in pd.unique(log[CASE].astype(str)):
         flat = _flat(runs.get(case, {}))

@@ -25,8 +25,10 @@ from typing import Any
 from tqdm import tqdm
 
 from robotale.errors import InputError
+from robotale.fame_runtime.manifest import RunManifest, write_manifest
+from robotale.files import write_file
 from robotale.sim import scenarios
-from robotale.sim.run import CRASHED, MANIFEST, RunPlan, simulate_run
+from robotale.sim.run import CRASHED, RunPlan, simulate_run
 
 SUMMARY = "robotale-batch.json"
 
@@ -54,12 +56,12 @@ def simulate_batch(
     if workers is None:
         workers = os.cpu_count() or 1
     workers = 0 if gui or pace or len(plans) == 1 else min(workers, len(plans))
-    manifests: dict[str, dict[str, Any]] = {}
+    manifests: dict[str, RunManifest] = {}
     with tqdm(
         total=len(plans), unit="run", desc="simulate", disable=not progress, leave=False
     ) as bar:
 
-        def finished(manifest: dict[str, Any]) -> None:
+        def finished(manifest: RunManifest) -> None:
             manifests[manifest["case"]] = manifest
             bar.update()
             bar.set_postfix(Counter(m["outcome"]["status"] for m in manifests.values()))
@@ -74,13 +76,13 @@ def simulate_batch(
             _remove_partials(out)
             raise
     summary = _summary(plans, [manifests[p.case] for p in plans], workers, began)
-    _write_json(out / SUMMARY, summary)
+    write_file(out / SUMMARY, json.dumps(summary, indent=2) + "\n")
     return summary
 
 
 def run_into(
     plan: RunPlan, out: Path, *, gui: bool = False, pace: float | None = None
-) -> dict[str, Any]:
+) -> RunManifest:
     """One run recorded into ``out/<case>`` (through a hidden partial folder)."""
     # rosbag2 names its storage files after the bag's folder, so the bag is written under its
     # final name inside the hidden folder and only the folder is moved.
@@ -120,10 +122,10 @@ def _pool_round(plans: Sequence[RunPlan], out: Path, workers: int, finished) -> 
     return sorted(lost, key=lambda p: p.index)
 
 
-def _died(plan: RunPlan, out: Path) -> dict[str, Any]:
+def _died(plan: RunPlan, out: Path) -> RunManifest:
     """The manifest of a run whose worker process died: no bag, the reason."""
     shutil.rmtree(out / f".{plan.case}.partial", ignore_errors=True)
-    manifest = {
+    manifest: RunManifest = {
         "case": plan.case,
         "scenario": plan.scenario,
         "seed": plan.seed,
@@ -137,7 +139,7 @@ def _died(plan: RunPlan, out: Path) -> dict[str, Any]:
     }
     folder = out / plan.case
     folder.mkdir(parents=True, exist_ok=True)
-    _write_json(folder / MANIFEST, manifest)
+    write_manifest(folder, manifest)
     return manifest
 
 
@@ -169,7 +171,7 @@ def _remove_partials(out: Path) -> None:
 
 
 def _summary(
-    plans: Sequence[RunPlan], manifests: Iterable[dict[str, Any]], workers: int, began: float
+    plans: Sequence[RunPlan], manifests: Iterable[RunManifest], workers: int, began: float
 ) -> dict[str, Any]:
     manifests = list(manifests)
     first = plans[0]
@@ -187,7 +189,7 @@ def _summary(
     }
 
 
-def _line(manifest: dict[str, Any]) -> dict[str, Any]:
+def _line(manifest: RunManifest) -> dict[str, Any]:
     line = {
         "case": manifest["case"],
         "seed": manifest["seed"],
@@ -199,9 +201,3 @@ def _line(manifest: dict[str, Any]) -> dict[str, Any]:
         if kind in manifest:
             line[kind] = manifest[kind]
     return line
-
-
-def _write_json(path: Path, data: Any) -> None:
-    temporary = path.with_name(path.name + ".tmp")
-    temporary.write_text(json.dumps(data, indent=2) + "\n", encoding="utf-8")
-    temporary.replace(path)

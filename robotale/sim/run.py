@@ -10,7 +10,6 @@ with the reason; whatever was recorded until then stays in the bag.
 from __future__ import annotations
 
 import datetime as dt
-import json
 import math
 import time
 import traceback
@@ -21,11 +20,12 @@ from typing import Any
 
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.labels import error_name, signal_topic
 from robotale.fame_runtime.library import Library
+from robotale.fame_runtime.manifest import RunManifest, write_manifest
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.model import Definitions
 from robotale.fame_runtime.parser import parse
-from robotale.fame_runtime.plan import error_name, signal_topic
 from robotale.fame_runtime.skills import Skill, load_skills
 from robotale.fame_runtime.tags import bus_sink
 from robotale.sim import faults as fault_model
@@ -37,7 +37,6 @@ from robotale.sim.skills import SKILLS
 from robotale.sim.world import SimWorld, WindowClosed
 from robotale.sim.worldspec import World
 
-MANIFEST = "robotale-run.json"
 ENDED, TIME_LIMIT, CRASHED = "ended", "time limit", "crashed"
 
 
@@ -81,7 +80,7 @@ def skills_of(world: World) -> dict[str, Skill]:
 
 def simulate_run(
     plan: RunPlan, folder: Path, *, gui: bool = False, pace: float | None = None
-) -> dict[str, Any]:
+) -> RunManifest:
     """Simulate and record one run into ``folder`` (created); returns its manifest."""
     began = time.perf_counter()
     world, start = plan.world, plan.start
@@ -128,7 +127,7 @@ def simulate_run(
     manifest.update(_what_happened(mission, sim, recorder, start))
     manifest["wall_time"] = round(time.perf_counter() - began, 3)
     folder.mkdir(parents=True, exist_ok=True)
-    (folder / MANIFEST).write_text(json.dumps(manifest, indent=2) + "\n", encoding="utf-8")
+    write_manifest(folder, manifest)
     return manifest
 
 
@@ -232,9 +231,9 @@ def _manifest(
     status: str,
     reason: str,
     detail: str,
-) -> dict[str, Any]:
+) -> RunManifest:
     world = plan.world
-    manifest: dict[str, Any] = {
+    manifest: RunManifest = {
         "case": plan.case,
         "scenario": plan.scenario or world.file.stem,
         "model": scenarios.describe(world.model),

@@ -9,9 +9,9 @@ from flask import Flask, redirect, url_for
 from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
-from robotale.webapp import errors, jobs, neo4j_access, pages, uploads
-from robotale.webapp.model_store import ModelStore
+from robotale.webapp import errors, pages, state, uploads
 from robotale.webapp.settings import WebSettings
+from robotale.webapp.views import assets, console, discover, logs, model, perspectives
 
 
 def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
@@ -25,15 +25,12 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
     app.config.update(
         SECRET_KEY=settings.secret_key,
         MAX_CONTENT_LENGTH=settings.upload_limit_mb * 1024 * 1024,
-        ROBOTALE=settings,
         JSON_SORT_KEYS=False,
     )
     app.json.sort_keys = False
     CSRFProtect(app)
-    neo4j_access.init_app(app)
-    jobs.init_app(app)
     uploads.remove_stale(settings.upload_dir)
-    ModelStore(settings.model_dir).add_shipped()
+    state.init_app(app, settings).models.add_shipped()
     errors.init_app(app)
     pages.init_app(app)
     _register_blueprints(app)
@@ -47,7 +44,5 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
 
 
 def _register_blueprints(app: Flask) -> None:
-    from robotale.webapp.views import assets, console, discover, logs, model, perspectives
-
     for module in (assets, logs, discover, perspectives, model, console):
         app.register_blueprint(module.blueprint)

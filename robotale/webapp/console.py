@@ -20,6 +20,7 @@ from neo4j.exceptions import ClientError
 from neo4j.graph import Node, Path, Relationship
 
 from robotale.ekg.connection import database
+from robotale.ekg.queries import split_statements
 from robotale.errors import InputError
 
 _PARAMETER = re.compile(r"\$([A-Za-z_][A-Za-z0-9_]*)")
@@ -81,42 +82,6 @@ def run_read_only(
             except ClientError as error:
                 raise _explain(error) from None
     return results
-
-
-def split_statements(text: str) -> list[str]:
-    """The statements of ``text``: split at each ``;`` outside strings, quoted names and
-    comments; statements that hold nothing but comments are dropped."""
-    statements, start, index, length = [], 0, 0, len(text)
-    while index < length:
-        char = text[index]
-        if char in "'\"`":
-            index = _closing_quote(text, index)
-        elif text.startswith("//", index):
-            index = _end(text, "\n", index)
-        elif text.startswith("/*", index):
-            index = _end(text, "*/", index + 2) + 1
-        elif char == ";":
-            statements.append(text[start:index])
-            start = index + 1
-        index += 1
-    statements.append(text[start:])
-    return [s.strip() for s in statements if _without_comments(s).strip()]
-
-
-def _closing_quote(text: str, opening: int) -> int:
-    quote, index = text[opening], opening + 1
-    while index < len(text) and text[index] != quote:
-        index += 2 if text[index] == "\\" and quote != "`" else 1
-    return index
-
-
-def _end(text: str, marker: str, start: int) -> int:
-    found = text.find(marker, start)
-    return len(text) if found < 0 else found
-
-
-def _without_comments(statement: str) -> str:
-    return re.sub(r"//[^\n]*|/\*.*?\*/", "", statement, flags=re.DOTALL)
 
 
 def _read(tx: neo4j.ManagedTransaction, statement: str, parameters: dict, limit: int):

@@ -19,17 +19,22 @@ from typing import Any
 import pandas as pd
 from neo4j import Driver
 
+from robotale.ekg.build import build_ekg
+from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
+from robotale.ekg.logs import stored_events
 from robotale.errors import InputError, RobotaleError
 from robotale.eventlog import schema
+from robotale.eventlog.prepare import find_runs, prepare
+from robotale.eventlog.readers import read_log
+from robotale.fame_runtime.manifest import read_manifests
+from robotale.sim import scenarios
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
-from robotale.webapp.logdata import class_graph, first_key, forget
+from robotale.webapp.logdata import LogData, first_key
 from robotale.webapp.model_store import ModelStore
 
 #: columns every stored log keeps, whatever the user unticks
 ALWAYS_STORED = (*schema.REQUIRED, schema.LIFECYCLE)
-#: entity columns ticked by default, where the log has them (as in thesis figure 7.3)
-DEFAULT_ENTITIES = ("robot", "msg_id")
 #: a zipped bag folder may unpack to this many times the upload limit
 UNPACK_FACTOR = 20
 
@@ -96,8 +101,6 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
         if upload.kind == "zip":
             pending.log, pending.model_id = _read_bags(upload, limit_bytes, models, job)
         else:
-            from robotale.eventlog.readers import read_log
-
             pending.log = read_log(upload.path, mapping=pending.mapping)
     except RobotaleError as error:
         # The message names our stored copy; the user knows the file by its own name.
@@ -114,8 +117,6 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
 def _read_bags(
     upload: uploads.Upload, limit_bytes: int, models: ModelStore, job: Job
 ) -> tuple[pd.DataFrame, str | None]:
-    from robotale.eventlog.prepare import prepare
-
     folder = uploads.unpack(upload, limit_bytes * UNPACK_FACTOR)
     try:
         job.step("preparing the recordings")
@@ -130,10 +131,7 @@ def _read_bags(
 
 def shipped_model(root: Path) -> Path | None:
     """The mission model of the shipped scenario the recordings' manifests name, if one."""
-    from robotale.eventlog.prepare import find_runs, run_manifests
-    from robotale.sim import scenarios
-
-    names = {m.get("scenario") for m in run_manifests(find_runs(root)).values()}
+    names = {m.get("scenario") for m in read_manifests(find_runs(root)).values()}
     if len(names) != 1 or (name := names.pop()) not in scenarios.names():
         return None
     return scenarios.FOLDER / f"{name}.bpmn"
@@ -150,7 +148,8 @@ def bag_root(folder: Path) -> Path:
 
 
 def columns(log: pd.DataFrame) -> list[Column]:
-    """The log's columns with the default choice: store everything, robot and msg_id entities."""
+    """The log's columns with the default choice: store everything; the default entity
+    columns (robot and msg_id, as in thesis figure 7.3) are entities where the log has them."""
     found = []
     for canonical in log.columns:
         name = schema.CSV_NAMES.get(canonical, canonical)
@@ -188,11 +187,10 @@ def ingest(
     entities: list[str],
     replace: bool,
     models: ModelStore,
+    logs: LogData,
     job: Job,
 ) -> dict[str, Any]:
     """Store the pending log as ``name``; the upload is deleted whatever happens."""
-    from robotale.ekg.build import build_ekg
-
     log = pending.log
     if log is None:
         raise InputError("That upload has not been read yet: wait for it, then choose again.")
@@ -204,7 +202,7 @@ def ingest(
                 log,
                 name,
                 entities=entities,
-                aggregate=aggregation_keys(entities),
+                aggregate=built_keys(entities),
                 replace=replace,
                 source=pending.upload.filename,
                 progress=False,
@@ -214,15 +212,9 @@ def ingest(
     if pending.model_id:
         models.link(name, pending.model_id)
     job.step("drawing its process")
-    forget(name)
-    class_graph(driver, name, first_key(entities))  # the Discover page's first view, ready
+    logs.forget(name)
+    logs.class_graph(driver, name, first_key(entities))  # the Discover page's first view, ready
     return {"log": summary.log, "events": summary.events, "seconds": round(summary.seconds, 2)}
-
-
-def aggregation_keys(entities: list[str]) -> list[str]:
-    """The class graphs built right away: by activity, and by activity and robot (the
-    Discover page's first view) when robots are entities; others are built when asked for."""
-    return ["activity", "activity,robot"] if "robot" in entities else ["activity"]
 
 
 class _ProgressWatch:
@@ -244,17 +236,11 @@ class _ProgressWatch:
             self._thread.join(timeout=5)
 
     def _watch(self) -> None:
-        from robotale.ekg.connection import database
-        from robotale.ekg.queries import cypher
-
         total = self.job.total
         while not self._stop.wait(0.5):
             try:
-                records, _, _ = self.driver.execute_query(
-                    cypher("webapp_build_progress"), log=self.log, database_=database()
-                )
+                events = stored_events(self.driver, self.log)
             except Exception:  # progress is a nicety; the build reports real failures
                 return
-            events = int(records[0]["events"])
             stage = "writing events" if events < total else "linking events and aggregating"
             self.job.step(stage, events, total)

@@ -16,11 +16,8 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
-from flask import Flask, current_app
-
 from robotale.errors import RobotaleError
 
-_KEY = "robotale.jobs"
 #: finished jobs are forgotten after this many seconds
 KEEP = 3600
 
@@ -84,11 +81,3 @@ def _run(job: Job, work: Callable[[Job], dict[str, Any]]) -> None:
     finally:
         job.finished = True
         job.ended_at = time.time()
-
-
-def init_app(app: Flask) -> None:
-    app.extensions[_KEY] = Jobs()
-
-
-def jobs() -> Jobs:
-    return current_app.extensions[_KEY]

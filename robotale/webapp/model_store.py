@@ -10,13 +10,16 @@ from __future__ import annotations
 
 import hashlib
 import json
-import os
 import re
-import tempfile
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
 from robotale.errors import InputError, ModelError
+from robotale.fame_runtime.parser import parse, parse_bytes
+from robotale.fame_runtime.splitter import split
+from robotale.files import write_file
+from robotale.sim import scenarios
+from robotale.webapp.settings import WebSettings
 
 _ID = re.compile(r"[0-9a-f]{16}")
 _LINKS = "links.json"
@@ -36,8 +39,6 @@ class ModelStore:
 
     def add(self, data: bytes, filename: str) -> StoredModel:
         """Check ``data`` with the FAME parser and store it; a ``ModelError`` if it is no model."""
-        from robotale.fame_runtime.parser import parse_bytes
-
         name = PurePosixPath(filename.replace("\\", "/")).name or "model.bpmn"
         if not name.lower().endswith(".bpmn"):
             raise InputError(f"{name!r} is not a .bpmn file.")
@@ -50,9 +51,9 @@ class ModelStore:
             raise InputError(f"{name!r} holds no process to show.")
         model_id = hashlib.sha256(data).hexdigest()[:16]
         self.folder.mkdir(parents=True, exist_ok=True)
-        _write_atomically(self.folder / f"{model_id}.bpmn", data)
+        write_file(self.folder / f"{model_id}.bpmn", data)
         meta = {"name": name, "pools": pools}
-        _write_atomically(self.folder / f"{model_id}.json", json.dumps(meta).encode())
+        write_file(self.folder / f"{model_id}.json", json.dumps(meta).encode())
         return StoredModel(model_id, name, self.folder / f"{model_id}.bpmn", pools)
 
     def get(self, model_id: str) -> StoredModel:
@@ -70,15 +71,10 @@ class ModelStore:
 
     def add_shipped(self) -> list[StoredModel]:
         """Store the mission models of the scenarios robotale ships (agri, rexdingo)."""
-        from robotale.sim import scenarios
-
         return [self.add(p.read_bytes(), p.name) for p in sorted(scenarios.FOLDER.glob("*.bpmn"))]
 
     def matching(self, robots: list[str]) -> StoredModel | None:
         """The first stored model whose pools bind all of ``robots`` (as the splitter would)."""
-        from robotale.fame_runtime.parser import parse
-        from robotale.fame_runtime.splitter import split
-
         for model in self.all():
             try:
                 split(parse(model.path), robots)
@@ -93,7 +89,7 @@ class ModelStore:
         links = self._links()
         links[log] = model_id
         self.folder.mkdir(parents=True, exist_ok=True)
-        _write_atomically(self.folder / _LINKS, json.dumps(links, indent=1).encode())
+        write_file(self.folder / _LINKS, json.dumps(links, indent=1).encode())
 
     def linked(self, log: str) -> StoredModel | None:
         model_id = self._links().get(log)
@@ -107,23 +103,10 @@ class ModelStore:
         return json.loads(path.read_text()) if path.is_file() else {}
 
 
-def _write_atomically(path: Path, data: bytes) -> None:
-    handle, partial = tempfile.mkstemp(dir=path.parent, prefix=".", suffix=".part")
-    try:
-        with os.fdopen(handle, "wb") as out:
-            out.write(data)
-        os.replace(partial, path)
-    except BaseException:
-        Path(partial).unlink(missing_ok=True)
-        raise
-
-
 def attach_model(log: str, model: Path, folder: Path | None = None) -> StoredModel:
     """Remember that the BPMN file ``model`` drove ``log``, for the Model page (scripts and
     ``robotale demo`` call it after storing a log; ``folder`` defaults to the dashboard's)."""
     if folder is None:
-        from robotale.webapp.settings import WebSettings
-
         folder = WebSettings.from_env().model_dir
     store = ModelStore(folder)
     stored = store.add(Path(model).read_bytes(), Path(model).name)

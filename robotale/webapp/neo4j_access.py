@@ -9,36 +9,27 @@ from __future__ import annotations
 
 import threading
 
-from flask import Flask, current_app
 from neo4j import Driver
 
 from robotale.ekg.connection import connect
 
-_KEY = "robotale.neo4j"
 
+class Neo4jAccess:
+    """One app's driver: connected by the first request that needs it, closed with the app."""
 
-class _Holder:
     def __init__(self) -> None:
-        self.lock = threading.Lock()
-        self.driver: Driver | None = None
+        self._lock = threading.Lock()
+        self._driver: Driver | None = None
 
+    def driver(self) -> Driver:
+        """The connected driver (a ``ServerError`` when Neo4j is down)."""
+        with self._lock:
+            if self._driver is None:
+                self._driver = connect()
+            return self._driver
 
-def init_app(app: Flask) -> None:
-    app.extensions[_KEY] = _Holder()
-
-
-def driver() -> Driver:
-    """The connected driver of the current app (a ``ServerError`` when Neo4j is down)."""
-    holder: _Holder = current_app.extensions[_KEY]
-    with holder.lock:
-        if holder.driver is None:
-            holder.driver = connect()
-        return holder.driver
-
-
-def close(app: Flask) -> None:
-    holder: _Holder = app.extensions[_KEY]
-    with holder.lock:
-        if holder.driver is not None:
-            holder.driver.close()
-            holder.driver = None
+    def close(self) -> None:
+        with self._lock:
+            if self._driver is not None:
+                self._driver.close()
+                self._driver = None

@@ -16,17 +16,19 @@ from typing import Any
 
 import pandas as pd
 
+from robotale.discovery.conformance import check_conformance
+from robotale.discovery.instances import activity_instances
 from robotale.errors import InputError, ModelError
 from robotale.eventlog.schema import ACTIVITY, ROBOT
 from robotale.fame_runtime.labels import element_label
 from robotale.fame_runtime.model import Node
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.splitter import split
 
 
 def frequencies(log: pd.DataFrame, model: Path) -> dict[str, dict[str, Any]]:
     """``{element id: {"count": n, "robots": [...]}}``: how often each element's activity
     happened, among the robots its pool binds."""
-    from robotale.discovery.instances import activity_instances
-
     instances = activity_instances(log)
     counts = Counter(
         zip(instances[ROBOT].astype(str), instances[ACTIVITY].astype(str), strict=True)
@@ -43,8 +45,6 @@ def frequencies(log: pd.DataFrame, model: Path) -> dict[str, dict[str, Any]]:
 def deviations(log: pd.DataFrame, model: Path) -> dict[str, Any]:
     """``{"elements": {element id: {"unexpected": n, "missing": m}}, "robots": [...]}``: the
     conformance deviations on the elements of their activity, and the fitness per robot."""
-    from robotale.discovery.conformance import check_conformance
-
     report = check_conformance(log, model)
     found = Counter()
     for row in report.deviations.itertuples(index=False):
@@ -59,9 +59,6 @@ def deviations(log: pd.DataFrame, model: Path) -> dict[str, Any]:
 
 def _bound_nodes(log: pd.DataFrame, model: Path) -> list[tuple[str, Node]]:
     """Every (robot, element) pair of the log's robots and their pools' processes."""
-    from robotale.fame_runtime.parser import parse
-    from robotale.fame_runtime.splitter import split
-
     if ROBOT not in log.columns:
         raise InputError("The log names no robots, so it cannot be compared with a model.")
     robots = sorted(log[ROBOT].dropna().astype(str).unique())

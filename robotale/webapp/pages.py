@@ -14,15 +14,14 @@ from typing import Any
 
 from flask import Flask, request, url_for
 
-from robotale.webapp.neo4j_access import driver
+from robotale.ekg.logs import list_logs
+from robotale.webapp.state import driver
 
 #: how long browsers keep a static file; its URL changes when its content does
 STATIC_MAX_AGE = 365 * 24 * 3600
 
 
 def context(endpoint: str) -> dict[str, Any]:
-    from robotale.ekg.logs import list_logs
-
     return {"active": endpoint, "log": request.args.get("log", ""), "logs": list_logs(driver())}
 
 

@@ -14,7 +14,9 @@ from flask import Flask
 from werkzeug.serving import BaseWSGIServer, make_server
 
 from robotale.errors import ServerError
+from robotale.webapp.app import create_app
 from robotale.webapp.settings import DEFAULT_HOST, DEFAULT_PORT
+from robotale.webapp.state import state
 
 
 class Dashboard:
@@ -23,12 +25,8 @@ class Dashboard:
     def __init__(
         self, app: Flask | None = None, host: str = DEFAULT_HOST, port: int = DEFAULT_PORT
     ):
-        if app is None:
-            from robotale.webapp.app import create_app
-
-            app = create_app()
-        self.app = app
-        self.server = _bind(app, host, port)
+        self.app = app if app is not None else create_app()
+        self.server = _bind(self.app, host, port)
         self._thread: threading.Thread | None = None
 
     @property
@@ -47,9 +45,7 @@ class Dashboard:
         self.server.server_close()
         if self._thread is not None:
             self._thread.join(timeout=10)
-        from robotale.webapp.neo4j_access import close
-
-        close(self.app)
+        state(self.app).neo4j.close()
 
     def __enter__(self) -> Dashboard:
         return self.start()

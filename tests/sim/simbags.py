@@ -10,9 +10,10 @@ from pathlib import Path
 from rosbags.rosbag2 import Reader
 from rosbags.typesys import Stores, get_typestore
 
+from robotale.fame_runtime.manifest import MANIFEST
 from robotale.fame_runtime.tags import register_tag_type
 from robotale.sim.batch import run_into
-from robotale.sim.run import MANIFEST, RunPlan
+from robotale.sim.run import RunPlan
 from robotale.sim.worldspec import World
 
 

@@ -21,9 +21,9 @@ def thesis_rows(thesis_csv) -> list[dict[str, str]]:
 def stored_thesis(neo4j_driver, thesis_csv):
     """The thesis log stored once for this module, as the dashboard stores it."""
     from robotale.ekg.build import build_ekg
+    from robotale.ekg.keys import built_keys
     from robotale.ekg.logs import delete_log
     from robotale.eventlog.readers import read_log
-    from robotale.webapp.ingest import aggregation_keys
 
     name = f"test_discover_{uuid.uuid4().hex[:8]}"
     entities = ["robot", "msg_id"]
@@ -32,7 +32,7 @@ def stored_thesis(neo4j_driver, thesis_csv):
         read_log(thesis_csv),
         name,
         entities=entities,
-        aggregate=aggregation_keys(entities),
+        aggregate=built_keys(entities),
         progress=False,
     )
     yield name

@@ -6,14 +6,13 @@ import hashlib
 from functools import cache
 
 from flask import Blueprint, Response, request
+from plotly.offline import get_plotlyjs
 
 blueprint = Blueprint("assets", __name__)
 
 
 @cache
 def _plotly() -> tuple[bytes, str]:
-    from plotly.offline import get_plotlyjs
-
     script = get_plotlyjs().encode("utf-8")
     return script, hashlib.sha256(script).hexdigest()[:16]
 

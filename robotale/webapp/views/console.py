@@ -4,11 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 
-from flask import Blueprint, current_app, jsonify, render_template, request
+from flask import Blueprint, jsonify, render_template, request
 
 from robotale.errors import InputError
 from robotale.webapp import console, pages
-from robotale.webapp.neo4j_access import driver
+from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("console", __name__)
 
@@ -32,7 +32,7 @@ def run():
     parameters = body.get("parameters") or {}
     if not isinstance(parameters, dict):
         raise InputError('The parameters must be a JSON object, e.g. {"log": "agri"}.')
-    settings = current_app.config["ROBOTALE"]
+    settings = state().settings
     results = console.run_read_only(
         driver(),
         body["query"],

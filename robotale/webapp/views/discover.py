@@ -5,9 +5,11 @@ from __future__ import annotations
 
 from flask import Blueprint, jsonify, render_template, request
 
+from robotale.discovery import LogFilter, discover_dfg
+from robotale.ekg.logs import log_values
 from robotale.webapp import pages
-from robotale.webapp.logdata import class_graph, log_frame, log_info
-from robotale.webapp.neo4j_access import driver
+from robotale.webapp.logdata import log_info
+from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("discover", __name__)
 
@@ -27,15 +29,9 @@ def chosen_log() -> str:
 @blueprint.get("/api/discover/values")
 def values():
     """What the filters and the aggregation selector offer for this log."""
-    from robotale.ekg.connection import database
-    from robotale.ekg.queries import cypher
-
     name = chosen_log()
     info = log_info(driver(), name)
-    records, _, _ = driver().execute_query(
-        cypher("webapp_filter_values"), log=name, database_=database()
-    )
-    found = records[0]
+    found = log_values(driver(), name)
     offered = {key: sorted(str(v) for v in found[key]) for key in FILTERS if found[key]}
     return jsonify(
         filters=offered,
@@ -47,15 +43,13 @@ def values():
 
 @blueprint.get("/api/discover/dfg")
 def dfg():
-    from robotale.discovery import LogFilter, discover_dfg
-
     selection = LogFilter(
         cases=request.args.getlist("case"),
         robots=request.args.getlist("robot"),
         robot_types=request.args.getlist("robot_type"),
         activities=request.args.getlist("activity"),
     )
-    return jsonify(discover_dfg(log_frame(driver(), chosen_log()), selection).to_dict())
+    return jsonify(discover_dfg(state().logs.frame(driver(), chosen_log()), selection).to_dict())
 
 
 @blueprint.get("/api/discover/ekg")
@@ -64,4 +58,4 @@ def ekg():
     of the entity types in ``edges`` (all of the log's when none is named)."""
     key = ["activity", *request.args.getlist("by")]
     edges = request.args.getlist("edges") or None
-    return jsonify(class_graph(driver(), chosen_log(), key, edges))
+    return jsonify(state().logs.class_graph(driver(), chosen_log(), key, edges))

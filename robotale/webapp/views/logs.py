@@ -5,7 +5,6 @@ from __future__ import annotations
 from flask import (
     Blueprint,
     abort,
-    current_app,
     flash,
     jsonify,
     redirect,
@@ -14,31 +13,31 @@ from flask import (
     url_for,
 )
 
+from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
 from robotale.webapp import ingest, pages, uploads
-from robotale.webapp.jobs import jobs
-from robotale.webapp.logdata import forget
-from robotale.webapp.neo4j_access import driver
-from robotale.webapp.views.model import store as model_store
+from robotale.webapp.jobs import Jobs
+from robotale.webapp.settings import WebSettings
+from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("logs", __name__)
-_PENDING = "robotale.pending"
 
 
 def pending_logs() -> ingest.PendingLogs:
-    return current_app.extensions.setdefault(_PENDING, ingest.PendingLogs())
+    return state().pending
 
 
-def settings():
-    return current_app.config["ROBOTALE"]
+def settings() -> WebSettings:
+    return state().settings
+
+
+def jobs() -> Jobs:
+    return state().jobs
 
 
 def stored_logs() -> list[dict]:
-    connected = driver()
-    from robotale.ekg.logs import list_logs
-
-    return list_logs(connected)
+    return list_logs(driver())
 
 
 @blueprint.get("/logs")
@@ -63,7 +62,7 @@ def upload():
     saved = uploads.save(file.stream, file.filename, settings().upload_dir)
     pending = pending_logs().add(saved, mapping)
     limit = settings().upload_limit_mb * 1024 * 1024
-    models = model_store()
+    models = state().models
     job = jobs().submit(
         f"Reading {saved.filename}",
         lambda job: ingest.read_upload(pending, limit, models, job) or {},
@@ -102,10 +101,10 @@ def start_ingest(token: str):
     pending.log = log
     pending_logs().pop(token)
     replace = request.form.get("replace") == "on"
-    connected, models = driver(), model_store()
+    connected, models, logs = driver(), state().models, state().logs
 
     def work(job):
-        return ingest.ingest(connected, pending, name, entities, replace, models, job)
+        return ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
 
     job = jobs().submit(f"Storing {name}", work)
     return redirect(url_for("logs.job_page", job_id=job.id, log=name))
@@ -125,12 +124,9 @@ def job_state(job_id: str):
 
 @blueprint.post("/logs/delete")
 def delete():
-    from robotale.ekg.logs import delete_log
-
     name = request.form.get("name", "")
-    if name not in {log["name"] for log in stored_logs()}:
-        raise InputError(f"There is no log named {name!r}.")
+    require_log(driver(), name, "the Logs page lists those stored")
     delete_log(driver(), name)
-    forget(name)
+    state().logs.forget(name)
     flash(f"Deleted the log {name!r}.", "success")
     return redirect(url_for("logs.page"))

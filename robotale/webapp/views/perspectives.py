@@ -5,9 +5,9 @@ from __future__ import annotations
 
 from flask import Blueprint, abort, jsonify, render_template, request
 
+from robotale import enhancement
 from robotale.webapp import pages
-from robotale.webapp.logdata import log_frame
-from robotale.webapp.neo4j_access import driver
+from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("perspectives", __name__)
 
@@ -27,13 +27,11 @@ def page():
 
 @blueprint.get("/api/perspectives/<name>")
 def perspective(name: str):
-    from robotale import enhancement
-
     if name not in NAMES:
         abort(404, f"There is no {name!r} perspective; there are {', '.join(NAMES)}.")
     make = getattr(enhancement, f"{name}_perspective")
     result = make(
-        log_frame(driver(), request.args.get("log", "")),
+        state().logs.frame(driver(), request.args.get("log", "")),
         activity=request.args.get("activity") or None,
         robot=request.args.get("robot") or None,
     )

@@ -1,3 +1,0 @@
-// How many events of log $log are stored so far: the dashboard's progress while a log is built.
-MATCH (e:Event {log: $log})
-RETURN count(e) AS events

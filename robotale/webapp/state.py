@@ -1,0 +1,55 @@
+"""The dashboard's app-level objects, made once by ``create_app`` and kept in
+``app.extensions``: the settings, the Neo4j driver, the background jobs, the uploads waiting for
+their column choice, the model store and the caches.
+
+Nothing of the kind lives in a module: two apps in one process (the tests, a benchmark) each
+have their own. Views reach the current app's through :func:`state`; work that runs outside a
+request (a job's thread) is handed the objects it needs.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+from flask import Flask, current_app
+from neo4j import Driver
+
+from robotale.webapp.ingest import PendingLogs
+from robotale.webapp.jobs import Jobs
+from robotale.webapp.logdata import Cache, LogData
+from robotale.webapp.model_store import ModelStore
+from robotale.webapp.neo4j_access import Neo4jAccess
+from robotale.webapp.settings import WebSettings
+
+_KEY = "robotale"
+#: conformance results are not small: the last two (frequencies and deviations) are enough
+OVERLAYS_KEPT = 2
+
+
+@dataclass
+class AppState:
+    settings: WebSettings
+    models: ModelStore
+    neo4j: Neo4jAccess = field(default_factory=Neo4jAccess)
+    jobs: Jobs = field(default_factory=Jobs)
+    pending: PendingLogs = field(default_factory=PendingLogs)
+    #: stored logs' DataFrames and class graphs
+    logs: LogData = field(default_factory=LogData)
+    #: the Model page's frequencies and deviations
+    overlays: Cache = field(default_factory=lambda: Cache(OVERLAYS_KEPT))
+
+
+def init_app(app: Flask, settings: WebSettings) -> AppState:
+    """Give ``app`` its objects."""
+    app.extensions[_KEY] = made = AppState(settings, ModelStore(settings.model_dir))
+    return made
+
+
+def state(app: Flask | None = None) -> AppState:
+    """The objects of ``app``, by default of the app handling the current request."""
+    return (app if app is not None else current_app).extensions[_KEY]
+
+
+def driver() -> Driver:
+    """The current app's connected Neo4j driver (a ``ServerError`` when Neo4j is down)."""
+    return state().neo4j.driver()
