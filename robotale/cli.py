@@ -119,7 +119,7 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
     )
     _handled_by(split, "fame.split_command")
 
-    run = sub.add_parser("run", help="run in process on a simulated clock, printing tags")
+    run = sub.add_parser("run", help="run a mission (simulated, or one process per robot)")
     run.add_argument("model", type=Path, help="the .bpmn collaboration")
     run.add_argument("--robots", **robots)
     run.add_argument("--skills", **skills)
@@ -128,7 +128,24 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         "--until",
         type=float,
         metavar="SECONDS",
-        help="stop at this simulated time at the latest (default 3600)",
+        help="stop this many seconds after the start at the latest (default 3600)",
+    )
+    run.add_argument(
+        "--start",
+        metavar="ISO",
+        help="the clock's start, e.g. 2024-05-01T08:00:00Z (default: now)",
+    )
+    run.add_argument(
+        "--bus",
+        choices=("inprocess", "dds"),
+        help="inprocess (default): one process, simulated clock; dds: one process per robot "
+        "over Cyclone DDS (ROS 2 topics) on the wall clock",
+    )
+    run.add_argument(
+        "--record",
+        type=Path,
+        metavar="DIR",
+        help="with --bus dds: record the tags and signals into this rosbag2 folder",
     )
     run.add_argument(
         "--latency",

@@ -17,7 +17,7 @@ from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Node, Process
 from robotale.fame_runtime.plan import problems
-from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, incompatibilities
+from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, pair_problems
 
 
 @dataclass(frozen=True, slots=True)
@@ -118,13 +118,7 @@ def _endpoint(pool: str, process: Process, node: Node) -> Endpoint:
 
 
 def _reasons(publisher: Endpoint, subscriber: Endpoint) -> list[str]:
-    reasons = incompatibilities(publisher.qos, subscriber.qos)
-    if publisher.msgtype and subscriber.msgtype and publisher.msgtype != subscriber.msgtype:
-        reasons.append(
-            f"type: the publisher sends {publisher.msgtype}, the subscriber expects "
-            f"{subscriber.msgtype}"
-        )
-    return reasons
+    return pair_problems(publisher.qos, subscriber.qos, publisher.msgtype, subscriber.msgtype)
 
 
 def _lonely(topic: str, publishers: list[Endpoint], subscribers: list[Endpoint]) -> list[str]:
