@@ -67,19 +67,12 @@ def check(
 ) -> Report:
     """Structure (what the engine would refuse) and QoS compatibility of a collaboration."""
     report = Report(str(definitions.file))
-    publishers: dict[str, list[Endpoint]] = defaultdict(list)
-    subscribers: dict[str, list[Endpoint]] = defaultdict(list)
     for pool, process in definitions.pools():
         report.pools.append(pool.name + (" (multi-instance)" if pool.multi_instance else ""))
         report.problems += [
             f"{pool.name}: {p}" for p in problems(process, skills=skills, library=library)
         ]
-        for node, owner in _signal_events(process, skills, library):
-            endpoint = _endpoint(pool.name, owner, node)
-            if node.kind in THROWING:
-                publishers[endpoint.topic].append(endpoint)
-            elif catches(node):
-                subscribers[endpoint.topic].append(endpoint)
+    publishers, subscribers = endpoints(definitions, skills=skills, library=library)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [
             Pairing(pub, sub, tuple(_reasons(pub, sub)))
@@ -88,6 +81,23 @@ def check(
         ]
         report.notes += _lonely(topic, publishers[topic], subscribers[topic])
     return report
+
+
+def endpoints(
+    definitions: Definitions, *, skills: Collection[str] = (), library: Library | None = None
+) -> tuple[dict[str, list[Endpoint]], dict[str, list[Endpoint]]]:
+    """Every pool's signal publishers and subscribers (building blocks included), by topic:
+    what a DDS participant declares before its robot starts."""
+    publishers: dict[str, list[Endpoint]] = defaultdict(list)
+    subscribers: dict[str, list[Endpoint]] = defaultdict(list)
+    for pool, process in definitions.pools():
+        for node, owner in _signal_events(process, skills, library):
+            endpoint = _endpoint(pool.name, owner, node)
+            if node.kind in THROWING:
+                publishers[endpoint.topic].append(endpoint)
+            elif catches(node):
+                subscribers[endpoint.topic].append(endpoint)
+    return publishers, subscribers
 
 
 def _signal_events(process: Process, skills: Collection[str], library: Library | None):
