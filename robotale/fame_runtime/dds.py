@@ -66,6 +66,8 @@ def dds_qos(qos: QoS, *, userdata: str = "") -> Any:
         else Policy.History.KeepAll,
         Policy.DataRepresentation(use_cdrv0_representation=True),  # plain CDR, as ROS 2 sends
     ]
+    if qos.durability == "transient_local":  # what late joiners get: the same history
+        policies.append(Policy.DurabilityService(0, policies[2], -1, -1, -1))
     if qos.deadline is not None:
         policies.append(Policy.Deadline(duration(seconds=qos.deadline)))
     if qos.lifespan is not None:
@@ -104,17 +106,19 @@ class _Reader:
             on_data_available=self._arrived,
             on_requested_incompatible_qos=self._incompatible,
         )
-        self.reader = DataReader(
-            bus.participant, bus.topic(topic, msgtype), qos=dds_qos(qos), listener=listener
-        )
+        # the listener is set once the reader exists: history that arrives while it is made
+        # would reach a listener with no reader to take from; it is taken just after
+        self.reader = DataReader(bus.participant, bus.topic(topic, msgtype), qos=dds_qos(qos))
+        self.reader.set_listener(listener)
+        self._arrived(self.reader)
 
-    def _arrived(self, reader) -> None:
+    def _arrived(self, _reader=None) -> None:
         # a Cyclone thread: take the samples, hand them to the clock's thread
-        for sample in reader.take(N=256):
+        for sample in self.reader.take(N=256):
             info = sample.sample_info
             if not info.valid_data:
                 continue
-            envelope = self.bus.envelope(self.topic, self.msgtype, sample, info)
+            envelope = self.bus.envelope(self.reader, self.topic, self.msgtype, sample, info)
             self.bus.hand_over(lambda envelope=envelope: self.dispatch(envelope))
 
     def dispatch(self, envelope: Envelope) -> None:
@@ -194,6 +198,12 @@ class DdsBus:
             self._readers[key] = _Reader(self, topic, msgtype, qos)
         return self._readers[key]
 
+    def raw_reader(self, topic: str, msgtype: str, qos: QoS) -> Any:
+        """A plain DDS reader (no listener) for what the caller polls itself."""
+        from cyclonedds.sub import DataReader
+
+        return DataReader(self.participant, self.topic(topic, msgtype), qos=dds_qos(qos))
+
     def matched(self) -> list[tuple[str, int]]:
         """(topic, matched remote endpoints) of every writer and reader made so far."""
         counts = [
@@ -268,9 +278,9 @@ class DdsBus:
 
         self.clock.call_soon(run)
 
-    def envelope(self, topic: str, msgtype: str, sample: Any, info: Any) -> Envelope:
+    def envelope(self, reader: Any, topic: str, msgtype: str, sample: Any, info: Any) -> Envelope:
         """A received sample with its sender and message id, stamped on arrival."""
-        sender, ids = self._sender(info.publication_handle)
+        sender, ids = self._sender(reader, info.publication_handle)
         stamp = info.source_timestamp
         msg_id = f"m_{ids}_{stamp}" if ids else f"m_{info.publication_handle:x}_{stamp}"
         qos = DEFAULT_QOS
@@ -278,15 +288,13 @@ class DdsBus:
             topic, to_data(sample, msgtype), msgtype, self.clock.now(), sender, msg_id, qos
         )
 
-    def _sender(self, handle: int) -> tuple[str, str]:
+    def _sender(self, reader: Any, handle: int) -> tuple[str, str]:
         """(sender, id space) from a robotale writer's user data; ("", "") for others."""
         if handle not in self._senders:
-            self._senders[handle] = ("", "")
-            for reader in self._readers.values():
-                found = reader.reader.get_matched_publication_data(handle)
-                if found is not None:
-                    self._senders[handle] = _parse_userdata(found.qos)
-                    break
+            found = reader.get_matched_publication_data(handle)
+            if found is None:
+                return "", ""  # not matched (any more): ask again next time
+            self._senders[handle] = _parse_userdata(found.qos)
         return self._senders[handle]
 
     def warn(self, text: str) -> None:
