@@ -170,7 +170,8 @@ def run_processes(
             relay.join(timeout=5)
         if recording is not None:
             recording.close(err)
-    codes = [c.returncode for c in children]
+    # a child ended by a signal has a negative code: the shell's 128 + signal instead
+    codes = [c.returncode if c.returncode >= 0 else 128 - c.returncode for c in children]
     return next((code for code in codes if code), 0)
 
 
