@@ -33,6 +33,7 @@ def build_parser() -> argparse.ArgumentParser:
     commands.required = True
     # One line per command group, in the order of the data flow (see DESIGN.md).
     _add_fame(commands)
+    _add_record(commands)
     _add_simulate(commands)
     _add_prepare(commands)
     _add_neo4j(commands)
@@ -126,7 +127,7 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
     )
     _handled_by(split, "fame.split_command")
 
-    run = sub.add_parser("run", help="run in process on a simulated clock, printing tags")
+    run = sub.add_parser("run", help="run a mission (simulated, or one process per robot)")
     run.add_argument("model", type=Path, help="the .bpmn collaboration")
     run.add_argument("--robots", **robots)
     run.add_argument("--skills", **skills)
@@ -135,7 +136,24 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         "--until",
         type=float,
         metavar="SECONDS",
-        help="stop at this simulated time at the latest (default 3600)",
+        help="stop this many seconds after the start at the latest (default 3600)",
+    )
+    run.add_argument(
+        "--start",
+        metavar="ISO",
+        help="the clock's start, e.g. 2024-05-01T08:00:00Z (default: now)",
+    )
+    run.add_argument(
+        "--bus",
+        choices=("inprocess", "dds"),
+        help="inprocess (default): one process, simulated clock; dds: one process per robot "
+        "over Cyclone DDS (ROS 2 topics) on the wall clock",
+    )
+    run.add_argument(
+        "--record",
+        type=Path,
+        metavar="DIR",
+        help="with --bus dds: record the tags and signals into this rosbag2 folder",
     )
     run.add_argument(
         "--latency",
@@ -151,6 +169,59 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         help="an initial variable, e.g. drone.delay=10 (repeatable)",
     )
     _handled_by(run, "fame.run_command")
+
+    node = sub.add_parser(
+        "node",
+        help="run one robot's engine in this process over DDS (on that robot's machine)",
+        description="One robot's engine on Cyclone DDS (ROS_DOMAIN_ID, CYCLONEDDS_URI): it "
+        "waits for the mission's other robots, runs until every robot is idle, publishes its "
+        "tags on /<robot>/tag. Ctrl-C runs the robot's safe-state handler first.",
+    )
+    node.add_argument("model", type=Path, help="the .bpmn collaboration")
+    node.add_argument("--robot", required=True, help="the robot this process runs")
+    node.add_argument("--robots", **robots)
+    node.add_argument("--skills", **skills)
+    node.add_argument("--library", **library)
+    node.add_argument(
+        "--until", type=float, metavar="SECONDS", help="stop this long after the start (3600)"
+    )
+    node.add_argument("--start", metavar="ISO", help="the clock's start (default: now)")
+    node.add_argument(
+        "--wait", type=float, metavar="SECONDS", help="how long to wait for the others (30)"
+    )
+    node.add_argument(
+        "--set",
+        dest="assignments",
+        action="append",
+        metavar="ROBOT.NAME=VALUE",
+        help="an initial variable (repeatable)",
+    )
+    # set by `fame run --bus dds` for the processes it starts
+    node.add_argument("--clock-offset", type=float, help=argparse.SUPPRESS)
+    node.add_argument("--origin", type=float, help=argparse.SUPPRESS)
+    node.add_argument(
+        "--wait-for-recorder",
+        dest="recorder",
+        action="store_const",
+        const=True,
+        help=argparse.SUPPRESS,
+    )
+    _handled_by(node, "fame_dds.node_command")
+
+
+def _add_record(commands: argparse._SubParsersAction) -> None:
+    record = commands.add_parser(
+        "record",
+        help="record live ROS 2 topics (tags, signals, odometry ...) into a rosbag2",
+        description="Record every topic with a ROS 2 type robotale knows on the DDS domain "
+        "(ROS_DOMAIN_ID) into a rosbag2 folder until Ctrl-C or --duration.",
+    )
+    record.add_argument("out_dir", type=Path, metavar="DIR", help="the bag folder to create")
+    record.add_argument(
+        "--robots", required=True, help="the robots' namespaces, e.g. drone,tractor_1"
+    )
+    record.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
+    _handled_by(record, "fame_dds.record_command")
 
 
 def _add_prepare(commands: argparse._SubParsersAction) -> None:

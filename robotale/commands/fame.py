@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import json
 import sys
+import time
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
@@ -18,6 +19,7 @@ from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split, unbound_pools, write_split
 from robotale.fame_runtime.tags import Tag
+from robotale.fame_runtime.timers import parse_date
 
 
 def robot_list(text: str | None) -> list[str] | None:
@@ -114,38 +116,93 @@ def run_command(
     until: float = 3600.0,
     latency: float = 0.0,
     assignments: Sequence[str] = (),
+    start: str | None = None,
+    bus: str = "inprocess",
+    record: Path | None = None,
     out: TextIO | None = None,
     err: TextIO | None = None,
 ) -> int:
-    """Run the mission on the in-process bus and a simulated clock, printing every tag as it
-    happens; 1 when a BPMN error went uncaught."""
+    """Run the mission, printing every tag as it happens (seconds since the start): on the
+    in-process bus and a simulated clock, or (``bus="dds"``) one process per robot over DDS
+    on the wall clock. 1 when a BPMN error went uncaught or robots were still working at
+    ``until`` seconds."""
     out, err = out or sys.stdout, err or sys.stderr
+    if bus == "dds":
+        from robotale.commands.fame_dds import run_processes
+
+        return run_processes(
+            model,
+            robots=robots,
+            skills=skills,
+            library=library,
+            until=until,
+            assignments=assignments,
+            start=start,
+            record=record,
+            out=out,
+            err=err,
+        )
+    if bus != "inprocess" or record is not None:
+        raise InputError(_bus_problem(bus, record))
     definitions = parse(model)
-    clock = SimClock()
+    begin = start_time(start)
+    clock = SimClock(start=begin)
     mission = Mission(
         definitions,
         robots=robot_list(robots),
         clock=clock,
-        bus=InProcessBus(clock, latency=latency),
+        bus=InProcessBus(
+            clock, latency=latency, on_warning=lambda text: print(f"# warning: {text}", file=err)
+        ),
         skills=load_skills(skills) if skills else None,
         library=library,
-        tag_sink=lambda tag: print(tag_line(tag), file=out),
+        tag_sink=lambda tag: print(tag_line(tag, begin), file=out),
         variables=parse_assignments(assignments),
     )
     for warning in definitions.warnings:  # as fame check prints them, before anything runs
         print(f"# warning: {warning}", file=err)
-    reached = mission.run(until=until)
-    state = "done" if mission.done else "still running"
+    mission.run(until=begin + until)
+    return run_verdict(mission, begin, err)
+
+
+def _bus_problem(bus: str, record: Path | None) -> str:
+    if bus != "inprocess":
+        return f"--bus {bus!r} is not one of inprocess, dds"
+    return "--record needs --bus dds (a simulation records with robotale simulate)"
+
+
+def start_time(text: str | None) -> float:
+    """The clock's start: now, or an ISO 8601 date-time (``timeDate`` timers fire on it)."""
+    if text is None:
+        return time.time()
+    try:
+        return parse_date(text)
+    except ValueError as error:
+        raise InputError(f"--start: {error}") from None
+
+
+def run_verdict(mission: Mission, begin: float, err: TextIO) -> int:
+    """Say how the run ended; 1 when an error went uncaught or robots are still working."""
+    reached = mission.clock.now() - begin
+    if mission.done:
+        state = "done"
+    elif mission.idle:
+        state = "waiting for a timer"
+    else:
+        state = "still running"
     counts = ", ".join(f"{r} {e.completed}" for r, e in mission.engines.items())
     print(f"# {state} at {reached:.3f} s; instances completed: {counts}", file=err)
+    for place in mission.whereabouts():
+        print(f"# {place}", file=err)
     for failure in mission.failures:
         print(f"# {failure}", file=err)
-    return 1 if mission.failures else 0
+    return 1 if mission.failures or not mission.idle else 0
 
 
-def tag_line(tag: Tag) -> str:
+def tag_line(tag: Tag, begin: float = 0.0) -> str:
+    """A tag as one tab-separated line, its stamp in seconds since ``begin``."""
     fields = (
-        f"{tag.stamp:10.3f}",
+        f"{tag.stamp - begin:10.3f}",
         tag.robot,
         tag.activity,
         tag.lifecycle,

@@ -2,20 +2,31 @@
 
 A :class:`Bus` carries :class:`Envelope` s from publishers to the subscribers of a topic. The
 in-process bus delivers through the shared clock, never inside ``publish``: a throw in one
-engine cannot re-enter another engine's step, and delivery order is deterministic. A DDS bus,
-where each robot's engine is its own process, implements the same interface.
+engine cannot re-enter another engine's step, and delivery order is deterministic. A DDS bus
+(:mod:`robotale.fame_runtime.dds`), where each robot's engine is its own process, implements
+the same interface.
+
+Both honour the QoS the way DDS does, so a simulation cannot succeed where ROS 2 would not:
+a publisher and a subscriber whose QoS or message types do not match
+(:func:`~robotale.fame_runtime.qos.pair_problems`, the rules ``fame check`` applies) never
+talk; a transient-local publisher keeps its last ``depth`` messages for subscribers that
+come later and ask for them; only best-effort deliveries are lost at random (``loss``).
 """
 
 from __future__ import annotations
 
 import itertools
-from collections import defaultdict
+import logging
+import random
+from collections import defaultdict, deque
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from robotale.fame_runtime.clock import Clock
-from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
+from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, pair_problems
+
+_log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True, slots=True)
@@ -80,17 +91,62 @@ class Bus(Protocol):
 #: decides whether one delivery is lost (fault injection: a dropped message).
 DropRule = Callable[[Envelope, Subscription], bool]
 
+#: a publisher as DDS sees it: one data writer per topic, sender, QoS and message type
+WriterKey = tuple[str, str, QoS, str]
+
+
+def reader_key(subscription: Subscription) -> tuple:
+    """A subscription as DDS sees it: a re-armed catch event is the same reader again."""
+    return (subscription.topic, subscription.owner, subscription.qos, subscription.msgtype)
+
+
+def mismatch_warning(envelope: Envelope, subscription: Subscription, reasons: list[str]) -> str:
+    """The one sentence a run prints for a publisher and subscriber that never talk."""
+    sender = envelope.sender or "a publisher"
+    owner = subscription.owner or "a subscriber"
+    return (
+        f"{envelope.topic}: {sender} and {owner} cannot talk, so nothing {sender} publishes "
+        f"there reaches {owner} ({'; '.join(reasons)})"
+    )
+
+
+def best_effort(offered: QoS, requested: QoS) -> bool:
+    """Whether a delivery goes without acknowledgement (either side best effort)."""
+    return "best_effort" in (offered.reliability, requested.reliability)
+
 
 class InProcessBus:
-    """Topics inside one process, delivered through the clock after ``latency`` seconds."""
+    """Topics inside one process, delivered through the clock after ``latency`` seconds.
 
-    def __init__(self, clock: Clock, *, latency: float = 0.0, drop: DropRule | None = None):
+    ``drop`` loses chosen deliveries (fault injection: a link that is down); ``loss`` is the
+    probability that a best-effort delivery is lost (reliable ones are resent by DDS, so they
+    always arrive). ``on_warning`` receives the sentence about each pair that cannot talk,
+    once per pair (default: the ``logging`` warning); ``warnings`` keeps them all.
+    """
+
+    def __init__(
+        self,
+        clock: Clock,
+        *,
+        latency: float = 0.0,
+        drop: DropRule | None = None,
+        loss: float = 0.0,
+        seed: int | None = None,
+        on_warning: Callable[[str], None] | None = None,
+    ):
         self.clock = clock
         self.latency = latency
         self.drop = drop
+        self.loss = loss
+        self._random = random.Random(seed)
+        self.on_warning = on_warning or _log.warning
+        self.warnings: list[str] = []
+        self._warned: set[tuple] = set()
         self._subscribers: dict[str, list[Subscription]] = defaultdict(list)
         self._taps: list[Subscription] = []
         self._ids = itertools.count(1)
+        #: what each transient-local publisher keeps for subscribers that come later
+        self._kept: dict[WriterKey, deque[Envelope]] = {}
         #: deliveries scheduled on the clock but not made yet (a mission is not over while
         #: a message is in flight)
         self.pending = 0
@@ -105,17 +161,75 @@ class InProcessBus:
         )
         for tap in list(self._taps):
             tap.callback(envelope)
+        self._keep(envelope)
         for subscription in list(self._subscribers.get(topic, ())):
+            if not self._talk(envelope, subscription):
+                continue
             if self.drop and self.drop(envelope, subscription):
                 continue
-            self.pending += 1
-            self.clock.call_later(self.latency, self._delivery(subscription, envelope))
+            if self._lost(envelope, subscription):
+                continue
+            self._send(subscription, envelope)
         return envelope
 
     def subscribe(self, topic, callback, *, msgtype=None, qos=None, owner="") -> Subscription:
         subscription = Subscription(topic, callback, msgtype, qos or DEFAULT_QOS, owner, _bus=self)
         self._subscribers[topic].append(subscription)
+        if subscription.qos.durability == "transient_local":
+            self._late_join(subscription)
         return subscription
+
+    def _send(self, subscription: Subscription, envelope: Envelope) -> None:
+        self.pending += 1
+        self.clock.call_later(self.latency, self._delivery(subscription, envelope))
+
+    def _talk(self, envelope: Envelope, subscription: Subscription) -> bool:
+        """Whether the envelope's publisher is matched with the subscriber (warn once if not)."""
+        reasons = pair_problems(
+            envelope.qos, subscription.qos, envelope.msgtype, subscription.msgtype
+        )
+        if not reasons:
+            return True
+        pair = (
+            envelope.topic,
+            envelope.sender,
+            envelope.qos,
+            envelope.msgtype,
+            reader_key(subscription),
+        )
+        if pair not in self._warned:
+            self._warned.add(pair)
+            warning = mismatch_warning(envelope, subscription, reasons)
+            self.warnings.append(warning)
+            self.on_warning(warning)
+        return False
+
+    def _lost(self, envelope: Envelope, subscription: Subscription) -> bool:
+        if not self.loss or not best_effort(envelope.qos, subscription.qos):
+            return False
+        return self._random.random() < self.loss
+
+    def _keep(self, envelope: Envelope) -> None:
+        """A transient-local publisher keeps its last ``depth`` messages (all: keep_all)."""
+        qos = envelope.qos
+        if qos.durability != "transient_local":
+            return
+        key = (envelope.topic, envelope.sender, qos, envelope.msgtype)
+        if key not in self._kept:
+            self._kept[key] = deque(maxlen=qos.depth if qos.history == "keep_last" else None)
+        self._kept[key].append(envelope)
+
+    def _late_join(self, subscription: Subscription) -> None:
+        """A transient-local subscriber gets what matched transient-local publishers kept
+        (its own ``depth`` last of them), as a DDS reader gets the writers' history."""
+        for (topic, *_), kept in self._kept.items():
+            if topic != subscription.topic or not kept or not self._talk(kept[0], subscription):
+                continue
+            samples = list(kept)
+            if subscription.qos.history == "keep_last":
+                samples = samples[-subscription.qos.depth :]
+            for envelope in samples:
+                self._send(subscription, envelope)
 
     def tap(self, callback) -> Subscription:
         """See every envelope at publish time (a recorder); taps are never dropped."""

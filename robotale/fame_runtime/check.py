@@ -17,7 +17,7 @@ from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Node, Process
 from robotale.fame_runtime.plan import problems
-from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, incompatibilities
+from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, pair_problems
 
 
 @dataclass(frozen=True, slots=True)
@@ -68,19 +68,12 @@ def check(
 ) -> Report:
     """Structure (what the engine would refuse) and QoS compatibility of a collaboration."""
     report = Report(str(definitions.file), warnings=list(definitions.warnings))
-    publishers: dict[str, list[Endpoint]] = defaultdict(list)
-    subscribers: dict[str, list[Endpoint]] = defaultdict(list)
     for pool, process in definitions.pools():
         report.pools.append(pool.name + (" (multi-instance)" if pool.multi_instance else ""))
         report.problems += [
             f"{pool.name}: {p}" for p in problems(process, skills=skills, library=library)
         ]
-        for node, owner in _signal_events(process, skills, library):
-            endpoint = _endpoint(pool.name, owner, node)
-            if node.kind in THROWING:
-                publishers[endpoint.topic].append(endpoint)
-            elif catches(node):
-                subscribers[endpoint.topic].append(endpoint)
+    publishers, subscribers = endpoints(definitions, skills=skills, library=library)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [
             Pairing(pub, sub, tuple(_reasons(pub, sub)))
@@ -89,6 +82,23 @@ def check(
         ]
         report.notes += _lonely(topic, publishers[topic], subscribers[topic])
     return report
+
+
+def endpoints(
+    definitions: Definitions, *, skills: Collection[str] = (), library: Library | None = None
+) -> tuple[dict[str, list[Endpoint]], dict[str, list[Endpoint]]]:
+    """Every pool's signal publishers and subscribers (building blocks included), by topic:
+    what a DDS participant declares before its robot starts."""
+    publishers: dict[str, list[Endpoint]] = defaultdict(list)
+    subscribers: dict[str, list[Endpoint]] = defaultdict(list)
+    for pool, process in definitions.pools():
+        for node, owner in _signal_events(process, skills, library):
+            endpoint = _endpoint(pool.name, owner, node)
+            if node.kind in THROWING:
+                publishers[endpoint.topic].append(endpoint)
+            elif catches(node):
+                subscribers[endpoint.topic].append(endpoint)
+    return publishers, subscribers
 
 
 def _signal_events(process: Process, skills: Collection[str], library: Library | None):
@@ -119,13 +129,7 @@ def _endpoint(pool: str, process: Process, node: Node) -> Endpoint:
 
 
 def _reasons(publisher: Endpoint, subscriber: Endpoint) -> list[str]:
-    reasons = incompatibilities(publisher.qos, subscriber.qos)
-    if publisher.msgtype and subscriber.msgtype and publisher.msgtype != subscriber.msgtype:
-        reasons.append(
-            f"type: the publisher sends {publisher.msgtype}, the subscriber expects "
-            f"{subscriber.msgtype}"
-        )
-    return reasons
+    return pair_problems(publisher.qos, subscriber.qos, publisher.msgtype, subscriber.msgtype)
 
 
 def _lonely(topic: str, publishers: list[Endpoint], subscribers: list[Endpoint]) -> list[str]:

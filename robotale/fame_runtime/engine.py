@@ -163,6 +163,25 @@ class Engine:
         """Nothing runs and nothing can start an instance any more."""
         return self.started and self.idle and (self.stopped or not self._start_disarms)
 
+    @property
+    def next_timer(self) -> float | None:
+        """When the next armed timer fires (a timer start event included), or None."""
+        return self.triggers.next_timer()
+
+    def where(self) -> list[str]:
+        """The elements where this robot's tokens are, innermost scopes included (what a
+        run that stops early reports)."""
+        places: list[str] = []
+        scopes = list(self._roots)
+        while scopes:
+            scope = scopes.pop(0)
+            for token in sorted(scope.tokens, key=lambda t: t.node.id):
+                node = token.node.node
+                places.append(f"{node.kind} {node.describe()}")
+                if token.child is not None:
+                    scopes.append(token.child)
+        return places
+
     def start(self) -> None:
         """Arm the start events; an instance for the none start events begins at the clock's
         next step (so every engine of a mission subscribes before anyone throws)."""

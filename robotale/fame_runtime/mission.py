@@ -68,9 +68,23 @@ class Mission:
 
     @property
     def done(self) -> bool:
+        """No robot runs an instance or is about to, no message is in flight and no timer
+        is armed (a timer start event will start an instance)."""
+        return self.idle and all(e.next_timer is None for e in self.engines.values())
+
+    @property
+    def idle(self) -> bool:
         """No robot runs an instance or is about to, and no message is in flight."""
         idle = all(engine.idle for engine in self.engines.values())
         return idle and not getattr(self.bus, "pending", 0)
+
+    def whereabouts(self) -> list[str]:
+        """One line per robot with a running instance: where its tokens are."""
+        return [
+            f"{robot} is at {', '.join(engine.where()) or 'the start of an instance'}"
+            for robot, engine in self.engines.items()
+            if not engine.idle
+        ]
 
     def run(self, until: float | None = None) -> float:
         """Start (if needed) and run the simulated clock until the mission is done or

@@ -125,6 +125,20 @@ def incompatibilities(offered: QoS, requested: QoS) -> list[str]:
     return reasons
 
 
+def pair_problems(
+    offered: QoS, requested: QoS, published_type: str | None, expected_type: str | None
+) -> list[str]:
+    """Why a publisher (its QoS and message type) and a subscriber cannot talk: the QoS rules
+    above, and a message type that differs on the two sides (DDS matches only same-typed
+    endpoints). An unknown type (None or empty) matches any."""
+    reasons = incompatibilities(offered, requested)
+    if published_type and expected_type and published_type != expected_type:
+        reasons.append(
+            f"type: the publisher sends {published_type}, the subscriber expects {expected_type}"
+        )
+    return reasons
+
+
 def _longer(offered: float | None, requested: float | None) -> bool:
     """Whether an offered period is longer than the requested one (None is infinite)."""
     if requested is None:

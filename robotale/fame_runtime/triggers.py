@@ -76,6 +76,12 @@ class Triggers:
         self._catchers: dict[str, list[_Catcher]] = defaultdict(list)
         self._error_topics: dict[str, Subscription] = {}
         self._order = itertools.count()
+        #: when each armed timer fires next (a mission is not over while one is armed)
+        self._timers: dict[int, float] = {}
+
+    def next_timer(self) -> float | None:
+        """When the next armed timer fires, or None when no timer is armed."""
+        return min(self._timers.values(), default=None)
 
     def arm(
         self, trigger: Trigger, fire: Fire, *, repeat: bool = False, depth: float = 0
@@ -113,18 +119,22 @@ class Triggers:
                 raise ModelError(f"timer {trigger.label} of robot {self.robot}: {error}") from None
         times = spec.fire_times(self.clock.now())
         pending: list = []
+        key = next(self._order)
 
         def schedule_next() -> None:
             when = next(times, None)
             if when is not None:
                 pending[:] = [self.clock.call_at(when, ring)]
+                self._timers[key] = when
 
         def ring() -> None:
+            self._timers.pop(key, None)
             if repeat:
                 schedule_next()
             self.schedule(lambda: fire(None))
 
         def disarm() -> None:
+            self._timers.pop(key, None)
             for timer in pending:
                 timer.cancel()
 

@@ -100,6 +100,9 @@ def test_run_prints_every_tag_with_skills_from_a_file(models, capsys):
             "rover.home_y=0",
             "--set",
             "rover.top_speed=2.5",
+            # the skill reports its arrival as clock time; the model expects 5.0
+            "--start",
+            "1970-01-01T00:00:00Z",
         ]
     )
     captured = capsys.readouterr()
@@ -152,6 +155,9 @@ def test_run_imports_a_skills_module_from_the_current_folder(models, capsys, mon
             "rover.home_y=0",
             "--set",
             "rover.top_speed=2.5",
+            # the skill reports its arrival as clock time; the model expects 5.0
+            "--start",
+            "1970-01-01T00:00:00Z",
         ]
     )
     assert code == 0 and capsys.readouterr().out.splitlines()[-1].endswith("celebrate\tcomplete")

@@ -1,0 +1,208 @@
+"""robotale on real Cyclone DDS, pinned to the loopback interface, on a domain of its own:
+two engine processes run the agri mission into one bag, plain DDS code that knows only the
+ROS 2 names talks to robotale, and DDS itself keeps QoS-incompatible pairs apart."""
+
+import os
+import time
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import pytest
+
+cyclonedds = pytest.importorskip("cyclonedds")
+
+from cyclonedds.domain import DomainParticipant  # noqa: E402
+from cyclonedds.idl import IdlStruct  # noqa: E402
+from cyclonedds.pub import DataWriter  # noqa: E402
+from cyclonedds.sub import DataReader  # noqa: E402
+from cyclonedds.topic import Topic  # noqa: E402
+from fame_suite import MODELS  # noqa: E402
+
+from robotale.cli import main  # noqa: E402
+from robotale.fame_runtime.clock import WallClock  # noqa: E402
+from robotale.fame_runtime.dds import DdsBus  # noqa: E402
+from robotale.fame_runtime.engine import Engine  # noqa: E402
+from robotale.fame_runtime.parser import parse  # noqa: E402
+from robotale.fame_runtime.qos import DEFAULT_QOS  # noqa: E402
+
+pytestmark = pytest.mark.timeout(180)
+
+AGRI = Path(__file__).resolve().parents[2] / "robotale" / "sim" / "scenarios" / "agri.bpmn"
+POINT = "geometry_msgs/msg/Point"
+LOOPBACK = """<CycloneDDS><Domain><General><Interfaces>
+<NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast>
+</General><Discovery><ParticipantIndex>auto</ParticipantIndex>
+<MaxAutoParticipantIndex>100</MaxAutoParticipantIndex>
+<Peers><Peer address="127.0.0.1"/></Peers></Discovery></Domain></CycloneDDS>"""
+
+
+@pytest.fixture(autouse=True)
+def loopback_domain(tmp_path_factory, monkeypatch) -> int:
+    """Cyclone on 127.0.0.1 only, on a domain no other test run shares (the pid decides)."""
+    config = tmp_path_factory.mktemp("dds") / "cyclonedds.xml"
+    config.write_text(LOOPBACK)
+    domain = 1 + os.getpid() % 200
+    monkeypatch.setenv("CYCLONEDDS_URI", config.as_uri())
+    monkeypatch.setenv("ROS_DOMAIN_ID", str(domain))
+    return domain
+
+
+@dataclass
+class String_(IdlStruct, typename="std_msgs::msg::dds_::String_"):
+    """std_msgs/msg/String as a ROS 2 node declares it, written here by hand."""
+
+    data: str
+
+
+def wait_until(condition, clock: WallClock, seconds: float = 10.0) -> None:
+    clock.run(until=clock.now() + seconds, stop_when=condition)
+
+
+def matched(endpoint, seconds: float = 10.0) -> None:
+    """Wait for DDS discovery to match ``endpoint`` with a peer."""
+    status = getattr(endpoint, "get_publication_matched_status", None) or (
+        endpoint.get_subscription_matched_status
+    )
+    deadline = time.monotonic() + seconds
+    while status().current_count == 0 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert status().current_count > 0, "discovery did not match the endpoint"
+
+
+def test_two_engine_processes_run_agri_into_one_bag_whose_comm_edges_match(tmp_path, capsys):
+    from robotale.commands.prepare import prepare_recordings
+    from robotale.ekg.tables import graph_tables
+
+    bag = tmp_path / "run"
+    skills = str(MODELS / "agri_skills.py")
+    robots = "drone,tractor_1"
+    args = ["fame", "run", str(AGRI), "--robots", robots, "--skills", skills]
+    assert main([*args, "--bus", "dds", "--record", str(bag), "--until", "60"]) == 0
+    live = capsys.readouterr()
+    assert "# drone: done" in live.err and "# tractor_1: done" in live.err
+    # the same mission in one process: the robots do the same things in the same order
+    assert main(args) == 0
+    simulated = capsys.readouterr().out
+    for robot in robots.split(","):
+        assert activities(live.out, robot) == activities(simulated, robot)
+
+    # what the nodes printed, message by message: the send's robot and the receive's
+    sent = {r[4]: r[1] for r in rows(live.out) if r[5:6] == ["send"]}
+    received = [(r[4], r[1]) for r in rows(live.out) if r[5:6] == ["receive"]]
+    assert len(received) >= 4  # weed_position, tractor_position, closest_tractor, field_cleaned
+    # weed_found comes from the Explore skill, not from a throw: it has no send tag
+    assert {m for m, _ in received if m not in sent} == {
+        r[4] for r in rows(live.out) if r[2] == "weed_found?"
+    }
+    expected = sorted({(sent[m], receiver, m) for m, receiver in received if m in sent})
+
+    log = prepare_recordings(bag)
+    assert set(log["robot"]) == {"drone", "tractor_1"}
+    tables = graph_tables(log, ["robot"])
+    robot_of = tables.events["robot"]
+    comm = sorted(
+        {(robot_of[s], robot_of[t], m) for s, t, m in tables.comm.itertuples(index=False)}
+    )
+    assert comm == expected
+
+
+def rows(text: str) -> list[list[str]]:
+    return [line.split("\t") for line in text.splitlines() if "\t" in line]
+
+
+def activities(text: str, robot: str) -> list[tuple[str, str]]:
+    return sorted((r[2], r[3]) for r in rows(text) if r[1] == robot)
+
+
+def test_a_plain_ros2_style_reader_receives_a_robotale_signal():
+    participant = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    reader = DataReader(participant, Topic(participant, "rt/chatter", String_))
+    clock = WallClock()
+    bus = DdsBus(clock, node="talker")
+    writer = bus.writer("/chatter", "std_msgs/msg/String", sender="talker")
+    matched(writer)
+    bus.publish("/chatter", {"data": "hello"}, msgtype="std_msgs/msg/String", sender="talker")
+    samples = list(reader.take_iter(timeout=5_000_000_000))[:1]
+    assert [s.data for s in samples] == ["hello"]
+
+
+def test_a_plain_writers_sample_is_caught_by_a_robotale_signal_catch_event(tmp_path):
+    model = tmp_path / "listener.bpmn"
+    model.write_text(LISTENER)
+    clock = WallClock()
+    bus = DdsBus(clock, node="listener")
+    tags = []
+    engine = Engine(
+        parse(model).processes["listener"],
+        robot="listener",
+        bus=bus,
+        clock=clock,
+        tag_sink=tags.append,
+    )
+    engine.start()
+    participant = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    writer = DataWriter(participant, Topic(participant, "rt/chatter", String_))
+    matched(writer)
+    writer.write(String_(data="from outside"))
+    wait_until(lambda: engine.completed == 1, clock)
+    caught = [t for t in tags if t.activity == "chatter?" and t.lifecycle == "complete"]
+    assert len(caught) == 1 and caught[0].payload == '{"data":"from outside"}'
+    assert engine.variables["heard"] == "from outside"
+
+
+LISTENER = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL"
+    xmlns:camunda="http://camunda.org/schema/1.0/bpmn" id="listener">
+  <bpmn:process id="listener">
+    <bpmn:startEvent id="start" name="chatter">
+      <bpmn:extensionElements><camunda:properties>
+        <camunda:property name="type" value="std_msgs/msg/String" />
+      </camunda:properties></bpmn:extensionElements>
+      <bpmn:signalEventDefinition />
+    </bpmn:startEvent>
+    <bpmn:scriptTask id="note" name="Note"><bpmn:script>heard = chatter["data"]</bpmn:script>
+    </bpmn:scriptTask>
+    <bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="note" />
+    <bpmn:sequenceFlow id="f2" sourceRef="note" targetRef="end" />
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+
+def test_a_qos_incompatible_pair_never_talks_over_dds():
+    clock = WallClock()
+    warnings: list[str] = []
+    talker = DdsBus(clock, node="talker")
+    listener = DdsBus(clock, node="listener", on_warning=warnings.append)
+    got: list = []
+    listener.subscribe("/p", got.append, msgtype=POINT, owner="listener")  # reliable
+    lossy = replace(DEFAULT_QOS, reliability="best_effort")
+    control = listener.reader("/q", POINT)  # a compatible pair, to know discovery is done
+    listener.subscribe("/q", got.append, msgtype=POINT)
+    matched(talker.writer("/q", POINT, sender="talker"))
+    talker.writer("/p", POINT, lossy, sender="talker")
+    wait_until(lambda: bool(warnings), clock, 5.0)
+    talker.publish("/p", {"x": 1.0}, msgtype=POINT, sender="talker", qos=lossy)
+    talker.publish("/q", {"x": 2.0}, msgtype=POINT, sender="talker")
+    wait_until(lambda: len(got) >= 2, clock, 2.0)
+    assert [e.topic for e in got] == ["/q"]  # the best-effort /p never arrived
+    assert control.reader.get_subscription_matched_status().current_count == 1
+    assert warnings and warnings[0].startswith("/p:") and "reliability" in warnings[0]
+
+
+def test_a_transient_local_late_joiner_gets_the_stored_samples_over_dds():
+    clock = WallClock()
+    latched = replace(DEFAULT_QOS, durability="transient_local", depth=2)
+    talker = DdsBus(clock, node="talker")
+    for x in (1.0, 2.0, 3.0):
+        talker.publish("/latched", {"x": x}, msgtype=POINT, sender="talker", qos=latched)
+    late = DdsBus(clock, node="late")
+    got, volatile = [], []
+    late.subscribe("/latched", got.append, msgtype=POINT, qos=latched)
+    wait_until(lambda: len(got) >= 2, clock, 5.0)
+    late.subscribe("/latched", volatile.append, msgtype=POINT)
+    wait_until(lambda: False, clock, 0.5)
+    assert [e.data["x"] for e in got] == [2.0, 3.0]  # the writer keeps depth 2
+    assert {e.sender for e in got} == {"talker"}
+    assert volatile == []  # a volatile reader asks for no history
