@@ -206,3 +206,70 @@ def test_a_transient_local_late_joiner_gets_the_stored_samples_over_dds():
     assert [e.data["x"] for e in got] == [2.0, 3.0]  # the writer keeps depth 2
     assert {e.sender for e in got} == {"talker"}
     assert volatile == []  # a volatile reader asks for no history
+
+
+PATROL = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="patrol_forever">
+  <bpmn:collaboration id="c"><bpmn:participant id="p" name="Rover" processRef="Rover" />
+  </bpmn:collaboration>
+  <bpmn:process id="Rover">
+    <bpmn:startEvent id="start" />
+    <bpmn:task id="patrol" name="Patrol" />
+    <bpmn:intermediateCatchEvent id="pause" name="pause">
+      <bpmn:timerEventDefinition><bpmn:timeDuration>PT0.2S</bpmn:timeDuration>
+      </bpmn:timerEventDefinition>
+    </bpmn:intermediateCatchEvent>
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="patrol" />
+    <bpmn:sequenceFlow id="f2" sourceRef="patrol" targetRef="pause" />
+    <bpmn:sequenceFlow id="f3" sourceRef="pause" targetRef="patrol" />
+    <bpmn:subProcess id="safe" name="Safe State" triggeredByEvent="true">
+      <bpmn:startEvent id="s_start" name="emergency"><bpmn:errorEventDefinition /></bpmn:startEvent>
+      <bpmn:task id="stop_motors" name="Stop Motors" />
+      <bpmn:endEvent id="s_end" />
+      <bpmn:sequenceFlow id="s1" sourceRef="s_start" targetRef="stop_motors" />
+      <bpmn:sequenceFlow id="s2" sourceRef="stop_motors" targetRef="s_end" />
+    </bpmn:subProcess>
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+
+def test_ctrl_c_stops_every_robot_through_its_safe_state_and_closes_the_bag(tmp_path):
+    """As a terminal's Ctrl-C does: SIGINT to the whole process group of a DDS run."""
+    import signal
+    import subprocess
+    import sys
+
+    from robotale.commands.prepare import prepare_recordings
+
+    model = tmp_path / "patrol.bpmn"
+    model.write_text(PATROL)
+    bag = tmp_path / "run"
+    command = [sys.executable, "-m", "robotale", "fame", "run", str(model), "--robots", "rover"]
+    command += ["--bus", "dds", "--record", str(bag), "--until", "600"]
+    environment = {**os.environ, "PYTHONUNBUFFERED": "1"}  # tags reach us as they happen
+    run = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        env=environment,
+    )
+    try:
+        seen = []
+        for line in run.stdout:  # wait until the robot patrols and the recorder listens
+            seen.append(line)
+            if sum("\tpatrol\tcomplete" in row for row in seen) >= 4:
+                break
+        os.killpg(run.pid, signal.SIGINT)
+        rest, errors = run.communicate(timeout=90)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    printed = "".join(seen) + rest
+    assert run.returncode == 130, errors
+    assert "\tstop_motors\tcomplete" in printed, "the safe-state handler did not run"
+    log = prepare_recordings(bag)
+    recorded = log[log["robot"].eq("rover")]["concept:name"].tolist()
+    assert "patrol" in recorded and "stop_motors" in recorded
