@@ -89,7 +89,7 @@ class _Loop:
         self.next = 0  # the index of the next instance to start
         self.completed = 0
         self.active: dict[_Token, int] = {}  # running instance -> its index
-        self.outputs: list[Any] = [None] * len(items) if items is not None else []
+        self.outputs: dict[int, Any] = {}  # instance index -> its output item
 
 
 class _Scope:
@@ -813,8 +813,9 @@ class Engine:
         run.completed += 1
         marker = run.node.loop.loop
         if marker.output_collection and run.items is not None:
+            # the outputs of the instances that completed, in instance order (as SpiffWorkflow)
             run.outputs[index] = self.variables.get(marker.output_element)
-            self.data.set({marker.output_collection: list(run.outputs)})
+            self.data.set({marker.output_collection: [run.outputs[i] for i in sorted(run.outputs)]})
         if run.items is not None:
             self.data.set(
                 {"nrOfCompletedInstances": run.completed, "nrOfActiveInstances": len(run.active)}
