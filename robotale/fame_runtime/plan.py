@@ -543,7 +543,7 @@ def _message_targets(definitions: Definitions | None, source: str) -> list[str]:
     if definitions is None:
         return []
     pools = {p.id: p for p in definitions.participants}
-    owner = {n.id: p.process_ref for p in definitions.processes.values() for n in p.walk()}
+    owner = {n.id: p.id for p in definitions.processes.values() for n in p.walk()}
     targets = []
     for _, flow_source, target in definitions.message_flows:
         if flow_source != source:
