@@ -4,6 +4,11 @@ by hand, and the same files run by SpiffWorkflow where it reads them."""
 import pytest
 from fame_suite import MODELS, pair, run, trace
 
+from robotale.errors import ModelError
+from robotale.fame_runtime.expressions import BpmnError
+from robotale.fame_runtime.parser import parse_bytes
+from robotale.fame_runtime.plan import deploy
+
 LOOP_VARIABLES = {"fields": ["a", "b", "c"], "blinks": 3, "depths": [5, 20, 35, 50]}
 LOOP_VARIABLES |= {"steps": 0, "tries": 0}
 
@@ -74,3 +79,74 @@ def test_parallel_multi_instance_skill_completion_condition_and_boundary(targets
         )
     assert trace(tags) == want
     assert mission.clock.next_time() is None and mission.done
+
+
+HEAD = (
+    '<?xml version="1.0" encoding="UTF-8"?>'
+    '<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="d">'
+    '<bpmn:process id="rover"><bpmn:startEvent id="start" />'
+)
+TAIL = (
+    '<bpmn:endEvent id="end" /><bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="a" />'
+    '<bpmn:sequenceFlow id="f2" sourceRef="a" targetRef="end" /></bpmn:process>'
+    "</bpmn:definitions>"
+)
+
+
+def test_every_malformed_loop_of_a_file_is_reported_at_once():
+    text = (
+        HEAD + '<bpmn:task id="a" name="a"><bpmn:standardLoopCharacteristics loopMaximum="many"/>'
+        "</bpmn:task>"
+        '<bpmn:task id="b"><bpmn:multiInstanceLoopCharacteristics /></bpmn:task>' + TAIL
+    )
+    with pytest.raises(ModelError) as error:
+        parse_bytes(text.encode(), "loops.bpmn")
+    assert str(error.value).splitlines() == [
+        "loops.bpmn: 2 problems:",
+        "loops.bpmn:1: the loop of task a has loopMaximum 'many', which is no whole number "
+        '(write e.g. loopMaximum="5")',
+        "loops.bpmn:1: the multi-instance marker of task b has neither a loopCardinality nor a "
+        "collection (loopDataInputRef or camunda:collection): give one, e.g. "
+        "<bpmn:loopCardinality>3</bpmn:loopCardinality>",
+    ]
+
+
+def test_a_standard_loop_without_condition_or_maximum_is_refused():
+    text = HEAD + '<bpmn:task id="a"><bpmn:standardLoopCharacteristics /></bpmn:task>' + TAIL
+    with pytest.raises(ModelError, match="task a has a standard loop without loopCondition or"):
+        deploy(parse_bytes(text.encode()).processes["rover"])
+
+
+def fail_on_two(robot, inputs, done):
+    """A skill that fails with the BPMN error ``stuck`` for the item 2, else takes 5 s."""
+    if robot.variables["item"] == 2:
+        raise BpmnError("stuck")
+    return robot.clock.call_later(5, lambda: done({})).cancel
+
+
+def test_an_error_in_one_instance_is_caught_around_the_whole_activity(tmp_path):
+    text = (
+        HEAD + '<bpmn:error id="E" name="stuck" /><bpmn:callActivity id="a" name="work" '
+        'calledElement="work"><bpmn:multiInstanceLoopCharacteristics>'
+        "<bpmn:loopDataInputRef>items</bpmn:loopDataInputRef>"
+        '<bpmn:inputDataItem id="item" /></bpmn:multiInstanceLoopCharacteristics>'
+        '</bpmn:callActivity><bpmn:boundaryEvent id="b" attachedToRef="a">'
+        '<bpmn:errorEventDefinition errorRef="E" /></bpmn:boundaryEvent>'
+        '<bpmn:task id="h" name="handle" /><bpmn:endEvent id="end2" />'
+        '<bpmn:sequenceFlow id="f3" sourceRef="b" targetRef="h" />'
+        '<bpmn:sequenceFlow id="f4" sourceRef="h" targetRef="end2" />' + TAIL
+    )
+    path = tmp_path / "mi_error.bpmn"
+    path.write_text(text)
+    mission, tags = run(
+        path, skills={"work": fail_on_two}, variables={"rover": {"items": [1, 2, 3]}}
+    )
+    # instance 1 starts its 5 s skill; instance 2 fails at once: the boundary cancels the
+    # whole activity (instance 1's skill, instance 3 before it starts) and handle runs
+    assert trace(tags) == [
+        (0, "rover", "work", "start"),
+        (0, "rover", "work", "start"),
+        *pair(0, "rover", "stuck"),
+        *pair(0, "rover", "handle"),
+    ]
+    assert mission.clock.next_time() is None and not mission.failures
