@@ -115,7 +115,7 @@ var __fame = (function () {
   // The usual outcome of a call -- variables set to numbers, booleans, null or strings, and
   // next() -- goes back as flat text: 'C', then triples of fields separated by \x1f (w name
   // value | d name '' | n run value). JSON.stringify costs more than such a script itself.
-  // Anything else goes as JSON ('J').
+  // Anything else goes as the JSON of an object.
   function fame_flat(v) {
     var t = typeof v;
     if (t === 'number') return isFinite(v) ? 'n' + v : null;
@@ -127,19 +127,20 @@ var __fame = (function () {
   function fame_plain(text) {
     return text.indexOf('\u001f') < 0;
   }
+  // (parts joined at the end: a long string built by += is a rope the embedding cannot return)
   function fame_drain() {
-    var flat = 'C', k, f, i, e = out;
+    var flat = ['C'], k, f, i, e = out;
     for (k in dirty) {
       f = store[k] === undefined ? '' : fame_flat(store[k]);
-      if (f === null || !fame_plain(k)) { flat = ''; break; }
-      flat += f ? '\u001fw\u001f' + k + '\u001f' + f : '\u001fd\u001f' + k + '\u001f';
+      if (f === null || !fame_plain(k)) { flat = null; break; }
+      flat.push(f ? 'w' : 'd', k, f);
     }
     for (i = 0; flat && i < e.length; i++) {
       f = e[i][0] === 'next' && e[i][2] === null ? fame_flat(e[i][3]) : null;
-      flat = f === null ? '' : flat + '\u001fn\u001f' + e[i][1] + '\u001f' + f;
+      if (f === null) flat = null; else flat.push('n', e[i][1], f);
     }
-    if (flat === 'C') return '';  // nothing written, nothing done
-    if (!flat) flat = 'J' + fame_json(e);
+    if (flat && flat.length === 1) return '';  // nothing written, nothing done
+    flat = flat ? flat.join('\u001f') : fame_json(e);
     dirty = {};
     out = [];
     return flat;
@@ -420,7 +421,7 @@ class JavaScript:
             if outbox[0] == "C":
                 self._apply_flat(outbox)
                 continue
-            outcome = json.loads(outbox[1:])
+            outcome = json.loads(outbox)
             written = self._take_writes(outcome)
             for effect in outcome["e"]:
                 self._effect(effect, run)

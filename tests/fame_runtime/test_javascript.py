@@ -282,3 +282,25 @@ def test_values_a_script_sets_reach_python_as_json_would_carry_them(tmp_path):
         one = f"this.environment.variables.{name} = {text}; next();"
         mission, _ = run(model(tmp_path, one))
         assert mission.engines["rover"].variables[name] == value, name
+
+
+def test_a_script_setting_many_variables_a_long_text_and_a_long_list(tmp_path):
+    """Long outboxes come back whole: many plain writes and a long string (flat text), a
+    long list of objects (JSON)."""
+    plain = """
+        var v = this.environment.variables;
+        for (var i = 0; i < 2000; i++) { v["value_" + i] = i; }
+        v.long = new Array(5001).join("ab");
+        next();
+    """
+    points = """
+        var points = [];
+        for (var i = 0; i < 2000; i++) { points.push({x: i, y: -i}); }
+        this.environment.variables.points = points;
+        next();
+    """
+    mission, _ = run(model(tmp_path, plain, points))
+    got = mission.engines["rover"].variables
+    assert [got[f"value_{i}"] for i in range(2000)] == list(range(2000))
+    assert got["long"] == "ab" * 5000
+    assert got["points"] == [{"x": i, "y": -i} for i in range(2000)]
