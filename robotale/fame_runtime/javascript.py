@@ -127,20 +127,21 @@ var __fame = (function () {
   function fame_plain(text) {
     return text.indexOf('\u001f') < 0;
   }
-  // (parts joined at the end: a long string built by += is a rope the embedding cannot return)
   function fame_drain() {
-    var flat = ['C'], k, f, i, e = out;
+    var flat = 'C', k, f, i, e = out;
     for (k in dirty) {
       f = store[k] === undefined ? '' : fame_flat(store[k]);
-      if (f === null || !fame_plain(k)) { flat = null; break; }
-      flat.push(f ? 'w' : 'd', k, f);
+      if (f === null || !fame_plain(k)) { flat = ''; break; }
+      flat += f ? '\u001fw\u001f' + k + '\u001f' + f : '\u001fd\u001f' + k + '\u001f';
     }
     for (i = 0; flat && i < e.length; i++) {
       f = e[i][0] === 'next' && e[i][2] === null ? fame_flat(e[i][3]) : null;
-      if (f === null) flat = null; else flat.push('n', e[i][1], f);
+      flat = f === null ? '' : flat + '\u001fn\u001f' + e[i][1] + '\u001f' + f;
     }
-    if (flat && flat.length === 1) return '';  // nothing written, nothing done
-    flat = flat ? flat.join('\u001f') : fame_json(e);
+    if (flat === 'C') return '';  // nothing written, nothing done
+    // a long string built by += may be a rope, which the embedding cannot return: rebuild it
+    if (flat.length > 256) flat = flat.split('\u001f').join('\u001f');
+    flat = flat || fame_json(e);
     dirty = {};
     out = [];
     return flat;
@@ -148,7 +149,7 @@ var __fame = (function () {
   function fame_json(e) {
     var w = {}, d = [], k;
     for (k in dirty) if (store[k] === undefined) d.push(k); else w[k] = store[k];
-    return JSON.stringify({w: w, d: d, e: e});
+    return JSON.stringify({w: w, d: d, e: e});  // made in one piece: never a rope
   }
   function fame_next(run) {
     var settled = false;
