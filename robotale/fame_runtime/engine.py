@@ -52,7 +52,17 @@ _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 
 
 class _Token:
-    __slots__ = ("alive", "boundaries", "child", "flow", "generation", "node", "scope", "waits")
+    __slots__ = (
+        "alive",
+        "boundaries",
+        "child",
+        "flow",
+        "generation",
+        "instance",
+        "node",
+        "scope",
+        "waits",
+    )
 
     def __init__(self, scope: _Scope, node: NodePlan) -> None:
         self.scope = scope
@@ -63,6 +73,23 @@ class _Token:
         self.child: _Scope | None = None
         self.alive = True
         self.generation = 0  # stale skill completions are ignored
+        self.instance: _Loop | None = None  # the loop this token runs one instance of
+
+
+class _Loop:
+    """One running loop or multi-instance activity: the token waiting at it (``holder``)
+    and its instances."""
+
+    __slots__ = ("active", "completed", "holder", "items", "next", "node", "outputs")
+
+    def __init__(self, holder: _Token, node: NodePlan, items: list[Any] | None) -> None:
+        self.holder = holder
+        self.node = node
+        self.items = items  # one per instance; None: a standard loop (until its condition)
+        self.next = 0  # the index of the next instance to start
+        self.completed = 0
+        self.active: dict[_Token, int] = {}  # running instance -> its index
+        self.outputs: dict[int, Any] = {}  # instance index -> its output item
 
 
 class _Scope:
@@ -323,7 +350,9 @@ class Engine:
         token.alive = False
         scope = token.scope
         scope.tokens.discard(token)
-        if not scope.tokens and not scope.ended:
+        if token.instance is not None:
+            self._instance_done(token)
+        elif not scope.tokens and not scope.ended:
             self._close(scope)
 
     def _cancel(self, token: _Token) -> None:
@@ -419,10 +448,14 @@ class Engine:
         return self._javascript
 
     def _condition(self, condition: Compiled, where: str) -> bool:
+        return bool(self._evaluate(condition, where))
+
+    def _evaluate(self, condition: Compiled, where: str) -> Any:
+        """The value of a condition or expression (a loop's cardinality), errors explained."""
         try:
             if condition.language == JAVASCRIPT:
-                return bool(self.javascript.condition(condition.source))
-            return bool(eval(condition.code, self.env, self.variables))
+                return self.javascript.condition(condition.source)
+            return eval(condition.code, self.env, self.variables)
         except BpmnError:
             raise
         except ScriptFailure as failure:
@@ -454,15 +487,21 @@ class Engine:
         return self._follow(token, self._taken(node, first=False))
 
     def _run_pass(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        if node.throw is not None:
+        if node.throw is not None and node.throw.kind == "escalation":
+            if not self._escalate(token, node):
+                return None  # an interrupting catcher cancelled the thrower
+        elif node.throw is not None:
             self._publish(node)
         return self._follow(token, self._taken(node, first=False))
 
     def _run_end(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        if node.throw is not None and node.throw.kind == "signal":
+        kind = node.throw.kind if node.throw is not None else "none"
+        if kind in ("signal", "message"):
             self._publish(node)
-        if node.throw is not None and node.throw.kind == "error":
+        if kind == "error":
             self._throw_error(token, node.throw.topic)  # the catching event is tagged
+            return None
+        if kind == "escalation" and not self._escalate(token, node):
             return None
         self._consume(token)
         return None
@@ -606,6 +645,7 @@ class Engine:
 
     def _run_catch(self, token: _Token, node: NodePlan) -> NodePlan | None:
         token.waits.append(self.triggers.arm(node.trigger, self._waker(token, node)))
+        self._arm_boundaries(token, node)  # a receive task may have boundary events
         return None
 
     def _waker(self, token: _Token, node: NodePlan) -> Callable[[Envelope | None], None]:
@@ -710,6 +750,128 @@ class Engine:
     def _run_event_subprocess(self, token: _Token, node: NodePlan) -> NodePlan | None:
         return None  # never entered by a sequence flow; _event_subprocess starts it
 
+    # -- loops and multi-instance activities -----------------------------------------------------
+
+    def _run_loop(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        """Run the activity's body once per instance (all at once when parallel), then leave
+        by the activity's flows; the token waits at the activity meanwhile, with its boundary
+        events armed, and cancelling it cancels the instances."""
+        marker = node.loop.loop
+        items = None if marker.kind == "standard" else self._loop_items(node)
+        run = _Loop(token, node, items)
+        if self._loop_finished(run, before=True):
+            return self._follow(token, self._taken(node, first=False))
+        self._arm_boundaries(token, node)
+        token.waits.append(lambda: self._stop_instances(run))
+        count = len(items) if marker.kind == "parallel" else 1
+        for _ in range(count):
+            self._start_instance(run)
+        return None
+
+    def _loop_items(self, node: NodePlan) -> list[Any]:
+        """The items of a multi-instance activity: its collection's, or ``loopCardinality``
+        times None."""
+        looped = node.loop
+        where = f"the multi-instance activity {node.node.describe()}"
+        if looped.cardinality is not None:
+            count = self._evaluate(looped.cardinality, where)
+            if not isinstance(count, int | float) or count < 0 or count != int(count):
+                raise ModelError(
+                    f"robot {self.robot.name}: the loopCardinality of {where} is {count!r}, "
+                    "not a whole number of instances"
+                )
+            return [None] * int(count)
+        name = looped.loop.collection
+        if name not in self.variables:
+            raise ModelError(
+                f"robot {self.robot.name}: {where} runs once per item of the variable "
+                f"{name!r}, which is not set"
+            )
+        collection = self.variables[name]
+        if isinstance(collection, Mapping):
+            return list(collection.values())
+        if isinstance(collection, str) or not isinstance(collection, Iterable):
+            raise ModelError(
+                f"robot {self.robot.name}: {where} runs once per item of the variable "
+                f"{name!r}, which holds {type(collection).__name__} {collection!r}, no list"
+            )
+        return list(collection)
+
+    def _start_instance(self, run: _Loop) -> None:
+        index = run.next
+        run.next += 1
+        body = run.node.loop.body
+        token = self._new_token(run.holder.scope, body)
+        token.instance = run
+        run.active[token] = index
+
+        def begin() -> None:
+            if token.alive:
+                self.data.set(self._instance_variables(run, index))
+                self._advance(token, body)
+
+        self._call(begin)
+
+    def _instance_variables(self, run: _Loop, index: int) -> dict[str, Any]:
+        """What an instance finds in the variables as it starts (Camunda's names)."""
+        marker = run.node.loop.loop
+        values: dict[str, Any] = {"loopCounter": index}
+        if run.items is not None:
+            values["nrOfInstances"] = len(run.items)
+            values["nrOfActiveInstances"] = len(run.active)
+            values["nrOfCompletedInstances"] = run.completed
+            if marker.element:
+                values[marker.element] = run.items[index]
+        return values
+
+    def _instance_done(self, token: _Token) -> None:
+        """One instance completed: collect its output, then start the next, wait for the
+        others or leave the activity."""
+        run = token.instance
+        index = run.active.pop(token)
+        run.completed += 1
+        marker = run.node.loop.loop
+        if marker.output_collection and run.items is not None:
+            # the outputs of the instances that completed, in instance order (as SpiffWorkflow)
+            run.outputs[index] = self.variables.get(marker.output_element)
+            self.data.set({marker.output_collection: [run.outputs[i] for i in sorted(run.outputs)]})
+        if run.items is not None:
+            self.data.set(
+                {"nrOfCompletedInstances": run.completed, "nrOfActiveInstances": len(run.active)}
+            )
+        if self._loop_finished(run, before=False):
+            holder = run.holder
+            self._disarm(holder)  # cancels the instances a completion condition cut short
+            self._go_on(holder, run.node)
+        elif marker.kind != "parallel":
+            self._start_instance(run)
+
+    def _loop_finished(self, run: _Loop, *, before: bool) -> bool:
+        """Whether no more instance is to run: a standard loop's maximum reached or its
+        condition false (before the first iteration only with ``testBefore``), every item
+        done, or a multi-instance completion condition true."""
+        looped = run.node.loop
+        marker = looped.loop
+        where = f"the loop of {run.node.node.describe()}"
+        if marker.kind == "standard":
+            if before and not marker.test_before:
+                return False
+            if marker.maximum is not None and run.completed >= marker.maximum:
+                return True
+            self.data.set({"loopCounter": run.completed})
+            return looped.condition is not None and not self._condition(looped.condition, where)
+        if run.completed >= len(run.items):
+            return True
+        if before or looped.condition is None:
+            return False
+        return self._condition(looped.condition, where)
+
+    def _stop_instances(self, run: _Loop) -> None:
+        for token in list(run.active):
+            token.instance = None  # cancelled, not completed
+            self._cancel(token)
+        run.active.clear()
+
     #: how a node runs, by the behaviour the deployer gave it (``NodePlan.behaviour``)
     _BEHAVIOURS: ClassVar[dict[str, Behaviour]] = {
         "start": _run_start,
@@ -724,6 +886,7 @@ class Engine:
         "call": _run_call,
         "subprocess": _run_call,  # its content runs like a called process
         "event_subprocess": _run_event_subprocess,
+        "loop": _run_loop,
         "exclusiveGateway": _run_exclusive_gateway,
         "parallelGateway": _run_parallel_gateway,
         "inclusiveGateway": _run_inclusive_gateway,
@@ -735,6 +898,8 @@ class Engine:
     def _arm_boundaries(self, token: _Token, node: NodePlan) -> None:
         depth = token.scope.depth + 0.5  # inside the scope, around the activity
         for boundary in node.boundaries:
+            if boundary.trigger.kind == "escalation":
+                continue  # found when an escalation is thrown inside (see _escalate)
             repeat = not boundary.node.cancel_activity
             fire = self._boundary_fire(token, boundary)
             token.boundaries.append(
@@ -764,6 +929,9 @@ class Engine:
     def _arm_event_subprocess(self, scope: _Scope, esp: NodePlan) -> None:
         start = esp.child.triggered_starts[0]
         interrupting = start.node.interrupting
+        if start.trigger.kind == "escalation":  # nothing to wait for outside the engine
+            scope.armed[esp.id] = _nothing
+            return
 
         def fire(envelope: Envelope | None) -> None:
             if not scope.ended and esp.id in scope.armed:
@@ -806,36 +974,51 @@ class Engine:
         """Hand a thrown BPMN error to the nearest catcher: the activity's own boundary
         events, then the event sub-processes of each enclosing scope and the boundary events
         of the activity holding it; nobody catching it ends the instance."""
-        catcher = self._boundary_catcher(token, name)
+        catcher = self._boundary_catcher(_outer(token), "error", name)
         if catcher is not None:
-            self._boundary(token, catcher, None)
+            self._boundary(_outer(token), catcher, None)
             return
+        if not self._catch_above(token, "error", name):
+            self._uncaught(token, name)
+
+    def _catch_above(self, token: _Token, kind: str, name: str) -> bool:
+        """Hand an error or escalation thrown at ``token`` to the event sub-processes of each
+        enclosing scope and the boundary events of the activity holding it, innermost first;
+        False when nobody catches it."""
         scope: _Scope | None = token.scope
         while scope is not None:
-            esp = self._esp_catcher(scope, name)
+            esp = self._esp_catcher(scope, kind, name)
             if esp is not None:
-                self._event_subprocess(scope, esp, None, interrupting=True)
-                return
-            holder = scope.holder
-            if holder is not None:
-                catcher = self._boundary_catcher(holder, name)
+                interrupting = kind == "error" or esp.child.triggered_starts[0].node.interrupting
+                self._event_subprocess(scope, esp, None, interrupting=interrupting)
+                return True
+            if scope.holder is not None:
+                holder = _outer(scope.holder)
+                catcher = self._boundary_catcher(holder, kind, name)
                 if catcher is not None:
                     self._boundary(holder, catcher, None)
-                    return
+                    return True
             scope = scope.parent
-        self._uncaught(token, name)
+        return False
 
-    def _boundary_catcher(self, token: _Token, name: str) -> NodePlan | None:
+    def _escalate(self, token: _Token, node: NodePlan) -> bool:
+        """Throw an escalation (tagged as the throwing event); True when the thrower goes on
+        (nobody caught it, or a non-interrupting catcher did)."""
+        self._tag.pair(node.throw.label)
+        self._catch_above(token, "escalation", node.throw.topic)
+        return token.alive
+
+    def _boundary_catcher(self, token: _Token, kind: str, name: str) -> NodePlan | None:
         for boundary in token.node.boundaries:
             trigger = boundary.trigger
-            if trigger.kind == "error" and trigger.topic in ("", name):
+            if trigger.kind == kind and trigger.topic in ("", name):
                 return boundary
         return None
 
-    def _esp_catcher(self, scope: _Scope, name: str) -> NodePlan | None:
+    def _esp_catcher(self, scope: _Scope, kind: str, name: str) -> NodePlan | None:
         for esp in scope.plan.event_subprocesses:
             trigger = esp.child.triggered_starts[0].trigger
-            if esp.id in scope.armed and trigger.kind == "error" and trigger.topic in ("", name):
+            if esp.id in scope.armed and trigger.kind == kind and trigger.topic in ("", name):
                 return esp
         return None
 
@@ -879,3 +1062,13 @@ class Engine:
 
     def _changed(self, names: Iterable[str]) -> None:
         self.triggers.changed(names)
+
+
+def _nothing() -> None:
+    return None
+
+
+def _outer(token: _Token) -> _Token:
+    """The token whose activity's boundary events catch for ``token``: an instance of a loop
+    or multi-instance activity is caught around the whole activity."""
+    return token.instance.holder if token.instance is not None else token

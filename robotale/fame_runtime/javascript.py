@@ -112,17 +112,44 @@ var __fame = (function () {
     for (k in p.set) store[k] = p.set[k];
     for (var i = 0; i < p.del.length; i++) delete store[p.del[i]];
   }
+  // The usual outcome of a call -- variables set to numbers, booleans, null or strings, and
+  // next() -- goes back as flat text: 'C', then triples of fields separated by \x1f (w name
+  // value | d name '' | n run value). JSON.stringify costs more than such a script itself.
+  // Anything else goes as the JSON of an object.
+  function fame_flat(v) {
+    var t = typeof v;
+    if (t === 'number') return isFinite(v) ? 'n' + v : null;
+    if (t === 'boolean') return v ? 't' : 'f';
+    if (v === null || v === undefined) return 'z';
+    if (t === 'string' && fame_plain(v)) return 's' + v;
+    return null;
+  }
+  function fame_plain(text) {
+    return text.indexOf('\u001f') < 0;
+  }
   function fame_drain() {
-    var w = {}, d = [], k, n = 0;
+    var flat = 'C', k, f, i, e = out;
     for (k in dirty) {
-      n++;
-      if (store[k] === undefined) d.push(k); else w[k] = store[k];
+      f = store[k] === undefined ? '' : fame_flat(store[k]);
+      if (f === null || !fame_plain(k)) { flat = ''; break; }
+      flat += f ? '\u001fw\u001f' + k + '\u001f' + f : '\u001fd\u001f' + k + '\u001f';
     }
+    for (i = 0; flat && i < e.length; i++) {
+      f = e[i][0] === 'next' && e[i][2] === null ? fame_flat(e[i][3]) : null;
+      flat = f === null ? '' : flat + '\u001fn\u001f' + e[i][1] + '\u001f' + f;
+    }
+    if (flat === 'C') return '';  // nothing written, nothing done
+    // a long string built by += may be a rope, which the embedding cannot return: rebuild it
+    if (flat.length > 256) flat = flat.split('\u001f').join('\u001f');
+    flat = flat || fame_json(e);
     dirty = {};
-    if (!n && !out.length) return '';
-    var e = out;
     out = [];
-    return JSON.stringify({w: w, d: d, e: e});
+    return flat;
+  }
+  function fame_json(e) {
+    var w = {}, d = [], k;
+    for (k in dirty) if (store[k] === undefined) d.push(k); else w[k] = store[k];
+    return JSON.stringify({w: w, d: d, e: e});  // made in one piece: never a rope
   }
   function fame_next(run) {
     var settled = false;
@@ -334,17 +361,16 @@ class JavaScript:
             function = self._functions[source] = self.context.eval(source)
         return function
 
-    def _call(self, function: Any, *args: Any) -> str:
-        """Call into JavaScript with the variables Python changed; its pending promise jobs
-        run before its effects are collected."""
+    def _call(self, function: Any, *args: Any) -> tuple[str, ...]:
+        """Call into JavaScript with the variables Python changed: its drained outbox, and a
+        second one when it left promise jobs (they run before anything is applied)."""
         try:
             result = function(*args, self._push())
             if self.context.execute_pending_job():
                 while self.context.execute_pending_job():
                     pass
-                tail = self._drain()
-                result = _merge(result, tail)
-            return result
+                return result, self._drain()
+            return (result,)
         except quickjs.JSException as error:
             text = str(error)
             if "interrupted" in text:
@@ -362,6 +388,11 @@ class JavaScript:
     def _push(self) -> str:
         """The variables that changed in Python since JavaScript last saw them, as JSON."""
         mirror, variables = self._mirror, self.variables
+        try:
+            if variables == mirror:  # the usual case, compared in C (identical values first)
+                return ""
+        except (TypeError, ValueError):
+            pass  # a value that cannot be compared (an array): look at each one
         changed = {
             k: v
             for k, v in variables.items()
@@ -384,13 +415,39 @@ class JavaScript:
 
     # -- effects -------------------------------------------------------------------------------
 
-    def _apply(self, result: str, run: int = 0) -> None:
-        if not result:
-            return
-        outcome = json.loads(result)
-        written = self._take_writes(outcome)
-        for effect in outcome["e"]:
-            self._effect(effect, run)
+    def _apply(self, outboxes: tuple[str, ...], run: int = 0) -> None:
+        for outbox in outboxes:
+            if not outbox:
+                continue
+            if outbox[0] == "C":
+                self._apply_flat(outbox)
+                continue
+            outcome = json.loads(outbox)
+            written = self._take_writes(outcome)
+            for effect in outcome["e"]:
+                self._effect(effect, run)
+            if written:
+                self.changed(written)
+
+    def _apply_flat(self, outbox: str) -> None:
+        """The flat outbox (see the prelude's ``fame_drain``): writes, then ``next`` calls."""
+        mirror, variables = self._mirror, self.variables
+        fields = iter(outbox.split("\x1f"))
+        next(fields)  # "C"
+        written = []
+        # the writes come first, then the next() calls: they complete after every write
+        for kind, name, value in zip(fields, fields, fields, strict=True):
+            if kind == "w":
+                variables[name] = mirror[name] = _flat(value)
+                written.append(name)
+            elif kind == "d":
+                variables.pop(name, None)
+                mirror.pop(name, None)
+                written.append(name)
+            else:  # "n": next(null, value) called by run ``name``
+                done = self._runs.pop(int(name), None)
+                if done is not None:
+                    done(None, _flat(value))
         if written:
             self.changed(written)
 
@@ -467,14 +524,16 @@ class JavaScript:
             ) from None
 
 
-def _merge(first: str, second: str) -> str:
-    """Two drained outboxes (before and after promise jobs) as one."""
-    if not second:
-        return first
-    if not first:
-        return second
-    a, b = json.loads(first), json.loads(second)
-    a["w"].update(b["w"])
-    a["d"] = [d for d in a["d"] if d not in b["w"]] + b["d"]
-    a["e"] += b["e"]
-    return json.dumps(a)
+_FLAT_CONSTANTS = {"t": True, "f": False, "z": None}
+
+
+def _flat(text: str) -> Any:
+    """One flat value: n<number> (as JSON reads it: int without fraction or exponent),
+    s<string>, t, f, z (null)."""
+    tag = text[0]
+    if tag == "n":
+        body = text[1:]
+        return int(body) if body.lstrip("-").isdigit() else float(body)
+    if tag == "s":
+        return text[1:]
+    return _FLAT_CONSTANTS[tag]

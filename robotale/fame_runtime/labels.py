@@ -15,9 +15,11 @@ import re
 from robotale.fame_runtime.model import Node
 
 #: element kinds whose event definition waits for something (a signal catch is a subscriber)
-CATCHING = frozenset({"startEvent", "intermediateCatchEvent", "boundaryEvent"})
+CATCHING = frozenset({"startEvent", "intermediateCatchEvent", "boundaryEvent", "receiveTask"})
 #: element kinds whose event definition is thrown (a signal throw is a publisher)
-THROWING = frozenset({"intermediateThrowEvent", "endEvent"})
+THROWING = frozenset({"intermediateThrowEvent", "endEvent", "sendTask"})
+#: tasks that send or receive a message: tagged by their own name, like any activity
+MESSAGE_TASKS = frozenset({"sendTask", "receiveTask"})
 
 #: how a message event's label ends, as in the thesis' logs: ``!`` sends, ``?`` receives
 SEND, RECEIVE = "!", "?"
@@ -67,12 +69,42 @@ def error_name(node: Node) -> str:
     return "_".join(name.strip().split())
 
 
+def message_name(node: Node) -> str:
+    """The name of the message a message event or send/receive task sends or waits for: the
+    referenced message's name, else the element's name; without ``!``/``?``."""
+    event = node.event
+    name = ((event.ref_name if event else "") or node.name).strip()
+    return "_".join(name.rstrip(SEND + RECEIVE).split())
+
+
+def message_topic(pool_namespace: str, node: Node) -> str:
+    """The point-to-point topic of a message: ``/<receiving pool>/<message>`` ("" when the
+    message has no name)."""
+    name = message_name(node).lstrip("/")
+    return f"/{pool_namespace}/{name}" if name and pool_namespace else ""
+
+
+def escalation_name(node: Node) -> str:
+    """The escalation an escalation event throws or catches ("" catches any): the referenced
+    escalation's name (or code), else the event's name."""
+    event = node.event
+    name = (event.ref_name if event else "") or node.name
+    return "_".join(name.strip().split())
+
+
 def element_label(node: Node) -> str:
-    """The activity the engine tags ``node`` with: a signal event is its signal with ``!``
-    (thrown) or ``?`` (caught), an error event its error, anything else its name."""
-    if node.event_kind == "signal":
+    """The activity the engine tags ``node`` with: a signal or message event is its signal or
+    message with ``!`` (thrown) or ``?`` (caught), an error or escalation event its error or
+    escalation, a send or receive task, like anything else, its name."""
+    if node.kind in MESSAGE_TASKS:
         suffix = RECEIVE if catches(node) else SEND
-        return activity_label(signal_name(node) + suffix, node.id)
+        return activity_label(node.name or message_name(node) + suffix, node.id)
+    if node.event_kind in ("signal", "message"):
+        suffix = RECEIVE if catches(node) else SEND
+        name = signal_name(node) if node.event_kind == "signal" else message_name(node)
+        return activity_label(name + suffix, node.id)
     if node.event_kind == "error":
         return activity_label(error_name(node), node.id)
+    if node.event_kind == "escalation":
+        return activity_label(escalation_name(node), node.id)
     return activity_label(node.name, node.id)

@@ -54,6 +54,27 @@ class EventDefinition:
     condition: Expression | None = None
 
 
+@dataclass(frozen=True, slots=True)
+class Loop:
+    """A loop or multi-instance marker of an activity (BPMN 2.0 section 10.3.8).
+
+    ``kind`` is ``standard`` (``standardLoopCharacteristics``), ``parallel`` or ``sequential``
+    (``multiInstanceLoopCharacteristics``). Names of variables are as the file gives them:
+    ``loopDataInputRef``/``camunda:collection`` and ``inputDataItem``/
+    ``camunda:elementVariable`` (the item's id, as SpiffWorkflow reads it).
+    """
+
+    kind: str
+    cardinality: Expression | None = None
+    collection: str = ""  # the variable holding the input collection
+    element: str = ""  # the variable each instance finds its item in
+    output_collection: str = ""
+    output_element: str = ""
+    condition: Expression | None = None  # loopCondition (standard) / completionCondition
+    test_before: bool = False
+    maximum: int | None = None
+
+
 @dataclass(slots=True)
 class DataObject:
     """A data object reference and its parameters (``${var}`` = filled in at run time)."""
@@ -97,6 +118,7 @@ class Node:
     outputs: dict[str, object] = field(default_factory=dict)  # camunda:outputParameter
     scope: Scope | None = None  # sub-process content
     triggered_by_event: bool = False
+    loop: Loop | None = None  # a loop or multi-instance marker
     quirks: list[str] = field(default_factory=list)  # what the engine would have to refuse
 
     @property
@@ -170,6 +192,8 @@ class Definitions:
     participants: list[Participant] = field(default_factory=list)
     signals: dict[str, str] = field(default_factory=dict)  # id -> name
     errors: dict[str, str] = field(default_factory=dict)  # id -> name (or errorCode)
+    messages: dict[str, str] = field(default_factory=dict)  # id -> name
+    escalations: dict[str, str] = field(default_factory=dict)  # id -> name (or code)
     message_flows: list[tuple[str, str, str]] = field(default_factory=list)
     #: silent choices made visible: "<file>:<line>: <element> <what happens>"
     warnings: list[str] = field(default_factory=list)

@@ -24,6 +24,7 @@ from robotale.fame_runtime.model import (
     EventDefinition,
     Expression,
     Flow,
+    Loop,
     Node,
     Participant,
     Process,
@@ -149,9 +150,12 @@ class _Reader:
             e.get("id", ""): e.get("name") or e.get("errorCode") or ""
             for e in root.iter(f"{_B}error")
         }
+        self.messages = _names(root, "message", "name")
+        self.escalations = _names(root, "escalation", "escalationCode")
         self.language = (root.get("expressionLanguage") or "").strip().lower()
         definitions = Definitions(self.file, root.get("id", ""), signals=dict(self.signals))
         definitions.errors = dict(self.errors)
+        definitions.messages, definitions.escalations = self.messages, self.escalations
         for element in _bpmn_children(root, "process"):
             process = self.process(element)
             process.definitions = definitions
@@ -323,13 +327,16 @@ class _Reader:
             triggered_by_event=element.get("triggeredByEvent") == "true",
         )
         node.events = [self.event_definition(d, node) for d in element if _is_definition(d)]
+        if kind in ("sendTask", "receiveTask"):  # its message, like a message event's
+            ref = element.get("messageRef", "")
+            node.events = [EventDefinition("message", ref, self.messages.get(ref, ""))]
         self.data_associations(element, node)
         self.markers(element, node)
         extensions = _Extensions(element.find(f"{_B}extensionElements"))
         for ignored in extensions.ignored:
             self.warn(node.line, f"{kind} {node.describe()}: {ignored} is ignored (not run)")
         node.inputs, node.outputs = extensions.inputs, extensions.outputs
-        if kind in EVENTS and node.events and node.events[0].kind in ("signal", "error"):
+        if node.events and node.events[0].kind in ("signal", "error", "message"):
             node.message = self.ros_message(extensions, element, node)
         if kind == "scriptTask":
             node.script = self.script(element, node)
@@ -342,10 +349,59 @@ class _Reader:
 
     def markers(self, element: etree._Element, node: Node) -> None:
         for child in element:
-            if _local(child) in ("standardLoopCharacteristics", "multiInstanceLoopCharacteristics"):
-                node.quirks.append("has a loop or multi-instance marker")
+            if _local(child) == "standardLoopCharacteristics":
+                node.loop = self.standard_loop(child, node)
+            elif _local(child) == "multiInstanceLoopCharacteristics":
+                node.loop = self.multi_instance(child, node)
         if element.get("isForCompensation") == "true":
             node.quirks.append("is a compensation activity")
+
+    def standard_loop(self, element: etree._Element, node: Node) -> Loop:
+        maximum = element.get("loopMaximum")
+        if maximum is not None and _int_or_none(maximum) is None:
+            self.problem(
+                element.sourceline,
+                f"the loop of {node.kind} {node.id} has loopMaximum {maximum!r}, which is no "
+                'whole number (write e.g. loopMaximum="5")',
+            )
+        return Loop(
+            "standard",
+            condition=self.loop_expression(element, "loopCondition", node),
+            test_before=element.get("testBefore") == "true",
+            maximum=_int_or_none(maximum),
+        )
+
+    def multi_instance(self, element: etree._Element, node: Node) -> Loop:
+        """Cardinality or collection, the item variables and the completion condition, in
+        the standard elements or Camunda's attributes."""
+        item = element.find(f"{_B}inputDataItem")
+        output_item = element.find(f"{_B}outputDataItem")
+        collection = _text(element.find(f"{_B}loopDataInputRef"))
+        collection = collection or _unwrap(element.get(_CAMUNDA + "collection") or "")
+        loop = Loop(
+            "sequential" if element.get("isSequential") == "true" else "parallel",
+            cardinality=self.loop_expression(element, "loopCardinality", node),
+            collection=collection,
+            element=_item_name(item) or (element.get(_CAMUNDA + "elementVariable") or ""),
+            output_collection=_text(element.find(f"{_B}loopDataOutputRef")),
+            output_element=_item_name(output_item),
+            condition=self.loop_expression(element, "completionCondition", node),
+        )
+        if loop.cardinality is None and not loop.collection:
+            self.problem(
+                element.sourceline,
+                f"the multi-instance marker of {node.kind} {node.id} has neither a "
+                "loopCardinality nor a collection (loopDataInputRef or camunda:collection): "
+                "give one, e.g. <bpmn:loopCardinality>3</bpmn:loopCardinality>",
+            )
+        return loop
+
+    def loop_expression(self, element: etree._Element, name: str, node: Node):
+        """``loopCardinality``, ``loopCondition`` or ``completionCondition``; Camunda's
+        ``${...}`` wrapping is taken off (the expression inside is what runs)."""
+        child = element.find(f"{_B}{name}")
+        text = _unwrap(_text(child))
+        return self.expression(child, text, node.id) if text else None
 
     def data_associations(self, element: etree._Element, node: Node) -> None:
         for assoc in _bpmn_children(element, "dataInputAssociation"):
@@ -363,6 +419,12 @@ class _Reader:
             return EventDefinition("error", ref, self.errors.get(ref, ""))
         if kind == "timer":
             return EventDefinition("timer", timer=self.timer(element, node))
+        if kind == "message":
+            ref = element.get("messageRef", "")
+            return EventDefinition("message", ref, self.messages.get(ref, ""))
+        if kind == "escalation":
+            ref = element.get("escalationRef", "")
+            return EventDefinition("escalation", ref, self.escalations.get(ref, ""))
         if kind == "conditional":
             condition = element.find(f"{_B}condition")
             text = _text(condition)
@@ -462,6 +524,31 @@ class _Reader:
         if not definitions.processes:
             raise self.fail(element, f"call activity {element.get('id')} embeds no bpmn:process")
         return next(iter(definitions.processes.values()))
+
+
+_CAMUNDA = "{http://camunda.org/schema/1.0/bpmn}"
+
+
+def _names(root: etree._Element, tag: str, fallback: str) -> dict[str, str]:
+    """id -> name of every ``bpmn:<tag>`` (its ``fallback`` attribute when it has no name)."""
+    return {
+        e.get("id", ""): (e.get("name") or e.get(fallback) or "").strip()
+        for e in root.iter(f"{_B}{tag}")
+    }
+
+
+def _unwrap(text: str) -> str:
+    """``${items}`` -> ``items``: Camunda writes expressions inside ``${}``."""
+    text = text.strip()
+    return text[2:-1].strip() if text.startswith("${") and text.endswith("}") else text
+
+
+def _item_name(element: etree._Element | None) -> str:
+    """The variable an ``inputDataItem``/``outputDataItem`` stands for: its id (as
+    SpiffWorkflow reads it), else its name."""
+    if element is None:
+        return ""
+    return (element.get("id") or element.get("name") or "").strip()
 
 
 def _is_definition(element: etree._Element) -> bool:

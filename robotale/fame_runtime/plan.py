@@ -14,17 +14,29 @@ from dataclasses import dataclass, field
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
-from robotale.fame_runtime.labels import catches, element_label, error_name, signal_topic
+from robotale.fame_runtime.labels import (
+    MESSAGE_TASKS,
+    catches,
+    element_label,
+    error_name,
+    escalation_name,
+    message_name,
+    message_topic,
+    signal_topic,
+)
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import (
     JAVASCRIPT,
     DataObject,
+    Definitions,
+    Loop,
     Node,
     Process,
     RosMessage,
     Scope,
 )
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
+from robotale.fame_runtime.splitter import namespace
 from robotale.fame_runtime.timers import TimerSpec
 
 EMPTY_MSGTYPE = "std_msgs/msg/Empty"
@@ -35,8 +47,6 @@ OUTSIDE = {
     "manualTask": "needs a person",
     "serviceTask": "is a service call (use a call activity bound to a skill)",
     "businessRuleTask": "needs a rule engine",
-    "sendTask": "uses messages (use a signal throw event, guideline G3)",
-    "receiveTask": "uses messages (use a signal catch event, guideline G3)",
     "transaction": "is a transaction",
     "adHocSubProcess": "is an ad-hoc sub-process",
     "complexGateway": "is a complex gateway",
@@ -55,22 +65,22 @@ _ROLES = {
 
 #: the event kinds each kind of event may have ("none" = no event definition)
 ALLOWED = {
-    "start": {"none", "signal", "timer", "conditional"},
-    "event_start": {"signal", "timer", "conditional", "error"},
+    "start": {"none", "signal", "timer", "conditional", "message"},
+    "event_start": {"signal", "timer", "conditional", "error", "message", "escalation"},
     "sub_start": {"none"},
-    "intermediateCatchEvent": {"signal", "timer", "conditional"},
-    "intermediateThrowEvent": {"none", "signal"},
-    "endEvent": {"none", "terminate", "signal", "error"},
-    "boundaryEvent": {"signal", "timer", "conditional", "error"},
+    "intermediateCatchEvent": {"signal", "timer", "conditional", "message"},
+    "intermediateThrowEvent": {"none", "signal", "message", "escalation"},
+    "endEvent": {"none", "terminate", "signal", "error", "message", "escalation"},
+    "boundaryEvent": {"signal", "timer", "conditional", "error", "message", "escalation"},
 }
 _SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
 
 
 @dataclass(slots=True, eq=False)
 class Trigger:
-    """What a catching event waits for."""
+    """What a catching event waits for (a message is a signal on its receiver's topic)."""
 
-    kind: str  # signal | timer | conditional | error
+    kind: str  # signal | timer | conditional | error | escalation
     label: str  # the activity its tags carry
     topic: str = ""  # signal: /name; error: the robot-relative name ("" catches any error)
     msgtype: str = ""
@@ -83,7 +93,7 @@ class Trigger:
 class Throw:
     """What a throwing event publishes or raises."""
 
-    kind: str  # signal | error
+    kind: str  # signal | message | error | escalation
     label: str
     topic: str
     msgtype: str = EMPTY_MSGTYPE
@@ -116,10 +126,22 @@ class NodePlan:
     data_inputs: list[DataObject] = field(default_factory=list)
     data_outputs: list[DataObject] = field(default_factory=list)
     reach: frozenset[str] | None = None  # see reachable_flows
+    loop: LoopPlan | None = None  # behaviour "loop": how often ``loop.body`` runs
 
     @property
     def id(self) -> str:
         return self.node.id
+
+
+@dataclass(slots=True, eq=False)
+class LoopPlan:
+    """A loop or multi-instance activity: its marker, the conditions compiled, and the
+    activity without its marker (``body``, no outgoing flows: one instance of it)."""
+
+    loop: Loop
+    body: NodePlan
+    cardinality: Compiled | None = None
+    condition: Compiled | None = None
 
 
 @dataclass(slots=True, eq=False)
@@ -212,6 +234,8 @@ class _Planner:
         self.problems: list[str] = []
         self.called: dict[int, ScopePlan] = {}
         self.where = ""  # which called process the planner is in, for messages
+        self.definitions: Definitions | None = None  # the top process's file (messages)
+        self.pool = ""  # the namespace of the top process's pool (its messages' topics)
 
     def refuse(self, node: Node, reason: str) -> None:
         self.problems.append(f"{node.kind} {node.describe()}{self.where} {reason}")
@@ -221,6 +245,9 @@ class _Planner:
             return self.called[id(process)]
         plan = ScopePlan(process, data_objects=list(process.data_objects.values()))
         self.called[id(process)] = plan
+        if top:
+            self.definitions = process.definitions
+            self.pool = _pool_namespace(process.definitions, process.id)
         outer = self.where
         if not top:
             file = f" ({process.file.name})" if process.file else ""
@@ -292,6 +319,38 @@ class _Planner:
             self.event(plan, scope, top=top, event=event)
         else:
             self.activity(plan, scope)
+        if node.loop is not None:
+            self.looped(plan)
+
+    def looped(self, plan: NodePlan) -> None:
+        """The activity becomes a loop around a copy of itself (its body): the loop owns the
+        outgoing flows and the boundary events, the body runs once per instance."""
+        loop = plan.node.loop
+        body = NodePlan(
+            plan.node,
+            plan.behaviour,
+            plan.label,
+            plan.scope,
+            trigger=plan.trigger,
+            throw=plan.throw,
+            script=plan.script,
+            skill=plan.skill,
+            child=plan.child,
+            data_inputs=plan.data_inputs,
+            data_outputs=plan.data_outputs,
+        )
+        looped = LoopPlan(loop, body)
+        for name in ("cardinality", "condition"):
+            expression = getattr(loop, name)
+            if expression is None:
+                continue
+            try:
+                setattr(looped, name, compile_condition(expression))
+            except ValueError as error:
+                self.refuse(plan.node, f"has a loop {name} the engine cannot run: {error}")
+        if loop.kind == "standard" and loop.condition is None and loop.maximum is None:
+            self.refuse(plan.node, "has a standard loop without loopCondition or loopMaximum")
+        plan.behaviour, plan.loop = "loop", looped
 
     def activity(self, plan: NodePlan, scope: ScopePlan) -> None:
         node = plan.node
@@ -305,10 +364,41 @@ class _Planner:
                 plan.script = compile_script(node.script) if node.script else None
             except ValueError as error:
                 self.refuse(node, f"has a script that cannot run: {error}")
+        elif node.kind in MESSAGE_TASKS:
+            self.message_task(plan)
         elif node.kind == "callActivity":
             self.call(plan)
         elif node.kind == "subProcess":
             self.subprocess(plan, scope)
+
+    def message_task(self, plan: NodePlan) -> None:
+        """A send task publishes like a message throw event, a receive task waits like a
+        message catch event; both are tagged by their own name."""
+        if plan.node.kind == "sendTask":
+            plan.behaviour = "pass"
+            plan.throw = self.message_throw(plan)
+        else:
+            plan.behaviour = "catch"
+            plan.trigger = self.trigger(plan)
+
+    def message_throw(self, plan: NodePlan) -> Throw | None:
+        """A message goes to the pool its message flow leads to, on that pool's topic."""
+        node = plan.node
+        targets = _message_targets(self.definitions, node.id)
+        if len(targets) != 1:
+            how = "no message flow leads" if not targets else f"{len(targets)} message flows lead"
+            self.refuse(
+                node,
+                f"sends message {message_name(node) or '(unnamed)'} but {how} from it to "
+                "another pool (draw exactly one message flow to the receiver)",
+            )
+            return None
+        topic = message_topic(targets[0], node)
+        if not topic:
+            self.refuse(node, "names no message (give the element or its message a name)")
+        message = node.message or RosMessage()
+        msgtype = message.msgtype or EMPTY_MSGTYPE
+        return Throw("message", plan.label, topic, msgtype, message.payload, message.qos)
 
     def call(self, plan: NodePlan) -> None:
         node = plan.node
@@ -392,6 +482,13 @@ class _Planner:
         if kind == "error":
             name = error_name(node)
             return Trigger("error", plan.label, name, EMPTY_MSGTYPE, message.qos)
+        if kind == "message":
+            topic = message_topic(self.pool, node)
+            if not topic:
+                self.refuse(node, "names no message (give the element or its message a name)")
+            return Trigger("signal", plan.label, topic, message.msgtype, message.qos)
+        if kind == "escalation":
+            return Trigger("escalation", plan.label, escalation_name(node))
         if kind == "timer":
             timer = node.event.timer if node.event else None
             if timer is None:
@@ -427,3 +524,33 @@ class _Planner:
             plan.throw = Throw("signal", plan.label, topic, msgtype, message.payload, message.qos)
         elif kind == "error":
             plan.throw = Throw("error", plan.label, error_name(node))
+        elif kind == "escalation":
+            plan.throw = Throw("escalation", plan.label, escalation_name(node))
+        elif kind == "message":
+            plan.throw = self.message_throw(plan)
+
+
+def _pool_namespace(definitions: Definitions | None, process_id: str) -> str:
+    """The namespace of the pool holding ``process_id`` (its process id without pools)."""
+    for participant in definitions.participants if definitions else ():
+        if participant.process_ref == process_id:
+            return namespace(participant.name)
+    return namespace(process_id)
+
+
+def _message_targets(definitions: Definitions | None, source: str) -> list[str]:
+    """The namespaces of the pools the message flows from ``source`` lead to."""
+    if definitions is None:
+        return []
+    pools = {p.id: p for p in definitions.participants}
+    owner = {n.id: p.id for p in definitions.processes.values() for n in p.walk()}
+    targets = []
+    for _, flow_source, target in definitions.message_flows:
+        if flow_source != source:
+            continue
+        pool = pools.get(target) or next(
+            (p for p in pools.values() if p.process_ref == owner.get(target)), None
+        )
+        if pool is not None:
+            targets.append(namespace(pool.name))
+    return targets

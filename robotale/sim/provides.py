@@ -92,9 +92,11 @@ def needs(
     definitions: Definitions, robots: list[str], library: Library | None = None
 ) -> Iterable[Need]:
     """What the model's scripts and uncaught signals need, per robot of ``robots``."""
+    # a building block's throw counts (REX's Detect throws DINGO's target_found)
     thrown = {
         signal_topic(node)
-        for _, process in definitions.pools()
+        for _, pool in definitions.pools()
+        for process in _with_blocks(pool, library)
         for node in process.walk()
         if node.event_kind == "signal" and node.kind in ("intermediateThrowEvent", "endEvent")
     }

@@ -255,3 +255,52 @@ def test_no_file_network_or_process_access_exists():
         context.eval("[typeof require, typeof std, typeof os, typeof fetch, typeof process].join()")
         == "undefined,undefined,undefined,undefined,undefined"
     )
+
+
+def test_values_a_script_sets_reach_python_as_json_would_carry_them(tmp_path):
+    """The usual outcome (plain values and next()) travels as flat text, anything else as
+    JSON; either way Python gets what JSON.stringify and json.loads make of the values."""
+    script = """
+        var v = this.environment.variables;
+        v.whole = 6; v.negative = -3; v.half = 0.5; v.huge = 1e21; v.small = 1e-7;
+        v.not_a_number = NaN; v.yes = true; v.no = false; v.empty = null;
+        v.text = "a b"; v.separator = "a\\u001fb"; delete v.gone;
+        next();
+    """
+    mission, _ = run(model(tmp_path, script), variables={"rover": {"gone": 1}})
+    got = mission.engines["rover"].variables
+    expected = {"whole": 6, "negative": -3, "half": 0.5, "huge": 1e21, "small": 1e-7}
+    expected |= {"not_a_number": None, "yes": True, "no": False, "empty": None}
+    expected |= {"text": "a b", "separator": "a\x1fb"}
+    assert {k: got[k] for k in expected} == expected and "gone" not in got
+    assert [type(got[k]) for k in ("whole", "negative", "half", "huge")] == [int, int, float, float]
+    # the same values one at a time: each alone takes the flat path unless it cannot
+    for name, value in expected.items():
+        text = {None: "null", True: "true", False: "false"}.get(value, repr(value))
+        if name in ("not_a_number", "separator"):
+            text = {"not_a_number": "NaN", "separator": '"a\\u001fb"'}[name]
+        one = f"this.environment.variables.{name} = {text}; next();"
+        mission, _ = run(model(tmp_path, one))
+        assert mission.engines["rover"].variables[name] == value, name
+
+
+def test_a_script_setting_many_variables_a_long_text_and_a_long_list(tmp_path):
+    """Long outboxes come back whole: many plain writes and a long string (flat text), a
+    long list of objects (JSON)."""
+    plain = """
+        var v = this.environment.variables;
+        for (var i = 0; i < 2000; i++) { v["value_" + i] = i; }
+        v.long = new Array(5001).join("ab");
+        next();
+    """
+    points = """
+        var points = [];
+        for (var i = 0; i < 2000; i++) { points.push({x: i, y: -i}); }
+        this.environment.variables.points = points;
+        next();
+    """
+    mission, _ = run(model(tmp_path, plain, points))
+    got = mission.engines["rover"].variables
+    assert [got[f"value_{i}"] for i in range(2000)] == list(range(2000))
+    assert got["long"] == "ab" * 5000
+    assert got["points"] == [{"x": i, "y": -i} for i in range(2000)]
