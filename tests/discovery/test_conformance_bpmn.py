@@ -107,10 +107,12 @@ def test_agricultural_pools_carry_the_message_labels(fame_models):
 
 def test_the_thesis_log_against_the_thesis_model(thesis_log, fame_models):
     # the authors tagged their ROS code by hand (move, cut_grass ...), so their log and their
-    # model disagree in places; the drone's single long run takes the token-replay fallback
+    # model disagree in places; the drone's single long run (thousands of events) takes the
+    # token-replay fallback, while a tractor's alignment needs well under the budget even on
+    # a busy machine (1 s was too tight under load)
     folder = fame_models / "fame-ros"
     report = check_conformance(
-        thesis_log, folder / "agri.bpmn", library=folder, seconds_per_trace=1
+        thesis_log, folder / "agri.bpmn", library=folder, seconds_per_trace=8
     )
     robots = report.robots.set_index("robot")
     assert robots.loc["drone", "method"] == "token replay"
