@@ -241,9 +241,10 @@ class Bag:
             try:
                 return deserialize(raw, msgtype)
             except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
+                reason = str(error).strip().rstrip(".") or type(error).__name__
                 raise InputError(
                     f"{self.path}: a message on {topic} cannot be decoded as {msgtype} "
-                    f"({error or type(error).__name__}); the definition registered for it does "
+                    f"({reason}); the definition registered for it does "
                     "not match the recording (give the right one with --msg or --distro)."
                 ) from None
 
