@@ -72,11 +72,24 @@ class Layout:
                 return False
         return True
 
+    def fitting(self, batch) -> tuple[np.ndarray, np.ndarray]:
+        """:meth:`fits` for every message of a :class:`~robotale.eventlog.messages.Batch` at
+        once: the rows that fit, and their first :attr:`end` bytes (what :func:`columns`
+        reads), one message per row."""
+        rows = np.flatnonzero(batch.lengths >= self.end)
+        heads = batch.heads(rows, self.end)
+        fits = (heads[:, :_HEADER] == np.frombuffer(self.header, dtype=np.uint8)).all(axis=1)
+        for offset, length in self.checks:
+            found = heads[:, offset : offset + 4] == np.frombuffer(length, dtype=np.uint8)
+            fits &= found.all(axis=1)
+        return rows[fits], heads[fits]
 
-def columns(layout: Layout, data: bytes | bytearray) -> list[np.ndarray]:
+
+def columns(layout: Layout, data: bytes | bytearray | np.ndarray) -> list[np.ndarray]:
     """One array per wanted field from messages that fit ``layout``, each cut to
-    ``layout.end`` bytes and laid end to end in ``data``."""
-    matrix = np.frombuffer(data, dtype=np.uint8).reshape(-1, layout.end)
+    ``layout.end`` bytes and laid end to end in ``data`` (or one per row of a matrix)."""
+    matrix = np.frombuffer(data, dtype=np.uint8) if not isinstance(data, np.ndarray) else data
+    matrix = matrix.reshape(-1, layout.end)
     arrays = []
     for offset, kind in layout.fields:
         size = _SIZES[kind]

@@ -291,7 +291,8 @@ def _once(report: Callable[[str], None] | None, told: set) -> Callable[[str], No
         key = text.partition(": ")[2]
         if report is not None and key not in told:
             told.add(key)
-            report(text)
+            with tqdm.external_write_mode():  # on a line of its own, not after the bar
+                report(text)
 
     return say
 

@@ -43,6 +43,7 @@ from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
 from robotale.eventlog.cdrlayout import Layout, columns
+from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
 
 TIME = "time"
@@ -183,8 +184,8 @@ class Bag:
             raise InputError(f"{self.path} has no topic {unknown[0]}.")
         connections = [c for c in self.reader.connections if c.topic in columns]
         rows = {topic: self._rows(topic, paths) for topic, paths in columns.items()}
-        for topic, recorded, raw in self._raw_messages(connections, progress):
-            rows[topic].add(recorded, raw)
+        for topic, batch in self._batches(connections, progress):
+            rows[topic].add(batch)
         tables = {}
         for topic, topic_rows in rows.items():
             table = topic_rows.table(list(columns[topic]), bag_time)
@@ -240,9 +241,10 @@ class Bag:
             try:
                 return deserialize(raw, msgtype)
             except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
+                reason = str(error).strip().rstrip(".") or type(error).__name__
                 raise InputError(
                     f"{self.path}: a message on {topic} cannot be decoded as {msgtype} "
-                    f"({error or type(error).__name__}); the definition registered for it does "
+                    f"({reason}); the definition registered for it does "
                     "not match the recording (give the right one with --msg or --distro)."
                 ) from None
 
@@ -269,30 +271,37 @@ class Bag:
 
         return check
 
-    def _raw_messages(
-        self, connections: list[Connection], progress
-    ) -> Iterator[tuple[str, int, bytes]]:
-        last = -1
+    def _batches(self, connections: list[Connection], progress) -> Iterator[tuple[str, Batch]]:
+        """The messages of ``connections`` in batches, a storage file after another, and an
+        error if a file's messages start before the previous file's end."""
+        spans: dict[str, list] = {}  # file -> [first time, its topic, last time]
         try:
-            for connection, recorded, raw in _storage_messages(self.reader, connections):
-                if recorded < last:
-                    raise InputError(
-                        _out_of_order(self.reader, self.path, connection.topic, recorded, last)
-                    )
-                last = recorded
+            for file, connection, batch in _storage_batches(self.reader, connections):
                 if progress is not None:
-                    progress.update()
-                yield connection.topic, recorded, raw
+                    progress.update(len(batch))
+                first, last = int(batch.recorded[0]), int(batch.recorded[-1])
+                span = spans.setdefault(file, [first, connection.topic, last])
+                if first < span[0]:
+                    span[0], span[1] = first, connection.topic
+                span[2] = max(span[2], last)
+                yield connection.topic, batch
         except ReaderError as error:
             raise InputError(f"{self.path} cannot be read: {error}") from None
+        except MalformedMcap as error:
+            raise InputError(f"{self.path} cannot be read: {error}.") from None
+        last = None
+        for first, topic, end in spans.values():
+            if last is not None and first < last:
+                raise InputError(_out_of_order(self.reader, self.path, topic, first, last))
+            last = end if last is None else max(last, end)
 
 
 class _TopicRows:
-    """The recording times and field values of one topic's messages.
+    """The recording times and field values of one topic's messages, gathered batch by batch.
 
     Numeric fields are read in bulk from the raw bytes of every message that shares the first
-    message's layout (:mod:`robotale.eventlog.cdrlayout`); other messages, and other fields, are
-    decoded one by one with rosbags.
+    message's layout (:mod:`robotale.eventlog.cdrlayout`), checked for a whole batch at once;
+    other messages, and other fields, are decoded one by one with rosbags.
     """
 
     def __init__(self, msgtype, paths: list[str], stamped: bool, typestore, decode, check) -> None:
@@ -300,27 +309,36 @@ class _TopicRows:
         self.typestore, self.decode, self.check = typestore, decode, check
         self.extract = _extractor(paths)
         self.layout: Layout | None = None
-        self.recorded: list[int] = []
-        self.bulk = bytearray()
+        self.recorded: list[np.ndarray] = []
+        self.count = 0
+        self.bulk: list[np.ndarray] = []  # the fitting messages' first layout.end bytes
         self.bulk_at: list[int] = []
         self.one_by_one: list[tuple] = []
         self.one_by_one_at: list[int] = []
 
-    def add(self, recorded: int, raw: bytes) -> None:
-        if not self.recorded:
-            self.check(raw, self.decode(raw))
+    def add(self, batch: Batch) -> None:
+        if not len(batch):
+            return
+        if not self.count:
+            first = batch.message(0)
+            self.check(first, self.decode(first))
             if self.paths:
-                self.layout = self._checked_layout(raw)
-        position = len(self.recorded)
-        self.recorded.append(recorded)
+                self.layout = self._checked_layout(first)
+        positions = np.arange(self.count, self.count + len(batch))
+        self.recorded.append(batch.recorded)
+        self.count += len(batch)
         if not self.paths:
             return
-        if self.layout is not None and self.layout.fits(raw):
-            self.bulk += raw[: self.layout.end]
-            self.bulk_at.append(position)
-        else:
-            self.one_by_one.append(self.extract(self.decode(raw)))
-            self.one_by_one_at.append(position)
+        fits = np.zeros(0, dtype=np.int64)
+        if self.layout is not None:
+            fits, heads = self.layout.fitting(batch)
+            self.bulk.append(heads)
+            self.bulk_at.extend(positions[fits].tolist())
+        rest = np.ones(len(batch), dtype=bool)
+        rest[fits] = False
+        for k in np.flatnonzero(rest).tolist():
+            self.one_by_one.append(self.extract(self.decode(batch.message(k))))
+            self.one_by_one_at.append(int(positions[k]))
 
     def _checked_layout(self, raw: bytes) -> Layout | None:
         """The first message's layout, if reading it in bulk gives what rosbags decodes."""
@@ -333,8 +351,9 @@ class _TopicRows:
         return layout if same else None
 
     def table(self, names: list[str], bag_time: bool) -> pd.DataFrame:
-        count = len(self.recorded)
-        bulk = columns(self.layout, self.bulk) if self.bulk_at else None
+        count = self.count
+        recorded = np.concatenate(self.recorded) if self.recorded else np.zeros(0, np.int64)
+        bulk = columns(self.layout, np.concatenate(self.bulk)) if self.bulk_at else None
         values = {}
         for k, name in enumerate(["_sec", "_nanosec"][: 2 * self.stamped] + names):
             if not self.one_by_one_at:
@@ -346,7 +365,12 @@ class _TopicRows:
             for position, row in zip(self.one_by_one_at, self.one_by_one, strict=True):
                 column[position] = row[k]  # one at a time: a value may itself be an array
             values[name] = pd.Series(column).infer_objects().to_numpy()
-        return _table(np.asarray(self.recorded, dtype=np.int64), values, names, bag_time)
+        # batches come a storage chunk at a time; chunks of a file may overlap in time
+        order = np.argsort(recorded, kind="stable")
+        if (order != np.arange(count)).any():
+            recorded = recorded[order]
+            values = {name: column[order] for name, column in values.items()}
+        return _table(recorded, values, names, bag_time)
 
 
 def read_bag(
@@ -533,7 +557,7 @@ def _qos_mismatches(reader: Reader) -> list[str]:
     """Topics whose QoS (or type hash) in metadata.yaml differs from what their storage says.
 
     rosbags pairs metadata and storage connections on those too, so it would read no message
-    of such a topic; :func:`_storage_messages` pairs them on topic and type only.
+    of such a topic; :func:`_storage_batches` pairs them on topic and type only.
     """
     storage_ext = {
         (c.topic, c.msgtype): (c.ext, c.digest)
@@ -554,13 +578,17 @@ def _storages(reader: Reader) -> list:
     return []
 
 
-def _storage_messages(
+def _storage_batches(
     reader: Reader, connections: list[Connection]
-) -> Iterator[tuple[Connection, int, bytes]]:
-    """The messages of ``connections``, read from each storage file by topic and type."""
+) -> Iterator[tuple[str, Connection, Batch]]:
+    """The messages of ``connections``, read from each storage file by topic and type, in
+    batches: (file, connection, batch)."""
     storages = _storages(reader)
     if not storages:  # not a directory reader: rosbags' own pairing is all there is
-        yield from reader.messages(connections=connections)
+        found = {c.id: c for c in connections}
+        plain = ((c.id, t, raw) for c, t, raw in reader.messages(connections=connections))
+        for key, batch in gathered(plain):
+            yield "", found[key], batch
         return
     wanted = {(c.topic, c.msgtype): c for c in connections}
     compressed = reader.compression_mode == "message"
@@ -570,11 +598,28 @@ def _storage_messages(
             for c in storage.connections
             if (c.topic, c.msgtype) in wanted
         }
-        own = [c for c in storage.connections if c.id in mine]
-        if not own:
+        if not mine:
             continue
-        for connection, recorded, raw in storage.messages(own, None, None):
-            yield mine[connection.id], recorded, _decompressed(raw) if compressed else raw
+        file = str(getattr(storage, "path", ""))
+        for key, batch in _file_batches(storage, mine, compressed):
+            yield file, mine[key], batch
+
+
+def _file_batches(storage, mine: Mapping[int, Connection], compressed: bool):
+    """One storage file's batches: straight from an indexed MCAP file's chunks, else from
+    rosbags' reading message by message."""
+    path = getattr(storage, "path", None)
+    if not compressed and isinstance(path, Path) and path.suffix == ".mcap":
+        batches = mcap_batches(path, mine)
+        if batches is not None:
+            yield from batches
+            return
+    own = [c for c in storage.connections if c.id in mine]
+    plain = (
+        (c.id, t, _decompressed(raw) if compressed else raw)
+        for c, t, raw in storage.messages(own, None, None)
+    )
+    yield from gathered(plain)
 
 
 def _decompressed(raw: bytes) -> bytes:

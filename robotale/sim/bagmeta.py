@@ -11,8 +11,16 @@ rosbags writes metadata version 8 or 9. Each distribution's reader
 A reader decodes the fields of the version a file states, so a file stating a newer version
 than the distribution's own (9 read by Humble: the QoS list where a string is expected) fails.
 :func:`for_distro` rewrites the metadata rosbags wrote (version 8 for Humble and Iron, 9 for
-Jazzy) into what the distribution itself writes, in metadata.yaml and in a sqlite3 bag's own
-``metadata`` table.
+Jazzy) into what the distribution itself writes, in metadata.yaml, in a sqlite3 bag's own
+``metadata`` table and in an MCAP file's ``rosbag2`` metadata record.
+
+That record is what rosbag2's MCAP plugin (``rosbag2_storage_mcap/src/mcap_storage.cpp``)
+writes: Humble's and Iron's ``{ROS_DISTRO: <distro>}`` (``ensure_rosdistro_metadata_added``),
+Jazzy's ``{serialized_metadata: <the bag's metadata as YAML>}`` (``update_metadata``). rosbags
+writes the latter whatever the version. Humble's and Iron's plugins never read the record;
+Jazzy's ``read_metadata`` decodes ``serialized_metadata`` (even with a metadata.yaml next to
+it: ``SequentialReader::seek`` asks the storage for its metadata) and falls back to version 8
+without it.
 """
 
 from __future__ import annotations
@@ -21,6 +29,9 @@ import sqlite3
 from pathlib import Path
 
 import yaml
+from mcap.reader import make_reader
+from mcap.writer import CompressionType
+from mcap.writer import Writer as McapWriter
 from rosbags.interfaces import (
     Qos,
     QosDurability,
@@ -69,6 +80,8 @@ def for_distro(bag: Path, distro: str) -> None:
     path.write_text(yaml.safe_dump(document, sort_keys=False), encoding="utf-8")
     for database in bag.glob("*.db3"):
         _store_in_database(database, info)
+    for mcap in bag.glob("*.mcap"):
+        _store_in_mcap(mcap, info, distro)
 
 
 def _converted(info: dict, distro: str) -> dict:
@@ -101,3 +114,54 @@ def _store_in_database(database: Path, info: dict) -> None:
                 (info["version"], yaml.safe_dump(info, sort_keys=False).strip()),
             )
     connection.close()
+
+
+def mcap_record(info: dict, distro: str) -> dict[str, str]:
+    """The ``rosbag2`` metadata record ``distro``'s MCAP plugin writes into each file."""
+    if VERSIONS[distro] < 9:
+        return {"ROS_DISTRO": distro}
+    return {"serialized_metadata": yaml.safe_dump(info, sort_keys=False)}
+
+
+def _store_in_mcap(file: Path, info: dict, distro: str) -> None:
+    """``file`` written again with ``distro``'s ``rosbag2`` record in place of rosbags' (the
+    record sits before the summary that indexes it, so the file is copied, not patched)."""
+    copy = file.with_name(f".{file.name}.part")
+    try:
+        _copy_mcap(file, copy, mcap_record(info, distro))
+        copy.replace(file)
+    finally:
+        copy.unlink(missing_ok=True)
+
+
+def _copy_mcap(file: Path, copy: Path, record: dict[str, str]) -> None:
+    with file.open("rb") as source, copy.open("wb") as target:
+        reader = make_reader(source)
+        summary = reader.get_summary()
+        compressed = any(chunk.compression for chunk in summary.chunk_indexes)
+        writer = McapWriter(
+            target, compression=CompressionType.ZSTD if compressed else CompressionType.NONE
+        )
+        header = reader.get_header()
+        writer.start(profile=header.profile, library=header.library)
+        schemas = {
+            key: writer.register_schema(schema.name, schema.encoding, schema.data)
+            for key, schema in summary.schemas.items()
+        }
+        channels = {
+            key: writer.register_channel(
+                channel.topic, channel.message_encoding, schemas.get(channel.schema_id, 0),
+                channel.metadata,
+            )
+            for key, channel in summary.channels.items()
+        }  # fmt: skip
+        for _, channel, message in reader.iter_messages(log_time_order=False):
+            writer.add_message(
+                channels[channel.id], message.log_time, message.data, message.publish_time,
+                message.sequence,
+            )  # fmt: skip
+        for metadata in reader.iter_metadata():
+            if metadata.name != "rosbag2":
+                writer.add_metadata(metadata.name, metadata.metadata)
+        writer.add_metadata("rosbag2", record)
+        writer.finish()

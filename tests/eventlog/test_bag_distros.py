@@ -138,3 +138,30 @@ def test_mcap_bags_read_back_with_the_mcap_reader(tmp_path, distro):
         seen[channel.topic] = seen.get(channel.topic, 0) + 1
     assert seen == counts
     assert info["message_count"] == sum(counts.values())
+
+
+@pytest.mark.parametrize("distro", ["humble", "iron", "jazzy"])
+def test_the_metadata_inside_an_mcap_file_is_the_distributions(tmp_path, distro):
+    """What rosbag2_storage_mcap writes (mcap_storage.cpp on each branch): Humble and Iron a
+    record {ROS_DISTRO}; Jazzy {serialized_metadata}, which its read_metadata decodes as
+    yaml.hpp's BagMetadata of the version it states."""
+    counts = record(tmp_path / "run", "mcap", distro)
+    info = yaml.safe_load((tmp_path / "run" / "metadata.yaml").read_text())
+    info = info["rosbag2_bagfile_information"]
+    with open(tmp_path / "run" / info["relative_file_paths"][0], "rb") as stream:
+        reader = make_reader(stream)
+        records = [(m.name, m.metadata) for m in reader.iter_metadata()]
+        seen = sum(1 for _ in reader.iter_messages())
+        indexed = reader.get_summary().chunk_indexes
+    assert seen == sum(counts.values()) and all(c.message_index_offsets for c in indexed)
+    if distro != "jazzy":
+        assert records == [("rosbag2", {"ROS_DISTRO": distro})]
+        return
+    [(name, data)] = records
+    assert name == "rosbag2" and list(data) == ["serialized_metadata"]
+    inside = yaml.safe_load(data["serialized_metadata"])
+    assert inside == info and inside["version"] == 9 and inside["ros_distro"] == "jazzy"
+    bag_keys, topic_keys = required("jazzy", inside["version"])
+    assert_kinds(inside, bag_keys, "serialized_metadata")
+    for entry in inside["topics_with_message_count"]:
+        assert_kinds(entry["topic_metadata"], topic_keys, entry["topic_metadata"]["name"])

@@ -9,6 +9,7 @@ import pytest
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.eventlog.cdrlayout import Layout, columns
+from robotale.eventlog.messages import Batch
 from robotale.eventlog.rosbag import Bag
 
 MIXED = "mixed_msgs/msg/Mixed"
@@ -69,6 +70,18 @@ def test_a_message_whose_lengths_differ_does_not_fit(store):
     assert Layout.of(first, MIXED, ["label"], store.fielddefs) is None  # strings: one by one
 
 
+def test_a_whole_batch_is_checked_as_each_message_would_be(store):
+    rng = np.random.default_rng(5)
+    shapes = [(5, 3), (5, 3), (6, 3), (5, 4), (5, 3), (1, 0), (5, 3)]
+    raws = [bytes(store.serialize_cdr(mixed(store, rng, *s), MIXED)) for s in shapes]
+    raws.append(raws[0][:-1][: Layout.of(raws[0], MIXED, WANTED, store.fielddefs).end - 1])
+    raws.append(b"\x00\x00" + raws[1][2:])  # big-endian: another header
+    layout = Layout.of(raws[0], MIXED, WANTED, store.fielddefs)
+    rows, heads = layout.fitting(Batch.of(range(len(raws)), raws))
+    assert rows.tolist() == [k for k, raw in enumerate(raws) if layout.fits(raw)] == [0, 1, 4, 6]
+    assert heads.tobytes() == b"".join(raws[k][: layout.end] for k in rows)
+
+
 def test_a_topic_mixing_layouts_reads_every_message_right(tmp_path, bag_builder):
     b = bag_builder()
     frames = ["odom", "odom", "map", "odom", "a_much_longer_frame", "odom"]
@@ -77,8 +90,8 @@ def test_a_topic_mixing_layouts_reads_every_message_right(tmp_path, bag_builder)
     paths = {"x": "pose.pose.position.x", "z": "pose.pose.position.z"}
     with Bag(b.write(tmp_path / "bag")) as bag:
         rows = bag._rows("/drone/odom", paths)
-        for _, recorded, raw in bag._raw_messages(bag.reader.connections, None):
-            rows.add(recorded, raw)
+        for _, batch in bag._batches(bag.reader.connections, None):
+            rows.add(batch)
     assert rows.bulk_at == [0, 1, 3, 5] and rows.one_by_one_at == [2, 4]
     table = rows.table(list(paths), bag_time=False)
     assert table["x"].tolist() == [t + 0.5 for t in range(6)]
