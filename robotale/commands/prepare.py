@@ -13,7 +13,8 @@ import pandas as pd
 
 from robotale.eventlog import writers
 from robotale.eventlog.enrich import PreparationWarning
-from robotale.eventlog.prepare import TagFields, find_runs, prepare, run_manifests
+from robotale.eventlog.prepare import TagFields, find_runs, prepare
+from robotale.fame_runtime.manifest import read_manifests
 
 
 def prepare_command(
@@ -61,7 +62,7 @@ def prepare_command(
         writers.write_xes(log, xes, name=source.resolve().name)
         written.append(xes)
     if ocel:
-        writers.write_ocel(log, ocel, runs=run_manifests(find_runs(source)))
+        writers.write_ocel(log, ocel, runs=read_manifests(find_runs(source)))
         written.append(ocel)
     cases = log["case:concept:name"].nunique()
     print(f"{len(log)} events from {cases} run(s) written to {', '.join(map(str, written))}")

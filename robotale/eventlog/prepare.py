@@ -51,9 +51,6 @@ from robotale.fame_runtime.manifest import RunManifest, read_manifests
 
 TAG_TOPICS = "/*/tag"
 DEFAULT_PERSPECTIVES = ("odom", "battery")
-#: each run's manifest by case id (the name ``robotale prepare`` imports; the manifest module
-#: owns the file)
-run_manifests = read_manifests
 #: the robot of tags that name none, on a topic without a namespace (a single-robot bag).
 DEFAULT_ROBOT = "robot"
 
@@ -523,5 +520,4 @@ __all__ = [
     "is_recording",
     "prepare",
     "robot_type",
-    "run_manifests",
 ]
