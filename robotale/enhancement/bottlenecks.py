@@ -39,17 +39,20 @@ import pandas as pd
 
 from robotale.discovery.graph import format_seconds
 from robotale.discovery.instances import DURATION, START_TIMESTAMP
-from robotale.enhancement.communication import TYPE, message_table
+from robotale.enhancement.communication import TYPE, shared_message_tables
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.performance import (
     ARROW,
     VARIANT,
     WAIT,
-    case_durations,
-    case_variant_table,
     finished_instances,
     robot_steps,
     robot_times,
+    shared_case_variants,
+    shared_cases,
+    shared_robot_times,
+    shared_steps,
 )
 from robotale.enhancement.result import Perspective, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP, message_roles
@@ -62,7 +65,7 @@ KEY = ["kind", "activity", "robot"]
 
 
 def find_bottlenecks(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
@@ -73,15 +76,21 @@ def find_bottlenecks(
     """Bottlenecks ranked by how much longer they make the cases (seconds per case), largest
     first; ``activity`` / ``robot`` keep the candidates of one activity or class. A variant is
     a candidate when at least ``min_variant_cases`` cases follow it."""
-    instances = finished_instances(log)
+    analysis = analysis_of(log)
+    instances = finished_instances(analysis)
     if instances.empty:
         return no_data("bottlenecks", "the log has no completed activity.")
-    if ROBOT not in instances.columns:
+    if ROBOT in instances.columns:
+        steps, robots = shared_steps(analysis), shared_robot_times(analysis)
+    else:
         instances = instances.assign(**{ROBOT: None})
-    steps = robot_steps(instances)
-    cases = case_durations(instances).set_index(CASE)["duration"]
-    presence = _keep(_presence(instances, steps, min_variant_cases), activity, robot)
-    excess = _keep(_steady_excess(log, instances, steps, baseline_quantile), activity, robot)
+        steps = robot_steps(instances)
+        robots = robot_times(instances, steps)
+    cases = shared_cases(analysis).set_index(CASE)["duration"]
+    paths = _paths(robots, shared_case_variants(analysis))
+    presence = _keep(_presence(instances, steps, paths, min_variant_cases), activity, robot)
+    excess = _steady_excess(analysis, instances, steps, baseline_quantile)
+    excess = _keep(excess, activity, robot)
     parts = [_effect_rows(presence, cases), _steady_rows(excess, cases)]
     parts = [part for part in parts if not part.empty]
     ranking = pd.concat(parts) if parts else pd.DataFrame({"delay_per_case": []})
@@ -118,7 +127,18 @@ def _keep(rows: pd.DataFrame, activity: str | None, robot: str | None) -> pd.Dat
 # -- effects: the cases with a thing against the cases without it ----------------------------
 
 
-def _presence(instances: pd.DataFrame, steps: pd.DataFrame, min_variant_cases: int):
+def _paths(robots: pd.DataFrame, case_variants: pd.DataFrame) -> pd.DataFrame:
+    """Rows of robot, case and variant: each robot's own path through a case and, when a case
+    has several robots, the case's path (robot missing)."""
+    paths = robots[[ROBOT, CASE, VARIANT]]
+    if paths[CASE].duplicated().any():  # several robots: their own paths and the case's
+        paths = pd.concat([paths, case_variants.assign(**{ROBOT: None})])
+    return paths[[ROBOT, CASE, VARIANT]]
+
+
+def _presence(
+    instances: pd.DataFrame, steps: pd.DataFrame, paths: pd.DataFrame, min_variant_cases: int
+) -> pd.DataFrame:
     """Rows of kind, activity, robot, case and occurrences: where each effect candidate is."""
     per_class = instances.groupby([ACTIVITY, ROBOT, CASE], dropna=False, sort=False).size()
     activities = _labelled(per_class, "activity")
@@ -134,10 +154,6 @@ def _presence(instances: pd.DataFrame, steps: pd.DataFrame, min_variant_cases: i
             "occurrences": moves["occurrences"],
         }
     )
-    paths = robot_times(instances, steps)[[ROBOT, CASE, VARIANT]]
-    if paths[CASE].duplicated().any():  # several robots: their own paths and the case's
-        paths = pd.concat([paths, case_variant_table(instances).assign(**{ROBOT: None})])
-    paths = paths[[ROBOT, CASE, VARIANT]]
     common = paths.groupby([VARIANT, ROBOT], dropna=False)[CASE].transform("size")
     paths = paths[common >= min_variant_cases]
     variants = pd.DataFrame(
@@ -197,14 +213,16 @@ def _same_cases(chosen: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
 # -- steady costs: time that need not be there --------------------------------------------------
 
 
-def _steady_excess(log, instances, steps, baseline_quantile: float) -> pd.DataFrame:
+def _steady_excess(
+    analysis: LogAnalysis, instances: pd.DataFrame, steps: pd.DataFrame, baseline_quantile: float
+) -> pd.DataFrame:
     waiting, resource = _waiting(steps, instances, _receive_activities(instances))
     parts = [
         waiting,
         resource,
         _rework(steps, instances),
         _delays(instances, baseline_quantile),
-        _queueing(log),
+        _queueing(analysis),
     ]
     parts = [part for part in parts if not part.empty]
     if not parts:
@@ -308,8 +326,8 @@ def _delays(instances: pd.DataFrame, quantile: float) -> pd.DataFrame:
     return _excess_rows(instances, "delay", instances[ACTIVITY], over)
 
 
-def _queueing(log: pd.DataFrame) -> pd.DataFrame:
-    messages = message_table(log)
+def _queueing(analysis: LogAnalysis) -> pd.DataFrame:
+    messages = shared_message_tables(analysis)[0]
     if messages.empty or CASE not in messages.columns:
         return pd.DataFrame()
     latency = messages["latency"].fillna(0)

@@ -29,8 +29,9 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import START_TIMESTAMP
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
-from robotale.enhancement.performance import case_durations, finished_instances
+from robotale.enhancement.performance import finished_instances, shared_cases
 from robotale.enhancement.result import Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
@@ -57,7 +58,7 @@ CHANNEL = ["sender", "receiver", TYPE]
 
 
 def communication_perspective(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
@@ -70,7 +71,9 @@ def communication_perspective(
     With ``activity`` (a send ``x!`` or receive ``x?`` activity) only the messages of that
     type; with ``robot`` only the messages that robot sent or received.
     """
-    messages, deliveries = message_tables(log, delay_threshold)
+    analysis = analysis_of(log)
+    log = analysis.log
+    messages, deliveries = shared_message_tables(analysis, delay_threshold)
     if messages.empty:
         return no_data("communication", "the log has no messages (no events with a msg_id).")
     keep = pd.Series(True, index=messages.index)
@@ -80,7 +83,7 @@ def communication_perspective(
         keep &= _involving(log, messages, robot)
     if not keep.any():
         return no_data("communication", f"no message involves {focus_label(activity, robot)}.")
-    lost, lost_effect = lost_messages(log, messages, following)
+    lost, lost_effect = lost_messages(analysis, messages, following)
     messages = messages[keep]
     deliveries = deliveries.merge(messages[_keys(messages)], on=_keys(messages))
     lost = lost.merge(messages[_keys(messages)], on=_keys(messages))
@@ -97,6 +100,15 @@ def message_table(log: pd.DataFrame) -> pd.DataFrame:
     """One row per message: type, sender, receiver(s), attempts, first send and receive,
     latency, whether it was lost, delayed or resent."""
     return message_tables(log)[0]
+
+
+def shared_message_tables(
+    analysis: LogAnalysis, delay_threshold: float | None = None
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`message_tables` of the analysed log, built once per analysis and threshold."""
+    return analysis.shared(
+        ("messages", delay_threshold), lambda: message_tables(analysis.log, delay_threshold)
+    )
 
 
 def message_tables(
@@ -135,7 +147,7 @@ def message_tables(
 
 
 def lost_messages(
-    log: pd.DataFrame, messages: pd.DataFrame, following: int = 3
+    log: pd.DataFrame | LogAnalysis, messages: pd.DataFrame, following: int = 3
 ) -> tuple[pd.DataFrame, dict]:
     """Every lost message with what its sender did next (``then``), whether it was resent and
     the resend got through, seconds from its send to its case's end, and how much later its
@@ -144,11 +156,12 @@ def lost_messages(
     lost = messages[messages["lost"]]
     columns = [*_keys(messages), TYPE, "sender", "receiver", "sent_at", "resent_as", "recovered"]
     lost = lost[[c for c in columns if c in lost.columns]].reset_index(drop=True)
-    instances = finished_instances(log)
+    analysis = analysis_of(log)
+    instances = finished_instances(analysis)
     if lost.empty or instances.empty or CASE not in lost.columns:
         return lost.assign(then=pd.Series(dtype=object)), {}
     lost["then"] = _what_followed(lost, instances, following)
-    cases = case_durations(instances).set_index(CASE)
+    cases = shared_cases(analysis).set_index(CASE)
     ends = cases["end"].reindex(lost[CASE]).to_numpy()
     lost["until_end"] = (pd.Series(ends) - lost["sent_at"]).dt.total_seconds()
     calm = cases.loc[~cases.index.isin(lost[CASE]), "duration"]
