@@ -39,7 +39,7 @@ import pandas as pd
 
 from robotale.discovery.graph import format_seconds
 from robotale.discovery.instances import DURATION, START_TIMESTAMP
-from robotale.enhancement.communication import TYPE, shared_message_tables
+from robotale.enhancement.communication import TYPE, event_roles, shared_message_tables
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.performance import (
@@ -55,7 +55,7 @@ from robotale.enhancement.performance import (
     shared_steps,
 )
 from robotale.enhancement.result import Perspective, focus_label, no_data
-from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP, message_roles
+from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP
 
 #: effect candidates, simplest first (the one named when several share their cases)
 EFFECTS = ("activity", "loop", "transition", "variant")
@@ -196,7 +196,7 @@ def _effect_rows(presence: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
 def _same_cases(chosen: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
     """Candidates found in exactly the same cases are one: the simplest kind (then the shortest
     name) is kept, and names the others in ``also``."""
-    signature = chosen.sort_values(CASE).groupby("_id")[CASE].agg(lambda c: hash(tuple(c)))
+    signature = _case_set_ids(chosen)
     order = table.assign(
         _sig=signature,
         _kind=table["kind"].map(EFFECTS.index),
@@ -208,6 +208,18 @@ def _same_cases(chosen: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
     others = label[~first].groupby(order.loc[~first, "_sig"]).agg("; ".join)
     also = order["_sig"].map(others).where(first)
     return pd.DataFrame({"_keep": first, "also": also}).reindex(table.index)
+
+
+def _case_set_ids(chosen: pd.DataFrame) -> pd.Series:
+    """Per ``_id``, a number shared by exactly the ids found in the same cases: each case gets
+    two random 64-bit tags, and a set is known by its size and the (wrapping) sums of its
+    cases' tags, a collision being as likely as guessing 128 random bits."""
+    codes, _ = pd.factorize(chosen[CASE])
+    tags = np.random.default_rng(0).integers(0, 2**63, size=(codes.max() + 2, 2), dtype=np.uint64)
+    mine = tags[codes]  # a missing case (code -1) takes the last row, its own tag
+    sums = pd.DataFrame({"a": mine[:, 0], "b": mine[:, 1]}).groupby(chosen["_id"].to_numpy())
+    signature = sums.sum().assign(n=sums.size())
+    return signature.groupby(["n", "a", "b"], sort=False).ngroup()
 
 
 # -- steady costs: time that need not be there --------------------------------------------------
@@ -232,7 +244,7 @@ def _steady_excess(
 
 
 def _receive_activities(instances: pd.DataFrame) -> set[str]:
-    return set(instances.loc[message_roles(instances) == RECEIVE, ACTIVITY])
+    return set(instances.loc[event_roles(instances) == RECEIVE, ACTIVITY])
 
 
 def _repeats(steps: pd.DataFrame) -> pd.Series:
@@ -375,15 +387,34 @@ def _hardest_hit(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
     """Per steady candidate, the cases whose excess is above its median case's (cases without
     any of it counting as 0): the cases it hits hardest."""
     per_case = excess.groupby(["_id", CASE], sort=False)["excess"].sum()
-    width = len(cases)
-    medians = per_case.groupby(level="_id").agg(lambda values: _median_with_zeros(values, width))
+    medians = _medians_with_zeros(per_case, len(cases))
     above = per_case > medians.reindex(per_case.index.get_level_values("_id")).to_numpy()
     return per_case[above].reset_index()[["_id", CASE]]
 
 
-def _median_with_zeros(values: pd.Series, width: int) -> float:
-    """The median of ``values`` padded with zeros to ``width`` values."""
-    return float(np.median(np.pad(values.to_numpy(float), (0, max(width - len(values), 0)))))
+def _medians_with_zeros(per_case: pd.Series, width: int) -> pd.Series:
+    """Per ``_id``, the median of its values padded with zeros to ``width`` values, for all
+    candidates at once: in the padded sorted values, its negative values come first, then the
+    zeros, then the rest."""
+    ids = per_case.index.get_level_values("_id")
+    frame = pd.DataFrame({"_id": ids, "v": per_case.to_numpy(float)})
+    frame = frame.sort_values(["_id", "v"], kind="stable")
+    size = frame.groupby("_id", sort=True).size()
+    negative = (frame["v"] < 0).groupby(frame["_id"], sort=True).sum().to_numpy()
+    start = np.concatenate([[0], np.cumsum(size.to_numpy())[:-1]])
+    count = size.to_numpy()
+    zeros = np.maximum(width - count, 0)
+    total = count + zeros
+    values = frame["v"].to_numpy()
+
+    def kth(k: np.ndarray) -> np.ndarray:
+        from_values = np.where(k < negative, k, k - zeros)  # among the group's own values
+        inside = (k >= negative) & (k < negative + zeros)
+        safe = np.clip(start + from_values, 0, max(len(values) - 1, 0))
+        return np.where(inside, 0.0, values[safe])
+
+    medians = (kth((total - 1) // 2) + kth(total // 2)) / 2
+    return pd.Series(medians, index=size.index)
 
 
 # -- the ranking -------------------------------------------------------------------------------
@@ -399,7 +430,7 @@ def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
         ["delay_per_case", "_kind", "occurrences"], ascending=[False, True, False], kind="stable"
     ).reset_index(drop=True)
     ranking.insert(0, "rank", range(1, len(ranking) + 1))
-    ranking["explanation"] = ranking.apply(_explain, axis=1)
+    ranking["explanation"] = [_explain(row) for row in ranking.to_dict("records")]
     if "also" not in ranking.columns:
         ranking["also"] = None
     columns = [
@@ -421,7 +452,7 @@ def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
     return ranking[columns]
 
 
-def _explain(row: pd.Series) -> str:
+def _explain(row: dict) -> str:
     who = row["robot"] if isinstance(row["robot"], str) else "the robot"
     each = format_seconds(row["mean"])
     per_case = format_seconds(row["delay_per_case"])
@@ -450,7 +481,7 @@ def _explain(row: pd.Series) -> str:
     return f"{sentence}: {per_case} per case"
 
 
-def _sure(row: pd.Series) -> str:
+def _sure(row: dict) -> str:
     return "" if pd.isna(row["p_value"]) else f", p = {row['p_value']:.2g}"
 
 

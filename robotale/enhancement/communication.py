@@ -41,6 +41,7 @@ from robotale.eventlog.schema import (
     MSG_ID,
     MSG_PAYLOAD,
     MSG_RECEIVER,
+    MSG_ROLE,
     MSG_SENDER,
     RECEIVE,
     ROBOT,
@@ -174,8 +175,28 @@ def lost_messages(
 def _message_events(log: pd.DataFrame) -> pd.DataFrame:
     if MSG_ID not in log.columns:
         return pd.DataFrame()
-    roles = message_roles(log)
-    return log.assign(_role=roles)[roles.notna().to_numpy(bool) & log[MSG_ID].notna()]
+    events = log[log[MSG_ID].notna().to_numpy(bool)]
+    roles = event_roles(events)
+    return events.assign(_role=roles)[roles.notna().to_numpy(bool)]
+
+
+def event_roles(events: pd.DataFrame) -> pd.Series:
+    """:func:`~robotale.eventlog.schema.message_roles` per event, worked out once per distinct
+    activity and ``msg_role`` (a log repeats a few names many times)."""
+    columns = [c for c in (ACTIVITY, MSG_ROLE) if c in events.columns]
+    combination = events.groupby(columns, dropna=False, sort=False).ngroup().to_numpy()
+    first = pd.Series(combination).drop_duplicates()
+    roles = np.empty(len(first), dtype=object)
+    roles[first.to_numpy()] = message_roles(events.iloc[first.index]).to_numpy(object)
+    return pd.Series(roles[combination], index=events.index, dtype=object, name=MSG_ROLE)
+
+
+def _ends_with(values: pd.Series, suffix: str) -> np.ndarray:
+    """Which ``values`` end in ``suffix`` (missing ones do not), tested once per distinct
+    value."""
+    codes, uniques = pd.factorize(values.astype(object))
+    ends = pd.Series(uniques, dtype="string").str.endswith(suffix).fillna(False)
+    return np.append(ends.to_numpy(bool), False)[codes]
 
 
 def _keys(frame: pd.DataFrame) -> list[str]:
@@ -185,7 +206,7 @@ def _keys(frame: pd.DataFrame) -> list[str]:
 def _types(sends: pd.DataFrame, receives: pd.DataFrame, keys: list[str]) -> pd.Series:
     # An activity that also sends, such as a selection that starts a message, does not name
     # it when the message activity itself (``x!``) is there.
-    marked = sends[ACTIVITY].astype("string").str.endswith("!").fillna(False).to_numpy(bool)
+    marked = _ends_with(sends[ACTIVITY], "!")
     named = _first(sends[marked], keys, ACTIVITY).combine_first(_first(sends, keys, ACTIVITY))
     from_receive = _first(receives, keys, ACTIVITY).map(_type_of)
     return named.combine_first(from_receive)
@@ -315,7 +336,9 @@ def _type_of(activity: str) -> str:
 def _first(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
     if column not in events.columns:
         return pd.Series(dtype=object)
-    ordered = events.sort_values(TIMESTAMP, kind="stable")
+    # events usually come in time order already; a stable sort would leave them as they are
+    in_order = events[TIMESTAMP].is_monotonic_increasing
+    ordered = events if in_order else events.sort_values(TIMESTAMP, kind="stable")
     return ordered.groupby(keys)[column].first().astype(object)
 
 
