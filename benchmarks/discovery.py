@@ -99,11 +99,13 @@ def pm4py_performance(log: pd.DataFrame) -> None:
 
 
 def robotale_performance(log: pd.DataFrame) -> None:
-    """The same questions answered by robotale: performance with variants, and bottlenecks."""
-    from robotale.enhancement import find_bottlenecks, performance_perspective
+    """The same questions answered by robotale: performance with variants, and bottlenecks,
+    sharing one analysis of the log as ``all_perspectives`` does."""
+    from robotale.enhancement import LogAnalysis, find_bottlenecks, performance_perspective
 
-    performance_perspective(log)
-    find_bottlenecks(log)
+    analysis = LogAnalysis(log)
+    performance_perspective(analysis)
+    find_bottlenecks(analysis)
 
 
 def main() -> int:

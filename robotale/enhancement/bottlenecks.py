@@ -39,7 +39,7 @@ import pandas as pd
 
 from robotale.discovery.graph import format_seconds
 from robotale.discovery.instances import DURATION, START_TIMESTAMP
-from robotale.enhancement.communication import TYPE, event_roles, shared_message_tables
+from robotale.enhancement.communication import TYPE, event_roles, shared_latencies
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.performance import (
@@ -339,7 +339,7 @@ def _delays(instances: pd.DataFrame, quantile: float) -> pd.DataFrame:
 
 
 def _queueing(analysis: LogAnalysis) -> pd.DataFrame:
-    messages = shared_message_tables(analysis)[0]
+    messages = shared_latencies(analysis)
     if messages.empty or CASE not in messages.columns:
         return pd.DataFrame()
     latency = messages["latency"].fillna(0)

@@ -117,20 +117,14 @@ def message_tables(
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The messages, and their deliveries: one row per message and receiver (a message nobody
     received has one, to the receiver it was meant for or ``unknown``)."""
-    events = _message_events(log)
-    if events.empty:
+    core = _message_core(log)
+    if core is None:
         return pd.DataFrame(), pd.DataFrame()
+    table, events, sends, receives = core
     keys = _keys(events)
-    sends = events[events["_role"] == SEND]
-    receives = events[events["_role"] == RECEIVE]
-    table = events.groupby(keys, sort=True).agg(first_event=(TIMESTAMP, "min"))
-    table[TYPE] = _types(sends, receives, keys).reindex(table.index)
-    sends = _sends_of_type(sends, table[TYPE], keys)
-    table["sender"] = _sender(events, sends, keys).reindex(table.index)
     if MSG_PAYLOAD in events.columns:
-        table["payload"] = _first(events, keys, MSG_PAYLOAD).reindex(table.index)
-    table["sent_at"] = sends.groupby(keys)[TIMESTAMP].min().reindex(table.index)
-    table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+        payload = _first(events, keys, MSG_PAYLOAD).reindex(table.index)
+        table.insert(table.columns.get_loc("sent_at"), "payload", payload)
     table["attempts"] = _attempts(sends, keys).reindex(table.index).fillna(0).astype(int)
     table["receivers"] = _distinct(receives, keys, ROBOT).reindex(table.index).fillna(0)
     table["receivers"] = table["receivers"].astype(int)
@@ -145,6 +139,42 @@ def message_tables(
     delayed = deliveries.groupby(keys)["delayed"].any()
     table["delayed"] = _lookup(table, keys, delayed).fillna(False).astype(bool)
     return _with_resends(table, keys), deliveries
+
+
+def shared_latencies(analysis: LogAnalysis) -> pd.DataFrame:
+    """Per message (rows as in :func:`message_table`): its type, sender and ``latency``, from
+    the analysis' message table when it has one, else from the little that needs."""
+    if ("messages", None) in analysis:
+        return shared_message_tables(analysis)[0]
+
+    def build() -> pd.DataFrame:
+        core = _message_core(analysis.log)
+        if core is None:
+            return pd.DataFrame()
+        table = core[0]
+        table["latency"] = (table["received_at"] - table["sent_at"]).dt.total_seconds()
+        return table.reset_index()
+
+    return analysis.shared("latencies", build)
+
+
+def _message_core(log: pd.DataFrame):
+    """The message events, the sends performed by the activity each message is named after,
+    the receives, and per message (indexed by case and id): type, sender, first send and
+    first receive; ``None`` when the log has no messages."""
+    events = _message_events(log)
+    if events.empty:
+        return None
+    keys = _keys(events)
+    sends = events[events["_role"] == SEND]
+    receives = events[events["_role"] == RECEIVE]
+    table = events.groupby(keys, sort=True).agg(first_event=(TIMESTAMP, "min"))
+    table[TYPE] = _types(sends, receives, keys).reindex(table.index)
+    sends = _sends_of_type(sends, table[TYPE], keys)
+    table["sender"] = _sender(events, sends, keys).reindex(table.index)
+    table["sent_at"] = sends.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+    table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+    return table, events, sends, receives
 
 
 def lost_messages(

@@ -30,6 +30,10 @@ class LogAnalysis:
             self._tables[key] = build()
         return self._tables[key]
 
+    def __contains__(self, key: Hashable) -> bool:
+        """Whether the table named ``key`` has been built."""
+        return key in self._tables
+
     def instances(self, carry: Sequence[str] = ()) -> pd.DataFrame:
         """:func:`~robotale.discovery.instances.activity_instances` of the log."""
         carry = tuple(carry)
