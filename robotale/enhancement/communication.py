@@ -31,7 +31,7 @@ import pandas as pd
 from robotale.discovery.instances import START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
-from robotale.enhancement.performance import finished_instances, shared_cases
+from robotale.enhancement.performance import ARROW, finished_instances, shared_cases
 from robotale.enhancement.result import Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
@@ -344,8 +344,10 @@ def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) 
     later = lost[[CASE, "sender", "sent_at"]].reset_index().merge(mine, on=[CASE, "sender"])
     later = later[later[START_TIMESTAMP] > later["sent_at"]]
     later = later.sort_values(["index", START_TIMESTAMP], kind="stable")
-    names = later.groupby("index").head(following).groupby("index")[ACTIVITY]
-    joined = names.agg(lambda a: " -> ".join(map(str, a)))
+    top = later.groupby("index").head(following)
+    # summing the strings joins them without a Python call per lost message
+    names = (top[ACTIVITY].astype(str) + ARROW).groupby(top["index"]).sum()
+    joined = names.str.slice(stop=-len(ARROW))
     return joined.reindex(lost.index).fillna("").tolist()
 
 
@@ -435,12 +437,11 @@ def _attempts(sends: pd.DataFrame, keys: list[str]) -> pd.Series:
 
 
 def _latency_figures(grouped) -> pd.DataFrame:
-    return grouped["latency"].agg(
-        latency_mean="mean",
-        latency_median="median",
-        latency_p95=lambda x: x.quantile(0.95),
-        latency_max="max",
-    )
+    latency = grouped["latency"]
+    table = latency.agg(latency_mean="mean", latency_median="median")
+    table["latency_p95"] = latency.quantile(0.95)  # one pass, not a call per channel
+    table["latency_max"] = latency.max()
+    return table
 
 
 def _by_type(messages: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:
