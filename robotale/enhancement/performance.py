@@ -291,7 +291,8 @@ def _transition_name(row: pd.Series) -> str:
 
 def _durations_figure(instances: pd.DataFrame):
     """Box plots of working time per activity, one colour per robot (plain traces: plotly
-    express spends seconds preparing a large frame)."""
+    express spends seconds preparing a large frame; fixed-width text arrays, which plotly
+    copies whole rather than string by string)."""
     import plotly.graph_objects as go
 
     figure = go.Figure()
@@ -299,9 +300,8 @@ def _durations_figure(instances: pd.DataFrame):
         instances.groupby(ROBOT, sort=True) if ROBOT in instances.columns else [("", instances)]
     )
     for robot, mine in robots:
-        figure.add_box(
-            x=mine[ACTIVITY].astype(str).to_numpy(), y=mine[DURATION].to_numpy(), name=str(robot)
-        )
+        names = mine[ACTIVITY].astype(str).to_numpy(str)
+        figure.add_box(x=names, y=mine[DURATION].to_numpy(), name=str(robot))
     return figure.update_layout(
         boxmode="group", title="Activity durations: working time (s)", yaxis_title=DURATION
     )

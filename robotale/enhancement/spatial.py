@@ -208,8 +208,9 @@ def _scatter(placed: pd.DataFrame):
             z=points[Z],
             mode="markers",
             name=str(activity),
-            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).tolist()},
-            text=None if who is None else who.tolist(),
+            # fixed-width text arrays: plotly copies them whole, not string by string
+            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).to_numpy(str)},
+            text=None if who is None else who.to_numpy(str),
             hovertemplate="%{text}<br>x %{x:.2f}, y %{y:.2f}, z %{z:.2f}",
         )
     figure.update_layout(
