@@ -238,7 +238,9 @@ def _types(sends: pd.DataFrame, receives: pd.DataFrame, keys: list[str]) -> pd.S
     # it when the message activity itself (``x!``) is there.
     marked = _ends_with(sends[ACTIVITY], "!")
     named = _first(sends[marked], keys, ACTIVITY).combine_first(_first(sends, keys, ACTIVITY))
-    from_receive = _first(receives, keys, ACTIVITY).map(_type_of)
+    received = _first(receives, keys, ACTIVITY)
+    codes, names = pd.factorize(received, use_na_sentinel=False)  # a few names, many messages
+    from_receive = pd.Series(names.map(_type_of).to_numpy(object)[codes], index=received.index)
     return named.combine_first(from_receive)
 
 

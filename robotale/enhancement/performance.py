@@ -300,7 +300,8 @@ def _durations_figure(instances: pd.DataFrame):
         instances.groupby(ROBOT, sort=True) if ROBOT in instances.columns else [("", instances)]
     )
     for robot, mine in robots:
-        names = mine[ACTIVITY].astype(str).to_numpy(str)
+        codes, names = pd.factorize(mine[ACTIVITY], use_na_sentinel=False)
+        names = pd.Series(names, dtype=object).astype(str).to_numpy(str)[codes]  # once a name
         figure.add_box(x=names, y=mine[DURATION].to_numpy(), name=str(robot))
     return figure.update_layout(
         boxmode="group", title="Activity durations: working time (s)", yaxis_title=DURATION
