@@ -386,18 +386,25 @@ def _steady_rows(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
 def _hardest_hit(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
     """Per steady candidate, the cases whose excess is above its median case's (cases without
     any of it counting as 0): the cases it hits hardest."""
-    per_case = excess.groupby(["_id", CASE], sort=False)["excess"].sum()
-    medians = _medians_with_zeros(per_case, len(cases))
-    above = per_case > medians.reindex(per_case.index.get_level_values("_id")).to_numpy()
-    return per_case[above].reset_index()[["_id", CASE]]
+    case_code, case_names = pd.factorize(excess[CASE])
+    known = case_code >= 0  # a row without a case belongs to no case
+    ids, case_code = excess["_id"].to_numpy()[known], case_code[known]
+    # one integer per candidate and case: grouping by it avoids hashing the case names again
+    pair = pd.Series(ids.astype(np.int64) * len(case_names) + case_code)
+    per_case = pd.Series(excess["excess"].to_numpy(float)[known]).groupby(pair, sort=False).sum()
+    pairs = pair.drop_duplicates()  # in the order of per_case's groups
+    per_id = ids[pairs.index.to_numpy()]
+    medians = _medians_with_zeros(per_id, per_case.to_numpy(), len(cases))
+    above = per_case.to_numpy() > medians.reindex(per_id).to_numpy()
+    cases_of = np.asarray(case_names.take(pairs.to_numpy() % max(len(case_names), 1)))
+    return pd.DataFrame({"_id": per_id[above], CASE: cases_of[above]})
 
 
-def _medians_with_zeros(per_case: pd.Series, width: int) -> pd.Series:
-    """Per ``_id``, the median of its values padded with zeros to ``width`` values, for all
+def _medians_with_zeros(ids: np.ndarray, values: np.ndarray, width: int) -> pd.Series:
+    """Per id, the median of its values padded with zeros to ``width`` values, for all
     candidates at once: in the padded sorted values, its negative values come first, then the
     zeros, then the rest."""
-    ids = per_case.index.get_level_values("_id")
-    frame = pd.DataFrame({"_id": ids, "v": per_case.to_numpy(float)})
+    frame = pd.DataFrame({"_id": ids, "v": values})
     frame = frame.sort_values(["_id", "v"], kind="stable")
     size = frame.groupby("_id", sort=True).size()
     negative = (frame["v"] < 0).groupby(frame["_id"], sort=True).sum().to_numpy()

@@ -213,8 +213,11 @@ def _message_events(log: pd.DataFrame) -> pd.DataFrame:
 def event_roles(events: pd.DataFrame) -> pd.Series:
     """:func:`~robotale.eventlog.schema.message_roles` per event, worked out once per distinct
     activity and ``msg_role`` (a log repeats a few names many times)."""
-    columns = [c for c in (ACTIVITY, MSG_ROLE) if c in events.columns]
-    combination = events.groupby(columns, dropna=False, sort=False).ngroup().to_numpy()
+    combination = np.zeros(len(events), dtype=np.int64)
+    for column in (c for c in (ACTIVITY, MSG_ROLE) if c in events.columns):
+        codes, uniques = pd.factorize(events[column], use_na_sentinel=False)
+        combination = combination * (len(uniques) + 1) + codes
+    combination = pd.factorize(combination)[0]  # numbered 0, 1, ... by first appearance
     first = pd.Series(combination).drop_duplicates()
     roles = np.empty(len(first), dtype=object)
     roles[first.to_numpy()] = message_roles(events.iloc[first.index]).to_numpy(object)
