@@ -275,10 +275,8 @@ def _resource_overlap(waits: pd.DataFrame, instances: pd.DataFrame) -> pd.Series
     if busy.empty or waits.empty:
         return pd.Series(0.0, index=waits.index)
     origin = busy[START_TIMESTAMP].min()
-    groups = pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)).unique()
-    busy_group = groups.get_indexer(pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)))
-    wait_group = groups.get_indexer(
-        pd.MultiIndex.from_arrays([waits[CASE].astype(str), waits["target"].astype(str)])
+    busy_group, wait_group = _group_numbers(
+        [busy[CASE], busy[ACTIVITY]], [waits[CASE], waits["target"]]
     )
     span = float((busy[TIMESTAMP].max() - origin).total_seconds()) + 1.0
     starts, lengths, cumulative = _busy_union(
@@ -296,6 +294,23 @@ def _resource_overlap(waits: pd.DataFrame, instances: pd.DataFrame) -> pd.Series
     overlap = np.zeros(len(waits))
     overlap[known] = busy_until(waits["target_start"]) - busy_until(waits["source_end"])
     return pd.Series(np.minimum(overlap, waits[WAIT].to_numpy()), index=waits.index)
+
+
+def _group_numbers(busy: list[pd.Series], waits: list[pd.Series]) -> tuple[np.ndarray, np.ndarray]:
+    """Numbers for the (case, activity) pairs of ``busy``, in order of first appearance, and
+    the number of each wait's pair (-1 when nothing was busy with it); values compare as text,
+    as a missing case matches a missing case."""
+    joint_busy = np.zeros(len(busy[0]), dtype=np.int64)
+    joint_waits = np.zeros(len(waits[0]), dtype=np.int64)
+    for mine, theirs in zip(busy, waits, strict=True):
+        both = np.concatenate(
+            [mine.astype(str).to_numpy(object), theirs.astype(str).to_numpy(object)]
+        )
+        codes, uniques = pd.factorize(both)
+        joint_busy = joint_busy * len(uniques) + codes[: len(mine)]
+        joint_waits = joint_waits * len(uniques) + codes[len(mine) :]
+    busy_group, pairs = pd.factorize(joint_busy)
+    return busy_group, pd.Index(pairs).get_indexer(joint_waits)
 
 
 def _seconds(times: pd.Series, origin: pd.Timestamp) -> np.ndarray:
