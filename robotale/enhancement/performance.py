@@ -124,7 +124,9 @@ def robot_steps(instances: pd.DataFrame) -> pd.DataFrame:
     keys = [CASE, ROBOT] if ROBOT in instances.columns else [CASE]
     ordered = instances.sort_values(keys, kind="stable")  # instances come in start order
     by_robot = ordered.groupby(keys, sort=False, dropna=False)
-    following = by_robot.shift(-1)
+    # only the columns a step reads from the next instance: shifting them all costs more
+    wanted = [c for c in (ACTIVITY, START_TIMESTAMP, MSG_ID, START_KNOWN) if c in ordered]
+    following = by_robot[wanted].shift(-1)
     busy_until = by_robot[TIMESTAMP].cummax()  # the latest completion so far
     steps = pd.DataFrame(
         {
@@ -194,7 +196,9 @@ def case_variant_table(instances: pd.DataFrame) -> pd.DataFrame:
 def _paths(instances: pd.DataFrame, keys: list[str]) -> pd.Series:
     """Per group, its activities in start order joined by arrows (summing the strings keeps
     the join vectorised)."""
-    names = instances[ACTIVITY].astype(str) + ARROW
+    codes, uniques = pd.factorize(instances[ACTIVITY], use_na_sentinel=False)
+    labels = pd.Series(uniques).astype(str) + ARROW  # once per name, not once per instance
+    names = pd.Series(labels.array.take(codes), index=instances.index)
     joined = names.groupby([instances[k] for k in keys], sort=True, dropna=False).sum()
     return joined.str.slice(stop=-len(ARROW))
 
