@@ -64,7 +64,8 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     if events.empty:
         return _empty_instances(log)
     events = events.assign(_order=np.arange(len(events)))
-    events = events.sort_values([TIMESTAMP, "_order"], kind="stable")
+    if not events[TIMESTAMP].is_monotonic_increasing:  # logs usually come in time order
+        events = events.sort_values([TIMESTAMP, "_order"], kind="stable")
     lifecycle = _lifecycle(events)
     group = events.groupby(_pairing_keys(events), dropna=False, sort=False).ngroup()
     starts = (lifecycle == START).to_numpy()
@@ -100,7 +101,11 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
 def _lifecycle(log: pd.DataFrame) -> pd.Series:
     if LIFECYCLE not in log.columns:
         return pd.Series(COMPLETE, index=log.index)
-    return log[LIFECYCLE].astype("string").fillna(COMPLETE).str.lower()
+    # lowered once per distinct value: a log repeats a handful of them
+    codes, uniques = pd.factorize(log[LIFECYCLE].astype(object))
+    lowered = pd.Series(uniques, dtype="string").str.lower()
+    lowered = pd.concat([lowered, pd.Series([COMPLETE], dtype="string")], ignore_index=True)
+    return pd.Series(lowered.array[codes], index=log.index)
 
 
 def _pairing_keys(events: pd.DataFrame) -> list[str]:

@@ -10,6 +10,7 @@ activity and/or robot for a drill-down::
 from robotale.enhancement.battery import battery_perspective, low_battery_events
 from robotale.enhancement.bottlenecks import find_bottlenecks
 from robotale.enhancement.communication import communication_perspective, message_table
+from robotale.enhancement.context import LogAnalysis
 from robotale.enhancement.performance import performance_perspective
 from robotale.enhancement.report import all_perspectives, report_html, write_report
 from robotale.enhancement.result import Perspective
@@ -17,6 +18,7 @@ from robotale.enhancement.spatial import Field, spatial_perspective
 
 __all__ = [
     "Field",
+    "LogAnalysis",
     "Perspective",
     "all_perspectives",
     "battery_perspective",

@@ -17,8 +17,9 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
-from robotale.enhancement.performance import WAIT, robot_steps
+from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP
+from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.performance import WAIT, finished_instances, shared_steps
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, ROBOT, TIMESTAMP
 
@@ -29,7 +30,7 @@ IDLE = "(waiting)"
 
 
 def battery_perspective(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
@@ -39,17 +40,19 @@ def battery_perspective(
 ) -> Perspective:
     """Battery levels per robot, what each activity consumed, and low-battery events with the
     ``following`` activities the robot performed next."""
+    analysis = analysis_of(log)
+    log = analysis.log
     levels = _levels(log)
     lows = low_battery_events(log, threshold=threshold, low_activity=low_activity)
     if levels.empty and lows.empty:
         return no_data("battery", f"the log has {NO_LEVELS} and no low-battery events.")
-    lows = _with_what_followed(lows, log, following)
+    lows = _with_what_followed(lows, analysis, following)
     focused = focus_events(levels, activity, robot) if not levels.empty else levels
     if activity is not None or robot is not None:
         lows = lows[_low_focus(lows, activity, robot)]
         if focused.empty and lows.empty:
             return no_data("battery", f"no battery data for {focus_label(activity, robot)}.")
-    consumption = activity_consumption(log, activity=activity, robot=robot)
+    consumption = activity_consumption(analysis, activity=activity, robot=robot)
     energy = case_energy(focused)
     return Perspective(
         name="battery",
@@ -84,18 +87,19 @@ def low_battery_events(
 
 
 def activity_consumption(
-    log: pd.DataFrame, *, activity: str | None = None, robot: str | None = None
+    log: pd.DataFrame | LogAnalysis, *, activity: str | None = None, robot: str | None = None
 ) -> pd.DataFrame:
     """Per activity and robot: the battery percentage points its instances used over their
     working time, in total, per instance and per minute, and the level at their starts; a
     ``(waiting)`` row per robot for what it used while idle between activities."""
-    levels = _levels(log)
+    analysis = analysis_of(log)
+    levels = _levels(analysis.log)
     if levels.empty:
         return pd.DataFrame()
-    instances = activity_instances(log, carry=[BATTERY])
+    instances = analysis.instances(carry=[BATTERY])
     instances = instances[instances[FINISHED]]
     instances = _fill_levels(instances, levels)
-    idle = _idle_use(instances, levels)
+    idle = _idle_use(analysis, levels)
     chosen = focus_events(instances, activity, robot).dropna(subset=[BATTERY, f"start_{BATTERY}"])
     if chosen.empty:
         return pd.DataFrame()
@@ -153,12 +157,12 @@ def _fill_levels(instances: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
     return filled
 
 
-def _idle_use(instances: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
+def _idle_use(analysis: LogAnalysis, levels: pd.DataFrame) -> pd.DataFrame:
     """Per robot, what it used between its activities: the level at one activity's completion
     minus the level at the next one's start, over the waits between them."""
-    if ROBOT not in instances.columns:
+    if ROBOT not in finished_instances(analysis).columns:
         return pd.DataFrame()
-    steps = robot_steps(instances).dropna(subset=[WAIT])
+    steps = shared_steps(analysis).dropna(subset=[WAIT])
     steps = steps[steps[WAIT] > 0]
     if steps.empty:
         return pd.DataFrame()
@@ -232,12 +236,12 @@ def _tagged_moments(events: pd.DataFrame) -> pd.DataFrame:
     return moments
 
 
-def _with_what_followed(lows: pd.DataFrame, log: pd.DataFrame, following: int) -> pd.DataFrame:
+def _with_what_followed(lows: pd.DataFrame, analysis: LogAnalysis, following: int) -> pd.DataFrame:
     """Adds ``then``: the next activities the robot started, and ``until_end``: seconds to its
     last completion in the case."""
     if lows.empty:
         return lows.assign(then=pd.Series(dtype=object), until_end=pd.Series(dtype=float))
-    instances = activity_instances(log)
+    instances = analysis.instances()
     then, until_end = [], []
     for _, low in lows.iterrows():
         mine = instances[(instances[CASE] == low[CASE]) & _same_robot(instances, low)]

@@ -39,20 +39,23 @@ import pandas as pd
 
 from robotale.discovery.graph import format_seconds
 from robotale.discovery.instances import DURATION, START_TIMESTAMP
-from robotale.enhancement.communication import TYPE, message_table
+from robotale.enhancement.communication import TYPE, event_roles, shared_latencies
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.performance import (
     ARROW,
     VARIANT,
     WAIT,
-    case_durations,
-    case_variant_table,
     finished_instances,
     robot_steps,
     robot_times,
+    shared_case_variants,
+    shared_cases,
+    shared_robot_times,
+    shared_steps,
 )
 from robotale.enhancement.result import Perspective, focus_label, no_data
-from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP, message_roles
+from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP
 
 #: effect candidates, simplest first (the one named when several share their cases)
 EFFECTS = ("activity", "loop", "transition", "variant")
@@ -62,7 +65,7 @@ KEY = ["kind", "activity", "robot"]
 
 
 def find_bottlenecks(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
@@ -73,15 +76,21 @@ def find_bottlenecks(
     """Bottlenecks ranked by how much longer they make the cases (seconds per case), largest
     first; ``activity`` / ``robot`` keep the candidates of one activity or class. A variant is
     a candidate when at least ``min_variant_cases`` cases follow it."""
-    instances = finished_instances(log)
+    analysis = analysis_of(log)
+    instances = finished_instances(analysis)
     if instances.empty:
         return no_data("bottlenecks", "the log has no completed activity.")
-    if ROBOT not in instances.columns:
+    if ROBOT in instances.columns:
+        steps, robots = shared_steps(analysis), shared_robot_times(analysis)
+    else:
         instances = instances.assign(**{ROBOT: None})
-    steps = robot_steps(instances)
-    cases = case_durations(instances).set_index(CASE)["duration"]
-    presence = _keep(_presence(instances, steps, min_variant_cases), activity, robot)
-    excess = _keep(_steady_excess(log, instances, steps, baseline_quantile), activity, robot)
+        steps = robot_steps(instances)
+        robots = robot_times(instances, steps)
+    cases = shared_cases(analysis).set_index(CASE)["duration"]
+    paths = _paths(robots, shared_case_variants(analysis))
+    presence = _keep(_presence(instances, steps, paths, min_variant_cases), activity, robot)
+    excess = _steady_excess(analysis, instances, steps, baseline_quantile)
+    excess = _keep(excess, activity, robot)
     parts = [_effect_rows(presence, cases), _steady_rows(excess, cases)]
     parts = [part for part in parts if not part.empty]
     ranking = pd.concat(parts) if parts else pd.DataFrame({"delay_per_case": []})
@@ -118,7 +127,18 @@ def _keep(rows: pd.DataFrame, activity: str | None, robot: str | None) -> pd.Dat
 # -- effects: the cases with a thing against the cases without it ----------------------------
 
 
-def _presence(instances: pd.DataFrame, steps: pd.DataFrame, min_variant_cases: int):
+def _paths(robots: pd.DataFrame, case_variants: pd.DataFrame) -> pd.DataFrame:
+    """Rows of robot, case and variant: each robot's own path through a case and, when a case
+    has several robots, the case's path (robot missing)."""
+    paths = robots[[ROBOT, CASE, VARIANT]]
+    if paths[CASE].duplicated().any():  # several robots: their own paths and the case's
+        paths = pd.concat([paths, case_variants.assign(**{ROBOT: None})])
+    return paths[[ROBOT, CASE, VARIANT]]
+
+
+def _presence(
+    instances: pd.DataFrame, steps: pd.DataFrame, paths: pd.DataFrame, min_variant_cases: int
+) -> pd.DataFrame:
     """Rows of kind, activity, robot, case and occurrences: where each effect candidate is."""
     per_class = instances.groupby([ACTIVITY, ROBOT, CASE], dropna=False, sort=False).size()
     activities = _labelled(per_class, "activity")
@@ -134,10 +154,6 @@ def _presence(instances: pd.DataFrame, steps: pd.DataFrame, min_variant_cases: i
             "occurrences": moves["occurrences"],
         }
     )
-    paths = robot_times(instances, steps)[[ROBOT, CASE, VARIANT]]
-    if paths[CASE].duplicated().any():  # several robots: their own paths and the case's
-        paths = pd.concat([paths, case_variant_table(instances).assign(**{ROBOT: None})])
-    paths = paths[[ROBOT, CASE, VARIANT]]
     common = paths.groupby([VARIANT, ROBOT], dropna=False)[CASE].transform("size")
     paths = paths[common >= min_variant_cases]
     variants = pd.DataFrame(
@@ -180,7 +196,7 @@ def _effect_rows(presence: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
 def _same_cases(chosen: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
     """Candidates found in exactly the same cases are one: the simplest kind (then the shortest
     name) is kept, and names the others in ``also``."""
-    signature = chosen.sort_values(CASE).groupby("_id")[CASE].agg(lambda c: hash(tuple(c)))
+    signature = _case_set_ids(chosen)
     order = table.assign(
         _sig=signature,
         _kind=table["kind"].map(EFFECTS.index),
@@ -194,17 +210,31 @@ def _same_cases(chosen: pd.DataFrame, table: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame({"_keep": first, "also": also}).reindex(table.index)
 
 
+def _case_set_ids(chosen: pd.DataFrame) -> pd.Series:
+    """Per ``_id``, a number shared by exactly the ids found in the same cases: each case gets
+    two random 64-bit tags, and a set is known by its size and the (wrapping) sums of its
+    cases' tags, a collision being as likely as guessing 128 random bits."""
+    codes, _ = pd.factorize(chosen[CASE])
+    tags = np.random.default_rng(0).integers(0, 2**63, size=(codes.max() + 2, 2), dtype=np.uint64)
+    mine = tags[codes]  # a missing case (code -1) takes the last row, its own tag
+    sums = pd.DataFrame({"a": mine[:, 0], "b": mine[:, 1]}).groupby(chosen["_id"].to_numpy())
+    signature = sums.sum().assign(n=sums.size())
+    return signature.groupby(["n", "a", "b"], sort=False).ngroup()
+
+
 # -- steady costs: time that need not be there --------------------------------------------------
 
 
-def _steady_excess(log, instances, steps, baseline_quantile: float) -> pd.DataFrame:
+def _steady_excess(
+    analysis: LogAnalysis, instances: pd.DataFrame, steps: pd.DataFrame, baseline_quantile: float
+) -> pd.DataFrame:
     waiting, resource = _waiting(steps, instances, _receive_activities(instances))
     parts = [
         waiting,
         resource,
         _rework(steps, instances),
         _delays(instances, baseline_quantile),
-        _queueing(log),
+        _queueing(analysis),
     ]
     parts = [part for part in parts if not part.empty]
     if not parts:
@@ -214,7 +244,7 @@ def _steady_excess(log, instances, steps, baseline_quantile: float) -> pd.DataFr
 
 
 def _receive_activities(instances: pd.DataFrame) -> set[str]:
-    return set(instances.loc[message_roles(instances) == RECEIVE, ACTIVITY])
+    return set(instances.loc[event_roles(instances) == RECEIVE, ACTIVITY])
 
 
 def _repeats(steps: pd.DataFrame) -> pd.Series:
@@ -245,10 +275,8 @@ def _resource_overlap(waits: pd.DataFrame, instances: pd.DataFrame) -> pd.Series
     if busy.empty or waits.empty:
         return pd.Series(0.0, index=waits.index)
     origin = busy[START_TIMESTAMP].min()
-    groups = pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)).unique()
-    busy_group = groups.get_indexer(pd.MultiIndex.from_frame(busy[[CASE, ACTIVITY]].astype(str)))
-    wait_group = groups.get_indexer(
-        pd.MultiIndex.from_arrays([waits[CASE].astype(str), waits["target"].astype(str)])
+    busy_group, wait_group = _group_numbers(
+        [busy[CASE], busy[ACTIVITY]], [waits[CASE], waits["target"]]
     )
     span = float((busy[TIMESTAMP].max() - origin).total_seconds()) + 1.0
     starts, lengths, cumulative = _busy_union(
@@ -266,6 +294,23 @@ def _resource_overlap(waits: pd.DataFrame, instances: pd.DataFrame) -> pd.Series
     overlap = np.zeros(len(waits))
     overlap[known] = busy_until(waits["target_start"]) - busy_until(waits["source_end"])
     return pd.Series(np.minimum(overlap, waits[WAIT].to_numpy()), index=waits.index)
+
+
+def _group_numbers(busy: list[pd.Series], waits: list[pd.Series]) -> tuple[np.ndarray, np.ndarray]:
+    """Numbers for the (case, activity) pairs of ``busy``, in order of first appearance, and
+    the number of each wait's pair (-1 when nothing was busy with it); values compare as text,
+    as a missing case matches a missing case."""
+    joint_busy = np.zeros(len(busy[0]), dtype=np.int64)
+    joint_waits = np.zeros(len(waits[0]), dtype=np.int64)
+    for mine, theirs in zip(busy, waits, strict=True):
+        both = np.concatenate(
+            [mine.astype(str).to_numpy(object), theirs.astype(str).to_numpy(object)]
+        )
+        codes, uniques = pd.factorize(both)
+        joint_busy = joint_busy * len(uniques) + codes[: len(mine)]
+        joint_waits = joint_waits * len(uniques) + codes[len(mine) :]
+    busy_group, pairs = pd.factorize(joint_busy)
+    return busy_group, pd.Index(pairs).get_indexer(joint_waits)
 
 
 def _seconds(times: pd.Series, origin: pd.Timestamp) -> np.ndarray:
@@ -308,8 +353,8 @@ def _delays(instances: pd.DataFrame, quantile: float) -> pd.DataFrame:
     return _excess_rows(instances, "delay", instances[ACTIVITY], over)
 
 
-def _queueing(log: pd.DataFrame) -> pd.DataFrame:
-    messages = message_table(log)
+def _queueing(analysis: LogAnalysis) -> pd.DataFrame:
+    messages = shared_latencies(analysis)
     if messages.empty or CASE not in messages.columns:
         return pd.DataFrame()
     latency = messages["latency"].fillna(0)
@@ -356,16 +401,42 @@ def _steady_rows(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
 def _hardest_hit(excess: pd.DataFrame, cases: pd.Series) -> pd.DataFrame:
     """Per steady candidate, the cases whose excess is above its median case's (cases without
     any of it counting as 0): the cases it hits hardest."""
-    per_case = excess.groupby(["_id", CASE], sort=False)["excess"].sum()
-    width = len(cases)
-    medians = per_case.groupby(level="_id").agg(lambda values: _median_with_zeros(values, width))
-    above = per_case > medians.reindex(per_case.index.get_level_values("_id")).to_numpy()
-    return per_case[above].reset_index()[["_id", CASE]]
+    case_code, case_names = pd.factorize(excess[CASE])
+    known = case_code >= 0  # a row without a case belongs to no case
+    ids, case_code = excess["_id"].to_numpy()[known], case_code[known]
+    # one integer per candidate and case: grouping by it avoids hashing the case names again
+    pair = pd.Series(ids.astype(np.int64) * len(case_names) + case_code)
+    per_case = pd.Series(excess["excess"].to_numpy(float)[known]).groupby(pair, sort=False).sum()
+    pairs = pair.drop_duplicates()  # in the order of per_case's groups
+    per_id = ids[pairs.index.to_numpy()]
+    medians = _medians_with_zeros(per_id, per_case.to_numpy(), len(cases))
+    above = per_case.to_numpy() > medians.reindex(per_id).to_numpy()
+    cases_of = np.asarray(case_names.take(pairs.to_numpy() % max(len(case_names), 1)))
+    return pd.DataFrame({"_id": per_id[above], CASE: cases_of[above]})
 
 
-def _median_with_zeros(values: pd.Series, width: int) -> float:
-    """The median of ``values`` padded with zeros to ``width`` values."""
-    return float(np.median(np.pad(values.to_numpy(float), (0, max(width - len(values), 0)))))
+def _medians_with_zeros(ids: np.ndarray, values: np.ndarray, width: int) -> pd.Series:
+    """Per id, the median of its values padded with zeros to ``width`` values, for all
+    candidates at once: in the padded sorted values, its negative values come first, then the
+    zeros, then the rest."""
+    frame = pd.DataFrame({"_id": ids, "v": values})
+    frame = frame.sort_values(["_id", "v"], kind="stable")
+    size = frame.groupby("_id", sort=True).size()
+    negative = (frame["v"] < 0).groupby(frame["_id"], sort=True).sum().to_numpy()
+    start = np.concatenate([[0], np.cumsum(size.to_numpy())[:-1]])
+    count = size.to_numpy()
+    zeros = np.maximum(width - count, 0)
+    total = count + zeros
+    values = frame["v"].to_numpy()
+
+    def kth(k: np.ndarray) -> np.ndarray:
+        from_values = np.where(k < negative, k, k - zeros)  # among the group's own values
+        inside = (k >= negative) & (k < negative + zeros)
+        safe = np.clip(start + from_values, 0, max(len(values) - 1, 0))
+        return np.where(inside, 0.0, values[safe])
+
+    medians = (kth((total - 1) // 2) + kth(total // 2)) / 2
+    return pd.Series(medians, index=size.index)
 
 
 # -- the ranking -------------------------------------------------------------------------------
@@ -381,7 +452,7 @@ def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
         ["delay_per_case", "_kind", "occurrences"], ascending=[False, True, False], kind="stable"
     ).reset_index(drop=True)
     ranking.insert(0, "rank", range(1, len(ranking) + 1))
-    ranking["explanation"] = ranking.apply(_explain, axis=1)
+    ranking["explanation"] = [_explain(row) for row in ranking.to_dict("records")]
     if "also" not in ranking.columns:
         ranking["also"] = None
     columns = [
@@ -403,7 +474,7 @@ def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
     return ranking[columns]
 
 
-def _explain(row: pd.Series) -> str:
+def _explain(row: dict) -> str:
     who = row["robot"] if isinstance(row["robot"], str) else "the robot"
     each = format_seconds(row["mean"])
     per_case = format_seconds(row["delay_per_case"])
@@ -432,7 +503,7 @@ def _explain(row: pd.Series) -> str:
     return f"{sentence}: {per_case} per case"
 
 
-def _sure(row: pd.Series) -> str:
+def _sure(row: dict) -> str:
     return "" if pd.isna(row["p_value"]) else f", p = {row['p_value']:.2g}"
 
 

@@ -29,8 +29,9 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import START_TIMESTAMP
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
-from robotale.enhancement.performance import case_durations, finished_instances
+from robotale.enhancement.performance import ARROW, finished_instances, shared_cases
 from robotale.enhancement.result import Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
@@ -40,6 +41,7 @@ from robotale.eventlog.schema import (
     MSG_ID,
     MSG_PAYLOAD,
     MSG_RECEIVER,
+    MSG_ROLE,
     MSG_SENDER,
     RECEIVE,
     ROBOT,
@@ -57,7 +59,7 @@ CHANNEL = ["sender", "receiver", TYPE]
 
 
 def communication_perspective(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
@@ -70,7 +72,9 @@ def communication_perspective(
     With ``activity`` (a send ``x!`` or receive ``x?`` activity) only the messages of that
     type; with ``robot`` only the messages that robot sent or received.
     """
-    messages, deliveries = message_tables(log, delay_threshold)
+    analysis = analysis_of(log)
+    log = analysis.log
+    messages, deliveries = shared_message_tables(analysis, delay_threshold)
     if messages.empty:
         return no_data("communication", "the log has no messages (no events with a msg_id).")
     keep = pd.Series(True, index=messages.index)
@@ -80,7 +84,7 @@ def communication_perspective(
         keep &= _involving(log, messages, robot)
     if not keep.any():
         return no_data("communication", f"no message involves {focus_label(activity, robot)}.")
-    lost, lost_effect = lost_messages(log, messages, following)
+    lost, lost_effect = lost_messages(analysis, messages, following)
     messages = messages[keep]
     deliveries = deliveries.merge(messages[_keys(messages)], on=_keys(messages))
     lost = lost.merge(messages[_keys(messages)], on=_keys(messages))
@@ -99,25 +103,28 @@ def message_table(log: pd.DataFrame) -> pd.DataFrame:
     return message_tables(log)[0]
 
 
+def shared_message_tables(
+    analysis: LogAnalysis, delay_threshold: float | None = None
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """:func:`message_tables` of the analysed log, built once per analysis and threshold."""
+    return analysis.shared(
+        ("messages", delay_threshold), lambda: message_tables(analysis.log, delay_threshold)
+    )
+
+
 def message_tables(
     log: pd.DataFrame, delay_threshold: float | None = None
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """The messages, and their deliveries: one row per message and receiver (a message nobody
     received has one, to the receiver it was meant for or ``unknown``)."""
-    events = _message_events(log)
-    if events.empty:
+    core = _message_core(log)
+    if core is None:
         return pd.DataFrame(), pd.DataFrame()
+    table, events, sends, receives = core
     keys = _keys(events)
-    sends = events[events["_role"] == SEND]
-    receives = events[events["_role"] == RECEIVE]
-    table = events.groupby(keys, sort=True).agg(first_event=(TIMESTAMP, "min"))
-    table[TYPE] = _types(sends, receives, keys).reindex(table.index)
-    sends = _sends_of_type(sends, table[TYPE], keys)
-    table["sender"] = _sender(events, sends, keys).reindex(table.index)
     if MSG_PAYLOAD in events.columns:
-        table["payload"] = _first(events, keys, MSG_PAYLOAD).reindex(table.index)
-    table["sent_at"] = sends.groupby(keys)[TIMESTAMP].min().reindex(table.index)
-    table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+        payload = _first(events, keys, MSG_PAYLOAD).reindex(table.index)
+        table.insert(table.columns.get_loc("sent_at"), "payload", payload)
     table["attempts"] = _attempts(sends, keys).reindex(table.index).fillna(0).astype(int)
     table["receivers"] = _distinct(receives, keys, ROBOT).reindex(table.index).fillna(0)
     table["receivers"] = table["receivers"].astype(int)
@@ -134,8 +141,44 @@ def message_tables(
     return _with_resends(table, keys), deliveries
 
 
+def shared_latencies(analysis: LogAnalysis) -> pd.DataFrame:
+    """Per message (rows as in :func:`message_table`): its type, sender and ``latency``, from
+    the analysis' message table when it has one, else from the little that needs."""
+    if ("messages", None) in analysis:
+        return shared_message_tables(analysis)[0]
+
+    def build() -> pd.DataFrame:
+        core = _message_core(analysis.log)
+        if core is None:
+            return pd.DataFrame()
+        table = core[0]
+        table["latency"] = (table["received_at"] - table["sent_at"]).dt.total_seconds()
+        return table.reset_index()
+
+    return analysis.shared("latencies", build)
+
+
+def _message_core(log: pd.DataFrame):
+    """The message events, the sends performed by the activity each message is named after,
+    the receives, and per message (indexed by case and id): type, sender, first send and
+    first receive; ``None`` when the log has no messages."""
+    events = _message_events(log)
+    if events.empty:
+        return None
+    keys = _keys(events)
+    sends = events[events["_role"] == SEND]
+    receives = events[events["_role"] == RECEIVE]
+    table = events.groupby(keys, sort=True).agg(first_event=(TIMESTAMP, "min"))
+    table[TYPE] = _types(sends, receives, keys).reindex(table.index)
+    sends = _sends_of_type(sends, table[TYPE], keys)
+    table["sender"] = _sender(events, sends, keys).reindex(table.index)
+    table["sent_at"] = sends.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+    table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+    return table, events, sends, receives
+
+
 def lost_messages(
-    log: pd.DataFrame, messages: pd.DataFrame, following: int = 3
+    log: pd.DataFrame | LogAnalysis, messages: pd.DataFrame, following: int = 3
 ) -> tuple[pd.DataFrame, dict]:
     """Every lost message with what its sender did next (``then``), whether it was resent and
     the resend got through, seconds from its send to its case's end, and how much later its
@@ -144,11 +187,12 @@ def lost_messages(
     lost = messages[messages["lost"]]
     columns = [*_keys(messages), TYPE, "sender", "receiver", "sent_at", "resent_as", "recovered"]
     lost = lost[[c for c in columns if c in lost.columns]].reset_index(drop=True)
-    instances = finished_instances(log)
+    analysis = analysis_of(log)
+    instances = finished_instances(analysis)
     if lost.empty or instances.empty or CASE not in lost.columns:
         return lost.assign(then=pd.Series(dtype=object)), {}
     lost["then"] = _what_followed(lost, instances, following)
-    cases = case_durations(instances).set_index(CASE)
+    cases = shared_cases(analysis).set_index(CASE)
     ends = cases["end"].reindex(lost[CASE]).to_numpy()
     lost["until_end"] = (pd.Series(ends) - lost["sent_at"]).dt.total_seconds()
     calm = cases.loc[~cases.index.isin(lost[CASE]), "duration"]
@@ -161,8 +205,31 @@ def lost_messages(
 def _message_events(log: pd.DataFrame) -> pd.DataFrame:
     if MSG_ID not in log.columns:
         return pd.DataFrame()
-    roles = message_roles(log)
-    return log.assign(_role=roles)[roles.notna().to_numpy(bool) & log[MSG_ID].notna()]
+    events = log[log[MSG_ID].notna().to_numpy(bool)]
+    roles = event_roles(events)
+    return events.assign(_role=roles)[roles.notna().to_numpy(bool)]
+
+
+def event_roles(events: pd.DataFrame) -> pd.Series:
+    """:func:`~robotale.eventlog.schema.message_roles` per event, worked out once per distinct
+    activity and ``msg_role`` (a log repeats a few names many times)."""
+    combination = np.zeros(len(events), dtype=np.int64)
+    for column in (c for c in (ACTIVITY, MSG_ROLE) if c in events.columns):
+        codes, uniques = pd.factorize(events[column], use_na_sentinel=False)
+        combination = combination * (len(uniques) + 1) + codes
+    combination = pd.factorize(combination)[0]  # numbered 0, 1, ... by first appearance
+    first = pd.Series(combination).drop_duplicates()
+    roles = np.empty(len(first), dtype=object)
+    roles[first.to_numpy()] = message_roles(events.iloc[first.index]).to_numpy(object)
+    return pd.Series(roles[combination], index=events.index, dtype=object, name=MSG_ROLE)
+
+
+def _ends_with(values: pd.Series, suffix: str) -> np.ndarray:
+    """Which ``values`` end in ``suffix`` (missing ones do not), tested once per distinct
+    value."""
+    codes, uniques = pd.factorize(values.astype(object))
+    ends = pd.Series(uniques, dtype="string").str.endswith(suffix).fillna(False)
+    return np.append(ends.to_numpy(bool), False)[codes]
 
 
 def _keys(frame: pd.DataFrame) -> list[str]:
@@ -172,9 +239,11 @@ def _keys(frame: pd.DataFrame) -> list[str]:
 def _types(sends: pd.DataFrame, receives: pd.DataFrame, keys: list[str]) -> pd.Series:
     # An activity that also sends, such as a selection that starts a message, does not name
     # it when the message activity itself (``x!``) is there.
-    marked = sends[ACTIVITY].astype("string").str.endswith("!").fillna(False).to_numpy(bool)
+    marked = _ends_with(sends[ACTIVITY], "!")
     named = _first(sends[marked], keys, ACTIVITY).combine_first(_first(sends, keys, ACTIVITY))
-    from_receive = _first(receives, keys, ACTIVITY).map(_type_of)
+    received = _first(receives, keys, ACTIVITY)
+    codes, names = pd.factorize(received, use_na_sentinel=False)  # a few names, many messages
+    from_receive = pd.Series(names.map(_type_of).to_numpy(object)[codes], index=received.index)
     return named.combine_first(from_receive)
 
 
@@ -280,8 +349,10 @@ def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) 
     later = lost[[CASE, "sender", "sent_at"]].reset_index().merge(mine, on=[CASE, "sender"])
     later = later[later[START_TIMESTAMP] > later["sent_at"]]
     later = later.sort_values(["index", START_TIMESTAMP], kind="stable")
-    names = later.groupby("index").head(following).groupby("index")[ACTIVITY]
-    joined = names.agg(lambda a: " -> ".join(map(str, a)))
+    top = later.groupby("index").head(following)
+    # summing the strings joins them without a Python call per lost message
+    names = (top[ACTIVITY].astype(str) + ARROW).groupby(top["index"]).sum()
+    joined = names.str.slice(stop=-len(ARROW))
     return joined.reindex(lost.index).fillna("").tolist()
 
 
@@ -302,7 +373,9 @@ def _type_of(activity: str) -> str:
 def _first(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
     if column not in events.columns:
         return pd.Series(dtype=object)
-    ordered = events.sort_values(TIMESTAMP, kind="stable")
+    # events usually come in time order already; a stable sort would leave them as they are
+    in_order = events[TIMESTAMP].is_monotonic_increasing
+    ordered = events if in_order else events.sort_values(TIMESTAMP, kind="stable")
     return ordered.groupby(keys)[column].first().astype(object)
 
 
@@ -369,12 +442,11 @@ def _attempts(sends: pd.DataFrame, keys: list[str]) -> pd.Series:
 
 
 def _latency_figures(grouped) -> pd.DataFrame:
-    return grouped["latency"].agg(
-        latency_mean="mean",
-        latency_median="median",
-        latency_p95=lambda x: x.quantile(0.95),
-        latency_max="max",
-    )
+    latency = grouped["latency"]
+    table = latency.agg(latency_mean="mean", latency_median="median")
+    table["latency_p95"] = latency.quantile(0.95)  # one pass, not a call per channel
+    table["latency_max"] = latency.max()
+    return table
 
 
 def _by_type(messages: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:

@@ -54,13 +54,34 @@ def compare_cases(members: pd.DataFrame, key: str, durations: pd.Series) -> pd.D
 
 
 def _medians_without(positions, values: np.ndarray) -> pd.Series:
-    """The median duration of the cases without each value (NaN when it is in every case)."""
-    result = {}
-    for name, index in positions:
-        others = np.ones(len(values), dtype=bool)
-        others[index.to_numpy()] = False
-        result[name] = float(np.median(values[others])) if others.any() else math.nan
-    return pd.Series(result, dtype=float)
+    """The median duration of the cases without each value (NaN when it is in every case).
+
+    All values at once: with the durations sorted, a value's cases sit at sorted positions
+    p_0 < p_1 < ...; the k-th smallest of the other cases is at k + t, where t counts the
+    cases with p_i - i <= k (the other cases before p_i number p_i - i)."""
+    n = len(values)
+    order = np.argsort(values, kind="stable")
+    sorted_values = values[order]
+    place = np.empty(n, dtype=np.int64)
+    place[order] = np.arange(n)
+    frame = positions.obj.to_frame("_i").assign(_p=place[positions.obj.to_numpy(np.int64)])
+    frame["_g"] = positions.ngroup().to_numpy()
+    frame = frame.sort_values(["_g", "_p"], kind="stable")
+    group = frame["_g"].to_numpy()
+    before = frame["_p"].to_numpy() - frame.groupby("_g", sort=False).cumcount().to_numpy()
+    size = np.bincount(group, minlength=positions.ngroups)
+    others = n - size
+    low, high = (others - 1) // 2, others // 2
+
+    def kth_other(k: np.ndarray) -> np.ndarray:
+        passed = np.bincount(group, weights=before <= k[group], minlength=len(k))
+        at = np.clip(k + passed.astype(np.int64), 0, max(n - 1, 0))
+        return sorted_values[at] if n else np.full(len(k), np.nan)
+
+    medians = (kth_other(low) + kth_other(high)) / 2
+    medians = np.where(others > 0, medians, math.nan)
+    names = positions.size().index  # group keys in ngroup order
+    return pd.Series(medians, index=names, dtype=float)
 
 
 def _mann_whitney(rank_sums: pd.Series, n_with: pd.Series, values: np.ndarray) -> pd.Series:

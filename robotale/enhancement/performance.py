@@ -16,13 +16,8 @@ from __future__ import annotations
 
 import pandas as pd
 
-from robotale.discovery.instances import (
-    DURATION,
-    FINISHED,
-    START_KNOWN,
-    START_TIMESTAMP,
-    activity_instances,
-)
+from robotale.discovery.instances import DURATION, FINISHED, START_KNOWN, START_TIMESTAMP
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.result import Perspective, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, CASE, MSG_ID, ROBOT, TIMESTAMP
 
@@ -34,7 +29,7 @@ ARROW = " -> "
 
 
 def performance_perspective(
-    log: pd.DataFrame, *, activity: str | None = None, robot: str | None = None
+    log: pd.DataFrame | LogAnalysis, *, activity: str | None = None, robot: str | None = None
 ) -> Perspective:
     """Activity durations, waiting per transition (slowest first), working and waiting time
     per robot and case, variants, and case durations.
@@ -42,16 +37,17 @@ def performance_perspective(
     With ``activity`` and/or ``robot``: that activity's (class's) durations, the transitions
     into and out of it, and the cases (and their variants) it occurs in.
     """
-    instances = finished_instances(log)
+    analysis = analysis_of(log)
+    instances = finished_instances(analysis)
     if instances.empty:
         return no_data("performance", "the log has no completed activity.")
-    steps = robot_steps(instances)
+    steps = shared_steps(analysis)
     chosen = _focus(instances, activity, robot)
     if chosen.empty:
         return no_data("performance", f"no instance of {focus_label(activity, robot)}.")
-    robots = robot_times(instances, steps)
-    cases = case_durations(instances, robots)
-    case_variants, robot_variants = case_variant_table(instances), robot_variant_table(robots)
+    robots, cases = shared_robot_times(analysis), shared_cases(analysis)
+    case_variants = shared_case_variants(analysis)
+    robot_variants = robot_variant_table(robots)
     if activity is not None or robot is not None:
         steps = steps[_touches(steps, activity, robot)]
         in_focus = cases[CASE].isin(chosen[CASE])
@@ -82,9 +78,43 @@ def performance_perspective(
     )
 
 
-def finished_instances(log: pd.DataFrame) -> pd.DataFrame:
-    instances = activity_instances(log)
-    return instances[instances[FINISHED]].reset_index(drop=True)
+def finished_instances(log: pd.DataFrame | LogAnalysis) -> pd.DataFrame:
+    """The activity instances that completed (shared by the analysis: do not modify)."""
+    analysis = analysis_of(log)
+
+    def build() -> pd.DataFrame:
+        instances = analysis.instances()
+        return instances[instances[FINISHED]].reset_index(drop=True)
+
+    return analysis.shared("finished", build)
+
+
+def shared_steps(analysis: LogAnalysis) -> pd.DataFrame:
+    """:func:`robot_steps` of the finished instances, built once per analysis."""
+    return analysis.shared("steps", lambda: robot_steps(finished_instances(analysis)))
+
+
+def shared_robot_times(analysis: LogAnalysis) -> pd.DataFrame:
+    """:func:`robot_times` of the finished instances, built once per analysis."""
+    return analysis.shared(
+        "robot_times",
+        lambda: robot_times(finished_instances(analysis), shared_steps(analysis)),
+    )
+
+
+def shared_cases(analysis: LogAnalysis) -> pd.DataFrame:
+    """:func:`case_durations` with the robots' times, built once per analysis."""
+    return analysis.shared(
+        "cases",
+        lambda: case_durations(finished_instances(analysis), shared_robot_times(analysis)),
+    )
+
+
+def shared_case_variants(analysis: LogAnalysis) -> pd.DataFrame:
+    """:func:`case_variant_table` of the finished instances, built once per analysis."""
+    return analysis.shared(
+        "case_variants", lambda: case_variant_table(finished_instances(analysis))
+    )
 
 
 def robot_steps(instances: pd.DataFrame) -> pd.DataFrame:
@@ -94,7 +124,9 @@ def robot_steps(instances: pd.DataFrame) -> pd.DataFrame:
     keys = [CASE, ROBOT] if ROBOT in instances.columns else [CASE]
     ordered = instances.sort_values(keys, kind="stable")  # instances come in start order
     by_robot = ordered.groupby(keys, sort=False, dropna=False)
-    following = by_robot.shift(-1)
+    # only the columns a step reads from the next instance: shifting them all costs more
+    wanted = [c for c in (ACTIVITY, START_TIMESTAMP, MSG_ID, START_KNOWN) if c in ordered]
+    following = by_robot[wanted].shift(-1)
     busy_until = by_robot[TIMESTAMP].cummax()  # the latest completion so far
     steps = pd.DataFrame(
         {
@@ -164,7 +196,9 @@ def case_variant_table(instances: pd.DataFrame) -> pd.DataFrame:
 def _paths(instances: pd.DataFrame, keys: list[str]) -> pd.Series:
     """Per group, its activities in start order joined by arrows (summing the strings keeps
     the join vectorised)."""
-    names = instances[ACTIVITY].astype(str) + ARROW
+    codes, uniques = pd.factorize(instances[ACTIVITY], use_na_sentinel=False)
+    labels = pd.Series(uniques).astype(str) + ARROW  # once per name, not once per instance
+    names = pd.Series(labels.array.take(codes), index=instances.index)
     joined = names.groupby([instances[k] for k in keys], sort=True, dropna=False).sum()
     return joined.str.slice(stop=-len(ARROW))
 
@@ -261,7 +295,8 @@ def _transition_name(row: pd.Series) -> str:
 
 def _durations_figure(instances: pd.DataFrame):
     """Box plots of working time per activity, one colour per robot (plain traces: plotly
-    express spends seconds preparing a large frame)."""
+    express spends seconds preparing a large frame; fixed-width text arrays, which plotly
+    copies whole rather than string by string)."""
     import plotly.graph_objects as go
 
     figure = go.Figure()
@@ -269,9 +304,9 @@ def _durations_figure(instances: pd.DataFrame):
         instances.groupby(ROBOT, sort=True) if ROBOT in instances.columns else [("", instances)]
     )
     for robot, mine in robots:
-        figure.add_box(
-            x=mine[ACTIVITY].astype(str).to_numpy(), y=mine[DURATION].to_numpy(), name=str(robot)
-        )
+        codes, names = pd.factorize(mine[ACTIVITY], use_na_sentinel=False)
+        names = pd.Series(names, dtype=object).astype(str).to_numpy(str)[codes]  # once a name
+        figure.add_box(x=names, y=mine[DURATION].to_numpy(), name=str(robot))
     return figure.update_layout(
         boxmode="group", title="Activity durations: working time (s)", yaxis_title=DURATION
     )

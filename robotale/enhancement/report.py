@@ -12,13 +12,14 @@ from robotale.discovery.output import write_texts
 from robotale.enhancement.battery import battery_perspective
 from robotale.enhancement.bottlenecks import find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.performance import performance_perspective
 from robotale.enhancement.result import Perspective
 from robotale.enhancement.spatial import Field, spatial_perspective
 
 
 def all_perspectives(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
@@ -28,12 +29,13 @@ def all_perspectives(
     """Spatial, communication, battery, performance and bottlenecks, for the whole log or for
     one activity and/or robot."""
     focus = {"activity": activity, "robot": robot}
+    analysis = analysis_of(log)  # instances, steps, cases and messages built once for all
     return {
-        "spatial": spatial_perspective(log, field=field, **focus),
-        "communication": communication_perspective(log, **focus),
-        "battery": battery_perspective(log, threshold=threshold, **focus),
-        "performance": performance_perspective(log, **focus),
-        "bottlenecks": find_bottlenecks(log, **focus),
+        "spatial": spatial_perspective(analysis, field=field, **focus),
+        "communication": communication_perspective(analysis, **focus),
+        "battery": battery_perspective(analysis, threshold=threshold, **focus),
+        "performance": performance_perspective(analysis, **focus),
+        "bottlenecks": find_bottlenecks(analysis, **focus),
     }
 
 

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 import pandas as pd
 
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
 from robotale.errors import InputError
 from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, TIMESTAMP, X, Y, Z
@@ -61,13 +62,14 @@ class Field:
 
 
 def spatial_perspective(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     activity: str | None = None,
     robot: str | None = None,
     field: Field | None = None,
 ) -> Perspective:
     """Positions per activity and robot, their bounds, a 3D scatter and the covered field."""
+    log = analysis_of(log).log
     if X not in log.columns or Y not in log.columns:
         return no_data("spatial", "the log has no positions (no x and y columns).")
     events = focus_events(log, activity, robot)
@@ -206,8 +208,9 @@ def _scatter(placed: pd.DataFrame):
             z=points[Z],
             mode="markers",
             name=str(activity),
-            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).tolist()},
-            text=None if who is None else who.tolist(),
+            # fixed-width text arrays: plotly copies them whole, not string by string
+            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).to_numpy(str)},
+            text=None if who is None else who.to_numpy(str),
             hovertemplate="%{text}<br>x %{x:.2f}, y %{y:.2f}, z %{z:.2f}",
         )
     figure.update_layout(

@@ -1,0 +1,45 @@
+"""Tables several perspectives share, built once per log.
+
+The perspectives all start from the same intermediate tables: the activity instances, each
+robot's steps between them, case durations, variants and the message table. Each perspective
+accepts a log or a :class:`LogAnalysis` of it; :func:`all_perspectives` hands one analysis to
+all of them so those tables are computed once. A table is built the first time a perspective
+asks for it and is then shared, so callers must never modify one in place.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable, Sequence
+from typing import Any
+
+import pandas as pd
+
+from robotale.discovery.instances import activity_instances
+
+
+class LogAnalysis:
+    """A log with the tables computed from it so far."""
+
+    def __init__(self, log: pd.DataFrame) -> None:
+        self.log = log
+        self._tables: dict[Hashable, Any] = {}
+
+    def shared(self, key: Hashable, build: Callable[[], Any]) -> Any:
+        """The table named ``key``, built by ``build()`` the first time it is asked for."""
+        if key not in self._tables:
+            self._tables[key] = build()
+        return self._tables[key]
+
+    def __contains__(self, key: Hashable) -> bool:
+        """Whether the table named ``key`` has been built."""
+        return key in self._tables
+
+    def instances(self, carry: Sequence[str] = ()) -> pd.DataFrame:
+        """:func:`~robotale.discovery.instances.activity_instances` of the log."""
+        carry = tuple(carry)
+        return self.shared(("instances", carry), lambda: activity_instances(self.log, carry))
+
+
+def analysis_of(source: pd.DataFrame | LogAnalysis) -> LogAnalysis:
+    """``source`` itself when it is an analysis already, else a fresh one of the log."""
+    return source if isinstance(source, LogAnalysis) else LogAnalysis(source)
