@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP
+from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.performance import WAIT, finished_instances, shared_steps
 from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
