@@ -17,7 +17,9 @@ import numpy as np
 import pandas as pd
 
 from robotale.eventlog.schema import (
+    ABORTED,
     ACTIVITY,
+    CANCELLED,
     CASE,
     COMPLETE,
     INPROGRESS,
@@ -104,6 +106,9 @@ def _lifecycle(log: pd.DataFrame) -> pd.Series:
     # lowered once per distinct value: a log repeats a handful of them
     codes, uniques = pd.factorize(log[LIFECYCLE].astype(object))
     lowered = pd.Series(uniques, dtype="string").str.lower()
+    # an aborted or cancelled activity ended all the same: it pairs with its start (the row
+    # keeps its own lifecycle, so the outcome stays visible)
+    lowered = lowered.replace({ABORTED: COMPLETE, CANCELLED: COMPLETE})
     lowered = pd.concat([lowered, pd.Series([COMPLETE], dtype="string")], ignore_index=True)
     return pd.Series(lowered.array[codes], index=log.index)
 

@@ -264,7 +264,7 @@ def canonical_log(
         case=case_text,
         cases=int(log[schema.CASE].nunique()),
         robots=robots,
-        events={kind: int((kinds == kind).sum()) for kind in reading.KINDS},
+        events=_event_counts(kinds),
         pairing=reading.pairing_description(log, renames),
         rows=len(table),
         missing=dict(missing or {}),
@@ -403,3 +403,9 @@ def _read_text(path: Path) -> str:
             f"{path} is not UTF-8 text (byte 0x{data[error.start]:02x} on line {line}); "
             "save it as UTF-8."
         ) from None
+
+
+def _event_counts(kinds: pd.Series) -> dict[str, int]:
+    """Events by kind; aborted and cancelled ends only where the log has them."""
+    counts = {kind: int((kinds == kind).sum()) for kind in (*reading.KINDS, *reading.OUTCOMES)}
+    return {k: n for k, n in counts.items() if n or k in reading.KINDS}

@@ -88,6 +88,15 @@ LIFECYCLE_VALUES: dict[str, str] = {
     "finished": schema.COMPLETE,
     "none": schema.NONE,
     "instant": schema.NONE,
+    # an end that says how it went (ROS 2 action goals, XES' abort transitions): robots fail,
+    # and the outcome stays in the log
+    "aborted": schema.ABORTED,
+    "abort": schema.ABORTED,
+    "ate_abort": schema.ABORTED,
+    "pi_abort": schema.ABORTED,
+    "cancelled": schema.CANCELLED,
+    "canceled": schema.CANCELLED,
+    "withdraw": schema.CANCELLED,
 }
 #: a state says in-progress when, lowercased without blanks, "_" and "-", it is this.
 INPROGRESS_STATE = "inprogress"
@@ -114,6 +123,8 @@ ROLE_NAMES: dict[str, str] = {
 }
 #: event kinds of :func:`event_kinds`, in the order a reading lists them.
 KINDS = ("start", "complete", "instant", "sample")
+#: ends of an activity that failed or was called off: completions that keep their outcome
+OUTCOMES = (schema.ABORTED, schema.CANCELLED)
 #: a dropped row's lines are listed up to this many.
 SHOWN_LINES = 5
 
@@ -277,6 +288,8 @@ def event_kinds(log: pd.DataFrame) -> pd.Series:
     kinds = pd.Series("instant", index=log.index, dtype=object)
     kinds[(meaning == schema.START).to_numpy(bool)] = "start"
     kinds[(meaning == schema.COMPLETE).to_numpy(bool)] = "complete"
+    for outcome in OUTCOMES:
+        kinds[(meaning == outcome).to_numpy(bool)] = outcome
     no_transition = absent | (meaning == schema.NONE).to_numpy(bool)
     kinds[absent & ~in_progress] = "complete"  # pm4py's default: a recorded completion
     kinds[no_transition & in_progress] = "sample"
@@ -287,7 +300,7 @@ def event_kinds(log: pd.DataFrame) -> pd.Series:
 
 def understood(kinds: pd.Series) -> pd.Series:
     """Which rows :func:`event_kinds` could read (the others are dropped)."""
-    return kinds.isin(KINDS)
+    return kinds.isin(KINDS + OUTCOMES)
 
 
 def _in_progress(log: pd.DataFrame) -> pd.Series:
@@ -314,6 +327,7 @@ def lifecycle_columns(log: pd.DataFrame, kinds: pd.Series) -> list[str]:
         log[schema.STATE] = pd.Series(schema.NONE, index=log.index, dtype="string")
         log.loc[samples, schema.STATE] = schema.INPROGRESS
     transitions = {"start": schema.START, "complete": schema.COMPLETE}
+    transitions |= {outcome: outcome for outcome in OUTCOMES}
     log[schema.LIFECYCLE] = kinds.map(transitions).fillna(schema.NONE).astype("string")
     return notes
 
@@ -322,7 +336,7 @@ def dropped_rows(kinds: pd.Series, lines: pd.Series) -> dict[str, list[int]]:
     """Reason -> file lines of the rows whose lifecycle is not understood."""
     unknown = kinds[~understood(kinds)]
     return {
-        f"lifecycle {value[1:]!r} is not start, complete or none": lines[group.index].tolist()
+        f"lifecycle {value[1:]!r} is not a start, an end or none": lines[group.index].tolist()
         for value, group in unknown.groupby(unknown, sort=True)
     }
 
@@ -529,7 +543,8 @@ def _details(reading: Reading) -> list[str]:
     robots = ", ".join(
         robot if kind is None else f"{robot} ({kind})" for robot, kind in reading.robots.items()
     )
-    events = ", ".join(f"{reading.events[kind]:,} {kind}" for kind in KINDS)
+    shown = [*KINDS, *(kind for kind in OUTCOMES if reading.events.get(kind))]
+    events = ", ".join(f"{reading.events[kind]:,} {kind}" for kind in shown)
     missing = ", ".join(f"{column} {count:,}" for column, count in reading.missing.items())
     return [
         "  columns:",

@@ -46,7 +46,7 @@ def test_inspect_names_dropped_rows_and_notes(tmp_path, capsys):
     code, out, _ = run(capsys, "inspect", str(path))
     assert code == 0
     assert out.startswith("Read odd.csv: 2 of 3 rows kept, 1 case (no case column: one case)")
-    assert "  1 dropped: lifecycle 'schedule' is not start, complete or none (line 2)\n" in out
+    assert "  1 dropped: lifecycle 'schedule' is not a start, an end or none (line 2)\n" in out
 
 
 def test_inspect_reports_the_lifecycle_winning_over_the_state(tmp_path, capsys):

@@ -248,8 +248,8 @@ def test_other_transitions_are_dropped_and_named(tmp_path):
     )
     log, reading = read_log_with_reading(path)
     assert reading.dropped == {
-        "lifecycle 'schedule' is not start, complete or none": [2, 5],
-        "lifecycle 'suspend' is not start, complete or none": [4],
+        "lifecycle 'schedule' is not a start, an end or none": [2, 5],
+        "lifecycle 'suspend' is not a start, an end or none": [4],
     }
     assert reading.rows == 5 and reading.kept == len(log) == 2
     assert log[schema.EVENT_ID].tolist() == ["1", "4"], "ids are the rows' places in the file"
@@ -338,3 +338,27 @@ def test_a_log_of_dropped_rows_is_refused(tmp_path):
     path = write(tmp_path, "odd.csv", "time,activity,lifecycle\n2024-01-01T10:00Z,a,assign\n")
     with pytest.raises(InputError, match=r"odd\.csv: no row is an event \(lifecycle 'assign'"):
         read_log(path)
+
+
+def test_aborted_and_cancelled_ends_keep_their_outcome_and_close_their_activity(tmp_path):
+    """Robots fail: an aborted or cancelled goal ends its activity (it has a duration) and the
+    log says how it went; XES' abort transitions read the same way."""
+    path = write(
+        tmp_path,
+        "goals.csv",
+        "case,time,activity,lifecycle,robot\n"
+        "1,2024-01-01T10:00:00Z,navigate,start,r1\n"
+        "1,2024-01-01T10:00:30Z,navigate,aborted,r1\n"
+        "1,2024-01-01T10:01:00Z,navigate,start,r1\n"
+        "1,2024-01-01T10:01:05Z,navigate,Cancelled,r1\n"
+        "1,2024-01-01T10:02:00Z,dock,start,r1\n"
+        "1,2024-01-01T10:02:20Z,dock,ate_abort,r1\n"
+        "1,2024-01-01T10:03:00Z,dock,start,r1\n"
+        "1,2024-01-01T10:03:10Z,dock,complete,r1\n",
+    )
+    log, reading = read_log_with_reading(path)
+    assert reading.dropped == {}
+    assert (reading.events["aborted"], reading.events["cancelled"]) == (2, 1)
+    found = activity_instances(log)
+    assert found["duration"].tolist() == [30.0, 5.0, 20.0, 10.0]
+    assert found[schema.LIFECYCLE].tolist() == ["aborted", "cancelled", "aborted", "complete"]
