@@ -229,6 +229,8 @@ class LocalServer:
         if password is None:
             password = os.environ.get("NEO4J_PASSWORD") or secrets.token_urlsafe(18)
             _write_private(self.password_file, password)
+        # A new database has no console user yet: the next console request creates it.
+        self.console_password_file.unlink(missing_ok=True)
         env = {**os.environ, "NEO4J_HOME": str(self.home), "NEO4J_CONF": str(self.home / "conf")}
         result = subprocess.run(
             # "--": a password may begin with "-" (token_urlsafe's do, now and then).
