@@ -8,7 +8,7 @@ WORKDIR /src
 COPY pyproject.toml setup.py constraints.txt README.md LICENSE ./
 COPY robotale ./robotale
 COPY cypher ./cypher
-RUN pip wheel --no-cache-dir --wheel-dir /wheels -c constraints.txt .
+RUN pip wheel --no-cache-dir --wheel-dir /wheels -c constraints.txt ".[server]"
 
 FROM python:3.11-slim
 COPY --from=build /wheels /wheels
@@ -20,4 +20,7 @@ USER robotale
 WORKDIR /home/robotale
 ENV ROBOTALE_HOME=/home/robotale/.robotale
 EXPOSE 5000
-CMD ["robotale", "serve", "--host", "0.0.0.0", "--port", "5000"]
+# waitress, a production WSGI server, not werkzeug's development one. The dashboard answers
+# to localhost and 127.0.0.1 (the published port); add the names it is reached by to
+# ROBOTALE_ALLOWED_HOSTS. ROBOTALE_SECRET_KEY keeps forms valid across restarts.
+CMD ["waitress-serve", "--listen=0.0.0.0:5000", "--threads=8", "--call", "robotale.webapp:create_app"]

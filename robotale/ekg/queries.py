@@ -51,6 +51,15 @@ def split_statements(text: str, *, comments: bool = True) -> list[str]:
     return found
 
 
+def code_only(text: str) -> str:
+    """``text`` with its strings, quoted names and comments blanked out (same length, so
+    offsets still point into ``text``): what is left are keywords, names and operators."""
+    return "".join(
+        piece if kind in ("code", "end") else re.sub(r"[^\n]", " ", piece)
+        for kind, piece in _pieces(text)
+    )
+
+
 def _pieces(text: str) -> Iterator[tuple[str, str]]:
     # An unterminated string or comment runs to the end of the text, as Neo4j reads it.
     for match in _PIECE.finditer(text):

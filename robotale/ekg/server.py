@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import json
 import os
+import re
 import secrets
 import shutil
 import signal
@@ -21,11 +22,12 @@ import urllib.request
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
-from neo4j import GraphDatabase
+from neo4j import Driver, GraphDatabase
 from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.config import robotale_home
 from robotale.ekg.jars import ensure_jars
+from robotale.ekg.queries import statements
 from robotale.errors import ServerError
 
 HOST = "127.0.0.1"
@@ -119,6 +121,34 @@ class LocalServer:
     def password(self) -> str | None:
         return self.password_file.read_text().strip() if self.password_file.is_file() else None
 
+    # -- the Cypher console's user -------------------------------------------------------
+
+    @property
+    def console_password_file(self) -> Path:
+        return self.home / "console-password"
+
+    def console_password(self) -> str | None:
+        path = self.console_password_file
+        return path.read_text().strip() if path.is_file() else None
+
+    def console_credentials(self) -> tuple[str, str]:
+        """User and password of the console's own user, created on the running server the
+        first time (the file keeping its password is the record that it exists)."""
+        password = self.console_password()
+        if password is not None:
+            return CONSOLE_USER, password
+        running = self.running()
+        if running is None:
+            raise ServerError(
+                "The local Neo4j is not running: start it with `robotale neo4j start`."
+            )
+        password = secrets.token_urlsafe(18)
+        auth = (USER, self.password() or "")
+        with GraphDatabase.driver(running.bolt_uri, auth=auth) as admin:
+            create_console_user(admin, CONSOLE_USER, password)
+        _write_private(self.console_password_file, password)
+        return CONSOLE_USER, password
+
     # -- start / stop --------------------------------------------------------------------
 
     def start(self, options: ServerOptions | None = None, timeout: float = 180) -> RunningServer:
@@ -180,6 +210,7 @@ class LocalServer:
             # (the databases stop and checkpoint first); a local server need not.
             "internal.server.bolt.connection_shutdown_wait_time": "1s",
             "internal.server.bolt.thread_pool_shutdown_wait_time": "1s",
+            **security_settings(options.heap),
         }
         lines = ["# Written by `robotale neo4j start` on every start; edits are overwritten."]
         lines += [f"{key}={value}" for key, value in settings.items()]
@@ -198,6 +229,8 @@ class LocalServer:
         if password is None:
             password = os.environ.get("NEO4J_PASSWORD") or secrets.token_urlsafe(18)
             _write_private(self.password_file, password)
+        # A new database has no console user yet: the next console request creates it.
+        self.console_password_file.unlink(missing_ok=True)
         env = {**os.environ, "NEO4J_HOME": str(self.home), "NEO4J_CONF": str(self.home / "conf")}
         result = subprocess.run(
             # "--": a password may begin with "-" (token_urlsafe's do, now and then).
@@ -362,3 +395,41 @@ def _last_lines(path: Path, count: int) -> str:
     if not path.is_file():
         return ""
     return "\n".join(path.read_text(errors="replace").splitlines()[-count:])
+
+
+# -- the Cypher console's user and the limits of one query -------------------------------
+
+#: the user the dashboard's Cypher console logs in as on the local server
+CONSOLE_USER = "robotale_console"
+#: the share of the heap one transaction may hold: a runaway query fails, the server lives on
+_TRANSACTION_SHARE = 0.5
+_SIZE = re.compile(r"(\d+)([kmg]?)", re.IGNORECASE)
+_UNITS = {"": 1, "k": 1024, "m": 1024**2, "g": 1024**3}
+
+
+def security_settings(heap: str) -> dict[str, str]:
+    """The settings that keep one query from reading the server's files or its whole heap."""
+    settings = {
+        # LOAD CSV may not read files (the console also refuses the clause before sending it).
+        "dbms.security.allow_csv_import_from_file_urls": "false",
+        "server.directories.import": "import",
+    }
+    limit = _share_of(heap, _TRANSACTION_SHARE)
+    if limit is not None:
+        settings["db.memory.transaction.max"] = limit
+    return settings
+
+
+def _share_of(size: str, share: float) -> str | None:
+    """``share`` of a JVM size such as ``1g``, in megabytes (None when it is no size)."""
+    match = _SIZE.fullmatch(size.strip())
+    if match is None:
+        return None
+    total = int(match.group(1)) * _UNITS[match.group(2).lower()]
+    return f"{max(1, int(total * share) // 1024**2)}m"
+
+
+def create_console_user(admin: Driver, user: str, password: str) -> None:
+    """Create (or reset the password of) the console's user, connected as an administrator."""
+    for statement in statements("console_user"):
+        admin.execute_query(statement, user=user, password=password, database_="system")

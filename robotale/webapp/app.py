@@ -9,7 +9,7 @@ from flask import Flask, redirect, url_for
 from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
-from robotale.webapp import errors, pages, state, uploads
+from robotale.webapp import defences, errors, pages, state, uploads
 from robotale.webapp.settings import WebSettings
 from robotale.webapp.views import assets, console, discover, logs, model, perspectives
 
@@ -28,6 +28,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
         JSON_SORT_KEYS=False,
     )
     app.json.sort_keys = False
+    defences.init_app(app, settings)
     CSRFProtect(app)
     uploads.remove_stale(settings.upload_dir)
     state.init_app(app, settings).models.add_shipped()

@@ -1,51 +1,58 @@
 """The Cypher console's work: run a user's query so that it can only read, and show the rows.
 
-Every statement runs in a transaction opened in Neo4j's READ access mode, so the server itself
-refuses anything that would write (nodes, relationships, indexes, ``IN TRANSACTIONS`` batches):
-nothing the console runs can change the graph. Values come in as parameters, never pasted into
-the text. The examples are the files of ``cypher/``, the queries robotale itself runs.
+The checks and the running are :mod:`robotale.ekg.readonly`'s (text, plan, READ transaction,
+bounded answer). Here the console picks its Neo4j user and runs each request in a child
+process whose memory is capped (``console_memory_mb``), so that no answer can grow the
+dashboard itself. Values come in as parameters, never pasted into the text. The examples are
+the files of ``cypher/``, the queries robotale itself runs.
+
+Its user: ``ROBOTALE_CONSOLE_USER`` and ``ROBOTALE_CONSOLE_PASSWORD`` when set; otherwise, on
+robotale's local server, a user of its own that the server creates (``robotale_console``);
+otherwise (``NEO4J_URI``) robotale's own user, and the page says how to give it a reader.
 """
 
 from __future__ import annotations
 
+import json
+import os
 import re
-from collections.abc import Mapping
+import subprocess
+import sys
 from dataclasses import dataclass
 from importlib.resources import files
 from typing import Any
 
-import neo4j
-from neo4j import Driver, unit_of_work
-from neo4j.exceptions import ClientError
-from neo4j.graph import Node, Path, Relationship
-
-from robotale.ekg.connection import database
+from robotale.ekg import readonly
+from robotale.ekg.connection import Settings, database, settings
 from robotale.ekg.queries import split_statements
-from robotale.errors import InputError
+from robotale.ekg.readonly import (
+    QueryRefused,
+    StatementResult,
+    WriteRefused,
+    cell,
+    run_read_only,
+)
+from robotale.ekg.server import LocalServer
+from robotale.errors import InputError, RobotaleError, ServerError
+from robotale.webapp.settings import WebSettings
+
+__all__ = [
+    "QueryRefused",
+    "StatementResult",
+    "WriteRefused",
+    "cell",
+    "examples",
+    "run",
+    "run_read_only",
+    "split_statements",
+]
 
 _PARAMETER = re.compile(r"\$([A-Za-z_][A-Za-z0-9_]*)")
-_ACCESS_MODE = "Neo.ClientError.Statement.AccessMode"
-
-
-class WriteRefused(InputError):
-    """The query would change the graph, and the console only reads."""
-
-
-@dataclass(frozen=True)
-class StatementResult:
-    statement: str
-    columns: list[str]
-    rows: list[list[Any]]
-    #: rows the query returned; more than ``len(rows)`` when the console's limit cut them
-    total: int
-
-    def to_dict(self) -> dict[str, Any]:
-        return {
-            "statement": self.statement,
-            "columns": self.columns,
-            "rows": self.rows,
-            "total": self.total,
-        }
+#: seconds the child may take beyond the query's own timeout (start, connect, send)
+_GRACE = 30
+_ERRORS: dict[str, type[RobotaleError]] = {
+    error.__name__: error for error in (InputError, QueryRefused, WriteRefused, ServerError)
+}
 
 
 @dataclass(frozen=True)
@@ -56,89 +63,85 @@ class Example:
     parameters: list[str]
 
 
-def run_read_only(
-    driver: Driver,
-    text: str,
-    parameters: Mapping[str, Any] | None = None,
-    row_limit: int = 1000,
-    timeout: float = 30.0,
-) -> list[StatementResult]:
-    """Run each statement of ``text`` (separated by ``;``) in its own read transaction.
-
-    Raises :class:`WriteRefused` when one would write and :class:`InputError` when Neo4j
-    rejects one (syntax, a missing parameter ...).
-    """
-    statements = split_statements(text)
-    if not statements:
-        raise InputError("Type a Cypher query (or pick an example) to run.")
-    work = unit_of_work(timeout=timeout)(_read)
-    results = []
-    with driver.session(database=database(), default_access_mode=neo4j.READ_ACCESS) as session:
-        for statement in statements:
-            try:
-                results.append(
-                    session.execute_read(work, statement, dict(parameters or {}), row_limit)
-                )
-            except ClientError as error:
-                raise _explain(error) from None
-    return results
+@dataclass(frozen=True)
+class Login:
+    settings: Settings
+    #: what the page says when the console's user may write (empty when it has its own)
+    notice: str = ""
 
 
-def _read(tx: neo4j.ManagedTransaction, statement: str, parameters: dict, limit: int):
-    result = tx.run(statement, parameters)
-    columns = list(result.keys())
-    rows, total = [], 0
-    for record in result:
-        total += 1
-        if total <= limit:
-            rows.append([cell(value) for value in record.values()])
-    return StatementResult(statement, columns, rows, total)
+def login() -> Login:
+    """The Neo4j user the console runs as (see the module docstring)."""
+    main = settings()
+    env = os.environ
+    if user := env.get("ROBOTALE_CONSOLE_USER"):
+        password = env.get("ROBOTALE_CONSOLE_PASSWORD", "")
+        return Login(Settings(main.uri, user, password, main.from_env))
+    if not main.from_env:
+        user, password = LocalServer().console_credentials()
+        return Login(Settings(main.uri, user, password, False))
+    return Login(
+        main,
+        f"The console logs in as {main.user!r}, robotale's own user: on a server with roles, "
+        "create a reader (CREATE USER console SET PASSWORD '…'; GRANT ROLE reader TO console) "
+        "and set ROBOTALE_CONSOLE_USER and ROBOTALE_CONSOLE_PASSWORD.",
+    )
 
 
-def _explain(error: ClientError) -> InputError:
-    if error.code == _ACCESS_MODE:
-        return WriteRefused(
-            "The console only reads, and this query would change the graph; run writes "
-            "with robotale's commands or in Neo4j Browser."
+def run(text: str, parameters: dict[str, Any], web: WebSettings) -> list[dict[str, Any]]:
+    """Run a console request in a capped child process; the results as JSON-ready dicts."""
+    where = login().settings
+    request = {
+        "uri": where.uri,
+        "user": where.user,
+        "password": where.password,
+        "database": database(),
+        "text": text,
+        "parameters": parameters,
+        "rows": web.console_row_limit,
+        "bytes": web.console_byte_limit,
+        "timeout": web.console_timeout,
+    }
+    reply = _child(request, web)
+    if "error" in reply:
+        if reply["kind"] == "MemoryError":
+            raise InputError(_too_large(web))
+        raise _ERRORS.get(reply["kind"], InputError)(reply["error"])
+    return reply["results"]
+
+
+def _child(request: dict[str, Any], web: WebSettings) -> dict[str, Any]:
+    command = [sys.executable, "-m", readonly.__name__, str(web.console_memory_mb)]
+    try:
+        done = subprocess.run(
+            command,
+            input=json.dumps(request),
+            capture_output=True,
+            text=True,
+            timeout=web.console_timeout + _GRACE,
+            check=False,
         )
-    message = (error.message or str(error)).strip().splitlines()[0]
-    return InputError(f"Neo4j could not run the query: {message}")
+    except subprocess.TimeoutExpired:
+        raise InputError(
+            f"The query did not finish within {web.console_timeout:.0f} s: narrow it (a LIMIT, "
+            "a WHERE on the log)."
+        ) from None
+    try:
+        return json.loads(done.stdout)
+    except json.JSONDecodeError:
+        pass
+    # The child died without answering: its memory cap is what ends such a query.
+    if "MemoryError" in done.stderr or done.returncode < 0:
+        return {"error": "memory", "kind": "MemoryError"}
+    last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
+    raise InputError(f"The console could not run the query ({last[:300]}).")
 
 
-def cell(value: Any) -> Any:
-    """A result value as JSON: graph elements as Neo4j Browser writes them, times as ISO text."""
-    if isinstance(value, Node):
-        labels = "".join(f":{label}" for label in sorted(value.labels))
-        return f"({labels} {_properties(value)})"
-    if isinstance(value, Relationship):
-        return f"[:{value.type} {_properties(value)}]"
-    if isinstance(value, Path):
-        return [cell(element) for element in _path_elements(value)]
-    if isinstance(value, list | tuple) and not hasattr(value, "srid"):
-        return [cell(item) for item in value]
-    if isinstance(value, dict):
-        return {str(key): cell(item) for key, item in value.items()}
-    if value is None or isinstance(value, bool | int | float | str):
-        return value
-    if hasattr(value, "iso_format"):
-        return value.iso_format()
-    return str(value)
-
-
-def _properties(entity: Node | Relationship) -> str:
-    shown = ", ".join(f"{key}: {_literal(cell(value))}" for key, value in sorted(entity.items()))
-    return "{" + shown + "}"
-
-
-def _literal(value: Any) -> str:
-    return repr(value) if isinstance(value, str) else str(value)
-
-
-def _path_elements(path: Path) -> list[Node | Relationship]:
-    elements: list[Node | Relationship] = [path.start_node]
-    for relationship in path.relationships:
-        elements += [relationship, relationship.end_node]
-    return elements
+def _too_large(web: WebSettings) -> str:
+    return (
+        f"The answer does not fit the console's {web.console_memory_mb} MB: narrow the query "
+        "(a LIMIT, fewer or smaller values)."
+    )
 
 
 def examples() -> list[Example]:

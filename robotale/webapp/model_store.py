@@ -2,7 +2,10 @@
 
 A model is stored as ``<id>.bpmn`` where the id is derived from its content (uploading the
 same file twice keeps one copy), with ``<id>.json`` holding the name it was uploaded under.
-Only files the FAME parser reads are stored, so every stored model can be drawn and checked.
+Only files the FAME parser reads are stored, so every stored model can be drawn and checked,
+and only as :func:`sanitised` writes them again: without web content (XHTML, SVG, scripts,
+event-handler attributes, processing instructions, a DOCTYPE), which a browser could run if it
+opened the file on the dashboard's origin.
 ``links.json`` remembers which model drove which log.
 """
 
@@ -14,6 +17,8 @@ import re
 from dataclasses import dataclass
 from pathlib import Path, PurePosixPath
 
+from lxml import etree
+
 from robotale.errors import InputError, ModelError
 from robotale.fame_runtime.parser import parse, parse_bytes
 from robotale.fame_runtime.splitter import split
@@ -23,6 +28,21 @@ from robotale.webapp.settings import WebSettings
 
 _ID = re.compile(r"[0-9a-f]{16}")
 _LINKS = "links.json"
+#: namespaces whose elements a browser renders or runs; BPMN never needs them
+_WEB_NAMESPACES = frozenset(
+    {
+        "http://www.w3.org/1999/xhtml",
+        "http://www.w3.org/2000/svg",
+        "http://www.w3.org/1998/Math/MathML",
+        "http://www.w3.org/1999/XSL/Transform",
+        "http://www.w3.org/1999/xlink",
+        "http://www.w3.org/2001/XInclude",
+        "http://www.w3.org/XML/1998/namespace/events",
+        "http://www.w3.org/2001/xml-events",
+    }
+)
+#: element names that embed or run content in any namespace a browser knows
+_WEB_ELEMENTS = frozenset({"script", "iframe", "object", "embed", "foreignobject", "style"})
 
 
 @dataclass(frozen=True)
@@ -49,6 +69,7 @@ class ModelStore:
         pools = [pool.name for pool, _ in definitions.pools()]
         if not pools:
             raise InputError(f"{name!r} holds no process to show.")
+        data = sanitised(data)
         model_id = hashlib.sha256(data).hexdigest()[:16]
         self.folder.mkdir(parents=True, exist_ok=True)
         write_file(self.folder / f"{model_id}.bpmn", data)
@@ -112,3 +133,49 @@ def attach_model(log: str, model: Path, folder: Path | None = None) -> StoredMod
     stored = store.add(Path(model).read_bytes(), Path(model).name)
     store.link(log, stored.id)
     return stored
+
+
+def sanitised(data: bytes) -> bytes:
+    """BPMN XML (already read by the FAME parser) written again without what a browser could
+    run: web elements, web and script-URL attributes, processing instructions, comments,
+    entity references and the DOCTYPE."""
+    parser = etree.XMLParser(
+        resolve_entities=False, no_network=True, remove_comments=True, remove_pis=True
+    )
+    root = etree.fromstring(data, parser)
+    for node in list(root.iter()):
+        if node is not root and (_is_web_element(node) or not isinstance(node.tag, str)):
+            _remove(node)
+    for element in root.iter(tag=etree.Element):
+        for attribute in list(element.attrib):
+            if _is_web_attribute(attribute, element.attrib[attribute]):
+                del element.attrib[attribute]
+    return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
+
+
+def _is_web_element(node: etree._Element) -> bool:
+    if not isinstance(node.tag, str):
+        return False
+    name = etree.QName(node)
+    return name.namespace in _WEB_NAMESPACES or name.localname.lower() in _WEB_ELEMENTS
+
+
+def _is_web_attribute(attribute: str, value: str) -> bool:
+    name = etree.QName(attribute)
+    # Event handlers and script URLs only run on web elements, which are gone; these would
+    # make a BPMN element one again.
+    return name.namespace in _WEB_NAMESPACES or value.strip().lower().startswith("javascript:")
+
+
+def _remove(node: etree._Element) -> None:
+    # Keep the text that follows the node (it belongs to the parent's content).
+    parent = node.getparent()
+    if parent is None:
+        return
+    if node.tail:
+        previous = node.getprevious()
+        if previous is not None:
+            previous.tail = (previous.tail or "") + node.tail
+        else:
+            parent.text = (parent.text or "") + node.tail
+    parent.remove(node)

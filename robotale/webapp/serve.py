@@ -83,7 +83,8 @@ def serve_until_interrupted(dashboard: Dashboard, log: str | None = None) -> Non
     if not _is_loopback(dashboard.server.host):
         print(
             f"Listening on {dashboard.server.host}: anyone who can reach this machine can read "
-            "the logs.",
+            "the logs. It answers to localhost and 127.0.0.1; add the names it is reached by "
+            "to ROBOTALE_ALLOWED_HOSTS.",
             file=sys.stderr,
         )
     try:

@@ -6,6 +6,12 @@ ingested, and are deleted then. BPMN models shown on the Model page are kept in
 ``$ROBOTALE_HOME/models`` (``ROBOTALE_MODEL_DIR``). ``ROBOTALE_SECRET_KEY`` signs sessions
 and CSRF tokens; without it every start picks a random one (forms of an earlier run then ask
 to be sent again).
+
+``ROBOTALE_ALLOWED_HOSTS`` (comma-separated names) are the host names the dashboard answers
+to besides ``localhost``, ``127.0.0.1`` and ``::1``: a request whose ``Host`` header names
+another is refused, so a web page cannot reach the dashboard by pointing a name of its own at
+this machine (DNS rebinding). Add the names it is reached by when it serves a network or runs in
+a container reached by name; ``*`` turns the check off.
 """
 
 from __future__ import annotations
@@ -20,6 +26,8 @@ from robotale.errors import InputError
 
 DEFAULT_HOST = "127.0.0.1"
 DEFAULT_PORT = 5000
+#: the names a dashboard on this machine is reached by
+LOCAL_HOSTS = ("localhost", "127.0.0.1", "::1")
 
 
 @dataclass(frozen=True)
@@ -32,6 +40,12 @@ class WebSettings:
     console_row_limit: int = 1000
     #: seconds a console query may run
     console_timeout: float = 30.0
+    #: bytes of JSON the console sends at most (rows past them are counted, not sent)
+    console_byte_limit: int = 5_000_000
+    #: megabytes the process that runs a console query may grow by
+    console_memory_mb: int = 256
+    #: host names the dashboard answers to ("*": any)
+    allowed_hosts: tuple[str, ...] = LOCAL_HOSTS
 
     @classmethod
     def from_env(cls) -> WebSettings:
@@ -41,7 +55,14 @@ class WebSettings:
             model_dir=Path(env.get("ROBOTALE_MODEL_DIR") or robotale_home() / "models"),
             upload_limit_mb=_megabytes(env.get("ROBOTALE_UPLOAD_LIMIT_MB"), cls.upload_limit_mb),
             secret_key=env.get("ROBOTALE_SECRET_KEY") or secrets.token_hex(32),
+            allowed_hosts=_hosts(env.get("ROBOTALE_ALLOWED_HOSTS")),
         )
+
+
+def _hosts(value: str | None) -> tuple[str, ...]:
+    # The names of this machine always stay: a remote name adds to them.
+    named = (name.strip().strip("[]").lower() for name in (value or "").split(","))
+    return LOCAL_HOSTS + tuple(name for name in named if name and name not in LOCAL_HOSTS)
 
 
 def _megabytes(value: str | None, default: int) -> int:

@@ -6,9 +6,9 @@ import dataclasses
 
 from flask import Blueprint, jsonify, render_template, request
 
-from robotale.errors import InputError
+from robotale.errors import InputError, RobotaleError
 from robotale.webapp import console, pages
-from robotale.webapp.state import driver, state
+from robotale.webapp.state import state
 
 blueprint = Blueprint("console", __name__)
 
@@ -20,8 +20,17 @@ def page():
         "cypher.html",
         examples=examples,
         examples_json=[dataclasses.asdict(example) for example in examples],
+        notice=_notice(),
         **pages.context("console.page"),
     )
+
+
+def _notice() -> str:
+    # The page shows without Neo4j; the console's user is then a question for later.
+    try:
+        return console.login().notice
+    except RobotaleError:
+        return ""
 
 
 @blueprint.post("/api/cypher")
@@ -32,12 +41,5 @@ def run():
     parameters = body.get("parameters") or {}
     if not isinstance(parameters, dict):
         raise InputError('The parameters must be a JSON object, e.g. {"log": "agri"}.')
-    settings = state().settings
-    results = console.run_read_only(
-        driver(),
-        body["query"],
-        parameters,
-        row_limit=settings.console_row_limit,
-        timeout=settings.console_timeout,
-    )
-    return jsonify(results=[result.to_dict() for result in results])
+    results = console.run(body["query"], parameters, state().settings)
+    return jsonify(results=results)

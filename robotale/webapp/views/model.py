@@ -49,7 +49,12 @@ def upload():
 @blueprint.get("/api/models/<model_id>.bpmn")
 def xml(model_id: str):
     model = state().models.get(model_id)
-    return Response(model.path.read_bytes(), mimetype="application/xml")
+    # Plain text, a download and a sandbox: opened in a tab, the file cannot run anything on
+    # the dashboard's origin (bpmn-js fetches it as text).
+    response = Response(model.path.read_bytes(), mimetype="text/plain")
+    response.headers["Content-Disposition"] = f'attachment; filename="{model_id}.bpmn"'
+    response.headers["Content-Security-Policy"] = "default-src 'none'; sandbox"
+    return response
 
 
 @blueprint.get("/api/models/<model_id>/frequencies")

@@ -28,8 +28,10 @@
       });
       status.textContent = data.results.map((r) => rows(r.total)).join(", ");
       for (const result of data.results) {
+        const counted = result.complete ? rows(result.total) : `at least ${rows(result.total)}`;
+        const why = result.cut === "bytes" ? " (the rest is larger than the console sends)" : "";
         const shown = result.rows.length < result.total
-          ? `showing the first ${result.rows.length} of ${rows(result.total)}` : rows(result.total);
+          ? `showing the first ${result.rows.length} of ${counted}${why}` : counted;
         results.append(
           robotale.el("pre", { class: "statement", text: result.statement }),
           robotale.el("p", { class: "count", text: shown }),

@@ -1,0 +1,384 @@
+"""Run someone else's Cypher so that it can only read the graph, and bound what comes back.
+
+The dashboard's console runs its queries here. Four fences, each enough against what it
+covers, checked in this order:
+
+1. The text, before anything is sent: ``LOAD CSV`` (files and URLs), administration commands
+   (``SHOW``, ``TERMINATE``, users, databases), ``USE`` and ``CALL ... IN TRANSACTIONS`` are
+   refused, as are integers Neo4j cannot hold.
+2. The plan (``EXPLAIN``, which runs nothing): every operator must work on robotale's database,
+   read no file, administer nothing, and call only the procedures of
+   :data:`ALLOWED_PROCEDURES`.
+3. The transaction: opened in READ access mode with a timeout and without retries, so Neo4j
+   refuses every write and a runaway query ends once.
+4. The answer: at most ``rows`` rows and ``bytes`` bytes of JSON are kept; the rest is counted
+   up to :data:`COUNTED` rows. Every value becomes valid JSON (:func:`cell`).
+
+``python -m robotale.ekg.readonly <megabytes>`` runs one request read from stdin as JSON in a
+process whose memory is capped, so that a single enormous value (``RETURN range(1, 1e8)``)
+costs that process, not the dashboard.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+import resource
+import sys
+from collections.abc import Mapping
+from dataclasses import asdict, dataclass
+from typing import Any
+
+import neo4j
+from neo4j import Driver
+from neo4j.exceptions import DriverError, Neo4jError, ServiceUnavailable, SessionExpired
+from neo4j.graph import Node, Path, Relationship
+
+from robotale.ekg.connection import database as default_database
+from robotale.ekg.queries import code_only, split_statements
+from robotale.errors import InputError, RobotaleError, ServerError
+
+#: procedures the console may call: they describe the graph and the server, and change nothing
+ALLOWED_PROCEDURES = frozenset(
+    {
+        "db.labels",
+        "db.relationshipTypes",
+        "db.propertyKeys",
+        "db.schema.visualization",
+        "db.schema.nodeTypeProperties",
+        "db.schema.relTypeProperties",
+        "dbms.components",
+        "dbms.showCurrentUser",
+    }
+)
+#: rows counted at most (shown or not): past that the total is "at least"
+COUNTED = 100_000
+#: JavaScript's numbers hold integers exactly up to here; larger ones are sent as text
+_EXACT_IN_JSON = 2**53 - 1
+_INT64 = (-(2**63), 2**63 - 1)
+_ACCESS_MODE = "Neo.ClientError.Statement.AccessMode"
+_TIMED_OUT = ("TransactionTimedOut", "TransactionTimedOutClientConfiguration")
+_ONLY_READS = "The console only reads the graph"
+
+_LOAD_CSV = re.compile(r"\bLOAD\s+CSV\b", re.IGNORECASE)
+_IN_TRANSACTIONS = re.compile(r"\bIN\s+(?:\d+\s+)?(?:CONCURRENT\s+)?TRANSACTIONS\b", re.I)
+_ADMIN_START = re.compile(
+    r"^\s*(?:(?:EXPLAIN|PROFILE)\s+)?"
+    r"(SHOW|TERMINATE|GRANT|DENY|REVOKE|ALTER|START|STOP|ENABLE|DRYRUN|RENAME)\b",
+    re.IGNORECASE,
+)
+_ADMIN_OBJECT = re.compile(
+    r"\b(?:CREATE|DROP)\s+(?:OR\s+REPLACE\s+)?(?:USER|ROLE|DATABASE|COMPOSITE|ALIAS|SERVER)\b",
+    re.IGNORECASE,
+)
+_USE = re.compile(r"(?:^|\{)\s*USE\b", re.IGNORECASE)
+_LEADING_MODE = re.compile(r"^\s*(?:EXPLAIN|PROFILE)\b", re.IGNORECASE)
+_PROCEDURE_NAME = re.compile(r"\s*([\w.]+)\s*\(")
+
+
+class QueryRefused(InputError):
+    """The console does not run this query (it would do more than read the graph)."""
+
+
+class WriteRefused(QueryRefused):
+    """The query would change the graph."""
+
+
+@dataclass(frozen=True)
+class Limits:
+    rows: int = 1000
+    bytes: int = 5_000_000
+    timeout: float = 30.0
+
+
+@dataclass(frozen=True)
+class StatementResult:
+    statement: str
+    columns: list[str]
+    rows: list[list[Any]]
+    #: rows the query returned; more than ``len(rows)`` when a limit cut them
+    total: int
+    #: False when counting stopped at :data:`COUNTED` rows (``total`` is then "at least")
+    complete: bool = True
+    #: why fewer rows are shown than counted: "" (none were cut), "rows" or "bytes"
+    cut: str = ""
+
+    def to_dict(self) -> dict[str, Any]:
+        return asdict(self)
+
+
+# -- the text -------------------------------------------------------------------------------
+
+
+def refuse_text(statement: str) -> None:
+    """Raise :class:`QueryRefused` for what the console never sends to Neo4j."""
+    code = code_only(statement)
+    if _LOAD_CSV.search(code):
+        raise QueryRefused(f"{_ONLY_READS}: LOAD CSV (reading files and URLs) is refused.")
+    if _IN_TRANSACTIONS.search(code):
+        raise WriteRefused(
+            f"{_ONLY_READS}, one transaction per statement: CALL {{ ... }} IN TRANSACTIONS "
+            "is refused."
+        )
+    if _ADMIN_START.search(code) or _ADMIN_OBJECT.search(code):
+        raise QueryRefused(
+            f"{_ONLY_READS}: administration commands (SHOW, TERMINATE, users, roles, "
+            "databases) are refused."
+        )
+    if _USE.search(code):
+        raise QueryRefused(f"{_ONLY_READS} of robotale's database: USE is refused.")
+
+
+def checked_parameters(parameters: Mapping[str, Any] | None) -> dict[str, Any]:
+    """The parameters, once every integer in them fits Neo4j's 64 bits."""
+    values = dict(parameters or {})
+    for name, value in values.items():
+        if not isinstance(name, str):
+            raise InputError(f"The parameter name {name!r} is not text.")
+        _check_integers(name, value)
+    return values
+
+
+def _check_integers(name: str, value: Any) -> None:
+    if isinstance(value, int) and not isinstance(value, bool):
+        if not _INT64[0] <= value <= _INT64[1]:
+            raise InputError(
+                f"The parameter ${name} holds {value}, outside Neo4j's 64-bit integers; "
+                "send it as text or as a float."
+            )
+    elif isinstance(value, list | tuple):
+        for item in value:
+            _check_integers(name, item)
+    elif isinstance(value, dict):
+        for item in value.values():
+            _check_integers(name, item)
+
+
+# -- the plan -------------------------------------------------------------------------------
+
+
+def refuse_plan(session: neo4j.Session, statement: str, parameters: dict, database: str) -> None:
+    """Ask Neo4j for the plan of ``statement`` (nothing runs) and refuse what it would do
+    beyond reading ``database``."""
+    code = code_only(statement)
+    leading = _LEADING_MODE.match(code)
+    body = statement[leading.end() :] if leading else statement
+    summary = session.run("EXPLAIN " + body, parameters).consume()
+    for operator, details in _operators(summary.plan or {}):
+        _check_operator(operator, details, database)
+
+
+def _operators(plan: Mapping[str, Any]) -> list[tuple[str, str]]:
+    found = [(str(plan.get("operatorType", "")), str(plan.get("args", {}).get("Details", "")))]
+    for child in plan.get("children", []):
+        found += _operators(child)
+    return found
+
+
+def _check_operator(operator: str, details: str, database: str) -> None:
+    name, _, where = operator.partition("@")
+    if where and where != database:
+        raise QueryRefused(f"{_ONLY_READS} of robotale's database ({database}).")
+    if name == "LoadCSV":
+        raise QueryRefused(f"{_ONLY_READS}: LOAD CSV (reading files and URLs) is refused.")
+    if name.startswith(("Show", "Terminate", "Administration", "System")):
+        raise QueryRefused(f"{_ONLY_READS}: administration commands are refused.")
+    if name.startswith("Transaction"):
+        raise WriteRefused(f"{_ONLY_READS}: CALL {{ ... }} IN TRANSACTIONS is refused.")
+    if "Procedure" in name:
+        match = _PROCEDURE_NAME.match(details)
+        procedure = match.group(1) if match else details
+        if procedure not in ALLOWED_PROCEDURES:
+            allowed = ", ".join(sorted(ALLOWED_PROCEDURES))
+            raise QueryRefused(
+                f"{_ONLY_READS}: the procedure {procedure} is not one it calls ({allowed})."
+            )
+
+
+# -- running --------------------------------------------------------------------------------
+
+
+def run_read_only(
+    driver: Driver,
+    text: str,
+    parameters: Mapping[str, Any] | None = None,
+    row_limit: int = Limits.rows,
+    timeout: float = Limits.timeout,
+    byte_limit: int = Limits.bytes,
+    database: str | None = None,
+) -> list[StatementResult]:
+    """Run each statement of ``text`` (separated by ``;``) in its own read transaction.
+
+    Every statement is checked (text, then plan) before the first one runs. Raises
+    :class:`QueryRefused` (:class:`WriteRefused` for writes) for what the console does not
+    run and :class:`InputError` when Neo4j rejects a statement, each with one sentence.
+    """
+    statements = split_statements(text)
+    if not statements:
+        raise InputError("Type a Cypher query (or pick an example) to run.")
+    values = checked_parameters(parameters)
+    for statement in statements:
+        refuse_text(statement)
+    limits = Limits(row_limit, byte_limit, timeout)
+    database = database or default_database()
+    with driver.session(database=database, default_access_mode=neo4j.READ_ACCESS) as session:
+        try:
+            for statement in statements:
+                refuse_plan(session, statement, values, database)
+            return [_run(session, statement, values, limits) for statement in statements]
+        except (ServiceUnavailable, SessionExpired):
+            raise
+        except (Neo4jError, DriverError) as error:
+            raise explain(error) from None
+
+
+def _run(
+    session: neo4j.Session, statement: str, parameters: dict, limits: Limits
+) -> StatementResult:
+    # An explicit transaction: the driver retries none of it (a query that exhausted the
+    # server's memory once fails once).
+    with session.begin_transaction(timeout=limits.timeout) as tx:
+        result = tx.run(statement, parameters)
+        columns = list(result.keys())
+        rows: list[list[Any]] = []
+        total, size, cut = 0, 0, ""
+        for record in result:
+            total += 1
+            if not cut:
+                row = [cell(value) for value in record.values()]
+                size += len(json.dumps(row))
+                if total > limits.rows or size > limits.bytes:
+                    cut = "rows" if total > limits.rows else "bytes"
+                else:
+                    rows.append(row)
+            if total >= COUNTED:
+                return StatementResult(statement, columns, rows, total, False, cut or "rows")
+        return StatementResult(statement, columns, rows, total, True, cut)
+
+
+def explain(error: Exception) -> InputError:
+    """Neo4j's refusal as one sentence."""
+    code = getattr(error, "code", "") or ""
+    if code == _ACCESS_MODE:
+        return WriteRefused(
+            "The console only reads, and this query would change the graph; run writes "
+            "with robotale's commands or in Neo4j Browser."
+        )
+    if code.endswith(_TIMED_OUT):
+        return InputError(
+            "The query ran longer than the console allows: narrow it (a LIMIT, a WHERE on the log)."
+        )
+    if "OutOfMemory" in code or "MemoryPool" in code:
+        return InputError(
+            "The query needs more memory than Neo4j gives one query: narrow it (a LIMIT, a "
+            "WHERE on the log)."
+        )
+    message = (getattr(error, "message", None) or str(error) or type(error).__name__).strip()
+    first = message.splitlines()[0] if message else type(error).__name__
+    return InputError(f"Neo4j could not run the query: {_shortened(first, 300)}")
+
+
+def _shortened(text: str, length: int) -> str:
+    return text if len(text) <= length else text[: length - 1] + "…"
+
+
+# -- values as JSON -------------------------------------------------------------------------
+
+
+def cell(value: Any) -> Any:
+    """A result value as JSON: graph elements as Neo4j Browser writes them, times as ISO text,
+    non-finite floats and integers beyond JavaScript's exact range as text."""
+    if isinstance(value, Node):
+        labels = "".join(f":{label}" for label in sorted(value.labels))
+        return f"({labels} {_properties(value)})"
+    if isinstance(value, Relationship):
+        return f"[:{value.type} {_properties(value)}]"
+    if isinstance(value, Path):
+        return [cell(element) for element in _path_elements(value)]
+    if isinstance(value, list | tuple) and not hasattr(value, "srid"):
+        return [cell(item) for item in value]
+    if isinstance(value, dict):
+        return {str(key): cell(item) for key, item in value.items()}
+    if value is None or isinstance(value, bool | str):
+        return value
+    if isinstance(value, int):
+        return value if abs(value) <= _EXACT_IN_JSON else str(value)
+    if isinstance(value, float):
+        return value if math.isfinite(value) else _NON_FINITE[str(value)]
+    if isinstance(value, bytes | bytearray):
+        return value.hex()
+    if hasattr(value, "iso_format"):
+        return value.iso_format()
+    return str(value)
+
+
+_NON_FINITE = {"nan": "NaN", "inf": "Infinity", "-inf": "-Infinity"}
+
+
+def _properties(entity: Node | Relationship) -> str:
+    shown = ", ".join(f"{key}: {_literal(cell(value))}" for key, value in sorted(entity.items()))
+    return "{" + shown + "}"
+
+
+def _literal(value: Any) -> str:
+    return repr(value) if isinstance(value, str) else str(value)
+
+
+def _path_elements(path: Path) -> list[Node | Relationship]:
+    elements: list[Node | Relationship] = [path.start_node]
+    for relationship in path.relationships:
+        elements += [relationship, relationship.end_node]
+    return elements
+
+
+# -- the capped process ---------------------------------------------------------------------
+
+
+def answer(request: Mapping[str, Any]) -> dict[str, Any]:
+    """Run one console request (connection, text, parameters, limits) and say how it went:
+    ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``."""
+    from robotale.ekg.connection import Settings, connect, unreachable_message
+
+    where = Settings(request["uri"], request["user"], request["password"], True)
+    try:
+        with connect(where) as driver:
+            results = run_read_only(
+                driver,
+                request["text"],
+                request.get("parameters"),
+                row_limit=request["rows"],
+                timeout=request["timeout"],
+                byte_limit=request["bytes"],
+                database=request["database"],
+            )
+    except RobotaleError as error:
+        return {"error": str(error), "kind": type(error).__name__}
+    except (ServiceUnavailable, SessionExpired):
+        return {"error": unreachable_message(where), "kind": ServerError.__name__}
+    return {"results": [result.to_dict() for result in results]}
+
+
+def _main(megabytes: int) -> None:
+    request = json.loads(sys.stdin.read())
+    # The cap is on top of what Python and the driver already map (their size varies).
+    limit = _mapped_bytes() + megabytes * 1024 * 1024
+    resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
+    try:
+        reply = answer(request)
+    except MemoryError:
+        reply = {"error": "memory", "kind": "MemoryError"}
+    # allow_nan=False: a value cell() let through as NaN would be invalid JSON; fail loudly.
+    sys.stdout.write(json.dumps(reply, allow_nan=False))
+
+
+def _mapped_bytes() -> int:
+    try:
+        with open("/proc/self/statm") as statm:
+            return int(statm.read().split()[0]) * resource.getpagesize()
+    except OSError:  # no /proc (not Linux): count a generous start instead
+        return 1024**3
+
+
+if __name__ == "__main__":
+    _main(int(sys.argv[1]))

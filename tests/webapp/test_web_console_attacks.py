@@ -1,0 +1,254 @@
+"""What an attacker tried with the read-only console, through the real app and the session's
+real Neo4j: reading files and loopback services, administration, other sessions'
+transactions, exhausting memory, and answers that are not JSON."""
+
+from __future__ import annotations
+
+import http.server
+import json
+import os
+import resource
+import threading
+import time
+import uuid
+from collections.abc import Iterator
+
+import pytest
+
+from robotale.ekg.server import create_console_user, security_settings
+from robotale.webapp import console
+
+#: the session's Neo4j is robotale's local server unless the run was pointed at another
+LOCAL_SERVER = not os.environ.get("NEO4J_URI")
+ONLY_READS = "The console only reads"
+
+
+def run(client, query: str, parameters: dict | None = None):
+    return client.post(
+        "/api/cypher",
+        json={"query": query, "parameters": parameters or {}},
+        headers={"X-CSRFToken": client.csrf},
+    )
+
+
+def refused(response) -> str:
+    """The one-sentence refusal of a console request."""
+    assert response.status_code == 400, response.get_data(as_text=True)[:500]
+    message = response.json["error"]
+    assert "\n" not in message and "results" not in response.json
+    return message
+
+
+@pytest.fixture
+def loopback_service() -> Iterator[dict]:
+    """An HTTP service on 127.0.0.1 holding a secret; ``hits`` counts the requests it got."""
+    seen = {"hits": 0, "secret": uuid.uuid4().hex}
+
+    class Handler(http.server.BaseHTTPRequestHandler):
+        def do_GET(self) -> None:
+            seen["hits"] += 1
+            body = f"secret\n{seen['secret']}\n".encode()
+            self.send_response(200)
+            self.send_header("Content-Length", str(len(body)))
+            self.end_headers()
+            self.wfile.write(body)
+
+        def log_message(self, *args: object) -> None:
+            pass
+
+    server = http.server.HTTPServer(("127.0.0.1", 0), Handler)
+    thread = threading.Thread(target=server.serve_forever, daemon=True)
+    thread.start()
+    seen["url"] = f"http://127.0.0.1:{server.server_port}/secret.csv"
+    yield seen
+    server.shutdown()
+    server.server_close()
+
+
+def test_load_csv_reads_no_file(client, tmp_path):
+    secret = uuid.uuid4().hex
+    path = tmp_path / "secret.csv"
+    path.write_text(f"secret\n{secret}\n")
+    for query in (
+        f"LOAD CSV FROM 'file://{path}' AS line RETURN line",
+        f"load  csv with headers from 'file://{path}' AS line RETURN line",
+        "LOAD/* hidden */CSV FROM $url AS line RETURN line",
+        f"CALL () {{ LOAD CSV FROM 'file://{path}' AS line RETURN line }} RETURN line",
+    ):
+        response = run(client, query, {"url": f"file://{path}"})
+        assert refused(response).startswith(f"{ONLY_READS} the graph: LOAD CSV")
+        assert secret not in response.get_data(as_text=True)
+
+
+def test_load_csv_fetches_no_loopback_service(client, loopback_service):
+    url = loopback_service["url"]
+    response = run(client, "LOAD CSV FROM $url AS line RETURN line", {"url": url})
+    assert "LOAD CSV" in refused(response)
+    assert loopback_service["hits"] == 0
+    assert loopback_service["secret"] not in response.get_data(as_text=True)
+
+
+@pytest.mark.parametrize(
+    "query",
+    [
+        "SHOW USERS",
+        "SHOW TRANSACTIONS",
+        "SHOW TRANSACTIONS YIELD currentQuery RETURN currentQuery",
+        "SHOW SETTINGS",
+        "show procedures",
+        "TERMINATE TRANSACTIONS 'neo4j-transaction-1'",
+        "USE system SHOW USERS",
+        "CREATE USER mallory SET PASSWORD 'secret-secret'",
+        "ALTER USER neo4j SET PASSWORD 'secret-secret'",
+        "STOP DATABASE neo4j",
+        "GRANT ROLE admin TO mallory",
+    ],
+)
+def test_administration_commands_are_refused(client, query):
+    message = refused(run(client, query))
+    assert message.startswith(ONLY_READS), message
+
+
+@pytest.mark.parametrize(
+    "query",
+    [
+        "CALL dbms.listConfig()",
+        "CALL dbms.listConfig() YIELD name, value RETURN name, value",
+        "CALL db.clearQueryCaches()",
+        "CALL `db`.`clearQueryCaches`()",
+        "call db.clearQueryCaches",
+        "MATCH (n) WITH count(n) AS c CALL dbms.listConnections() YIELD connectionId RETURN *",
+    ],
+)
+def test_procedures_outside_the_allow_list_are_refused(client, query):
+    message = refused(run(client, query))
+    assert message.startswith(f"{ONLY_READS} the graph: the procedure "), message
+
+
+def test_allowed_procedures_answer_as_neo4j_does(client, neo4j_driver, log_name):
+    neo4j_driver.execute_query("CREATE (:ConsoleLabelProbe {log: $log})", log=log_name)
+    response = run(client, "CALL db.labels() YIELD label RETURN label ORDER BY label")
+    assert response.status_code == 200
+    records, _, _ = neo4j_driver.execute_query(
+        "CALL db.labels() YIELD label RETURN label ORDER BY label"
+    )
+    expected = [[record["label"]] for record in records]
+    assert "ConsoleLabelProbe" in {row[0] for row in expected}
+    assert response.json["results"][0]["rows"] == expected
+
+
+def test_another_sessions_transaction_cannot_be_terminated(client, neo4j_driver, log_name):
+    with neo4j_driver.session() as session:
+        tx = session.begin_transaction(metadata={"probe": log_name})
+        tx.run("CREATE (:ConsoleKeep {log: $log})", log=log_name).consume()
+        found, _, _ = neo4j_driver.execute_query(
+            "SHOW TRANSACTIONS YIELD transactionId, metaData "
+            "WHERE metaData.probe = $log RETURN transactionId",
+            log=log_name,
+        )
+        [transaction] = [record["transactionId"] for record in found]
+        response = run(client, "TERMINATE TRANSACTIONS $id", {"id": transaction})
+        assert refused(response).startswith(ONLY_READS)
+        tx.commit()  # still alive: the console did not end it
+    kept, _, _ = neo4j_driver.execute_query(
+        "MATCH (n:ConsoleKeep {log: $log}) RETURN count(n) AS n", log=log_name
+    )
+    assert kept[0]["n"] == 1
+
+
+def test_read_only_batches_in_transactions_are_refused(client):
+    query = "UNWIND range(1, 3) AS i CALL (i) { RETURN i * 2 AS j } IN TRANSACTIONS RETURN j"
+    message = refused(run(client, query))
+    assert message.startswith(ONLY_READS) and "IN TRANSACTIONS" in message
+
+
+def test_a_heap_exhausting_query_fails_once_with_a_sentence(client):
+    started = time.monotonic()
+    response = run(client, "RETURN reduce(s = 'ab', i IN range(1, 40) | s + s) AS s")
+    message = refused(response)
+    assert "memory" in message
+    # Not the driver's retries (more than 30 s before): Neo4j refuses once, the console says so.
+    assert time.monotonic() - started < 30
+    assert run(client, "RETURN 1 AS one").json["results"][0]["rows"] == [[1]]
+
+
+def test_one_enormous_value_does_not_grow_the_dashboard(client):
+    before = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024
+    message = refused(run(client, "RETURN range(1, 20000000) AS numbers"))
+    grown = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss // 1024 - before
+    assert "does not fit" in message or "did not finish" in message, message
+    # 20 million integers take about 700 MB as Python objects; the dashboard took none of it.
+    assert grown < 100, f"the dashboard grew by {grown} MB"
+
+
+def test_answers_are_bounded_in_bytes(neo4j_driver):
+    query = "UNWIND range(1, 50) AS i RETURN i, 'xxxxxxxxxx' AS text"
+    limit = 200
+    sizes = [len(json.dumps([i, "xxxxxxxxxx"])) for i in range(1, 51)]
+    expected = sum(1 for end in range(1, 51) if sum(sizes[:end]) <= limit)
+    [result] = console.run_read_only(neo4j_driver, query, byte_limit=limit)
+    assert len(result.rows) == expected < 50
+    assert result.total == 50 and result.cut == "bytes" and result.complete
+
+
+def test_every_value_is_valid_json(client):
+    response = run(
+        client,
+        "RETURN 0.0 / 0.0 AS nan, 1.0 / 0.0 AS inf, -1.0 / 0.0 AS minus, "
+        "9223372036854775807 AS largest, -9223372036854775808 AS smallest, "
+        "9007199254740991 AS exact",
+    )
+    assert response.status_code == 200
+
+    def no_constants(name: str) -> None:
+        raise AssertionError(f"{name} is not JSON")
+
+    body = json.loads(response.get_data(as_text=True), parse_constant=no_constants)
+    assert body["results"][0]["rows"] == [
+        ["NaN", "Infinity", "-Infinity", str(2**63 - 1), str(-(2**63)), 2**53 - 1]
+    ]
+
+
+def test_integers_neo4j_cannot_hold_are_one_sentence(client):
+    response = client.post(
+        "/api/cypher",
+        data='{"query": "RETURN $n AS n", "parameters": {"n": 1180591620717411303424}}',
+        content_type="application/json",
+        headers={"X-CSRFToken": client.csrf},
+    )
+    message = refused(response)
+    assert "$n" in message and str(2**70) in message
+
+
+def test_the_console_logs_in_as_its_own_user(client, neo4j_driver, monkeypatch):
+    user, password = f"console_{uuid.uuid4().hex[:8]}", uuid.uuid4().hex
+    create_console_user(neo4j_driver, user, password)
+    try:
+        monkeypatch.setenv("ROBOTALE_CONSOLE_USER", user)
+        monkeypatch.setenv("ROBOTALE_CONSOLE_PASSWORD", password)
+        response = run(client, "CALL dbms.showCurrentUser() YIELD username RETURN username")
+        assert response.json["results"][0]["rows"] == [[user]]
+        assert "ROBOTALE_CONSOLE_USER" not in client.get("/cypher").get_data(as_text=True)
+    finally:
+        neo4j_driver.execute_query("DROP USER $user", user=user, database_="system")
+
+
+def test_with_robotales_own_user_the_page_says_how_to_give_it_a_reader(client, monkeypatch):
+    monkeypatch.delenv("ROBOTALE_CONSOLE_USER", raising=False)
+    page = client.get("/cypher").get_data(as_text=True)
+    assert "GRANT ROLE reader" in page and "ROBOTALE_CONSOLE_USER" in page
+
+
+def test_the_local_server_caps_a_transaction_and_reads_no_file_urls(neo4j_driver):
+    assert security_settings("1g")["db.memory.transaction.max"] == "512m"
+    assert security_settings("2048m")["db.memory.transaction.max"] == "1024m"
+    if not LOCAL_SERVER:
+        pytest.skip("the tests run against a server robotale did not start")
+    records, _, _ = neo4j_driver.execute_query(
+        "CALL dbms.listConfig() YIELD name, value "
+        "WHERE name IN ['dbms.security.allow_csv_import_from_file_urls', "
+        "'db.memory.transaction.max'] RETURN name, value"
+    )
+    values = {record["name"]: record["value"] for record in records}
+    assert values["dbms.security.allow_csv_import_from_file_urls"] == "false"
+    assert values["db.memory.transaction.max"] != "0B"
