@@ -43,3 +43,22 @@ def launch(playwright: Any, profile: Path) -> Any:
     return playwright.chromium.launch_persistent_context(
         profile, executable_path=str(path), headless=True, args=list(FLAGS), viewport=VIEWPORT
     )
+
+
+def wait_for(page: Any, expression: str, timeout: float = 60.0) -> Any:
+    """Wait until the JavaScript ``expression`` is truthy in ``page``; its value.
+
+    Playwright's ``wait_for_function`` evaluates its predicate with ``eval`` inside the page,
+    which the dashboard's Content-Security-Policy forbids (no 'unsafe-eval'); ``evaluate``
+    goes through the DevTools protocol, which the policy does not govern.
+    """
+    import time
+
+    deadline = time.monotonic() + timeout
+    while True:
+        value = page.evaluate(expression)
+        if value:
+            return value
+        if time.monotonic() > deadline:
+            raise TimeoutError(f"{expression} was still false after {timeout:.0f} s")
+        page.wait_for_timeout(100)

@@ -8,6 +8,7 @@ import subprocess
 import sys
 
 import pytest
+from browser import wait_for
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.browser
@@ -114,9 +115,9 @@ def test_upload_ingest_discover_and_drill_down(page, screenshot, thesis_csv, sce
 
     # Change the aggregation: by activity alone, then by activity and robot again.
     page.uncheck("input[name=by][value=robot]")
-    page.wait_for_function(f"{CLASSES}.length === {len({a for a, _ in pairs})}")
+    wait_for(page, f"{CLASSES}.length === {len({a for a, _ in pairs})}")
     page.check("input[name=by][value=robot]")
-    page.wait_for_function(f"{CLASSES}.length === {len(pairs)}")
+    wait_for(page, f"{CLASSES}.length === {len(pairs)}")
     expect(page.locator("#graph")).to_have_attribute("data-drawn", re.compile(r"\d+"))
 
     # Zoom with the wheel and pan by dragging the background.
@@ -126,7 +127,7 @@ def test_upload_ingest_discover_and_drill_down(page, screenshot, thesis_csv, sce
     box = page.locator("#graph").bounding_box()
     page.mouse.move(box["x"] + 15, box["y"] + 15)
     page.mouse.wheel(0, -400)
-    page.wait_for_function(f"document.getElementById('graph')._cy.zoom() > {before_zoom}")
+    wait_for(page, f"document.getElementById('graph')._cy.zoom() > {before_zoom}")
     page.mouse.down()
     page.mouse.move(box["x"] + 200, box["y"] + 60, steps=8)
     page.mouse.up()
@@ -146,13 +147,13 @@ def test_upload_ingest_discover_and_drill_down(page, screenshot, thesis_csv, sce
     expect(page.locator("#graph")).to_have_attribute("data-kind", "dfg")
     page.select_option("#filter-robot", ["drone"])
     page.click("#dfg-form button[type=submit]")
-    page.wait_for_function(f"{CLASSES}.every((n) => n.data('node').robot === 'drone')")
+    wait_for(page, f"{CLASSES}.every((n) => n.data('node').robot === 'drone')")
     screenshot(page, "dfg-drone")
 
     # All perspectives of the drone's explore class.
     page.click("#tab-ekg")
     expect(page.locator("#graph")).to_have_attribute("data-kind", "ekg")
-    page.wait_for_function("document.getElementById('graph').dataset.drawn")
+    wait_for(page, "document.getElementById('graph').dataset.drawn")
     click_node(page, "node.properties.activity === 'explore' && node.properties.robot === 'drone'")
     page.click("#details-link")
     expect(page.locator("#focus-label")).to_have_text("explore by drone")
