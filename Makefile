@@ -18,7 +18,7 @@ install: $(STAMP)
 $(STAMP): pyproject.toml constraints.txt
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev,dds]'
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev,dds,dask]'
 	touch $(STAMP)
 
 # Installs the missing Debian packages when we are allowed to (root or passwordless sudo);

@@ -244,7 +244,19 @@ def _add_prepare(commands: argparse._SubParsersAction) -> None:
     prepare.add_argument("--xes", type=Path, metavar="FILE", help="also write IEEE XES")
     prepare.add_argument("--ocel", type=Path, metavar="FILE", help="also write OCEL 2.0 JSON")
     _add_preparation_options(prepare)
+    _add_executor(prepare)
     _handled_by(prepare, "prepare.prepare_command")
+
+
+def _add_executor(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
+        "--executor",
+        dest="executor",
+        default=None,
+        metavar="local[:N]|dask://HOST:PORT",
+        help="where the runs go: a local process pool (N processes) or the scheduler of a "
+        "Dask cluster whose workers reach the bags at the same path (docs/scale.md)",
+    )
 
 
 def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
@@ -480,6 +492,7 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
     simulate.add_argument(
         "--workers", type=int, metavar="N", help="worker processes (one per CPU); 0: none"
     )
+    _add_executor(simulate)
     simulate.add_argument(
         "--gui", action="store_true", default=None, help="watch in pybullet's window"
     )

@@ -35,9 +35,11 @@ def prepare_command(
     bt_log: str | None = None,
     auto: bool = False,
     distro: str | None = None,
+    executor: str | None = None,
 ) -> int:
     """Write the event log of the recordings at ``source`` as CSV (``out``, by default
-    ``<source name>.csv`` when no other output is asked for), XES and/or OCEL 2.0."""
+    ``<source name>.csv`` when no other output is asked for), XES and/or OCEL 2.0; ``executor``
+    (``local[:N]``, ``dask://HOST:PORT``) reads the runs in parallel."""
     csv = out or (None if xes or ocel else Path(f"{source.resolve().name}.csv"))
     log = prepare_recordings(
         source,
@@ -53,6 +55,7 @@ def prepare_command(
         bt_log=bt_log,
         auto=auto,
         distro=distro,
+        executor=executor,
     )
     written = []
     if csv:
@@ -84,9 +87,10 @@ def prepare_recordings(
     bt_log: str | None = None,
     auto: bool = False,
     distro: str | None = None,
+    executor: str | None = None,
 ) -> pd.DataFrame:
     """The event log of the recordings at ``source``; an option left ``None`` takes
-    :func:`~robotale.eventlog.prepare.prepare`'s default."""
+    :func:`~robotale.eventlog.prepare.prepare`'s default (``executor``: read in this process)."""
     given: dict[str, Any] = {
         "tags": tags,
         "perspectives": (
@@ -105,6 +109,7 @@ def prepare_recordings(
         bt_logs=bt_log,
         auto=bool(auto),
         distro=distro,
+        executor=executor,
         **{key: value for key, value in given.items() if value is not None},
     )
 

@@ -33,6 +33,7 @@ def simulate_command(
     topics: str | None = None,
     time_limit: float | None = None,
     workers: int | None = None,
+    executor: str | None = None,
     gui: bool = False,
     pace: float | None = None,
     overwrite: bool = False,
@@ -40,7 +41,8 @@ def simulate_command(
     out: TextIO | None = None,
 ) -> int:
     """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``); with ``gui``
-    one run in pybullet's window at ``pace`` simulated seconds per wall second."""
+    one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
+    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go."""
     out = out or sys.stdout
     loaded, scenario = resolve_world(scenario, model, world, library)
     group_counts = dict(_count(text) for text in counts)
@@ -85,6 +87,7 @@ def simulate_command(
         batch,
         target,
         workers=workers,
+        executor=executor,
         overwrite=overwrite,
         progress=not (quiet or watching),
         gui=gui,
@@ -98,6 +101,8 @@ def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
     outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
     runs, workers = summary["runs"], summary["workers"]
     where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
+    if "executor" in summary:
+        where += f" on {summary['executor']}"
     print(
         f"{runs} run{'s' if runs != 1 else ''} of {summary['scenario']} "
         f"in {summary['wall_time']:.1f} s ({where}): {outcomes}",

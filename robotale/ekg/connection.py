@@ -1,7 +1,8 @@
 """Where Neo4j is and how to talk to it.
 
 With ``NEO4J_URI`` set (plus ``NEO4J_USER``, default ``neo4j``, and ``NEO4J_PASSWORD``)
-robotale uses that server: docker compose, a cluster, Aura. Otherwise it uses the local server
+robotale uses that server: docker compose, a cluster, Aura (``neo4j://`` and ``neo4j+s://``
+give the routing driver a cluster needs; see docs/scale.md). Otherwise it uses the local server
 of ``robotale neo4j start`` (its port and generated password live under the robotale home).
 ``NEO4J_DATABASE`` picks the database (default ``neo4j``).
 """

@@ -19,6 +19,7 @@ from __future__ import annotations
 import re
 import warnings
 from collections.abc import Callable, Mapping, Sequence
+from concurrent.futures import as_completed
 from dataclasses import dataclass, fields, replace
 from fnmatch import fnmatchcase
 from pathlib import Path
@@ -130,6 +131,7 @@ def prepare(
     auto: bool = False,
     distro: str | None = None,
     report: Callable[[str], None] | None = None,
+    executor: str | None = None,
 ) -> pd.DataFrame:
     """The multi-perspective event log of a rosbag2 directory or of a folder of them.
 
@@ -145,6 +147,10 @@ def prepare(
     ``bt_logs`` (a glob of behaviour-tree logs); ``auto`` adds whatever of those each bag
     holds and tells ``report`` what it chose. ``distro`` names the ROS 2 distribution whose
     standard types fill in those a bag does not define.
+
+    ``executor`` (``local[:N]``, ``dask://HOST:PORT``; see :mod:`robotale.executors`) reads
+    the runs in parallel, each run on its own (no reading crosses runs), with the same log as
+    reading them here one after the other.
     """
     chosen = [p if isinstance(p, Perspective) else parse_perspective(p) for p in perspectives]
     if lifecycle is not None and lifecycle not in LIFECYCLE_MODES:
@@ -158,22 +164,15 @@ def prepare(
         chosen,
         bag_time,
     )
-    extra_types = message_types([Path(p) for p in msg_files])
     distro = check_distro(distro)
     runs = find_runs(Path(source))
-    globs = [tags, *(glob for p in chosen for glob in p.topic.split("|"))]
-    with tqdm(
-        total=sum(_message_count(run, globs) for run in runs),
-        unit="msg",
-        desc="prepare",
-        disable=not progress,
-        leave=False,
-    ) as bar:
+    if executor is not None:
         told: set[tuple[str, ...]] = set()
-        parts = [
-            _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
-            for run in runs
-        ]
+        parts = _read_in_parallel(
+            runs, reading, msg_files, distro, executor, progress, _once(report, told)
+        )
+    else:
+        parts = _read_here(runs, reading, msg_files, distro, progress, report)
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
     if tag_rows.empty:
         raise InputError(_nothing_found(source, reading))
@@ -185,6 +184,94 @@ def prepare(
     tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, read_manifests(runs))
     log = enrich(tag_rows, samples, rate=rate)
     return _canonical(log, chosen)
+
+
+def _read_here(
+    runs: Sequence[Path],
+    reading: _Reading,
+    msg_files: Sequence[str | Path],
+    distro: str,
+    progress: bool,
+    report: Callable[[str], None] | None,
+) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
+    """Every run read in this process, with a progress bar over their messages."""
+    extra_types = message_types([Path(p) for p in msg_files])
+    globs = [reading.tags, *(glob for p in reading.perspectives for glob in p.topic.split("|"))]
+    with tqdm(
+        total=sum(_message_count(run, globs) for run in runs),
+        unit="msg",
+        desc="prepare",
+        disable=not progress,
+        leave=False,
+    ) as bar:
+        told: set[tuple[str, ...]] = set()
+        return [
+            _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
+            for run in runs
+        ]
+
+
+def _read_in_parallel(
+    runs: Sequence[Path],
+    reading: _Reading,
+    msg_files: Sequence[str | Path],
+    distro: str,
+    executor: str,
+    progress: bool,
+    say: Callable[[str], None],
+) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
+    """Every run read by the executor's workers, a progress bar over runs as they finish;
+    what the workers warned and reported is said here, run by run in order."""
+    from robotale.executors import open_executor, parse_executor, worker_lost
+
+    spec = parse_executor(executor)
+    files = tuple(Path(p).resolve() for p in msg_files)
+    done: dict[Path, _RunRead] = {}
+    with (
+        open_executor(spec, len(runs)) as (pool, _),
+        tqdm(total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False) as bar,
+    ):
+        futures = {pool.submit(_read_alone, r.resolve(), reading, files, distro): r for r in runs}
+        for future in as_completed(futures):
+            try:
+                done[futures[future]] = future.result()
+            except Exception as error:
+                if worker_lost(error):
+                    raise InputError(
+                        f"{futures[future]}: the worker process reading it died"
+                    ) from None
+                raise
+            bar.update()
+    for run in runs:
+        for category, message in done[run].warned:
+            warnings.warn(message, category, stacklevel=2)
+        for text in done[run].reported:
+            say(text)
+    return [(done[run].tag_rows, done[run].samples) for run in runs]
+
+
+@dataclass
+class _RunRead:
+    """One run as a worker read it, with what it warned and reported on the way."""
+
+    tag_rows: pd.DataFrame
+    samples: dict[str, pd.DataFrame]
+    warned: list[tuple[type[Warning], str]]
+    reported: list[str]
+
+
+def _read_alone(run: Path, reading: _Reading, msg_files: Sequence[Path], distro: str) -> _RunRead:
+    """:func:`_read_run` in a worker process: warnings and reports are kept to be said by
+    the process that asked, as they would not reach its terminal from here."""
+    reported: list[str] = []
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PreparationWarning)
+        bag = Bag(run, message_types(list(msg_files)), distro)
+        tag_rows, samples = _read_run(bag, reading, None, reported.append)
+    warned = [
+        (w.category, str(w.message)) for w in caught if issubclass(w.category, PreparationWarning)
+    ]
+    return _RunRead(tag_rows, samples, warned, reported)
 
 
 def is_recording(path: str | Path) -> bool:
@@ -224,7 +311,7 @@ def robot_type(robot: str) -> str:
 
 
 def _read_run(
-    opened: Bag, reading: _Reading, bar: tqdm, report: Callable[[str], None]
+    opened: Bag, reading: _Reading, bar: tqdm | None, report: Callable[[str], None]
 ) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
     run = opened.path
     with opened as bag:

@@ -6,25 +6,30 @@ recorded inside a hidden ``.run_0001.partial`` folder and moved into place when 
 ``<out>`` never holds half a bag (and the bag's files carry the run's own name). A run that
 raises is recorded as crashed and the batch goes on; a run that kills its worker process is
 retried alone once, then recorded as crashed (a manifest without a bag).
+
+The runs go to the executor ``--executor`` names (:mod:`robotale.executors`): a local process
+pool, or a Dask cluster whose workers write into ``out`` themselves, so ``out`` must be a
+folder every worker reaches at the same path (a shared folder). On Dask a run whose worker
+died is retried by the scheduler (``distributed.scheduler.allowed-failures``), then recorded
+as crashed.
 """
 
 from __future__ import annotations
 
 import json
-import multiprocessing
-import os
 import shutil
 import time
 from collections import Counter
-from collections.abc import Iterable, Sequence
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
-from concurrent.futures.process import BrokenProcessPool
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import Future, as_completed
+from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
 from tqdm import tqdm
 
 from robotale.errors import InputError
+from robotale.executors import ExecutorSpec, open_executor, parse_executor, worker_lost
 from robotale.fame_runtime.manifest import RunManifest, write_manifest
 from robotale.files import write_file
 from robotale.sim import scenarios
@@ -42,20 +47,23 @@ def simulate_batch(
     progress: bool = False,
     gui: bool = False,
     pace: float | None = None,
+    executor: str | ExecutorSpec | None = None,
 ) -> dict[str, Any]:
     """Simulate every run of ``plans`` into ``out``; returns the batch summary.
 
     ``workers`` processes run them (default: one per CPU, at most one per run; 0 runs them in
-    this process). ``overwrite`` replaces the runs of an earlier batch in ``out``. With ``gui``
-    (pybullet's window) or ``pace`` (simulated seconds per wall second) the runs go one after
-    the other in this process, for a person to watch.
+    this process); ``executor`` (``local:N``, ``dask://HOST:PORT``) names where else they go.
+    ``overwrite`` replaces the runs of an earlier batch in ``out``. With ``gui`` (pybullet's
+    window) or ``pace`` (simulated seconds per wall second) the runs go one after the other in
+    this process, for a person to watch.
     """
-    out = Path(out)
+    spec = executor if isinstance(executor, ExecutorSpec) else parse_executor(executor, workers)
+    # absolute: a Dask worker's working folder is not ours
+    out = Path(out).resolve() if spec.remote else Path(out)
     prepare_folder(out, overwrite)
     began = time.perf_counter()
-    if workers is None:
-        workers = os.cpu_count() or 1
-    workers = 0 if gui or pace or len(plans) == 1 else min(workers, len(plans))
+    here = gui or pace or spec.workers == 0 or (len(plans) == 1 and not spec.remote)
+    workers = 0
     manifests: dict[str, RunManifest] = {}
     with tqdm(
         total=len(plans), unit="run", desc="simulate", disable=not progress, leave=False
@@ -67,15 +75,17 @@ def simulate_batch(
             bar.set_postfix(Counter(m["outcome"]["status"] for m in manifests.values()))
 
         try:
-            if workers == 0:
+            if here:
                 for plan in plans:
                     finished(run_into(plan, out, gui=gui, pace=pace))
             else:
-                _in_pool(plans, out, workers, finished)
+                workers = _in_pool(plans, out, spec, finished)
         except BaseException:
             _remove_partials(out)
             raise
     summary = _summary(plans, [manifests[p.case] for p in plans], workers, began)
+    if spec.remote:
+        summary["executor"] = spec.describe()
     write_file(out / SUMMARY, json.dumps(summary, indent=2) + "\n")
     return summary
 
@@ -91,35 +101,50 @@ def run_into(
     partial.mkdir(parents=True)
     try:
         manifest = simulate_run(plan, partial / plan.case, gui=gui, pace=pace)
+        # A Dask cluster runs a finished run again when the worker holding its result dies
+        # before handing it over; the run is deterministic, so its second bag replaces the first.
+        shutil.rmtree(final, ignore_errors=True)
         (partial / plan.case).rename(final)
     finally:
         shutil.rmtree(partial, ignore_errors=True)
     return manifest
 
 
-def _in_pool(plans: Sequence[RunPlan], out: Path, workers: int, finished) -> None:
-    broken = _pool_round(plans, out, workers, finished)
-    for plan in broken:  # alone in a fresh worker, so a crash is pinned on its run
-        if _pool_round([plan], out, 1, finished):
+Finished = Callable[[RunManifest], None]
+
+
+def _in_pool(plans: Sequence[RunPlan], out: Path, spec: ExecutorSpec, finished: Finished) -> int:
+    """Run ``plans`` on the executor; returns how many workers it had."""
+    broken, workers = _pool_round(plans, out, spec, finished)
+    for plan in broken:
+        # Dask already retried it on other workers; a local pool breaks as a whole, so the
+        # run goes alone into a fresh pool to pin the crash on its run.
+        if spec.remote or _pool_round([plan], out, replace(spec, workers=1), finished)[0]:
             finished(_died(plan, out))
+    return workers
 
 
-def _pool_round(plans: Sequence[RunPlan], out: Path, workers: int, finished) -> list[RunPlan]:
-    """Run ``plans`` in a pool; returns those lost when a worker process died."""
-    context = multiprocessing.get_context("spawn")
+def _pool_round(
+    plans: Sequence[RunPlan], out: Path, spec: ExecutorSpec, finished: Finished
+) -> tuple[list[RunPlan], int]:
+    """Run ``plans`` on the executor; returns those lost when a worker process died, and how
+    many workers there were."""
     lost: list[RunPlan] = []
-    with ProcessPoolExecutor(max_workers=workers, mp_context=context) as pool:
+    with open_executor(spec, len(plans)) as (pool, workers):
         futures: dict[Future, RunPlan] = {pool.submit(run_into, p, out): p for p in plans}
         try:
             for future in as_completed(futures):
                 try:
                     finished(future.result())
-                except BrokenProcessPool:
+                except Exception as error:
+                    if not worker_lost(error):
+                        raise
                     lost.append(futures[future])
         except BaseException:
-            pool.shutdown(wait=False, cancel_futures=True)
+            for future in futures:
+                future.cancel()
             raise
-    return sorted(lost, key=lambda p: p.index)
+    return sorted(lost, key=lambda p: p.index), workers
 
 
 def _died(plan: RunPlan, out: Path) -> RunManifest:
