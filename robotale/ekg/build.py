@@ -27,9 +27,10 @@ from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
 from robotale.ekg.load import Loader
-from robotale.ekg.logs import delete_log, log_exists
+from robotale.ekg.logs import delete_log, log_exists, log_run
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import GraphTables, entity_types, graph_tables
+from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, ServerError
 
 
@@ -70,16 +71,18 @@ def build_ekg(
     keys = [aggregation_key(key) for key in aggregate]
     _check_keys(tables.events, keys)
     ensure_schema(driver)
-    existing = log_exists(driver, name)
-    if existing and not replace:
-        raise InputError(
-            f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
-            f"or `robotale logs delete {name}` first."
-        )
-    target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
-    summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress))
-    if existing:
-        _swap(driver, target, name)
+    # Checked under the lock: another ingest of this name may have finished a moment ago.
+    with log_write_lock(driver, name, "ingesting") as run:
+        existing = log_exists(driver, name)
+        if existing and not replace:
+            raise InputError(
+                f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
+                f"or `robotale logs delete {name}` first."
+            )
+        target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
+        summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress, run))
+        if existing:
+            _swap(driver, target, name)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
 
 
@@ -107,6 +110,7 @@ class _Job:
     target: str  # the log's name, or a temporary one while an existing log is rebuilt
     source: str
     progress: bool
+    run: str  # the id of this run's write lock, recorded on the Log node
 
 
 def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
@@ -116,7 +120,7 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
             return _write(driver, job, interrupt.check)
     except BaseException as error:
         try:
-            delete_log(driver, target)
+            _undo(driver, target, job.run)
         except (Neo4jError, DriverError, OSError):
             raise ServerError(
                 f"Writing the log {target!r} to Neo4j failed ({error}) and what was written could "
@@ -129,12 +133,21 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
         raise
 
 
+def _undo(driver: Driver, target: str, run: str) -> None:
+    """Remove what this run wrote under ``target``: nothing if the Log node there is another
+    run's (the lock makes this run the only writer of ``target`` while it lasts)."""
+    owner = log_run(driver, target)
+    if owner in (None, run):
+        delete_log(driver, target)
+
+
 def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> BuildSummary:
     tables, target = job.tables, job.target
     events, entities = tables.events, tables.entities
     driver.execute_query(
         cypher("ekg_log_begin"),
         log=target,
+        run=job.run,
         source=job.source,
         properties=list(events.columns),
         entityTypes=entities["type"].unique().tolist(),
