@@ -8,7 +8,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from robotale.errors import InputError
+from robotale.errors import InputError, require_range
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.check import Report, check
 from robotale.fame_runtime.clock import SimClock
@@ -120,6 +120,8 @@ def run_command(
     """Run the mission on the in-process bus and a simulated clock, printing every tag as it
     happens; 1 when a BPMN error went uncaught."""
     out, err = out or sys.stdout, err or sys.stderr
+    require_range(until, "--until", 0, unit=" seconds")
+    require_range(latency, "--latency", 0, unit=" seconds")
     definitions = parse(model)
     clock = SimClock()
     mission = Mission(

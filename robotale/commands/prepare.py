@@ -38,6 +38,9 @@ def prepare_command(
     """Write the event log of the recordings at ``source`` as CSV (``out``, by default
     ``<source name>.csv`` when no other output is asked for), XES and/or OCEL 2.0."""
     csv = out or (None if xes or ocel else Path(f"{source.resolve().name}.csv"))
+    for target in (csv, xes, ocel):  # all refused before hours of preparation, not after
+        if target is not None:
+            writers.check_target(target)
     log = prepare_recordings(
         source,
         tags=tags,

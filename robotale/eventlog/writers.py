@@ -41,9 +41,20 @@ _XES_EXTENSIONS = (
 _EPOCH = "1970-01-01T00:00:00+00:00"
 
 
+def check_target(path: str | Path) -> Path:
+    """``path`` if a file can be written there: a folder is refused before anything is
+    written (a command writing several files checks them all first)."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(
+            f"{path} is a folder: give the name of the file to write (e.g. {path / 'log.json'})."
+        )
+    return path
+
+
 def _target(path: str | Path) -> Path:
     """``path``, with its folder created if need be."""
-    path = Path(path)
+    path = check_target(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
