@@ -36,6 +36,6 @@ def require_range(
     """``value`` of the command-line ``option`` if it is a number from ``low`` to ``high``;
     otherwise an :class:`InputError` naming the option (argparse takes ``nan`` and ``-5``)."""
     if not low <= value <= high:  # also false for nan
-        wanted = f"at least {low:g}" if high == float("inf") else f"from {low:g} to {high:g}"
+        wanted = f"of at least {low:g}" if high == float("inf") else f"from {low:g} to {high:g}"
         raise InputError(f"{option} {value:g} is not usable: give a number {wanted}{unit}.")
     return value
