@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import shlex
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -70,6 +71,7 @@ def build_ekg(
     tables = graph_tables(log, default_entities(log.columns) if entities is None else entities)
     keys = [aggregation_key(key) for key in aggregate]
     _check_keys(tables.events, keys)
+    _check_key_sizes(tables, keys)
     ensure_schema(driver)
     # Checked under the lock: another ingest of this name may have finished a moment ago.
     with log_write_lock(driver, name, "ingesting") as run:
@@ -103,6 +105,28 @@ def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
         entity_types(list(events.columns), key, what="aggregate by")
 
 
+# Neo4j refuses index keys longer than about 8 kB with a long text that names no row; the
+# ids of events, entities and classes are index keys (UTF-8 bytes; a margin for the log name).
+KEY_BYTES = 4000
+
+
+def _check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
+    """One sentence naming the event and column of the first value too long to be a key."""
+    events = tables.events
+    columns = {"id"} | {column for key in keys for column in key}
+    columns |= set(tables.entities["type"].unique())  # entity types are event columns
+    for column in sorted(c for c in columns if c in events.columns):
+        sizes = events[column].astype("string").fillna("").str.encode("utf-8").str.len()
+        if (sizes > KEY_BYTES).any():
+            row = int(sizes.to_numpy().argmax())
+            raise InputError(
+                f"Event {row + 1} of the log (id {str(events['id'].iloc[row])[:40]!r}) has "
+                f"{int(sizes.iloc[row]):,} bytes as its {column}; {column} values become "
+                f"keys of Neo4j's indexes, which take at most {KEY_BYTES:,} bytes: shorten it "
+                "or leave that column out of --entities and --aggregate."
+            )
+
+
 @dataclass(frozen=True)
 class _Job:
     tables: GraphTables
@@ -119,18 +143,48 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
         with DeferredInterrupt() as interrupt:
             return _write(driver, job, interrupt.check)
     except BaseException as error:
+        if isinstance(error, Neo4jError | DriverError | OSError) and not _answers(driver):
+            # Retrying the undo against a server that is gone would only take minutes.
+            raise ServerError(
+                f"Neo4j went away while the log {target!r} was written ({_why(error)}); once it "
+                "runs again, `robotale logs list` shows the log as failed and "
+                f"`robotale logs delete {shlex.quote(target)}` removes it."
+            ) from error
         try:
             _undo(driver, target, job.run)
         except (Neo4jError, DriverError, OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({error}) and what was written could "
-                f"not be removed; remove it with `robotale logs delete {target!r}`."
+                f"Writing the log {target!r} to Neo4j failed ({_why(error)}) and what was "
+                "written could not be removed; remove it with "
+                f"`robotale logs delete {shlex.quote(target)}`."
             ) from error
         if isinstance(error, Neo4jError | DriverError | OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({error}); nothing of it was kept."
+                f"Writing the log {target!r} to Neo4j failed ({_why(error)}); nothing of it "
+                "was kept."
             ) from error
         raise
+
+
+def _answers(driver: Driver) -> bool:
+    """Whether the server still answers (one attempt, no retries)."""
+    try:
+        driver.verify_connectivity()
+        return True
+    except (Neo4jError, DriverError, OSError):
+        return False
+
+
+def _why(error: BaseException) -> str:
+    """The gist of a server's or driver's error, on one line: the driver's own text spans
+    lines and names connection objects."""
+    if isinstance(error, Neo4jError):
+        text = error.message or error.code or type(error).__name__
+    elif isinstance(error, DriverError):
+        text = "the connection to Neo4j was lost"
+    else:
+        text = str(error) or type(error).__name__
+    return " ".join(str(text).split())[:300]
 
 
 def _undo(driver: Driver, target: str, run: str) -> None:

@@ -94,10 +94,9 @@ def log_write_lock(driver: Driver, name: str, doing: str = "writing") -> Iterato
     finally:
         _ACTIVE.discard(run)
         # If Neo4j is gone the lock stays; its run is no longer active, so it counts as stale.
-        with suppress(Neo4jError, DriverError, OSError):
-            driver.execute_query(
-                cypher("ekg_lock_release"), name=name, run=run, database_=database()
-            )
+        with suppress(Neo4jError, DriverError, OSError), driver.session(database=database()) as s:
+            # One attempt: managed retries against a server that is gone take half a minute.
+            s.run(cypher("ekg_lock_release"), name=name, run=run).consume()
 
 
 def _take(driver: Driver, name: str, doing: str) -> str:

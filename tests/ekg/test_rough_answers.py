@@ -72,6 +72,20 @@ def test_bad_logs(tmp_path, capsys, graph_counts, log_name, name, content, expec
     assert graph_counts() == before
 
 
+def test_a_value_too_long_for_an_index(tmp_path, capsys, graph_counts, log_name):
+    path = tmp_path / "long.csv"
+    huge = "x" * 10_000_000
+    path.write_text(
+        f"time,activity,robot\n2024-01-01T00:00:00Z,a,r\n2024-01-01T00:00:01Z,{huge},r\n"
+    )
+    before = graph_counts()
+    code, message = run(capsys, "ingest", str(path), "--log", log_name)
+    assert code == 1 and one_sentence(message), message
+    assert "Event 2 of the log (id '1') has 10,000,000 bytes as its activity" in message
+    assert len(message) < 400
+    assert graph_counts() == before
+
+
 @pytest.mark.parametrize("threshold", ["nan", "-5", "120", "inf"])
 def test_a_battery_threshold_that_is_no_percentage(tmp_path, capsys, thesis_csv, threshold):
     report = tmp_path / "report.json"
