@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import csv
 import io
+import warnings
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 
@@ -140,20 +141,42 @@ def _csv_table(
     only a file with blanks around a marker is read as text and cleared cell by cell.
     """
     try:
-        if reading.has_padded_markers(text):
-            table = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
-            missing = reading.mark_missing(table)
-            return reading.typed_columns(table, text_columns), missing
-        table = pd.read_csv(
-            io.StringIO(text),
-            dtype=dict.fromkeys(text_columns, str),
-            keep_default_na=False,
-            na_values=sorted(reading.MISSING_MARKERS),
-        )
+        # index_col=False: a first row with more cells than the header would otherwise turn
+        # the first column into the index; pandas warns instead, and the warning is an error.
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            if reading.has_padded_markers(text):
+                table = pd.read_csv(
+                    io.StringIO(text), dtype=str, keep_default_na=False, index_col=False
+                )
+                missing = reading.mark_missing(table)
+                return reading.typed_columns(table, text_columns), missing
+            table = pd.read_csv(
+                io.StringIO(text),
+                dtype=dict.fromkeys(text_columns, str),
+                keep_default_na=False,
+                na_values=sorted(reading.MISSING_MARKERS),
+                index_col=False,
+            )
+    except pd.errors.ParserWarning:
+        raise InputError(_long_row(path, text)) from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as error:
         raise InputError(f"{path} is not a readable CSV file: {_one_line(error)}") from None
     counts = table.isna().sum()  # every NaN is a marker: no other value reads as one
     return table, {str(column): int(n) for column, n in counts.items() if n}
+
+
+def _long_row(path: Path, text: str) -> str:
+    """Which row has more cells than the header has names (found only once there is one)."""
+    rows = csv.reader(io.StringIO(text))
+    width = len(next(rows))
+    for row in rows:
+        if len(row) > width:
+            return (
+                f"{path} line {rows.line_num}: {len(row)} cells, but the header names "
+                f"{width} columns."
+            )
+    return f"{path}: a row has more cells than the header names columns."
 
 
 def _read_xes(

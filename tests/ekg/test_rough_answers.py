@@ -51,6 +51,11 @@ def one_sentence(message: str) -> bool:
             "twice.csv line 1: the column 'activity' appears 2 times (columns 2, 3)",
         ),
         (
+            "wide.csv",
+            b"time,activity\n2024-01-01T00:00:00Z,2024-01-01T00:00:00Z,a\n",
+            "wide.csv line 2: 3 cells, but the header names 2 columns.",
+        ),
+        (
             "roles.xes",
             XES_BOOLEAN_ROLE.encode(),
             "roles.xes line 6: the message role is the boolean true, not text",
