@@ -20,6 +20,7 @@ import csv
 import io
 import warnings
 from collections.abc import Mapping, Sequence
+from contextlib import suppress
 from pathlib import Path
 
 import numpy as np
@@ -169,13 +170,14 @@ def _csv_table(
 def _long_row(path: Path, text: str) -> str:
     """Which row has more cells than the header has names (found only once there is one)."""
     rows = csv.reader(io.StringIO(text))
-    width = len(next(rows))
-    for row in rows:
-        if len(row) > width:
-            return (
-                f"{path} line {rows.line_num}: {len(row)} cells, but the header names "
-                f"{width} columns."
-            )
+    with suppress(csv.Error):  # a line csv cannot split (a lone CR): the sentence below
+        width = len(next(rows))
+        for row in rows:
+            if len(row) > width:
+                return (
+                    f"{path} line {rows.line_num}: {len(row)} cells, but the header names "
+                    f"{width} columns."
+                )
     return f"{path}: a row has more cells than the header names columns."
 
 
