@@ -39,9 +39,13 @@ def _with_truth(driver: Driver, row: dict[str, Any], locks: dict[str, Holder]) -
     """A log still marked ``building`` whose writer has ended (killed, or its Neo4j went away
     before it could finish or undo) is ``failed``; such logs, and those being built, get the
     number of events stored so far rather than the count a finished build records."""
+    row = dict(row)
+    run = row.pop("run", None)
     if row["status"] != "building":
         return row
-    writer = locks.get(row["name"])
+    # A rebuild writes under a temporary name while the lock guards the log's own name:
+    # the writer is the lock of the same run.
+    writer = next((lock for lock in locks.values() if lock.run == run), None)
     status = "building" if writer is not None and writer.alive() else FAILED
     return row | {"status": status, "events": stored_events(driver, row["name"])}
 
