@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 # Graphviz to draw discovered process models as SVG.
 SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
-.PHONY: install system-deps test demo bench lint format constraints clean
+.PHONY: install system-deps test demo bench lint format constraints clean fuzz
 
 install: $(STAMP)
 
@@ -37,6 +37,13 @@ system-deps:
 test: install system-deps
 	$(BIN)/ruff check .
 	$(BIN)/pytest
+
+# The fuzz suite with many more examples than `make test` runs (FUZZ_EXAMPLES per test):
+# nothing but robotale's own errors may come out of the log readers, the bag reader and the
+# BPMN parser.
+FUZZ_EXAMPLES ?= 20000
+fuzz: install
+	ROBOTALE_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/pytest -p no:timeout tests/test_fuzz*.py tests/eventlog/test_fuzz*.py
 
 # DEMO_ARGS passes options on (`make demo DEMO_ARGS="--port 5001"`); ROBOTALE_DEMO_RUNS
 # shortens the simulation (20 runs by default).

@@ -2,7 +2,7 @@
 // describe them.
 MATCH (l:Log)
 WHERE $log IS NULL OR l.name = $log
-RETURN l.name AS name, l.status AS status, l.events AS events, l.source AS source,
+RETURN l.name AS name, l.status AS status, l.run AS run, l.events AS events, l.source AS source,
        l.entityTypes AS entityTypes, l.classTypes AS classTypes,
        toString(l.created) AS created
 ORDER BY name

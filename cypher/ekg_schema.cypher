@@ -8,3 +8,5 @@ CREATE CONSTRAINT ekg_class_key IF NOT EXISTS
 FOR (c:Class) REQUIRE (c.log, c.type, c.id) IS UNIQUE;
 CREATE CONSTRAINT ekg_log_name IF NOT EXISTS
 FOR (l:Log) REQUIRE l.name IS UNIQUE;
+CREATE CONSTRAINT ekg_log_lock IF NOT EXISTS
+FOR (k:LogLock) REQUIRE k.name IS UNIQUE;

@@ -28,3 +28,14 @@ class LogNotFound(InputError):
     def __init__(self, name: str, hint: str | None = None) -> None:
         self.name, self.hint = name, hint or "see `robotale logs list`"
         super().__init__(f"There is no log named {name!r} in Neo4j ({self.hint}).")
+
+
+def require_range(
+    value: float, option: str, low: float, high: float = float("inf"), unit: str = ""
+) -> float:
+    """``value`` of the command-line ``option`` if it is a number from ``low`` to ``high``;
+    otherwise an :class:`InputError` naming the option (argparse takes ``nan`` and ``-5``)."""
+    if not low <= value <= high:  # also false for nan
+        wanted = f"of at least {low:g}" if high == float("inf") else f"from {low:g} to {high:g}"
+        raise InputError(f"{option} {value:g} is not usable: give a number {wanted}{unit}.")
+    return value

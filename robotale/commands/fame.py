@@ -9,7 +9,7 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from robotale.errors import InputError
+from robotale.errors import InputError, require_range
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.check import Report, check
 from robotale.fame_runtime.clock import SimClock
@@ -127,6 +127,8 @@ def run_command(
     on the wall clock. 1 when a BPMN error went uncaught or robots were still working at
     ``until`` seconds."""
     out, err = out or sys.stdout, err or sys.stderr
+    require_range(until, "--until", 0, unit=" seconds")
+    require_range(latency, "--latency", 0, unit=" seconds")
     if bus == "dds":
         from robotale.commands.fame_dds import run_processes
 

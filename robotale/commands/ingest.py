@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import shlex
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -12,7 +13,7 @@ from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
-from robotale.ekg.logs import delete_log, list_logs, log_summary, require_log
+from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping, read_log_with_reading
 from robotale.eventlog.reading import format_reading
@@ -102,6 +103,11 @@ def logs_list() -> int:
             f"entities: {', '.join(log['entityTypes'] or []) or '-'}  "
             f"classes: {', '.join(log['classTypes'] or []) or '-'}  created {log['created']}"
         )
+        if log["status"] == FAILED:
+            print(
+                "  its ingest ended before it was complete; remove it with "
+                f"`robotale logs delete {shlex.quote(log['name'])}`"
+            )
     return 0
 
 
@@ -117,7 +123,7 @@ def logs_show(name: str) -> int:
 def logs_delete(name: str) -> int:
     with session_driver() as driver:
         require_log(driver, name)
-        delete_log(driver, name)
+        delete_log_locked(driver, name)
     print(f"Deleted the log {name!r}.")
     return 0
 

@@ -4,10 +4,11 @@ from __future__ import annotations
 
 import dataclasses
 import os
+import sys
 
 from robotale.ekg.connection import bolt_answers, settings
 from robotale.ekg.jars import NEO4J_VERSION
-from robotale.ekg.server import LocalServer, ServerOptions
+from robotale.ekg.server import CRASHED, OTHER, RUNNING, LocalServer
 
 
 def neo4j_start(
@@ -24,10 +25,12 @@ def neo4j_start(
         return 0
     given = {"bolt_port": bolt_port, "http_port": http_port, "heap": heap, "pagecache": pagecache}
     overrides = {field: value for field, value in given.items() if value is not None}
-    options = dataclasses.replace(ServerOptions.from_env(), **overrides)
     server = LocalServer()
+    options = dataclasses.replace(server.recorded_options(), **overrides)
     already = server.running()
-    state = server.start(options, timeout=timeout)
+    if already is None and server.condition().condition == CRASHED:
+        print("The local Neo4j had crashed; starting it again.")
+    state = server.start(options, timeout=timeout, progress=_progress)
     verb = "was already running" if already else "is running"
     print(f"Neo4j {NEO4J_VERSION} {verb} at {state.bolt_uri} (pid {state.pid}).")
     print(f"Neo4j Browser: {state.browser_url}  user neo4j, password in {server.password_file}")
@@ -45,13 +48,38 @@ def neo4j_stop() -> int:
 
 
 def neo4j_status() -> int:
-    """Exit status 0 when the server answers, 3 when it does not (as init scripts do)."""
+    """Exit status as init scripts give it: 0 running and answering, 1 crashed (its pid is
+    gone, it was not stopped), 3 stopped or not answering, 4 stopped while something else
+    answers on its port (robotale will not use that)."""
     where = settings()
-    answers = bolt_answers(where.uri, where.auth)
     if where.from_env:
-        origin = "NEO4J_URI"
-    else:
-        running = LocalServer().running()
-        origin = f"local, pid {running.pid}" if running else "local, not running"
-    print(f"Neo4j at {where.uri} ({origin}): {'answers' if answers else 'does not answer'}.")
-    return 0 if answers else 3
+        answers = bolt_answers(where.uri, where.auth)
+        print(f"Neo4j at {where.uri} (NEO4J_URI): {'answers' if answers else 'does not answer'}.")
+        return 0 if answers else 3
+    state = LocalServer().condition()
+    record = state.record
+    if state.condition == RUNNING and record is not None:
+        answers = bolt_answers(where.uri, where.auth)
+        print(
+            f"Neo4j at {where.uri} (local, pid {record.pid}): "
+            f"{'answers' if answers else 'does not answer yet'}."
+        )
+        return 0 if answers else 3
+    if state.condition == CRASHED and record is not None:
+        print(
+            f"Neo4j at {where.uri} (local, crashed): its process {record.pid} is gone but it "
+            "was never stopped; start it again with `robotale neo4j start`."
+        )
+        return 1
+    if state.condition == OTHER:
+        print(
+            f"Neo4j at {where.uri} (local, not running): something else answers on that port; "
+            "robotale does not use it (set NEO4J_URI to use that server)."
+        )
+        return 4
+    print(f"Neo4j at {where.uri} (local, not running): does not answer.")
+    return 3
+
+
+def _progress(line: str) -> None:
+    print(line, file=sys.stderr, flush=True)

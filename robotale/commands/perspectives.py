@@ -8,7 +8,7 @@ from pathlib import Path
 from robotale.commands.logsource import read_event_log
 from robotale.enhancement.report import all_perspectives, write_report
 from robotale.enhancement.spatial import Field
-from robotale.errors import InputError
+from robotale.errors import InputError, require_range
 
 
 def perspectives_command(
@@ -28,6 +28,8 @@ def perspectives_command(
     """The perspectives of a log (a file or ``log_name``) as HTML (``out``) and/or JSON."""
     if not out and not json_out:
         raise InputError("say where the report goes: --out report.html and/or --json report.json.")
+    if threshold is not None:
+        require_range(threshold, "--threshold", 0, 100, unit=" percent")
     area = Field.parse(field) if field else None
     events = read_event_log(
         log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap

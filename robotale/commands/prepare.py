@@ -41,6 +41,9 @@ def prepare_command(
     ``<source name>.csv`` when no other output is asked for), XES and/or OCEL 2.0; ``executor``
     (``local[:N]``, ``dask://HOST:PORT``) reads the runs in parallel."""
     csv = out or (None if xes or ocel else Path(f"{source.resolve().name}.csv"))
+    for target in (csv, xes, ocel):  # all refused before hours of preparation, not after
+        if target is not None:
+            writers.check_target(target)
     log = prepare_recordings(
         source,
         tags=tags,

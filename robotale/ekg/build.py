@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import dataclasses
 import itertools
+import shlex
 import time
 import uuid
 from collections.abc import Callable, Sequence
@@ -27,9 +28,10 @@ from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
 from robotale.ekg.load import Loader
-from robotale.ekg.logs import delete_log, log_exists
+from robotale.ekg.logs import delete_log, log_exists, log_run
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import GraphTables, entity_types, graph_tables
+from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, ServerError
 
 
@@ -69,17 +71,20 @@ def build_ekg(
     tables = graph_tables(log, default_entities(log.columns) if entities is None else entities)
     keys = [aggregation_key(key) for key in aggregate]
     _check_keys(tables.events, keys)
+    _check_key_sizes(tables, keys)
     ensure_schema(driver)
-    existing = log_exists(driver, name)
-    if existing and not replace:
-        raise InputError(
-            f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
-            f"or `robotale logs delete {name}` first."
-        )
-    target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
-    summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress))
-    if existing:
-        _swap(driver, target, name)
+    # Checked under the lock: another ingest of this name may have finished a moment ago.
+    with log_write_lock(driver, name, "ingesting") as run:
+        existing = log_exists(driver, name)
+        if existing and not replace:
+            raise InputError(
+                f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
+                f"or `robotale logs delete {name}` first."
+            )
+        target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
+        summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress, run))
+        if existing:
+            _swap(driver, target, name)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
 
 
@@ -100,6 +105,28 @@ def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
         entity_types(list(events.columns), key, what="aggregate by")
 
 
+# Neo4j refuses index keys longer than about 8 kB with a long text that names no row; the
+# ids of events, entities and classes are index keys (UTF-8 bytes; a margin for the log name).
+KEY_BYTES = 4000
+
+
+def _check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
+    """One sentence naming the event and column of the first value too long to be a key."""
+    events = tables.events
+    columns = {"id"} | {column for key in keys for column in key}
+    columns |= set(tables.entities["type"].unique())  # entity types are event columns
+    for column in sorted(c for c in columns if c in events.columns):
+        sizes = events[column].astype("string").fillna("").str.encode("utf-8").str.len()
+        if (sizes > KEY_BYTES).any():
+            row = int(sizes.to_numpy().argmax())
+            raise InputError(
+                f"Event {row + 1} of the log (id {str(events['id'].iloc[row])[:40]!r}) has "
+                f"{int(sizes.iloc[row]):,} bytes as its {column}; {column} values become "
+                f"keys of Neo4j's indexes, which take at most {KEY_BYTES:,} bytes: shorten it "
+                "or leave that column out of --entities and --aggregate."
+            )
+
+
 @dataclass(frozen=True)
 class _Job:
     tables: GraphTables
@@ -107,6 +134,7 @@ class _Job:
     target: str  # the log's name, or a temporary one while an existing log is rebuilt
     source: str
     progress: bool
+    run: str  # the id of this run's write lock, recorded on the Log node
 
 
 def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
@@ -115,18 +143,56 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
         with DeferredInterrupt() as interrupt:
             return _write(driver, job, interrupt.check)
     except BaseException as error:
+        if isinstance(error, Neo4jError | DriverError | OSError) and not _answers(driver):
+            # Retrying the undo against a server that is gone would only take minutes.
+            raise ServerError(
+                f"Neo4j went away while the log {target!r} was written ({_why(error)}); once it "
+                "runs again, `robotale logs list` shows the log as failed and "
+                f"`robotale logs delete {shlex.quote(target)}` removes it."
+            ) from error
         try:
-            delete_log(driver, target)
+            _undo(driver, target, job.run)
         except (Neo4jError, DriverError, OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({error}) and what was written could "
-                f"not be removed; remove it with `robotale logs delete {target!r}`."
+                f"Writing the log {target!r} to Neo4j failed ({_why(error)}) and what was "
+                "written could not be removed; remove it with "
+                f"`robotale logs delete {shlex.quote(target)}`."
             ) from error
         if isinstance(error, Neo4jError | DriverError | OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({error}); nothing of it was kept."
+                f"Writing the log {target!r} to Neo4j failed ({_why(error)}); nothing of it "
+                "was kept."
             ) from error
         raise
+
+
+def _answers(driver: Driver) -> bool:
+    """Whether the server still answers (one attempt, no retries)."""
+    try:
+        driver.verify_connectivity()
+        return True
+    except (Neo4jError, DriverError, OSError):
+        return False
+
+
+def _why(error: BaseException) -> str:
+    """The gist of a server's or driver's error, on one line: the driver's own text spans
+    lines and names connection objects."""
+    if isinstance(error, Neo4jError):
+        text = error.message or error.code or type(error).__name__
+    elif isinstance(error, DriverError):
+        text = "the connection to Neo4j was lost"
+    else:
+        text = str(error) or type(error).__name__
+    return " ".join(str(text).split())[:300]
+
+
+def _undo(driver: Driver, target: str, run: str) -> None:
+    """Remove what this run wrote under ``target``: nothing if the Log node there is another
+    run's (the lock makes this run the only writer of ``target`` while it lasts)."""
+    owner = log_run(driver, target)
+    if owner in (None, run):
+        delete_log(driver, target)
 
 
 def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> BuildSummary:
@@ -135,6 +201,7 @@ def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> Bu
     driver.execute_query(
         cypher("ekg_log_begin"),
         log=target,
+        run=job.run,
         source=job.source,
         properties=list(events.columns),
         entityTypes=entities["type"].unique().tolist(),

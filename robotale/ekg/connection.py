@@ -20,13 +20,13 @@ from neo4j import Driver, GraphDatabase
 from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.ekg.queries import cypher
-from robotale.ekg.server import HOST, USER, LocalServer, ServerOptions
+from robotale.ekg.server import CRASHED, HOST, OTHER, RUNNING, USER, LocalServer
 from robotale.ekg.server import bolt_answers as bolt_answers  # re-exported: the server owns it
 from robotale.errors import ServerError
 
-# The driver logs every refused connection attempt as a warning; robotale turns the failure
-# into one sentence instead.
-logging.getLogger("neo4j").setLevel(logging.ERROR)
+# The driver logs every refused connection attempt and every connection a server dropped
+# (as errors, on stderr); robotale turns the failure into one sentence instead.
+logging.getLogger("neo4j").setLevel(logging.CRITICAL)
 
 
 @dataclass(frozen=True)
@@ -53,13 +53,15 @@ def settings() -> Settings:
         return Settings(uri, user, os.environ.get("NEO4J_PASSWORD", ""), True)
     server = LocalServer()
     running = server.running()
-    port = running.bolt_port if running else ServerOptions.from_env().bolt_port
+    port = running.bolt_port if running else server.recorded_options().bolt_port
     return Settings(f"bolt://{HOST}:{port}", USER, server.password() or "", False)
 
 
 def connect(where: Settings | None = None) -> Driver:
     """A driver for the server that answers; a :class:`ServerError` saying what to do if not."""
     where = where or settings()
+    if not where.from_env:
+        _require_local_server()
     driver = GraphDatabase.driver(where.uri, auth=where.auth, connection_timeout=5)
     try:
         driver.verify_connectivity()
@@ -83,6 +85,29 @@ def session_driver(where: Settings | None = None) -> Iterator[Driver]:
         yield driver
     finally:
         driver.close()
+
+
+def _require_local_server() -> None:
+    """Refuse before connecting when the local server is not running: whatever answers on
+    its port then is not robotale's server (and its password is not for that one)."""
+    server = LocalServer()
+    state = server.condition()
+    if state.condition == RUNNING:
+        return
+    record = state.record
+    port = record.bolt_port if record else server.recorded_options().bolt_port
+    if state.condition == CRASHED and record is not None:
+        raise ServerError(
+            f"The local Neo4j (pid {record.pid}, bolt port {port}) has crashed: start it again "
+            "with `robotale neo4j start`."
+        )
+    if state.condition == OTHER:
+        raise ServerError(
+            f"The local Neo4j is not running and something else answers on its bolt port {port}:"
+            " robotale does not use it; set NEO4J_URI to use that server, or stop it and run "
+            "`robotale neo4j start`."
+        )
+    raise ServerError(unreachable_message(Settings(f"bolt://{HOST}:{port}", USER, "", False)))
 
 
 def unreachable_message(where: Settings) -> str:

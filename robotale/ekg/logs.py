@@ -13,12 +13,17 @@ from neo4j import Driver
 
 from robotale.ekg.connection import database
 from robotale.ekg.queries import cypher, statements
+from robotale.ekg.writelock import Holder, holders, log_write_lock
 from robotale.errors import LogNotFound
+
+# The status of a log whose ingest ended before it was complete.
+FAILED = "failed"
 
 
 def list_logs(driver: Driver) -> list[dict[str, Any]]:
-    """Every stored log as its Log node describes it, by name."""
-    return _rows(driver, "ekg_list_logs", log=None)
+    """Every stored log as its Log node describes it, by name (see :func:`_with_truth`)."""
+    locks = holders(driver)
+    return [_with_truth(driver, row, locks) for row in _rows(driver, "ekg_list_logs", log=None)]
 
 
 def log_info(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
@@ -27,7 +32,28 @@ def log_info(driver: Driver, name: str, hint: str | None = None) -> dict[str, An
     rows = _rows(driver, "ekg_log_info", log=name)
     if not rows:
         raise LogNotFound(name, hint)
-    return rows[0]
+    return _with_truth(driver, rows[0], holders(driver))
+
+
+def _with_truth(driver: Driver, row: dict[str, Any], locks: dict[str, Holder]) -> dict[str, Any]:
+    """A log still marked ``building`` whose writer has ended (killed, or its Neo4j went away
+    before it could finish or undo) is ``failed``; such logs, and those being built, get the
+    number of events stored so far rather than the count a finished build records."""
+    row = dict(row)
+    run = row.pop("run", None)
+    if row["status"] != "building":
+        return row
+    # A rebuild writes under a temporary name while the lock guards the log's own name:
+    # the writer is the lock of the same run.
+    writer = next((lock for lock in locks.values() if lock.run == run), None)
+    status = "building" if writer is not None and writer.alive() else FAILED
+    return row | {"status": status, "events": stored_events(driver, row["name"])}
+
+
+def log_run(driver: Driver, name: str) -> str | None:
+    """The id of the run that wrote the Log node of ``name`` (None without one)."""
+    rows = _rows(driver, "ekg_log_run", log=name)
+    return rows[0]["run"] if rows else None
 
 
 def log_summary(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
@@ -77,6 +103,13 @@ def delete_log(driver: Driver, name: str) -> None:
     with driver.session(database=database()) as session:
         for statement in statements("ekg_delete_log"):
             session.run(statement, log=name).consume()
+
+
+def delete_log_locked(driver: Driver, name: str) -> None:
+    """:func:`delete_log` under the log's write lock: refused while a live writer builds it;
+    a lock left by a writer that died is taken over."""
+    with log_write_lock(driver, name, "deleting"):
+        delete_log(driver, name)
 
 
 def graph_counts(driver: Driver) -> dict[str, int]:

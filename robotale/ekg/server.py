@@ -3,12 +3,15 @@
 Neo4j Community runs from the jars of :mod:`robotale.ekg.jars` through its real server entry
 point (Bolt, HTTP and Neo4j Browser at ``/browser/``), bound to 127.0.0.1 only. Its home is
 ``$ROBOTALE_HOME/neo4j``: ``conf/neo4j.conf``, ``data/``, ``logs/``, ``server.json`` (pid and
-ports of the running server) and ``password`` (mode 0600; user ``neo4j``). The password is
+ports of the running server), ``ports.json`` (the last server's pid and ports and whether it was
+stopped: it outlives a crash, so robotale keeps talking about the right port) and ``password``
+(mode 0600; user ``neo4j``). The password is
 ``NEO4J_PASSWORD`` when that is set at the first start, otherwise a generated one.
 """
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import re
@@ -19,6 +22,7 @@ import socket
 import subprocess
 import time
 import urllib.request
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
@@ -34,6 +38,8 @@ HOST = "127.0.0.1"
 USER = "neo4j"
 DEFAULT_BOLT_PORT = 7687
 DEFAULT_HTTP_PORT = 7474
+# How long `start` waits for the ports of a server that crashed or was just stopped.
+PORT_WAIT = 60.0
 ENTRY_POINT = "org.neo4j.server.CommunityEntryPoint"
 _ADMIN_TOOL = "org.neo4j.cli.AdminTool"
 # The JVM options of Neo4j's own launcher (we start java directly, so we pass them ourselves).
@@ -96,12 +102,25 @@ class PortInUse(ServerError):
     """The port the server should listen on is taken."""
 
 
+# What `neo4j status` can tell about the local server.
+RUNNING, STOPPED, CRASHED, OTHER = "running", "stopped", "crashed", "something else answers"
+
+
+@dataclass(frozen=True)
+class ServerCondition:
+    """The local server's condition and its last known pid and ports (None: never started)."""
+
+    condition: str
+    record: RunningServer | None
+
+
 class LocalServer:
     """The Neo4j server whose home is ``<robotale home>/neo4j``."""
 
     def __init__(self, home: Path | None = None) -> None:
         self.home = (home or robotale_home()) / "neo4j"
         self.state_file = self.home / "server.json"
+        self.ports_file = self.home / "ports.json"
         self.password_file = self.home / "password"
         self.log_file = self.home / "logs" / "neo4j.log"
         self.console_file = self.home / "logs" / "console.log"
@@ -117,6 +136,39 @@ class LocalServer:
             return state
         self.state_file.unlink(missing_ok=True)
         return None
+
+    def last_record(self) -> tuple[RunningServer | None, bool]:
+        """The last started server's pid and ports, and whether it was stopped by us."""
+        if not self.ports_file.is_file():
+            return None, True
+        record = json.loads(self.ports_file.read_text())
+        stopped = bool(record.pop("stopped", False))
+        return RunningServer(**record), stopped
+
+    def condition(self) -> ServerCondition:
+        """Running, stopped, crashed (its process died without `stop`), or stopped while
+        something else answers on its Bolt port."""
+        if (running := self.running()) is not None:
+            return ServerCondition(RUNNING, running)
+        record, stopped = self.last_record()
+        port = record.bolt_port if record else ServerOptions.from_env().bolt_port
+        if _port_answers(port):
+            return ServerCondition(OTHER, record)
+        return ServerCondition(STOPPED if stopped else CRASHED, record)
+
+    def recorded_options(self) -> ServerOptions:
+        """:meth:`ServerOptions.from_env`, with the last server's ports where the environment
+        names none: a restart after a crash comes back where the logs' users look for it."""
+        options = ServerOptions.from_env()
+        record, _ = self.last_record()
+        if record is None:
+            return options
+        env = os.environ
+        return dataclasses.replace(
+            options,
+            bolt_port=options.bolt_port if "ROBOTALE_NEO4J_BOLT_PORT" in env else record.bolt_port,
+            http_port=options.http_port if "ROBOTALE_NEO4J_HTTP_PORT" in env else record.http_port,
+        )
 
     def password(self) -> str | None:
         return self.password_file.read_text().strip() if self.password_file.is_file() else None
@@ -151,15 +203,26 @@ class LocalServer:
 
     # -- start / stop --------------------------------------------------------------------
 
-    def start(self, options: ServerOptions | None = None, timeout: float = 180) -> RunningServer:
+    def start(
+        self,
+        options: ServerOptions | None = None,
+        timeout: float = 180,
+        progress: Callable[[str], None] = lambda line: None,
+    ) -> RunningServer:
         """Start the server in the background and wait until Bolt answers.
 
-        Returns the already running server if there is one.
+        Returns the already running server if there is one. Ports the last server of this home
+        held (it crashed, or was stopped a moment ago) are waited for, with ``progress`` lines;
+        any other port in use is refused at once.
         """
         if (state := self.running()) is not None:
             return state
-        options = options or ServerOptions.from_env()
+        options = options or self.recorded_options()
+        record, _ = self.last_record()
+        ours = {record.bolt_port, record.http_port} if record else set()
         for port, flag in ((options.bolt_port, "bolt"), (options.http_port, "http")):
+            if port in ours:
+                _wait_until_free(port, flag, PORT_WAIT, progress)
             _require_free(port, flag)
         java = java_executable()
         lib = ensure_jars()
@@ -168,11 +231,13 @@ class LocalServer:
         process = self._launch(java, lib, options)
         state = RunningServer(process.pid, options.bolt_port, options.http_port)
         self.state_file.write_text(json.dumps(asdict(state)))
+        self._record(state, stopped=False)
         try:
             self._wait_until_answering(process, state, timeout)
         except BaseException:
             _terminate(process.pid, grace=30)
             self.state_file.unlink(missing_ok=True)
+            self._record(state, stopped=True)  # it did not start: no crash to report later
             raise
         return state
 
@@ -185,7 +250,13 @@ class LocalServer:
         if state is not None:
             _terminate(state.pid, grace)
         self.state_file.unlink(missing_ok=True)
+        record, _ = self.last_record()
+        if record is not None:
+            self._record(record, stopped=True)
         return state
+
+    def _record(self, state: RunningServer, stopped: bool) -> None:
+        self.ports_file.write_text(json.dumps(asdict(state) | {"stopped": stopped}))
 
     # -- helpers -------------------------------------------------------------------------
 
@@ -320,16 +391,55 @@ def java_executable() -> str:
     return java
 
 
-def _require_free(port: int, what: str) -> None:
+def _is_free(port: int) -> bool:
     with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        # As Neo4j binds: connections of a server that just ended (TIME_WAIT) do not count.
+        probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
         try:
             probe.bind((HOST, port))
         except OSError:
+            return False
+    return True
+
+
+def _port_answers(port: int) -> bool:
+    """Whether anything accepts connections on ``port`` of 127.0.0.1."""
+    try:
+        with socket.create_connection((HOST, port), timeout=2):
+            return True
+    except OSError:
+        return False
+
+
+def _wait_until_free(port: int, what: str, timeout: float, progress: Callable[[str], None]) -> None:
+    """Wait for a port the last server of this home held; something answering there is not
+    that server (it is not running), so that is refused at once."""
+    deadline = time.monotonic() + timeout
+    while not _is_free(port):
+        if _port_answers(port):
             raise PortInUse(
-                f"The Neo4j {what} port {port} on {HOST} is in use; choose another with "
-                f"--{what}-port (or ROBOTALE_NEO4J_{what.upper()}_PORT), or set NEO4J_URI "
-                "to use the server that is listening there."
-            ) from None
+                f"The last local Neo4j's {what} port {port} on {HOST} is held by something else "
+                f"that answers there; stop it, choose another port with --{what}-port, or set "
+                "NEO4J_URI to use that server."
+            )
+        left = deadline - time.monotonic()
+        if left <= 0:
+            raise PortInUse(
+                f"The {what} port {port} on {HOST} of the last local Neo4j was still not free "
+                f"after {timeout:.0f} s; see which process holds it (`ss -ltnp`) or choose "
+                f"another port with --{what}-port."
+            )
+        progress(f"Waiting for the {what} port {port} to be free ({left:.0f} s left) ...")
+        time.sleep(1)
+
+
+def _require_free(port: int, what: str) -> None:
+    if not _is_free(port):
+        raise PortInUse(
+            f"The Neo4j {what} port {port} on {HOST} is in use; choose another with "
+            f"--{what}-port (or ROBOTALE_NEO4J_{what.upper()}_PORT), or set NEO4J_URI "
+            "to use the server that is listening there."
+        )
 
 
 def free_port() -> int:

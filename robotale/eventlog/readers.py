@@ -16,10 +16,14 @@ one, the line.
 
 from __future__ import annotations
 
+import csv
 import io
+import warnings
 from collections.abc import Mapping, Sequence
+from contextlib import suppress
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from robotale.errors import InputError
@@ -94,7 +98,7 @@ def _read_csv(
     path: Path, mapping: Mapping[str, str] | None, case: str | None, case_gap: Gap
 ) -> tuple[pd.DataFrame, Reading]:
     text = _read_text(path)
-    header = pd.read_csv(io.StringIO(text), nrows=0).columns
+    header = _csv_header(path, text)
     renames = column_mapping(path, list(header), mapping)
     text_columns = [src for src, canonical in renames.items() if canonical in TEXT_COLUMNS]
     if case is not None:
@@ -102,6 +106,30 @@ def _read_csv(
     table, missing = _csv_table(path, text, text_columns)
     lines = pd.Series(range(2, len(table) + 2), index=table.index)  # line 1 is the header
     return canonical_log(path, table, renames, lines, case, case_gap, missing)
+
+
+def _csv_header(path: Path, text: str) -> list[str]:
+    """The column names of line 1, refused if a name is repeated (pandas would silently read
+    the second ``activity`` as ``activity.1``) or if the file is JSON (an OCEL log, say)."""
+    if text.lstrip().startswith(("{", "[")):
+        raise InputError(
+            f"{path} is JSON (an OCEL 2.0 log?), not a CSV or XES event log: give ingest a "
+            "CSV or XES file, or a folder of recordings."
+        )
+    try:
+        names = next(csv.reader(io.StringIO(text), strict=True), [])
+    except csv.Error as error:
+        raise InputError(f"{path} line 1: the header is not readable CSV ({error}).") from None
+    if not any(name.strip() for name in names):
+        raise InputError(f"{path} line 1 names no columns: the first line must be the header.")
+    repeated = sorted({name for name in names if names.count(name) > 1})
+    if repeated:
+        positions = [i + 1 for i, name in enumerate(names) if name == repeated[0]]
+        raise InputError(
+            f"{path} line 1: the column {repeated[0]!r} appears {len(positions)} times "
+            f"(columns {', '.join(map(str, positions))}); give each column its own name."
+        )
+    return names
 
 
 def _csv_table(
@@ -114,20 +142,43 @@ def _csv_table(
     only a file with blanks around a marker is read as text and cleared cell by cell.
     """
     try:
-        if reading.has_padded_markers(text):
-            table = pd.read_csv(io.StringIO(text), dtype=str, keep_default_na=False)
-            missing = reading.mark_missing(table)
-            return reading.typed_columns(table, text_columns), missing
-        table = pd.read_csv(
-            io.StringIO(text),
-            dtype=dict.fromkeys(text_columns, str),
-            keep_default_na=False,
-            na_values=sorted(reading.MISSING_MARKERS),
-        )
-    except (pd.errors.ParserError, ValueError) as error:
-        raise InputError(f"{path} is not a readable CSV file: {error}") from None
+        # index_col=False: a first row with more cells than the header would otherwise turn
+        # the first column into the index; pandas warns instead, and the warning is an error.
+        with warnings.catch_warnings():
+            warnings.simplefilter("error", pd.errors.ParserWarning)
+            if reading.has_padded_markers(text):
+                table = pd.read_csv(
+                    io.StringIO(text), dtype=str, keep_default_na=False, index_col=False
+                )
+                missing = reading.mark_missing(table)
+                return reading.typed_columns(table, text_columns), missing
+            table = pd.read_csv(
+                io.StringIO(text),
+                dtype=dict.fromkeys(text_columns, str),
+                keep_default_na=False,
+                na_values=sorted(reading.MISSING_MARKERS),
+                index_col=False,
+            )
+    except pd.errors.ParserWarning:
+        raise InputError(_long_row(path, text)) from None
+    except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as error:
+        raise InputError(f"{path} is not a readable CSV file: {_one_line(error)}") from None
     counts = table.isna().sum()  # every NaN is a marker: no other value reads as one
     return table, {str(column): int(n) for column, n in counts.items() if n}
+
+
+def _long_row(path: Path, text: str) -> str:
+    """Which row has more cells than the header has names (found only once there is one)."""
+    rows = csv.reader(io.StringIO(text))
+    with suppress(csv.Error):  # a line csv cannot split (a lone CR): the sentence below
+        width = len(next(rows))
+        for row in rows:
+            if len(row) > width:
+                return (
+                    f"{path} line {rows.line_num}: {len(row)} cells, but the header names "
+                    f"{width} columns."
+                )
+    return f"{path}: a row has more cells than the header names columns."
 
 
 def _read_xes(
@@ -250,7 +301,8 @@ def canonical_log(
     notes = reading.lifecycle_columns(log, kinds)
     case_text, warnings = _cases(path, log, renames, case, gap, traces)
     if schema.MSG_ROLE in log.columns:
-        log[schema.MSG_ROLE] = log[schema.MSG_ROLE].str.strip().str.lower()
+        _require_text(path, log, schema.MSG_ROLE, lines)
+        log[schema.MSG_ROLE] = log[schema.MSG_ROLE].astype("string").str.strip().str.lower()
     notes += reading.message_roles_from_ends(log)
     log[schema.EVENT_ID] = _event_ids(path, log, lines)
     for column in TEXT_COLUMNS:
@@ -276,6 +328,24 @@ def canonical_log(
         + reading.no_pairs_warning(log),
     )
     return log, found
+
+
+def _require_text(path: Path, log: pd.DataFrame, column: str, lines: pd.Series) -> None:
+    """Refuse a typed value (an XES ``<boolean>`` or ``<int>``) in a column that holds words."""
+    values = log[column]
+    typed = values.notna() & ~values.map(lambda value: isinstance(value, str))
+    if typed.any():
+        first = typed.idxmax()
+        value = values[first]
+        kind = "boolean" if isinstance(value, bool | np.bool_) else type(value).__name__
+        raise InputError(
+            f"{path} line {lines[first]}: the {reading.ROLE_NAMES.get(column, column)} is the "
+            f"{kind} {str(value).lower()}, not text; give {column} as text (send or receive)."
+        )
+
+
+def _one_line(error: BaseException) -> str:
+    return " ".join(str(error).split())
 
 
 def _cases(
@@ -396,13 +466,16 @@ def _require_content(path: Path) -> bytes:
 def _read_text(path: Path) -> str:
     data = _require_content(path)
     try:
-        return data.decode("utf-8-sig")
+        text = data.decode("utf-8-sig")
     except UnicodeDecodeError as error:
         line = data[: error.start].count(b"\n") + 1
         raise InputError(
             f"{path} is not UTF-8 text (byte 0x{data[error.start]:02x} on line {line}); "
             "save it as UTF-8."
         ) from None
+    if not text.strip():
+        raise InputError(f"{path} holds nothing but a byte order mark: it has no header line.")
+    return text
 
 
 def _event_counts(kinds: pd.Series) -> dict[str, int]:

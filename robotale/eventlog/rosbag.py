@@ -126,8 +126,9 @@ class Bag:
         try:
             reader = Reader(self.path)
             reader.open()
-        except (ReaderError, OSError, KeyError, ValueError) as error:
-            reason = " ".join(str(error).split())
+        # MemoryError: a damaged MCAP index names a record of exabytes, which rosbags reads.
+        except (ReaderError, OSError, KeyError, ValueError, MemoryError) as error:
+            reason = " ".join(str(error).split()) or "a damaged index names an impossible size"
             raise InputError(f"{self.path} is not a readable rosbag2 directory: {reason}") from None
         self._reader = reader
         self._topics = {n: i.msgtype or "" for n, i in sorted(reader.topics.items())}

@@ -41,9 +41,20 @@ _XES_EXTENSIONS = (
 _EPOCH = "1970-01-01T00:00:00+00:00"
 
 
+def check_target(path: str | Path) -> Path:
+    """``path`` if a file can be written there: a folder is refused before anything is
+    written (a command writing several files checks them all first)."""
+    path = Path(path)
+    if path.is_dir():
+        raise InputError(
+            f"{path} is a folder: give the name of the file to write (e.g. {path / 'log.json'})."
+        )
+    return path
+
+
 def _target(path: str | Path) -> Path:
     """``path``, with its folder created if need be."""
-    path = Path(path)
+    path = check_target(path)
     try:
         path.parent.mkdir(parents=True, exist_ok=True)
     except OSError as error:
@@ -183,6 +194,7 @@ _OCEL_TYPES = {"float": "float", "int": "integer", "boolean": "boolean", "date":
 #: log columns that become objects or the event's own fields, not event attributes
 _OCEL_STRUCTURE = {CASE, TIME, ACTIVITY, schema.ROBOT, schema.ROBOT_TYPE, schema.EVENT_ID}
 _OCEL_MESSAGE = {schema.MSG_ID, schema.MSG_PAYLOAD}
+_OCEL_OBJECTS = (schema.ROBOT, schema.MSG_ID)
 
 
 def write_ocel(
@@ -195,6 +207,14 @@ def write_ocel(
     Each event is related to its robot (``performed by``), its run (``in run``) and, for a
     message event, its message (qualified ``send`` or ``receive``).
     """
+    # A log may name no robots or messages at all (any CSV read as a log): none are objects.
+    log = log.assign(
+        **{
+            c: pd.Series(pd.NA, index=log.index, dtype="string")
+            for c in _OCEL_OBJECTS
+            if c not in log
+        }
+    )
     events, event_types = _ocel_events(log)
     document = {
         "objectTypes": _ocel_object_types(log, runs or {}),
@@ -276,7 +296,8 @@ def _ocel_object_types(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> li
 
 def _ocel_robots(log: pd.DataFrame) -> list[dict]:
     columns = [CASE, schema.ROBOT] + ([schema.ROBOT_TYPE] if schema.ROBOT_TYPE in log else [])
-    robots = log[columns].drop_duplicates([CASE, schema.ROBOT])
+    named = log[schema.ROBOT].notna() & (log[schema.ROBOT].astype(str) != "")
+    robots = log.loc[named, columns].drop_duplicates([CASE, schema.ROBOT])
     objects = []
     for row in robots.itertuples(index=False):
         case, robot = str(row[0]), str(row[1])

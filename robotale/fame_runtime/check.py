@@ -12,10 +12,11 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Collection
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
-from robotale.fame_runtime.model import Definitions, Node, Process
+from robotale.fame_runtime.model import Definitions, Node, Process, Scope
 from robotale.fame_runtime.plan import problems
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, pair_problems
 
@@ -68,11 +69,13 @@ def check(
 ) -> Report:
     """Structure (what the engine would refuse) and QoS compatibility of a collaboration."""
     report = Report(str(definitions.file), warnings=list(definitions.warnings))
+    report.problems += duplicate_ids(definitions.file)
     for pool, process in definitions.pools():
         report.pools.append(pool.name + (" (multi-instance)" if pool.multi_instance else ""))
         report.problems += [
             f"{pool.name}: {p}" for p in problems(process, skills=skills, library=library)
         ]
+        report.problems += [f"{pool.name}: {p}" for p in progress_problems(process)]
     publishers, subscribers = endpoints(definitions, skills=skills, library=library)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [
@@ -140,3 +143,158 @@ def _lonely(topic: str, publishers: list[Endpoint], subscribers: list[Endpoint])
         who = ", ".join(sorted({p.describe() for p in publishers}))
         return [f"{topic}: thrown by {who} but caught by no pool"]
     return []
+
+
+# -- flows that can never complete -------------------------------------------------------------
+
+GATEWAYS = frozenset(
+    {
+        "exclusiveGateway",
+        "parallelGateway",
+        "inclusiveGateway",
+        "eventBasedGateway",
+        "complexGateway",
+    }
+)
+
+
+def progress_problems(process: Process) -> list[str]:
+    """Loops made only of gateways (a token there does nothing, forever) and parallel joins
+    that wait for a token only they can let through (a deadlock), in every (sub-)scope."""
+    found: list[str] = []
+    for scope in _scopes(process):
+        graph = _successors(scope)
+        found += _gateway_loops(scope, graph) + _deadlocked_joins(scope, graph)
+    return found
+
+
+def _scopes(scope: Scope) -> list[Scope]:
+    scopes = [scope]
+    for node in scope.nodes.values():
+        if node.scope is not None:
+            scopes += _scopes(node.scope)
+    return scopes
+
+
+def _successors(scope: Scope) -> dict[str, list[str]]:
+    """Each node's successors: its sequence flows, and from an activity its boundary events."""
+    graph: dict[str, list[str]] = {node: [] for node in scope.nodes}
+    for flow in scope.flows.values():
+        if flow.source in graph and flow.target in graph:
+            graph[flow.source].append(flow.target)
+    for node in scope.nodes.values():
+        if node.attached_to in graph:
+            graph[node.attached_to].append(node.id)
+    return graph
+
+
+def _gateway_loops(scope: Scope, graph: dict[str, list[str]]) -> list[str]:
+    gateways = {n for n, node in scope.nodes.items() if node.kind in GATEWAYS}
+    only_gateways = {n: [t for t in graph[n] if t in gateways] for n in gateways}
+    return [
+        f"{_names(scope, loop)} form a loop of gateways only: a token there never reaches a task "
+        "or event, so the loop can never progress (add the activity the loop repeats)"
+        for loop in _cycles(only_gateways)
+    ]
+
+
+def _deadlocked_joins(scope: Scope, graph: dict[str, list[str]]) -> list[str]:
+    """A parallel join waits for a token on every incoming flow; a flow whose source can only
+    be reached through the join itself never gets one before the join has fired."""
+    incoming: dict[str, list[str]] = defaultdict(list)
+    for source, targets in graph.items():
+        for target in targets:
+            incoming[target].append(source)
+    starts = [n for n in graph if not incoming[n]]
+    found = []
+    for join, node in scope.nodes.items():
+        if node.kind != "parallelGateway" or len(incoming[join]) < 2:
+            continue
+        reached = _reachable(graph, starts, avoid=join)
+        stuck = sorted(source for source in incoming[join] if source not in reached)
+        if stuck:
+            found.append(
+                f"{node.describe()} joins in parallel but its flow from {_names(scope, stuck)} "
+                "can only carry a token after the join itself has fired: it deadlocks (join "
+                "that loop with an exclusive gateway)"
+            )
+    return found
+
+
+def _reachable(graph: dict[str, list[str]], starts: list[str], avoid: str) -> set[str]:
+    seen = {start for start in starts if start != avoid}
+    stack = list(seen)
+    while stack:
+        for target in graph[stack.pop()]:
+            if target != avoid and target not in seen:
+                seen.add(target)
+                stack.append(target)
+    return seen
+
+
+def _cycles(graph: dict[str, list[str]]) -> list[list[str]]:
+    """The strongly connected parts of ``graph`` that hold a cycle (Tarjan, iteratively)."""
+    index: dict[str, int] = {}
+    low: dict[str, int] = {}
+    on_stack: set[str] = set()
+    stack: list[str] = []
+    cycles = []
+    for root in sorted(graph):
+        if root in index:
+            continue
+        work = [(root, iter(graph[root]))]
+        index[root] = low[root] = len(index)
+        stack.append(root)
+        on_stack.add(root)
+        while work:
+            node, targets = work[-1]
+            target = next(targets, None)
+            if target is None:
+                work.pop()
+                if work:
+                    low[work[-1][0]] = min(low[work[-1][0]], low[node])
+                if low[node] == index[node]:
+                    part = []
+                    while True:
+                        member = stack.pop()
+                        on_stack.discard(member)
+                        part.append(member)
+                        if member == node:
+                            break
+                    if len(part) > 1 or node in graph[node]:
+                        cycles.append(sorted(part))
+            elif target not in index:
+                index[target] = low[target] = len(index)
+                stack.append(target)
+                on_stack.add(target)
+                work.append((target, iter(graph[target])))
+            elif target in on_stack:
+                low[node] = min(low[node], index[target])
+    return cycles
+
+
+def _names(scope: Scope, ids: list[str]) -> str:
+    return ", ".join(scope.nodes[n].describe() for n in ids)
+
+
+def duplicate_ids(file: Path | None) -> list[str]:
+    """Element ids given to more than one element of the file: the parser keeps only one of
+    them, so a model with two ``start`` ids would look as if it had none."""
+    if file is None or not Path(file).is_file():
+        return []
+    from lxml import etree
+
+    lines: dict[str, list[int]] = defaultdict(list)
+    try:
+        tree = etree.parse(str(file), etree.XMLParser(resolve_entities=False, no_network=True))
+    except etree.XMLSyntaxError:
+        return []  # the parser has refused it already
+    for element in tree.iter():
+        if isinstance(element.tag, str) and (ident := element.get("id")):
+            lines[ident].append(element.sourceline or 0)
+    return [
+        f"the id {ident!r} is given to {len(at)} elements (lines "
+        f"{', '.join(map(str, at))}); each element needs its own id"
+        for ident, at in sorted(lines.items())
+        if len(at) > 1
+    ]

@@ -1,0 +1,143 @@
+"""A local Neo4j killed with SIGKILL in the middle of an ingest, then started again: what
+`neo4j status`, `logs list` and `logs delete` say is true, and the delete restores the counts.
+Also: a stopped server whose port something else answers on is not talked to."""
+
+from __future__ import annotations
+
+import os
+import signal
+import socket
+import subprocess
+import sys
+import time
+from functools import partial
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from neo4j import GraphDatabase
+
+from robotale.ekg import jars
+from robotale.ekg.server import LocalServer, free_port
+
+ROBOTALE = [sys.executable, "-m", "robotale"]
+EVENTS = 150_000
+
+
+def _big_log(path: Path) -> Path:
+    """A log long enough that the kill lands while it is being written."""
+    times = pd.date_range("2024-01-01", periods=EVENTS, freq="s", tz="UTC")
+    pd.DataFrame(
+        {
+            "case": [f"c{i // 50}" for i in range(EVENTS)],
+            "activity": [f"a{i % 7}" for i in range(EVENTS)],
+            "timestamp": times.strftime("%Y-%m-%dT%H:%M:%SZ"),
+            "robot": [f"r{i % 5}" for i in range(EVENTS)],
+        }
+    ).to_csv(path, index=False)
+    return path
+
+
+def _count(driver, query: str, **params) -> int:
+    records, _, _ = driver.execute_query(query, params)
+    return int(records[0][0])
+
+
+def _wait_for_events(driver, name: str, ingest: subprocess.Popen) -> None:
+    deadline = time.monotonic() + 300
+    query = "MATCH (e:Event) WHERE e.log = $name AND e.id IS NOT NULL RETURN count(e)"
+    while _count(driver, query, name=name) == 0:
+        assert ingest.poll() is None, ingest.communicate()
+        assert time.monotonic() < deadline
+        time.sleep(0.2)
+
+
+@pytest.fixture
+def env(tmp_path, neo4j_server) -> dict[str, str]:
+    # neo4j_server first: it provisions the jar cache this second server shares.
+    clean = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")}
+    return clean | {
+        "ROBOTALE_HOME": str(tmp_path / "home"),
+        "ROBOTALE_CACHE": str(jars.server_dir().parent),
+        "ROBOTALE_NEO4J_HEAP": "512m",
+        "ROBOTALE_NEO4J_PAGECACHE": "64m",
+    }
+
+
+@pytest.mark.slow
+def test_sigkill_mid_ingest_then_start_status_list_delete(tmp_path, env):
+    run = partial(subprocess.run, env=env, capture_output=True, text=True, timeout=300)
+    bolt, http_port = free_port(), free_port()
+    started = run(
+        [*ROBOTALE, "neo4j", "start", "--bolt-port", str(bolt), "--http-port", str(http_port)]
+    )
+    assert started.returncode == 0, started.stderr
+    server = LocalServer(tmp_path / "home")
+    auth = ("neo4j", server.password() or "")
+    uri = f"bolt://127.0.0.1:{bolt}"
+    try:
+        csv = _big_log(tmp_path / "big.csv")
+        ingest = subprocess.Popen(
+            [*ROBOTALE, "ingest", str(csv), "--log", "big"],
+            env=env,
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        with GraphDatabase.driver(uri, auth=auth) as driver:
+            _wait_for_events(driver, "big", ingest)
+        pid = server.running().pid
+        os.kill(pid, signal.SIGKILL)
+        _, error = ingest.communicate(timeout=300)
+        assert ingest.returncode == 1
+        assert len(error.strip().splitlines()) == 1 and "robotale logs delete" in error
+
+        status = run([*ROBOTALE, "neo4j", "status"])
+        assert status.returncode == 1
+        assert f"crashed): its process {pid} is gone" in status.stdout
+        refused = run([*ROBOTALE, "logs", "list"])
+        assert refused.returncode == 1
+        assert f"(pid {pid}, bolt port {bolt}) has crashed" in refused.stderr
+
+        again = run([*ROBOTALE, "neo4j", "start"])  # no ports given: the recorded ones
+        assert again.returncode == 0, again.stderr
+        assert f"is running at {uri}" in again.stdout
+        assert run([*ROBOTALE, "neo4j", "status"]).returncode == 0
+
+        with GraphDatabase.driver(uri, auth=auth) as driver:
+            stored = _count(driver, "MATCH (e:Event {log: 'big'}) RETURN count(e)")
+            assert 0 < stored < EVENTS
+            listed = run([*ROBOTALE, "logs", "list"])
+            assert listed.returncode == 0, listed.stderr
+            assert f"big  [failed]  {stored:,} events" in listed.stdout
+            assert "remove it with `robotale logs delete big`" in listed.stdout
+            deleted = run([*ROBOTALE, "logs", "delete", "big"])
+            assert deleted.returncode == 0, deleted.stderr
+            # The database was empty before the ingest: nothing is left, not even its lock.
+            assert _count(driver, "MATCH (n) RETURN count(n)") == 0
+    finally:
+        run([*ROBOTALE, "neo4j", "stop"])
+
+
+@pytest.mark.slow
+def test_a_stopped_servers_port_answered_by_something_else(tmp_path, env):
+    run = partial(subprocess.run, env=env, capture_output=True, text=True, timeout=300)
+    bolt, http_port = free_port(), free_port()
+    started = run(
+        [*ROBOTALE, "neo4j", "start", "--bolt-port", str(bolt), "--http-port", str(http_port)]
+    )
+    assert started.returncode == 0, started.stderr
+    assert run([*ROBOTALE, "neo4j", "stop"]).returncode == 0
+    assert run([*ROBOTALE, "neo4j", "status"]).returncode == 3
+    with socket.socket() as impostor:
+        impostor.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        impostor.bind(("127.0.0.1", bolt))
+        impostor.listen()
+        status = run([*ROBOTALE, "neo4j", "status"])
+        assert status.returncode == 4 and "something else answers" in status.stdout
+        listed = run([*ROBOTALE, "logs", "list"])
+        assert listed.returncode == 1
+        assert f"something else answers on its bolt port {bolt}" in listed.stderr
+        restart = run([*ROBOTALE, "neo4j", "start"])
+        assert restart.returncode == 1
+        assert f"port {bolt} on 127.0.0.1 is held by something else" in restart.stderr
