@@ -1,4 +1,8 @@
-"""How fast the simulator runs the agri scenario, headless.
+"""How fast the simulator runs the agri scenario, headless, in kinematic and dynamics mode.
+
+Both steps run once per mode, side by side: kinematic (poses set from the commands) and
+dynamics (``dynamics: true``: ground robots with mass, forces and collisions, pybullet stepped
+at the world's ``physics_rate``).
 
 1. One agri run (drone + 2 tractors, the scenario's random weeds and batteries), recorded as a
    rosbag2: simulated seconds per wall second, against the wall clock itself (1x = real time).
@@ -13,6 +17,7 @@
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import os
 import statistics
 import sys
@@ -36,9 +41,12 @@ def main() -> int:
     parser.add_argument("--workers", type=int, default=os.cpu_count() or 1)
     args = parser.parse_args()
     world = adjust(load_world(scenarios.world_file("agri")), counts={"tractor": 2})
-    with tempfile.TemporaryDirectory(prefix="sim-speed-") as scratch:
-        walls, simulated = single_runs(world, Path(scratch) / "single", args.single)
-        batch_runs(world, Path(scratch) / "batch", args.runs, args.workers, walls, simulated)
+    for mode, dynamics in (("kinematic", False), ("dynamics", True)):
+        print(f"-- {mode} mode")
+        moded = dataclasses.replace(world, dynamics=dynamics)
+        with tempfile.TemporaryDirectory(prefix="sim-speed-") as scratch:
+            walls, simulated = single_runs(moded, Path(scratch) / "single", args.single)
+            batch_runs(moded, Path(scratch) / "batch", args.runs, args.workers, walls, simulated)
     return 0
 
 

@@ -11,6 +11,11 @@ a publisher and a subscriber whose QoS or message types do not match
 (:func:`~robotale.fame_runtime.qos.pair_problems`, the rules ``fame check`` applies) never
 talk; a transient-local publisher keeps its last ``depth`` messages for subscribers that
 come later and ask for them; only best-effort deliveries are lost at random (``loss``).
+
+A :class:`Network` makes the in-process bus behave like a radio link: each delivery waits a
+latency drawn per message and is lost with a probability that can grow with the distance
+between sender and receiver; a reliable delivery that is lost is resent every ``retry`` seconds
+until it arrives or its ``deadline`` passes, a best-effort one is gone.
 """
 
 from __future__ import annotations
@@ -19,7 +24,7 @@ import itertools
 import logging
 import random
 from collections import defaultdict, deque
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -115,13 +120,57 @@ def best_effort(offered: QoS, requested: QoS) -> bool:
     return "best_effort" in (offered.reliability, requested.reliability)
 
 
+def _nowhere(_name: str) -> tuple[float, float] | None:
+    """No robot's position is known (a module function, so a network can be pickled)."""
+    return None
+
+
+@dataclass(frozen=True)
+class Link:
+    """How messages travel from one robot to another."""
+
+    latency: float = 0.01  # seconds, the mean
+    jitter: float = 0.0  # seconds, the standard deviation (normal, never below zero)
+    loss: float = 0.0  # probability that one transmission is lost, at distance 0
+    loss_per_metre: float = 0.0  # added to ``loss`` per metre between the two robots
+    retry: float = 0.05  # seconds between a reliable writer's resends
+    deadline: float = 1.0  # seconds after which a reliable writer gives a message up
+
+
+@dataclass
+class Network:
+    """A link for every pair of robots: ``links[(sender, receiver)]`` or ``default``.
+
+    ``locate`` tells where a robot is (None when unknown, for example a subscriber that is not
+    a robot); without a position, distance counts as zero.
+    """
+
+    default: Link = field(default_factory=Link)
+    links: Mapping[tuple[str, str], Link] = field(default_factory=dict)
+    locate: Callable[[str], tuple[float, float] | None] = _nowhere
+
+    def link(self, sender: str, receiver: str) -> Link:
+        return self.links.get((sender, receiver), self.default)
+
+    def loss(self, link: Link, sender: str, receiver: str) -> float:
+        if not link.loss_per_metre:
+            return link.loss
+        here, there = self.locate(sender), self.locate(receiver)
+        if here is None or there is None:
+            return link.loss
+        distance = ((here[0] - there[0]) ** 2 + (here[1] - there[1]) ** 2) ** 0.5
+        return min(1.0, link.loss + link.loss_per_metre * distance)
+
+
 class InProcessBus:
     """Topics inside one process, delivered through the clock after ``latency`` seconds.
 
     ``drop`` loses chosen deliveries (fault injection: a link that is down); ``loss`` is the
     probability that a best-effort delivery is lost (reliable ones are resent by DDS, so they
-    always arrive). ``on_warning`` receives the sentence about each pair that cannot talk,
-    once per pair (default: the ``logging`` warning); ``warnings`` keeps them all.
+    always arrive). ``network`` (a :class:`Network`) replaces the fixed ``latency`` with per-link
+    latencies, losses and reliable resends. ``on_warning`` receives the sentence about each
+    pair that cannot talk, once per pair (default: the ``logging`` warning); ``warnings`` keeps
+    them all.
     """
 
     def __init__(
@@ -133,9 +182,11 @@ class InProcessBus:
         loss: float = 0.0,
         seed: int | None = None,
         on_warning: Callable[[str], None] | None = None,
+        network: Network | None = None,
     ):
         self.clock = clock
         self.latency = latency
+        self.network = network
         self.drop = drop
         self.loss = loss
         self._random = random.Random(seed)
@@ -169,7 +220,10 @@ class InProcessBus:
                 continue
             if self._lost(envelope, subscription):
                 continue
-            self._send(subscription, envelope)
+            if self.network is not None:
+                self._transmit(subscription, envelope)
+            else:
+                self._send(subscription, envelope)
         return envelope
 
     def subscribe(self, topic, callback, *, msgtype=None, qos=None, owner="") -> Subscription:
@@ -182,6 +236,27 @@ class InProcessBus:
     def _send(self, subscription: Subscription, envelope: Envelope) -> None:
         self.pending += 1
         self.clock.call_later(self.latency, self._delivery(subscription, envelope))
+
+    def _transmit(self, subscription: Subscription, envelope: Envelope) -> None:
+        """Send over the network: each try is lost with the link's probability; a reliable
+        writer tries again every ``retry`` seconds until ``deadline``, best effort once."""
+        network = self.network
+        assert network is not None
+        sender, receiver = envelope.sender, subscription.owner
+        link = network.link(sender, receiver)
+        chance = network.loss(link, sender, receiver)
+        tries = 1 if best_effort(envelope.qos, subscription.qos) else _tries(link)
+        for attempt in range(tries):
+            if self._random.random() >= chance:
+                delay = attempt * link.retry + self._latency(link)
+                self.pending += 1
+                self.clock.call_later(delay, self._delivery(subscription, envelope))
+                return
+
+    def _latency(self, link: Link) -> float:
+        if not link.jitter:
+            return link.latency
+        return max(0.0, self._random.gauss(link.latency, link.jitter))
 
     def _talk(self, envelope: Envelope, subscription: Subscription) -> bool:
         """Whether the envelope's publisher is matched with the subscriber (warn once if not)."""
@@ -253,3 +328,8 @@ class InProcessBus:
                 subscription.callback(envelope)
 
         return deliver
+
+
+def _tries(link: Link) -> int:
+    """How many times a reliable writer sends: the first time and each resend in the deadline."""
+    return 1 + int(link.deadline / link.retry + 1e-9) if link.retry > 0 else 1

@@ -1,8 +1,10 @@
-"""The pybullet side of the world: bodies, ray tests, overlap queries and the window.
+"""The pybullet side of the world: bodies, ray tests, overlap queries, dynamics and the window.
 
-Robots move kinematically (their pose is set each control step from the commanded velocity),
-so pybullet never integrates dynamics: it holds the bodies the sensors see, answers ray tests
-(ultrasonic range) and box queries (a camera footprint), and draws the GUI. Each world has its
+In kinematic mode robots move by having their pose set each control step, so pybullet never
+integrates: it holds the bodies the sensors see, answers ray tests (ultrasonic range) and box
+queries (a camera footprint), and draws the GUI. In dynamics mode (:meth:`Physics.dynamics`)
+ground robots are bodies with mass, pushed by forces and stepped with ``stepSimulation`` at a
+fixed rate, so they have inertia and collide (:mod:`robotale.sim.dynamics`). Each world has its
 own pybullet client, so several worlds can live in one process.
 """
 
@@ -45,6 +47,8 @@ with _quiet():
     import pybullet
 
 Color = tuple[float, float, float, float]
+GRAVITY = 9.81  # m/s2
+_ROBOTS = 4  # the collision group of driven robots (bit 1 is the rays' group)
 
 
 #: headless clients of this process, emptied and unused
@@ -105,7 +109,9 @@ class Physics:
         *,
         collide: bool = True,
         yaw: float = 0.0,
+        mass: float = 0.0,
     ) -> int:
+        """A box; ``mass`` > 0 makes it a dynamic body (static, moved only by placing, if 0)."""
         shape = (
             pybullet.createCollisionShape(
                 pybullet.GEOM_BOX, halfExtents=half_extents, physicsClientId=self.client
@@ -119,7 +125,7 @@ class Physics:
             rgbaColor=color,
             physicsClientId=self.client,
         )
-        return self._body(shape, visual, position, yaw)
+        return self._body(shape, visual, position, yaw, mass)
 
     def cylinder(
         self, radius: float, height: float, position: Sequence[float], color: Color, collide=True
@@ -140,9 +146,11 @@ class Physics:
         )
         return self._body(shape, visual, position, 0.0)
 
-    def _body(self, shape: int, visual: int, position: Sequence[float], yaw: float) -> int:
+    def _body(
+        self, shape: int, visual: int, position: Sequence[float], yaw: float, mass: float = 0.0
+    ) -> int:
         return pybullet.createMultiBody(
-            baseMass=0,
+            baseMass=mass,
             baseCollisionShapeIndex=shape,
             baseVisualShapeIndex=visual,
             basePosition=position,
@@ -154,6 +162,67 @@ class Physics:
         pybullet.resetBasePositionAndOrientation(
             body, position, _quaternion(yaw), physicsClientId=self.client
         )
+
+    # -- dynamics ---------------------------------------------------------------------------------
+
+    def dynamics(self, rate: float) -> None:
+        """Integrate at ``rate`` steps a second under gravity (one :meth:`step` = one step)."""
+        pybullet.setGravity(0, 0, -GRAVITY, physicsClientId=self.client)
+        pybullet.setPhysicsEngineParameter(fixedTimeStep=1.0 / rate, physicsClientId=self.client)
+
+    def floor(self) -> int:
+        """An endless invisible ground at height 0: bases and robots may lie outside the
+        field, and a body with mass must not fall off its edge."""
+        shape = pybullet.createCollisionShape(pybullet.GEOM_PLANE, physicsClientId=self.client)
+        return self._body(shape, -1, (0.0, 0.0, 0.0), 0.0)
+
+    def step(self) -> None:
+        pybullet.stepSimulation(physicsClientId=self.client)
+
+    def slippery(self, body: int) -> None:
+        """A driven robot: no contact friction, since its wheels' grip is modelled by the
+        forces pushing it (:mod:`robotale.sim.dynamics`), so the box must neither drag on the
+        ground nor be slowed by pybullet's default damping; in the robots' collision group."""
+        pybullet.changeDynamics(
+            body,
+            -1,
+            lateralFriction=0.0,
+            restitution=0.0,
+            linearDamping=0.0,
+            angularDamping=0.0,
+            physicsClientId=self.client,
+        )
+        pybullet.setCollisionFilterGroupMask(body, -1, _ROBOTS, -1, physicsClientId=self.client)
+
+    def ghost(self, body: int) -> None:
+        """``body`` (a weed driven over) never collides with a driven robot, yet rays (of the
+        default group) and box queries still see it."""
+        pybullet.setCollisionFilterGroupMask(body, -1, 2, ~_ROBOTS, physicsClientId=self.client)
+
+    def motion(self, body: int) -> tuple[tuple[float, float, float], float, tuple, float]:
+        """Position, yaw, linear velocity and yaw rate of a body."""
+        position, orientation = pybullet.getBasePositionAndOrientation(
+            body, physicsClientId=self.client
+        )
+        linear, angular = pybullet.getBaseVelocity(body, physicsClientId=self.client)
+        x, y, z, w = orientation
+        yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+        return position, yaw, linear, angular[2]
+
+    def push(self, body: int, force: Sequence[float], torque: float) -> None:
+        """Apply a force (world frame, at the centre of mass) and a yaw torque for one step."""
+        position, _ = pybullet.getBasePositionAndOrientation(body, physicsClientId=self.client)
+        pybullet.applyExternalForce(
+            body, -1, force, position, pybullet.WORLD_FRAME, physicsClientId=self.client
+        )
+        pybullet.applyExternalTorque(
+            body, -1, (0.0, 0.0, torque), pybullet.WORLD_FRAME, physicsClientId=self.client
+        )
+
+    def touching(self, body: int) -> set[int]:
+        """The bodies in contact with ``body`` after the last step."""
+        contacts = pybullet.getContactPoints(bodyA=body, physicsClientId=self.client)
+        return {contact[2] for contact in contacts or ()}
 
     def recolor(self, body: int, color: Color) -> None:
         pybullet.changeVisualShape(body, -1, rgbaColor=color, physicsClientId=self.client)

@@ -8,7 +8,7 @@ is still in the bag, as ``ros2 bag record`` on the sender's side would have it).
   second per topic;
 - every signal topic (any topic outside a robot's namespace), every error topic of the model
   (``/<robot>/low_battery``), and the robots' event-like topics: take-off, land, blade, LED,
-  detections;
+  detections, collisions;
 - any other robot topic named in ``extra`` (``range``, ``cmd_vel`` ...), at ``rate``.
 
 The connections of the topics the mission is known to use are announced when the bag opens;
@@ -33,7 +33,7 @@ from robotale.sim.robots import BATTERY, ODOM
 
 STORAGES = {"sqlite3": StoragePlugin.SQLITE3, "mcap": StoragePlugin.MCAP}
 THROTTLED = frozenset({"odom", "battery"})
-EVENT_TOPICS = frozenset({"tag", "takeoff", "land", "blade_force", "led", "detection"})
+EVENT_TOPICS = frozenset({"tag", "takeoff", "land", "blade_force", "led", "detection", "collision"})
 KEEP, THROTTLE, SKIP = "keep", "throttle", "skip"
 
 

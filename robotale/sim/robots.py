@@ -1,11 +1,12 @@
-"""Simulated robots: kinematic bodies driven by velocity commands, reached only through topics.
+"""Simulated robots: bodies driven by velocity commands, reached only through topics.
 
 A ground robot (tractor, REX, DINGO) is a differential drive: ``/<robot>/cmd_vel`` gives its
 forward speed (``linear.x``) and turn rate (``angular.z``). A drone takes off on
 ``/<robot>/takeoff`` and lands on ``/<robot>/land`` (``std_msgs/msg/Empty``), climbing to its
 altitude, and while flying obeys ``cmd_vel`` in its body frame like the Tello of the thesis.
 Each control step the pose is integrated from the commands, clipped to the robot's limits, and
-set on its pybullet body; a robot whose battery is empty stops (a drone drops to the ground).
+set on its pybullet body (in dynamics mode a ground robot's pose comes from pybullet instead,
+:mod:`robotale.sim.dynamics`); a robot whose battery is empty stops (a drone drops to the ground).
 A drone also serves the Tello driver's ``tello_action`` service the thesis' scripts call,
 as the topics ``/<robot>/tello_action/request`` (``cmd``: ``takeoff``, ``land``) and
 ``/<robot>/tello_action/response`` (``rc``: 1 done, 3 busy or unknown).
@@ -62,6 +63,8 @@ class SimRobot:
     blade: float = 0.0
     led: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     speed: float = 0.0  # m/s actually moved in the last step
+    driven: bool = False  # its pose comes from the physics (dynamics mode), not from move()
+    drift: tuple[float, float] = (0.0, 0.0)  # metres its odometry is off, x and y
     _command: tuple[float, float, float] = (0.0, 0.0, 0.0)  # forward, turn, climb
     _subscriptions: list[Any] = field(default_factory=list)
 
@@ -144,6 +147,8 @@ class SimRobot:
             self.blade = 0.0
             if self.flies and self.pose.z > 0:
                 self.pose.z, self.flight = 0.0, LANDED  # it falls
+        if self.driven:
+            return  # the physics moved it (robotale.sim.dynamics)
         forward, turn = self._limited()
         if self.flies:
             self._fly_vertically(dt)
@@ -152,6 +157,12 @@ class SimRobot:
         pose.x += forward * math.cos(pose.yaw) * dt
         pose.y += forward * math.sin(pose.yaw) * dt
         self.speed = abs(forward)
+
+    def wanted(self) -> tuple[float, float]:
+        """The forward speed and turn rate its drive aims at (nothing once dead or empty)."""
+        if not self.alive or self.battery.empty:
+            return 0.0, 0.0
+        return self._limited()
 
     def _limited(self) -> tuple[float, float]:
         if self.flies and self.flight != FLYING:
@@ -171,6 +182,14 @@ class SimRobot:
             if pose.z <= 0.0:
                 self.flight = LANDED
 
+    def wander(self, dt: float, rng) -> None:
+        """Odometry drifts: a random walk of ``odom_drift`` metres per root metre travelled."""
+        travelled = self.speed * dt
+        if not self.spec.odom_drift or travelled <= 0:
+            return
+        spread = self.spec.odom_drift * math.sqrt(travelled)
+        self.drift = (self.drift[0] + rng.gauss(0, spread), self.drift[1] + rng.gauss(0, spread))
+
     def on_charger(self) -> bool:
         """Still on its charging spot, or anywhere on its base (a drone: landed)."""
         base = self.base
@@ -185,7 +204,7 @@ class SimRobot:
     def odometry(self, now: float) -> dict[str, Any]:
         """A ``nav_msgs/msg/Odometry``: pose in the field's frame, velocity in the body frame."""
         pose = self.pose
-        forward, turn = self._limited() if self.alive and not self.battery.empty else (0.0, 0.0)
+        forward, turn = self.wanted()
         climb = 0.0
         if self.flight == CLIMBING:
             climb = self.spec.climb
@@ -197,8 +216,8 @@ class SimRobot:
             "pose": {
                 "pose": {
                     "position": {
-                        "x": round(pose.x, 6),
-                        "y": round(pose.y, 6),
+                        "x": round(pose.x + self.drift[0], 6),
+                        "y": round(pose.y + self.drift[1], 6),
                         "z": round(pose.z, 6),
                     },
                     "orientation": {"z": math.sin(pose.yaw / 2), "w": math.cos(pose.yaw / 2)},

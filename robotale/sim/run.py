@@ -9,6 +9,7 @@ with the reason; whatever was recorded until then stays in the bag.
 
 from __future__ import annotations
 
+import dataclasses
 import datetime as dt
 import math
 import time
@@ -18,7 +19,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from robotale.fame_runtime.bus import InProcessBus
+from robotale.fame_runtime.bus import InProcessBus, Network
 from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.labels import error_name, signal_topic
 from robotale.fame_runtime.library import Library
@@ -87,7 +88,14 @@ def simulate_run(
     setup = draw(world, plan.seed)
     planned = fault_model.plan(plan.faults, plan.seed)
     clock = SimClock(start)
-    bus = InProcessBus(clock, latency=world.latency, drop=fault_model.drop_rule(planned, start))
+    network = _network(world)
+    bus = InProcessBus(
+        clock,
+        latency=world.latency,
+        drop=fault_model.drop_rule(planned, start),
+        seed=plan.seed,
+        network=network,
+    )
     recorder = sim = mission = None
     status, reason, detail = CRASHED, "", ""
     try:
@@ -108,6 +116,8 @@ def simulate_run(
         sim = SimWorld(
             world, setup, clock=clock, bus=bus, gui=gui, silent=skill_signals(definitions)
         )
+        if network is not None:
+            network.locate = sim.position
         mission.start()
         sim.start()
         _schedule(planned, clock, start, sim, mission)
@@ -129,6 +139,11 @@ def simulate_run(
     folder.mkdir(parents=True, exist_ok=True)
     write_manifest(folder, manifest)
     return manifest
+
+
+def _network(world: World) -> Network | None:
+    """A fresh copy of the world's network model, so this run's positions are its own."""
+    return None if world.network is None else dataclasses.replace(world.network)
 
 
 def _what_happened(

@@ -5,11 +5,18 @@ Both can report objects of one kind (weeds, targets) on ``/<robot>/detection``
 (``geometry_msgs/msg/PointStamped``, ``header.frame_id`` = the object's id, ``point`` = where
 it is), every control step the object is in view: the detector a real robot would run on its
 camera or sonar. Telling a new object from one seen before is the listener's job.
+
+Both are imperfect as configured in the world file, with draws from the run's seed: a range
+reading has gaussian ``noise`` and is lost (read as ``max_range``) with probability
+``dropout``; the camera detects an object in view with probability ``detection`` less
+``falloff`` per metre from the camera, and sees ``false_positives`` phantoms a second
+somewhere in its footprint.
 """
 
 from __future__ import annotations
 
 import math
+import random
 from typing import Any
 
 from robotale.sim.messages import header
@@ -20,6 +27,8 @@ from robotale.sim.worldspec import CameraSpec, RangeSpec
 RANGE = "sensor_msgs/msg/Range"
 DETECTION = "geometry_msgs/msg/PointStamped"
 ULTRASOUND = 0  # sensor_msgs/msg/Range radiation_type
+MIN_RANGE = 0.02  # metres
+MIN_ALTITUDE = 0.3  # metres: a camera lower sees nothing
 
 
 def sonar(physics: Physics, robot: SimRobot, spec: RangeSpec) -> tuple[float, int]:
@@ -34,6 +43,15 @@ def sonar(physics: Physics, robot: SimRobot, spec: RangeSpec) -> tuple[float, in
         )
     fraction, body = min((f, b) for b, f in hits)
     return fraction * spec.max_range, body
+
+
+def reading(distance: float, spec: RangeSpec, rng: random.Random) -> float | None:
+    """The distance the sensor reports for a true ``distance``; None when the echo is lost."""
+    if spec.dropout and rng.random() < spec.dropout:
+        return None
+    if not spec.noise:
+        return distance
+    return min(spec.max_range, max(MIN_RANGE, distance + rng.gauss(0.0, spec.noise)))
 
 
 def _along(start, end, fraction: float) -> tuple[float, ...]:
@@ -71,7 +89,7 @@ def range_message(now: float, robot: SimRobot, spec: RangeSpec, distance: float)
         "header": header(now, f"{robot.name}/sonar"),
         "radiation_type": ULTRASOUND,
         "field_of_view": 2 * math.radians(spec.cone),
-        "min_range": 0.02,
+        "min_range": MIN_RANGE,
         "max_range": spec.max_range,
         "range": round(distance, 4),
     }
@@ -80,7 +98,7 @@ def range_message(now: float, robot: SimRobot, spec: RangeSpec, distance: float)
 def camera_view(physics: Physics, robot: SimRobot, spec: CameraSpec) -> set[int]:
     """The bodies on the ground inside the camera's footprint (nothing below 0.3 m)."""
     pose = robot.pose
-    if pose.z < 0.3:
+    if pose.z < MIN_ALTITUDE:
         return set()
     half = pose.z * math.tan(math.radians(spec.fov) / 2)
     if physics.gui:
@@ -94,6 +112,33 @@ def camera_view(physics: Physics, robot: SimRobot, spec: CameraSpec) -> set[int]
 
 
 _SQUARE = ((-1, -1), (1, -1), (1, 1), (-1, 1))
+
+
+def detected(
+    robot: SimRobot, spec: CameraSpec, where: tuple[float, float], rng: random.Random
+) -> bool:
+    """Whether the camera's detector finds an object at ``where`` in view this frame."""
+    if spec.detection >= 1.0 and not spec.falloff:
+        return True
+    pose = robot.pose
+    distance = math.dist((pose.x, pose.y, pose.z), (*where, 0.0))
+    return rng.random() < spec.detection - spec.falloff * distance
+
+
+def phantoms(
+    robot: SimRobot, spec: CameraSpec, dt: float, rng: random.Random
+) -> list[tuple[float, float]]:
+    """Where the detector sees objects that are not there in a frame of ``dt`` seconds (at
+    most one a frame: a Bernoulli draw with ``false_positives * dt``)."""
+    pose = robot.pose
+    if (
+        not spec.false_positives
+        or pose.z < MIN_ALTITUDE
+        or rng.random() >= spec.false_positives * dt
+    ):
+        return []
+    half = pose.z * math.tan(math.radians(spec.fov) / 2)
+    return [(pose.x + rng.uniform(-half, half), pose.y + rng.uniform(-half, half))]
 
 
 def detection_message(now: float, robot: SimRobot, object_id: str, x: float, y: float):

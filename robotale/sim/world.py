@@ -13,7 +13,12 @@ topic                      type                               when
 ``/<robot>/range``         ``sensor_msgs/msg/Range``          every control step (if fitted)
 ``/<robot>/detection``     ``geometry_msgs/msg/PointStamped`` each step an object is seen
 ``/<camera signal>``       ``geometry_msgs/msg/Vector3``      once per new object (if named)
+``/<robot>/collision``     ``std_msgs/msg/String``            a contact begins (dynamics)
 =========================  =================================  ==============================
+
+With ``dynamics: true`` ground robots are pushed by their drives and pybullet steps the world
+``physics_rate`` times a second (:mod:`robotale.sim.dynamics`); the control steps then read
+their poses from the physics.
 
 A tractor's blade cuts the weeds within its radius while ``blade_force`` > 0; a robot whose
 LED turns red destroys the targets within :data:`FIRE_RANGE`. The engines never see this
@@ -23,13 +28,14 @@ module: they reach the robots through the bus only.
 from __future__ import annotations
 
 import math
+import random
 from dataclasses import dataclass
 from typing import Any
 
 from robotale.errors import RobotaleError
 from robotale.fame_runtime.bus import Bus
 from robotale.fame_runtime.clock import SimClock
-from robotale.sim import sensors
+from robotale.sim import dynamics, sensors
 from robotale.sim.battery import Battery
 from robotale.sim.physics import Physics
 from robotale.sim.robots import BATTERY, EMPTY, ODOM, Pose, SimRobot, place
@@ -82,6 +88,9 @@ class SimWorld:
         self._signalled: set[tuple[str, int]] = set()  # (robot, object) a signal announced
         self.clock, self.bus = clock, bus
         self.dt = 1.0 / world.control_rate
+        self.contacts = dynamics.Contacts({})
+        self.noise = random.Random(setup.seed)  # the sensors' draws, repeatable per run
+        self._phantoms = 0
         self.physics = Physics(gui=gui)
         try:
             self._build()
@@ -91,11 +100,22 @@ class SimWorld:
 
     def _build(self) -> None:
         world, physics = self.spec, self.physics
+        if world.dynamics:
+            physics.dynamics(world.physics_rate)
+            physics.floor()
         physics.ground(world.field, FIELD_COLOR)
+        names = {}
+        for obstacle in world.obstacles:
+            half = [size / 2 for size in obstacle.size]
+            position = (*obstacle.position, half[2])
+            body = physics.box(half, position, obstacle.color, yaw=math.radians(obstacle.yaw))
+            names[body] = obstacle.name
         for base in world.bases.values():
             physics.cylinder(base.radius, 0.01, (*base.position, 0.005), base.color, collide=False)
         specs = {name: spec for spec in world.robots for name in spec.names()}
         self.robots = {s.name: self._robot(s, specs[s.name]) for s in self.setup.robots}
+        names.update({robot.body: name for name, robot in self.robots.items()})
+        self.contacts = dynamics.Contacts(names)
         looks = {o.kind: o for o in world.objects}
         self.things: dict[int, Thing] = {}
         for placed in self.setup.objects:
@@ -122,7 +142,13 @@ class SimWorld:
             home=start.home,
         )
         half = [size / 2 for size in spec.size]
-        robot.body = self.physics.box(half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw)
+        robot.driven = self.spec.dynamics and not robot.flies
+        mass = spec.mass if robot.driven else 0.0
+        robot.body = self.physics.box(
+            half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw, mass=mass
+        )
+        if robot.driven:
+            self.physics.slippery(robot.body)
         robot.connect(self.bus)
         return robot
 
@@ -132,6 +158,8 @@ class SimWorld:
         else:
             half = look.size / 2
             body = self.physics.box((half, half, half), (placed.x, placed.y, half), look.color)
+        if self.spec.dynamics:  # robots drive over weeds and beside targets, never into them
+            self.physics.ghost(body)
         return Thing(placed.kind, placed.id, placed.x, placed.y, body)
 
     # -- running ----------------------------------------------------------------------------------
@@ -143,6 +171,8 @@ class SimWorld:
         for start in self.setup.robots:
             robot = self.robots[start.name]
             self.clock.call_at(now + start.phase * self.dt, self._loop(robot, now))
+        if self.spec.dynamics:
+            self.clock.call_at(now, self._physics_loop())
 
     def close(self) -> None:
         for robot in self.robots.values():
@@ -167,9 +197,33 @@ class SimWorld:
 
         return tick
 
+    def _physics_loop(self):
+        """Step pybullet at the world's physics rate: drives push, bodies move and collide."""
+        step = 1.0 / self.spec.physics_rate
+        driven = {name: robot for name, robot in self.robots.items() if robot.driven}
+
+        def tick() -> None:
+            for robot in driven.values():
+                dynamics.drive(self.physics, robot, step)
+            self.physics.step()
+            for robot in driven.values():
+                dynamics.follow(self.physics, robot)
+            for collision in self.contacts.update(self.physics, driven, self.clock.now()):
+                self._collided(collision)
+            self.clock.call_later(step, tick)
+
+        return tick
+
+    def _collided(self, collision: dynamics.Collision) -> None:
+        robot = self.robots[collision.robot]
+        if robot.alive:
+            self._publish(robot, "collision", {"data": collision.other}, dynamics.COLLISION)
+
     def _step(self, robot: SimRobot, now: float, dt: float, battery_due: bool) -> None:
         robot.move(dt)
-        place(self.physics, robot)
+        robot.wander(dt, self.noise)
+        if not robot.driven:
+            place(self.physics, robot)
         on_charger = robot.on_charger()
         if robot.battery.step(dt, robot.speed, on_charger, now):
             self._publish(robot, "low_battery", {}, EMPTY)
@@ -185,16 +239,45 @@ class SimWorld:
     def _sense(self, robot: SimRobot, now: float) -> None:
         spec = robot.spec
         if spec.range is not None:
-            distance, body = sensors.sonar(self.physics, robot, spec.range)
-            message = sensors.range_message(now, robot, spec.range, distance)
-            self._publish(robot, "range", message, sensors.RANGE)
-            if spec.range.detects and distance <= spec.range.detect_distance:
-                self._detected(robot, {body}, spec.range.detects, now)
+            self._sonar(robot, spec.range, now)
         if spec.camera is not None:
-            seen = sensors.camera_view(self.physics, robot, spec.camera)
-            self._detected(robot, seen, spec.camera.detects, now)
-            if spec.camera.signal and spec.camera.signal not in self.silent:
-                self._announce(robot, seen, spec.camera)
+            camera = spec.camera
+            seen = {
+                body
+                for body in sensors.camera_view(self.physics, robot, camera)
+                if body not in self.things
+                or sensors.detected(robot, camera, self._where(body), self.noise)
+            }
+            self._detected(robot, seen, camera.detects, now)
+            if camera.signal and camera.signal not in self.silent:
+                self._announce(robot, seen, camera)
+            for x, y in sensors.phantoms(robot, camera, self.dt, self.noise):
+                self._phantom(robot, camera, x, y, now)
+
+    def _where(self, body: int) -> tuple[float, float]:
+        thing = self.things[body]
+        return thing.x, thing.y
+
+    def _sonar(self, robot: SimRobot, spec, now: float) -> None:
+        distance, body = sensors.sonar(self.physics, robot, spec)
+        measured = sensors.reading(distance, spec, self.noise)
+        reported = spec.max_range if measured is None else measured
+        self._publish(
+            robot, "range", sensors.range_message(now, robot, spec, reported), sensors.RANGE
+        )
+        if measured is not None and spec.detects and measured <= spec.detect_distance:
+            self._detected(robot, {body}, spec.detects, now)
+
+    def _phantom(self, robot: SimRobot, camera, x: float, y: float, now: float) -> None:
+        """A false positive: detected (and announced) like an object, though nothing is there."""
+        self._phantoms += 1
+        name = f"phantom_{self._phantoms}"
+        self._publish(
+            robot, "detection", sensors.detection_message(now, robot, name, x, y), sensors.DETECTION
+        )
+        if camera.signal and camera.signal not in self.silent:
+            point = {"x": round(x, 4), "y": round(y, 4), "z": 0.0}
+            self.bus.publish(f"/{camera.signal}", point, msgtype=VECTOR3, sender=robot.name)
 
     def _announce(self, robot: SimRobot, bodies: set[int], camera) -> None:
         """The detector's signal, once per object this robot sees (the thesis' drone tells
@@ -233,6 +316,11 @@ class SimWorld:
             if math.hypot(thing.x - robot.pose.x, thing.y - robot.pose.y) <= reach:
                 thing.state, thing.done_by, thing.done_at = state, robot.name, now
                 self.physics.recolor(thing.body, color)
+
+    def position(self, name: str) -> tuple[float, float] | None:
+        """Where a robot is (for the network model's distances); None for anything else."""
+        robot = self.robots.get(name)
+        return None if robot is None else (robot.pose.x, robot.pose.y)
 
     # -- faults -----------------------------------------------------------------------------------
 
@@ -273,6 +361,10 @@ class SimWorld:
                 for t in things
             ],
             "counts": counts,
+            "collisions": [
+                {"after": _since(c.time, start), "robot": c.robot, "other": c.other}
+                for c in self.contacts.collisions
+            ],
             "robots_final": {
                 name: {
                     "x": round(r.pose.x, 4),

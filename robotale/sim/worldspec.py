@@ -27,6 +27,7 @@ from typing import Any
 import yaml
 
 from robotale.errors import InputError
+from robotale.fame_runtime.bus import Link, Network
 
 Range = tuple[float, float]
 
@@ -51,6 +52,9 @@ class CameraSpec:
     # a global signal the robot's detector publishes once per new object (``weed_found``),
     # as the thesis' drone does, unless a skill of the mission throws that signal itself
     signal: str = ""
+    detection: float = 1.0  # probability an object in view is detected, per frame, at 0 m
+    falloff: float = 0.0  # less probability per metre between the camera and the object
+    false_positives: float = 0.0  # phantom detections per second, anywhere in view
 
 
 @dataclass(frozen=True)
@@ -61,6 +65,8 @@ class RangeSpec:
     direction: str = "forward"  # forward | down
     detects: str = ""  # an object kind the sensor reports on the detection topic
     detect_distance: float = 1.5
+    noise: float = 0.0  # metres, standard deviation of a reading
+    dropout: float = 0.0  # probability a reading is lost (reported as max_range)
 
 
 @dataclass(frozen=True)
@@ -77,10 +83,16 @@ class RobotSpec:
     color: tuple[float, float, float, float] = (0.8, 0.1, 0.1, 1.0)
     blade: bool = False
     blade_radius: float = 0.5
+    # dynamics mode only (robotale.sim.dynamics): the body and its drive
+    mass: float = 20.0  # kg
+    max_force: float = 40.0  # N, the motors' forward force limit (braking too)
+    max_torque: float = 10.0  # N m, the yaw torque limit
+    friction: float = 0.8  # tyre grip: no more force than friction * mass * g
     led: bool = False
     camera: CameraSpec | None = None
     range: RangeSpec | None = None
     battery: BatterySpec = field(default_factory=BatterySpec)
+    odom_drift: float = 0.0  # metres of odometry error per square root of metre travelled
     spacing: tuple[float, float] = (0.0, 1.0)  # start offset between instances of a group
     start_jitter: float = 0.0  # metres, drawn per run
     variables: Mapping[str, Any] = field(default_factory=dict)
@@ -113,6 +125,17 @@ class ObjectsSpec:
 
 
 @dataclass(frozen=True)
+class ObstacleSpec:
+    """A fixed box robots collide with (in dynamics mode)."""
+
+    name: str
+    position: tuple[float, float]
+    size: tuple[float, float, float] = (1.0, 1.0, 0.5)
+    yaw: float = 0.0  # degrees
+    color: tuple[float, float, float, float] = (0.4, 0.4, 0.4, 1.0)
+
+
+@dataclass(frozen=True)
 class World:
     file: Path
     model: Path
@@ -124,6 +147,10 @@ class World:
     control_rate: float = 10.0
     record_rate: float = 2.0
     latency: float = 0.01
+    dynamics: bool = False  # ground robots with mass, forces and collisions (else kinematic)
+    physics_rate: float = 120.0  # physics steps a second in dynamics mode
+    obstacles: tuple[ObstacleSpec, ...] = ()
+    network: Network | None = None  # None: every message arrives after ``latency``
     start: float = dt.datetime.fromisoformat(DEFAULT_START).timestamp()
     variables: Mapping[str, Any] = field(default_factory=dict)
     faults: tuple[str, ...] = ()
@@ -210,6 +237,13 @@ class _Reader:
             control_rate=self.number(data.get("control_rate", 10.0), "control_rate", True),
             record_rate=self.number(data.get("record_rate", 2.0), "record_rate", positive=True),
             latency=self.number(data.get("latency", 0.01), "latency"),
+            dynamics=self.flag(data.get("dynamics", False), "dynamics"),
+            physics_rate=self.number(data.get("physics_rate", 120.0), "physics_rate", True),
+            network=self.network(data.get("network")),
+            obstacles=tuple(
+                self.obstacle(name, self.mapping(spec, f"obstacles.{name}"))
+                for name, spec in self.mapping(data.get("obstacles", {}), "obstacles").items()
+            ),
             start=self.start(data.get("start", DEFAULT_START)),
             variables=self.mapping(data.get("variables", {}), "variables"),
             faults=tuple(str(f) for f in self.sequence(data.get("faults", []), "faults")),
@@ -231,6 +265,49 @@ class _Reader:
         text = str(value)
         local = self.path.parent / text
         return str(local) if text.endswith(".py") and local.is_file() else text
+
+    def network(self, value: Any) -> Network | None:
+        """``network: {latency, jitter, loss, ..., links: {"a -> b": {...}}}``: the default
+        link, and links between named robots that differ from it."""
+        if value is None:
+            return None
+        data = dict(self.mapping(value, "network"))
+        links = self.mapping(data.pop("links", {}), "network.links")
+        default = self.link(data, "network", Link())
+        pairs = {}
+        for key, spec in links.items():
+            ends = [end.strip() for end in str(key).split("->")]
+            if len(ends) != 2 or not all(ends):
+                raise self.fail(f"network.links.{key}", "must be written 'sender -> receiver'")
+            where = f"network.links.{key}"
+            pairs[(ends[0], ends[1])] = self.link(self.mapping(spec, where), where, default)
+        return Network(default, pairs)
+
+    def link(self, data: Mapping[str, Any], where: str, defaults: Link) -> Link:
+        fields = Link.__dataclass_fields__
+        self.known(data, where, set(fields))
+        values = {
+            key: self.number(data.get(key, getattr(defaults, key)), f"{where}.{key}")
+            for key in fields
+        }
+        for key in ("loss", "loss_per_metre"):
+            if values[key] > 1:
+                raise self.fail(f"{where}.{key}", f"is {values[key]!r}; it must be at most 1")
+        return Link(**values)
+
+    def obstacle(self, name: str, data: Mapping[str, Any]) -> ObstacleSpec:
+        where = f"obstacles.{name}"
+        self.known(data, where, {"position", "size", "yaw", "color"})
+        size = self.triple(data.get("size", ObstacleSpec.size), f"{where}.size")
+        if min(size) <= 0:
+            raise self.fail(f"{where}.size", f"is {list(size)!r}; all three must be positive")
+        return ObstacleSpec(
+            name=name,
+            position=self.pair(data.get("position"), f"{where}.position"),
+            size=size,
+            yaw=float(self.numbers([data.get("yaw", 0.0)], f"{where}.yaw", 1)[0]),
+            color=self.color(data.get("color", ObstacleSpec.color), f"{where}.color"),
+        )
 
     def base(self, name: str, data: Mapping[str, Any]) -> BaseSpec:
         where = f"bases.{name}"
@@ -260,7 +337,17 @@ class _Reader:
         defaults = RobotSpec(name, kind, base)
         numbers = {
             key: self.number(data.get(key, getattr(defaults, key)), f"{where}.{key}", True)
-            for key in ("max_speed", "max_turn", "altitude", "climb", "blade_radius")
+            for key in (
+                "max_speed",
+                "max_turn",
+                "altitude",
+                "climb",
+                "blade_radius",
+                "mass",
+                "max_force",
+                "max_torque",
+                "friction",
+            )
         }
         return RobotSpec(
             name=name,
@@ -276,6 +363,7 @@ class _Reader:
             battery=self.battery(self.mapping(data.get("battery", {}), f"{where}.battery"), where),
             spacing=self.pair(data.get("spacing", defaults.spacing), f"{where}.spacing"),
             start_jitter=self.number(data.get("start_jitter", 0.0), f"{where}.start_jitter"),
+            odom_drift=self.number(data.get("odom_drift", 0.0), f"{where}.odom_drift"),
             variables=self.mapping(data.get("variables", {}), f"{where}.variables"),
             **numbers,
         )
@@ -284,12 +372,23 @@ class _Reader:
         if data is None:
             return None
         data = self.mapping(data, where)
-        self.known(data, where, {"fov", "detects", "signal"})
+        self.known(data, where, set(CameraSpec.__dataclass_fields__))
         return CameraSpec(
             fov=self.number(data.get("fov", 90.0), f"{where}.fov", positive=True),
             detects=str(data.get("detects", "weed")),
             signal=str(data.get("signal") or "").strip("/"),
+            detection=self.probability(data.get("detection", 1.0), f"{where}.detection"),
+            falloff=self.number(data.get("falloff", 0.0), f"{where}.falloff"),
+            false_positives=self.number(
+                data.get("false_positives", 0.0), f"{where}.false_positives"
+            ),
         )
+
+    def probability(self, value: Any, where: str) -> float:
+        number = self.number(value, where)
+        if number > 1:
+            raise self.fail(where, f"is {value!r}; a probability is at most 1")
+        return number
 
     def range_sensor(self, data: Any, where: str) -> RangeSpec | None:
         if data is None:
@@ -311,6 +410,8 @@ class _Reader:
             detect_distance=self.number(
                 data.get("detect_distance", 1.5), f"{where}.detect_distance", True
             ),
+            noise=self.number(data.get("noise", 0.0), f"{where}.noise"),
+            dropout=self.probability(data.get("dropout", 0.0), f"{where}.dropout"),
         )
 
     def battery(self, data: Mapping[str, Any], robot: str) -> BatterySpec:
@@ -376,6 +477,11 @@ class _Reader:
                 f"has unknown key {', '.join(map(repr, unknown))} "
                 f"(known: {', '.join(sorted(keys))})",
             )
+
+    def flag(self, value: Any, where: str) -> bool:
+        if not isinstance(value, bool):
+            raise self.fail(where, f"is {value!r}; it must be true or false")
+        return value
 
     def mapping(self, value: Any, where: str) -> Mapping[str, Any]:
         if value is None:
@@ -444,6 +550,10 @@ _WORLD_KEYS = {
     "control_rate",
     "record_rate",
     "latency",
+    "dynamics",
+    "physics_rate",
+    "obstacles",
+    "network",
     "start",
     "variables",
     "faults",
@@ -462,6 +572,11 @@ _ROBOT_KEYS = {
     "color",
     "blade",
     "blade_radius",
+    "mass",
+    "max_force",
+    "max_torque",
+    "friction",
+    "odom_drift",
     "led",
     "camera",
     "range",
