@@ -351,7 +351,8 @@ def message_answer(communication: Perspective) -> Answer:
 def _message_example(kind: str, row: pd.Series, communication: Perspective) -> str:
     where = f"{row['msg_id']} ({row['message_type']}) from {row['sender']} in run {row['case']}"
     if kind == "delayed":
-        return f"Delayed, for example: {where} reached {row['receiver']} after {row['latency']:.1f}s."
+        late = seconds_text(row["latency"])
+        return f"Delayed, for example: {where} reached {row['receiver']} after {late}."
     if kind == "resent":
         new = _value(row.get("resent_as"))
         how = f"under the new id {new}" if new else "under the same id"
@@ -412,4 +413,3 @@ def _sentence(text: str | None) -> str:
         return ""
     text = text[0].upper() + text[1:]
     return text if text.endswith((".", "!", "?")) else text + "."
-
