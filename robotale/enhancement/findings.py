@@ -15,12 +15,14 @@ overlap, the runs with a low-battery moment) is computed here.
 
 from __future__ import annotations
 
+from collections import Counter
 from dataclasses import dataclass, field
 from typing import Any
 
 import pandas as pd
 
 from robotale.discovery.graph import json_ready
+from robotale.enhancement.performance import ARROW
 from robotale.enhancement.report import all_perspectives
 from robotale.enhancement.result import Perspective
 from robotale.eventlog.schema import ROBOT, X, Y
@@ -115,11 +117,28 @@ def sequence_answer(performance: Perspective) -> Answer:
     )
     for _, other in variants.iloc[1:MAIN].iterrows():
         answer.sentences.append(
-            f"{int(other['cases'])} of {runs} runs ({other['share']:.0%}) follow "
-            f"{_path(other['variant'])} instead, in {seconds_text(other['median'])} (median)."
+            f"{int(other['cases'])} of {runs} runs ({other['share']:.0%}) differ from it: "
+            f"{variant_difference(top['variant'], other['variant'])}; they take "
+            f"{seconds_text(other['median'])} (median)."
         )
     answer.evidence.append({"kind": "runs", "label": "the runs and their variants"})
     return answer
+
+
+def variant_difference(common: str, other: str) -> str:
+    """What ``other`` does that ``common`` does not, and the reverse, counting repeats; the
+    same activities in another order when neither."""
+    mine, theirs = Counter(common.split(ARROW)), Counter(other.split(ARROW))
+    parts = [
+        f"{word} {_listed(extra)}"
+        for word, extra in (("with", theirs - mine), ("without", mine - theirs))
+        if extra
+    ]
+    return ", ".join(parts) if parts else "the same activities in another order"
+
+
+def _listed(counts: Counter) -> str:
+    return ", ".join(f"{name}" + (f" ×{n}" if n > 1 else "") for name, n in sorted(counts.items()))
 
 
 # -- 2. delays and bottlenecks -----------------------------------------------------------------
@@ -147,7 +166,7 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
         robot = _value(row.get("robot"))
         label = f"{row['activity']}" + (f" by {robot}" if robot else "")
         # a step between two activities is shown at the node it leads to
-        node = str(row["activity"]).split(" -> ")[-1]
+        node = str(row["activity"]).split(ARROW)[-1]
         answer.evidence.append({"kind": "node", "label": label, "activity": node, "robot": robot})
     slowest = _slowest_run(runs)
     if slowest is not None:
@@ -387,7 +406,7 @@ def _count(number: int, noun: str) -> str:
 
 
 def _path(variant: str, limit: int = 8) -> str:
-    steps = str(variant).split(" -> ")
+    steps = str(variant).split(ARROW)
     shown = " → ".join(steps[:limit])
     return shown + (f" … ({len(steps)} activities)" if len(steps) > limit else "")
 
