@@ -6,8 +6,9 @@ from the code under test):
 
 - **bottleneck**: in :data:`REFILL_RUNS` tractor_1 refills for :data:`REFILL_SECONDS` before it
   moves to the weed, and those runs end that much later (so they are also the second variant);
-- **delayed message**: in run :data:`DELAYED_RUN` the first weed position reaches tractor_1
-  after :data:`DELAYED_LATENCY` seconds instead of 1.5;
+- **delayed message**: in run :data:`DELAYED_RUN` the second weed position reaches tractor_1
+  after :data:`DELAYED_LATENCY` seconds instead of 1.5 (the last to tractor_1, so nothing
+  sent after it can pass for a resend);
 - **lost message**: in :data:`LOST_RUNS` the position for tractor_2 is lost and resent under
   a new id;
 - **low battery**: in :data:`LOW_BATTERY_RUNS` the drone raises a ``low_battery`` instant
@@ -72,8 +73,8 @@ def _run(truth: GroundTruth, case: str, begin: pd.Timestamp) -> None:
     instance("drone", "takeoff", 0, 5)
     instance("tractor_2", "wait", 1, 46)
     instance("drone", "explore", 6, 40)
-    message(1, "tractor_1", 20, 20 + late)
-    message(2, "tractor_1", 25, 26.5)
+    message(1, "tractor_1", 20, 21.5)
+    message(2, "tractor_1", 25, 25 + late)
     if case in LOST_RUNS:
         lost = message(3, "tractor_2", 30, None)
         message(4, "tractor_2", 44, 46.5, resend_of=lost)

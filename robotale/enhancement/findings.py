@@ -29,6 +29,8 @@ from robotale.eventlog.schema import ROBOT, X, Y
 
 #: how many variants and bottlenecks an answer names
 MAIN = 3
+#: a case-duration effect with a p-value at least this large may be chance
+ALPHA = 0.05
 
 
 @dataclass(slots=True)
@@ -149,10 +151,11 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
     if not bottlenecks.has_data:
         answer.sentences.append(_sentence(bottlenecks.message))
         return answer
-    ranking = bottlenecks.table.head(MAIN)
+    ranking = trusted_first(bottlenecks.table).head(MAIN)
     answer.facts["bottlenecks"] = [
         {
             "rank": int(row["rank"]),
+            "p_value": _value(row.get("p_value")),
             "kind": row["kind"],
             "activity": row["activity"],
             "robot": _value(row.get("robot")),
@@ -162,7 +165,7 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
         for _, row in ranking.iterrows()
     ]
     for _, row in ranking.iterrows():
-        answer.sentences.append(f"{int(row['rank'])}. {_sentence(row['explanation'])}")
+        answer.sentences.append(f"{row['rank']}. {_sentence(row['explanation'])}")
         robot = _value(row.get("robot"))
         label = f"{row['activity']}" + (f" by {robot}" if robot else "")
         # a step between two activities is shown at the node it leads to
@@ -180,6 +183,17 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
             f"Between activities the robots wait {share:.0%} of their time in the runs."
         )
     return answer
+
+
+def trusted_first(ranking: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
+    """The bottleneck ranking with the effects the runs do not show for certain (a p-value of
+    ``alpha`` or more: the runs with it may be longer by chance) after the others, each part
+    still by delay per case; ``rank`` numbers the new order."""
+    if ranking.empty or "p_value" not in ranking.columns:
+        return ranking
+    uncertain = pd.to_numeric(ranking["p_value"], errors="coerce").ge(alpha).to_numpy(bool)
+    ordered = pd.concat([ranking[~uncertain], ranking[uncertain]]).reset_index(drop=True)
+    return ordered.assign(rank=range(1, len(ordered) + 1))
 
 
 def _slowest_run(runs: pd.DataFrame) -> str | None:
