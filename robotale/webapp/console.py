@@ -3,7 +3,7 @@
 Every statement runs in a transaction opened in Neo4j's READ access mode, so the server itself
 refuses anything that would write (nodes, relationships, indexes, ``IN TRANSACTIONS`` batches):
 nothing the console runs can change the graph. Values come in as parameters, never pasted into
-the text. The examples are the files of ``cypher/``, the queries robotale itself runs.
+the text. The examples are the analyst's questions among the files of ``cypher/``.
 """
 
 from __future__ import annotations
@@ -141,11 +141,16 @@ def _path_elements(path: Path) -> list[Node | Relationship]:
     return elements
 
 
+#: the files of ``cypher/`` that ask an analyst's questions of an EKG; robotale's own queries
+#: (which build and read the graph) stay there but are not offered as examples
+EXAMPLE_PREFIX = "ask_"
+
+
 def examples() -> list[Example]:
-    """The files of ``cypher/``, each with its leading comment as description."""
+    """The analyst's queries of ``cypher/``, each with its leading comment as description."""
     found = []
     for resource in sorted(files("robotale.cypher").iterdir(), key=lambda r: r.name):
-        if not resource.name.endswith(".cypher"):
+        if not (resource.name.startswith(EXAMPLE_PREFIX) and resource.name.endswith(".cypher")):
             continue
         text = resource.read_text(encoding="utf-8")
         comment = []

@@ -60,7 +60,8 @@ def upload():
     mapping = parse_mapping(pairs)
     uploads.remove_stale(settings().upload_dir)
     saved = uploads.save(file.stream, file.filename, settings().upload_dir)
-    pending = pending_logs().add(saved, mapping)
+    case_gap = request.form.get("case_gap", "").strip() or None
+    pending = pending_logs().add(saved, mapping, case_gap)
     limit = settings().upload_limit_mb * 1024 * 1024
     models = state().models
     job = jobs().submit(
@@ -85,6 +86,7 @@ def choose(token: str):
         filename=pending.upload.filename,
         name=pending.upload.suggested_name,
         events=len(pending.log),
+        reading=pending.reading,
         columns=ingest.columns(pending.log),
         **context,
     )

@@ -26,7 +26,7 @@ def page():
     context = pages.context("model.page")
     store = state().models
     log = context["log"]
-    robots = log_robots(driver(), log) if log else []
+    robots = sorted(log_robots(driver(), log)) if log else []
     models = _offered(store, log, robots) if log else store.all()
     chosen = request.args.get("model") or (models[0].id if models else "")
     return render_template(

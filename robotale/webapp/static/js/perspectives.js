@@ -35,6 +35,15 @@
     return [];
   }
 
+  // A figure whose traces hold no point would be empty axes (a flat line at 0, say): the
+  // summary says what is missing instead.
+  function hasPoints(figure) {
+    return (figure.data || []).some((trace) => ["x", "y", "z", "lat", "values"].some((axis) => {
+      const values = trace[axis];
+      return values !== undefined && values !== null && (!Array.isArray(values) || values.length > 0);
+    }));
+  }
+
   async function showOne(article, focus) {
     const name = article.dataset.name;
     const summary = article.querySelector(".summary");
@@ -49,7 +58,7 @@
         : robotalePerspective.summaryText(result.summary);
       article.querySelector(".highlights").replaceChildren(...highlights(name, result));
       figures.replaceChildren();
-      for (const figure of Object.values(result.figures)) {
+      for (const figure of Object.values(result.figures).filter(hasPoints)) {
         const box = robotale.el("div", { class: "figure" });
         figures.append(box);
         await robotalePerspective.plot(box, figure);
