@@ -1,5 +1,6 @@
 // The messages of log $log that were sent and never received (no COMM edge from any of their
-// events), and the next $following activities their sender started after sending them.
+// events), and the next $following (default 3) activities their sender started after sending
+// them.
 MATCH (s:Event {log: $log})
 WHERE s.msg_id IS NOT NULL AND s.activity ENDS WITH '!'
 WITH s.case AS run, s.msg_id AS message, s.activity AS activity, s.robot AS sender,
@@ -14,7 +15,7 @@ CALL (run, sender, sent) {
   WHERE n.case = run AND n.timestamp > sent
     AND coalesce(n.lifecycle, 'none') <> 'complete'
     AND coalesce(n.state, 'none') <> 'inprogress'
-  WITH n ORDER BY n.timestamp, n.order LIMIT $following
+  WITH n ORDER BY n.timestamp, n.order LIMIT coalesce($following, 3)
   RETURN collect(n.activity) AS then
 }
 RETURN run, message, activity, sender, toString(sent) AS sent, then

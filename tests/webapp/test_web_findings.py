@@ -162,3 +162,82 @@ def test_a_log_without_battery_or_model_says_so(page, stranger_log):
     expect(page.locator("#model-none")).to_contain_text("No stored model has pools that bind")
     expect(page.locator("#model-none")).to_contain_text(robots)
     expect(page.locator("#model-picker option")).to_have_text(["none binds this log"])
+
+
+# -- the console's analyst questions -----------------------------------------------------------
+
+
+def _ask(driver, name: str, **parameters) -> pd.DataFrame:
+    from robotale.webapp import console
+
+    example = next(e for e in console.examples() if e.name == name)
+    result = console.run_read_only(driver, example.text, parameters)[-1]
+    return pd.DataFrame(result.rows, columns=result.columns)
+
+
+def test_the_console_offers_only_the_analysts_questions(client):
+    from robotale.webapp import console
+
+    names = [e.name for e in console.examples()]
+    assert names == [
+        "ask_concurrent_activities",
+        "ask_lost_messages",
+        "ask_robot_path",
+        "ask_slowest_steps",
+    ]
+    page = client.get("/cypher").get_data(as_text=True)
+    assert 'data-name="ekg_delete_log"' not in page and 'data-name="ask_robot_path"' in page
+
+
+def test_a_robots_path_in_one_run(neo4j_driver, mission_log):
+    table = TRUTH.instance_table()
+    mine = table[(table["robot"] == "tractor_1") & (table["case"] == "run02")]
+    rows = _ask(neo4j_driver, "ask_robot_path", log=mission_log, robot="tractor_1", case="run02")
+    assert rows["activity"].tolist() == mine.sort_values("start")["activity"].tolist()
+
+
+def test_lost_messages_and_what_followed(neo4j_driver, mission_log):
+    rows = _ask(neo4j_driver, "ask_lost_messages", log=mission_log, following=2)
+    table = TRUTH.instance_table()
+    expected = []
+    for message in TRUTH.messages:
+        if message.received is None:
+            later = table[
+                (table["case"] == message.case)
+                & (table["robot"] == message.sender)
+                & (table["start"] > message.sent)
+            ]
+            expected.append((message.msg_id, later.sort_values("start")["activity"][:2].tolist()))
+    assert list(zip(rows["message"], rows["then"], strict=True)) == expected
+
+
+def test_activities_two_robots_did_at_once(neo4j_driver, mission_log):
+    rows = _ask(
+        neo4j_driver, "ask_concurrent_activities", log=mission_log, robot="drone", other="tractor_2"
+    )
+    table = TRUTH.instance_table()
+    spans = table[table["seconds"] > 0]
+    pairs = spans[spans["robot"] == "drone"].merge(
+        spans[spans["robot"] == "tractor_2"], on="case", suffixes=("", "_other")
+    )
+    begins = pairs[["start", "start_other"]].max(axis=1)
+    ends = pairs[["end", "end_other"]].min(axis=1)
+    overlapping = pairs[begins < ends]
+    seconds = (ends - begins)[begins < ends].dt.total_seconds()
+    assert len(rows) == len(overlapping)
+    assert sorted(rows["seconds"]) == sorted(seconds.astype(int))
+    assert set(zip(rows["activity"], rows["other_activity"], strict=True)) == set(
+        zip(overlapping["activity"], overlapping["activity_other"], strict=True)
+    )
+
+
+def test_slowest_steps_stay_within_a_run(neo4j_driver, mission_log):
+    rows = _ask(neo4j_driver, "ask_slowest_steps", log=mission_log, top=None, classType=None)
+    assert len(rows) == 10
+    # the runs are three hours apart: no step between two of them is among the slowest
+    assert rows["median_seconds"].max() < 3 * 3600
+    first = rows.iloc[0]
+    # tractor_1's refill: from its start to its completion, REFILL_SECONDS in every refill run
+    assert (first["source"], first["target"]) == ("refill|tractor_1", "refill|tractor_1")
+    assert first["median_seconds"] == mission.REFILL_SECONDS
+    assert first["count"] == len(mission.REFILL_RUNS)
