@@ -62,6 +62,7 @@
       runsBox.hidden = !data.runs.length;
       status.textContent = `Log ${log}`;
       box.dataset.state = "shown";
+      performance.mark("robotale-findings-shown");
     } catch (error) {
       status.textContent = "";
       box.dataset.state = "failed";
