@@ -9,8 +9,8 @@
 Each :class:`Answer` holds its sentences, the numbers behind them (``facts``) and the evidence a
 reader can open: a node of the process graph (``node``: activity and robot), the runs
 (``runs``) and one run's timeline (``timeline``). The numbers come from the perspectives
-(:func:`all_perspectives`), computed once; what they do not give (the robots' areas and their
-overlap, the runs with a low-battery moment) is computed here.
+(performance, bottlenecks, battery, communication), each computed once; what they do not give
+(the robots' areas and their overlap, the runs with a low-battery moment) is computed here.
 """
 
 from __future__ import annotations
@@ -22,8 +22,10 @@ from typing import Any
 import pandas as pd
 
 from robotale.discovery.graph import json_ready
-from robotale.enhancement.performance import ARROW
-from robotale.enhancement.report import all_perspectives
+from robotale.enhancement.battery import battery_perspective
+from robotale.enhancement.bottlenecks import find_bottlenecks
+from robotale.enhancement.communication import communication_perspective
+from robotale.enhancement.performance import ARROW, performance_perspective
 from robotale.enhancement.result import Perspective
 from robotale.eventlog.schema import ROBOT, X, Y
 
@@ -79,7 +81,13 @@ class Findings:
 def find(log: pd.DataFrame, *, threshold: float = 20.0) -> Findings:
     """The answers to the five questions for ``log`` (``threshold``: the battery level, in
     percent, below which a robot's battery counts as low)."""
-    perspectives = all_perspectives(log, threshold=threshold)
+    # the spatial perspective's figures are not needed: the areas are two numbers per robot
+    perspectives = {
+        "performance": performance_perspective(log),
+        "bottlenecks": find_bottlenecks(log),
+        "battery": battery_perspective(log, threshold=threshold),
+        "communication": communication_perspective(log),
+    }
     performance = perspectives["performance"]
     runs = performance.tables.get("cases", pd.DataFrame(columns=["case", "duration"]))
     answers = [

@@ -13,22 +13,19 @@ import pandas as pd
 from robotale.discovery.graph import json_ready
 from robotale.discovery.output import write_texts
 from robotale.enhancement.findings import Answer, Findings
-from robotale.enhancement.timeline import case_timeline, timeline_figure
+from robotale.enhancement.timeline import Timeline, case_timeline, timeline_figure
 
 
-def findings_dict(findings: Findings, log: pd.DataFrame, title: str) -> dict[str, Any]:
-    """The answers, and the timelines' data (not their figures) of the runs they point at."""
-    timelines = [case_timeline(log, case) for case in findings.timeline_cases()]
+def findings_dict(findings: Findings, timelines: list[Timeline], title: str) -> dict[str, Any]:
+    """The answers, and the counts of the timelines of the runs they point at."""
     return json_ready(
-        {
-            "title": title,
-            **findings.to_dict(),
-            "timelines": [
-                {key: value for key, value in t.to_dict().items() if key != "figure"}
-                for t in timelines
-            ],
-        }
+        {"title": title, **findings.to_dict(), "timelines": [t.counts() for t in timelines]}
     )
+
+
+def timelines_of(findings: Findings, log: pd.DataFrame) -> list[Timeline]:
+    """The timelines of the runs the answers point at."""
+    return [case_timeline(log, case) for case in findings.timeline_cases()]
 
 
 def findings_text(findings: Findings) -> str:
@@ -40,19 +37,18 @@ def findings_text(findings: Findings) -> str:
     return "\n\n".join(blocks)
 
 
-def findings_html(findings: Findings, log: pd.DataFrame, title: str) -> str:
+def findings_html(findings: Findings, timelines: list[Timeline], title: str) -> str:
     """One page that works offline: plotly's script inlined once, before the first timeline."""
     answers = "".join(_answer_html(answer) for answer in findings.answers)
     figures = []
-    for number, case in enumerate(findings.timeline_cases()):
-        figure = timeline_figure(case_timeline(log, case))
-        plotted = figure.to_html(full_html=False, include_plotlyjs=number == 0)
-        figures.append(f"<section id='{_anchor(case)}'>{plotted}</section>")
-    timelines = "<h2>Timelines</h2>" + "".join(figures) if figures else ""
+    for number, timeline in enumerate(timelines):
+        plotted = timeline_figure(timeline).to_html(full_html=False, include_plotlyjs=number == 0)
+        figures.append(f"<section id='{_anchor(timeline.case)}'>{plotted}</section>")
+    shown = "<h2>Timelines</h2>" + "".join(figures) if figures else ""
     return (
         "<!DOCTYPE html><html><head><meta charset='utf-8'>"
         f"<title>{html.escape(title)}</title><style>{_STYLE}</style></head>"
-        f"<body><h1>{html.escape(title)}</h1>{answers}{timelines}</body></html>"
+        f"<body><h1>{html.escape(title)}</h1>{answers}{shown}</body></html>"
     )
 
 
@@ -66,10 +62,11 @@ def write_findings(
 ) -> None:
     """Write the HTML page and/or JSON file; either both appear complete or neither does."""
     outputs = []
+    timelines = timelines_of(findings, log) if html_path or json_path else []
     if html_path is not None:
-        outputs.append((Path(html_path), findings_html(findings, log, title)))
+        outputs.append((Path(html_path), findings_html(findings, timelines, title)))
     if json_path is not None:
-        data = findings_dict(findings, log, title)
+        data = findings_dict(findings, timelines, title)
         outputs.append((Path(json_path), json.dumps(data, ensure_ascii=False, indent=1)))
     write_texts(outputs)
 

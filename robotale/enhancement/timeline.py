@@ -43,7 +43,8 @@ class Timeline:
     def lost(self) -> int:
         return int(self.messages["lost"].sum()) if not self.messages.empty else 0
 
-    def to_dict(self) -> dict[str, Any]:
+    def counts(self) -> dict[str, Any]:
+        """The run, its robots and how many bars, messages, lost ones and battery readings."""
         return {
             "case": self.case,
             "robots": self.robots,
@@ -51,8 +52,10 @@ class Timeline:
             "messages": len(self.messages),
             "lost": self.lost,
             "battery_samples": len(self.battery),
-            "figure": json.loads(timeline_figure(self).to_json()),
         }
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**self.counts(), "figure": json.loads(timeline_figure(self).to_json())}
 
 
 def run_list(log: pd.DataFrame) -> pd.DataFrame:

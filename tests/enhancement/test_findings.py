@@ -11,7 +11,12 @@ import pandas as pd
 import pytest
 
 from robotale.enhancement.findings import area_overlaps, find, robot_areas, seconds_text
-from robotale.enhancement.findings_report import findings_dict, findings_html, findings_text
+from robotale.enhancement.findings_report import (
+    findings_dict,
+    findings_html,
+    findings_text,
+    timelines_of,
+)
 from robotale.eventlog.readers import read_log
 
 TRUTH = mission.injected_truth()
@@ -153,10 +158,11 @@ def test_messages(logged):
 
 def test_report_outputs_carry_the_same_sentences(logged):
     log, findings = logged
-    data = findings_dict(findings, log, "t")
+    timelines = timelines_of(findings, log)
+    data = findings_dict(findings, timelines, "t")
     json.dumps(data)
     text = findings_text(findings)
-    page = findings_html(findings, log, "t")
+    page = findings_html(findings, timelines, "t")
     for answer in data["answers"]:
         for sentence in answer["sentences"]:
             assert sentence in text
