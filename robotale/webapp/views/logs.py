@@ -17,6 +17,7 @@ from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
 from robotale.webapp import ingest, pages, uploads
+from robotale.webapp.findings_data import stored_findings
 from robotale.webapp.jobs import Jobs
 from robotale.webapp.settings import WebSettings
 from robotale.webapp.state import driver, state
@@ -103,10 +104,13 @@ def start_ingest(token: str):
     pending.log = log
     pending_logs().pop(token)
     replace = request.form.get("replace") == "on"
-    connected, models, logs = driver(), state().models, state().logs
+    connected, models, logs, findings = driver(), state().models, state().logs, state().findings
 
     def work(job):
-        return ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
+        stored = ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
+        job.step("answering the analyst's questions")
+        stored_findings(connected, logs, findings, name)  # the Findings page, ready
+        return stored
 
     job = jobs().submit(f"Storing {name}", work)
     return redirect(url_for("logs.job_page", job_id=job.id, log=name))
@@ -130,5 +134,6 @@ def delete():
     require_log(driver(), name, "the Logs page lists those stored")
     delete_log(driver(), name)
     state().logs.forget(name)
+    state().findings.forget(name)
     flash(f"Deleted the log {name!r}.", "success")
     return redirect(url_for("logs.page"))
