@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 from flask import (
     Blueprint,
     abort,
@@ -108,8 +110,11 @@ def start_ingest(token: str):
 
     def work(job):
         stored = ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
-        job.step("answering the analyst's questions")
-        stored_findings(connected, logs, findings, name)  # the Findings page, ready
+        # the Findings page's answers, prepared while the user reads that the log is stored
+        # (a visit before they are ready waits for this one computation)
+        threading.Thread(
+            target=stored_findings, args=(connected, logs, findings, name), daemon=True
+        ).start()
         return stored
 
     job = jobs().submit(f"Storing {name}", work)
