@@ -44,6 +44,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_demo(commands)
     _add_discover(commands)
     _add_perspectives(commands)
+    _add_report(commands)
     return parser
 
 
@@ -633,6 +634,29 @@ def _add_perspectives(commands: argparse._SubParsersAction) -> None:
         help="battery level counted as low (default: 20)",
     )
     _handled_by(perspectives, "perspectives.perspectives_command")
+
+
+def _add_report(commands: argparse._SubParsersAction) -> None:
+    report = commands.add_parser(
+        "report",
+        help="what happened and why: sequence, delays, robots, battery, messages",
+        description="Answer an analyst's five questions about a log (its typical sequence "
+        "and variants, the bottlenecks, where each robot worked, whether battery mattered, "
+        "which messages were delayed, lost or resent) in plain sentences; also as HTML with "
+        "the runs' timelines (works offline) and/or JSON.",
+    )
+    _add_log_source(report, stored=True)
+    report.add_argument("--out", type=Path, metavar="HTML", help="write the report as HTML")
+    report.add_argument(
+        "--json", dest="json_out", type=Path, metavar="JSON", help="write the report as JSON"
+    )
+    report.add_argument(
+        "--threshold",
+        type=float,
+        metavar="PERCENT",
+        help="battery level counted as low (default: 20)",
+    )
+    _handled_by(report, "report.report_command")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -11,7 +11,16 @@ from flask_wtf.csrf import CSRFProtect
 from robotale import __version__
 from robotale.webapp import defences, errors, pages, state, uploads
 from robotale.webapp.settings import WebSettings
-from robotale.webapp.views import assets, console, discover, logs, model, perspectives
+from robotale.webapp.views import (
+    assets,
+    console,
+    discover,
+    findings,
+    logs,
+    model,
+    perspectives,
+    timeline,
+)
 
 
 def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
@@ -45,5 +54,5 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
 
 
 def _register_blueprints(app: Flask) -> None:
-    for module in (assets, logs, discover, perspectives, model, console):
+    for module in (assets, logs, findings, discover, perspectives, timeline, model, console):
         app.register_blueprint(module.blueprint)

@@ -4,7 +4,7 @@ The checks and the running are :mod:`robotale.ekg.readonly`'s (text, plan, READ 
 bounded answer). Here the console picks its Neo4j user and runs each request in a child
 process whose memory is capped (``console_memory_mb``), so that no answer can grow the
 dashboard itself. Values come in as parameters, never pasted into the text. The examples are
-the files of ``cypher/``, the queries robotale itself runs.
+the analyst's questions among the files of ``cypher/`` (``ask_*``).
 
 Its user: ``ROBOTALE_CONSOLE_USER`` and ``ROBOTALE_CONSOLE_PASSWORD`` when set; otherwise, on
 robotale's local server, a user of its own that the server creates (``robotale_console``);
@@ -144,11 +144,16 @@ def _too_large(web: WebSettings) -> str:
     )
 
 
+#: the files of ``cypher/`` that ask an analyst's questions of an EKG; robotale's own queries
+#: (which build and read the graph) stay there but are not offered as examples
+EXAMPLE_PREFIX = "ask_"
+
+
 def examples() -> list[Example]:
-    """The files of ``cypher/``, each with its leading comment as description."""
+    """The analyst's queries of ``cypher/``, each with its leading comment as description."""
     found = []
     for resource in sorted(files("robotale.cypher").iterdir(), key=lambda r: r.name):
-        if not resource.name.endswith(".cypher"):
+        if not (resource.name.startswith(EXAMPLE_PREFIX) and resource.name.endswith(".cypher")):
             continue
         text = resource.read_text(encoding="utf-8")
         comment = []

@@ -25,7 +25,8 @@ from robotale.ekg.logs import stored_events
 from robotale.errors import InputError, RobotaleError
 from robotale.eventlog import schema
 from robotale.eventlog.prepare import find_runs, prepare
-from robotale.eventlog.readers import read_log
+from robotale.eventlog.readers import read_log_with_reading
+from robotale.eventlog.reading import format_reading
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.sim import scenarios
 from robotale.webapp import uploads
@@ -47,6 +48,10 @@ class Pending:
     log: pd.DataFrame | None = None
     model_id: str | None = None
     created: float = field(default_factory=time.time)
+    #: without a case column, a new case after every pause this long ("1h", "90s")
+    case_gap: str | None = None
+    #: how the file was read (``format_reading``), for the column-choice page
+    reading: str = ""
 
 
 @dataclass(frozen=True)
@@ -68,8 +73,10 @@ class PendingLogs:
         self._items: dict[str, Pending] = {}
         self._lock = threading.Lock()
 
-    def add(self, upload: uploads.Upload, mapping: dict[str, str]) -> Pending:
-        pending = Pending(upload, mapping)
+    def add(
+        self, upload: uploads.Upload, mapping: dict[str, str], case_gap: str | None = None
+    ) -> Pending:
+        pending = Pending(upload, mapping, case_gap=case_gap)
         with self._lock:
             self._forget_stale()
             self._items[upload.token] = pending
@@ -101,7 +108,11 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
         if upload.kind == "zip":
             pending.log, pending.model_id = _read_bags(upload, limit_bytes, models, job)
         else:
-            pending.log = read_log(upload.path, mapping=pending.mapping)
+            pending.log, reading = read_log_with_reading(
+                upload.path, mapping=pending.mapping, case_gap=pending.case_gap
+            )
+            # the reading names our stored copy; the user knows the file by its own name
+            pending.reading = format_reading(reading).replace(str(upload.path), upload.filename)
     except RobotaleError as error:
         # The message names our stored copy; the user knows the file by its own name.
         raise type(error)(str(error).replace(str(upload.path), repr(upload.filename))) from None

@@ -21,10 +21,11 @@ def text(response) -> str:
     return html.unescape(response.get_data(as_text=True))
 
 
-def upload(client, name: str, data: bytes, mapping: str = ""):
+def upload(client, name: str, data: bytes, mapping: str = "", case_gap: str = ""):
+    form = {"csrf_token": client.csrf, "file": (io.BytesIO(data), name), "mapping": mapping}
     return client.post(
         "/logs/upload",
-        data={"csrf_token": client.csrf, "file": (io.BytesIO(data), name), "mapping": mapping},
+        data={**form, "case_gap": case_gap},
         content_type="multipart/form-data",
     )
 
@@ -41,9 +42,11 @@ def wait(client, job_id: str, seen: list | None = None, timeout: float = 300) ->
     raise AssertionError(f"job {job_id} did not finish in {timeout} s")
 
 
-def read_step(client, name: str, data: bytes, mapping: str = "") -> tuple[str, str]:
+def read_step(
+    client, name: str, data: bytes, mapping: str = "", case_gap: str = ""
+) -> tuple[str, str]:
     """Upload and wait until it is read: the upload's token and the column page."""
-    response = upload(client, name, data, mapping)
+    response = upload(client, name, data, mapping, case_gap)
     assert response.status_code == 302, text(response)
     token, job_id = re.search(r"/logs/upload/(\w+)\?job=(\w+)", response.location).groups()
     job = wait(client, job_id)
@@ -272,3 +275,25 @@ def test_a_zipped_bag_folder_is_prepared_and_linked_to_its_mission(
     model_id = re.search(r'data-model="(\w+)"', model_page).group(1)
     # stored and served re-serialised without web content (test_web_security.py)
     assert client.get(f"/api/models/{model_id}.bpmn").data == sanitised(agri)
+
+
+def test_the_reading_is_shown_and_the_findings_are_ready_once_stored(
+    client, app, web_settings, thesis_csv, log_name
+):
+    import pandas as pd
+
+    from robotale.webapp.state import state
+
+    token, page = read_step(client, "robotic_data.csv", thesis_csv.read_bytes(), case_gap="1h")
+    days = pd.to_datetime(pd.read_csv(thesis_csv)["time"]).dt.date.nunique()
+    assert "How the file was read" in page
+    assert f"{days} cases" in page
+    assert str(web_settings.upload_dir) not in page  # the user's file name, not our copy's
+    job, _ = ingest(client, token, {"name": log_name, "entity": ["robot", "msg_id"]})
+    assert job["error"] is None, job["error"]
+    deadline = time.monotonic() + 300
+    while not [key for key in state(app).findings.items if key[0] == log_name]:
+        assert time.monotonic() < deadline, "the findings were not prepared after storing"
+        time.sleep(0.1)  # prepared without anyone asking
+    findings = client.get(f"/api/findings?log={log_name}").json
+    assert findings["answers"][0]["facts"]["runs"] == days

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+
 from flask import (
     Blueprint,
     abort,
@@ -17,6 +19,7 @@ from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
 from robotale.webapp import ingest, pages, uploads
+from robotale.webapp.findings_data import stored_findings
 from robotale.webapp.jobs import Jobs
 from robotale.webapp.settings import WebSettings
 from robotale.webapp.state import driver, state
@@ -60,7 +63,8 @@ def upload():
     mapping = parse_mapping(pairs)
     uploads.remove_stale(settings().upload_dir)
     saved = uploads.save(file.stream, file.filename, settings().upload_dir)
-    pending = pending_logs().add(saved, mapping)
+    case_gap = request.form.get("case_gap", "").strip() or None
+    pending = pending_logs().add(saved, mapping, case_gap)
     limit = settings().upload_limit_mb * 1024 * 1024
     models = state().models
     job = jobs().submit(
@@ -85,6 +89,7 @@ def choose(token: str):
         filename=pending.upload.filename,
         name=pending.upload.suggested_name,
         events=len(pending.log),
+        reading=pending.reading,
         columns=ingest.columns(pending.log),
         **context,
     )
@@ -101,10 +106,16 @@ def start_ingest(token: str):
     pending.log = log
     pending_logs().pop(token)
     replace = request.form.get("replace") == "on"
-    connected, models, logs = driver(), state().models, state().logs
+    connected, models, logs, findings = driver(), state().models, state().logs, state().findings
 
     def work(job):
-        return ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
+        stored = ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
+        # the Findings page's answers, prepared while the user reads that the log is stored
+        # (a visit before they are ready waits for this one computation)
+        threading.Thread(
+            target=stored_findings, args=(connected, logs, findings, name), daemon=True
+        ).start()
+        return stored
 
     job = jobs().submit(f"Storing {name}", work)
     return redirect(url_for("logs.job_page", job_id=job.id, log=name))
@@ -128,5 +139,6 @@ def delete():
     require_log(driver(), name, "the Logs page lists those stored")
     delete_log(driver(), name)
     state().logs.forget(name)
+    state().findings.forget(name)
     flash(f"Deleted the log {name!r}.", "success")
     return redirect(url_for("logs.page"))

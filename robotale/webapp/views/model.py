@@ -10,9 +10,12 @@ import pandas as pd
 from flask import Blueprint, Response, jsonify, redirect, render_template, request, url_for
 
 from robotale.ekg.logs import log_robots
-from robotale.errors import InputError
+from robotale.errors import InputError, ModelError
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.splitter import split
 from robotale.webapp import overlay, pages
 from robotale.webapp.logdata import log_info
+from robotale.webapp.model_store import ModelStore, StoredModel
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("model", __name__)
@@ -22,15 +25,38 @@ blueprint = Blueprint("model", __name__)
 def page():
     context = pages.context("model.page")
     store = state().models
-    models = store.all()
-    chosen = request.args.get("model") or ""
-    if not chosen and context["log"]:
-        log = context["log"]
-        found = store.linked(log) or store.matching(log_robots(driver(), log))
-        chosen = found.id if found else ""
-    if not chosen and models:
-        chosen = models[0].id
-    return render_template("model.html", models=models, model=chosen, **context)
+    log = context["log"]
+    robots = sorted(log_robots(driver(), log)) if log else []
+    models = _offered(store, log, robots) if log else store.all()
+    chosen = request.args.get("model") or (models[0].id if models else "")
+    return render_template(
+        "model.html",
+        models=models,
+        model=chosen,
+        robots=robots,
+        none_binds=bool(log) and not models,
+        **context,
+    )
+
+
+def _offered(store: ModelStore, log: str, robots: list[str]) -> list[StoredModel]:
+    """The model linked to ``log`` first, then every stored model whose pools bind all of the
+    log's robots (none when the log names no robot)."""
+    linked = store.linked(log)
+    offered = [linked] if linked else []
+    if robots:
+        others = [m for m in store.all() if m.id != getattr(linked, "id", None)]
+        offered += [m for m in others if _binds(m, robots)]
+    return offered
+
+
+def _binds(model: StoredModel, robots: list[str]) -> bool:
+    """Whether the splitter binds every one of ``robots`` to a pool of ``model``."""
+    try:
+        split(parse(model.path), robots)
+    except ModelError:
+        return False
+    return True
 
 
 @blueprint.post("/model")

@@ -51,8 +51,10 @@
     document.getElementById("job-log").textContent = job.result.log;
     document.getElementById("job-events").textContent = job.result.events;
     document.getElementById("job-seconds").textContent = job.result.seconds;
-    const link = document.getElementById("discover-link");
-    if (link) link.href = `/discover?log=${encodeURIComponent(job.result.log)}`;
+    for (const [id, page] of [["findings-link", "findings"], ["discover-link", "discover"]]) {
+      const link = document.getElementById(id);
+      if (link) link.href = `/${page}?log=${encodeURIComponent(job.result.log)}`;
+    }
     document.getElementById("job-done").hidden = false;
     localStorage.setItem("robotale.log", job.result.log);
     box.dataset.state = "done";

@@ -14,6 +14,36 @@
     return activity ? { activity, robot: robot || null } : null;
   }
 
+  function sentence(text) {
+    return text.charAt(0).toUpperCase() + text.slice(1);
+  }
+
+  // What an analyst looks for first, shown open: the bottleneck ranking in words and the
+  // variants (the rest stays in the tables below).
+  function highlights(name, result) {
+    const tables = result.tables || {};
+    if (name === "bottlenecks" && tables.bottlenecks) {
+      const items = tables.bottlenecks.slice(0, 10).map((row) => robotale.el("li", { text: sentence(row.explanation) }));
+      return [robotale.el("ol", { class: "ranking" }, ...items)];
+    }
+    if (name === "performance" && tables.variants && tables.variants.length) {
+      const columns = ["cases", "share", "median", "activities", "variant"];
+      const rows = tables.variants.slice(0, 10).map((row) => columns.map((c) =>
+        (c === "share" ? `${Math.round(row.share * 100)}%` : row[c])));
+      return [robotale.el("h3", { text: "variants" }), robotale.table(columns, rows)];
+    }
+    return [];
+  }
+
+  // A figure whose traces hold no point would be empty axes (a flat line at 0, say): the
+  // summary says what is missing instead.
+  function hasPoints(figure) {
+    return (figure.data || []).some((trace) => ["x", "y", "z", "lat", "values"].some((axis) => {
+      const values = trace[axis];
+      return values !== undefined && values !== null && (!Array.isArray(values) || values.length > 0);
+    }));
+  }
+
   async function showOne(article, focus) {
     const name = article.dataset.name;
     const summary = article.querySelector(".summary");
@@ -23,9 +53,12 @@
     article.dataset.state = "loading";
     try {
       const result = await robotalePerspective.load(log, name, focus);
-      summary.textContent = result.message || robotalePerspective.summaryText(result.summary);
+      summary.textContent = result.message
+        ? sentence(result.message)
+        : robotalePerspective.summaryText(result.summary);
+      article.querySelector(".highlights").replaceChildren(...highlights(name, result));
       figures.replaceChildren();
-      for (const figure of Object.values(result.figures)) {
+      for (const figure of Object.values(result.figures).filter(hasPoints)) {
         const box = robotale.el("div", { class: "figure" });
         figures.append(box);
         await robotalePerspective.plot(box, figure);

@@ -1,0 +1,177 @@
+"""How long the whole findings report takes, against pm4py doing the same work, and how soon
+the dashboard's Findings page shows it.
+
+    python benchmarks/report.py [--sizes 10000 100000 1000000] [--stored 10000 100000 1000000]
+                                [--page 10000 100000] [--repeat 3]
+
+The logs are the thesis' five runs repeated as further runs (the mission's real shape) until
+they have the given number of events. For each size, in the same run:
+
+- *pm4py*: its discovery and performance functions on the same DataFrame (DFG, performance
+  DFG, variants, case durations): the work the report's first two answers rest on;
+- *findings*: ``robotale.enhancement.findings.find`` on that DataFrame (all five answers:
+  variants, bottlenecks with their effect on the runs, robots' work, battery, messages);
+  target: within 2x of pm4py's time;
+- *report from a file*: ``robotale report LOG.csv --out --json`` as the command does it (read
+  the CSV, the findings, the timelines, the HTML and JSON written);
+- *report from a stored log*: the same with ``--log NAME`` (the log read back from Neo4j),
+  for the ``--stored`` sizes, in a private Neo4j (see ``ekg_build.py``).
+
+With ``--page`` sizes, the dashboard serves those stored logs and headless Chromium (Debian's,
+driven by Playwright) opens ``/findings?log=...``: the first paint of the findings runs from
+the start of the navigation to the page's ``robotale-findings-shown`` mark, cold (the
+dashboard's caches of the log emptied first: a log stored by the command line) and warm (as
+after the dashboard stored the log: it prepares the findings while storing). Targets: under
+1 s at 10,000 events and under 3 s at 100,000.
+"""
+
+from __future__ import annotations
+
+import argparse
+import contextlib
+import io
+import logging
+import statistics
+import sys
+import tempfile
+import time
+import warnings
+from pathlib import Path
+
+BENCHMARKS = Path(__file__).resolve().parent
+sys.path.insert(0, str(BENCHMARKS))
+
+from dashboard import store, thesis_runs  # noqa: E402
+from discovery import pm4py_performance  # noqa: E402
+from ekg_build import private_neo4j  # noqa: E402
+
+PAGE_TARGETS = {10_000: 1.0, 100_000: 3.0}
+SHOWN = "performance.getEntriesByName('robotale-findings-shown').length > 0"
+MARK = "performance.getEntriesByName('robotale-findings-shown')[0].startTime"
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000, 1_000_000])
+    parser.add_argument("--stored", type=int, nargs="*", default=[10_000, 100_000, 1_000_000])
+    parser.add_argument("--page", type=int, nargs="*", default=[10_000, 100_000])
+    parser.add_argument("--repeat", type=int, default=3, help="page loads per log (median)")
+    parser.add_argument("--heap", default="2g", help="heap of the private Neo4j (2g)")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")
+    warm_up()
+    with tempfile.TemporaryDirectory(prefix="robotale-bench-report-") as scratch:
+        for size in args.sizes:
+            measure_file(size, Path(scratch))
+        if args.stored or args.page:
+            with private_neo4j(args.heap) as driver:
+                stored = {}
+                for size in sorted(set(args.stored) | set(args.page)):
+                    stored[size] = store(driver, f"bench_report_{size}", thesis_runs(size))[0]
+                for size in args.stored:
+                    measure_stored(size, stored[size], Path(scratch))
+                if args.page:
+                    measure_pages({size: stored[size] for size in args.page}, args.repeat)
+    return 0
+
+
+def warm_up() -> None:
+    """Imports and first calls stay out of the figures."""
+    from robotale.enhancement.findings import find
+
+    small = thesis_runs(2_000)
+    find(small)
+    pm4py_performance(small)
+
+
+def timed(function, *args, **kwargs) -> float:
+    began = time.perf_counter()
+    function(*args, **kwargs)
+    return time.perf_counter() - began
+
+
+def quietly(function, *args, **kwargs) -> None:
+    """A command's printed findings and reading stay out of the benchmark's output."""
+    with contextlib.redirect_stdout(io.StringIO()), contextlib.redirect_stderr(io.StringIO()):
+        function(*args, **kwargs)
+
+
+def measure_file(size: int, folder: Path) -> None:
+    from robotale.commands.report import report_command
+    from robotale.enhancement.findings import find
+    from robotale.eventlog.writers import write_csv
+
+    log = thesis_runs(size)
+    path = folder / f"runs_{size}.csv"
+    write_csv(log, path)
+    theirs = timed(pm4py_performance, log)
+    ours = timed(find, log)
+    command = timed(
+        quietly, report_command, path, out=folder / "report.html", json_out=folder / "r.json"
+    )
+    verdict = "met" if ours <= 2 * theirs else "MISSED"
+    print(f"== {len(log):,} events, {log['case:concept:name'].nunique():,} runs")
+    print(f"  pm4py dfg + performance dfg + variants + durations  {theirs:7.2f} s")
+    print(f"  robotale findings (five answers)                    {ours:7.2f} s  "
+          f"{ours / theirs:.2f}x pm4py (target <= 2x: {verdict})")  # fmt: skip
+    print(f"  robotale report FILE.csv --out --json               {command:7.2f} s")
+
+
+def measure_stored(size: int, name: str, folder: Path) -> None:
+    from robotale.commands.report import report_command
+
+    seconds = timed(quietly, report_command, log_name=name, json_out=folder / "stored.json")
+    print(f"  robotale report --log (stored, {size:,} events)       {seconds:7.2f} s")
+
+
+def measure_pages(logs: dict[int, str], repeat: int) -> None:
+    from playwright.sync_api import sync_playwright
+
+    from robotale.webapp import create_app
+    from robotale.webapp.serve import Dashboard
+
+    sys.path.insert(0, str(BENCHMARKS.parent / "tests" / "webapp"))
+    from browser import launch
+
+    with tempfile.TemporaryDirectory(prefix="robotale-bench-web-") as scratch:
+        folder = Path(scratch)
+        app = create_app(upload_dir=folder / "uploads", model_dir=folder / "models")
+        logging.getLogger("werkzeug").setLevel(logging.WARNING)
+        with Dashboard(app, port=0) as dashboard, sync_playwright() as playwright:
+            context = launch(playwright, folder / "profile")
+            page = context.new_page()
+            page.goto(f"{dashboard.url}/cypher")  # the browser's cache of the scripts
+            for size, name in logs.items():
+                target = PAGE_TARGETS.get(size)
+                for cold in (True, False):
+                    seconds = first_paint(page, dashboard, name, repeat, cold)
+                    verdict = (
+                        f"target < {target:.0f} s: {'met' if seconds < target else 'MISSED'}"
+                        if target
+                        else "no target"
+                    )
+                    print(f"{size:>9,} events: Findings page first paint {seconds:.2f} s "
+                          f"({'cold' if cold else 'warm'}; {verdict})")  # fmt: skip
+            context.close()
+
+
+def first_paint(page, dashboard, log: str, repeat: int, cold: bool) -> float:
+    """Median seconds from navigation start to the findings on screen; ``cold``: with the
+    dashboard's caches of the log emptied first (a log stored by the command line), else as
+    after the dashboard stored it (it prepares the findings while storing)."""
+    from robotale.webapp.state import state
+
+    timings = []
+    for _ in range(repeat):
+        current = state(dashboard.app)
+        if cold:
+            current.logs.forget(log)
+            current.findings.forget(log)
+        page.goto(f"{dashboard.url}/findings?log={log}")
+        page.wait_for_function(SHOWN, timeout=600_000)
+        timings.append(page.evaluate(MARK) / 1000)
+    return statistics.median(timings)
+
+
+if __name__ == "__main__":
+    sys.exit(main())

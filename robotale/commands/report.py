@@ -1,0 +1,34 @@
+"""``robotale report``: the answers to an analyst's five questions about a log, printed, and
+as HTML (with the runs' timelines) and/or JSON."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from pathlib import Path
+
+from robotale.commands.logsource import read_event_log
+from robotale.enhancement.findings import find
+from robotale.enhancement.findings_report import findings_text, write_findings
+
+
+def report_command(
+    log: Path | None = None,
+    *,
+    log_name: str | None = None,
+    mapping: Sequence[str] = (),
+    case_column: str | None = None,
+    case_gap: str | None = None,
+    out: Path | None = None,
+    json_out: Path | None = None,
+    threshold: float | None = None,
+) -> int:
+    """The findings of a log (a file or ``log_name``): printed, and written to ``out`` (HTML)
+    and/or ``json_out``."""
+    events = read_event_log(
+        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
+    )
+    findings = find(events) if threshold is None else find(events, threshold=threshold)
+    title = f"robotale findings: {log_name or Path(log or '').name}"
+    write_findings(findings, events, html_path=out, json_path=json_out, title=title)
+    print(findings_text(findings))
+    return 0

@@ -1,0 +1,456 @@
+"""The five questions an analyst of a robot mission asks, answered in plain sentences.
+
+1. What is the typical sequence, and its main variants?
+2. What delayed the runs (the bottlenecks, ranked by how much longer they make a run)?
+3. Where did each robot work, and where do robots overlap?
+4. Did battery affect the mission?
+5. Which messages were delayed, lost or resent (one example each)?
+
+Each :class:`Answer` holds its sentences, the numbers behind them (``facts``) and the evidence a
+reader can open: a node of the process graph (``node``: activity and robot), the runs
+(``runs``) and one run's timeline (``timeline``). The numbers come from the perspectives
+(performance, bottlenecks, battery, communication), each computed once; what they do not give
+(the robots' areas and their overlap, the runs with a low-battery moment) is computed here.
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass, field
+from typing import Any
+
+import pandas as pd
+
+from robotale.discovery.graph import json_ready
+from robotale.enhancement.battery import battery_perspective
+from robotale.enhancement.bottlenecks import find_bottlenecks
+from robotale.enhancement.communication import communication_perspective
+from robotale.enhancement.performance import ARROW, performance_perspective
+from robotale.enhancement.result import Perspective
+from robotale.eventlog.schema import ROBOT, X, Y
+
+#: how many variants and bottlenecks an answer names
+MAIN = 3
+#: a case-duration effect with a p-value at least this large may be chance
+ALPHA = 0.05
+
+
+@dataclass(slots=True)
+class Answer:
+    key: str
+    question: str
+    sentences: list[str] = field(default_factory=list)
+    facts: dict[str, Any] = field(default_factory=dict)
+    evidence: list[dict[str, Any]] = field(default_factory=list)
+
+    def to_dict(self) -> dict[str, Any]:
+        return json_ready(
+            {
+                "key": self.key,
+                "question": self.question,
+                "sentences": self.sentences,
+                "facts": self.facts,
+                "evidence": self.evidence,
+            }
+        )
+
+
+@dataclass(slots=True)
+class Findings:
+    answers: list[Answer]
+    perspectives: dict[str, Perspective]
+    runs: pd.DataFrame
+
+    def answer(self, key: str) -> Answer:
+        return next(a for a in self.answers if a.key == key)
+
+    def timeline_cases(self, limit: int = 4) -> list[str]:
+        """The runs the evidence points at, then the longest run: the timelines worth
+        drawing."""
+        cases: list[str] = []
+        for answer in self.answers:
+            cases += [e["case"] for e in answer.evidence if e["kind"] == "timeline"]
+        if not self.runs.empty:
+            cases.append(str(self.runs.sort_values("duration").iloc[-1]["case"]))
+        return list(dict.fromkeys(cases))[:limit]
+
+    def to_dict(self) -> dict[str, Any]:
+        return {"answers": [a.to_dict() for a in self.answers]}
+
+
+def find(log: pd.DataFrame, *, threshold: float = 20.0) -> Findings:
+    """The answers to the five questions for ``log`` (``threshold``: the battery level, in
+    percent, below which a robot's battery counts as low)."""
+    # the spatial perspective's figures are not needed: the areas are two numbers per robot
+    perspectives = {
+        "performance": performance_perspective(log),
+        "bottlenecks": find_bottlenecks(log),
+        "battery": battery_perspective(log, threshold=threshold),
+        "communication": communication_perspective(log),
+    }
+    performance = perspectives["performance"]
+    runs = performance.tables.get("cases", pd.DataFrame(columns=["case", "duration"]))
+    answers = [
+        sequence_answer(performance),
+        delay_answer(perspectives["bottlenecks"], performance, runs),
+        robot_answer(log, performance),
+        battery_answer(perspectives["battery"], runs),
+        message_answer(perspectives["communication"]),
+    ]
+    return Findings(answers, perspectives, runs)
+
+
+# -- 1. the typical sequence -------------------------------------------------------------------
+
+
+def sequence_answer(performance: Perspective) -> Answer:
+    answer = Answer("sequence", "What is the typical sequence, and its main variants?")
+    if not performance.has_data:
+        answer.sentences.append(_sentence(performance.message))
+        return answer
+    variants = performance.tables["variants"]
+    runs = int(performance.summary["cases"])
+    top = variants.iloc[0]
+    answer.facts = {
+        "runs": runs,
+        "variants": len(variants),
+        "main": [
+            {"variant": v["variant"], "runs": int(v["cases"]), "share": float(v["share"])}
+            for _, v in variants.head(MAIN).iterrows()
+        ],
+        "median_duration": float(performance.summary["case_duration_median"]),
+    }
+    answer.sentences.append(
+        f"{_count(runs, 'run')} follow {_count(len(variants), 'variant')}; "
+        f"the most common ({int(top['cases'])} of {runs}, {top['share']:.0%}) is "
+        f"{_path(top['variant'])}, and takes {seconds_text(top['median'])} (median)."
+    )
+    for _, other in variants.iloc[1:MAIN].iterrows():
+        answer.sentences.append(
+            f"{int(other['cases'])} of {runs} runs ({other['share']:.0%}) differ from it: "
+            f"{variant_difference(top['variant'], other['variant'])}; they take "
+            f"{seconds_text(other['median'])} (median)."
+        )
+    answer.evidence.append({"kind": "runs", "label": "the runs and their variants"})
+    return answer
+
+
+def variant_difference(common: str, other: str) -> str:
+    """What ``other`` does that ``common`` does not, and the reverse, counting repeats; the
+    same activities in another order when neither."""
+    mine, theirs = Counter(common.split(ARROW)), Counter(other.split(ARROW))
+    parts = [
+        f"{word} {_listed(extra)}"
+        for word, extra in (("with", theirs - mine), ("without", mine - theirs))
+        if extra
+    ]
+    return ", ".join(parts) if parts else "the same activities in another order"
+
+
+def _listed(counts: Counter) -> str:
+    return ", ".join(f"{name}" + (f" ×{n}" if n > 1 else "") for name, n in sorted(counts.items()))
+
+
+# -- 2. delays and bottlenecks -----------------------------------------------------------------
+
+
+def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.DataFrame) -> Answer:
+    answer = Answer("delays", "What delayed the runs, and where are the bottlenecks?")
+    if not bottlenecks.has_data:
+        answer.sentences.append(_sentence(bottlenecks.message))
+        return answer
+    ranking = trusted_first(bottlenecks.table).head(MAIN)
+    answer.facts["bottlenecks"] = [
+        {
+            "rank": int(row["rank"]),
+            "p_value": _value(row.get("p_value")),
+            "kind": row["kind"],
+            "activity": row["activity"],
+            "robot": _value(row.get("robot")),
+            "delay_per_case": float(row["delay_per_case"]),
+            "runs": int(row["cases"]),
+        }
+        for _, row in ranking.iterrows()
+    ]
+    for _, row in ranking.iterrows():
+        answer.sentences.append(f"{row['rank']}. {_sentence(row['explanation'])}")
+        robot = _value(row.get("robot"))
+        label = f"{row['activity']}" + (f" by {robot}" if robot else "")
+        # a step between two activities is shown at the node it leads to
+        node = str(row["activity"]).split(ARROW)[-1]
+        answer.evidence.append({"kind": "node", "label": label, "activity": node, "robot": robot})
+    slowest = _slowest_run(runs)
+    if slowest is not None:
+        answer.evidence.append(
+            {"kind": "timeline", "label": f"the slowest run, {slowest}", "case": slowest}
+        )
+    share = performance.summary.get("waiting_share") if performance.has_data else None
+    if share is not None:
+        answer.facts["waiting_share"] = float(share)
+        answer.sentences.append(
+            f"Between activities the robots wait {share:.0%} of their time in the runs."
+        )
+    return answer
+
+
+def trusted_first(ranking: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
+    """The bottleneck ranking with the effects the runs do not show for certain (a p-value of
+    ``alpha`` or more: the runs with it may be longer by chance) after the others, each part
+    still by delay per case; ``rank`` numbers the new order."""
+    if ranking.empty or "p_value" not in ranking.columns:
+        return ranking
+    uncertain = pd.to_numeric(ranking["p_value"], errors="coerce").ge(alpha).to_numpy(bool)
+    ordered = pd.concat([ranking[~uncertain], ranking[uncertain]]).reset_index(drop=True)
+    return ordered.assign(rank=range(1, len(ordered) + 1))
+
+
+def _slowest_run(runs: pd.DataFrame) -> str | None:
+    if runs.empty:
+        return None
+    return str(runs.loc[runs["duration"].idxmax(), "case"])
+
+
+# -- 3. where each robot worked ----------------------------------------------------------------
+
+
+def robot_answer(log: pd.DataFrame, performance: Perspective) -> Answer:
+    answer = Answer("robots", "Where did each robot work, and where do robots overlap?")
+    if ROBOT not in log.columns:
+        answer.sentences.append("The log does not say which robot did what (no robot column).")
+        return answer
+    work = _robot_work(performance)
+    areas = robot_areas(log)
+    answer.facts["robots"] = work
+    for robot in work:
+        area = areas.get(robot["robot"])
+        where = f" in x {_span(area['x'])}, y {_span(area['y'])}" if area else ""
+        robot["area"] = area
+        answer.sentences.append(
+            f"{robot['robot']} worked {seconds_text(robot['working'])} in "
+            f"{_count(robot['runs'], 'run')}{where}, most of it on {robot['main_activity']}."
+        )
+    if X not in log.columns or Y not in log.columns:
+        answer.sentences.append("The log has no positions, so where robots overlap is unknown.")
+        return answer
+    overlaps = area_overlaps(areas)
+    answer.facts["overlaps"] = overlaps
+    if not overlaps:
+        answer.sentences.append("No two robots' working areas overlap.")
+    for overlap in overlaps:
+        answer.sentences.append(
+            f"{overlap['robots'][0]} and {overlap['robots'][1]} share the area x "
+            f"{_span(overlap['x'])}, y {_span(overlap['y'])}."
+        )
+    return answer
+
+
+def _robot_work(performance: Perspective) -> list[dict[str, Any]]:
+    """Per robot: working seconds, runs, and the activity it spent most time on."""
+    if not performance.has_data:
+        return []
+    robots = performance.tables["robots"]
+    activities = performance.tables["activities"]
+    main = activities.sort_values("total", ascending=False, kind="stable").drop_duplicates("robot")
+    main = main.set_index("robot")["activity"]
+    grouped = robots.groupby("robot", sort=True).agg(
+        working=("working", "sum"), runs=("case", "nunique")
+    )
+    return [
+        {
+            "robot": str(robot),
+            "working": float(row["working"]),
+            "runs": int(row["runs"]),
+            "main_activity": str(main.get(robot, "")),
+        }
+        for robot, row in grouped.iterrows()
+    ]
+
+
+def robot_areas(log: pd.DataFrame) -> dict[str, dict[str, list[float]]]:
+    """Per robot, the box (x and y ranges) its positions span."""
+    if X not in log.columns or Y not in log.columns or ROBOT not in log.columns:
+        return {}
+    placed = log[[ROBOT, X, Y]].dropna()
+    if placed.empty:
+        return {}
+    box = placed.groupby(placed[ROBOT].astype(str))[[X, Y]].agg(["min", "max"])
+    return {
+        str(robot): {
+            "x": [float(row[(X, "min")]), float(row[(X, "max")])],
+            "y": [float(row[(Y, "min")]), float(row[(Y, "max")])],
+        }
+        for robot, row in box.iterrows()
+    }
+
+
+def area_overlaps(areas: dict[str, dict[str, list[float]]]) -> list[dict[str, Any]]:
+    """Every pair of robots whose boxes intersect, with the intersection."""
+    names = sorted(areas)
+    overlaps = []
+    for i, first in enumerate(names):
+        for second in names[i + 1 :]:
+            shared = {
+                axis: [
+                    max(areas[first][axis][0], areas[second][axis][0]),
+                    min(areas[first][axis][1], areas[second][axis][1]),
+                ]
+                for axis in ("x", "y")
+            }
+            if all(low <= high for low, high in shared.values()):
+                overlaps.append({"robots": [first, second], **shared})
+    return overlaps
+
+
+# -- 4. battery --------------------------------------------------------------------------------
+
+
+def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
+    answer = Answer("battery", "Did battery affect the mission?")
+    if not battery.has_data:
+        answer.sentences.append(_sentence(battery.message))
+        return answer
+    summary = battery.summary
+    lows = battery.tables.get("low_battery", pd.DataFrame())
+    energy = summary.get("energy_per_case_mean")
+    answer.facts = {
+        "low_battery_events": int(summary.get("low_battery_events", 0)),
+        "energy_per_run": None if energy is None else float(energy),
+        "most_used_by": summary.get("most_used_by"),
+    }
+    if energy is not None:
+        answer.sentences.append(
+            f"The robots used {energy:.1f}% of battery per run on average, most of it on "
+            f"{summary.get('most_used_by')}."
+        )
+    if lows.empty:
+        answer.sentences.append(
+            f"No robot's battery ran low (below {summary.get('threshold', 20):g}%), so battery "
+            "did not hold the mission back."
+        )
+        return answer
+    affected = sorted(lows["case"].astype(str).unique()) if "case" in lows else []
+    answer.facts["runs_with_low_battery"] = len(affected)
+    first = lows.iloc[0]
+    answer.sentences.append(
+        f"{_count(len(lows), 'low-battery moment')} in {len(affected)} of {len(runs)} runs; "
+        f"the first: {first['robot']} in run {first['case']} at {_clock(first['time'])}"
+        + (f", after which it did {first['then']}." if _value(first.get("then")) else ".")
+    )
+    answer.sentences.append(_low_battery_effect(runs, affected, answer.facts))
+    answer.evidence.append(
+        {"kind": "timeline", "label": f"run {first['case']}", "case": str(first["case"])}
+    )
+    return answer
+
+
+def _low_battery_effect(runs: pd.DataFrame, affected: list[str], facts: dict) -> str:
+    """How much longer the runs with a low-battery moment took than the others (median)."""
+    durations = runs.set_index(runs["case"].astype(str))["duration"]
+    hit = durations[durations.index.isin(affected)]
+    calm = durations[~durations.index.isin(affected)]
+    if hit.empty or calm.empty:
+        return "Every run had a low-battery moment, so there is no run without one to compare."
+    longer = float(hit.median() - calm.median())
+    facts["longer_by"] = longer
+    if longer <= 0:
+        return "The runs with a low-battery moment were not slower than the others (median)."
+    return (
+        f"Those runs took {seconds_text(longer)} longer than the others (median "
+        f"{seconds_text(hit.median())} against {seconds_text(calm.median())})."
+    )
+
+
+# -- 5. messages -------------------------------------------------------------------------------
+
+
+def message_answer(communication: Perspective) -> Answer:
+    answer = Answer("messages", "Which messages were delayed, lost or resent?")
+    if not communication.has_data:
+        answer.sentences.append(_sentence(communication.message))
+        return answer
+    summary = communication.summary
+    messages = communication.tables["messages"]
+    keys = ("messages", "received", "lost", "delayed", "resends", "resends_new_id", "recovered")
+    answer.facts = {key: int(summary.get(key, 0)) for key in keys}
+    answer.sentences.append(
+        f"{_count(summary['messages'], 'message')} sent: {summary['received']} received, "
+        f"{summary['lost']} lost, {summary.get('delayed', 0)} delayed, "
+        f"{_count(summary['resends'], 'resend')} "
+        f"({summary.get('resends_new_id', 0)} under a new id)."
+    )
+    for kind, rows in (
+        ("delayed", messages[messages["delayed"]]),
+        ("lost", messages[messages["lost"]]),
+        ("resent", messages[messages["resends"] > 0]),
+    ):
+        if not rows.empty:
+            answer.sentences.append(_message_example(kind, rows.iloc[0], communication))
+            answer.evidence.append(_timeline(rows.iloc[0], f"the {kind} message"))
+    return answer
+
+
+def _message_example(kind: str, row: pd.Series, communication: Perspective) -> str:
+    where = f"{row['msg_id']} ({row['message_type']}) from {row['sender']} in run {row['case']}"
+    if kind == "delayed":
+        late = seconds_text(row["latency"])
+        return f"Delayed, for example: {where} reached {row['receiver']} after {late}."
+    if kind == "resent":
+        new = _value(row.get("resent_as"))
+        how = f"under the new id {new}" if new else "under the same id"
+        return f"Resent, for example: {where}, {how}."
+    lost = communication.tables.get("lost", pd.DataFrame())
+    then = lost.loc[lost["msg_id"] == row["msg_id"], "then"] if "then" in lost else pd.Series()
+    followed = f"; then the sender did {then.iloc[0]}" if len(then) and _value(then.iloc[0]) else ""
+    return f"Lost, for example: {where}, sent at {_clock(row['sent_at'])}{followed}."
+
+
+def _timeline(row: pd.Series, label: str) -> dict[str, Any]:
+    return {"kind": "timeline", "label": f"{label}, run {row['case']}", "case": str(row["case"])}
+
+
+# -- wording -----------------------------------------------------------------------------------
+
+
+def seconds_text(seconds: float) -> str:
+    """A duration the way a person says it: 42.0s, 3.5 min, 2.1 h."""
+    if seconds is None or pd.isna(seconds):
+        return "an unknown time"
+    seconds = float(seconds)
+    if abs(seconds) < 120:
+        return f"{seconds:.1f}s"
+    if abs(seconds) < 7200:
+        return f"{seconds / 60:.1f} min"
+    return f"{seconds / 3600:.1f} h"
+
+
+def _count(number: int, noun: str) -> str:
+    return f"{int(number)} {noun}{'' if int(number) == 1 else 's'}"
+
+
+def _path(variant: str, limit: int = 8) -> str:
+    steps = str(variant).split(ARROW)
+    shown = " → ".join(steps[:limit])
+    return shown + (f" … ({len(steps)} activities)" if len(steps) > limit else "")
+
+
+def _span(bounds: list[float]) -> str:
+    return f"{bounds[0]:.1f}–{bounds[1]:.1f}"
+
+
+def _clock(time: Any) -> str:
+    return pd.Timestamp(time).strftime("%Y-%m-%d %H:%M:%S") if not pd.isna(time) else "?"
+
+
+def _value(value: Any) -> Any:
+    """None for a missing value (NaN, NA, None, an empty string)."""
+    if value is None or (pd.api.types.is_scalar(value) and pd.isna(value)):
+        return None
+    return None if isinstance(value, str) and not value else value
+
+
+def _sentence(text: str | None) -> str:
+    text = (text or "").strip()
+    if not text:
+        return ""
+    text = text[0].upper() + text[1:]
+    return text if text.endswith((".", "!", "?")) else text + "."

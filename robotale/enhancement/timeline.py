@@ -1,0 +1,218 @@
+"""One run at a glance: a lane per robot with its activity instances as bars, the messages
+between robots as arrows from sender to receiver (a lost message marked where it was sent) and
+each robot's battery as a line.
+
+The figure is plain plotly JSON, so the HTML report embeds it and the dashboard draws the same
+thing from a JSON endpoint.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from typing import Any
+
+import pandas as pd
+import plotly.graph_objects as go
+
+from robotale.discovery.instances import START_TIMESTAMP
+from robotale.enhancement.communication import message_table
+from robotale.enhancement.performance import case_durations, finished_instances
+from robotale.errors import InputError
+from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, MSG_ID, ROBOT, TIMESTAMP
+
+#: the lane of events whose robot the log does not name
+NO_ROBOT = "(no robot)"
+LOST_COLOUR = "#d62728"
+MESSAGE_COLOUR = "#555555"
+
+
+@dataclass(slots=True)
+class Timeline:
+    """The data of one run's timeline: ``bars`` (robot, activity, start, end, seconds),
+    ``messages`` (msg_id, sender, receiver, sent, received, lost, delayed) and ``battery``
+    (robot, time, level)."""
+
+    case: str
+    robots: list[str]
+    bars: pd.DataFrame
+    messages: pd.DataFrame
+    battery: pd.DataFrame
+
+    @property
+    def lost(self) -> int:
+        return int(self.messages["lost"].sum()) if not self.messages.empty else 0
+
+    def counts(self) -> dict[str, Any]:
+        """The run, its robots and how many bars, messages, lost ones and battery readings."""
+        return {
+            "case": self.case,
+            "robots": self.robots,
+            "bars": len(self.bars),
+            "messages": len(self.messages),
+            "lost": self.lost,
+            "battery_samples": len(self.battery),
+        }
+
+    def to_dict(self) -> dict[str, Any]:
+        return {**self.counts(), "figure": json.loads(timeline_figure(self).to_json())}
+
+
+def run_list(log: pd.DataFrame) -> pd.DataFrame:
+    """The runs of ``log`` with their start, end and duration, in start order."""
+    instances = finished_instances(log)
+    if instances.empty:
+        return pd.DataFrame(columns=["case", "start", "end", "duration"])
+    runs = case_durations(instances)[[CASE, "start", "end", "duration"]]
+    return runs.sort_values("start", kind="stable").rename(columns={CASE: "case"})
+
+
+def case_timeline(log: pd.DataFrame, case: str) -> Timeline:
+    """The timeline of run ``case`` of ``log`` (an :class:`InputError` naming the runs there
+    are when it has no such run)."""
+    cases = log[CASE].astype("string")
+    events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
+    if events.empty:
+        known = ", ".join(sorted(cases.dropna().unique())[:5])
+        raise InputError(f"the log has no run {case!r}; its runs include {known}.")
+    events = events.assign(**{ROBOT: _robots(events)})
+    bars = _bars(events)
+    messages = _messages(events)
+    battery = _battery(events)
+    robots = sorted(set(bars["robot"]) | set(battery["robot"]) | _message_robots(messages))
+    return Timeline(str(case), robots, bars, messages, battery)
+
+
+def _robots(events: pd.DataFrame) -> pd.Series:
+    if ROBOT not in events.columns:
+        return pd.Series(NO_ROBOT, index=events.index)
+    return events[ROBOT].astype("string").fillna(NO_ROBOT)
+
+
+def _bars(events: pd.DataFrame) -> pd.DataFrame:
+    instances = finished_instances(events)
+    bars = pd.DataFrame(
+        {
+            "robot": instances[ROBOT].astype(str),
+            "activity": instances[ACTIVITY].astype(str),
+            "start": instances[START_TIMESTAMP],
+            "end": instances[TIMESTAMP],
+        }
+    )
+    bars["seconds"] = (bars["end"] - bars["start"]).dt.total_seconds()
+    return bars.sort_values(["start", "robot"], kind="stable").reset_index(drop=True)
+
+
+def _messages(events: pd.DataFrame) -> pd.DataFrame:
+    columns = ["msg_id", "sender", "receiver", "sent", "received", "lost", "delayed"]
+    table = message_table(events)
+    if table.empty:
+        return pd.DataFrame(columns=columns)
+    named = table.drop(columns=["sent", "received"])
+    named = named.rename(columns={"sent_at": "sent", "received_at": "received", MSG_ID: "msg_id"})
+    return named[columns].sort_values("sent", kind="stable").reset_index(drop=True)
+
+
+def _message_robots(messages: pd.DataFrame) -> set[str]:
+    ends = pd.concat([messages["sender"], messages["receiver"]]).dropna().astype(str)
+    # a receiver list ("a, b") or an unknown receiver is no lane of its own
+    return {robot for robot in ends if robot != "unknown" and ", " not in robot}
+
+
+def _battery(events: pd.DataFrame) -> pd.DataFrame:
+    if BATTERY not in events.columns:
+        return pd.DataFrame(columns=["robot", "time", "level"])
+    levels = pd.to_numeric(events[BATTERY], errors="coerce")
+    known = levels.notna().to_numpy(bool)
+    table = pd.DataFrame(
+        {
+            "robot": events.loc[known, ROBOT].astype(str),
+            "time": events.loc[known, TIMESTAMP],
+            "level": levels[known],
+        }
+    )
+    return table.sort_values(["robot", "time"], kind="stable").reset_index(drop=True)
+
+
+def timeline_figure(timeline: Timeline) -> go.Figure:
+    """Lanes (robots) on the left axis, battery (%) on the right one, time along."""
+    figure = go.Figure()
+    for activity, bars in timeline.bars.groupby("activity", sort=True):
+        figure.add_trace(_bar_trace(str(activity), bars))
+    if not timeline.messages.empty:
+        figure.add_traces(_message_traces(timeline.messages, set(timeline.robots)))
+    for robot, levels in timeline.battery.groupby("robot", sort=True):
+        figure.add_trace(
+            go.Scatter(
+                x=levels["time"],
+                y=levels["level"],
+                yaxis="y2",
+                mode="lines",
+                name=f"battery {robot}",
+                line={"width": 1, "dash": "dot"},
+            )
+        )
+    figure.update_layout(
+        title=f"run {timeline.case}",
+        barmode="overlay",
+        height=max(260, 90 * len(timeline.robots) + 120),
+        yaxis={"categoryorder": "array", "categoryarray": timeline.robots, "title": "robot"},
+        yaxis2={"overlaying": "y", "side": "right", "range": [0, 105], "title": "battery %"},
+        xaxis={"type": "date", "title": "time"},
+        legend={"orientation": "h", "y": -0.2},
+    )
+    if timeline.battery.empty:
+        figure.update_layout(yaxis2={"visible": False})
+    return figure
+
+
+def _bar_trace(activity: str, bars: pd.DataFrame) -> go.Bar:
+    milliseconds = (bars["seconds"] * 1000).clip(lower=200)  # an instant stays visible
+    return go.Bar(
+        base=bars["start"],
+        x=milliseconds,
+        y=bars["robot"],
+        orientation="h",
+        name=activity,
+        text=[activity] * len(bars),
+        textposition="inside",
+        insidetextanchor="start",
+        customdata=bars["seconds"],
+        hovertemplate=f"{activity}<br>%{{base}}<br>%{{customdata:.1f}} s<extra></extra>",
+        opacity=0.75,
+    )
+
+
+def _message_traces(messages: pd.DataFrame, lanes: set[str]) -> list[go.Scatter]:
+    """One line per delivered message (ending in an arrow head at the receiver) and a cross on
+    the sender's lane for each lost one."""
+    delivered = messages[~messages["lost"] & messages["receiver"].isin(lanes)]
+    xs: list = []
+    ys: list = []
+    for row in delivered.itertuples(index=False):
+        xs += [row.sent, row.received, None]
+        ys += [row.sender, row.receiver, None]
+    traces = [
+        go.Scatter(
+            x=xs,
+            y=ys,
+            mode="lines+markers",
+            name="message",
+            line={"color": MESSAGE_COLOUR, "width": 1},
+            marker={"symbol": "arrow", "angleref": "previous", "size": 10},
+            hoverinfo="skip",
+        )
+    ]
+    lost = messages[messages["lost"]]
+    traces.append(
+        go.Scatter(
+            x=lost["sent"],
+            y=lost["sender"],
+            mode="markers",
+            name="lost message",
+            marker={"symbol": "x", "size": 12, "color": LOST_COLOUR},
+            text=lost["msg_id"],
+            hovertemplate="lost message %{text}<extra></extra>",
+        )
+    )
+    return traces

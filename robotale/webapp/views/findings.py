@@ -1,0 +1,25 @@
+"""The Findings page, the first after a log is stored: the answers to an analyst's five
+questions with links to their evidence (the graph node on the Perspectives page, the runs, a
+run's timeline)."""
+
+from __future__ import annotations
+
+from flask import Blueprint, jsonify, render_template, request
+
+from robotale.webapp import pages
+from robotale.webapp.findings_data import stored_findings
+from robotale.webapp.state import driver, state
+
+blueprint = Blueprint("findings", __name__)
+
+
+@blueprint.get("/findings")
+def page():
+    return render_template("findings.html", **pages.context("findings.page"))
+
+
+@blueprint.get("/api/findings")
+def findings():
+    current = state()
+    name = request.args.get("log", "")
+    return jsonify(stored_findings(driver(), current.logs, current.findings, name))
