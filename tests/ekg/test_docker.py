@@ -39,9 +39,10 @@ def test_compose_runs_neo4j_and_the_dashboard_against_it():
         "NEO4J_URI": "bolt://neo4j:7687",
         "NEO4J_USER": "neo4j",
         "NEO4J_PASSWORD": "a-secret-1",
+        "ROBOTALE_ALLOWED_HOSTS": "",
     }
     assert dashboard["depends_on"] == {"neo4j": {"condition": "service_healthy"}}
-    assert dashboard["command"][:4] == ["robotale", "serve", "--host", "0.0.0.0"]
+    assert "command" not in dashboard, "the image's production server serves the dashboard"
     assert Path(dashboard["build"]["context"]) == REPO
     ports = neo4j["ports"] + dashboard["ports"]
     assert all(str(port).startswith("127.0.0.1:") for port in ports), "this machine only"
@@ -70,4 +71,7 @@ def test_dockerfile_copies_only_what_exists_and_is_not_ignored():
         assert (REPO / source).exists(), source
         assert not any(fnmatch.fnmatch(source, pattern) for pattern in ignored), source
     command = re.search(r"^CMD \[(.*)\]$", dockerfile, re.M).group(1)
-    assert command.replace('"', "").split(", ")[:2] == ["robotale", "serve"]
+    # a production WSGI server, not werkzeug's development one, serving the app factory
+    words = command.replace('"', "").split(", ")
+    assert words[0] == "waitress-serve" and words[-1] == "robotale.webapp:create_app"
+    assert "--call" in words and "--listen=0.0.0.0:5000" in words
