@@ -9,9 +9,9 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
-from robotale.errors import InputError, require_range
+from robotale.errors import InputError, ModelError, require_range
 from robotale.fame_runtime.bus import InProcessBus
-from robotale.fame_runtime.check import Report, check
+from robotale.fame_runtime.check import Report, check, duplicate_ids
 from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
@@ -129,6 +129,7 @@ def run_command(
     out, err = out or sys.stdout, err or sys.stderr
     require_range(until, "--until", 0, unit=" seconds")
     require_range(latency, "--latency", 0, unit=" seconds")
+    refuse_duplicate_ids(model)
     if bus == "dds":
         from robotale.commands.fame_dds import run_processes
 
@@ -165,6 +166,15 @@ def run_command(
         print(f"# warning: {warning}", file=err)
     mission.run(until=begin + until)
     return run_verdict(mission, begin, err)
+
+
+def refuse_duplicate_ids(model: Path) -> None:
+    """The parser keeps one of the elements sharing an id, so a run would fail later with a
+    misleading sentence (no start event ...): name the shared id instead, before anything runs."""
+    shared = duplicate_ids(model)
+    if shared:
+        more = f" (and {len(shared) - 1} more)" if len(shared) > 1 else ""
+        raise ModelError(f"{model}: {shared[0]}{more}")
 
 
 def _bus_problem(bus: str, record: Path | None) -> str:

@@ -219,6 +219,7 @@ def check_conformance(
         observed = set(traces.loc[traces[ROBOT] == assignment.robot, ACTIVITY])
         net = process_net(assignment.process, observed, resolve)
         models[assignment.robot] = RobotModel(assignment.robot_type, *net)
+        _require_completable(models[assignment.robot], model)
     outside = _outside_the_models(traces, models)
     report = replay(traces[~outside], models, seconds_per_trace=seconds_per_trace)
     report.outside = (
@@ -226,6 +227,21 @@ def check_conformance(
     ).rename(columns={ACTIVITY: "activity"})
     report.summary["model"] = str(model)
     return report
+
+
+def _require_completable(robot_model: RobotModel, file: str | Path) -> None:
+    """Alignments need a net whose end can be reached from its start at all (pm4py: "easy
+    sound"); a pool where no run can complete (an exclusive split into a parallel join, say)
+    is a modelling error, named here rather than as pm4py's exception."""
+    from pm4py.objects.petri_net.utils import check_soundness  # pm4py: 2 s, conformance only
+
+    net, initial, final = robot_model.net, robot_model.initial, robot_model.final
+    if not check_soundness.check_easy_soundness_net_in_fin_marking(net, initial, final):
+        raise ModelError(
+            f"{file}: no run of pool {robot_model.pool} can reach its end event (a join waits "
+            "for a branch that never comes, or a branch never ends), so its runs cannot be "
+            "aligned; `robotale fame check` shows where."
+        )
 
 
 def _outside_the_models(traces: pd.DataFrame, models: dict[str, RobotModel]) -> pd.Series:

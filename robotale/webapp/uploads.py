@@ -114,6 +114,10 @@ def _check_content(path: Path, kind: str, filename: str) -> None:
     if b"\0" in head:
         raise InputError(f"{filename!r} is not a text file, so it is no {kind.upper()} event log.")
     text = head.decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
+    if not text:
+        raise InputError(
+            f"{filename!r} holds nothing but a byte order mark: it has no header line."
+        )
     if kind == "xes" and not (text.startswith("<?xml") or text.startswith("<log")):
         raise InputError(f"{filename!r} is not an XES document: it does not start with XML.")
     if kind == "csv" and ("," not in text.splitlines()[0] and ";" not in text.splitlines()[0]):

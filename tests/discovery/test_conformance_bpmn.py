@@ -125,3 +125,44 @@ def test_the_thesis_log_against_the_thesis_model(thesis_log, fame_models):
     assert report.outside.to_dict("records") == [
         {"robot": "drone", "activity": "select_closest_tractor", "instances": 108}
     ]
+
+
+NO_END = """<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="unsound">
+  <bpmn:collaboration id="collab">
+    <bpmn:participant id="p" name="Rover" processRef="Rover" />
+  </bpmn:collaboration>
+  <bpmn:process id="Rover">
+    <bpmn:startEvent id="start" />
+    <bpmn:exclusiveGateway id="split" />
+    <bpmn:task id="a" name="a" />
+    <bpmn:task id="b" name="b" />
+    <bpmn:parallelGateway id="merge" />
+    <bpmn:task id="c" name="c" />
+    <bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="split" />
+    <bpmn:sequenceFlow id="f2" sourceRef="split" targetRef="a" />
+    <bpmn:sequenceFlow id="f3" sourceRef="split" targetRef="b" />
+    <bpmn:sequenceFlow id="f4" sourceRef="a" targetRef="merge" />
+    <bpmn:sequenceFlow id="f5" sourceRef="b" targetRef="merge" />
+    <bpmn:sequenceFlow id="f6" sourceRef="merge" targetRef="c" />
+    <bpmn:sequenceFlow id="f7" sourceRef="c" targetRef="end" />
+  </bpmn:process>
+</bpmn:definitions>"""
+
+
+def test_a_pool_whose_end_cannot_be_reached_is_one_sentence(tmp_path, capsys):
+    """An exclusive split into a parallel join: no run can complete, so nothing can be
+    aligned (pm4py would raise its own exception)."""
+    from robotale.cli import main
+
+    model = tmp_path / "no_end.bpmn"
+    model.write_text(NO_END)
+    log = tmp_path / "rover.csv"
+    log.write_text(
+        "case,time,activity,lifecycle,robot\n"
+        "1,2024-01-01T10:00:00Z,a,start,rover\n1,2024-01-01T10:00:01Z,a,complete,rover\n"
+        "1,2024-01-01T10:00:02Z,c,start,rover\n1,2024-01-01T10:00:03Z,c,complete,rover\n"
+    )
+    assert main(["discover", "conformance", str(log), "--model", str(model)]) == 1
+    err = capsys.readouterr().err.strip().splitlines()[-1]
+    assert err.startswith(f"robotale: {model}: no run of pool Rover can reach its end event")

@@ -95,3 +95,12 @@ def test_fame_run_refuses_an_until_below_zero(tmp_path, capsys, until):
     assert err == (
         f"robotale: --until {float(until):g} is not usable: give a number of at least 0 seconds."
     )
+
+
+def test_run_names_a_shared_id_instead_of_a_missing_start(tmp_path, capsys):
+    body, expected = MODELS["duplicate_ids"]
+    path = tmp_path / "shared.bpmn"
+    path.write_text(HEAD + body + TAIL)
+    assert main(["fame", "run", str(path)]) == 1
+    err = capsys.readouterr().err
+    assert err == f"robotale: {path}: {expected}; each element needs its own id\n"

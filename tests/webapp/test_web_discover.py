@@ -73,6 +73,19 @@ def test_dfg_filtered_to_the_drone_has_only_its_activities(client, stored_thesis
     assert activities(whole) == {r["activity"] for r in thesis_rows}
 
 
+def test_a_time_window_keeps_its_events_and_a_garbage_time_is_one_sentence(
+    client, stored_thesis, thesis_rows
+):
+    days = sorted({r["time"][:10] for r in thesis_rows})
+    since, until = f"{days[1]}T00:00:00Z", f"{days[1]}T23:59:59Z"
+    graph = client.get(f"/api/discover/dfg?log={stored_thesis}&since={since}&until={until}").json
+    that_day = {r["activity"] for r in thesis_rows if r["time"][:10] == days[1]}
+    assert activities(graph) == that_day
+    response = client.get(f"/api/discover/dfg?log={stored_thesis}&since=yesterday-ish")
+    assert response.status_code == 400
+    assert response.json["error"] == "the start time 'yesterday-ish' is not a date and time."
+
+
 def test_a_filter_that_matches_nothing_says_what_there_is(client, stored_thesis):
     response = client.get(f"/api/discover/dfg?log={stored_thesis}&robot=ufo")
     assert response.status_code == 400

@@ -297,3 +297,9 @@ def test_the_reading_is_shown_and_the_findings_are_ready_once_stored(
         time.sleep(0.1)  # prepared without anyone asking
     findings = client.get(f"/api/findings?log={log_name}").json
     assert findings["answers"][0]["facts"]["runs"] == days
+
+
+def test_a_csv_of_only_a_byte_order_mark_is_one_sentence(client):
+    response = upload(client, "bom.csv", "\ufeff".encode())
+    assert response.status_code == 400
+    assert "'bom.csv' holds nothing but a byte order mark: it has no header line." in text(response)

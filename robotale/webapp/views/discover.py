@@ -48,6 +48,9 @@ def dfg():
         robots=request.args.getlist("robot"),
         robot_types=request.args.getlist("robot_type"),
         activities=request.args.getlist("activity"),
+        # a time that is no time is one sentence (LogFilter), never a filter silently dropped
+        start=request.args.get("since") or None,
+        end=request.args.get("until") or None,
     )
     return jsonify(discover_dfg(state().logs.frame(driver(), chosen_log()), selection).to_dict())
 
