@@ -38,6 +38,17 @@ if TYPE_CHECKING:
     from robotale.ekg.connection import Settings
 
 REPO = Path(__file__).resolve().parent.parent
+
+# The fuzz tests: `make test` replays a fixed sequence of examples, so a run cannot fail by
+# chance; `make fuzz` (ROBOTALE_FUZZ_EXAMPLES set) explores new ones.
+try:
+    from hypothesis import settings as _hypothesis
+
+    _hypothesis.register_profile("fixed", derandomize=True)
+    _hypothesis.register_profile("explore", derandomize=False)
+    _hypothesis.load_profile("explore" if os.environ.get("ROBOTALE_FUZZ_EXAMPLES") else "fixed")
+except ImportError:  # hypothesis is a development dependency
+    pass
 EXAMPLES = REPO / "examples"
 
 

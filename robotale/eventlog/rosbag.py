@@ -27,6 +27,7 @@ from dataclasses import dataclass, field
 from operator import attrgetter
 from pathlib import Path
 
+import apsw  # rosbags' SQLite binding: a damaged database raises its errors
 import numpy as np
 import pandas as pd
 from rosbags.interfaces import Connection, MessageDefinitionFormat
@@ -126,8 +127,17 @@ class Bag:
         try:
             reader = Reader(self.path)
             reader.open()
-        # MemoryError: a damaged MCAP index names a record of exabytes, which rosbags reads.
-        except (ReaderError, OSError, KeyError, ValueError, MemoryError) as error:
+        # MemoryError, OverflowError: a damaged MCAP index names a record of exabytes, which
+        # rosbags tries to read; apsw.Error: a damaged SQLite file.
+        except (
+            ReaderError,
+            OSError,
+            KeyError,
+            ValueError,
+            MemoryError,
+            OverflowError,
+            apsw.Error,
+        ) as error:
             reason = " ".join(str(error).split()) or "a damaged index names an impossible size"
             raise InputError(f"{self.path} is not a readable rosbag2 directory: {reason}") from None
         self._reader = reader
@@ -290,6 +300,11 @@ class Bag:
             raise InputError(f"{self.path} cannot be read: {error}") from None
         except MalformedMcap as error:
             raise InputError(f"{self.path} cannot be read: {error}.") from None
+        except (apsw.Error, OverflowError, MemoryError) as error:  # damaged storage
+            reason = " ".join(str(error).split()) or type(error).__name__
+            raise InputError(
+                f"{self.path} cannot be read: its storage is damaged ({reason})."
+            ) from None
         last = None
         for first, topic, end in spans.values():
             if last is not None and first < last:

@@ -14,7 +14,7 @@ from pathlib import Path
 
 import pytest
 from bagbuilder import BagBuilder
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from robotale.errors import RobotaleError
@@ -81,6 +81,9 @@ def damaged_copy(bags: dict[str, Path], storage: str, target: str, cuts) -> Path
 
 @FUZZ
 @given(case=damage())
+# found by fuzzing: an MCAP index naming an impossible size, a truncated SQLite file
+@example(case=("mcap", "storage", [(0.5, 0.6875, b"\x00\x00\x00\x00\x00")]))
+@example(case=("sqlite3", "storage", [(0.875, 1.0, b"")]))
 def test_damaged_bags(bags, case):
     bag = damaged_copy(bags, *case)
     try:
