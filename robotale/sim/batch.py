@@ -30,7 +30,7 @@ from tqdm import tqdm
 
 from robotale.errors import InputError
 from robotale.executors import ExecutorSpec, open_executor, parse_executor, worker_lost
-from robotale.fame_runtime.manifest import RunManifest, write_manifest
+from robotale.fame_runtime.manifest import RunManifest, read_manifest, write_manifest
 from robotale.files import write_file
 from robotale.sim import scenarios
 from robotale.sim.run import CRASHED, RunPlan, simulate_run
@@ -97,14 +97,22 @@ def run_into(
     # rosbag2 names its storage files after the bag's folder, so the bag is written under its
     # final name inside the hidden folder and only the folder is moved.
     partial, final = out / f".{plan.case}.partial", out / plan.case
+    # A Dask cluster runs a finished run again when the worker holding its result dies, even
+    # after the batch has taken the result; the run is deterministic and its folder only
+    # appears whole, so a second attempt hands back the first's manifest and touches nothing.
+    if (done := read_manifest(final)) is not None:
+        return done
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     try:
         manifest = simulate_run(plan, partial / plan.case, gui=gui, pace=pace)
-        # A Dask cluster runs a finished run again when the worker holding its result dies
-        # before handing it over; the run is deterministic, so its second bag replaces the first.
-        shutil.rmtree(final, ignore_errors=True)
-        (partial / plan.case).rename(final)
+        try:
+            (partial / plan.case).rename(final)
+        except OSError:
+            # another attempt of the same run got there first (a worker Dask thought lost)
+            if (done := read_manifest(final)) is None:
+                raise
+            return done
     finally:
         shutil.rmtree(partial, ignore_errors=True)
     return manifest

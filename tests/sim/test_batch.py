@@ -12,7 +12,7 @@ from simbags import manifest, record
 
 from robotale.cli import main
 from robotale.errors import InputError
-from robotale.sim.batch import SUMMARY, simulate_batch
+from robotale.sim.batch import SUMMARY, run_into, simulate_batch
 from robotale.sim.plans import plans
 from robotale.sim.worldspec import load_world
 
@@ -194,3 +194,18 @@ def test_manifests_name_shipped_scenarios_the_same_on_every_machine(short_agri, 
     written = manifest(bag)
     assert written["model"] == "robotale/sim/scenarios/agri.bpmn"
     assert written["world"] == "robotale/sim/scenarios/agri.yaml"
+
+
+def test_a_run_attempted_again_after_it_finished_keeps_the_first_bag(tmp_path):
+    # A Dask cluster reruns a finished task when the worker holding its result dies, possibly
+    # after the batch has moved on; the second attempt must leave the folder as it was.
+    world = rover_world(tmp_path / "model", "pass")
+    (plan,) = plans(world, "rover", runs=1, seed=5)
+    out = tmp_path / "runs"
+    out.mkdir()
+    first = run_into(plan, out)
+    before = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in (out / plan.case).iterdir()}
+    assert run_into(plan, out) == json.loads(json.dumps(first))  # as the manifest file has it
+    after = {p: (p.stat().st_mtime_ns, p.read_bytes()) for p in (out / plan.case).iterdir()}
+    assert after == before
+    assert sorted(p.name for p in out.iterdir()) == [plan.case]
