@@ -6,7 +6,9 @@
   (``${expr}`` evaluated then); camunda input parameters likewise; a skill gets them as inputs.
 - Output parameters and data output associations are evaluated after the activity or catch,
   with the activity's outputs or the message's fields in scope.
-- A caught message becomes the variable named after its signal.
+- A caught message becomes the variable named after its signal. In FAME's dialect each of its
+  fields also goes to the first variable whose name starts with the field's name (``x`` to
+  ``x_target``), as FAME's engine stores a caught payload (``received``).
 - A thrown signal's payload template is filled in from the variables.
 - In a process written in FAME's JavaScript dialect, a ``${name}`` of a variable nobody set
   stays as written in a variable and is null in a payload, as FAME's engine leaves it
@@ -75,10 +77,13 @@ class Data:
 
     def received(self, topic: str, data: Any) -> dict[str, Any]:
         """A caught message: the variable named after the signal; its fields, for outputs."""
+        fields = dict(data) if isinstance(data, Mapping) else {}
+        if self.keep_unset:
+            self.set(prefix_matches(fields, self.variables))
         variable = topic.strip("/").replace("/", "_")
         if variable.isidentifier():
             self.set({variable: data})
-        return dict(data) if isinstance(data, Mapping) else {}
+        return fields
 
     def payload(self, node: NodePlan) -> dict[str, Any]:
         """The data a signal throw publishes, its template filled in."""
@@ -129,6 +134,19 @@ class Data:
         if isinstance(value, dict):
             return {k: self._parameter(v, names) for k, v in value.items()}
         return value
+
+
+def prefix_matches(fields: Mapping[str, Any], variables: Mapping[str, Any]) -> dict[str, Any]:
+    """FAME's engine (fame-ros ``controller.js``, the catch callback of ``camundaExtProperties``)
+    gives each field of a caught payload to the first existing variable, in the order they
+    were set, whose name starts with the field's name; a field no variable matches is
+    dropped. DINGO's ``x_target``/``y_target`` get the ``x``/``y`` of ``target_found`` so."""
+    values = {}
+    for field, value in fields.items():
+        match = next((name for name in variables if name.startswith(str(field))), None)
+        if match is not None:
+            values[match] = value
+    return values
 
 
 def _nest(flat: Mapping[str, Any]) -> dict[str, Any]:
