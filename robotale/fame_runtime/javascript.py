@@ -51,18 +51,28 @@ NODE_NAMES = ("node", "ros_node")
 #: so that an error's stack can be cut down to the script's own lines
 _PRELUDE = r"""
 var __fame = (function () {
-  var out = [], dirty = {}, store = {}, subs = {}, calls = {}, ids = 0;
+  var out = [], dirty = {}, order = [], store = {}, subs = {}, calls = {}, ids = 0;
+  // the run being called and whether it called next(null, value) meanwhile: the usual
+  // completion travels as the outbox's first field instead of an effect
+  var current = 0, settledNow = false, valueNow;
   var hidden = {node: true, ros_node: true};
   var variables = new Proxy(store, {
     get: function fame_get(t, k) {
       var v = t[k];
       // an object read may be changed in place (points.shift()): copy it back too
-      if (typeof k === 'string' && v !== null && typeof v === 'object' && !hidden[k]) dirty[k] = 1;
+      if (typeof k === 'string' && v !== null && typeof v === 'object' && !hidden[k]) fame_dirty(k);
       return v;
     },
-    set: function fame_set(t, k, v) { t[k] = v; if (!hidden[k]) dirty[k] = 1; return true; },
-    deleteProperty: function fame_delete(t, k) { delete t[k]; dirty[k] = 1; return true; }
+    set: function fame_set(t, k, v) {
+      t[k] = v;
+      if (dirty[k] !== 1 && !hidden[k]) { dirty[k] = 1; order.push(k); }
+      return true;
+    },
+    deleteProperty: function fame_delete(t, k) { delete t[k]; fame_dirty(k); return true; }
   });
+  function fame_dirty(k) {
+    if (dirty[k] !== 1) { dirty[k] = 1; order.push(k); }
+  }
   var environment = {variables: variables, services: {}, output: {}, settings: {}};
   var context = {environment: environment};
   function fame_text(args) {
@@ -70,7 +80,7 @@ var __fame = (function () {
       return typeof a === 'string' ? a : JSON.stringify(a);
     }).join(' ');
   }
-  function fame_log() { out.push(['log', fame_text(arguments)]); }
+  function fame_log() { fame_settle(); out.push(['log', fame_text(arguments)]); }
   var console = {log: fame_log, info: fame_log, warn: fame_log, error: fame_log, debug: fame_log};
   function fame_node(name) {
     return {
@@ -79,16 +89,17 @@ var __fame = (function () {
       getLogger: function fame_logger() { return console; },
       createPublisher: function fame_publisher(type, topic) {
         return {topic: topic, publish: function fame_publish(msg) {
-          out.push(['pub', topic, type, msg]); }};
+          fame_settle(); out.push(['pub', topic, type, msg]); }};
       },
       createSubscription: function fame_subscription(type, topic, options, callback) {
         var id = ++ids;
         subs[id] = typeof options === 'function' ? options : callback;
+        fame_settle();
         out.push(['sub', id, topic, type]);
         return {id: id, topic: topic};
       },
       destroySubscription: function fame_destroy(s) {
-        if (s && subs[s.id]) { delete subs[s.id]; out.push(['unsub', s.id]); }
+        if (s && subs[s.id]) { delete subs[s.id]; fame_settle(); out.push(['unsub', s.id]); }
       },
       createClient: function fame_client(type, service) {
         return {
@@ -97,6 +108,7 @@ var __fame = (function () {
           sendRequest: function fame_request(request, callback) {
             var id = ++ids;
             calls[id] = callback;
+            fame_settle();
             out.push(['req', id, service, type, request]);
           }
         };
@@ -127,7 +139,31 @@ var __fame = (function () {
   function fame_plain(text) {
     return text.indexOf('\u001f') < 0;
   }
+  // The most usual outcome of all -- no effect but next(null, value) of the run called, and
+  // variables set to flat values -- is 'F<value>' then pairs (name, value).
+  function fame_fast(head) {
+    var flat = 'F' + head, k, f, i;
+    for (i = 0; i < order.length; i++) {
+      k = order[i];
+      f = store[k] === undefined ? null : fame_flat(store[k]);
+      if (f === null || !fame_plain(k)) return '';
+      flat += '\u001f' + k + '\u001f' + f;
+    }
+    if (flat.length > 256) flat = flat.split('\u001f').join('\u001f');  // see fame_drain
+    if (i) { dirty = {}; order = []; }
+    settledNow = false;
+    return flat;
+  }
   function fame_drain() {
+    if (out.length === 0) {
+      var head = settledNow ? fame_flat(valueNow) : '';
+      if (head !== null) {
+        if (order.length === 0) { settledNow = false; return 'F' + head; }
+        var fast = fame_fast(head);
+        if (fast) return fast;
+      }
+    }
+    fame_settle();
     var flat = 'C', k, f, i, e = out;
     for (k in dirty) {
       f = store[k] === undefined ? '' : fame_flat(store[k]);
@@ -143,6 +179,7 @@ var __fame = (function () {
     if (flat.length > 256) flat = flat.split('\u001f').join('\u001f');
     flat = flat || fame_json(e);
     dirty = {};
+    order = [];
     out = [];
     return flat;
   }
@@ -156,18 +193,32 @@ var __fame = (function () {
     return function next(err, value) {
       if (settled) return;
       settled = true;
+      if (run === current && err == null && out.length === 0) {
+        settledNow = true;
+        valueNow = value;
+        return;
+      }
+      fame_settle();
       out.push(['next', run, err == null ? null : String(err && err.message || err),
                 value === undefined ? null : value]);
     };
   }
+  function fame_settle() {  // the run's next() as an effect, in its place among the others
+    if (settledNow) out.push(['next', current, null, valueNow === undefined ? null : valueNow]);
+    settledNow = false;
+  }
   function fame_fail(run, e) {
+    fame_settle();
     var text = e instanceof Error ? e.name + ': ' + e.message : String(e);
     out.push(['throw', run, text, e instanceof Error ? String(e.stack) : '']);
   }
   function fame_run(fn, run, push) {
-    fame_absorb(push);
+    if (push) fame_absorb(push);
+    current = run;
     try { fn.call(context, fame_next(run)); } catch (e) { fame_fail(run, e); }
-    return fame_drain();
+    var drained = fame_drain();
+    current = 0;
+    return drained;
   }
   function fame_deliver(table, id, msg, push, once) {
     fame_absorb(push);
@@ -195,7 +246,11 @@ var console = __fame.console, environment = __fame.environment;
 _FRAME = re.compile(r"at (?P<name>\S+) \(<input>:(?P<line>\d+)")
 _NEXT_CALL = re.compile(r"\bnext\s*\(")
 _MEMBER = re.compile(r"\.\s*([A-Za-z_$][\w$]*)|\[\s*[\"']([^\"']+)[\"']\s*\]")
-_WRAP = "(function (next) {\n%s\n})"  # the body's line n is the wrapper's line n + 1
+_WRAP = "(function (next) {\n%s\n})"
+#: what can leave promise jobs behind; a runtime that never compiled any skips running them
+_PROMISES = re.compile(
+    r"Promise|\bthen\b|\basync\b|\bawait\b|waitForService|\bimport\b"
+)  # the body's line n is the wrapper's line n + 1
 
 
 def function_source(text: str, *, condition: bool) -> str:
@@ -314,6 +369,7 @@ class JavaScript:
             hide(name, node)
         self.context.set_time_limit(time_limit)
         self._functions: dict[str, Any] = {}
+        self._promises = False  # a script that may queue promise jobs was compiled
         self._mirror: dict[str, Any] = {}  # what the JavaScript side holds, by identity
         self._runs: dict[int, Completion] = {}
         self._run_ids = 0
@@ -359,6 +415,7 @@ class JavaScript:
         function = self._functions.get(source)
         if function is None:
             function = self._functions[source] = self.context.eval(source)
+            self._promises = self._promises or bool(_PROMISES.search(source))
         return function
 
     def _call(self, function: Any, *args: Any) -> tuple[str, ...]:
@@ -366,7 +423,7 @@ class JavaScript:
         second one when it left promise jobs (they run before anything is applied)."""
         try:
             result = function(*args, self._push())
-            if self.context.execute_pending_job():
+            if self._promises and self.context.execute_pending_job():
                 while self.context.execute_pending_job():
                     pass
                 return result, self._drain()
@@ -419,6 +476,9 @@ class JavaScript:
         for outbox in outboxes:
             if not outbox:
                 continue
+            if outbox[0] == "F":
+                self._apply_fast(outbox, run)
+                continue
             if outbox[0] == "C":
                 self._apply_flat(outbox)
                 continue
@@ -428,6 +488,21 @@ class JavaScript:
                 self._effect(effect, run)
             if written:
                 self.changed(written)
+
+    def _apply_fast(self, outbox: str, run: int) -> None:
+        """The usual outbox (see the prelude's ``fame_fast``): the value the run passed to
+        ``next`` (empty: not called), then the variables it wrote."""
+        fields = outbox.split("\x1f")
+        if len(fields) > 1:
+            mirror, variables = self._mirror, self.variables
+            names = fields[1::2]
+            for name, value in zip(names, fields[2::2], strict=True):
+                variables[name] = mirror[name] = _flat(value)
+            self.changed(names)
+        if len(fields[0]) > 1:
+            done = self._runs.pop(run, None)
+            if done is not None:
+                done(None, _flat(fields[0][1:]))
 
     def _apply_flat(self, outbox: str) -> None:
         """The flat outbox (see the prelude's ``fame_drain``): writes, then ``next`` calls."""
