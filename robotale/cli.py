@@ -438,10 +438,13 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
         help="run missions with simulated robots (pybullet), one rosbag2 per run",
         description="Simulated robots carry out a BPMN mission, each run recorded as a rosbag2 "
         "directory (<out>/run_0001/ ...) with a robotale-run.json manifest. Scenarios: agri "
-        "(drone + tractors, thesis ch. 3) and rexdingo (thesis 5.3); or your own --model with a "
-        "--world file.",
+        "(drone + tractors, thesis ch. 3), rexdingo (thesis 5.3) and stop (the stop-distance "
+        "experiment of 5.3.5: FAME against direct code at 0.8, 0.9, 1.0 m/s, with its table); "
+        "or your own --model with a --world file.",
     )
-    simulate.add_argument("scenario", nargs="?", help="agri or rexdingo (or omit with --world)")
+    simulate.add_argument(
+        "scenario", nargs="?", help="agri, rexdingo or stop (or omit with --world)"
+    )
     simulate.add_argument("--model", type=Path, metavar="BPMN", help="the mission to run instead")
     simulate.add_argument("--world", type=Path, metavar="YAML", help="a world file of your own")
     simulate.add_argument(
@@ -490,6 +493,12 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
     )
     simulate.add_argument("--topics", metavar="A,B", help="also record these robot topics")
     simulate.add_argument("--time-limit", type=float, metavar="SECONDS", help="per run (900)")
+    simulate.add_argument(
+        "--engine-cost",
+        metavar="SPEC",
+        help="simulated time the engines' work takes: script=S,condition=S,step=S (seconds), "
+        "measured=FACTOR (wall time times FACTOR) or 0 (the world's engine_cost, else 0)",
+    )
     simulate.add_argument(
         "--workers", type=int, metavar="N", help="worker processes (one per CPU); 0: none"
     )

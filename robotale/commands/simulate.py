@@ -5,12 +5,17 @@ from __future__ import annotations
 import os
 import sys
 from collections.abc import Sequence
+from dataclasses import replace
 from pathlib import Path
 from typing import Any, TextIO
 
 from robotale.errors import InputError
+from robotale.fame_runtime.clock import EngineCost
+from robotale.sim import stopping
 from robotale.sim.batch import simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world
+from robotale.sim.run import RunPlan
+from robotale.sim.worldspec import World
 
 
 def simulate_command(
@@ -19,7 +24,7 @@ def simulate_command(
     model: Path | None = None,
     world: Path | None = None,
     library: Path | None = None,
-    runs: int = 1,
+    runs: int | None = None,
     seed: int = 1,
     first: int = 1,
     out_dir: Path | None = None,
@@ -32,6 +37,7 @@ def simulate_command(
     rate: float | None = None,
     topics: str | None = None,
     time_limit: float | None = None,
+    engine_cost: str | None = None,
     workers: int | None = None,
     executor: str | None = None,
     gui: bool = False,
@@ -42,7 +48,8 @@ def simulate_command(
 ) -> int:
     """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
-    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go."""
+    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go. The ``stop`` scenario runs
+    the stop-distance experiment (``runs`` per variant and speed, 10) and prints its table."""
     out = out or sys.stdout
     loaded, scenario = resolve_world(scenario, model, world, library)
     group_counts = dict(_count(text) for text in counts)
@@ -55,6 +62,10 @@ def simulate_command(
         time_limit=time_limit,
         rate=rate,
     )
+    if engine_cost is not None:
+        loaded = replace(loaded, engine_cost=_engine_cost(engine_cost))
+    experiment = scenario == "stop" and world is None
+    runs = runs or (10 if experiment else 1)
     missing = check(loaded)
     if missing:  # before anything runs, like fame check --world
         print(f"simulation lacks: {len(missing)}", file=out)
@@ -67,34 +78,62 @@ def simulate_command(
         "faults": list(faults) or None,
         "extra_topics": _topics(topics) or None,
     }
-    batch = plans(
-        loaded,
-        scenario,
-        runs=runs,
-        seed=seed,
-        first=first,
-        faults=faults,
-        storage=storage,
-        extra_topics=_topics(topics),
-        settings={key: value for key, value in overrides.items() if value is not None},
-        distro=distro,
-    )
+
+    def plans_for(changed: World) -> list[RunPlan]:
+        return plans(
+            changed,
+            scenario,
+            runs=runs,
+            seed=seed,
+            first=first,
+            faults=faults,
+            storage=storage,
+            extra_topics=_topics(topics),
+            settings={key: value for key, value in overrides.items() if value is not None},
+            distro=distro,
+        )
+
     target = out_dir or Path("runs") / scenario
     if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise InputError("--gui needs a display (DISPLAY is not set); run without --gui")
     watching = gui or bool(pace)
-    summary = simulate_batch(
-        batch,
-        target,
-        workers=workers,
-        executor=executor,
-        overwrite=overwrite,
-        progress=not (quiet or watching),
-        gui=gui,
-        pace=(pace or 1.0) if watching else None,
-    )
-    print_summary(summary, target, out)
+
+    def simulate(batch: list[RunPlan], folder: Path) -> dict[str, Any]:
+        return simulate_batch(
+            batch,
+            folder,
+            workers=workers,
+            executor=executor,
+            overwrite=overwrite,
+            progress=not (quiet or watching),
+            gui=gui,
+            pace=(pace or 1.0) if watching else None,
+        )
+
+    if experiment:
+        return stop_experiment(loaded, plans_for, simulate, target, out)
+    print_summary(simulate(plans_for(loaded), target), target, out)
     return 0
+
+
+def stop_experiment(world: World, plans_for, simulate, target: Path, out: TextIO) -> int:
+    """The stop scenario: both variants at each speed, one batch folder each, then the table."""
+    cells = stopping.run_cells(world, plans_for, simulate, target)
+    for cell in cells:
+        ended = len(cell.gaps)
+        print(
+            f"{cell.variant} at {cell.speed:g} m/s: {ended} runs ended in {target / cell.folder}",
+            file=out,
+        )
+    print_table_of(world, cells, out)
+    return 0 if all(cell.gaps for cell in cells) else 1
+
+
+def print_table_of(world: World, cells, out: TextIO) -> None:
+    cost = world.engine_cost
+    what = ", ".join(f"{k} {v:g} s" for k, v in cost.as_dict().items()) if cost else "none"
+    print(f"engine cost: {what}", file=out)
+    stopping.print_table(cells, out)
 
 
 def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
@@ -118,6 +157,30 @@ def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
             done = sum(t[verb] for t in totals)
             print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
     print(f"recorded in {target} (summary: {target / 'robotale-batch.json'})", file=out)
+
+
+def _engine_cost(text: str) -> EngineCost:
+    """``--engine-cost script=0.002,condition=0.0005,step=0.0001``, ``measured=F`` or 0."""
+    if text.strip() in ("0", "none"):
+        return EngineCost()
+    fields = set(EngineCost.__dataclass_fields__)
+    costs = {}
+    for part in text.split(","):
+        key, sep, value = part.partition("=")
+        key = key.strip()
+        try:
+            number = float(value)
+        except ValueError:
+            number = -1.0
+        if not sep or key not in fields or number < 0:
+            raise InputError(
+                f"--engine-cost {text!r}: {part.strip()!r} must be KEY=SECONDS with KEY one of "
+                f"{', '.join(sorted(fields))} (or 0 for none)"
+            )
+        costs[key] = number
+    if costs.get("measured") and len(costs) > 1:
+        raise InputError(f"--engine-cost {text!r}: either measured=FACTOR or fixed costs")
+    return EngineCost(**costs)
 
 
 def _count(text: str) -> tuple[str, int]:

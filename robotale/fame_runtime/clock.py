@@ -4,15 +4,22 @@
 callback to the next, so a run goes as fast as the machine allows; ``run(pace=1.0)`` paces it
 to wall time for a person watching. Time is seconds since the Unix epoch, so tag stamps are
 real datetimes. :class:`WallClock` is real time, for engines that run one per process.
+
+On a simulated clock an engine's own computing takes no time unless the clock carries an
+:class:`EngineCost`: then each engine keeps an :class:`EngineTime`, the account of how long
+its scripts, conditions and token steps keep it busy, and the work after them waits for the
+clock to get there (the world goes on meanwhile).
 """
 
 from __future__ import annotations
 
+import contextlib
 import heapq
 import itertools
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
+from dataclasses import asdict, dataclass
 from typing import Protocol
 
 
@@ -47,10 +54,12 @@ class SimClock:
     runs deterministic for a seed.
     """
 
-    def __init__(self, start: float = 0.0) -> None:
+    def __init__(self, start: float = 0.0, *, engine_cost: EngineCost | None = None) -> None:
         self._now = float(start)
         self._queue: list[tuple[float, int, Timer]] = []
         self._order = itertools.count()
+        #: what the engines on this clock charge for their work (None: nothing)
+        self.engine_cost = engine_cost
 
     def now(self) -> float:
         return self._now
@@ -106,6 +115,90 @@ class SimClock:
         if until is not None and self._now < until and not (stop_when and stop_when()):
             self._now = until
         return self._now
+
+
+@dataclass(frozen=True)
+class EngineCost:
+    """Simulated seconds an engine's work takes: a fixed cost per script task run, condition
+    evaluated and token step (deterministic), or, with ``measured`` > 0, the wall time of each
+    step (and of each condition evaluated outside a step) times ``measured`` (depends on the
+    machine and its load)."""
+
+    script: float = 0.0
+    condition: float = 0.0
+    step: float = 0.0
+    measured: float = 0.0
+
+    @property
+    def free(self) -> bool:
+        """Nothing is charged: engines run as if computing took no time."""
+        return not (self.script or self.condition or self.step or self.measured)
+
+    def as_dict(self) -> dict[str, float]:
+        return {key: value for key, value in asdict(self).items() if value}
+
+
+class EngineTime:
+    """One engine's account of its computing time on a simulated clock.
+
+    The engine is busy until :attr:`free_at`; work charged while it is busy queues behind
+    (one processor per robot). Measured work may nest (a script inside a step): only the
+    outermost piece is timed, so nothing is charged twice.
+    """
+
+    def __init__(self, clock: Clock, cost: EngineCost) -> None:
+        self.clock, self.cost = clock, cost
+        self.free_at = float("-inf")
+        self._open = 0  # pieces of work begun and not yet charged
+        self._waiting = False  # a callback for when the engine is free is scheduled
+
+    @classmethod
+    def of(cls, clock: Clock) -> EngineTime | None:
+        """The account for an engine on ``clock``; None when its work costs nothing."""
+        cost = getattr(clock, "engine_cost", None)
+        return None if cost is None or cost.free else cls(clock, cost)
+
+    def begin(self) -> float:
+        self._open += 1
+        return time.perf_counter()
+
+    def spent(self, kind: str, began: float) -> bool:
+        """Charge a piece of work of ``kind`` (script, condition, step) that began at
+        ``began`` (:meth:`begin`); True while the engine is still busy computing."""
+        self._open -= 1
+        cost = self.cost
+        if cost.measured:
+            seconds = (time.perf_counter() - began) * cost.measured if not self._open else 0.0
+        else:
+            seconds = getattr(cost, kind)
+        if seconds > 0:
+            self.free_at = max(self.free_at, self.clock.now()) + seconds
+        return self.busy()
+
+    @contextlib.contextmanager
+    def work(self, kind: str) -> Iterator[None]:
+        """Charge what the ``with`` block does as work of ``kind``."""
+        began = self.begin()
+        try:
+            yield
+        finally:
+            self.spent(kind, began)
+
+    def busy(self) -> bool:
+        return self.free_at > self.clock.now()
+
+    def wait(self, then: Callable[[], None]) -> bool:
+        """False when the engine is free; else ``then`` runs once it is (scheduled once)."""
+        if not self.busy():
+            return False
+        if not self._waiting:
+            self._waiting = True
+            self.clock.call_at(self.free_at, lambda: self._free(then))
+        return True
+
+    def _free(self, then: Callable[[], None]) -> None:
+        self._waiting = False
+        then()
 
 
 class WallClock:

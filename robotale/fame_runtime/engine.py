@@ -13,6 +13,7 @@ See ``docs/fame_runtime.md`` for the API and the exact semantics.
 from __future__ import annotations
 
 import builtins
+import contextlib
 import types
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
@@ -21,7 +22,7 @@ from typing import Any, ClassVar
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Bus, Envelope
-from robotale.fame_runtime.clock import Clock
+from robotale.fame_runtime.clock import Clock, EngineTime
 from robotale.fame_runtime.data import Data
 from robotale.fame_runtime.expressions import BpmnError, Compiled
 from robotale.fame_runtime.javascript import JavaScript, ScriptFailure
@@ -49,6 +50,9 @@ Behaviour = Callable[["Engine", "_Token", NodePlan], "NodePlan | None"]
 
 #: values a script leaves behind that are not variables (``import math``, functions it defines)
 _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
+
+#: what charging work costs when the engine's clock charges nothing
+_FREE = contextlib.nullcontext()
 
 
 class _Token:
@@ -168,6 +172,7 @@ class Engine:
         self.failures: list[str] = []  # BPMN errors nobody caught
         self.output = output or (lambda line: print(f"[{robot}] {line}", flush=True))
         self._javascript: JavaScript | None = None  # made when a first script needs it
+        self._time = EngineTime.of(clock)  # None: computing takes no simulated time
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -183,7 +188,7 @@ class Engine:
     def idle(self) -> bool:
         """No process instance is running or about to (one may still start on a signal or
         a timer)."""
-        return not self._roots and not self._starting
+        return not self._roots and not self._starting and not self._work
 
     @property
     def ended(self) -> bool:
@@ -296,8 +301,12 @@ class Engine:
     def _drain(self) -> None:
         self._busy = True
         self._steps = 0
+        computing = False
         try:
             while self._work:
+                if self._time is not None and self._time.wait(self._drain):
+                    computing = True  # what is queued waits until the clock catches up
+                    break
                 self._work.popleft()()
                 if not self._work and self._inclusive:
                     self._recheck_joins()
@@ -305,8 +314,9 @@ class Engine:
             self._work.clear()
             raise
         finally:
-            self._busy = False
-        self._idle_check()
+            self._busy = computing
+        if not computing:
+            self._idle_check()
 
     def _idle_check(self) -> None:
         if self._roots or not self._when_idle or self._busy:
@@ -326,7 +336,27 @@ class Engine:
                     f"robot {self.robot.name}: {node.node.kind} {node.node.describe()} is in a "
                     f"loop that ran {MAX_STEPS} steps without waiting for anything"
                 )
+            if self._time is not None:
+                node = self._timed_step(token, node)
+                continue
             node = behaviours[node.behaviour](self, token, node)
+
+    def _timed_step(self, token: _Token, node: NodePlan) -> NodePlan | None:
+        """Run one step, charged to the clock; while the engine computes, the token's next
+        step waits at the head of the queue (None: it waits or has gone)."""
+        began = self._time.begin()
+        try:
+            next_node = self._BEHAVIOURS[node.behaviour](self, token, node)
+        finally:
+            computing = self._time.spent("step", began)
+        if computing and next_node is not None and token.alive:
+            self._work.appendleft(lambda: self._advance(token, next_node))
+            return None
+        return next_node
+
+    def _charged(self, kind: str) -> contextlib.AbstractContextManager[None]:
+        """A ``with`` block of work of ``kind`` (script, condition) charged to the clock."""
+        return _FREE if self._time is None else self._time.work(kind)
 
     # -- tokens and scopes ---------------------------------------------------------------------
 
@@ -453,9 +483,10 @@ class Engine:
     def _evaluate(self, condition: Compiled, where: str) -> Any:
         """The value of a condition or expression (a loop's cardinality), errors explained."""
         try:
-            if condition.language == JAVASCRIPT:
-                return self.javascript.condition(condition.source)
-            return eval(condition.code, self.env, self.variables)
+            with self._charged("condition"):
+                if condition.language == JAVASCRIPT:
+                    return self.javascript.condition(condition.source)
+                return eval(condition.code, self.env, self.variables)
         except BpmnError:
             raise
         except ScriptFailure as failure:
@@ -475,7 +506,8 @@ class Engine:
         try:
             if condition.language == JAVASCRIPT:
                 return self._condition(condition, "a conditional event")
-            return eval(condition.code, self.env, self.variables)
+            with self._charged("condition"):
+                return eval(condition.code, self.env, self.variables)
         except NameError:
             return False
         except Exception:
@@ -535,7 +567,8 @@ class Engine:
     def _exec(self, node: NodePlan) -> None:
         script = node.script
         try:
-            exec(script.code, self.env, self.variables)
+            with self._charged("script"):
+                exec(script.code, self.env, self.variables)
         except BpmnError:
             raise
         except Exception as error:
@@ -564,7 +597,8 @@ class Engine:
             self._call(lambda: self._skill_done(token, generation, outcome))
 
         try:
-            self.javascript.run_script(node.script.source, done)
+            with self._charged("script"):
+                self.javascript.run_script(node.script.source, done)
         except ScriptFailure as failure:
             self._throw_error(token, f"script task {node.node.describe()}: {failure.text}")
             return None

@@ -87,7 +87,7 @@ def simulate_run(
     world, start = plan.world, plan.start
     setup = draw(world, plan.seed)
     planned = fault_model.plan(plan.faults, plan.seed)
-    clock = SimClock(start)
+    clock = SimClock(start, engine_cost=world.engine_cost)
     network = _network(world)
     bus = InProcessBus(
         clock,
@@ -266,6 +266,7 @@ def _manifest(
             "latency": world.latency,
             "storage": plan.storage,
             "robots": world.robot_names(),
+            **_engine_cost(world),
             **plan.settings,
         },
         "faults": [p.as_dict() for p in planned],
@@ -274,6 +275,12 @@ def _manifest(
     if detail:
         manifest["outcome"]["traceback"] = detail
     return manifest
+
+
+def _engine_cost(world: World) -> dict[str, Any]:
+    """The manifest's ``engine_cost`` setting, for worlds whose engines' work takes time."""
+    cost = world.engine_cost
+    return {"engine_cost": cost.as_dict()} if cost is not None and not cost.free else {}
 
 
 def _counts(counts: Mapping[str, Mapping[str, int]]) -> dict[str, Any]:

@@ -28,6 +28,7 @@ import yaml
 
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Link, Network
+from robotale.fame_runtime.clock import EngineCost
 
 Range = tuple[float, float]
 
@@ -156,6 +157,7 @@ class World:
     faults: tuple[str, ...] = ()
     library: Path | None = None  # a folder of .bpmn building blocks
     skills: str | None = None  # a Python module (or .py file) with more SKILLS
+    engine_cost: EngineCost | None = None  # simulated time the engines' work takes (None: none)
 
     def robot_names(self) -> list[str]:
         return [name for robot in self.robots for name in robot.names()]
@@ -249,7 +251,19 @@ class _Reader:
             faults=tuple(str(f) for f in self.sequence(data.get("faults", []), "faults")),
             library=self.folder(data.get("library"), "library"),
             skills=self.skills(data.get("skills")),
+            engine_cost=self.engine_cost(data.get("engine_cost")),
         )
+
+    def engine_cost(self, value: Any) -> EngineCost | None:
+        """``engine_cost: {script, condition, step}`` in seconds, or ``{measured: factor}``."""
+        if value is None:
+            return None
+        data = self.mapping(value, "engine_cost")
+        self.known(data, "engine_cost", set(EngineCost.__dataclass_fields__))
+        costs = {key: self.number(data[key], f"engine_cost.{key}") for key in data}
+        if costs.get("measured") and len(costs) > 1:
+            raise self.fail("engine_cost", "is either measured or fixed costs, not both")
+        return EngineCost(**costs)
 
     def folder(self, value: Any, where: str) -> Path | None:
         if value is None:
@@ -559,6 +573,7 @@ _WORLD_KEYS = {
     "faults",
     "library",
     "skills",
+    "engine_cost",
 }
 _ROBOT_KEYS = {
     "kind",

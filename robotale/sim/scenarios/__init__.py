@@ -5,6 +5,9 @@ collaboration following the FAME guidelines) and its world (``<name>.yaml``).
   field, the closest of the tractors cuts each weed it finds.
 - ``rexdingo``: the physical scenario of section 5.3: REX explores and finds a target, DINGO
   drives there and fires.
+- ``stop``: the stop-distance experiment of section 5.3.5: a car drives at a wall and is
+  stopped by a FAME model or by direct code (its skills: ``stop.py``; the experiment:
+  :mod:`robotale.sim.stopping`).
 """
 
 from pathlib import Path
