@@ -242,26 +242,12 @@ def _read_in_parallel(
 ) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
     """Every run read by the executor's workers, a progress bar over runs as they finish;
     what the workers warned and reported is said here, run by run in order."""
-    from robotale.executors import open_executor, parse_executor, worker_lost
-
-    spec = parse_executor(executor)
     files = tuple(Path(p).resolve() for p in msg_files)
-    done: dict[Path, _RunRead] = {}
-    with (
-        open_executor(spec, len(runs)) as (pool, _),
-        tqdm(total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False) as bar,
-    ):
-        futures = {pool.submit(_read_alone, r.resolve(), reading, files, distro): r for r in runs}
-        for future in as_completed(futures):
-            try:
-                done[futures[future]] = future.result()
-            except Exception as error:
-                if worker_lost(error):
-                    raise InputError(
-                        f"{futures[future]}: the worker process reading it died"
-                    ) from None
-                raise
-            bar.update()
+    with tqdm(
+        total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False
+    ) as bar:
+        read = _on_executor(executor, runs, bar, "reading", _read_alone, reading, files, distro)
+    done = dict(zip(runs, read, strict=True))
     for run in runs:
         for category, message in done[run].warned:
             warnings.warn(message, category, stacklevel=2)
@@ -369,22 +355,35 @@ def _runs_written(
                 written.append(_prepare_into(run, job, target))
                 bar.update()
             return written
-        from robotale.executors import open_executor, parse_executor, worker_lost
+        return _on_executor(executor, runs, bar, "preparing", _prepare_into, job, target)
 
-        done: dict[Path, _RunPrepared] = {}
-        with open_executor(parse_executor(executor), len(runs)) as (pool, _):
-            futures = {pool.submit(_prepare_into, r.resolve(), job, target): r for r in runs}
-            for future in as_completed(futures):
-                try:
-                    done[futures[future]] = future.result()
-                except Exception as error:
-                    if worker_lost(error):
-                        raise InputError(
-                            f"{futures[future]}: the worker process preparing it died"
-                        ) from None
-                    raise
-                bar.update()
-        return [done[run] for run in runs]
+
+def _on_executor(
+    executor: str,
+    runs: Sequence[Path],
+    bar: tqdm,
+    doing: str,
+    task: Callable[..., Any],
+    *arguments: Any,
+) -> list[Any]:
+    """``task(run, *arguments)`` for every run on the executor's workers (each run given as
+    an absolute path), the bar counting runs as they finish; the results in run order."""
+    from robotale.executors import open_executor, parse_executor, worker_lost
+
+    done: dict[Path, Any] = {}
+    with open_executor(parse_executor(executor), len(runs)) as (pool, _):
+        futures = {pool.submit(task, run.resolve(), *arguments): run for run in runs}
+        for future in as_completed(futures):
+            try:
+                done[futures[future]] = future.result()
+            except Exception as error:
+                if worker_lost(error):
+                    raise InputError(
+                        f"{futures[future]}: the worker process {doing} it died"
+                    ) from None
+                raise
+            bar.update()
+    return [done[run] for run in runs]
 
 
 def _prepare_into(run: Path, job: Job, target: Place) -> _RunPrepared:
