@@ -44,10 +44,18 @@ class Place:
         return Place(self.fs, path, posixpath.join(self.text.rstrip("/"), *parts))
 
     def exists(self) -> bool:
+        self.fs.invalidate_cache()  # other processes (the workers) write here too
         return bool(self.fs.exists(self.path))
 
     def is_dir(self) -> bool:
+        self.fs.invalidate_cache()
         return bool(self.fs.isdir(self.path))
+
+    def names(self) -> list[str]:
+        """The names of what this folder holds."""
+        self.fs.invalidate_cache()
+        listed = self.fs.ls(self.path, detail=False)
+        return sorted(posixpath.basename(str(p).rstrip("/")) for p in listed)
 
     def read_bytes(self) -> bytes:
         return bytes(self.fs.cat_file(self.path))
@@ -65,7 +73,11 @@ class Place:
         self.fs.mv(hidden, self.path)
 
     def remove(self) -> None:
-        if self.fs.exists(self.path):
+        if not self.exists():
+            return
+        if self.fs.isfile(self.path):  # a recursive rm lists a file as a folder on FTP
+            self.fs.rm_file(self.path)
+        else:
             self.fs.rm(self.path, recursive=True)
 
 
@@ -114,4 +126,8 @@ def upload_folder(folder: Path, target: Place) -> None:
         remote = posixpath.join(hidden, *file.relative_to(folder).parts)
         fs.makedirs(posixpath.dirname(remote), exist_ok=True)
         fs.put_file(str(file), remote)
-    fs.mv(hidden, target.path, recursive=True)
+    try:
+        fs.mv(hidden, target.path, recursive=True)
+    except BaseException:
+        fs.rm(hidden, recursive=True)
+        raise

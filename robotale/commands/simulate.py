@@ -9,7 +9,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from robotale.errors import InputError
-from robotale.sim.batch import simulate_batch
+from robotale.sim.batch import SUMMARY, simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world
 
 
@@ -22,7 +22,7 @@ def simulate_command(
     runs: int = 1,
     seed: int = 1,
     first: int = 1,
-    out_dir: Path | None = None,
+    out_dir: str | Path | None = None,
     tractors: int | None = None,
     counts: Sequence[str] = (),
     weeds: str | None = None,
@@ -40,7 +40,8 @@ def simulate_command(
     quiet: bool = False,
     out: TextIO | None = None,
 ) -> int:
-    """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``); with ``gui``
+    """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``; a folder or an
+    fsspec URL); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
     (``local[:N]``, ``dask://HOST:PORT``) says where the runs go."""
     out = out or sys.stdout
@@ -97,7 +98,7 @@ def simulate_command(
     return 0
 
 
-def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
+def print_summary(summary: dict[str, Any], target: str | Path, out: TextIO) -> None:
     outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
     runs, workers = summary["runs"], summary["workers"]
     where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
@@ -117,7 +118,8 @@ def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
         if totals:
             done = sum(t[verb] for t in totals)
             print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
-    print(f"recorded in {target} (summary: {target / 'robotale-batch.json'})", file=out)
+    summary_file = f"{str(target).rstrip('/')}/{SUMMARY}"
+    print(f"recorded in {target} (summary: {summary_file})", file=out)
 
 
 def _count(text: str) -> tuple[str, int]:

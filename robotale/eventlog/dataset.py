@@ -126,7 +126,7 @@ def check_target(dataset: Place) -> None:
             "free or an earlier dataset's."
         )
     ours = dataset.child(MANIFEST).exists() or dataset.child(WRITING).exists()
-    if not ours and dataset.fs.ls(dataset.path, detail=False):
+    if not ours and dataset.names():
         raise InputError(
             f"{dataset.text} is a folder that holds other files, not a robotale Parquet "
             "dataset: give a name that is free or an earlier dataset's."
