@@ -227,17 +227,12 @@ def _died(plan: RunPlan, out: Path | Place) -> RunManifest:
 
 
 def _prepare_destination(where: Path | Place, overwrite: bool) -> None:
-    if isinstance(where, Place):
-        _prepare_place(where, overwrite)
-    else:
-        prepare_folder(where, overwrite)
-
-
-def _prepare_place(out: Place, overwrite: bool) -> None:
-    """:func:`prepare_folder` on another filesystem."""
+    """Refuse a destination holding an earlier batch unless ``overwrite`` (then remove its
+    runs); create it; remove the partial runs an interrupted batch left."""
+    out = where if isinstance(where, Place) else place(where)
     if out.exists() and not out.is_dir():
         raise InputError(f"{out.text} is a file; --out needs a folder for the runs")
-    earlier = _earlier_places(out)
+    earlier = _earlier_runs(out)
     if earlier and not overwrite:
         raise InputError(
             f"{out.text} already holds recorded runs ({earlier[0].name} ...); choose another "
@@ -249,7 +244,7 @@ def _prepare_place(out: Place, overwrite: bool) -> None:
     _remove_partials(out)
 
 
-def _earlier_places(out: Place) -> list[Place]:
+def _earlier_runs(out: Place) -> list[Place]:
     if not out.is_dir():
         return []
     names = out.names()
@@ -257,36 +252,11 @@ def _earlier_places(out: Place) -> list[Place]:
     return runs + ([out.child(SUMMARY)] if SUMMARY in names else [])
 
 
-def prepare_folder(out: Path, overwrite: bool) -> None:
-    if out.exists() and not out.is_dir():
-        raise InputError(f"{out} is a file; --out needs a folder for the runs")
-    earlier = _earlier_runs(out)
-    if earlier and not overwrite:
-        raise InputError(
-            f"{out} already holds recorded runs ({earlier[0].name} ...); choose another --out "
-            "or pass --overwrite to replace them"
-        )
-    for path in earlier:
-        shutil.rmtree(path) if path.is_dir() else path.unlink()
-    out.mkdir(parents=True, exist_ok=True)
-    _remove_partials(out)
-
-
-def _earlier_runs(out: Path) -> list[Path]:
-    if not out.is_dir():
-        return []
-    found = sorted(p for p in out.glob("run_*") if p.is_dir())
-    return found + ([out / SUMMARY] if (out / SUMMARY).exists() else [])
-
-
 def _remove_partials(out: Path | Place) -> None:
-    if isinstance(out, Place):
-        for name in out.names() if out.is_dir() else []:
-            if fnmatch.fnmatch(name, ".run_*.partial"):
-                out.child(name).remove()
-        return
-    for partial in out.glob(".run_*.partial"):
-        shutil.rmtree(partial, ignore_errors=True)
+    out = out if isinstance(out, Place) else place(out)
+    for name in out.names() if out.is_dir() else []:
+        if fnmatch.fnmatch(name, ".run_*.partial"):
+            out.child(name).remove()
 
 
 def _summary(
