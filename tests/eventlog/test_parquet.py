@@ -175,3 +175,22 @@ def test_a_dataset_replaces_an_earlier_one_but_no_other_folder(tmp_path, runs, c
     assert main(["prepare", str(runs), "--out", str(other)]) == 1
     assert "holds other files, not a robotale Parquet dataset" in capsys.readouterr().err
     assert [p.name for p in other.iterdir()] == ["cat.jpg"]
+
+
+def test_ingest_stores_a_dataset_as_it_stores_the_csv(tmp_path, runs, neo4j_driver, log_name):
+    from robotale.ekg.logs import delete_log, log_summary
+
+    csv, parquet = tmp_path / "agri.csv", tmp_path / "agri.parquet"
+    prepared(runs, csv)
+    prepared(runs, parquet)
+    counts = {}
+    for log in (csv, parquet):
+        name = f"{log_name}_{log.suffix[1:]}"
+        args = ["ingest", str(log), "--log", name, "--entities", "robot,msg_id"]
+        try:
+            assert main(args) == 0
+            counts[log.suffix] = log_summary(neo4j_driver, name)["counts"]
+        finally:
+            delete_log(neo4j_driver, name)
+    assert counts[".parquet"] == counts[".csv"]
+    assert counts[".csv"]["events"] == len(pd.read_csv(csv))
