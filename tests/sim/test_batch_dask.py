@@ -172,6 +172,9 @@ def test_runs_and_a_dataset_written_to_an_ftp_url_are_the_local_ones(
     tmp_path, short_agri, cluster, ftp
 ):
     url, home = ftp
+    # a test before may have killed workers: their nannies bring them back
+    with distributed.Client(cluster.replace("dask://", "tcp://")) as client:
+        client.wait_for_workers(2, timeout=120)
     world = adjust(short_agri, time_limit=30)
     batch = plans(world, "agri", runs=2, seed=3)
     local = tmp_path / "local"
