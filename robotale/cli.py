@@ -238,9 +238,9 @@ def _add_prepare(commands: argparse._SubParsersAction) -> None:
     )
     prepare.add_argument(
         "--out",
-        type=Path,
-        metavar="CSV",
-        help="CSV file (default: SOURCE_NAME.csv if no other output)",
+        metavar="CSV|DATASET.parquet",
+        help="CSV file, or with .parquet a Parquet dataset partitioned by run; a path or an "
+        "fsspec URL (default: SOURCE_NAME.csv if no other output)",
     )
     prepare.add_argument("--xes", type=Path, metavar="FILE", help="also write IEEE XES")
     prepare.add_argument("--ocel", type=Path, metavar="FILE", help="also write OCEL 2.0 JSON")
@@ -459,9 +459,8 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
     simulate.add_argument(
         "--out",
         dest="out_dir",
-        type=Path,
         metavar="DIR",
-        help="where the runs go (runs/<scenario>)",
+        help="where the runs go, a folder or an fsspec URL (runs/<scenario>)",
     )
     simulate.add_argument("--tractors", type=int, metavar="N", help="agri: how many tractors")
     simulate.add_argument(

@@ -15,7 +15,7 @@ from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
-from robotale.eventlog.readers import parse_mapping, read_log_with_reading
+from robotale.eventlog.readers import is_parquet, parse_mapping, read_log_with_reading
 from robotale.eventlog.reading import format_reading
 
 
@@ -40,7 +40,7 @@ def ingest_command(
     """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
     Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the other
     options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto ...)."""
-    if path.is_dir():
+    if path.is_dir() and not is_parquet(path):
         if mapping or case:
             raise InputError(
                 f"{path} holds recordings: --map and --case apply to CSV and XES files "
@@ -88,6 +88,8 @@ def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> 
 
 def log_name(path: Path) -> str:
     """A log's default name: the file's stem, or the folder's name (also for ``.``)."""
+    if is_parquet(path):  # a dataset folder is named like a file: agri.parquet
+        return path.resolve().stem
     return path.resolve().name if path.is_dir() else path.stem
 
 

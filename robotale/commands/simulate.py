@@ -12,10 +12,11 @@ from typing import Any, TextIO
 from robotale.errors import InputError
 from robotale.fame_runtime.clock import EngineCost
 from robotale.sim import stopping
-from robotale.sim.batch import simulate_batch
+from robotale.sim.batch import SUMMARY, simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world
 from robotale.sim.run import RunPlan
 from robotale.sim.worldspec import World
+from robotale.storage import local_path
 
 
 def simulate_command(
@@ -27,7 +28,7 @@ def simulate_command(
     runs: int | None = None,
     seed: int = 1,
     first: int = 1,
-    out_dir: Path | None = None,
+    out_dir: str | Path | None = None,
     tractors: int | None = None,
     counts: Sequence[str] = (),
     weeds: str | None = None,
@@ -46,7 +47,8 @@ def simulate_command(
     quiet: bool = False,
     out: TextIO | None = None,
 ) -> int:
-    """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``); with ``gui``
+    """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``; a folder or an
+    fsspec URL); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
     (``local[:N]``, ``dask://HOST:PORT``) says where the runs go. The ``stop`` scenario runs
     the stop-distance experiment (``runs`` per variant and speed, 10) and prints its table."""
@@ -111,7 +113,12 @@ def simulate_command(
         )
 
     if experiment:
-        return stop_experiment(loaded, plans_for, simulate, target, out)
+        if (folder := local_path(target)) is None:
+            raise InputError(
+                f"--out {target}: the stop experiment reads its runs back to measure them; "
+                "give it a folder on this machine"
+            )
+        return stop_experiment(loaded, plans_for, simulate, folder, out)
     print_summary(simulate(plans_for(loaded), target), target, out)
     return 0
 
@@ -136,7 +143,7 @@ def print_table_of(world: World, cells, out: TextIO) -> None:
     stopping.print_table(cells, out)
 
 
-def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
+def print_summary(summary: dict[str, Any], target: str | Path, out: TextIO) -> None:
     outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
     runs, workers = summary["runs"], summary["workers"]
     where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
@@ -156,7 +163,8 @@ def print_summary(summary: dict[str, Any], target: Path, out: TextIO) -> None:
         if totals:
             done = sum(t[verb] for t in totals)
             print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
-    print(f"recorded in {target} (summary: {target / 'robotale-batch.json'})", file=out)
+    summary_file = f"{str(target).rstrip('/')}/{SUMMARY}"
+    print(f"recorded in {target} (summary: {summary_file})", file=out)
 
 
 def _engine_cost(text: str) -> EngineCost:

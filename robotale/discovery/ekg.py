@@ -28,7 +28,7 @@ import pandas as pd
 from robotale.discovery.graph import Edge, Node, ProcessGraph
 from robotale.ekg.aggregate import aggregate as build_classes
 from robotale.ekg.aggregate import aggregation_key, class_type
-from robotale.ekg.connection import database, session_driver
+from robotale.ekg.connection import read_rows, session_driver
 from robotale.ekg.keys import DISCOVERY_KEY
 from robotale.ekg.logs import log_info
 from robotale.ekg.queries import cypher
@@ -92,8 +92,7 @@ def read_stored_log(log: str, *, driver: Any = None) -> pd.DataFrame:
 
 
 def _run(driver: Any, query: str, **parameters: Any) -> list[dict[str, Any]]:
-    records, _, _ = driver.execute_query(cypher(query), parameters, database_=database())
-    return [record.data() for record in records]
+    return read_rows(driver, cypher(query), **parameters)
 
 
 def _entity_types(info: dict[str, Any], chosen: Sequence[str] | None, log: str) -> list[str]:

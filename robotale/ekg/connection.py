@@ -2,8 +2,10 @@
 
 With ``NEO4J_URI`` set (plus ``NEO4J_USER``, default ``neo4j``, and ``NEO4J_PASSWORD``)
 robotale uses that server: docker compose, a cluster, Aura (``neo4j://`` and ``neo4j+s://``
-give the routing driver a cluster needs; see docs/scale.md). Otherwise it uses the local server
-of ``robotale neo4j start`` (its port and generated password live under the robotale home).
+give the routing driver a cluster needs; see docs/scale.md): what only reads goes through
+:func:`read_rows` or a read session, so a cluster sends it to a follower. Otherwise it uses
+the local server of ``robotale neo4j start`` (its port and generated password live under the
+robotale home).
 ``NEO4J_DATABASE`` picks the database (default ``neo4j``).
 """
 
@@ -16,7 +18,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
 
-from neo4j import Driver, GraphDatabase
+from neo4j import Driver, GraphDatabase, RoutingControl
 from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.ekg.queries import cypher
@@ -122,7 +124,17 @@ def unreachable_message(where: Settings) -> str:
     )
 
 
+def read_rows(driver: Driver, query: str, **parameters: Any) -> list[dict[str, Any]]:
+    """The rows of ``query``, which only reads, in a read transaction: a cluster routes it to
+    a follower (the driver's bookmarks still make it see this process's own writes), and
+    Neo4j refuses it should it ever write."""
+    records, _, _ = driver.execute_query(
+        query, parameters, database_=database(), routing_=RoutingControl.READ
+    )
+    return [record.data() for record in records]
+
+
 def server_version(driver: Driver) -> dict[str, Any]:
     """Name, version and edition of the server behind ``driver``."""
-    records, _, _ = driver.execute_query(cypher("ekg_server_version"))
+    records, _, _ = driver.execute_query(cypher("ekg_server_version"), routing_=RoutingControl.READ)
     return records[0].data()

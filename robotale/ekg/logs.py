@@ -1,6 +1,7 @@
 """The event logs stored in Neo4j: list them, read one log, delete one.
 
-Every read of one stored log goes through here, each query a file of ``cypher/``, and a name
+Every read of one stored log goes through here, each query a file of ``cypher/`` run in a read
+transaction (a cluster's followers answer it; see docs/scale.md), and a name
 under which nothing is stored raises :class:`~robotale.errors.LogNotFound` (whose ``hint``
 lets each caller say where logs come from: the command line, the dashboard's Logs page).
 """
@@ -9,9 +10,9 @@ from __future__ import annotations
 
 from typing import Any
 
-from neo4j import Driver
+from neo4j import READ_ACCESS, Driver
 
-from robotale.ekg.connection import database
+from robotale.ekg.connection import database, read_rows
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.writelock import Holder, holders, log_write_lock
 from robotale.errors import LogNotFound
@@ -114,11 +115,10 @@ def delete_log_locked(driver: Driver, name: str) -> None:
 
 def graph_counts(driver: Driver) -> dict[str, int]:
     """``{"node:Event": n, "relationship:DF": m, ...}`` for the whole database."""
-    with driver.session(database=database()) as session:
+    with driver.session(database=database(), default_access_mode=READ_ACCESS) as session:
         result = session.run(cypher("ekg_graph_counts"))
         return {f"{r['kind']}:{r['name']}": r["count"] for r in result if r["count"]}
 
 
 def _rows(driver: Driver, query: str, **parameters: Any) -> list[dict[str, Any]]:
-    records, _, _ = driver.execute_query(cypher(query), parameters, database_=database())
-    return [record.data() for record in records]
+    return read_rows(driver, cypher(query), **parameters)

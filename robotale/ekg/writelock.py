@@ -19,7 +19,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from neo4j import Driver
+from neo4j import Driver, RoutingControl
 from neo4j.exceptions import ConstraintError, DriverError, Neo4jError
 
 from robotale.ekg.connection import database
@@ -70,8 +70,10 @@ class Holder:
 
 
 def holders(driver: Driver) -> dict[str, Holder]:
-    """Every lock by the name of the log it guards."""
-    records, _, _ = driver.execute_query(cypher("ekg_lock_holders"), database_=database())
+    """Every lock by the name of the log it guards (read as ``logs list`` reads)."""
+    records, _, _ = driver.execute_query(
+        cypher("ekg_lock_holders"), database_=database(), routing_=RoutingControl.READ
+    )
     return {str(r["name"]): Holder.of(r.data()) for r in records}
 
 

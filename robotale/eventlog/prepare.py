@@ -23,6 +23,7 @@ from concurrent.futures import as_completed
 from dataclasses import dataclass, fields, replace
 from fnmatch import fnmatchcase
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -30,7 +31,8 @@ import yaml
 from tqdm import tqdm
 
 from robotale.errors import InputError
-from robotale.eventlog import activities, schema, sources
+from robotale.eventlog import activities, dataset, schema, sources
+from robotale.eventlog.dataset import PartWritten
 from robotale.eventlog.enrich import (
     BUILTIN,
     Perspective,
@@ -49,6 +51,7 @@ from robotale.eventlog.rosbag import (
 )
 from robotale.eventlog.sources import Sources
 from robotale.fame_runtime.manifest import RunManifest, read_manifests
+from robotale.storage import Place, place
 
 TAG_TOPICS = "/*/tag"
 DEFAULT_PERSPECTIVES = ("odom", "battery")
@@ -114,28 +117,28 @@ class _Reading:
     bag_time: bool
 
 
+@dataclass(frozen=True)
+class Job:
+    """A preparation's options, checked: what a worker needs to prepare a run on its own."""
+
+    reading: _Reading
+    msg_files: tuple[Path, ...]
+    distro: str
+    rate: float
+
+
 def prepare(
     source: str | Path,
     *,
-    tags: str = TAG_TOPICS,
-    tag_fields: TagFields | None = None,
-    perspectives: Sequence[str | Perspective] = DEFAULT_PERSPECTIVES,
-    rate: float = 1.0,
-    msg_files: Sequence[str | Path] = (),
-    bag_time: bool = False,
     progress: bool = False,
-    lifecycle: str | None = None,
-    actions: str | None = None,
-    states: Sequence[str] = (),
-    bt_logs: str | None = None,
-    auto: bool = False,
-    distro: str | None = None,
     report: Callable[[str], None] | None = None,
     executor: str | None = None,
+    **options: Any,
 ) -> pd.DataFrame:
     """The multi-perspective event log of a rosbag2 directory or of a folder of them.
 
-    ``tags`` is the glob of the tag topics; ``perspectives`` are built-in names (``odom``,
+    ``options`` are those of :func:`preparation`: ``tags`` is the glob of the tag topics
+    (default :data:`TAG_TOPICS`); ``perspectives`` are built-in names (``odom``,
     ``battery``), ``NAME=TOPIC_GLOB:FIELD`` strings or :class:`Perspective` objects; ``rate`` is
     the number of ``inprogress`` events per second of an activity (0: none); ``msg_files`` are
     ``.msg`` / ``.idl`` files (or folders) for types the bags do not define; ``bag_time`` uses
@@ -152,19 +155,9 @@ def prepare(
     the runs in parallel, each run on its own (no reading crosses runs), with the same log as
     reading them here one after the other.
     """
-    chosen = [p if isinstance(p, Perspective) else parse_perspective(p) for p in perspectives]
-    if lifecycle is not None and lifecycle not in LIFECYCLE_MODES:
-        raise InputError(f"Unknown lifecycle mode {lifecycle!r}: use {', '.join(LIFECYCLE_MODES)}.")
-    reading = _Reading(
-        tags,
-        tag_fields or TagFields(),
-        lifecycle,
-        Sources(actions, tuple(states), bt_logs),
-        auto,
-        chosen,
-        bag_time,
-    )
-    distro = check_distro(distro)
+    job = preparation(**options)
+    reading, msg_files, distro, rate = job.reading, job.msg_files, job.distro, job.rate
+    chosen = list(reading.perspectives)
     runs = find_runs(Path(source))
     if executor is not None:
         told: set[tuple[str, ...]] = set()
@@ -184,6 +177,33 @@ def prepare(
     tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, read_manifests(runs))
     log = enrich(tag_rows, samples, rate=rate)
     return _canonical(log, chosen)
+
+
+def preparation(
+    *,
+    tags: str = TAG_TOPICS,
+    tag_fields: TagFields | None = None,
+    perspectives: Sequence[str | Perspective] = DEFAULT_PERSPECTIVES,
+    rate: float = 1.0,
+    msg_files: Sequence[str | Path] = (),
+    bag_time: bool = False,
+    lifecycle: str | None = None,
+    actions: str | None = None,
+    states: Sequence[str] = (),
+    bt_logs: str | None = None,
+    auto: bool = False,
+    distro: str | None = None,
+) -> Job:
+    """The options of :func:`prepare` and :func:`prepare_dataset`, checked: what every bag is
+    read for and how its events are enriched."""
+    chosen = [p if isinstance(p, Perspective) else parse_perspective(p) for p in perspectives]
+    if lifecycle is not None and lifecycle not in LIFECYCLE_MODES:
+        raise InputError(f"Unknown lifecycle mode {lifecycle!r}: use {', '.join(LIFECYCLE_MODES)}.")
+    if rate < 0:
+        raise InputError(f"The inprogress rate must be 0 or more per second, not {rate}.")
+    sources = Sources(actions, tuple(states), bt_logs)
+    reading = _Reading(tags, tag_fields or TagFields(), lifecycle, sources, auto, chosen, bag_time)
+    return Job(reading, tuple(Path(p).resolve() for p in msg_files), check_distro(distro), rate)
 
 
 def _read_here(
@@ -222,26 +242,12 @@ def _read_in_parallel(
 ) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
     """Every run read by the executor's workers, a progress bar over runs as they finish;
     what the workers warned and reported is said here, run by run in order."""
-    from robotale.executors import open_executor, parse_executor, worker_lost
-
-    spec = parse_executor(executor)
     files = tuple(Path(p).resolve() for p in msg_files)
-    done: dict[Path, _RunRead] = {}
-    with (
-        open_executor(spec, len(runs)) as (pool, _),
-        tqdm(total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False) as bar,
-    ):
-        futures = {pool.submit(_read_alone, r.resolve(), reading, files, distro): r for r in runs}
-        for future in as_completed(futures):
-            try:
-                done[futures[future]] = future.result()
-            except Exception as error:
-                if worker_lost(error):
-                    raise InputError(
-                        f"{futures[future]}: the worker process reading it died"
-                    ) from None
-                raise
-            bar.update()
+    with tqdm(
+        total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False
+    ) as bar:
+        read = _on_executor(executor, runs, bar, "reading", _read_alone, reading, files, distro)
+    done = dict(zip(runs, read, strict=True))
     for run in runs:
         for category, message in done[run].warned:
             warnings.warn(message, category, stacklevel=2)
@@ -272,6 +278,138 @@ def _read_alone(run: Path, reading: _Reading, msg_files: Sequence[Path], distro:
         (w.category, str(w.message)) for w in caught if issubclass(w.category, PreparationWarning)
     ]
     return _RunRead(tag_rows, samples, warned, reported)
+
+
+# -- a Parquet dataset, written run by run ------------------------------------------------------
+
+
+@dataclass
+class _RunPrepared:
+    """One run prepared and written as its part (None: the run has no activities), with its
+    samples per perspective (how many, which robots had none) and what it warned and
+    reported on the way."""
+
+    part: PartWritten | None
+    samples: dict[str, int]
+    unsampled: dict[str, list[str]]
+    warned: list[tuple[type[Warning], str]]
+    reported: list[str]
+
+
+def prepare_dataset(
+    source: str | Path,
+    out: str | Path,
+    *,
+    progress: bool = False,
+    report: Callable[[str], None] | None = None,
+    executor: str | None = None,
+    **options: Any,
+) -> dict:
+    """The event log of :func:`prepare`, written as a Parquet dataset partitioned by case at
+    ``out`` (a path or an fsspec URL; see :mod:`robotale.eventlog.dataset`); returns its
+    manifest.
+
+    Each run is prepared and written by whoever reads it: this process, or with ``executor``
+    a worker, so the events of a batch never travel to this process. Its rows are those
+    :func:`prepare` gives the run (enrichment works within a case). A failure removes what
+    was written.
+    """
+    job = preparation(**options)
+    reading = job.reading
+    runs = find_runs(Path(source))
+    target = place(out)
+    dataset.begin(target, str(source))
+    try:
+        done = _runs_written(runs, job, target, executor, progress)
+        told: set[tuple[str, ...]] = set()
+        say = _once(report, told)
+        for run in done:
+            for category, message in run.warned:
+                warnings.warn(message, category, stacklevel=2)
+            for text in run.reported:
+                say(text)
+        parts = [run.part for run in done if run.part is not None]
+        if not parts:
+            raise InputError(_nothing_found(source, reading))
+        chosen = reading.perspectives
+        _say_missing_samples(
+            {p.name: sum(run.samples[p.name] for run in done) for p in chosen},
+            {p.name: [r for run in done for r in run.unsampled[p.name]] for p in chosen},
+            chosen,
+        )
+        return dataset.finish(target, parts, str(source))
+    except BaseException:
+        dataset.abandon(target)
+        raise
+
+
+def _runs_written(
+    runs: Sequence[Path], job: Job, target: Place, executor: str | None, progress: bool
+) -> list[_RunPrepared]:
+    """Every run prepared into ``target``, here or by the executor's workers, in run order."""
+    bar = tqdm(total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False)
+    with bar:
+        if executor is None:
+            written = []
+            for run in runs:
+                written.append(_prepare_into(run, job, target))
+                bar.update()
+            return written
+        return _on_executor(executor, runs, bar, "preparing", _prepare_into, job, target)
+
+
+def _on_executor(
+    executor: str,
+    runs: Sequence[Path],
+    bar: tqdm,
+    doing: str,
+    task: Callable[..., Any],
+    *arguments: Any,
+) -> list[Any]:
+    """``task(run, *arguments)`` for every run on the executor's workers (each run given as
+    an absolute path), the bar counting runs as they finish; the results in run order."""
+    from robotale.executors import open_executor, parse_executor, worker_lost
+
+    done: dict[Path, Any] = {}
+    with open_executor(parse_executor(executor), len(runs)) as (pool, _):
+        futures = {pool.submit(task, run.resolve(), *arguments): run for run in runs}
+        for future in as_completed(futures):
+            try:
+                done[futures[future]] = future.result()
+            except Exception as error:
+                if worker_lost(error):
+                    raise InputError(
+                        f"{futures[future]}: the worker process {doing} it died"
+                    ) from None
+                raise
+            bar.update()
+    return [done[run] for run in runs]
+
+
+def _prepare_into(run: Path, job: Job, target: Place) -> _RunPrepared:
+    """One run read, enriched and written as its part of ``target`` (in a worker process or
+    here); its warnings and reports are kept to be said by the process that asked."""
+    reported: list[str] = []
+    perspectives = job.reading.perspectives
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PreparationWarning)
+        bag = Bag(run, message_types(list(job.msg_files)), job.distro)
+        tag_rows, samples = _read_run(bag, job.reading, None, reported.append)
+        part = None
+        if not tag_rows.empty:
+            tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, read_manifests([run]))
+            log = _canonical(enrich(tag_rows, samples, rate=job.rate), perspectives)
+            part = dataset.write_part(log, target)
+    warned = [
+        (w.category, str(w.message)) for w in caught if issubclass(w.category, PreparationWarning)
+    ]
+    return _RunPrepared(
+        part,
+        {p.name: len(samples[p.name]) for p in perspectives},
+        {p.name: robots_without_samples(tag_rows, samples[p.name]) for p in perspectives},
+        warned,
+        reported,
+    )
 
 
 def is_recording(path: str | Path) -> bool:
@@ -547,8 +685,20 @@ def _declared_type(value: object) -> str | None:
 def _warn_missing_samples(
     tags: pd.DataFrame, samples: Mapping[str, pd.DataFrame], perspectives: Sequence[Perspective]
 ) -> None:
+    counts = {p.name: len(samples[p.name]) for p in perspectives}
+    missing = {p.name: robots_without_samples(tags, samples[p.name]) for p in perspectives}
+    _say_missing_samples(counts, missing, perspectives)
+
+
+def _say_missing_samples(
+    counts: Mapping[str, int],
+    missing_robots: Mapping[str, Sequence[str]],
+    perspectives: Sequence[Perspective],
+) -> None:
+    """The warnings of perspectives without samples (``counts``), and of robots with tags
+    but no samples (``missing_robots``, ``run/robot``), per perspective."""
     for p in perspectives:
-        if samples[p.name].empty:
+        if not counts[p.name]:
             warnings.warn(
                 f"No bag has samples of the {p.name} perspective ({p.topic}), so the log's "
                 f"{', '.join(p.columns)} column(s) are empty.",
@@ -556,7 +706,7 @@ def _warn_missing_samples(
                 stacklevel=3,
             )
             continue
-        missing = robots_without_samples(tags, samples[p.name])
+        missing = sorted(missing_robots[p.name])
         if missing:
             warnings.warn(
                 f"{len(missing)} robot(s) have tags but no {p.name} samples ({p.topic}): "
@@ -605,6 +755,8 @@ __all__ = [
     "TagFields",
     "find_runs",
     "is_recording",
+    "preparation",
     "prepare",
+    "prepare_dataset",
     "robot_type",
 ]

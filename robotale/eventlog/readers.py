@@ -1,4 +1,4 @@
-"""Read an event log from CSV or XES into the canonical DataFrame of :mod:`.schema`.
+"""Read an event log from CSV, XES or Parquet into the canonical DataFrame of :mod:`.schema`.
 
 How a log is read (which column is the case, the robot, its type, the lifecycle, which cells
 mean "missing", which rows are samples) is decided in :mod:`.reading`, which also describes the
@@ -7,8 +7,10 @@ log. Columns are recognised by their usual names (see :data:`.reading.SYNONYMS`)
 explicitly with ``mapping={"Zeit": "time"}`` (the command line's ``--map Zeit=time``). Without a
 case column the whole log is one case (``"1"``), unless ``case=`` names the column that tells
 cases apart or ``case_gap=`` starts a new case after every pause that long. In XES the trace's
-name is the case. Rows keep their order in the file, which breaks ties between equal timestamps
-later on.
+name is the case. Parquet is a file or a dataset folder: robotale's own, partitioned by case
+(:mod:`.dataset`), or any Hive-partitioned folder of Parquet files; its rows count from 1 where
+a sentence names a line. Rows keep their order in the file, which breaks ties between equal
+timestamps later on.
 
 Every problem is one :class:`~robotale.errors.InputError` naming the file and, where there is
 one, the line.
@@ -25,10 +27,15 @@ from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.dataset as pads
+import pyarrow.parquet as pq
 
 from robotale.errors import InputError
-from robotale.eventlog import reading, schema
+from robotale.eventlog import dataset, reading, schema
+from robotale.eventlog.dataset import MANIFEST, WRITING
 from robotale.eventlog.reading import SYNONYMS, TEXT_COLUMNS, Reading, column_mapping, listing
+from robotale.storage import place
 
 SINGLE_CASE = "1"
 #: a duration such as ``pd.Timedelta("1h")`` or the text ``"1h"``
@@ -52,7 +59,8 @@ def read_log(
     case: str | None = None,
     case_gap: Gap = None,
 ) -> pd.DataFrame:
-    """Read a ``.csv`` or ``.xes`` event log (chosen by the file's extension)."""
+    """Read a ``.csv``, ``.xes`` or Parquet event log (chosen by the file's extension; a
+    Parquet dataset is a folder)."""
     return read_log_with_reading(path, mapping, case, case_gap)[0]
 
 
@@ -71,7 +79,18 @@ def read_log_with_reading(
     path = Path(path)
     if path.suffix.lower() == ".xes":
         return _read_xes(path, mapping, case, case_gap)
+    if is_parquet(path):
+        return _read_parquet(path, mapping, case, case_gap)
     return _read_csv(path, mapping, case, case_gap)
+
+
+def is_parquet(path: str | Path) -> bool:
+    """Whether ``path`` is read as Parquet: a ``.parquet`` file or folder, or a folder robotale
+    wrote a dataset into (under another name)."""
+    path = Path(path)
+    if path.suffix.lower() == ".parquet":
+        return True
+    return path.is_dir() and any((path / name).exists() for name in (MANIFEST, WRITING))
 
 
 def read_csv(
@@ -190,6 +209,40 @@ def _read_xes(
     table = table.infer_objects()  # an int column whose markers were text is numbers again
     renames = column_mapping(path, list(table.columns), mapping)
     return canonical_log(path, table, renames, lines, case, case_gap, missing, traces=True)
+
+
+# -- Parquet ---------------------------------------------------------------------------------
+
+
+def _read_parquet(
+    path: Path, mapping: Mapping[str, str] | None, case: str | None, case_gap: Gap
+) -> tuple[pd.DataFrame, Reading]:
+    table = _parquet_table(path).to_pandas()
+    missing = {str(c): int(n) for c, n in table.isna().sum().items() if n}
+    for column, count in reading.mark_missing(table).items():
+        missing[column] = missing.get(column, 0) + count
+    renames = column_mapping(path, list(table.columns), mapping)
+    lines = pd.Series(range(1, len(table) + 1), index=table.index)
+    return canonical_log(path, table, renames, lines, case, case_gap, missing)
+
+
+def _parquet_table(path: Path) -> pa.Table:
+    """A Parquet file, robotale's dataset folder (checked against its manifest) or another
+    Hive-partitioned folder of Parquet files, as one table."""
+    if not path.exists():
+        raise InputError(f"{path} does not exist.")
+    if path.is_dir():
+        folder = place(path)
+        manifest = dataset.read_manifest(folder)
+        if manifest is not None:
+            return dataset.read_table(folder, manifest)
+    try:
+        if path.is_dir():
+            return pads.dataset(path, format="parquet", partitioning="hive").to_table()
+        return pq.read_table(path)
+    except (pa.ArrowException, OSError) as error:
+        reason = " ".join(str(error).split())[:200]
+        raise InputError(f"{path} is not a readable Parquet event log ({reason}).") from None
 
 
 # -- XES -------------------------------------------------------------------------------------

@@ -9,15 +9,19 @@ retried alone once, then recorded as crashed (a manifest without a bag).
 
 The runs go to the executor ``--executor`` names (:mod:`robotale.executors`): a local process
 pool, or a Dask cluster whose workers write into ``out`` themselves, so ``out`` must be a
-folder every worker reaches at the same path (a shared folder). On Dask a run whose worker
-died is retried by the scheduler (``distributed.scheduler.allowed-failures``), then recorded
-as crashed.
+folder every worker reaches at the same path (a shared folder), or an fsspec URL
+(:mod:`robotale.storage`): then each run is recorded in a local temporary folder of its worker
+and uploaded whole, through a hidden ``.run_0001.partial`` moved into place. On Dask a run
+whose worker died is retried by the scheduler (``distributed.scheduler.allowed-failures``),
+then recorded as crashed.
 """
 
 from __future__ import annotations
 
+import fnmatch
 import json
 import shutil
+import tempfile
 import time
 from collections import Counter
 from collections.abc import Callable, Iterable, Sequence
@@ -30,10 +34,11 @@ from tqdm import tqdm
 
 from robotale.errors import InputError
 from robotale.executors import ExecutorSpec, open_executor, parse_executor, worker_lost
-from robotale.fame_runtime.manifest import RunManifest, read_manifest, write_manifest
+from robotale.fame_runtime.manifest import MANIFEST, RunManifest, read_manifest, write_manifest
 from robotale.files import write_file
 from robotale.sim import scenarios
 from robotale.sim.run import CRASHED, RunPlan, simulate_run
+from robotale.storage import Place, local_path, place, upload_folder
 
 SUMMARY = "robotale-batch.json"
 
@@ -58,9 +63,10 @@ def simulate_batch(
     this process, for a person to watch.
     """
     spec = executor if isinstance(executor, ExecutorSpec) else parse_executor(executor, workers)
+    local = local_path(out)
     # absolute: a Dask worker's working folder is not ours
-    out = Path(out).resolve() if spec.remote else Path(out)
-    prepare_folder(out, overwrite)
+    where: Path | Place = place(out) if local is None else local.resolve() if spec.remote else local
+    _prepare_destination(where, overwrite)
     began = time.perf_counter()
     here = gui or pace or spec.workers == 0 or (len(plans) == 1 and not spec.remote)
     workers = 0
@@ -77,17 +83,55 @@ def simulate_batch(
         try:
             if here:
                 for plan in plans:
-                    finished(run_into(plan, out, gui=gui, pace=pace))
+                    finished(_run(plan, where, gui=gui, pace=pace))
             else:
-                workers = _in_pool(plans, out, spec, finished)
+                workers = _in_pool(plans, where, spec, finished)
         except BaseException:
-            _remove_partials(out)
+            _remove_partials(where)
             raise
     summary = _summary(plans, [manifests[p.case] for p in plans], workers, began)
     if spec.remote:
         summary["executor"] = spec.describe()
-    write_file(out / SUMMARY, json.dumps(summary, indent=2) + "\n")
+    text = json.dumps(summary, indent=2) + "\n"
+    if isinstance(where, Place):
+        where.child(SUMMARY).write_whole(text)
+    else:
+        write_file(where / SUMMARY, text)
     return summary
+
+
+def _run(
+    plan: RunPlan, where: Path | Place, *, gui: bool = False, pace: float | None = None
+) -> RunManifest:
+    """One run recorded into a local folder, or recorded here and uploaded to a place."""
+    if isinstance(where, Place):
+        return run_uploaded(plan, where, gui=gui, pace=pace)
+    return run_into(plan, where, gui=gui, pace=pace)
+
+
+def run_uploaded(
+    plan: RunPlan, target: Place, *, gui: bool = False, pace: float | None = None
+) -> RunManifest:
+    """One run recorded in a local temporary folder (rosbag2 writes local files only), then
+    uploaded as ``target/<case>`` through a hidden folder moved into place."""
+    final = target.child(plan.case)
+    if (done := _remote_manifest(final)) is not None:  # a late second attempt, as in run_into
+        return done
+    with tempfile.TemporaryDirectory(prefix="robotale-run-") as folder:
+        manifest = run_into(plan, Path(folder), gui=gui, pace=pace)
+        try:
+            upload_folder(Path(folder) / plan.case, final)
+        except Exception:  # ftplib's refusals are no OSError
+            # another attempt of the same run got there first (a worker Dask thought lost)
+            if (done := _remote_manifest(final)) is None:
+                raise
+            return done
+    return manifest
+
+
+def _remote_manifest(run: Place) -> RunManifest | None:
+    found = run.child(MANIFEST)
+    return json.loads(found.read_bytes()) if found.exists() else None
 
 
 def run_into(
@@ -121,7 +165,9 @@ def run_into(
 Finished = Callable[[RunManifest], None]
 
 
-def _in_pool(plans: Sequence[RunPlan], out: Path, spec: ExecutorSpec, finished: Finished) -> int:
+def _in_pool(
+    plans: Sequence[RunPlan], out: Path | Place, spec: ExecutorSpec, finished: Finished
+) -> int:
     """Run ``plans`` on the executor; returns how many workers it had."""
     broken, workers = _pool_round(plans, out, spec, finished)
     for plan in broken:
@@ -133,13 +179,13 @@ def _in_pool(plans: Sequence[RunPlan], out: Path, spec: ExecutorSpec, finished: 
 
 
 def _pool_round(
-    plans: Sequence[RunPlan], out: Path, spec: ExecutorSpec, finished: Finished
+    plans: Sequence[RunPlan], out: Path | Place, spec: ExecutorSpec, finished: Finished
 ) -> tuple[list[RunPlan], int]:
     """Run ``plans`` on the executor; returns those lost when a worker process died, and how
     many workers there were."""
     lost: list[RunPlan] = []
     with open_executor(spec, len(plans)) as (pool, workers):
-        futures: dict[Future, RunPlan] = {pool.submit(run_into, p, out): p for p in plans}
+        futures: dict[Future, RunPlan] = {pool.submit(_run, p, out): p for p in plans}
         try:
             for future in as_completed(futures):
                 try:
@@ -155,9 +201,8 @@ def _pool_round(
     return sorted(lost, key=lambda p: p.index), workers
 
 
-def _died(plan: RunPlan, out: Path) -> RunManifest:
+def _died(plan: RunPlan, out: Path | Place) -> RunManifest:
     """The manifest of a run whose worker process died: no bag, the reason."""
-    shutil.rmtree(out / f".{plan.case}.partial", ignore_errors=True)
     manifest: RunManifest = {
         "case": plan.case,
         "scenario": plan.scenario,
@@ -170,37 +215,48 @@ def _died(plan: RunPlan, out: Path) -> RunManifest:
             "exit called by the model)",
         },
     }
+    if isinstance(out, Place):
+        out.child(f".{plan.case}.partial").remove()
+        out.child(plan.case, MANIFEST).write_whole(json.dumps(manifest, indent=2) + "\n")
+        return manifest
+    shutil.rmtree(out / f".{plan.case}.partial", ignore_errors=True)
     folder = out / plan.case
     folder.mkdir(parents=True, exist_ok=True)
     write_manifest(folder, manifest)
     return manifest
 
 
-def prepare_folder(out: Path, overwrite: bool) -> None:
+def _prepare_destination(where: Path | Place, overwrite: bool) -> None:
+    """Refuse a destination holding an earlier batch unless ``overwrite`` (then remove its
+    runs); create it; remove the partial runs an interrupted batch left."""
+    out = where if isinstance(where, Place) else place(where)
     if out.exists() and not out.is_dir():
-        raise InputError(f"{out} is a file; --out needs a folder for the runs")
+        raise InputError(f"{out.text} is a file; --out needs a folder for the runs")
     earlier = _earlier_runs(out)
     if earlier and not overwrite:
         raise InputError(
-            f"{out} already holds recorded runs ({earlier[0].name} ...); choose another --out "
-            "or pass --overwrite to replace them"
+            f"{out.text} already holds recorded runs ({earlier[0].name} ...); choose another "
+            "--out or pass --overwrite to replace them"
         )
-    for path in earlier:
-        shutil.rmtree(path) if path.is_dir() else path.unlink()
-    out.mkdir(parents=True, exist_ok=True)
+    for found in earlier:
+        found.remove()
+    out.fs.makedirs(out.path, exist_ok=True)
     _remove_partials(out)
 
 
-def _earlier_runs(out: Path) -> list[Path]:
+def _earlier_runs(out: Place) -> list[Place]:
     if not out.is_dir():
         return []
-    found = sorted(p for p in out.glob("run_*") if p.is_dir())
-    return found + ([out / SUMMARY] if (out / SUMMARY).exists() else [])
+    names = out.names()
+    runs = [out.child(n) for n in names if n.startswith("run_") and out.child(n).is_dir()]
+    return runs + ([out.child(SUMMARY)] if SUMMARY in names else [])
 
 
-def _remove_partials(out: Path) -> None:
-    for partial in out.glob(".run_*.partial"):
-        shutil.rmtree(partial, ignore_errors=True)
+def _remove_partials(out: Path | Place) -> None:
+    out = out if isinstance(out, Place) else place(out)
+    for name in out.names() if out.is_dir() else []:
+        if fnmatch.fnmatch(name, ".run_*.partial"):
+            out.child(name).remove()
 
 
 def _summary(

@@ -5,6 +5,8 @@ run that kills its worker must be reported while the other workers finish the ba
 from __future__ import annotations
 
 import json
+import logging
+import threading
 from pathlib import Path
 
 import dask
@@ -15,7 +17,9 @@ from test_batch import east, rover_world
 
 from robotale.cli import main
 from robotale.errors import InputError
-from robotale.eventlog.prepare import prepare
+from robotale.eventlog.prepare import prepare, prepare_dataset
+from robotale.eventlog.readers import read_log
+from robotale.eventlog.writers import write_csv
 from robotale.sim.batch import SUMMARY, simulate_batch
 from robotale.sim.plans import adjust, plans
 
@@ -75,6 +79,15 @@ def test_a_dask_batch_writes_the_local_batchs_bags_and_log(tmp_path, short_agri,
     parallel = prepare(tmp_path / "dask", executor=cluster)
     pd.testing.assert_frame_equal(here, parallel)
     assert sorted(here["case:concept:name"].unique()) == ["run_0001", "run_0002", "run_0003"]
+    # each worker writes its run's part of the dataset; it reads back as the CSV
+    write_csv(here, tmp_path / "agri.csv")
+    written = prepare_dataset(tmp_path / "dask", tmp_path / "agri.parquet", executor=cluster)
+    assert [p["rows"] for p in written["parts"]] == here.groupby(
+        "case:concept:name"
+    ).size().tolist()
+    pd.testing.assert_frame_equal(
+        read_log(tmp_path / "agri.csv"), read_log(tmp_path / "agri.parquet")
+    )
 
 
 def test_the_commands_take_a_dask_executor(tmp_path, short_agri, cluster, capsys):
@@ -131,3 +144,55 @@ def test_a_scheduler_that_does_not_answer_is_named(tmp_path):
         simulate_batch(
             plans(world, "rover", runs=2, seed=1), tmp_path / "runs", executor="dask://127.0.0.1:9"
         )
+
+
+@pytest.fixture(scope="module")
+def ftp(tmp_path_factory):
+    """An FTP server on loopback (pyftpdlib), serving a folder of this machine: a
+    destination the workers reach only through fsspec's ftp:// filesystem."""
+    from pyftpdlib.authorizers import DummyAuthorizer
+    from pyftpdlib.handlers import FTPHandler
+    from pyftpdlib.servers import ThreadedFTPServer
+
+    logging.getLogger("pyftpdlib").setLevel(logging.WARNING)
+    home = tmp_path_factory.mktemp("ftp")
+    users = DummyAuthorizer()
+    users.add_user("robot", "secret", str(home), perm="elradfmwMT")
+    handler = type("Handler", (FTPHandler,), {"authorizer": users})
+    server = ThreadedFTPServer(("127.0.0.1", 0), handler)
+    serving = threading.Thread(target=server.serve_forever, kwargs={"timeout": 0.2}, daemon=True)
+    serving.start()
+    port = server.socket.getsockname()[1]
+    yield f"ftp://robot:secret@127.0.0.1:{port}", home
+    server.close_all()
+    serving.join(timeout=5)
+
+
+def test_runs_and_a_dataset_written_to_an_ftp_url_are_the_local_ones(
+    tmp_path, short_agri, cluster, ftp
+):
+    url, home = ftp
+    # a test before may have killed workers: their nannies bring them back
+    with distributed.Client(cluster.replace("dask://", "tcp://")) as client:
+        client.wait_for_workers(2, timeout=120)
+    world = adjust(short_agri, time_limit=30)
+    batch = plans(world, "agri", runs=2, seed=3)
+    local = tmp_path / "local"
+    simulate_batch(batch, f"file://{local}", executor="local:2")
+    summary = simulate_batch(batch, f"{url}/runs/agri", executor=cluster)
+    uploaded = home / "runs" / "agri"
+    assert files(uploaded) == files(local) and len(files(local)) > 2
+    assert manifests(uploaded) == manifests(local)
+    assert json.loads((uploaded / SUMMARY).read_text())["cases"] == summary["cases"]
+    assert not list(uploaded.glob(".*"))
+    again = simulate_batch(batch, f"{url}/runs/agri", executor=cluster, overwrite=True)
+    assert again["outcomes"] == summary["outcomes"]
+    with pytest.raises(InputError, match=r"runs/agri already holds recorded runs \(run_0001"):
+        simulate_batch(batch, f"{url}/runs/agri", executor=cluster)
+    write_csv(prepare(local), tmp_path / "agri.csv")
+    assert (
+        main(["prepare", str(uploaded), "--out", f"{url}/agri.parquet", "--executor", cluster]) == 0
+    )
+    pd.testing.assert_frame_equal(read_log(tmp_path / "agri.csv"), read_log(home / "agri.parquet"))
+    assert main(["prepare", str(uploaded), "--out", f"{url}/agri.csv"]) == 0
+    assert (home / "agri.csv").read_bytes() == (tmp_path / "agri.csv").read_bytes()
