@@ -19,6 +19,7 @@ def simulate_command(
     model: Path | None = None,
     world: Path | None = None,
     library: Path | None = None,
+    thesis: bool = False,
     runs: int = 1,
     seed: int = 1,
     first: int = 1,
@@ -42,9 +43,11 @@ def simulate_command(
 ) -> int:
     """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
-    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go."""
+    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go; ``thesis`` takes the
+    scenario's world calibrated to the thesis."""
     out = out or sys.stdout
-    loaded, scenario = resolve_world(scenario, model, world, library)
+    preset = "thesis" if thesis else None
+    loaded, scenario = resolve_world(scenario, model, world, library, preset=preset)
     group_counts = dict(_count(text) for text in counts)
     if tractors is not None:
         group_counts["tractor"] = tractors

@@ -72,6 +72,10 @@ class SimRobot:
     def flies(self) -> bool:
         return self.spec.kind == "drone"
 
+    @property
+    def airborne(self) -> bool:
+        return self.flies and self.flight != LANDED
+
     def topic(self, name: str) -> str:
         return f"/{self.name}/{name}"
 

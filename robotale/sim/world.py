@@ -91,6 +91,7 @@ class SimWorld:
         self.contacts = dynamics.Contacts({})
         self.noise = random.Random(setup.seed)  # the sensors' draws, repeatable per run
         self._phantoms = 0
+        self.footprints = sensors.Footprints(world.field)
         self.physics = Physics(gui=gui)
         try:
             self._build()
@@ -138,6 +139,7 @@ class SimWorld:
                 battery.charge,
                 battery.low,
                 battery.warn_period,
+                start.flight_drain,
             ),
             home=start.home,
         )
@@ -225,7 +227,7 @@ class SimWorld:
         if not robot.driven:
             place(self.physics, robot)
         on_charger = robot.on_charger()
-        if robot.battery.step(dt, robot.speed, on_charger, now):
+        if robot.battery.step(dt, robot.speed, on_charger, now, robot.airborne):
             self._publish(robot, "low_battery", {}, EMPTY)
         self._publish(robot, "odom", robot.odometry(now), ODOM)
         if battery_due:
@@ -242,6 +244,7 @@ class SimWorld:
             self._sonar(robot, spec.range, now)
         if spec.camera is not None:
             camera = spec.camera
+            self.footprints.look(robot, camera)
             seen = {
                 body
                 for body in sensors.camera_view(self.physics, robot, camera)
@@ -361,6 +364,8 @@ class SimWorld:
                 for t in things
             ],
             "counts": counts,
+            # the share of the field each camera saw (not the cells its robot passed over)
+            "coverage": {"cell": self.footprints.cell, "seen": self.footprints.fractions()},
             "collisions": [
                 {"after": _since(c.time, start), "robot": c.robot, "other": c.other}
                 for c in self.contacts.collisions
