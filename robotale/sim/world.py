@@ -18,7 +18,7 @@ topic                      type                               when
 
 With ``dynamics: true`` ground robots are pushed by their drives and pybullet steps the world
 ``physics_rate`` times a second (:mod:`robotale.sim.dynamics`); the control steps then read
-their poses from the physics.
+their poses from the physics. Drones then fly by thrust against drag (``dynamics.fly``).
 
 A tractor's blade cuts the weeds within its radius while ``blade_force`` > 0; a robot whose
 LED turns red destroys the targets within :data:`FIRE_RANGE`. The engines never see this
@@ -122,6 +122,9 @@ class SimWorld:
         for placed in self.setup.objects:
             thing = self._thing(placed, looks[placed.kind])
             self.things[thing.body] = thing
+            for robot in self.robots.values():
+                if robot.driven:
+                    physics.pass_through(robot.body, thing.body)
         if physics.gui:
             physics.follow((world.field[0] / 2, world.field[1] / 2, 0.0))
 
@@ -145,6 +148,7 @@ class SimWorld:
         )
         half = [size / 2 for size in spec.size]
         robot.driven = self.spec.dynamics and not robot.flies
+        robot.thrust = self.spec.dynamics and robot.flies
         mass = spec.mass if robot.driven else 0.0
         robot.body = self.physics.box(
             half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw, mass=mass
@@ -223,6 +227,8 @@ class SimWorld:
 
     def _step(self, robot: SimRobot, now: float, dt: float, battery_due: bool) -> None:
         robot.move(dt)
+        if robot.thrust:
+            dynamics.fly(robot, dt)
         robot.wander(dt, self.noise)
         if not robot.driven:
             place(self.physics, robot)

@@ -89,6 +89,7 @@ class RobotSpec:
     max_force: float = 40.0  # N, the motors' forward force limit (braking too)
     max_torque: float = 10.0  # N m, the yaw torque limit
     friction: float = 0.8  # tyre grip: no more force than friction * mass * g
+    drag: float = 0.0  # drones: N of air drag per (m/s)^2 (their thrust limit is max_force)
     led: bool = False
     camera: CameraSpec | None = None
     range: RangeSpec | None = None
@@ -350,6 +351,7 @@ class _Reader:
                 "friction",
             )
         }
+        numbers["drag"] = self.number(data.get("drag", defaults.drag), f"{where}.drag")
         return RobotSpec(
             name=name,
             kind=kind,
@@ -580,6 +582,7 @@ _ROBOT_KEYS = {
     "max_force",
     "max_torque",
     "friction",
+    "drag",
     "odom_drift",
     "led",
     "camera",
