@@ -118,7 +118,10 @@ def test_agri_in_dynamics_mode_cuts_every_weed_though_its_tractors_meet(tmp_path
     finals = manifest["robots_final"]
     for weed in manifest["objects"]:
         assert weed["done_by"] in finals
-    assert math.dist(
-        (finals["tractor_1"]["x"], finals["tractor_1"]["y"]),
-        (finals["tractor_2"]["x"], finals["tractor_2"]["y"]),
-    ) > 0.4
+    assert (
+        math.dist(
+            (finals["tractor_1"]["x"], finals["tractor_1"]["y"]),
+            (finals["tractor_2"]["x"], finals["tractor_2"]["y"]),
+        )
+        > 0.4
+    )
