@@ -448,6 +448,12 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
     simulate.add_argument("--model", type=Path, metavar="BPMN", help="the mission to run instead")
     simulate.add_argument("--world", type=Path, metavar="YAML", help="a world file of your own")
     simulate.add_argument(
+        "--thesis",
+        action="store_true",
+        default=None,
+        help="agri: the world calibrated to the thesis' 70 runs (docs/sim.md)",
+    )
+    simulate.add_argument(
         "--library",
         type=Path,
         metavar="DIR",

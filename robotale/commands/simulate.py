@@ -25,6 +25,7 @@ def simulate_command(
     model: Path | None = None,
     world: Path | None = None,
     library: Path | None = None,
+    thesis: bool = False,
     runs: int | None = None,
     seed: int = 1,
     first: int = 1,
@@ -50,10 +51,12 @@ def simulate_command(
     """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``; a folder or an
     fsspec URL); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
-    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go. The ``stop`` scenario runs
-    the stop-distance experiment (``runs`` per variant and speed, 10) and prints its table."""
+    (``local[:N]``, ``dask://HOST:PORT``) says where the runs go; ``thesis`` takes the
+    scenario's world calibrated to the thesis. The ``stop`` scenario runs the stop-distance
+    experiment (``runs`` per variant and speed, 10) and prints its table."""
     out = out or sys.stdout
-    loaded, scenario = resolve_world(scenario, model, world, library)
+    preset = "thesis" if thesis else None
+    loaded, scenario = resolve_world(scenario, model, world, library, preset=preset)
     group_counts = dict(_count(text) for text in counts)
     if tractors is not None:
         group_counts["tractor"] = tractors

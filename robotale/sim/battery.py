@@ -1,4 +1,5 @@
-"""A robot's battery: drains with time and motion, refills on a charging base, warns when low.
+"""A robot's battery: drains with time, motion and flight, refills on a charging base, warns
+when low.
 
 The warning is what real battery monitors do: a message on ``/<robot>/low_battery``
 (``std_msgs/msg/Empty``) when the charge falls below the threshold, repeated every
@@ -25,6 +26,7 @@ class Battery:
     charge_rate: float  # per second on a charging base
     low: float  # the low_battery threshold
     warn_period: float
+    flight_drain: float = 0.0  # per second more while airborne (a drone's rotors hovering)
     fault_drain: float = 0.0  # per second, from a "battery empties" fault on
     charging: bool = False
     _warned_at: float | None = None
@@ -33,13 +35,18 @@ class Battery:
     def empty(self) -> bool:
         return self.level <= 0.0
 
-    def step(self, dt: float, speed: float, on_charger: bool, now: float) -> bool:
-        """Advance ``dt`` seconds; True when a low_battery warning is due now."""
+    def step(
+        self, dt: float, speed: float, on_charger: bool, now: float, flying: bool = False
+    ) -> bool:
+        """Advance ``dt`` seconds (``flying``: airborne); True when a low_battery warning is
+        due now."""
         self.charging = on_charger and self.level < 1.0 and not self.fault_drain
         if self.charging:
             self.level = min(1.0, self.level + self.charge_rate * dt)
         else:
             use = self.drain + self.move_drain * abs(speed) + self.fault_drain
+            if flying:
+                use += self.flight_drain
             self.level = max(0.0, self.level - use * dt)
         if self.level >= self.low:
             self._warned_at = None

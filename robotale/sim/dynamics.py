@@ -16,7 +16,14 @@ Pybullet integrates the rest (inertia, contacts): robots stop against each other
 obstacles instead of driving through them. Each contact that begins between a robot and another
 robot or an obstacle is a :class:`Collision`; the world publishes it on
 ``/<robot>/collision`` (``std_msgs/msg/String``, the other body's name) for both robots of a
-pair. Drones stay kinematic (placed each control step) in both modes.
+pair.
+
+A drone (no wheels, above everything) is not a pybullet body with mass; :func:`fly` integrates
+its horizontal motion each control step in :data:`FLIGHT_SUBSTEPS` steps: its rotors' thrust
+pushes it towards the commanded velocity with at most ``max_force`` N, and air drag of
+``drag * v**2`` N holds it back, on its ``mass``. So it speeds up and brakes instead of
+jumping to the commanded speed; told to stop at speed v it still travels about
+``v**2 / (2 * max_force / mass)`` (less with drag).
 """
 
 from __future__ import annotations
@@ -29,6 +36,7 @@ from robotale.sim.physics import GRAVITY, Physics
 from robotale.sim.robots import SimRobot
 
 COLLISION = "std_msgs/msg/String"
+FLIGHT_SUBSTEPS = 5  # integration steps of a drone's flight per control step
 
 
 @dataclass(frozen=True)
@@ -61,6 +69,34 @@ def drive(physics: Physics, robot: SimRobot, dt: float) -> None:
     inertia = spec.mass * (length**2 + width**2) / 12
     torque = _clip(inertia * (turn - yaw_rate) / dt, spec.max_torque)
     physics.push(robot.body, force, torque)
+
+
+def fly(robot: SimRobot, dt: float) -> None:
+    """Move a flying robot ``dt`` seconds under thrust and drag towards its command."""
+    if dt <= 0:
+        return
+    spec = robot.spec
+    forward, _ = robot.wanted()
+    yaw = robot.pose.yaw
+    wanted = (forward * math.cos(yaw), forward * math.sin(yaw))
+    h = dt / FLIGHT_SUBSTEPS
+    vx, vy = robot.velocity
+    for _ in range(FLIGHT_SUBSTEPS):
+        thrust = _limited(
+            (spec.mass * (wanted[0] - vx) / h, spec.mass * (wanted[1] - vy) / h), spec.max_force
+        )
+        speed = math.hypot(vx, vy)
+        vx += (thrust[0] - spec.drag * speed * vx) / spec.mass * h
+        vy += (thrust[1] - spec.drag * speed * vy) / spec.mass * h
+        robot.pose.x += vx * h
+        robot.pose.y += vy * h
+    robot.velocity = (vx, vy)
+    robot.speed = math.hypot(vx, vy)
+
+
+def _limited(force: tuple[float, float], limit: float) -> tuple[float, float]:
+    size = math.hypot(*force)
+    return force if size <= limit else (force[0] * limit / size, force[1] * limit / size)
 
 
 def follow(physics: Physics, robot: SimRobot) -> None:

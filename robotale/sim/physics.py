@@ -199,6 +199,11 @@ class Physics:
         default group) and box queries still see it."""
         pybullet.setCollisionFilterGroupMask(body, -1, 2, ~_ROBOTS, physicsClientId=self.client)
 
+    def pass_through(self, body: int, other: int) -> None:
+        """``body`` and ``other`` never collide (a robot drives over a weed): the group masks
+        of :meth:`ghost` do not keep a static body off a dynamic one, a pair filter does."""
+        pybullet.setCollisionFilterPair(body, other, -1, -1, 0, physicsClientId=self.client)
+
     def motion(self, body: int) -> tuple[tuple[float, float, float], float, tuple, float]:
         """Position, yaw, linear velocity and yaw rate of a body."""
         position, orientation = pybullet.getBasePositionAndOrientation(

@@ -28,10 +28,13 @@ def resolve_world(
     model: Path | None = None,
     world: Path | None = None,
     library: Path | None = None,
+    *,
+    preset: str | None = None,
 ) -> tuple[World, str]:
-    """The world to simulate and the scenario's name: a shipped scenario, or a world file;
-    ``model`` replaces the world's mission model, ``library`` its building blocks."""
-    loaded, name = _world(scenario, model, world)
+    """The world to simulate and the scenario's name: a shipped scenario (its ``preset``
+    world, such as ``thesis``, when named), or a world file; ``model`` replaces the world's
+    mission model, ``library`` its building blocks."""
+    loaded, name = _world(scenario, model, world, preset)
     if library is not None:
         if not Path(library).is_dir():
             raise InputError(f"--library {library}: there is no such folder")
@@ -39,7 +42,11 @@ def resolve_world(
     return loaded, name
 
 
-def _world(scenario: str | None, model: Path | None, world: Path | None) -> tuple[World, str]:
+def _world(
+    scenario: str | None, model: Path | None, world: Path | None, preset: str | None
+) -> tuple[World, str]:
+    if preset is not None and (world is not None or scenario is None):
+        raise InputError(f"--{preset} takes a shipped scenario's {preset} world, not --world")
     if world is not None:
         loaded = load_world(world, model)
         return loaded, scenario or Path(world).stem
@@ -47,6 +54,14 @@ def _world(scenario: str | None, model: Path | None, world: Path | None) -> tupl
         raise InputError(
             f"name a scenario ({', '.join(scenarios.names())}) or give --world (with --model)"
         )
+    if preset is not None and scenario in scenarios.names():
+        path = scenarios.world_file(scenario, preset)
+        if path is None:
+            having = ", ".join(scenarios.presets(preset)) or "none"
+            raise InputError(
+                f"the scenario {scenario} has no {preset} world (scenarios with one: {having})"
+            )
+        return load_world(path, model), scenario
     path = scenarios.world_file(scenario)
     if path is None:
         raise InputError(

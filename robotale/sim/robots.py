@@ -64,6 +64,8 @@ class SimRobot:
     led: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 0.0)
     speed: float = 0.0  # m/s actually moved in the last step
     driven: bool = False  # its pose comes from the physics (dynamics mode), not from move()
+    thrust: bool = False  # a drone in dynamics mode: its rotors accelerate it (dynamics.fly)
+    velocity: tuple[float, float] = (0.0, 0.0)  # m/s in the field's frame (thrust only)
     drift: tuple[float, float] = (0.0, 0.0)  # metres its odometry is off, x and y
     _command: tuple[float, float, float] = (0.0, 0.0, 0.0)  # forward, turn, climb
     _subscriptions: list[Any] = field(default_factory=list)
@@ -71,6 +73,10 @@ class SimRobot:
     @property
     def flies(self) -> bool:
         return self.spec.kind == "drone"
+
+    @property
+    def airborne(self) -> bool:
+        return self.flies and self.flight != LANDED
 
     def topic(self, name: str) -> str:
         return f"/{self.name}/{name}"
@@ -147,12 +153,16 @@ class SimRobot:
             self.blade = 0.0
             if self.flies and self.pose.z > 0:
                 self.pose.z, self.flight = 0.0, LANDED  # it falls
+                self.velocity = (0.0, 0.0)
         if self.driven:
             return  # the physics moved it (robotale.sim.dynamics)
         forward, turn = self._limited()
         if self.flies:
             self._fly_vertically(dt)
         pose = self.pose
+        if self.thrust:  # its rotors move it across (robotale.sim.dynamics.fly)
+            pose.yaw = _wrap(pose.yaw + turn * dt)
+            return
         pose.yaw = _wrap(pose.yaw + turn * dt)
         pose.x += forward * math.cos(pose.yaw) * dt
         pose.y += forward * math.sin(pose.yaw) * dt

@@ -19,6 +19,8 @@ import math
 import random
 from typing import Any
 
+import numpy as np
+
 from robotale.sim.messages import header
 from robotale.sim.physics import Physics
 from robotale.sim.robots import SimRobot
@@ -147,3 +149,37 @@ def detection_message(now: float, robot: SimRobot, object_id: str, x: float, y: 
         "header": header(now, object_id),
         "point": {"x": round(x, 4), "y": round(y, 4), "z": 0.0},
     }
+
+
+class Footprints:
+    """The part of the field a robot's camera has seen: a grid of ``cell``-sized squares,
+    each marked once any camera footprint (at least :data:`MIN_ALTITUDE` up) covered its
+    centre. This, not the cells the robot flew over, is what the robot could find weeds in:
+    a drone 1.5 m up with a 90 degree camera sees a 3 m wide strip."""
+
+    def __init__(self, field: tuple[float, float], cell: float = 0.1) -> None:
+        self.cell = cell
+        self.shape = (max(1, round(field[0] / cell)), max(1, round(field[1] / cell)))
+        self.seen: dict[str, np.ndarray] = {}
+
+    def look(self, robot: SimRobot, spec: CameraSpec) -> None:
+        """Mark what the camera sees from the robot's pose now."""
+        pose = robot.pose
+        if pose.z < MIN_ALTITUDE:
+            return
+        half = pose.z * math.tan(math.radians(spec.fov) / 2)
+        grid = self.seen.get(robot.name)
+        if grid is None:
+            grid = self.seen[robot.name] = np.zeros(self.shape, dtype=bool)
+        grid[self._cells(pose.x, half, 0), self._cells(pose.y, half, 1)] = True
+
+    def _cells(self, centre: float, half: float, axis: int) -> slice:
+        """The cells whose centres lie within ``half`` of ``centre`` along one axis."""
+        low = math.ceil((centre - half) / self.cell - 0.5)
+        high = math.floor((centre + half) / self.cell - 0.5)
+        size = self.shape[axis]
+        return slice(min(size, max(0, low)), min(size, max(0, high + 1)))
+
+    def fractions(self) -> dict[str, float]:
+        """Per robot with a camera, the share of the field it has seen (0-1)."""
+        return {name: round(float(grid.mean()), 4) for name, grid in sorted(self.seen.items())}

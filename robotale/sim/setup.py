@@ -29,6 +29,7 @@ class RobotStart:
     drain: float
     move_drain: float
     phase: float = 0.0  # share of a control step its sensors and motors lag the clock's ticks
+    flight_drain: float = 0.0
 
 
 @dataclass(frozen=True)
@@ -99,6 +100,8 @@ def _robot_starts(world: World, spec: RobotSpec, rng: np.random.Generator):
             level=_uniform(rng, battery.level),
             drain=_uniform(rng, battery.drain),
             move_drain=_uniform(rng, battery.move_drain),
+            # drawn after the others, so worlds without it draw what they always drew
+            flight_drain=_uniform(rng, battery.flight_drain),
         )
 
 

@@ -48,6 +48,9 @@ ODOM = "nav_msgs/msg/Odometry"
 TURN_GAIN = 2.0
 SLOW_DOWN = 0.8  # forward speed <= this times the remaining distance
 HEADING_WINDOW = 0.6  # radians of heading error beyond which a robot turns on the spot
+RANGE = "sensor_msgs/msg/Range"
+YIELD_TURN = 1.0  # rad/s: a robot that finds its way blocked turns right on the spot ...
+SIDESTEP = 0.6  # metres: ... then drives this far along its new heading before steering back
 SAME_OBJECT = 0.25  # metres: detections closer than this are one object
 
 
@@ -107,17 +110,39 @@ def _steer(pose: _Pose, target: tuple[float, float], speed: float) -> tuple[floa
 
 
 class _Drive:
-    """Drives the robot through waypoints; ``arrived()`` after the last one."""
+    """Drives the robot through waypoints; ``arrived()`` after the last one.
 
-    def __init__(self, robot: Robot, waypoints, speed: float, tolerance: float, arrived) -> None:
+    With a ``clearance`` (metres) the robot yields to what its forward range sensor sees
+    nearer than that, short of its waypoint: it turns right on the spot until the way is
+    clear, drives :data:`SIDESTEP` along its new heading, then heads for the waypoint again.
+    Two robots meeting head on both turn right and pass each other, as road users do."""
+
+    def __init__(
+        self,
+        robot: Robot,
+        waypoints,
+        speed: float,
+        tolerance: float,
+        arrived,
+        clearance: float = 0.0,
+    ) -> None:
         self.robot, self.speed, self.tolerance = robot, speed, tolerance
         self.waypoints = deque(waypoints)
         self.arrived = arrived
         self.paused = False
+        self.clearance = clearance
+        self.ahead = math.inf  # metres to the nearest thing the range sensor sees
+        self.detour: tuple[float, float] | None = None  # where the last sidestep began
+        self.ranges = robot.subscribe("range", self._on_range, RANGE) if clearance > 0 else None
         self.odometry = _Odometry(robot, self._on_pose)
 
+    def _on_range(self, envelope: Envelope) -> None:
+        data = envelope.data or {}
+        reading = float(data.get("range", math.inf))
+        self.ahead = reading if reading < float(data.get("max_range", math.inf)) else math.inf
+
     def _on_pose(self, pose: _Pose) -> None:
-        if self.paused:
+        if self.paused or self._yielding(pose):
             return
         while self.waypoints:
             target = self.waypoints[0]
@@ -128,6 +153,23 @@ class _Drive:
         self.stop()
         self.arrived()
 
+    def _yielding(self, pose: _Pose) -> bool:
+        """Turn away from, then drive past, what blocks the way (True while doing so)."""
+        if not self.waypoints or self.clearance <= 0:
+            return False
+        target = self.waypoints[0]
+        if self.ahead < min(self.clearance, math.hypot(target[0] - pose.x, target[1] - pose.y)):
+            self.detour = (pose.x, pose.y)
+            _twist(self.robot, 0.0, -YIELD_TURN)
+            return True
+        if self.detour is None:
+            return False
+        if math.hypot(pose.x - self.detour[0], pose.y - self.detour[1]) < SIDESTEP:
+            _twist(self.robot, self.speed, 0.0)
+            return True
+        self.detour = None
+        return False
+
     def pause(self) -> None:
         self.paused = True
         _twist(self.robot, 0.0, 0.0)
@@ -136,6 +178,9 @@ class _Drive:
         self.paused = False
 
     def stop(self) -> None:
+        if self.ranges is not None:
+            self.ranges.unsubscribe()
+            self.ranges = None
         if self.odometry is not None:
             self.odometry.close()
             self.odometry = None
@@ -158,7 +203,8 @@ def return_to_base(robot: Robot, inputs: Mapping[str, Any], done: Done) -> Cance
 def _go(robot: Robot, inputs, target: tuple[float, float], done: Done) -> Cancel:
     speed = _number(inputs, robot, "speed", 1.0)
     tolerance = _number(inputs, robot, "tolerance", 0.2)
-    drive = _Drive(robot, [target], speed, tolerance, lambda: done({}))
+    clearance = _number(inputs, robot, "clearance", 0.0)
+    drive = _Drive(robot, [target], speed, tolerance, lambda: done({}), clearance)
     return drive.stop
 
 

@@ -18,7 +18,7 @@ topic                      type                               when
 
 With ``dynamics: true`` ground robots are pushed by their drives and pybullet steps the world
 ``physics_rate`` times a second (:mod:`robotale.sim.dynamics`); the control steps then read
-their poses from the physics.
+their poses from the physics. Drones then fly by thrust against drag (``dynamics.fly``).
 
 A tractor's blade cuts the weeds within its radius while ``blade_force`` > 0; a robot whose
 LED turns red destroys the targets within :data:`FIRE_RANGE`. The engines never see this
@@ -91,6 +91,7 @@ class SimWorld:
         self.contacts = dynamics.Contacts({})
         self.noise = random.Random(setup.seed)  # the sensors' draws, repeatable per run
         self._phantoms = 0
+        self.footprints = sensors.Footprints(world.field)
         self.physics = Physics(gui=gui)
         try:
             self._build()
@@ -121,6 +122,9 @@ class SimWorld:
         for placed in self.setup.objects:
             thing = self._thing(placed, looks[placed.kind])
             self.things[thing.body] = thing
+            for robot in self.robots.values():
+                if robot.driven:
+                    physics.pass_through(robot.body, thing.body)
         if physics.gui:
             physics.follow((world.field[0] / 2, world.field[1] / 2, 0.0))
 
@@ -138,11 +142,13 @@ class SimWorld:
                 battery.charge,
                 battery.low,
                 battery.warn_period,
+                start.flight_drain,
             ),
             home=start.home,
         )
         half = [size / 2 for size in spec.size]
         robot.driven = self.spec.dynamics and not robot.flies
+        robot.thrust = self.spec.dynamics and robot.flies
         mass = spec.mass if robot.driven else 0.0
         robot.body = self.physics.box(
             half, (start.x, start.y, half[2]), spec.color, yaw=start.yaw, mass=mass
@@ -221,11 +227,13 @@ class SimWorld:
 
     def _step(self, robot: SimRobot, now: float, dt: float, battery_due: bool) -> None:
         robot.move(dt)
+        if robot.thrust:
+            dynamics.fly(robot, dt)
         robot.wander(dt, self.noise)
         if not robot.driven:
             place(self.physics, robot)
         on_charger = robot.on_charger()
-        if robot.battery.step(dt, robot.speed, on_charger, now):
+        if robot.battery.step(dt, robot.speed, on_charger, now, robot.airborne):
             self._publish(robot, "low_battery", {}, EMPTY)
         self._publish(robot, "odom", robot.odometry(now), ODOM)
         if battery_due:
@@ -242,6 +250,7 @@ class SimWorld:
             self._sonar(robot, spec.range, now)
         if spec.camera is not None:
             camera = spec.camera
+            self.footprints.look(robot, camera)
             seen = {
                 body
                 for body in sensors.camera_view(self.physics, robot, camera)
@@ -361,6 +370,8 @@ class SimWorld:
                 for t in things
             ],
             "counts": counts,
+            # the share of the field each camera saw (not the cells its robot passed over)
+            "coverage": {"cell": self.footprints.cell, "seen": self.footprints.fractions()},
             "collisions": [
                 {"after": _since(c.time, start), "robot": c.robot, "other": c.other}
                 for c in self.contacts.collisions

@@ -41,6 +41,7 @@ class BatterySpec:
     level: Range = (1.0, 1.0)  # charge at the start, 0-1
     drain: Range = (0.0005, 0.0005)  # per second, always
     move_drain: Range = (0.001, 0.001)  # per second at 1 m/s
+    flight_drain: Range = (0.0, 0.0)  # per second more while a drone is airborne
     charge: float = 0.02  # per second while resting on a charging base
     low: float = 0.2  # low_battery below this
     warn_period: float = 10.0  # low_battery repeats this often while low
@@ -89,6 +90,7 @@ class RobotSpec:
     max_force: float = 40.0  # N, the motors' forward force limit (braking too)
     max_torque: float = 10.0  # N m, the yaw torque limit
     friction: float = 0.8  # tyre grip: no more force than friction * mass * g
+    drag: float = 0.0  # drones: N of air drag per (m/s)^2 (their thrust limit is max_force)
     led: bool = False
     camera: CameraSpec | None = None
     range: RangeSpec | None = None
@@ -363,6 +365,7 @@ class _Reader:
                 "friction",
             )
         }
+        numbers["drag"] = self.number(data.get("drag", defaults.drag), f"{where}.drag")
         return RobotSpec(
             name=name,
             kind=kind,
@@ -440,6 +443,9 @@ class _Reader:
             drain=self.range(data.get("drain", defaults.drain), f"{where}.drain"),
             move_drain=self.range(
                 data.get("move_drain", defaults.move_drain), f"{where}.move_drain"
+            ),
+            flight_drain=self.range(
+                data.get("flight_drain", defaults.flight_drain), f"{where}.flight_drain"
             ),
             charge=self.number(data.get("charge", defaults.charge), f"{where}.charge"),
             low=self.number(data.get("low", defaults.low), f"{where}.low"),
@@ -591,6 +597,7 @@ _ROBOT_KEYS = {
     "max_force",
     "max_torque",
     "friction",
+    "drag",
     "odom_drift",
     "led",
     "camera",

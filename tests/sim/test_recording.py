@@ -79,7 +79,7 @@ def test_odometry_and_battery_are_recorded_at_the_chosen_rate_in_simulated_time(
     assert stamps[-1] - stamps[0] == pytest.approx(run["duration"], abs=0.6)
     battery = [m.percentage for _, _, m in messages(bag, {"/drone/battery"})]
     assert all(0 <= p <= 1 for p in battery)
-    assert battery[0] > battery[-1]  # flying drains it
+    assert min(battery) < battery[0]  # flying drains it (landed on its base, it charges again)
     tags = [m for _, _, m in messages(bag, {"/drone/tag"})]
     assert json.loads(next(t for t in tags if t.activity == "weed_found!").payload).keys() == {
         "x",

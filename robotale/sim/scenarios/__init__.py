@@ -2,7 +2,8 @@
 collaboration following the FAME guidelines) and its world (``<name>.yaml``).
 
 - ``agri``: the running scenario of the thesis (chapter 3, section 5.2): a drone explores a
-  field, the closest of the tractors cuts each weed it finds.
+  field, the closest of the tractors cuts each weed it finds. ``agri.thesis.yaml`` is its
+  world calibrated to the thesis' 70 runs (section 7.2), ``simulate agri --thesis``.
 - ``rexdingo``: the physical scenario of section 5.3: REX explores and finds a target, DINGO
   drives there and fires.
 - ``stop``: the stop-distance experiment of section 5.3.5: a car drives at a wall and is
@@ -16,14 +17,20 @@ FOLDER = Path(__file__).resolve().parent
 
 
 def names() -> list[str]:
-    """The scenarios shipped, by name."""
-    return sorted(p.stem for p in FOLDER.glob("*.yaml"))
+    """The scenarios shipped, by name (``agri.thesis.yaml`` is a preset of agri, no scenario)."""
+    return sorted(p.stem for p in FOLDER.glob("*.yaml") if "." not in p.stem)
 
 
-def world_file(name: str) -> Path | None:
-    """The world file of a shipped scenario, or None."""
-    path = FOLDER / f"{name}.yaml"
+def world_file(name: str, preset: str | None = None) -> Path | None:
+    """The world file of a shipped scenario (or of its ``preset``: ``agri.thesis.yaml``), or
+    None."""
+    path = FOLDER / (f"{name}.{preset}.yaml" if preset else f"{name}.yaml")
     return path if path.is_file() else None
+
+
+def presets(preset: str) -> list[str]:
+    """The scenarios that have a world of that preset."""
+    return [name for name in names() if world_file(name, preset) is not None]
 
 
 def model_file(name: str) -> Path:
