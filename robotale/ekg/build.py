@@ -77,8 +77,8 @@ def build_ekg(
     check_log_name(name)
     tables = graph_tables(log, default_entities(log.columns) if entities is None else entities)
     keys = unique_keys(aggregate)
-    _check_keys(tables.events, keys)
-    _check_key_sizes(tables, keys)
+    check_keys(tables.events, keys)
+    check_key_sizes(tables, keys)
     classes = [class_tables(tables, key) for key in keys]
     ensure_schema(driver)
     # Checked under the lock: another ingest of this name may have finished a moment ago.
@@ -117,7 +117,7 @@ def ensure_schema(driver: Driver) -> None:
         driver.execute_query(statement, database_=database())
 
 
-def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
+def check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
     for key in keys:
         entity_types(list(events.columns), key, what="aggregate by")
 
@@ -127,7 +127,7 @@ def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
 KEY_BYTES = 4000
 
 
-def _check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
+def check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
     """One sentence naming the event and column of the first value too long to be a key."""
     events = tables.events
     columns = {"id"} | {column for key in keys for column in key}
@@ -163,7 +163,7 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
         if isinstance(error, Neo4jError | DriverError | OSError) and not _answers(driver):
             # Retrying the undo against a server that is gone would only take minutes.
             raise ServerError(
-                f"Neo4j went away while the log {target!r} was written ({_why(error)}); once it "
+                f"Neo4j went away while the log {target!r} was written ({why(error)}); once it "
                 "runs again, `robotale logs list` shows the log as failed and "
                 f"`robotale logs delete {shlex.quote(target)}` removes it."
             ) from error
@@ -171,13 +171,13 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
             _undo(driver, target, job.run)
         except (Neo4jError, DriverError, OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({_why(error)}) and what was "
+                f"Writing the log {target!r} to Neo4j failed ({why(error)}) and what was "
                 "written could not be removed; remove it with "
                 f"`robotale logs delete {shlex.quote(target)}`."
             ) from error
         if isinstance(error, Neo4jError | DriverError | OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({_why(error)}); nothing of it "
+                f"Writing the log {target!r} to Neo4j failed ({why(error)}); nothing of it "
                 "was kept."
             ) from error
         raise
@@ -192,7 +192,7 @@ def _answers(driver: Driver) -> bool:
         return False
 
 
-def _why(error: BaseException) -> str:
+def why(error: BaseException) -> str:
     """The gist of a server's or driver's error, on one line: the driver's own text spans
     lines and names connection objects."""
     if isinstance(error, Neo4jError):

@@ -1,9 +1,10 @@
 """Write the tables of :mod:`robotale.ekg.tables` into Neo4j in batches.
 
 Each batch is one ``UNWIND`` query from ``cypher/`` run in a managed transaction (retried on
-transient errors), or, for an append, all of them in the one transaction the caller gives. Values travel as columns (one list per property) rather than one map per row:
-that is much less to encode. Nodes are created first and their internal ids returned, so each
-edge finds its two ends directly instead of through an index.
+transient errors), or, for an append, all of them in the one transaction the caller gives.
+Values travel as columns (one list per property) rather than one map per row: that is much
+less to encode. Nodes are created first and their internal ids returned, so each edge finds
+its two ends directly instead of through an index.
 """
 
 from __future__ import annotations
@@ -32,7 +33,7 @@ class Loader:
 
     def __init__(
         self,
-        driver: Driver,
+        driver: Driver | None,
         log: str,
         progress: tqdm | None = None,
         between_batches: Callable[[], None] = lambda: None,
@@ -79,6 +80,7 @@ class Loader:
     def _execute(self, text: str, parameters: dict[str, Any]) -> list[Any]:
         if self.tx is not None:
             return list(self.tx.run(text, parameters))
+        assert self.driver is not None, "a Loader without a transaction needs a driver"
         records, _, _ = self.driver.execute_query(text, parameters, database_=database())
         return records
 
