@@ -70,27 +70,22 @@ def ingest_command(
         events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
         print(format_reading(reading, short=True))
+    name = log or log_name(path)
+    names = {"entities": split_names(entities) if entities else None}
     with session_driver() as driver:
         if append:
-            summary = append_ekg(
+            summary = append_ekg(driver, events, name, aggregate=aggregate, **names)
+        else:
+            summary = build_ekg(
                 driver,
                 events,
-                log or log_name(path),
-                entities=split_names(entities) if entities else None,
-                aggregate=aggregate or None,
+                name,
+                aggregate=aggregate or DEFAULT_AGGREGATE,
+                replace=replace,
+                source=str(path),
+                **names,
             )
-            print(describe(summary, appended=True))
-            return 0
-        summary = build_ekg(
-            driver,
-            events,
-            log or log_name(path),
-            entities=split_names(entities) if entities else None,
-            aggregate=aggregate or DEFAULT_AGGREGATE,
-            replace=replace,
-            source=str(path),
-        )
-    print(describe(summary))
+    print(describe(summary, appended=append))
     return 0
 
 
