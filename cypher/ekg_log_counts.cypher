@@ -23,6 +23,12 @@ CALL () {
   MATCH (c:Class) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL
   RETURN 'classes' AS what, c.type AS type, count(c) AS count
   UNION ALL
+  MATCH (c:Class)<-[r:OBSERVED]-(:Event) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL
+  RETURN 'OBSERVED' AS what, c.type AS type, count(r) AS count
+  UNION ALL
+  MATCH (c:Class)<-[r:BEGINS]-(:Entity) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL
+  RETURN 'BEGINS' AS what, c.type AS type, count(r) AS count
+  UNION ALL
   MATCH (c:Class)-[r:DF_C]->(:Class) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL
   RETURN 'DF_C' AS what, c.type + ' / ' + r.entityType AS type, count(r) AS count
 }

@@ -1,3 +1,4 @@
-// Mark a log complete and record how many events it has.
+// Mark a log complete and record what the pages open with: $summary holds the number of
+// events and the distinct cases, robots, robotTypes and activities (as text).
 MATCH (l:Log {name: $log})
-SET l.status = 'complete', l.events = $events, l.finished = datetime()
+SET l += $summary, l.status = 'complete', l.finished = datetime()

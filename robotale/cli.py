@@ -372,6 +372,12 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
     ingest.add_argument(
         "--replace", action="store_true", default=None, help="rebuild a log that exists"
     )
+    ingest.add_argument(
+        "--append",
+        action="store_true",
+        default=None,
+        help="add new runs (cases) to a log that exists, with its entities and keys",
+    )
     _add_preparation_options(ingest.add_argument_group("recordings (rosbag2 directories)"))
     _handled_by(ingest, "ingest.ingest_command")
 

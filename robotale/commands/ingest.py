@@ -10,6 +10,7 @@ from typing import Any
 import pandas as pd
 
 from robotale.commands.prepare import prepare_recordings
+from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
@@ -29,6 +30,7 @@ def ingest_command(
     case: str | None = None,
     case_gap: str | None = None,
     replace: bool = False,
+    append: bool = False,
     tags: str | None = None,
     tag_fields: Sequence[str] = (),
     perspectives: str | None = None,
@@ -39,7 +41,10 @@ def ingest_command(
 ) -> int:
     """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
     Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the other
-    options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto ...)."""
+    options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto ...).
+    With ``append`` its runs are added to the stored log of that name."""
+    if append and replace:
+        raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
     if path.is_dir() and not is_parquet(path):
         if mapping or case:
             raise InputError(
@@ -65,17 +70,22 @@ def ingest_command(
         events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
         print(format_reading(reading, short=True))
+    name = log or log_name(path)
+    names = {"entities": split_names(entities) if entities else None}
     with session_driver() as driver:
-        summary = build_ekg(
-            driver,
-            events,
-            log or log_name(path),
-            entities=split_names(entities) if entities else None,
-            aggregate=aggregate or DEFAULT_AGGREGATE,
-            replace=replace,
-            source=str(path),
-        )
-    print(describe(summary))
+        if append:
+            summary = append_ekg(driver, events, name, aggregate=aggregate, **names)
+        else:
+            summary = build_ekg(
+                driver,
+                events,
+                name,
+                aggregate=aggregate or DEFAULT_AGGREGATE,
+                replace=replace,
+                source=str(path),
+                **names,
+            )
+    print(describe(summary, appended=append))
     return 0
 
 
@@ -134,13 +144,14 @@ def split_names(text: str) -> list[str]:
     return [name.strip() for name in text.split(",") if name.strip()]
 
 
-def describe(summary: BuildSummary) -> str:
+def describe(summary: BuildSummary, appended: bool = False) -> str:
     def counts(values: dict[str, int]) -> str:
         return ", ".join(f"{k} {v:,}" for k, v in sorted(values.items())) or "-"
 
+    what = "appended" if appended else "events"
     return "\n".join(
         [
-            f"Log {summary.log!r}: {summary.events:,} events in {summary.seconds:.1f} s",
+            f"Log {summary.log!r}: {summary.events:,} {what} in {summary.seconds:.1f} s",
             f"  entities  {counts(summary.entities)} (CORR {summary.corr:,})",
             f"  DF        {counts(summary.df)}",
             f"  COMM      {summary.comm:,}",

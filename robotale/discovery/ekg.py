@@ -159,12 +159,13 @@ def _entry(entity_type: str, rows: list[dict[str, Any]]) -> tuple[list[Node], li
     """Entry nodes of one entity type: one per entity, or one for all when there are many.
 
     An entity begins once per case it appears in (directly-follows never crosses a case), so
-    an edge counts the cases in which the entity began at that class.
+    an edge counts the cases in which the entity began at that class (``cases``, stored with
+    the classes as BEGINS edges).
     """
     entities = sorted({row["entity"] for row in rows})
     if len(entities) <= ENTRY_NODES_PER_TYPE:
         nodes = [_entity_node(f"{entity_type}:{e}", str(e), 1, entity_type) for e in entities]
-        starts = Counter((row["entity"], row["class"]) for row in rows)
+        starts = {(row["entity"], row["class"]): int(row["cases"]) for row in rows}
         edges = [
             Edge(f"{entity_type}:{e}", c, n, str(n) if n > 1 else "", entity_type)
             for (e, c), n in sorted(starts.items())
@@ -172,7 +173,9 @@ def _entry(entity_type: str, rows: list[dict[str, Any]]) -> tuple[list[Node], li
         return nodes, edges
     node_id = f"{entity_type}:*"
     node = _entity_node(node_id, f"{entity_type} ({len(entities)})", len(entities), entity_type)
-    counts = Counter(row["class"] for row in rows)
+    counts: Counter[str] = Counter()
+    for row in rows:
+        counts[row["class"]] += int(row["cases"])
     edges = [Edge(node_id, c, n, str(n), entity_type) for c, n in sorted(counts.items())]
     return [node], edges
 

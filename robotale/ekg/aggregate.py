@@ -1,8 +1,10 @@
-"""Aggregate a stored log into a Class graph: Class nodes, OBSERVED and DF_C edges.
+"""Aggregate a stored log into a Class graph: Class nodes, OBSERVED, DF_C and BEGINS edges.
 
-The aggregation runs in Neo4j (``cypher/ekg_aggregate_*.cypher``), so any log already in the
-database can be aggregated again by another key, e.g. ``["activity", "robot"]`` (the thesis'
-"multi-slider": one class per activity and robot).
+The keys a log is ingested with are aggregated in pandas and written with the events
+(:func:`robotale.ekg.tables.class_tables`). This aggregation runs in Neo4j
+(``cypher/ekg_aggregate_*.cypher``), so any log already in the database can be aggregated
+again by another key, e.g. ``["activity", "robot"]`` (the thesis' "multi-slider": one class
+per activity and robot), with the same result.
 """
 
 from __future__ import annotations
@@ -53,6 +55,7 @@ def aggregate_unchecked(driver: Driver, log: str, key: list[str]) -> int:
     """:func:`aggregate` for a key already checked against the log's properties."""
     kind = create_classes(driver, log, key)
     edges = create_df_c(driver, log, kind)
+    driver.execute_query(cypher("ekg_aggregate_begins"), log=log, type=kind, database_=database())
     driver.execute_query(cypher("ekg_log_add_class_type"), log=log, type=kind, database_=database())
     return edges
 
@@ -70,6 +73,6 @@ def create_classes(driver: Driver, log: str, key: list[str]) -> str:
 def create_df_c(driver: Driver, log: str, kind: str) -> int:
     """DF_C edges between the classes of type ``kind``; how many."""
     records, _, _ = driver.execute_query(
-        cypher("ekg_aggregate_df_c"), log=log, type=kind, database_=database()
+        cypher("ekg_aggregate_df_c"), log=log, type=kind, sources=None, database_=database()
     )
     return int(records[0]["edges"])

@@ -23,14 +23,21 @@ from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
 from tqdm import tqdm
 
-from robotale.ekg.aggregate import aggregate_unchecked, aggregation_key, class_type
+from robotale.ekg.aggregate import aggregation_key
 from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
-from robotale.ekg.load import Loader
+from robotale.ekg.load import Loader, neo4j_values
 from robotale.ekg.logs import delete_log, log_exists, log_run
 from robotale.ekg.queries import cypher, statements
-from robotale.ekg.tables import GraphTables, entity_types, graph_tables
+from robotale.ekg.tables import (
+    ClassTables,
+    GraphTables,
+    class_tables,
+    entity_types,
+    graph_tables,
+    log_values,
+)
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, ServerError
 
@@ -69,9 +76,10 @@ def build_ekg(
     started = time.perf_counter()
     check_log_name(name)
     tables = graph_tables(log, default_entities(log.columns) if entities is None else entities)
-    keys = [aggregation_key(key) for key in aggregate]
-    _check_keys(tables.events, keys)
-    _check_key_sizes(tables, keys)
+    keys = unique_keys(aggregate)
+    check_keys(tables.events, keys)
+    check_key_sizes(tables, keys)
+    classes = [class_tables(tables, key) for key in keys]
     ensure_schema(driver)
     # Checked under the lock: another ingest of this name may have finished a moment ago.
     with log_write_lock(driver, name, "ingesting") as run:
@@ -82,10 +90,19 @@ def build_ekg(
                 f"or `robotale logs delete {name}` first."
             )
         target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
-        summary = _write_or_undo(driver, _Job(tables, keys, target, source, progress, run))
+        summary = _write_or_undo(driver, _Job(tables, classes, target, source, progress, run))
         if existing:
             _swap(driver, target, name)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
+
+
+def unique_keys(aggregate: Sequence[str | Sequence[str]]) -> list[list[str]]:
+    """The aggregation keys as property names, each once."""
+    keys: list[list[str]] = []
+    for key in map(aggregation_key, aggregate):
+        if key not in keys:
+            keys.append(key)
+    return keys
 
 
 def check_log_name(name: object) -> str:
@@ -100,7 +117,7 @@ def ensure_schema(driver: Driver) -> None:
         driver.execute_query(statement, database_=database())
 
 
-def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
+def check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
     for key in keys:
         entity_types(list(events.columns), key, what="aggregate by")
 
@@ -110,7 +127,7 @@ def _check_keys(events: pd.DataFrame, keys: list[list[str]]) -> None:
 KEY_BYTES = 4000
 
 
-def _check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
+def check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
     """One sentence naming the event and column of the first value too long to be a key."""
     events = tables.events
     columns = {"id"} | {column for key in keys for column in key}
@@ -130,7 +147,7 @@ def _check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
 @dataclass(frozen=True)
 class _Job:
     tables: GraphTables
-    keys: list[list[str]]
+    classes: list[ClassTables]
     target: str  # the log's name, or a temporary one while an existing log is rebuilt
     source: str
     progress: bool
@@ -146,7 +163,7 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
         if isinstance(error, Neo4jError | DriverError | OSError) and not _answers(driver):
             # Retrying the undo against a server that is gone would only take minutes.
             raise ServerError(
-                f"Neo4j went away while the log {target!r} was written ({_why(error)}); once it "
+                f"Neo4j went away while the log {target!r} was written ({why(error)}); once it "
                 "runs again, `robotale logs list` shows the log as failed and "
                 f"`robotale logs delete {shlex.quote(target)}` removes it."
             ) from error
@@ -154,13 +171,13 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
             _undo(driver, target, job.run)
         except (Neo4jError, DriverError, OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({_why(error)}) and what was "
+                f"Writing the log {target!r} to Neo4j failed ({why(error)}) and what was "
                 "written could not be removed; remove it with "
                 f"`robotale logs delete {shlex.quote(target)}`."
             ) from error
         if isinstance(error, Neo4jError | DriverError | OSError):
             raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({_why(error)}); nothing of it "
+                f"Writing the log {target!r} to Neo4j failed ({why(error)}); nothing of it "
                 "was kept."
             ) from error
         raise
@@ -175,7 +192,7 @@ def _answers(driver: Driver) -> bool:
         return False
 
 
-def _why(error: BaseException) -> str:
+def why(error: BaseException) -> str:
     """The gist of a server's or driver's error, on one line: the driver's own text spans
     lines and names connection objects."""
     if isinstance(error, Neo4jError):
@@ -207,39 +224,58 @@ def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> Bu
         entityTypes=entities["type"].unique().tolist(),
         database_=database(),
     )
-    rows = len(events) + len(entities) + len(tables.df) + len(tables.comm)
-    with tqdm(
-        total=rows,
-        unit="row",
-        desc=f"EKG {target}",
-        disable=None if job.progress else True,
-        leave=False,
-    ) as bar:
-        _write_graph(Loader(driver, target, bar, between_batches), tables)
-    df_c = {}
-    for key in job.keys:
-        between_batches()
-        df_c[class_type(key)] = aggregate_unchecked(driver, target, key)
+    with _progress(tables, job.classes, target, job.progress) as bar:
+        loader = Loader(driver, target, bar, between_batches)
+        class_nodes = write_graph(loader, tables, job.classes)
+        for classes, nodes in zip(job.classes, class_nodes, strict=True):
+            write_df_c(loader, classes, nodes)
+    for classes in job.classes:
+        driver.execute_query(
+            cypher("ekg_log_add_class_type"), log=target, type=classes.type, database_=database()
+        )
     between_batches()
     driver.execute_query(
-        cypher("ekg_log_finish"), log=target, events=len(events), database_=database()
-    )
-    return BuildSummary(
+        cypher("ekg_log_finish"),
         log=target,
-        events=len(events),
-        entities=entities.groupby("type").size().to_dict(),
+        summary={"events": len(events)} | log_values(events),
+        database_=database(),
+    )
+    return summarise(target, tables, job.classes)
+
+
+def summarise(log: str, tables: GraphTables, classes: Sequence[ClassTables]) -> BuildSummary:
+    """What was written of ``tables`` (DF_C: the edges computed for them)."""
+    return BuildSummary(
+        log=log,
+        events=len(tables.events),
+        entities=tables.entities.groupby("type").size().to_dict(),
         corr=len(tables.corr),
         df=tables.df.groupby("entityType").size().to_dict(),
         comm=len(tables.comm),
-        df_c=df_c,
+        df_c={c.type: len(c.df_c) for c in classes},
     )
 
 
-def _write_graph(loader: Loader, tables: GraphTables) -> None:
-    """Entities, then events with their CORR edges, then DF and COMM edges."""
+def _progress(
+    tables: GraphTables, classes: Sequence[ClassTables], target: str, shown: bool
+) -> tqdm:
+    rows = len(tables.events) + len(tables.entities) + len(tables.df) + len(tables.comm)
+    rows += sum(len(c.classes) + len(c.df_c) + len(c.entries) for c in classes)
+    return tqdm(
+        total=rows, unit="row", desc=f"EKG {target}", disable=None if shown else True, leave=False
+    )
+
+
+def write_graph(
+    loader: Loader, tables: GraphTables, classes: Sequence[ClassTables]
+) -> list[np.ndarray]:
+    """Entities and classes, then events with their CORR and OBSERVED edges, then DF, COMM
+    and BEGINS edges. Returns the node ids of each key's classes, by class row."""
     entity_nodes = _write_entities(loader, tables.entities)
+    class_nodes = [_write_classes(loader, c) for c in classes]
     per_event = _per_event(tables.corr, entity_nodes, len(tables.events))
-    event_nodes = loader.events(tables.events, per_event)
+    observed = _observed(classes, class_nodes, len(tables.events))
+    event_nodes = loader.events(tables.events, per_event, observed, tables.first)
     for entity_type, part in tables.df.groupby("entityType", sort=True):
         loader.run(
             "ekg_create_df",
@@ -259,6 +295,27 @@ def _write_graph(loader: Loader, tables: GraphTables) -> None:
                 "msgIds": tables.comm["msgId"].tolist(),
             },
         )
+    for kind, nodes in zip(classes, class_nodes, strict=True):
+        _write_begins(loader, kind.entries, entity_nodes, nodes)
+    return class_nodes
+
+
+def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:
+    """The DF_C edges computed in ``classes`` (``nodes``: the classes' node ids)."""
+    df_c = classes.df_c
+    if df_c.empty:
+        return
+    loader.run(
+        "ekg_create_df_c",
+        {
+            "sources": nodes[df_c["source"].to_numpy()].tolist(),
+            "targets": nodes[df_c["target"].to_numpy()].tolist(),
+            "entityTypes": df_c["entityType"].tolist(),
+            "counts": df_c["count"].tolist(),
+            "means": df_c["meanSeconds"].tolist(),
+            "medians": df_c["medianSeconds"].tolist(),
+        },
+    )
 
 
 def _write_entities(loader: Loader, entities: pd.DataFrame) -> np.ndarray:
@@ -269,12 +326,50 @@ def _write_entities(loader: Loader, entities: pd.DataFrame) -> np.ndarray:
     return nodes
 
 
+def _write_classes(loader: Loader, classes: ClassTables) -> np.ndarray:
+    table = classes.classes
+    properties = {name: neo4j_values(table[name]) for name in classes.key}
+    created = loader.run(
+        "ekg_create_classes",
+        {"ids": table["id"].tolist()},
+        {"properties": properties},
+        type=classes.type,
+        key=classes.key,
+    )
+    return np.asarray(created, dtype=np.int64)
+
+
+def _write_begins(
+    loader: Loader, entries: pd.DataFrame, entity_nodes: np.ndarray, class_nodes: np.ndarray
+) -> None:
+    if entries.empty:
+        return
+    loader.run(
+        "ekg_create_begins",
+        {
+            "entities": entity_nodes[entries["entity"].to_numpy()].tolist(),
+            "classes": class_nodes[entries["class"].to_numpy()].tolist(),
+            "cases": entries["cases"].tolist(),
+        },
+    )
+
+
 def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> list[list[int]]:
     """The entity node ids of each event, as one list per event."""
     ordered = corr.sort_values("event", kind="stable")
     nodes = entity_nodes[ordered["entity"].to_numpy()].tolist()
     bounds = np.searchsorted(ordered["event"].to_numpy(), np.arange(events + 1)).tolist()
     return [nodes[start:end] for start, end in itertools.pairwise(bounds)]
+
+
+def _observed(
+    classes: Sequence[ClassTables], class_nodes: Sequence[np.ndarray], events: int
+) -> list[list[int]]:
+    """The class node ids of each event (one per key), as one list per event."""
+    if not classes:
+        return [[] for _ in range(events)]
+    columns = [nodes[c.observed] for c, nodes in zip(classes, class_nodes, strict=True)]
+    return np.column_stack(columns).tolist()
 
 
 def _swap(driver: Driver, new: str, name: str) -> None:

@@ -1,9 +1,10 @@
 """Write the tables of :mod:`robotale.ekg.tables` into Neo4j in batches.
 
 Each batch is one ``UNWIND`` query from ``cypher/`` run in a managed transaction (retried on
-transient errors). Values travel as columns (one list per property) rather than one map per row:
-that is much less to encode. Nodes are created first and their internal ids returned, so each
-edge finds its two ends directly instead of through an index.
+transient errors), or, for an append, all of them in the one transaction the caller gives.
+Values travel as columns (one list per property) rather than one map per row: that is much
+less to encode. Nodes are created first and their internal ids returned, so each edge finds
+its two ends directly instead of through an index.
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
-from neo4j import Driver
+from neo4j import Driver, ManagedTransaction
 from tqdm import tqdm
 
 from robotale.ekg.connection import database
@@ -32,15 +33,19 @@ class Loader:
 
     def __init__(
         self,
-        driver: Driver,
+        driver: Driver | None,
         log: str,
         progress: tqdm | None = None,
         between_batches: Callable[[], None] = lambda: None,
+        tx: ManagedTransaction | None = None,
     ) -> None:
         self.driver = driver
         self.log = log
         self.progress = progress
         self.between_batches = between_batches  # e.g. DeferredInterrupt.check
+        # With a transaction every batch goes into it, one after the other: an append is
+        # kept or undone as a whole.
+        self.tx = tx
 
     def run(
         self,
@@ -62,18 +67,32 @@ class Loader:
             params = {name: _slice(values, start) for name, values in columns.items()}
             for name, columns_of_map in (maps or {}).items():
                 params[name] = {k: _slice(v, start) for k, v in columns_of_map.items()}
-            records, _, _ = self.driver.execute_query(
-                text, params | constants, log=self.log, database_=database()
-            )
+            records = self._execute(text, params | constants | {"log": self.log})
             if self.progress is not None:
                 self.progress.update(min(BATCH, size - start))
             created = records[0].get("nodes") if records else None
             return [node for _, node in sorted(created or [])]
 
+        if self.tx is not None:
+            return [node for start in range(0, size, BATCH) for node in write(start)]
         return _in_flight(write, range(0, size, BATCH))
 
-    def events(self, events: pd.DataFrame, entities: list[list[int]]) -> np.ndarray:
-        """Create the events and their CORR edges (``entities``: node ids per event).
+    def _execute(self, text: str, parameters: dict[str, Any]) -> list[Any]:
+        if self.tx is not None:
+            return list(self.tx.run(text, parameters))
+        assert self.driver is not None, "a Loader without a transaction needs a driver"
+        records, _, _ = self.driver.execute_query(text, parameters, database_=database())
+        return records
+
+    def events(
+        self,
+        events: pd.DataFrame,
+        entities: list[list[int]],
+        classes: list[list[int]],
+        first: int = 0,
+    ) -> np.ndarray:
+        """Create the events with their CORR and OBSERVED edges (``entities``, ``classes``:
+        node ids per event); ``first`` is the first event's position in the stored log.
 
         Returns the events' node ids by row.
         """
@@ -81,10 +100,11 @@ class Loader:
         nanos = times.dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
         columns = {
             "ids": events["id"].tolist(),
-            "orders": list(range(len(events))),
+            "orders": list(range(first, first + len(events))),
             "seconds": (nanos // 1_000_000_000).tolist(),
             "nanos": (nanos % 1_000_000_000).tolist(),
             "entities": entities,
+            "classes": classes,
         }
         others = [c for c in events.columns if c not in ("id", "timestamp")]
         properties = {name: neo4j_values(events[name]) for name in others}

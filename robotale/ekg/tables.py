@@ -11,6 +11,12 @@ stored is refused before the database is touched, and the writes are plain batch
   events of one entity in one case, ordered by time and then by their order in the log.
 - ``comm``: ``source``, ``target``, ``msgId``: from each send event to each receive event of
   the same message in the same case.
+- ``starts``: ``event``, ``entity``: where each entity begins in each case (the first event of
+  its chain, the one no DF edge of that entity leads to).
+
+:func:`class_tables` aggregates them by a key (``activity``, ``activity+robot``): the classes,
+the class of each event (OBSERVED), DF_C with counts and durations, and the entry classes,
+so the class graph is written with the events instead of computed by a second pass in Neo4j.
 
 A case is one run of the robots: directly-follows and messages never cross from one run to
 another, even where runs reuse message ids or overlap in time (simulated runs all start at
@@ -50,6 +56,20 @@ class GraphTables:
     corr: pd.DataFrame
     df: pd.DataFrame
     comm: pd.DataFrame
+    starts: pd.DataFrame
+    first: int = 0  # the position of the first event in the stored log (> 0 when appended)
+
+
+@dataclass(frozen=True)
+class ClassTables:
+    """The classes of one aggregation key and what connects them (rows refer to positions)."""
+
+    type: str
+    key: list[str]
+    classes: pd.DataFrame  # ``id`` and the key's properties, one row per class
+    observed: np.ndarray  # the class row of each event
+    df_c: pd.DataFrame  # ``source``, ``target``, ``entityType``, ``count``, ``meanSeconds``, ...
+    entries: pd.DataFrame  # ``entity``, ``class``, ``cases``: where entities begin, how often
 
 
 def property_name(column: str) -> str:
@@ -67,9 +87,11 @@ def check_name(name: object, what: str) -> str:
     return name
 
 
-def graph_tables(log: pd.DataFrame, entities: Sequence[str]) -> GraphTables:
-    """Check ``log`` (a canonical event log) and derive the tables of its EKG."""
-    events = event_table(log)
+def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> GraphTables:
+    """Check ``log`` (a canonical event log) and derive the tables of its EKG; ``first`` is
+    the position its first event takes in the stored log (the number of events already
+    stored when it is appended)."""
+    events = event_table(log, first)
     types = entity_types([property_name(c) for c in log.columns], entities)
     corr_ids = _correlations(events, types)
     entity_table = corr_ids[["type", "id"]].drop_duplicates().reset_index(drop=True)
@@ -77,16 +99,19 @@ def graph_tables(log: pd.DataFrame, entities: Sequence[str]) -> GraphTables:
         pd.MultiIndex.from_frame(corr_ids[["type", "id"]])
     )
     corr = pd.DataFrame({"event": corr_ids["event"].to_numpy(), "entity": position})
+    df, starts = _directly_follows(events, corr_ids.assign(entity=position))
     return GraphTables(
         events=events,
         entities=entity_table,
         corr=corr,
-        df=_directly_follows(events, corr_ids),
+        df=df,
         comm=_communication(events),
+        starts=starts,
+        first=first,
     )
 
 
-def event_table(log: pd.DataFrame) -> pd.DataFrame:
+def event_table(log: pd.DataFrame, first: int = 0) -> pd.DataFrame:
     """The events with Neo4j property names, checked, in log order."""
     for column in schema.REQUIRED:
         if column not in log.columns:
@@ -109,7 +134,7 @@ def event_table(log: pd.DataFrame) -> pd.DataFrame:
     _check_timestamps(events["timestamp"])
     events = events.reset_index(drop=True)
     if "id" not in events.columns:
-        events["id"] = [str(i) for i in range(len(events))]
+        events["id"] = [str(i) for i in range(first, first + len(events))]
     events["id"] = events["id"].astype("string")
     if events["id"].isna().any() or events["id"].duplicated().any():
         bad = events["id"][events["id"].isna() | events["id"].duplicated()].iloc[0]
@@ -179,7 +204,10 @@ def _correlations(events: pd.DataFrame, types: list[str]) -> pd.DataFrame:
     return corr.drop_duplicates(["event", "type", "id"]).reset_index(drop=True)
 
 
-def _directly_follows(events: pd.DataFrame, corr: pd.DataFrame) -> pd.DataFrame:
+def _directly_follows(
+    events: pd.DataFrame, corr: pd.DataFrame
+) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """DF edges, and the events that begin each entity's chain in each case."""
     times = events["timestamp"].dt.tz_convert("UTC")
     at = corr["event"].to_numpy()
     ordered = corr.assign(
@@ -192,13 +220,19 @@ def _directly_follows(events: pd.DataFrame, corr: pd.DataFrame) -> pd.DataFrame:
         same &= (ordered[key].shift(-1) == ordered[key]).fillna(False).to_numpy(bool)
     following = ordered["event"].shift(-1)[same]
     sources = ordered[same]
-    return pd.DataFrame(
+    df = pd.DataFrame(
         {
             "source": sources["event"].to_numpy(),
             "target": following.to_numpy().astype(np.int64),
             "entityType": sources["type"].to_numpy(),
             "entityId": sources["id"].to_numpy(),
         }
+    )
+    # A chain begins where no DF edge arrives: the first row, and every row after a last one.
+    begins = np.concatenate([[True], ~same[:-1]]) if len(same) else same
+    starts = ordered[begins]
+    return df, pd.DataFrame(
+        {"event": starts["event"].to_numpy(), "entity": starts["entity"].to_numpy()}
     )
 
 
@@ -241,3 +275,91 @@ def _communication(events: pd.DataFrame) -> pd.DataFrame:
             "msgId": pairs["msgId"].to_numpy(),
         }
     )
+
+
+def class_tables(tables: GraphTables, key: Sequence[str]) -> ClassTables:
+    """The classes of ``key`` (Event property names) and their DF_C and entry edges.
+
+    A class's id joins its key values with ``|`` (``move|tractor_1``, a missing value as
+    nothing), as the Cypher aggregation of a stored log names them. The seconds of a DF edge
+    are those between the two events' times in whole milliseconds, as Neo4j's
+    ``epochMillis`` gives them; DF_C's median interpolates between the middle two, as
+    ``percentileCont(x, 0.5)`` does.
+    """
+    events = tables.events
+    codes, ids = pd.factorize(_class_ids(events, key))
+    first = pd.Series(np.arange(len(codes))).groupby(codes).first().to_numpy()
+    classes = events[list(key)].iloc[first].reset_index(drop=True).assign(id=ids.to_numpy())
+    return ClassTables(
+        type="+".join(key),
+        key=list(key),
+        classes=classes,
+        observed=codes,
+        df_c=_df_c(tables, codes),
+        entries=_entries(tables.starts, codes),
+    )
+
+
+def _class_ids(events: pd.DataFrame, key: Sequence[str]) -> pd.Series:
+    parts = [_neo4j_text(events[name]) for name in key]
+    ids = parts[0]
+    for part in parts[1:]:
+        ids = ids + "|" + part
+    return ids
+
+
+def _neo4j_text(values: pd.Series) -> pd.Series:
+    """The values as Cypher's ``toString`` writes them, a missing value as ``''``."""
+    if pd.api.types.is_bool_dtype(values):
+        text = values.map({True: "true", False: "false"})
+    elif pd.api.types.is_float_dtype(values):
+        text = values.map(lambda v: None if pd.isna(v) else repr(float(v)))
+    else:
+        text = values.astype("string")
+    return text.astype("string").fillna("")
+
+
+def _milliseconds(events: pd.DataFrame) -> np.ndarray:
+    nanos = events["timestamp"].dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
+    return nanos // 1_000_000
+
+
+def _df_c(tables: GraphTables, codes: np.ndarray) -> pd.DataFrame:
+    df = tables.df
+    millis = _milliseconds(tables.events)
+    source, target = df["source"].to_numpy(), df["target"].to_numpy()
+    edges = pd.DataFrame(
+        {
+            "source": codes[source],
+            "target": codes[target],
+            "entityType": df["entityType"].to_numpy(),
+            "seconds": (millis[target] - millis[source]) / 1000.0,
+        }
+    )
+    grouped = edges.groupby(["source", "target", "entityType"], sort=True)["seconds"]
+    result = grouped.agg(["count", "mean", "median"]).reset_index()
+    return result.rename(columns={"mean": "meanSeconds", "median": "medianSeconds"})
+
+
+def _entries(starts: pd.DataFrame, codes: np.ndarray) -> pd.DataFrame:
+    begins = pd.DataFrame({"entity": starts["entity"].to_numpy()})
+    begins["class"] = codes[starts["event"].to_numpy()]
+    return begins.groupby(["entity", "class"], sort=True).size().rename("cases").reset_index()
+
+
+#: what the Log node keeps of a log's values (Discover's filters, the Model page's robots)
+SUMMARY_PROPERTIES = {
+    "cases": "case",
+    "robots": "robot",
+    "robotTypes": "robot_type",
+    "activities": "activity",
+}
+
+
+def log_values(events: pd.DataFrame) -> dict[str, list[str]]:
+    """The distinct values of the summary columns, as text, sorted (empty when absent)."""
+    found = {}
+    for name, column in SUMMARY_PROPERTIES.items():
+        values = events[column].dropna() if column in events.columns else pd.Series([])
+        found[name] = sorted(values.astype(str).unique().tolist())
+    return found

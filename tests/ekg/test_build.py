@@ -177,3 +177,28 @@ def test_reaggregating_a_stored_log(neo4j_driver, thesis_ekg, graph_counts):
         aggregate(neo4j_driver, name, "activity,battery")
     with pytest.raises(InputError, match="There is no log named 'no such log'"):
         aggregate(neo4j_driver, "no such log", "activity")
+
+
+@pytest.mark.parametrize("entity_type", ["robot", "msg_id"])
+def test_df_c_written_at_ingest_equals_pm4py_per_entity_type(
+    neo4j_driver, thesis_ekg, thesis_log, entity_type
+):
+    """Counts, mean and median seconds of every DF_C edge, against pm4py's DFG and
+    performance DFG with the entity as the case (the thesis' log is one case)."""
+    name, _ = thesis_ekg
+    column = {"robot": schema.ROBOT, "msg_id": schema.MSG_ID}[entity_type]
+    events = thesis_log.dropna(subset=[column])
+    keys = {"case_id_key": column, "activity_key": schema.ACTIVITY}
+    dfg, _, _ = pm4py.discover_dfg(events, timestamp_key=schema.TIMESTAMP, **keys)
+    performance, _, _ = pm4py.discover_performance_dfg(
+        events, timestamp_key=schema.TIMESTAMP, **keys
+    )
+    edges = query(
+        neo4j_driver, "ekg_class_graph", log=name, type="activity", entityType=entity_type
+    )
+    ours = {(e["source"]["id"], e["target"]["id"]): e for e in edges}
+    assert {pair: e["count"] for pair, e in ours.items()} == dict(dfg)
+    for pair, edge in ours.items():
+        assert edge["meanSeconds"] == pytest.approx(performance[pair]["mean"], abs=1e-6)
+        assert edge["medianSeconds"] == pytest.approx(performance[pair]["median"], abs=1e-6)
+    assert len(ours) > 10 and any(e["medianSeconds"] != e["meanSeconds"] for e in edges)

@@ -1,0 +1,5 @@
+// Remove the outgoing DF_C edges of the classes (node ids $sources) of type $type in log
+// $log, before an append computes them again.
+MATCH (c:Class {log: $log, type: $type})-[r:DF_C]->()
+WHERE id(c) IN $sources
+DELETE r
