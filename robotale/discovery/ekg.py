@@ -27,7 +27,7 @@ import pandas as pd
 
 from robotale.discovery.graph import Edge, Node, ProcessGraph
 from robotale.ekg.aggregate import aggregate as build_classes
-from robotale.ekg.aggregate import aggregation_key, class_type
+from robotale.ekg.aggregate import aggregation_key, class_type, ensure_begins
 from robotale.ekg.connection import read_rows, session_driver
 from robotale.ekg.keys import DISCOVERY_KEY
 from robotale.ekg.logs import log_info
@@ -59,6 +59,8 @@ def discover_ekg(
     kind = class_type(key)
     if kind not in (info["classTypes"] or []):
         build_classes(driver, log, key)
+    else:
+        ensure_begins(driver, log, kind)
     types = _entity_types(info, entities, log)
     graph = ProcessGraph(
         kind="ekg", info={"log": log, "aggregate": key, "class_type": kind, "entities": types}

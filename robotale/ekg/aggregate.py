@@ -60,6 +60,18 @@ def aggregate_unchecked(driver: Driver, log: str, key: list[str]) -> int:
     return edges
 
 
+def ensure_begins(driver: Driver, log: str, kind: str) -> None:
+    """Write the BEGINS edges of the classes ``kind`` when the log has none: logs stored by
+    earlier versions of robotale computed where entities begin on every reading instead."""
+    records, _, _ = driver.execute_query(
+        cypher("ekg_has_begins"), log=log, type=kind, database_=database()
+    )
+    if not records[0]["recorded"]:
+        driver.execute_query(
+            cypher("ekg_aggregate_begins"), log=log, type=kind, database_=database()
+        )
+
+
 def create_classes(driver: Driver, log: str, key: list[str]) -> str:
     """Class nodes and OBSERVED edges for ``key`` (replacing earlier ones); the class type."""
     kind = class_type(key)

@@ -97,6 +97,18 @@ def test_each_run_begins_an_entity_anew(neo4j_driver, thesis_log, log_name):
     assert entries == {(f"robot:{r}", f"{row[ACTIVITY]}|{r}"): 2 for r, row in firsts.iterrows()}
 
 
+def test_a_log_stored_without_begins_edges_gets_them_on_first_discovery(
+    neo4j_driver, thesis_log, log_name
+):
+    # Earlier versions of robotale stored no BEGINS edges and computed entry nodes on reading.
+    build_ekg(neo4j_driver, thesis_log, log_name, entities=["robot"], progress=False)
+    neo4j_driver.execute_query("MATCH (:Entity {log: $log})-[b:BEGINS]->() DELETE b", log=log_name)
+    graph = discover_ekg(log_name, "activity", ["robot"], driver=neo4j_driver)
+    entries = {(e.source, e.target): e.count for e in graph.edges if e.source.startswith("robot:")}
+    firsts = thesis_log.groupby(ROBOT).first()
+    assert entries == {(f"robot:{r}", row[ACTIVITY]): 1 for r, row in firsts.iterrows()}
+
+
 def test_choose_the_entity_types_to_show(stored, neo4j_driver):
     graph = discover_ekg(stored, "activity", ["msg_id"], driver=neo4j_driver)
     assert {e.entity_type for e in graph.edges} == {"msg_id", COMM}
