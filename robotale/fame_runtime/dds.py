@@ -112,6 +112,16 @@ class _Reader:
         self.reader.set_listener(listener)
         self._arrived(self.reader)
 
+    def detach(self) -> None:
+        """No more callbacks from Cyclone's threads. The binding frees a listener's C callbacks
+        with its Python object, so the old listener is kept until Cyclone has let go of it:
+        a callback into freed code, or into a reader the garbage collector is finalising,
+        crashes the process."""
+        old = self.reader._listener
+        with contextlib.suppress(Exception):
+            self.reader.set_listener(None)
+        del old
+
     def _arrived(self, _reader=None) -> None:
         # a Cyclone thread: take the samples, hand them to the clock's thread
         for sample in self.reader.take(N=256):
@@ -310,6 +320,8 @@ class DdsBus:
             # a reader that left does not acknowledge: there is nothing to wait for then
             with contextlib.suppress(Exception):
                 writer.wait_for_acks(duration(seconds=ACK_TIMEOUT))
+        for reader in self._readers.values():
+            reader.detach()
         self._taps.clear()
         self.participant = None
 

@@ -2,6 +2,7 @@
 two engine processes run the agri mission into one bag, plain DDS code that knows only the
 ROS 2 names talks to robotale, and DDS itself keeps QoS-incompatible pairs apart."""
 
+import gc
 import os
 import time
 from dataclasses import dataclass, replace
@@ -45,6 +46,24 @@ def loopback_domain(tmp_path_factory, monkeypatch) -> int:
     monkeypatch.setenv("CYCLONEDDS_URI", config.as_uri())
     monkeypatch.setenv("ROS_DOMAIN_ID", str(domain))
     return domain
+
+
+@pytest.fixture(autouse=True)
+def closed_buses(monkeypatch):
+    """Every bus a test opens is closed after it: a bus left to the garbage collector keeps
+    Cyclone calling into Python until it is finalised, which can crash a later test."""
+    opened: list[DdsBus] = []
+    original = DdsBus.__init__
+
+    def recording(self, *args, **kwargs):
+        original(self, *args, **kwargs)
+        opened.append(self)
+
+    monkeypatch.setattr(DdsBus, "__init__", recording)
+    yield opened
+    for bus in opened:
+        bus.close()
+    gc.collect()
 
 
 @dataclass
