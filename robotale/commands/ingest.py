@@ -11,6 +11,7 @@ import pandas as pd
 
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.build import BuildSummary, build_ekg
+from robotale.ekg.columnar import delete_copies, store_copy
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
@@ -75,6 +76,7 @@ def ingest_command(
             replace=replace,
             source=str(path),
         )
+        store_copy(driver, summary.log, events)
     print(describe(summary))
     return 0
 
@@ -83,6 +85,7 @@ def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> 
     """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
     with session_driver() as driver:
         summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
+        store_copy(driver, summary.log, log)
     print(describe(summary))
 
 
@@ -124,6 +127,7 @@ def logs_delete(name: str) -> int:
     with session_driver() as driver:
         require_log(driver, name)
         delete_log_locked(driver, name)
+    delete_copies(name)
     print(f"Deleted the log {name!r}.")
     return 0
 

@@ -15,6 +15,7 @@ from flask import (
     url_for,
 )
 
+from robotale.ekg.columnar import delete_copies
 from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
@@ -138,6 +139,7 @@ def delete():
     name = request.form.get("name", "")
     require_log(driver(), name, "the Logs page lists those stored")
     delete_log(driver(), name)
+    delete_copies(name)
     state().logs.forget(name)
     state().findings.forget(name)
     flash(f"Deleted the log {name!r}.", "success")
