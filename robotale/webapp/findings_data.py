@@ -7,6 +7,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 from neo4j import Driver
+from neo4j.exceptions import DriverError, Neo4jError
 
 from robotale import enhancement
 from robotale.enhancement.findings import find, trusted_first
@@ -94,3 +95,5 @@ def prepare(driver: Driver, logs: LogData, name: str) -> None:
             step()
         except RobotaleError:  # the page says why when it is visited; the rest is still useful
             continue
+        except (Neo4jError, DriverError, OSError):  # Neo4j or the log went away: a visit says so
+            return

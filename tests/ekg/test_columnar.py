@@ -135,3 +135,13 @@ def test_the_ingest_command_keeps_a_copy(neo4j_server, neo4j_driver, log_name, t
     assert main(["ingest", str(thesis_csv), "--log", log_name, "--entities", "robot"]) == 0
     path = copy_path(neo4j_driver, log_name)
     pd.testing.assert_frame_equal(pq.read_table(path).to_pandas(), read_log(thesis_csv))
+
+
+def test_discover_dfg_of_a_stored_log_writes_what_its_file_gives(
+    neo4j_server, neo4j_driver, log_name, thesis_csv, tmp_path
+):
+    ingest(neo4j_driver, read_log(thesis_csv), log_name)
+    from_file, from_store = tmp_path / "file.json", tmp_path / "stored.json"
+    assert main(["discover", "dfg", str(thesis_csv), "--out", str(from_file)]) == 0
+    assert main(["discover", "dfg", "--log", log_name, "--out", str(from_store)]) == 0
+    assert from_store.read_text() == from_file.read_text()
