@@ -14,7 +14,7 @@ from robotale.enhancement.findings import find, trusted_first
 from robotale.enhancement.result import Perspective
 from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import RobotaleError
-from robotale.webapp.logdata import LogData
+from robotale.webapp.logdata import LogData, log_info
 
 #: the Perspectives page's sections, in the order it shows them
 PERSPECTIVES: dict[str, Callable[..., Perspective]] = {
@@ -81,10 +81,23 @@ def stored_timeline(driver: Driver, logs: LogData, name: str, case: str) -> byte
     return logs.result(driver, name, ("timeline", case), compute)
 
 
+def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict:
+    """The class graph the Perspectives page draws beside its sections: by activity and
+    robot when the log has robots as entities (``perspectives.js`` asks for the same)."""
+    types = log_info(driver, name).get("entityTypes") or []
+    return logs.class_graph(
+        driver, name, ("activity", "robot") if "robot" in types else ("activity",)
+    )
+
+
 def prepare(driver: Driver, logs: LogData, name: str) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
-    perspectives of the whole log, the runs and the first run's timeline."""
-    steps = [lambda: stored_findings(driver, logs, name)]
+    perspectives of the whole log, the class graph beside them, the runs and the first run's
+    timeline."""
+    steps = [
+        lambda: stored_findings(driver, logs, name),
+        lambda: perspectives_graph(driver, logs, name),
+    ]
     steps += [lambda w=which: stored_perspective(driver, logs, name, w) for which in PERSPECTIVES]
     steps += [
         lambda: stored_runs(driver, logs, name),

@@ -116,8 +116,9 @@ def test_storing_prepares_everything_the_pages_show_first(app, neo4j_driver, the
     prepare(neo4j_driver, state(app).logs, name)
     computed = state(app).logs.computed.copy()
     files = kept(neo4j_driver, name)
-    assert len(files) == 8  # findings, five perspectives, the runs, the first run's timeline
+    # findings, five perspectives, the class graph, the runs, the first run's timeline
+    assert len(files) == 9
     client = app.test_client()
-    for url in PAGES[:6] + PAGES[7:]:
+    for url in [*PAGES[:6], *PAGES[7:], "/api/discover/ekg?log={}&by=robot"]:
         assert client.get(url.format(name)).status_code == 200
     assert state(app).logs.computed == computed and kept(neo4j_driver, name) == files
