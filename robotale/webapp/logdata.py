@@ -93,8 +93,9 @@ class LogData:
     def __init__(self, keep: int = KEEP) -> None:
         self.frames = Cache(keep)
         self.graphs = Cache(4 * keep)
-        #: how often each result was computed (not read from disk): what the tests count
-        self.computed: Counter[str] = Counter()
+        #: how often each kind of result of each log was computed (not read from disk), by
+        #: (log, kind): what the tests count
+        self.computed: Counter[tuple[str, str]] = Counter()
         self._lock = threading.Lock()
         self._computing: dict[str, threading.Lock] = {}
 
@@ -123,7 +124,7 @@ class LogData:
             if data is None:
                 data = _json(compute())
                 write_file(path, data)
-                self.computed[what[0]] += 1
+                self.computed[(name, what[0])] += 1
         return data
 
     def class_graph(
