@@ -124,3 +124,16 @@ def test_storing_prepares_everything_the_pages_show_first(app, neo4j_driver, the
     for url in [*PAGES[:6], *PAGES[7:], "/api/discover/ekg?log={}&by=robot"]:
         assert client.get(url.format(name)).status_code == 200
     assert computed(app, name) == prepared and kept(neo4j_driver, name) == files
+
+
+def test_deleting_a_log_removes_its_copy_and_results(client, neo4j_driver, thesis):
+    from robotale.ekg.columnar import log_folder
+
+    name, _ = thesis
+    assert client.get(f"/api/findings?log={name}").status_code == 200
+    assert log_folder(name).is_dir()
+    response = client.post("/logs/delete", data={"csrf_token": client.csrf, "name": name})
+    assert response.status_code == 302
+    assert not log_folder(name).exists()
+    gone = client.get(f"/api/findings?log={name}")
+    assert gone.status_code == 404 or "There is no log named" in gone.get_data(as_text=True)
