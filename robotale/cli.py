@@ -576,7 +576,7 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
     actions = discover.add_subparsers(dest="_action", metavar="ACTION", required=True)
 
     dfg = actions.add_parser("dfg", help="directly-follows graph (pm4py)")
-    _add_log_source(dfg)
+    _add_log_source(dfg, stored=True)
     for flag, dest, text in (
         ("--case", "cases", "keep these cases (runs)"),
         ("--robot", "robots", "keep these robots"),

@@ -12,6 +12,7 @@ import pandas as pd
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg
+from robotale.ekg.columnar import delete_copies, store_copy
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
@@ -74,6 +75,8 @@ def ingest_command(
     names = {"entities": split_names(entities) if entities else None}
     with session_driver() as driver:
         if append:
+            # the log's columnar copy no longer matches its build: the next analysis reads
+            # the whole log back from the graph and keeps that copy instead
             summary = append_ekg(driver, events, name, aggregate=aggregate, **names)
         else:
             summary = build_ekg(
@@ -85,6 +88,7 @@ def ingest_command(
                 source=str(path),
                 **names,
             )
+            store_copy(driver, summary.log, events)
     print(describe(summary, appended=append))
     return 0
 
@@ -93,6 +97,7 @@ def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> 
     """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
     with session_driver() as driver:
         summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
+        store_copy(driver, summary.log, log)
     print(describe(summary))
 
 
@@ -136,6 +141,7 @@ def logs_delete(name: str) -> int:
     with session_driver() as driver:
         require_log(driver, name)
         delete_log_locked(driver, name)
+    delete_copies(name)
     print(f"Deleted the log {name!r}.")
     return 0
 

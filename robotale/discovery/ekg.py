@@ -17,24 +17,21 @@ Every query is a file ``cypher/discover_*.cypher``, run with parameters.
 
 from __future__ import annotations
 
-import datetime as dt
 from collections import Counter
 from collections.abc import Sequence
 from typing import Any
 
-import numpy as np
 import pandas as pd
 
 from robotale.discovery.graph import Edge, Node, ProcessGraph
 from robotale.ekg.aggregate import aggregate as build_classes
 from robotale.ekg.aggregate import aggregation_key, class_type, ensure_begins
+from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import read_rows, session_driver
 from robotale.ekg.keys import DISCOVERY_KEY
 from robotale.ekg.logs import log_info
 from robotale.ekg.queries import cypher
-from robotale.ekg.tables import EVENT_PROPERTIES
 from robotale.errors import InputError
-from robotale.eventlog import schema
 
 COMM = "COMM"
 #: above this many entities of a type, one entry node stands for all of them
@@ -76,21 +73,13 @@ def discover_ekg(
     return graph
 
 
-def read_stored_log(log: str, *, driver: Any = None) -> pd.DataFrame:
-    """The events of a stored log as a canonical event log (pm4py column names)."""
+def read_stored_log(log: str, *, driver: Any = None, hint: str | None = None) -> pd.DataFrame:
+    """The events of a stored log as a canonical event log (pm4py column names, the column
+    types the log was read with), from its columnar copy (:mod:`robotale.ekg.columnar`)."""
     if driver is None:
         with session_driver() as connected:
-            return read_stored_log(log, driver=connected)
-    log_info(driver, log)
-    chunks = _run(driver, "discover_events", log=log)
-    table = pd.DataFrame([event for chunk in chunks for event in chunk["properties"]])
-    table = table.drop(columns=["timestamp", "log", "order"], errors="ignore")
-    seconds = np.array([s for chunk in chunks for s in chunk["seconds"]], dtype="int64")
-    nanos = np.array([n for chunk in chunks for n in chunk["nanos"]], dtype="int64")
-    times = pd.to_datetime(pd.Series(seconds * 10**9 + nanos), unit="ns", utc=True)
-    zone = chunks[0]["zones"][0] if chunks else "UTC"
-    table[schema.TIMESTAMP] = times.dt.tz_convert(_zone(zone))
-    return table.rename(columns=_canonical_names(table.columns))
+            return read_stored_log(log, driver=connected, hint=hint)
+    return stored_table(driver, log, hint)
 
 
 def _run(driver: Any, query: str, **parameters: Any) -> list[dict[str, Any]]:
@@ -190,21 +179,3 @@ def _entity_node(node_id: str, label: str, count: int, entity_type: str) -> Node
         kind="entity",
         properties={"entity_type": entity_type},
     )
-
-
-def _canonical_names(properties) -> dict[str, str]:
-    """Event property -> canonical column (``activity`` -> ``concept:name`` ...)."""
-    back = {prop: column for column, prop in EVENT_PROPERTIES.items()}
-    back |= {short: column for column, short in schema.CSV_NAMES.items() if short not in back}
-    return {p: back[p] for p in properties if p in back}
-
-
-def _zone(name: str) -> dt.tzinfo | str:
-    """A zone Neo4j reports (``Europe/Rome``, ``UTC``, ``+01:00``, ``Z``) for pandas."""
-    if name in ("Z", "UTC", "+00:00"):
-        return "UTC"
-    if name[:1] in "+-" and ":" in name:
-        hours, minutes = name[1:].split(":")
-        offset = dt.timedelta(hours=int(hours), minutes=int(minutes))
-        return dt.timezone(-offset if name[0] == "-" else offset)
-    return name

@@ -1,25 +1,112 @@
-"""The findings of stored logs as the Findings page shows them, computed once per version of a
-log and kept in the app's cache; storing a log prepares them, so the first page after it is
-ready at once."""
+"""What the Findings, Perspectives and Timeline pages show of a stored log, as JSON computed once
+per build of the log (:meth:`LogData.result`); storing a log prepares all of it in the
+background, so the first visit after that computes nothing."""
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
 
 from neo4j import Driver
+from neo4j.exceptions import DriverError, Neo4jError
 
-from robotale.discovery.graph import json_ready
-from robotale.enhancement.findings import find
-from robotale.webapp.logdata import Cache, LogData, log_info
+from robotale import enhancement
+from robotale.enhancement.findings import find, trusted_first
+from robotale.enhancement.result import Perspective
+from robotale.enhancement.timeline import case_timeline, run_list
+from robotale.errors import RobotaleError
+from robotale.webapp.logdata import LogData, log_info
+
+#: the Perspectives page's sections, in the order it shows them
+PERSPECTIVES: dict[str, Callable[..., Perspective]] = {
+    "bottlenecks": enhancement.find_bottlenecks,
+    "spatial": enhancement.spatial_perspective,
+    "communication": enhancement.communication_perspective,
+    "battery": enhancement.battery_perspective,
+    "performance": enhancement.performance_perspective,
+}
 
 
-def stored_findings(driver: Driver, logs: LogData, cache: Cache, name: str) -> dict[str, Any]:
+def stored_findings(driver: Driver, logs: LogData, name: str) -> bytes:
     """The answers for the stored log ``name`` and its runs (case, start, duration)."""
-    version = str(log_info(driver, name).get("created"))
 
-    def compute() -> dict[str, Any]:
+    def compute() -> dict:
         result = find(logs.frame(driver, name))
         runs = result.runs.reindex(columns=["case", "start", "duration"])
-        return json_ready({**result.to_dict(), "runs": runs.to_dict(orient="records")})
+        return {**result.to_dict(), "runs": runs.to_dict(orient="records")}
 
-    return cache.get((name, version), compute)
+    return logs.result(driver, name, ("findings",), compute)
+
+
+def stored_perspective(
+    driver: Driver,
+    logs: LogData,
+    name: str,
+    which: str,
+    activity: str | None = None,
+    robot: str | None = None,
+) -> bytes:
+    """The perspective ``which`` of the whole log, or of one activity (and robot)."""
+
+    def compute() -> dict:
+        result = PERSPECTIVES[which](logs.frame(driver, name), activity=activity, robot=robot)
+        if which == "bottlenecks" and result.has_data:
+            # the same order as the Findings page: effects that may be chance come last
+            result.tables["bottlenecks"] = trusted_first(result.tables["bottlenecks"])
+        return result.to_dict()
+
+    focus = ("activity", activity or "", "robot", robot or "") if activity or robot else ()
+    return logs.result(driver, name, ("perspective", which, *focus), compute)
+
+
+def stored_runs(driver: Driver, logs: LogData, name: str) -> bytes:
+    """The log's runs in start order, for the Timeline page's run picker."""
+    return logs.result(
+        driver,
+        name,
+        ("runs",),
+        lambda: {"runs": run_list(logs.frame(driver, name)).to_dict(orient="records")},
+    )
+
+
+def stored_timeline(driver: Driver, logs: LogData, name: str, case: str) -> bytes:
+    """The timeline of the run ``case`` (the first run when empty)."""
+
+    def compute() -> dict:
+        frame = logs.frame(driver, name)
+        if case:
+            return case_timeline(frame, case).to_dict()
+        runs = run_list(frame)
+        return case_timeline(frame, str(runs["case"].iloc[0]) if not runs.empty else "").to_dict()
+
+    return logs.result(driver, name, ("timeline", case), compute)
+
+
+def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict:
+    """The class graph the Perspectives page draws beside its sections: by activity and
+    robot when the log has robots as entities (``perspectives.js`` asks for the same)."""
+    types = log_info(driver, name).get("entityTypes") or []
+    return logs.class_graph(
+        driver, name, ("activity", "robot") if "robot" in types else ("activity",)
+    )
+
+
+def prepare(driver: Driver, logs: LogData, name: str) -> None:
+    """Compute what the pages show first of ``name`` (after it was stored): the findings, the
+    perspectives of the whole log, the class graph beside them, the runs and the first run's
+    timeline."""
+    steps = [
+        lambda: stored_findings(driver, logs, name),
+        lambda: perspectives_graph(driver, logs, name),
+    ]
+    steps += [lambda w=which: stored_perspective(driver, logs, name, w) for which in PERSPECTIVES]
+    steps += [
+        lambda: stored_runs(driver, logs, name),
+        lambda: stored_timeline(driver, logs, name, ""),
+    ]
+    for step in steps:
+        try:
+            step()
+        except RobotaleError:  # the page says why when it is visited; the rest is still useful
+            continue
+        except (Neo4jError, DriverError, OSError):  # Neo4j or the log went away: a visit says so
+            return

@@ -1,28 +1,36 @@
-"""Stored logs as the pages need them, kept in memory between requests.
+"""Stored logs as the pages need them, computed once per build of a log.
 
-Discovery and the perspectives work on the canonical DataFrame, and the Discover page first
-shows the aggregated class graph; reading either from Neo4j on every click would be slow, so
-the last few stay cached (each app in its own :class:`LogData`). A cached result is used only
-while the log's Log node still has the same creation time, so a log rebuilt elsewhere (the
-command line, another dashboard) is read again. Concurrent requests for the same log wait for
-one read instead of reading it twice.
+Discovery and the perspectives work on the canonical DataFrame (read from the log's columnar
+copy, :mod:`robotale.ekg.columnar`), and the last few stay in memory (each app in its own
+:class:`LogData`). What the pages show of a log (each perspective, the findings, the timeline,
+the class graph) is computed once per build and kept as JSON in the build's folder beside the
+copy, so no later visit, and no restarted dashboard, computes it again; a new build of the
+log (the command line, another dashboard) gets a new folder. Concurrent requests for the same
+log wait for one read or one computation instead of doing it twice.
 """
 
 from __future__ import annotations
 
+import hashlib
+import json
+import re
 import threading
-from collections import OrderedDict
+from collections import Counter, OrderedDict
 from collections.abc import Callable, Hashable, Sequence
+from pathlib import Path
 from typing import Any
 
 import pandas as pd
 from neo4j import Driver
 
-from robotale.discovery.ekg import discover_ekg, read_stored_log
+from robotale.discovery.ekg import discover_ekg
+from robotale.discovery.graph import json_ready
 from robotale.ekg.aggregate import aggregation_key
+from robotale.ekg.columnar import Build, log_build, results_folder, stored_table
 from robotale.ekg.keys import DISCOVERY_KEY, built_keys
 from robotale.ekg.logs import log_info as stored_log_info
 from robotale.errors import InputError
+from robotale.files import write_file
 
 #: how many logs (and class graphs) stay in memory
 KEEP = 4
@@ -72,17 +80,52 @@ def log_info(driver: Driver, name: str) -> dict[str, Any]:
     return stored_log_info(driver, name, MISSING_HINT)
 
 
+def current_build(driver: Driver, name: str) -> Build:
+    """The build of the stored log ``name`` (a :class:`LogNotFound` if there is none)."""
+    if not name:
+        raise InputError("Choose a log first (upload one on the Logs page).")
+    return log_build(driver, name, MISSING_HINT)
+
+
 class LogData:
-    """One app's cache of stored logs: their DataFrames and their class graphs."""
+    """One app's stored logs: their DataFrames in memory, their results on disk."""
 
     def __init__(self, keep: int = KEEP) -> None:
         self.frames = Cache(keep)
         self.graphs = Cache(4 * keep)
+        #: how often each kind of result of each log was computed (not read from disk), by
+        #: (log, kind): what the tests count
+        self.computed: Counter[tuple[str, str]] = Counter()
+        self._lock = threading.Lock()
+        self._computing: dict[str, threading.Lock] = {}
 
     def frame(self, driver: Driver, name: str) -> pd.DataFrame:
         """The stored log ``name`` as a canonical event log."""
-        version = str(log_info(driver, name).get("created"))
-        return self.frames.get((name, version), lambda: read_stored_log(name, driver=driver))
+        build = current_build(driver, name)
+        return self.frames.get((name, build.key), lambda: stored_table(driver, name, MISSING_HINT))
+
+    def result(
+        self, driver: Driver, name: str, what: Sequence[str], compute: Callable[[], Any]
+    ) -> bytes:
+        """The JSON of ``compute()`` for the current build of ``name``: read from the build's
+        folder when it was computed before, else computed (one computation per log at a time,
+        so the section a page asks for first is ready first) and kept."""
+        build = current_build(driver, name)
+        if not build.complete:  # being written or failed: nothing to keep it for
+            return _json(compute())
+        path = results_folder(build) / _file_name(what)
+        with self._lock:
+            computing = self._computing.setdefault(name, threading.Lock())
+        data = _read(path)
+        if data is not None:
+            return data
+        with computing:
+            data = _read(path)
+            if data is None:
+                data = _json(compute())
+                write_file(path, data)
+                self.computed[(name, what[0])] += 1
+        return data
 
     def class_graph(
         self,
@@ -97,16 +140,45 @@ class LogData:
         if entity_types is not None and set(entity_types) == set(info.get("entityTypes") or []):
             entity_types = None  # the same graph as "all", so the same cache entry
         shown = tuple(entity_types) if entity_types is not None else None
-        version = str(info.get("created"))
-        return self.graphs.get(
-            (name, version, tuple(key), shown),
-            lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
-        )
+        version = current_build(driver, name).key  # a rebuild or an append is a new build
+
+        def compute() -> dict[str, Any]:
+            what = ("class-graph", *key, "|", *(shown or ("all",)))
+            data = self.result(
+                driver,
+                name,
+                what,
+                lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
+            )
+            return json.loads(data)
+
+        return self.graphs.get((name, version, tuple(key), shown), compute)
 
     def forget(self, name: str) -> None:
-        """Drop what is cached of ``name`` (it was deleted or rebuilt)."""
+        """Drop what is kept in memory of ``name`` (it was deleted or rebuilt)."""
         self.frames.forget(name)
         self.graphs.forget(name)
+
+
+def _file_name(what: Sequence[str]) -> str:
+    """A file name for the result ``what`` (its words, readable, and a digest of them all:
+    activity and robot names may hold any character)."""
+    words = re.sub(r"[^\w.-]+", "_", "-".join(what))[:60]
+    digest = hashlib.sha256("\x00".join(what).encode("utf-8")).hexdigest()[:16]
+    return f"{words}-{digest}.json"
+
+
+def _json(value: Any) -> bytes:
+    return json.dumps(json_ready(value), separators=(",", ":")).encode("utf-8")
+
+
+def _read(path: Path) -> bytes | None:
+    """A kept result, or None when there is none (or it cannot be read: it is computed again)."""
+    try:
+        data = path.read_bytes()
+    except OSError:
+        return None
+    return data if data else None
 
 
 def first_key(entity_types: Sequence[str]) -> tuple[str, ...]:

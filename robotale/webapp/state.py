@@ -24,8 +24,6 @@ from robotale.webapp.settings import WebSettings
 _KEY = "robotale"
 #: conformance results are not small: the last two (frequencies and deviations) are enough
 OVERLAYS_KEPT = 2
-#: findings are small: one per log the cache of DataFrames keeps
-FINDINGS_KEPT = 4
 
 
 @dataclass
@@ -35,12 +33,10 @@ class AppState:
     neo4j: Neo4jAccess = field(default_factory=Neo4jAccess)
     jobs: Jobs = field(default_factory=Jobs)
     pending: PendingLogs = field(default_factory=PendingLogs)
-    #: stored logs' DataFrames and class graphs
+    #: stored logs' DataFrames, class graphs and the results the pages show
     logs: LogData = field(default_factory=LogData)
     #: the Model page's frequencies and deviations
     overlays: Cache = field(default_factory=lambda: Cache(OVERLAYS_KEPT))
-    #: the Findings page's answers, per log and version
-    findings: Cache = field(default_factory=lambda: Cache(FINDINGS_KEPT))
 
 
 def init_app(app: Flask, settings: WebSettings) -> AppState:

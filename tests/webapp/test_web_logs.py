@@ -289,14 +289,16 @@ def test_the_reading_is_shown_and_the_findings_are_ready_once_stored(
     assert "How the file was read" in page
     assert f"{days} cases" in page
     assert str(web_settings.upload_dir) not in page  # the user's file name, not our copy's
+    computed = state(app).logs.computed
     job, _ = ingest(client, token, {"name": log_name, "entity": ["robot", "msg_id"]})
     assert job["error"] is None, job["error"]
     deadline = time.monotonic() + 300
-    while not [key for key in state(app).findings.items if key[0] == log_name]:
+    while not computed[(log_name, "findings")]:
         assert time.monotonic() < deadline, "the findings were not prepared after storing"
         time.sleep(0.1)  # prepared without anyone asking
     findings = client.get(f"/api/findings?log={log_name}").json
     assert findings["answers"][0]["facts"]["runs"] == days
+    assert computed[(log_name, "findings")] == 1  # the visit read what storing prepared
 
 
 def test_a_csv_of_only_a_byte_order_mark_is_one_sentence(client):

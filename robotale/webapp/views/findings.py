@@ -4,7 +4,7 @@ run's timeline)."""
 
 from __future__ import annotations
 
-from flask import Blueprint, jsonify, render_template, request
+from flask import Blueprint, Response, render_template, request
 
 from robotale.webapp import pages
 from robotale.webapp.findings_data import stored_findings
@@ -20,6 +20,5 @@ def page():
 
 @blueprint.get("/api/findings")
 def findings():
-    current = state()
     name = request.args.get("log", "")
-    return jsonify(stored_findings(driver(), current.logs, current.findings, name))
+    return Response(stored_findings(driver(), state().logs, name), mimetype="application/json")

@@ -15,11 +15,12 @@ from flask import (
     url_for,
 )
 
+from robotale.ekg.columnar import delete_copies
 from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
 from robotale.webapp import ingest, pages, uploads
-from robotale.webapp.findings_data import stored_findings
+from robotale.webapp.findings_data import prepare
 from robotale.webapp.jobs import Jobs
 from robotale.webapp.settings import WebSettings
 from robotale.webapp.state import driver, state
@@ -106,15 +107,13 @@ def start_ingest(token: str):
     pending.log = log
     pending_logs().pop(token)
     replace = request.form.get("replace") == "on"
-    connected, models, logs, findings = driver(), state().models, state().logs, state().findings
+    connected, models, logs = driver(), state().models, state().logs
 
     def work(job):
         stored = ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
-        # the Findings page's answers, prepared while the user reads that the log is stored
-        # (a visit before they are ready waits for this one computation)
-        threading.Thread(
-            target=stored_findings, args=(connected, logs, findings, name), daemon=True
-        ).start()
+        # the findings, perspectives and timeline, prepared while the user reads that the log
+        # is stored (a visit before they are ready waits for this one computation)
+        threading.Thread(target=prepare, args=(connected, logs, name), daemon=True).start()
         return stored
 
     job = jobs().submit(f"Storing {name}", work)
@@ -138,7 +137,7 @@ def delete():
     name = request.form.get("name", "")
     require_log(driver(), name, "the Logs page lists those stored")
     delete_log(driver(), name)
+    delete_copies(name)
     state().logs.forget(name)
-    state().findings.forget(name)
     flash(f"Deleted the log {name!r}.", "success")
     return redirect(url_for("logs.page"))

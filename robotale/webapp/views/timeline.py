@@ -3,11 +3,10 @@ between robots as arrows (lost ones marked) and each robot's battery as a line."
 
 from __future__ import annotations
 
-from flask import Blueprint, jsonify, render_template, request
+from flask import Blueprint, Response, render_template, request
 
-from robotale.discovery.graph import json_ready
-from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.webapp import pages
+from robotale.webapp.findings_data import stored_runs, stored_timeline
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("timeline", __name__)
@@ -23,18 +22,14 @@ def page():
 @blueprint.get("/api/timeline/runs")
 def runs():
     """The log's runs in start order, for the run picker."""
-    frame = state().logs.frame(driver(), request.args.get("log", ""))
-    return jsonify(runs=json_ready(run_list(frame).to_dict(orient="records")))
+    data = stored_runs(driver(), state().logs, request.args.get("log", ""))
+    return Response(data, mimetype="application/json")
 
 
 @blueprint.get("/api/timeline")
 def timeline():
     """One run's timeline (the first run when none is named)."""
-    frame = state().logs.frame(driver(), request.args.get("log", ""))
-    case = request.args.get("case") or _first_run(frame)
-    return jsonify(case_timeline(frame, case).to_dict())
-
-
-def _first_run(frame) -> str:
-    runs = run_list(frame)
-    return str(runs["case"].iloc[0]) if not runs.empty else ""
+    name, case = request.args.get("log", ""), request.args.get("case", "")
+    return Response(
+        stored_timeline(driver(), state().logs, name, case), mimetype="application/json"
+    )
