@@ -19,10 +19,12 @@ import pytest
 
 from robotale.cli import main
 from robotale.ekg.append import append_ekg
+from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import database
 from robotale.ekg.logs import delete_log, log_info, log_summary, log_values
 from robotale.ekg.queries import cypher
 from robotale.eventlog.readers import read_csv
+from robotale.eventlog.schema import EVENT_ID
 
 ENTITIES = "robot,msg_id"
 KEYS = ("activity", "activity,robot")
@@ -130,6 +132,14 @@ def test_appending_runs_gives_the_graph_of_one_ingest(
     # Each entity is one node for the whole log: three robots, however many runs.
     assert appended["counts"]["entities:robot"] == 3
     assert log_info(neo4j_driver, log_name)["events"] == len(runs)
+
+    # The columnar copy kept at the first ingest holds ten runs: analyses read all twenty.
+    def table(name: str) -> pd.DataFrame:
+        events = stored_table(neo4j_driver, name)
+        return events.sort_values(EVENT_ID, kind="stable").reset_index(drop=True)
+
+    pd.testing.assert_frame_equal(table(log_name), table(other_name))
+    assert len(table(log_name)) == len(runs)
 
 
 def test_refused_appends_change_nothing(
