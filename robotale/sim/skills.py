@@ -303,18 +303,25 @@ class _Explorer:
         self.resume_on = str(inputs.get("resume_on") or "")
         self.resume_after = _number(inputs, robot, "resume_after", 60.0)
         self.stop_after = int(_number(inputs, robot, "stop_after", 0))
+        self.plan = [*area, swath]
+        reached, seen = _progress(
+            inputs.get("explored") or robot.variables.get("explored"), self.plan
+        )
+        self.seen = seen  # what an earlier Explore of this area reported: not new
         self.found: list[tuple[float, float]] = []
         self.queue: deque[tuple[float, float]] = deque()
         self.waiting: list[Any] = []  # the resume subscription and timer while held
+        self.path = lanes(*area, swath)
         self.drive = _Drive(
-            robot, lanes(*area, swath), _number(inputs, robot, "speed", 1.0), 0.3, self._finish
+            robot, self.path[reached:], _number(inputs, robot, "speed", 1.0), 0.3, self._finish
         )
         self.detections = robot.subscribe("detection", self._detected)
 
     def _detected(self, envelope: Envelope) -> None:
         point = envelope.data["point"]
         spot = (point["x"], point["y"])
-        if any(math.dist(spot, seen) < SAME_OBJECT for seen in (*self.found, *self.queue)):
+        known = (*self.seen, *self.found, *self.queue)
+        if any(math.dist(spot, seen) < SAME_OBJECT for seen in known):
             return  # seen before: a detector reports an object every frame it is in view
         self.queue.append(spot)
         if not self.waiting:
@@ -327,10 +334,13 @@ class _Explorer:
         self.found.append((x, y))
         if self.signal:
             throw(self.robot, self.signal, {"x": x, "y": y, "z": 0.0}, self.signal_type)
-        if self.stop_after and len(self.found) >= self.stop_after:
-            self._finish()
-        elif self.resume_on:
+        if self.resume_on:
             self._hold()
+        elif self._enough():
+            self._finish()
+
+    def _enough(self) -> bool:
+        return bool(self.stop_after) and len(self.found) >= self.stop_after
 
     def _hold(self) -> None:
         self.drive.pause()
@@ -342,6 +352,9 @@ class _Explorer:
 
     def _resume(self) -> None:
         self._release()
+        if self._enough():  # the last find answered: end here, still holding
+            self._finish()
+            return
         self.drive.resume()
         self._next()
 
@@ -353,14 +366,31 @@ class _Explorer:
             timer.cancel()
 
     def _finish(self) -> None:
+        reached = len(self.path) - len(self.drive.waypoints)
         self.cancel()
         last = self.found[-1] if self.found else (None, None)
-        self.done({"found": len(self.found), "x_found": last[0], "y_found": last[1]})
+        explored = {
+            "plan": self.plan,
+            "reached": reached,
+            "seen": [list(spot) for spot in (*self.seen, *self.found)],
+        }
+        self.done(
+            {"found": len(self.found), "x_found": last[0], "y_found": last[1], "explored": explored}
+        )
 
     def cancel(self) -> None:
         self._release()
         self.detections.unsubscribe()
         self.drive.stop()
+
+
+def _progress(explored: Any, plan: list[float]) -> tuple[int, list[tuple[float, float]]]:
+    """Where an earlier Explore of the same area and swath stopped: the waypoints it had
+    reached and the objects it had reported (none if it explored something else)."""
+    if not isinstance(explored, Mapping) or list(explored.get("plan") or ()) != plan:
+        return 0, []
+    seen = [(float(x), float(y)) for x, y in explored.get("seen") or ()]
+    return int(explored.get("reached") or 0), seen
 
 
 def lanes(

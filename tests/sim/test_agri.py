@@ -73,6 +73,18 @@ def test_a_short_agri_run_cuts_every_weed_and_its_tags_follow_the_model(short_ag
     order = [t.activity for t in drone if t.lifecycle == "start"]
     assert order.index("field_cleaned!") < order.index("return_to_base") < order.index("land")
 
+    # the drone explores anew after each weed it handed to a tractor (figure 7.4's
+    # closest_tractor! -> explore), and its last Explore, finding nothing more, ends the field
+    handed = [t for t in drone if t.activity == "closest_tractor!" and t.lifecycle == "start"]
+    explores = [t for t in drone if t.activity == "explore" and t.lifecycle == "start"]
+    assert len(explores) == len(handed) + 1 == 3
+    for chosen, again in zip(handed, explores[1:], strict=True):
+        assert 0 <= seconds(again) - seconds(chosen) < 1.0
+    found = [t for t in drone if t.activity == "weed_found!" and t.lifecycle == "start"]
+    assert len(found) == 2  # each weed reported once, though the next Explore still sees it
+    last = [t.activity for t in drone if t.lifecycle == "start"][-4:]
+    assert last == ["explore", "field_cleaned!", "return_to_base", "land"]
+
 
 def test_a_tractor_running_low_goes_home_charges_until_full_and_leaves_its_weed(
     short_agri, tmp_path

@@ -9,6 +9,7 @@ no ``x?`` activity has its id."""
 from __future__ import annotations
 
 import dataclasses
+import itertools
 import math
 
 import pandas as pd
@@ -28,6 +29,18 @@ pytestmark = pytest.mark.filterwarnings("ignore:Install the optional requirement
 #: thesis 7.2.2, over 70 runs: (sent, lost) per message type
 THESIS = {"weed_position": (1748, 334), "tractor_position": (1816, 0), "closest_tractor": (1080, 0)}
 TOLERANCE = 0.25
+#: the thesis' ten drone activities (7.2.1), as robotale's agri tags them
+DRONE_ACTIVITIES = {
+    *("take_off", "explore", "weed_found", "weed_position!", "tractor_position?"),
+    *("closest_tractor!", "low_battery", "field_cleaned!", "return_to_base", "land"),
+}
+#: figure 7.4, the drone's DFG, as 7.2.2 reads it: explore, a weed, its messages, explore
+#: again ... until a low battery sends the drone home
+FIGURE_7_4_PATH = (
+    "take_off explore weed_found weed_position! tractor_position? closest_tractor! explore "
+    "low_battery return_to_base land"
+)
+FIGURE_7_4 = set(itertools.pairwise(FIGURE_7_4_PATH.split()))
 
 
 def simulated(folder, runs: int) -> tuple[pd.DataFrame, dict]:
@@ -91,11 +104,40 @@ def test_every_drone_run_ends_on_a_low_battery_with_part_of_the_field_seen(two_r
         assert manifest["outcome"]["status"] == "ended"
 
 
+def drone_edges(log: pd.DataFrame) -> set[tuple[str, str]]:
+    """The drone's directly-follows pairs over the thesis' activities, by hand: each activity
+    instance's start, in time order, run by run."""
+    drone = log[
+        (log[ROBOT] == "drone") & (log[LIFECYCLE] == START) & log[ACTIVITY].isin(DRONE_ACTIVITIES)
+    ].sort_values([CASE, TIMESTAMP], kind="stable")
+    edges = set()
+    for _, activities in drone.groupby(CASE)[ACTIVITY]:
+        steps = activities.tolist()
+        edges |= set(itertools.pairwise(steps))
+    return edges
+
+
+def test_the_drone_dfg_has_every_edge_of_figure_7_4_and_no_field_cleaned(two_runs):
+    log, _ = two_runs
+    edges = drone_edges(log)
+    assert FIGURE_7_4 - edges == set()
+    assert not any("field_cleaned!" in edge for edge in edges)
+    # the figure's loop: every weed handed to a tractor sends the drone exploring again
+    drone = log[(log[ROBOT] == "drone") & (log[LIFECYCLE] == START)]
+    for case, steps in drone.sort_values(TIMESTAMP, kind="stable").groupby(CASE)[ACTIVITY]:
+        steps = steps.tolist()
+        handed = [i for i, a in enumerate(steps) if a == "closest_tractor!"]
+        assert handed, case
+        for i in handed:  # the next of the thesis' activities after it is explore (or the end)
+            after = [a for a in steps[i + 1 :] if a in DRONE_ACTIVITIES]
+            assert after[0] in ("explore", "low_battery"), (case, steps[i:])
+
+
 @pytest.mark.slow
 @pytest.mark.xfail(
     strict=True,
-    reason="tractor_position! is about 0.7x the thesis' count: losses per delivery leave most "
-    "weed_position heard by one tractor only (docs/sim.md)",
+    reason="of the 10 runs' 195 tractor_position, 15 (7.7 %) are lost: the radio's loss per "
+    "metre cuts off a tractor farther than 6.7 m from the drone (docs/sim.md)",
 )
 def test_ten_runs_keep_the_thesis_message_counts_and_losses(tmp_path):
     log, _ = simulated(tmp_path / "agri", 10)
