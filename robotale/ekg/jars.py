@@ -116,6 +116,12 @@ def plugin_jar(artifact: str, repository: str | None = None) -> Path:
     return ensure_jar(pinned[artifact], cache_dir() / "neo4j-plugins", repository)
 
 
+def apoc_with_file_access(repository: str | None = None) -> list[Path]:
+    """Every jar ``plugin_jars.lock`` pins: APOC core and extended with what their file
+    procedures (``apoc.load.csv``) need on this server, for one plugins folder."""
+    return [plugin_jar(jar.artifact, repository) for jar in read_lock(PLUGIN_LOCK_FILE)]
+
+
 def ensure_jar(jar: Jar, folder: Path, repository: str | None = None) -> Path:
     """``folder/<jar's file name>``, downloaded unless a copy with the pinned sha1 is there."""
     target = folder / jar.filename
