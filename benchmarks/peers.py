@@ -72,6 +72,12 @@ def main() -> int:
     parser.add_argument("--heap", default="2g", help="heap of the private Neo4j (2g)")
     parser.add_argument("--batch-size", type=int, default=10_000, help="PromG's batch size")
     parser.add_argument(
+        "--repeat",
+        type=int,
+        default=2,
+        help="builds per tool and log, the fastest counts: the first runs on a cold server (2)",
+    )
+    parser.add_argument(
         "--venv", type=Path, help="a virtual environment that has PromG (default: a new one)"
     )
     args = parser.parse_args()
@@ -87,16 +93,28 @@ def main() -> int:
             if args.synthetic:
                 logs.append((f"synthetic {args.synthetic:,}", synthetic(args.synthetic)))
             for title, log in logs:
-                ours = robotale_build(driver, log)
+                ours = fastest(robotale_build(driver, log) for _ in range(args.repeat))
                 theirs = None
                 if python is not None:
-                    theirs, why_not = promg_build(python, driver, server, log, work, args)
+                    runs = [promg_build(python, driver, server, log, work, args)]
+                    runs += [
+                        promg_build(python, driver, server, log, work, args)
+                        for _ in range(args.repeat - 1)
+                        if runs[-1][0] is not None
+                    ]
+                    built = [build for build, _ in runs if build is not None]
+                    theirs = fastest(built) if built else None
+                    why_not = runs[-1][1]
                 report(title, len(log), ours, theirs, why_not)
     print(f"load average after: {os.getloadavg()[0]:.1f}")
     return 0
 
 
 # -- the two builds --------------------------------------------------------------------------
+
+
+def fastest(builds) -> Build:
+    return min(builds, key=lambda build: build.seconds)
 
 
 def robotale_build(driver, log: pd.DataFrame) -> Build:
@@ -348,6 +366,15 @@ def _table(ours: Build, theirs: Build | None) -> None:
         mine = _count(ours.counts, our_key)
         other = "-" if theirs is None else f"{_count(theirs.counts, their_key):,}"
         print(f"  {row:10} {mine:>10,} {other:>10}")
+    if theirs is not None:
+        compared = {key for _, _, key in ROWS} | {"node:Robot", "node:Message"}
+        extra = {k: n for k, n in theirs.counts.items() if k not in compared}
+        extra = {k: n for k, n in extra.items() if not k.startswith("relationship:DF_A_")}
+        print(f"  PromG also keeps its input: {', '.join(f'{k} {n:,}' for k, n in extra.items())}")
+        print(
+            "  (robotale's DF stays within a case, a run; PromG's spans the whole log. "
+            "PromG's DF_A leaves out self-loops, an activity directly followed by itself)"
+        )
 
 
 def _count(found: dict[str, int], key: str) -> int:
