@@ -7,6 +7,9 @@ ports of the running server), ``ports.json`` (the last server's pid and ports an
 stopped: it outlives a crash, so robotale keeps talking about the right port) and ``password``
 (mode 0600; user ``neo4j``). The password is
 ``NEO4J_PASSWORD`` when that is set at the first start, otherwise a generated one.
+
+Plugin jars (``--plugins`` or ``<robotale home>/plugins``) and the user's settings
+(``<robotale home>/neo4j.conf``) join in as :mod:`robotale.ekg.server_config` describes.
 """
 
 from __future__ import annotations
