@@ -240,3 +240,15 @@ def _ended(pid: int) -> bool:
     except FileNotFoundError:
         return True
     return state == "Z"
+
+
+def test_an_unpinned_plugin_is_refused_naming_the_pinned_ones():
+    with pytest.raises(ServerError, match=r"No plugin 'apoc-full' is pinned .*apoc-core, "):
+        jars.plugin_jar("apoc-full")
+
+
+def test_apoc_core_and_extended_are_pinned_at_one_version():
+    pinned = {jar.artifact: jar for jar in jars.read_lock(jars.PLUGIN_LOCK_FILE)}
+    assert pinned["apoc-core"].version == pinned["apoc-extended"].version
+    assert pinned["apoc-core"].version.split(".")[:2] == jars.NEO4J_VERSION.split(".")[:2]
+    assert all(len(jar.sha1) == 40 and jar.size > 0 for jar in pinned.values())
