@@ -75,6 +75,12 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
     start.add_argument("--http-port", type=int, help="HTTP port (ROBOTALE_NEO4J_HTTP_PORT, 7474)")
     start.add_argument("--heap", help="JVM heap, e.g. 2g (ROBOTALE_NEO4J_HEAP, 1g)")
     start.add_argument("--pagecache", help="page cache, e.g. 1g (ROBOTALE_NEO4J_PAGECACHE, 512m)")
+    start.add_argument(
+        "--plugins",
+        metavar="DIR",
+        help="folder of plugin jars such as APOC (ROBOTALE_NEO4J_PLUGINS; default: the "
+        "plugins folder of the robotale home, when there is one)",
+    )
     start.add_argument("--timeout", type=float, help="seconds to wait (180)")
     _handled_by(start, "neo4j.neo4j_start")
     stop = actions.add_parser("stop", help="stop the server cleanly")

@@ -5,10 +5,12 @@ from __future__ import annotations
 import dataclasses
 import os
 import sys
+from pathlib import Path
 
 from robotale.ekg.connection import bolt_answers, settings
 from robotale.ekg.jars import NEO4J_VERSION
-from robotale.ekg.server import CRASHED, OTHER, RUNNING, LocalServer
+from robotale.ekg.server import CRASHED, OTHER, RUNNING, LocalServer, ServerOptions
+from robotale.ekg.server_config import check_plugins
 
 
 def neo4j_start(
@@ -17,13 +19,20 @@ def neo4j_start(
     http_port: int | None = None,
     heap: str | None = None,
     pagecache: str | None = None,
+    plugins: str | None = None,
     timeout: float = 180.0,
 ) -> int:
     """Start the local server (options not given come from the environment's defaults)."""
     if os.environ.get("NEO4J_URI"):
         print(f"NEO4J_URI is set: robotale uses {os.environ['NEO4J_URI']}; nothing to start.")
         return 0
-    given = {"bolt_port": bolt_port, "http_port": http_port, "heap": heap, "pagecache": pagecache}
+    given = {
+        "bolt_port": bolt_port,
+        "http_port": http_port,
+        "heap": heap,
+        "pagecache": pagecache,
+        "plugins": Path(plugins).expanduser() if plugins else None,
+    }
     overrides = {field: value for field, value in given.items() if value is not None}
     server = LocalServer()
     options = dataclasses.replace(server.recorded_options(), **overrides)
@@ -34,7 +43,16 @@ def neo4j_start(
     verb = "was already running" if already else "is running"
     print(f"Neo4j {NEO4J_VERSION} {verb} at {state.bolt_uri} (pid {state.pid}).")
     print(f"Neo4j Browser: {state.browser_url}  user neo4j, password in {server.password_file}")
+    if not already:
+        _report_plugins(server, options)
     return 0
+
+
+def _report_plugins(server: LocalServer, options: ServerOptions) -> None:
+    folder = server.plugins_folder(options)
+    if folder is not None:
+        names = ", ".join(jar.name for jar in check_plugins(folder)) or "none"
+        print(f"Plugins from {folder}: {names}")
 
 
 def neo4j_stop() -> int:

@@ -29,6 +29,8 @@ from robotale.errors import ServerError
 NEO4J_VERSION = "5.26.30"
 BROWSER_VERSION = "5.24.0"
 LOCK_FILE = Path(__file__).with_name("neo4j_jars.lock")
+#: plugins (APOC) pinned for tests and benchmarks; a user's own plugins need no pin
+PLUGIN_LOCK_FILE = Path(__file__).with_name("plugin_jars.lock")
 #: Maven Central, or a mirror of it (``ROBOTALE_MAVEN_REPO``).
 DEFAULT_REPOSITORY = "https://repo1.maven.org/maven2"
 _MARKER = ".complete"
@@ -102,6 +104,36 @@ def ensure_jars(
     return lib
 
 
+def plugin_jar(artifact: str, repository: str | None = None) -> Path:
+    """The cached jar of the pinned plugin ``artifact`` (e.g. ``apoc-core``), downloaded and
+    sha1-checked the first time; ``cache_dir()/neo4j-plugins`` keeps it for every later call."""
+    pinned = {jar.artifact: jar for jar in read_lock(PLUGIN_LOCK_FILE)}
+    if artifact not in pinned:
+        raise ServerError(
+            f"No plugin {artifact!r} is pinned in {PLUGIN_LOCK_FILE.name}; "
+            f"pinned: {', '.join(sorted(pinned))}."
+        )
+    return ensure_jar(pinned[artifact], cache_dir() / "neo4j-plugins", repository)
+
+
+def apoc_with_file_access(repository: str | None = None) -> list[Path]:
+    """Every jar ``plugin_jars.lock`` pins: APOC core and extended with what their file
+    procedures (``apoc.load.csv``) need on this server, for one plugins folder."""
+    return [plugin_jar(jar.artifact, repository) for jar in read_lock(PLUGIN_LOCK_FILE)]
+
+
+def ensure_jar(jar: Jar, folder: Path, repository: str | None = None) -> Path:
+    """``folder/<jar's file name>``, downloaded unless a copy with the pinned sha1 is there."""
+    target = folder / jar.filename
+    if _is_in_place(target, jar):
+        return target
+    folder.mkdir(parents=True, exist_ok=True)
+    with _file_lock(folder / f".{jar.filename}.lock"):
+        if not _is_in_place(target, jar):  # another process may have finished meanwhile
+            _download_all([jar], folder, repository or _repository(), jar.artifact)
+    return target
+
+
 def _repository() -> str:
     return os.environ.get("ROBOTALE_MAVEN_REPO", DEFAULT_REPOSITORY).rstrip("/")
 
@@ -132,7 +164,9 @@ def _file_lock(path: Path) -> Iterator[None]:
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
-def _download_all(jars: list[Jar], lib: Path, repository: str) -> None:
+def _download_all(
+    jars: list[Jar], lib: Path, repository: str, what: str = f"Neo4j {NEO4J_VERSION} jars"
+) -> None:
     total = sum(jar.size for jar in jars)
     with (
         tqdm(
@@ -140,7 +174,7 @@ def _download_all(jars: list[Jar], lib: Path, repository: str) -> None:
             unit="B",
             unit_scale=True,
             file=sys.stderr,
-            desc=f"Neo4j {NEO4J_VERSION} jars",
+            desc=what,
         ) as progress,
         ThreadPoolExecutor(max_workers=8) as pool,
     ):

@@ -7,6 +7,9 @@ ports of the running server), ``ports.json`` (the last server's pid and ports an
 stopped: it outlives a crash, so robotale keeps talking about the right port) and ``password``
 (mode 0600; user ``neo4j``). The password is
 ``NEO4J_PASSWORD`` when that is set at the first start, otherwise a generated one.
+
+Plugin jars (``--plugins`` or ``<robotale home>/plugins``) and the user's settings
+(``<robotale home>/neo4j.conf``) join in as :mod:`robotale.ekg.server_config` describes.
 """
 
 from __future__ import annotations
@@ -31,7 +34,18 @@ from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.config import robotale_home
 from robotale.ekg.jars import ensure_jars
+from robotale.ekg.port_holder import port_holder
 from robotale.ekg.queries import statements
+from robotale.ekg.server_config import (
+    APOC_CONF_NAME,
+    OVERLAY_NAME,
+    PLUGINS_NAME,
+    Overlay,
+    check_plugins,
+    compose,
+    read_overlay,
+    render,
+)
 from robotale.errors import ServerError
 
 HOST = "127.0.0.1"
@@ -69,15 +83,19 @@ class ServerOptions:
     http_port: int = DEFAULT_HTTP_PORT
     heap: str = "1g"
     pagecache: str = "512m"
+    #: the folder of plugin jars; None: the robotale home's ``plugins/`` when it exists
+    plugins: Path | None = None
 
     @classmethod
     def from_env(cls) -> ServerOptions:
         env = os.environ
+        plugins = env.get("ROBOTALE_NEO4J_PLUGINS")
         return cls(
             bolt_port=int(env.get("ROBOTALE_NEO4J_BOLT_PORT", DEFAULT_BOLT_PORT)),
             http_port=int(env.get("ROBOTALE_NEO4J_HTTP_PORT", DEFAULT_HTTP_PORT)),
             heap=env.get("ROBOTALE_NEO4J_HEAP", cls.heap),
             pagecache=env.get("ROBOTALE_NEO4J_PAGECACHE", cls.pagecache),
+            plugins=Path(plugins).expanduser() if plugins else None,
         )
 
 
@@ -118,7 +136,9 @@ class LocalServer:
     """The Neo4j server whose home is ``<robotale home>/neo4j``."""
 
     def __init__(self, home: Path | None = None) -> None:
-        self.home = (home or robotale_home()) / "neo4j"
+        self.root = home or robotale_home()
+        self.home = self.root / "neo4j"
+        self.overlay_file = self.root / OVERLAY_NAME
         self.state_file = self.home / "server.json"
         self.ports_file = self.home / "ports.json"
         self.password_file = self.home / "password"
@@ -224,11 +244,19 @@ class LocalServer:
             if port in ours:
                 _wait_until_free(port, flag, PORT_WAIT, progress)
             _require_free(port, flag)
+        plugins = self.plugins_folder(options)
+        if plugins is not None:
+            check_plugins(plugins)
+        overlay = read_overlay(self.overlay_file, progress)
         java = java_executable()
         lib = ensure_jars()
-        self._write_config(options)
+        self._write_config(options, overlay)
         self._ensure_password(java, lib)
-        process = self._launch(java, lib, options)
+        # Plugins' extensions (APOC's configuration, for one) are found through the class
+        # path, not the plugins folder. The server's jars come first: plugins bundle older
+        # copies of libraries the server needs (APOC's commons-lang3 breaks its settings).
+        classpath = f"{lib}/*:{plugins}/*" if plugins else f"{lib}/*"
+        process = self._launch(java, classpath, options, overlay.jvm_options)
         state = RunningServer(process.pid, options.bolt_port, options.http_port)
         self.state_file.write_text(json.dumps(asdict(state)))
         self._record(state, stopped=False)
@@ -247,10 +275,12 @@ class LocalServer:
         Returns what was running, or None when nothing was.
         """
         state = self.running()
+        record, _ = self.last_record()
+        if state is None and record is not None and _is_our_process(record.pid, self.home):
+            state = record  # its server.json was lost, yet it still runs
         if state is not None:
             _terminate(state.pid, grace)
         self.state_file.unlink(missing_ok=True)
-        record, _ = self.last_record()
         if record is not None:
             self._record(record, stopped=True)
         return state
@@ -260,20 +290,36 @@ class LocalServer:
 
     # -- helpers -------------------------------------------------------------------------
 
-    def _write_config(self, options: ServerOptions) -> None:
+    def plugins_folder(self, options: ServerOptions) -> Path | None:
+        """The plugins folder the server loads: ``--plugins``, else the home's ``plugins/``."""
+        if options.plugins is not None:
+            return options.plugins.resolve()
+        default = self.root / PLUGINS_NAME
+        return default.resolve() if default.is_dir() else None
+
+    def _write_config(self, options: ServerOptions, overlay: Overlay | None = None) -> None:
         conf = self.home / "conf"
         conf.mkdir(parents=True, exist_ok=True)
         (self.home / "logs").mkdir(exist_ok=True)
-        settings = {
+        plugins = self.plugins_folder(options)
+        owned = {
             "server.default_listen_address": HOST,
             "server.default_advertised_address": HOST,
             "server.bolt.listen_address": f"{HOST}:{options.bolt_port}",
             "server.bolt.advertised_address": f"{HOST}:{options.bolt_port}",
             "server.http.listen_address": f"{HOST}:{options.http_port}",
             "server.http.advertised_address": f"{HOST}:{options.http_port}",
-            "server.https.enabled": "false",
+            "server.bolt.enabled": "true",
+            "server.http.enabled": "true",
             "server.memory.pagecache.size": options.pagecache,
             "dbms.security.auth_enabled": "true",
+            "server.directories.data": "data",
+            "server.directories.logs": "logs",
+            "server.directories.import": "import",
+            "server.directories.plugins": str(plugins) if plugins else "plugins",
+        }
+        defaults = {
+            "server.https.enabled": "false",
             "dbms.usage_report.enabled": "false",
             # Transaction logs are for backups and clusters; a local analysis server needs none.
             "db.tx_log.rotation.retention_policy": "keep_none",
@@ -283,9 +329,16 @@ class LocalServer:
             "internal.server.bolt.thread_pool_shutdown_wait_time": "1s",
             **security_settings(options.heap),
         }
-        lines = ["# Written by `robotale neo4j start` on every start; edits are overwritten."]
-        lines += [f"{key}={value}" for key, value in settings.items()]
-        (conf / "neo4j.conf").write_text("\n".join(lines) + "\n")
+        settings = compose(owned, defaults, overlay or Overlay({}, ()))
+        (conf / "neo4j.conf").write_text(render(settings, self.overlay_file))
+        self._copy_apoc_conf(conf)
+
+    def _copy_apoc_conf(self, conf: Path) -> None:
+        source, target = self.root / APOC_CONF_NAME, conf / APOC_CONF_NAME
+        if source.is_file():
+            shutil.copyfile(source, target)
+        else:  # one removed from the home must not linger
+            target.unlink(missing_ok=True)
 
     def _ensure_password(self, java: str, lib: Path) -> None:
         auth_store = self.home / "data" / "dbms" / "auth.ini"
@@ -314,14 +367,17 @@ class LocalServer:
         if result.returncode != 0:
             raise ServerError(f"Could not set the Neo4j password: {result.stderr.strip()}")
 
-    def _launch(self, java: str, lib: Path, options: ServerOptions) -> subprocess.Popen:
+    def _launch(
+        self, java: str, classpath: str, options: ServerOptions, jvm_options: tuple[str, ...] = ()
+    ) -> subprocess.Popen:
         command = [
             java,
             f"-Xms{options.heap}",
             f"-Xmx{options.heap}",
             *_JVM_OPTIONS,
+            *jvm_options,
             "-cp",
-            f"{lib}/*",
+            classpath,
             ENTRY_POINT,
             f"--home-dir={self.home}",
             f"--config-dir={self.home / 'conf'}",
@@ -344,17 +400,25 @@ class LocalServer:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if process.poll() is not None:
-                self._fail(f"Neo4j exited with status {process.returncode} while starting")
+                self._fail(f"Neo4j exited with status {process.returncode} while starting", state)
             # HTTP comes up last: once it answers, Bolt, Browser and the databases are ready.
             if _http_answers(state) and bolt_answers(state.bolt_uri, (USER, self.password() or "")):
                 return
             time.sleep(0.5)
-        self._fail(f"Neo4j did not answer on {state.bolt_uri} within {timeout:.0f} s")
+        self._fail(f"Neo4j did not answer on {state.bolt_uri} within {timeout:.0f} s", state)
 
-    def _fail(self, what: str) -> None:
+    def _fail(self, what: str, state: RunningServer) -> None:
         tail = _last_lines(self.log_file, 15) or _last_lines(self.console_file, 15)
         if "Address already in use" in tail:
-            raise PortInUse(f"{what}: a port it needs is in use; see {self.log_file}.")
+            # Taken between our check and Neo4j's bind: say by whom, if we can still see it.
+            ports = (("bolt", state.bolt_port), ("http", state.http_port))
+            taken = [
+                f"{flag} port {port} ({_held_by(port)})"
+                for flag, port in ports
+                if not _is_free(port)
+            ]
+            held = ", ".join(taken) or f"see {self.log_file}"
+            raise PortInUse(f"{what}: a port it needs is in use: {held}.")
         raise ServerError(f"{what}; the last lines of {self.log_file}:\n{tail}")
 
 
@@ -418,16 +482,16 @@ def _wait_until_free(port: int, what: str, timeout: float, progress: Callable[[s
     while not _is_free(port):
         if _port_answers(port):
             raise PortInUse(
-                f"The last local Neo4j's {what} port {port} on {HOST} is held by something else "
-                f"that answers there; stop it, choose another port with --{what}-port, or set "
-                "NEO4J_URI to use that server."
+                f"The last local Neo4j's {what} port {port} on {HOST} is held by "
+                f"{port_holder(port) or 'something else'}, which answers there; stop it, choose "
+                f"another port with --{what}-port, or set NEO4J_URI to use that server."
             )
         left = deadline - time.monotonic()
         if left <= 0:
             raise PortInUse(
                 f"The {what} port {port} on {HOST} of the last local Neo4j was still not free "
-                f"after {timeout:.0f} s; see which process holds it (`ss -ltnp`) or choose "
-                f"another port with --{what}-port."
+                f"after {timeout:.0f} s ({_held_by(port)}); choose another port with "
+                f"--{what}-port."
             )
         progress(f"Waiting for the {what} port {port} to be free ({left:.0f} s left) ...")
         time.sleep(1)
@@ -436,10 +500,15 @@ def _wait_until_free(port: int, what: str, timeout: float, progress: Callable[[s
 def _require_free(port: int, what: str) -> None:
     if not _is_free(port):
         raise PortInUse(
-            f"The Neo4j {what} port {port} on {HOST} is in use; choose another with "
-            f"--{what}-port (or ROBOTALE_NEO4J_{what.upper()}_PORT), or set NEO4J_URI "
-            "to use the server that is listening there."
+            f"The Neo4j {what} port {port} on {HOST} is in use ({_held_by(port)}); choose "
+            f"another with --{what}-port (or ROBOTALE_NEO4J_{what.upper()}_PORT), or set "
+            "NEO4J_URI to use the server that is listening there."
         )
+
+
+def _held_by(port: int) -> str:
+    holder = port_holder(port)
+    return f"held by {holder}" if holder else "its holder is unknown: try `ss -ltnp`"
 
 
 def free_port() -> int:

@@ -17,7 +17,6 @@ import pandas as pd
 import pytest
 from neo4j import GraphDatabase
 
-from robotale.ekg import jars
 from robotale.ekg.server import LocalServer, free_port
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
@@ -50,18 +49,6 @@ def _wait_for_events(driver, name: str, ingest: subprocess.Popen) -> None:
         assert ingest.poll() is None, ingest.communicate()
         assert time.monotonic() < deadline
         time.sleep(0.2)
-
-
-@pytest.fixture
-def env(tmp_path, neo4j_server) -> dict[str, str]:
-    # neo4j_server first: it provisions the jar cache this second server shares.
-    clean = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")}
-    return clean | {
-        "ROBOTALE_HOME": str(tmp_path / "home"),
-        "ROBOTALE_CACHE": str(jars.server_dir().parent),
-        "ROBOTALE_NEO4J_HEAP": "512m",
-        "ROBOTALE_NEO4J_PAGECACHE": "64m",
-    }
 
 
 @pytest.mark.slow

@@ -1,0 +1,22 @@
+"""Fixtures of the ekg tests."""
+
+from __future__ import annotations
+
+import os
+
+import pytest
+
+
+@pytest.fixture
+def env(tmp_path, neo4j_server) -> dict[str, str]:
+    """The environment of a `robotale` with a Neo4j home of its own under ``tmp_path/home``
+    (neo4j_server first: it provisions the jar cache this second server shares)."""
+    from robotale.ekg import jars
+
+    clean = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")}
+    return clean | {
+        "ROBOTALE_HOME": str(tmp_path / "home"),
+        "ROBOTALE_CACHE": str(jars.server_dir().parent),
+        "ROBOTALE_NEO4J_HEAP": "512m",
+        "ROBOTALE_NEO4J_PAGECACHE": "64m",
+    }
