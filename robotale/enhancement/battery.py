@@ -20,7 +20,13 @@ import pandas as pd
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.performance import WAIT, finished_instances, shared_steps
-from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
+from robotale.enhancement.result import (
+    Figures,
+    Perspective,
+    focus_events,
+    focus_label,
+    no_data,
+)
 from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, ROBOT, TIMESTAMP
 
 LOW_ACTIVITY = "low_battery"
@@ -62,7 +68,7 @@ def battery_perspective(
             "energy": energy,
             "levels": _level_table(focused),
         },
-        figures={"levels": _levels_figure(focused, lows)},
+        figures=Figures({"levels": lambda: _levels_figure(focused, lows)}),
         summary={
             "robots": sorted(focused[ROBOT].dropna().unique()) if ROBOT in focused else [],
             "low_battery_events": len(lows),
@@ -242,20 +248,26 @@ def _with_what_followed(lows: pd.DataFrame, analysis: LogAnalysis, following: in
     if lows.empty:
         return lows.assign(then=pd.Series(dtype=object), until_end=pd.Series(dtype=float))
     instances = analysis.instances()
-    then, until_end = [], []
-    for _, low in lows.iterrows():
-        mine = instances[(instances[CASE] == low[CASE]) & _same_robot(instances, low)]
-        after = mine[mine[START_TIMESTAMP] > low[TIMESTAMP]]
-        then.append(" -> ".join(after[ACTIVITY].astype(str).head(following)))
-        end = mine[TIMESTAMP].max()
-        until_end.append((end - low[TIMESTAMP]).total_seconds() if pd.notna(end) else None)
-    return lows.assign(then=then, until_end=until_end)
-
-
-def _same_robot(instances: pd.DataFrame, low: pd.Series) -> pd.Series:
-    if ROBOT not in instances.columns or ROBOT not in low.index:
-        return pd.Series(True, index=instances.index)
-    return instances[ROBOT] == low[ROBOT]
+    keys = [CASE] + ([ROBOT] if ROBOT in instances.columns and ROBOT in lows.columns else [])
+    # one join of every low moment with its robot's instances in the case, instead of a scan
+    # of all instances per moment; a moment without a case or robot matches nothing
+    moments = lows[keys].assign(_low=np.arange(len(lows)), _at=lows[TIMESTAMP].to_numpy())
+    moments = moments.dropna(subset=keys)
+    mine = instances[[*keys, ACTIVITY, START_TIMESTAMP, TIMESTAMP]].assign(
+        _pos=np.arange(len(instances))
+    )
+    joined = moments.merge(mine, on=keys).sort_values(["_low", "_pos"], kind="stable")
+    ends = joined.groupby("_low")[TIMESTAMP].max().reindex(range(len(lows)))
+    until_end = (ends - pd.Series(lows[TIMESTAMP].to_numpy())).dt.total_seconds()
+    after = joined[joined[START_TIMESTAMP] > joined["_at"]]
+    first = after.groupby("_low", sort=False).head(following)
+    names = (first[ACTIVITY].astype(str) + " -> ").groupby(first["_low"]).sum()
+    then = names.str.slice(stop=-len(" -> ")).reindex(range(len(lows))).fillna("")
+    known = until_end.notna().to_numpy()
+    return lows.assign(
+        then=then.tolist(),
+        until_end=[float(v) if k else None for v, k in zip(until_end, known, strict=True)],
+    )
 
 
 def _low_focus(lows: pd.DataFrame, activity: str | None, robot: str | None) -> pd.Series:

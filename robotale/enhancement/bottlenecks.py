@@ -54,7 +54,7 @@ from robotale.enhancement.performance import (
     shared_robot_times,
     shared_steps,
 )
-from robotale.enhancement.result import Perspective, focus_label, no_data
+from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP
 
 #: effect candidates, simplest first (the one named when several share their cases)
@@ -105,7 +105,7 @@ def find_bottlenecks(
     return Perspective(
         name="bottlenecks",
         tables={"bottlenecks": ranking},
-        figures={"bottlenecks": _figure(ranking)},
+        figures=Figures({"bottlenecks": lambda: _figure(ranking)}),
         summary={
             "first": first["explanation"],
             "first_kind": first["kind"],

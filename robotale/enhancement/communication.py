@@ -32,7 +32,7 @@ from robotale.discovery.instances import START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.performance import ARROW, finished_instances, shared_cases
-from robotale.enhancement.result import Perspective, focus_label, no_data
+from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
@@ -92,7 +92,7 @@ def communication_perspective(
     return Perspective(
         name="communication",
         tables={"message_types": types, "channels": channels, "messages": messages, "lost": lost},
-        figures={"messages": _figure(types)},
+        figures=Figures({"messages": lambda: _figure(types)}),
         summary=_summary(messages, channels, lost_effect),
     )
 
