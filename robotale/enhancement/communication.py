@@ -301,9 +301,8 @@ def _meant_for(missing, events, reached, keys) -> np.ndarray:
     stated = pd.Series(np.nan, index=missing.index, dtype=object)
     if MSG_RECEIVER in events.columns:
         stated = _lookup(missing, keys, _first(events, keys, MSG_RECEIVER))
-    usual = reached.groupby(["sender", TYPE])["receiver"].agg(
-        lambda r: r.iloc[0] if r.nunique() == 1 else np.nan
-    )
+    receivers = reached.groupby(["sender", TYPE])["receiver"]
+    usual = receivers.first().astype(object).where(receivers.nunique() == 1, np.nan)
     guessed = pd.Series(
         usual.reindex(pd.MultiIndex.from_frame(missing[["sender", TYPE]])).to_numpy(),
         index=missing.index,
@@ -386,16 +385,19 @@ def _distinct(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
 
 
 def _joined(deliveries: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
-    """Per message, its distinct ``column`` values joined (most messages have one)."""
-    values = deliveries[[*keys, column]].astype({column: str}).drop_duplicates()
-    values = values.sort_values(column, kind="stable")
-    grouped = values.groupby(keys)[column]
-    joined = grouped.first()
-    several = grouped.size() > 1
-    if several.any():
-        many = values[_in(values, several[several].reset_index(), keys)]
-        joined.update(many.groupby(keys)[column].agg(", ".join))
-    return joined
+    """Per message, its distinct ``column`` values in text order, joined (most messages have
+    one)."""
+    grouped = deliveries.groupby(keys, sort=True)
+    message = grouped.ngroup().to_numpy()
+    codes, names = pd.factorize(deliveries[column].astype(str))
+    names = names.to_numpy(object)
+    rank = np.empty(len(names), dtype=np.int64)
+    rank[np.argsort(names, kind="stable")] = np.arange(len(names))
+    # each (message, value) once, messages in key order and values in text order within one
+    pairs = np.unique(message[message >= 0] * len(names) + rank[codes[message >= 0]])
+    labels = np.sort(names)[pairs % len(names)] + ", "
+    joined = pd.Series(labels, dtype=object).groupby(pairs // len(names)).sum()
+    return pd.Series(joined.str.slice(stop=-2).to_numpy(object), index=grouped.size().index)
 
 
 def _lookup(frame: pd.DataFrame, keys: list[str], values: pd.Series) -> pd.Series:
