@@ -244,7 +244,7 @@ def _steady_excess(
 
 
 def _receive_activities(instances: pd.DataFrame) -> set[str]:
-    return set(instances.loc[event_roles(instances) == RECEIVE, ACTIVITY])
+    return set(instances.loc[event_roles(instances) == RECEIVE, ACTIVITY].unique())
 
 
 def _repeats(steps: pd.DataFrame) -> pd.Series:

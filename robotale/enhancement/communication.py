@@ -202,10 +202,26 @@ def lost_messages(
     return lost, _lost_effect(effect)
 
 
+#: the columns the message tables read: a wide log's other columns are not copied along
+MESSAGE_COLUMNS = (
+    CASE,
+    MSG_ID,
+    ACTIVITY,
+    TIMESTAMP,
+    LIFECYCLE,
+    ROBOT,
+    MSG_ROLE,
+    MSG_SENDER,
+    MSG_RECEIVER,
+    MSG_PAYLOAD,
+)
+
+
 def _message_events(log: pd.DataFrame) -> pd.DataFrame:
     if MSG_ID not in log.columns:
         return pd.DataFrame()
-    events = log[log[MSG_ID].notna().to_numpy(bool)]
+    wanted = log[[c for c in log.columns if c in MESSAGE_COLUMNS]]
+    events = wanted[log[MSG_ID].notna().to_numpy(bool)]
     roles = event_roles(events)
     return events.assign(_role=roles)[roles.notna().to_numpy(bool)]
 
