@@ -364,12 +364,13 @@ def _queueing(analysis: LogAnalysis) -> pd.DataFrame:
 
 
 def _excess_rows(rows: pd.DataFrame, kind: str, activity: pd.Series, excess: pd.Series):
+    # the columns' own arrays: turning text columns into Python objects costs more than the rest
     return pd.DataFrame(
         {
             "kind": kind,
-            "activity": activity.to_numpy(),
-            "robot": rows[ROBOT].to_numpy(),
-            CASE: rows[CASE].to_numpy(),
+            "activity": activity.array,
+            "robot": rows[ROBOT].array,
+            CASE: rows[CASE].array,
             "excess": np.asarray(excess, dtype=float),
         }
     )
