@@ -165,12 +165,15 @@ def test_what_followed_every_low_moment_of_the_thesis_days(thesis_csv):
 
 
 def test_a_low_moment_after_its_robots_last_activity_is_followed_by_nothing(events):
+    rows = [
+        ("drone", "survey", "start", 0),
+        ("drone", "survey", "complete", 50),
+        ("rover", "dig", "start", 55),
+        ("drone", "low_battery", "none", 60),
+        ("rover", "dig", "complete", 90),
+    ]
     log = events(
-        {"case": "1", "robot": "drone", "activity": "survey", "lifecycle": "start", "t": 0},
-        {"case": "1", "robot": "drone", "activity": "survey", "lifecycle": "complete", "t": 50},
-        {"case": "1", "robot": "rover", "activity": "dig", "lifecycle": "start", "t": 55},
-        {"case": "1", "robot": "drone", "activity": "low_battery", "lifecycle": "none", "t": 60},
-        {"case": "1", "robot": "rover", "activity": "dig", "lifecycle": "complete", "t": 90},
+        *[{"case": "1", "robot": r, "activity": a, "lifecycle": lc, "t": t} for r, a, lc, t in rows]
     )
     [low] = battery_perspective(log).tables["low_battery"].to_dict("records")
     # the rover's dig, later, is another robot's work; the drone's last completion is the
