@@ -19,6 +19,7 @@ import pandas as pd
 
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.followed import what_followed
 from robotale.enhancement.performance import WAIT, finished_instances, shared_steps
 from robotale.enhancement.result import (
     Figures,
@@ -249,23 +250,13 @@ def _with_what_followed(lows: pd.DataFrame, analysis: LogAnalysis, following: in
         return lows.assign(then=pd.Series(dtype=object), until_end=pd.Series(dtype=float))
     instances = analysis.instances()
     keys = [CASE] + ([ROBOT] if ROBOT in instances.columns and ROBOT in lows.columns else [])
-    # one join of every low moment with its robot's instances in the case, instead of a scan
-    # of all instances per moment; a moment without a case or robot matches nothing
-    moments = lows[keys].assign(_low=np.arange(len(lows)), _at=lows[TIMESTAMP].to_numpy())
-    moments = moments.dropna(subset=keys)
-    mine = instances[[*keys, ACTIVITY, START_TIMESTAMP, TIMESTAMP]].assign(
-        _pos=np.arange(len(instances))
-    )
-    joined = moments.merge(mine, on=keys).sort_values(["_low", "_pos"], kind="stable")
-    ends = joined.groupby("_low")[TIMESTAMP].max().reindex(range(len(lows)))
-    until_end = (ends - pd.Series(lows[TIMESTAMP].to_numpy())).dt.total_seconds()
-    after = joined[joined[START_TIMESTAMP] > joined["_at"]]
-    first = after.groupby("_low", sort=False).head(following)
-    names = (first[ACTIVITY].astype(str) + " -> ").groupby(first["_low"]).sum()
-    then = names.str.slice(stop=-len(" -> ")).reindex(range(len(lows))).fillna("")
+    # a moment without a case or robot is about no instance
+    named = lows.dropna(subset=keys)
+    found = what_followed(instances, named, keys, TIMESTAMP, following).reindex(lows.index)
+    until_end = (pd.to_datetime(found["last_end"], utc=True) - lows[TIMESTAMP]).dt.total_seconds()
     known = until_end.notna().to_numpy()
     return lows.assign(
-        then=then.tolist(),
+        then=found["then"].fillna("").tolist(),
         until_end=[float(v) if k else None for v, k in zip(until_end, known, strict=True)],
     )
 

@@ -28,10 +28,10 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.discovery.instances import START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
-from robotale.enhancement.performance import ARROW, finished_instances, shared_cases
+from robotale.enhancement.followed import what_followed
+from robotale.enhancement.performance import finished_instances, shared_cases
 from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
@@ -360,15 +360,8 @@ def _with_resends(table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
 
 def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) -> list[str]:
     """The sender's next activities (started after the message was first sent)."""
-    mine = instances[[CASE, ROBOT, ACTIVITY, START_TIMESTAMP]].rename(columns={ROBOT: "sender"})
-    later = lost[[CASE, "sender", "sent_at"]].reset_index().merge(mine, on=[CASE, "sender"])
-    later = later[later[START_TIMESTAMP] > later["sent_at"]]
-    later = later.sort_values(["index", START_TIMESTAMP], kind="stable")
-    top = later.groupby("index").head(following)
-    # summing the strings joins them without a Python call per lost message
-    names = (top[ACTIVITY].astype(str) + ARROW).groupby(top["index"]).sum()
-    joined = names.str.slice(stop=-len(ARROW))
-    return joined.reindex(lost.index).fillna("").tolist()
+    mine = instances.rename(columns={ROBOT: "sender"})
+    return what_followed(mine, lost, [CASE, "sender"], "sent_at", following)["then"].tolist()
 
 
 def _lost_effect(effect: pd.DataFrame) -> dict:
