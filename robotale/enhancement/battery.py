@@ -282,7 +282,7 @@ def _levels_figure(levels: pd.DataFrame, lows: pd.DataFrame):
 
     figure = go.Figure()
     robots = levels.groupby(ROBOT, sort=True) if ROBOT in levels.columns else [("all", levels)]
-    for name, mine in robots:
+    for name, mine in robots if BATTERY in levels.columns else []:  # tagged lows, no levels
         figure.add_scatter(x=mine[TIMESTAMP], y=mine[BATTERY], mode="lines", name=str(name))
     if not lows.empty:
         figure.add_scatter(

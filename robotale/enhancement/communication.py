@@ -359,7 +359,10 @@ def _with_resends(table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
 
 
 def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) -> list[str]:
-    """The sender's next activities (started after the message was first sent)."""
+    """The sender's next activities (started after the message was first sent); none when the
+    log does not say which robot did what."""
+    if ROBOT not in instances.columns:
+        return [""] * len(lost)
     mine = instances.rename(columns={ROBOT: "sender"})
     return what_followed(mine, lost, [CASE, "sender"], "sent_at", following)["then"].tolist()
 

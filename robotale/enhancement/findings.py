@@ -338,7 +338,7 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
     first = lows.iloc[0]
     answer.sentences.append(
         f"{_count(len(lows), 'low-battery moment')} in {len(affected)} of {len(runs)} runs; "
-        f"the first: {first['robot']} in run {first['case']} at {_clock(first['time'])}"
+        f"the first: {_who(first)}run {first['case']} at {_clock(first['time'])}"
         + (f", after which it did {first['then']}." if _value(first.get("then")) else ".")
     )
     answer.sentences.append(_low_battery_effect(runs, affected, answer.facts))
@@ -346,6 +346,12 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         {"kind": "timeline", "label": f"run {first['case']}", "case": str(first["case"])}
     )
     return answer
+
+
+def _who(moment: pd.Series) -> str:
+    """The robot of a moment, for a sentence ('' when the log names no robot)."""
+    robot = _value(moment.get("robot"))
+    return f"{robot} in " if robot else ""
 
 
 def _low_battery_effect(runs: pd.DataFrame, affected: list[str], facts: dict) -> str:
