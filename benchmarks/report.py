@@ -2,7 +2,7 @@
 the dashboard's Findings page shows it.
 
     python benchmarks/report.py [--sizes 10000 100000 1000000] [--stored 10000 100000 1000000]
-                                [--page 10000 100000] [--repeat 3]
+                                [--page 10000 100000] [--repeat 3] [--runs 3]
 
 The logs are the thesis' five runs repeated as further runs (the mission's real shape) until
 they have the given number of events. For each size, in the same run:
@@ -11,7 +11,9 @@ they have the given number of events. For each size, in the same run:
   DFG, variants, case durations): the work the report's first two answers rest on;
 - *findings*: ``robotale.enhancement.findings.find`` on that DataFrame (all five answers:
   variants, bottlenecks with their effect on the runs, robots' work, battery, messages);
-  target: within 2x of pm4py's time;
+  target: within 2x of pm4py's time. Both are the best of ``--runs`` runs (3), so a busy
+  moment of a shared machine weighs less, in wall-clock and in CPU time of the process (which
+  leaves the other processes out); the load average is printed first;
 - *report from a file*: ``robotale report LOG.csv --out --json`` as the command does it (read
   the CSV, the findings, the timelines, the HTML and JSON written);
 - *report from a stored log*: the same with ``--log NAME`` (the log read back from Neo4j),
@@ -31,6 +33,7 @@ import argparse
 import contextlib
 import io
 import logging
+import os
 import statistics
 import sys
 import tempfile
@@ -57,12 +60,14 @@ def main() -> int:
     parser.add_argument("--page", type=int, nargs="*", default=[10_000, 100_000])
     parser.add_argument("--repeat", type=int, default=3, help="page loads per log (median)")
     parser.add_argument("--heap", default="2g", help="heap of the private Neo4j (2g)")
+    parser.add_argument("--runs", type=int, default=3, help="runs of pm4py and findings (best)")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
     warm_up()
+    print("load average (1, 5, 15 min): " + ", ".join(f"{n:.1f}" for n in os.getloadavg()))
     with tempfile.TemporaryDirectory(prefix="robotale-bench-report-") as scratch:
         for size in args.sizes:
-            measure_file(size, Path(scratch))
+            measure_file(size, Path(scratch), args.runs)
         if args.stored or args.page:
             with private_neo4j(args.heap) as driver:
                 stored = {}
@@ -96,7 +101,18 @@ def quietly(function, *args, **kwargs) -> None:
         function(*args, **kwargs)
 
 
-def measure_file(size: int, folder: Path) -> None:
+def best(runs: int, function, *args) -> tuple[float, float]:
+    """The least wall-clock and the least CPU seconds of the process over ``runs`` runs (CPU
+    time leaves out the other processes of a shared machine)."""
+    times = []
+    for _ in range(runs):
+        wall, cpu = time.perf_counter(), time.process_time()
+        function(*args)
+        times.append((time.perf_counter() - wall, time.process_time() - cpu))
+    return min(t[0] for t in times), min(t[1] for t in times)
+
+
+def measure_file(size: int, folder: Path, runs: int) -> None:
     from robotale.commands.report import report_command
     from robotale.enhancement.findings import find
     from robotale.eventlog.writers import write_csv
@@ -104,16 +120,17 @@ def measure_file(size: int, folder: Path) -> None:
     log = thesis_runs(size)
     path = folder / f"runs_{size}.csv"
     write_csv(log, path)
-    theirs = timed(pm4py_performance, log)
-    ours = timed(find, log)
+    (theirs, their_cpu), (ours, our_cpu) = best(runs, pm4py_performance, log), best(runs, find, log)
     command = timed(
         quietly, report_command, path, out=folder / "report.html", json_out=folder / "r.json"
     )
     verdict = "met" if ours <= 2 * theirs else "MISSED"
     print(f"== {len(log):,} events, {log['case:concept:name'].nunique():,} runs")
-    print(f"  pm4py dfg + performance dfg + variants + durations  {theirs:7.2f} s")
+    print(f"  pm4py dfg + performance dfg + variants + durations  {theirs:7.2f} s  "
+          f"(CPU {their_cpu:.2f} s)")  # fmt: skip
     print(f"  robotale findings (five answers)                    {ours:7.2f} s  "
-          f"{ours / theirs:.2f}x pm4py (target <= 2x: {verdict})")  # fmt: skip
+          f"(CPU {our_cpu:.2f} s)  {ours / theirs:.2f}x pm4py, CPU {our_cpu / their_cpu:.2f}x "
+          f"(target <= 2x: {verdict})")  # fmt: skip
     print(f"  robotale report FILE.csv --out --json               {command:7.2f} s")
 
 

@@ -19,8 +19,15 @@ import pandas as pd
 
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.followed import what_followed
 from robotale.enhancement.performance import WAIT, finished_instances, shared_steps
-from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
+from robotale.enhancement.result import (
+    Figures,
+    Perspective,
+    focus_events,
+    focus_label,
+    no_data,
+)
 from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, ROBOT, TIMESTAMP
 
 LOW_ACTIVITY = "low_battery"
@@ -62,7 +69,7 @@ def battery_perspective(
             "energy": energy,
             "levels": _level_table(focused),
         },
-        figures={"levels": _levels_figure(focused, lows)},
+        figures=Figures({"levels": lambda: _levels_figure(focused, lows)}),
         summary={
             "robots": sorted(focused[ROBOT].dropna().unique()) if ROBOT in focused else [],
             "low_battery_events": len(lows),
@@ -242,20 +249,16 @@ def _with_what_followed(lows: pd.DataFrame, analysis: LogAnalysis, following: in
     if lows.empty:
         return lows.assign(then=pd.Series(dtype=object), until_end=pd.Series(dtype=float))
     instances = analysis.instances()
-    then, until_end = [], []
-    for _, low in lows.iterrows():
-        mine = instances[(instances[CASE] == low[CASE]) & _same_robot(instances, low)]
-        after = mine[mine[START_TIMESTAMP] > low[TIMESTAMP]]
-        then.append(" -> ".join(after[ACTIVITY].astype(str).head(following)))
-        end = mine[TIMESTAMP].max()
-        until_end.append((end - low[TIMESTAMP]).total_seconds() if pd.notna(end) else None)
-    return lows.assign(then=then, until_end=until_end)
-
-
-def _same_robot(instances: pd.DataFrame, low: pd.Series) -> pd.Series:
-    if ROBOT not in instances.columns or ROBOT not in low.index:
-        return pd.Series(True, index=instances.index)
-    return instances[ROBOT] == low[ROBOT]
+    keys = [CASE] + ([ROBOT] if ROBOT in instances.columns and ROBOT in lows.columns else [])
+    # a moment without a case or robot is about no instance
+    named = lows.dropna(subset=keys)
+    found = what_followed(instances, named, keys, TIMESTAMP, following).reindex(lows.index)
+    until_end = (pd.to_datetime(found["last_end"], utc=True) - lows[TIMESTAMP]).dt.total_seconds()
+    known = until_end.notna().to_numpy()
+    return lows.assign(
+        then=found["then"].fillna("").tolist(),
+        until_end=[float(v) if k else None for v, k in zip(until_end, known, strict=True)],
+    )
 
 
 def _low_focus(lows: pd.DataFrame, activity: str | None, robot: str | None) -> pd.Series:
@@ -279,7 +282,7 @@ def _levels_figure(levels: pd.DataFrame, lows: pd.DataFrame):
 
     figure = go.Figure()
     robots = levels.groupby(ROBOT, sort=True) if ROBOT in levels.columns else [("all", levels)]
-    for name, mine in robots:
+    for name, mine in robots if BATTERY in levels.columns else []:  # tagged lows, no levels
         figure.add_scatter(x=mine[TIMESTAMP], y=mine[BATTERY], mode="lines", name=str(name))
     if not lows.empty:
         figure.add_scatter(

@@ -54,7 +54,7 @@ from robotale.enhancement.performance import (
     shared_robot_times,
     shared_steps,
 )
-from robotale.enhancement.result import Perspective, focus_label, no_data
+from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, CASE, RECEIVE, ROBOT, TIMESTAMP
 
 #: effect candidates, simplest first (the one named when several share their cases)
@@ -105,7 +105,7 @@ def find_bottlenecks(
     return Perspective(
         name="bottlenecks",
         tables={"bottlenecks": ranking},
-        figures={"bottlenecks": _figure(ranking)},
+        figures=Figures({"bottlenecks": lambda: _figure(ranking)}),
         summary={
             "first": first["explanation"],
             "first_kind": first["kind"],
@@ -244,7 +244,7 @@ def _steady_excess(
 
 
 def _receive_activities(instances: pd.DataFrame) -> set[str]:
-    return set(instances.loc[event_roles(instances) == RECEIVE, ACTIVITY])
+    return set(instances.loc[event_roles(instances) == RECEIVE, ACTIVITY].unique())
 
 
 def _repeats(steps: pd.DataFrame) -> pd.Series:
@@ -364,12 +364,13 @@ def _queueing(analysis: LogAnalysis) -> pd.DataFrame:
 
 
 def _excess_rows(rows: pd.DataFrame, kind: str, activity: pd.Series, excess: pd.Series):
+    # the columns' own arrays: turning text columns into Python objects costs more than the rest
     return pd.DataFrame(
         {
             "kind": kind,
-            "activity": activity.to_numpy(),
-            "robot": rows[ROBOT].to_numpy(),
-            CASE: rows[CASE].to_numpy(),
+            "activity": activity.array,
+            "robot": rows[ROBOT].array,
+            CASE: rows[CASE].array,
             "excess": np.asarray(excess, dtype=float),
         }
     )

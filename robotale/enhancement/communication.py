@@ -28,11 +28,11 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.discovery.instances import START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
-from robotale.enhancement.performance import ARROW, finished_instances, shared_cases
-from robotale.enhancement.result import Perspective, focus_label, no_data
+from robotale.enhancement.followed import what_followed
+from robotale.enhancement.performance import finished_instances, shared_cases
+from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
@@ -92,7 +92,7 @@ def communication_perspective(
     return Perspective(
         name="communication",
         tables={"message_types": types, "channels": channels, "messages": messages, "lost": lost},
-        figures={"messages": _figure(types)},
+        figures=Figures({"messages": lambda: _figure(types)}),
         summary=_summary(messages, channels, lost_effect),
     )
 
@@ -202,10 +202,26 @@ def lost_messages(
     return lost, _lost_effect(effect)
 
 
+#: the columns the message tables read: a wide log's other columns are not copied along
+MESSAGE_COLUMNS = (
+    CASE,
+    MSG_ID,
+    ACTIVITY,
+    TIMESTAMP,
+    LIFECYCLE,
+    ROBOT,
+    MSG_ROLE,
+    MSG_SENDER,
+    MSG_RECEIVER,
+    MSG_PAYLOAD,
+)
+
+
 def _message_events(log: pd.DataFrame) -> pd.DataFrame:
     if MSG_ID not in log.columns:
         return pd.DataFrame()
-    events = log[log[MSG_ID].notna().to_numpy(bool)]
+    wanted = log[[c for c in log.columns if c in MESSAGE_COLUMNS]]
+    events = wanted[log[MSG_ID].notna().to_numpy(bool)]
     roles = event_roles(events)
     return events.assign(_role=roles)[roles.notna().to_numpy(bool)]
 
@@ -301,9 +317,8 @@ def _meant_for(missing, events, reached, keys) -> np.ndarray:
     stated = pd.Series(np.nan, index=missing.index, dtype=object)
     if MSG_RECEIVER in events.columns:
         stated = _lookup(missing, keys, _first(events, keys, MSG_RECEIVER))
-    usual = reached.groupby(["sender", TYPE])["receiver"].agg(
-        lambda r: r.iloc[0] if r.nunique() == 1 else np.nan
-    )
+    receivers = reached.groupby(["sender", TYPE])["receiver"]
+    usual = receivers.first().astype(object).where(receivers.nunique() == 1, np.nan)
     guessed = pd.Series(
         usual.reindex(pd.MultiIndex.from_frame(missing[["sender", TYPE]])).to_numpy(),
         index=missing.index,
@@ -344,16 +359,12 @@ def _with_resends(table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
 
 
 def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) -> list[str]:
-    """The sender's next activities (started after the message was first sent)."""
-    mine = instances[[CASE, ROBOT, ACTIVITY, START_TIMESTAMP]].rename(columns={ROBOT: "sender"})
-    later = lost[[CASE, "sender", "sent_at"]].reset_index().merge(mine, on=[CASE, "sender"])
-    later = later[later[START_TIMESTAMP] > later["sent_at"]]
-    later = later.sort_values(["index", START_TIMESTAMP], kind="stable")
-    top = later.groupby("index").head(following)
-    # summing the strings joins them without a Python call per lost message
-    names = (top[ACTIVITY].astype(str) + ARROW).groupby(top["index"]).sum()
-    joined = names.str.slice(stop=-len(ARROW))
-    return joined.reindex(lost.index).fillna("").tolist()
+    """The sender's next activities (started after the message was first sent); none when the
+    log does not say which robot did what."""
+    if ROBOT not in instances.columns:
+        return [""] * len(lost)
+    mine = instances.rename(columns={ROBOT: "sender"})
+    return what_followed(mine, lost, [CASE, "sender"], "sent_at", following)["then"].tolist()
 
 
 def _lost_effect(effect: pd.DataFrame) -> dict:
@@ -386,16 +397,19 @@ def _distinct(events: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
 
 
 def _joined(deliveries: pd.DataFrame, keys: list[str], column: str) -> pd.Series:
-    """Per message, its distinct ``column`` values joined (most messages have one)."""
-    values = deliveries[[*keys, column]].astype({column: str}).drop_duplicates()
-    values = values.sort_values(column, kind="stable")
-    grouped = values.groupby(keys)[column]
-    joined = grouped.first()
-    several = grouped.size() > 1
-    if several.any():
-        many = values[_in(values, several[several].reset_index(), keys)]
-        joined.update(many.groupby(keys)[column].agg(", ".join))
-    return joined
+    """Per message, its distinct ``column`` values in text order, joined (most messages have
+    one)."""
+    grouped = deliveries.groupby(keys, sort=True)
+    message = grouped.ngroup().to_numpy()
+    codes, names = pd.factorize(deliveries[column].astype(str))
+    names = names.to_numpy(object)
+    rank = np.empty(len(names), dtype=np.int64)
+    rank[np.argsort(names, kind="stable")] = np.arange(len(names))
+    # each (message, value) once, messages in key order and values in text order within one
+    pairs = np.unique(message[message >= 0] * len(names) + rank[codes[message >= 0]])
+    labels = np.sort(names)[pairs % len(names)] + ", "
+    joined = pd.Series(labels, dtype=object).groupby(pairs // len(names)).sum()
+    return pd.Series(joined.str.slice(stop=-2).to_numpy(object), index=grouped.size().index)
 
 
 def _lookup(frame: pd.DataFrame, keys: list[str], values: pd.Series) -> pd.Series:

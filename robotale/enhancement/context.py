@@ -14,7 +14,33 @@ from typing import Any
 
 import pandas as pd
 
-from robotale.discovery.instances import activity_instances
+from robotale.discovery.instances import INSTANCE_KEYS, activity_instances
+from robotale.eventlog.schema import (
+    ACTIVITY,
+    BATTERY,
+    CASE,
+    LIFECYCLE,
+    MSG_ID,
+    MSG_ROLE,
+    ROBOT,
+    STATE,
+    TIMESTAMP,
+)
+
+#: the columns the perspectives read from activity instances (with those a caller carries):
+#: a wide log's other columns are not copied through every step of the pairing
+INSTANCE_COLUMNS = (
+    CASE,
+    ROBOT,
+    ACTIVITY,
+    TIMESTAMP,
+    LIFECYCLE,
+    STATE,
+    MSG_ID,
+    MSG_ROLE,
+    BATTERY,
+    *INSTANCE_KEYS,
+)
 
 
 class LogAnalysis:
@@ -35,9 +61,13 @@ class LogAnalysis:
         return key in self._tables
 
     def instances(self, carry: Sequence[str] = ()) -> pd.DataFrame:
-        """:func:`~robotale.discovery.instances.activity_instances` of the log."""
+        """:func:`~robotale.discovery.instances.activity_instances` of the log, with the
+        columns of :data:`INSTANCE_COLUMNS` and ``carry``."""
         carry = tuple(carry)
-        return self.shared(("instances", carry), lambda: activity_instances(self.log, carry))
+        wanted = [c for c in self.log.columns if c in INSTANCE_COLUMNS or c in carry]
+        return self.shared(
+            ("instances", carry), lambda: activity_instances(self.log[wanted], carry)
+        )
 
 
 def analysis_of(source: pd.DataFrame | LogAnalysis) -> LogAnalysis:

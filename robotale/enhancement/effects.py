@@ -31,11 +31,10 @@ def compare_cases(members: pd.DataFrame, key: str, durations: pd.Series) -> pd.D
     the other cases of ``durations`` (seconds, indexed by case): counts, means, the extra mean
     and median seconds of the cases with it, and the p-value."""
     values = durations.to_numpy(float)
-    position = pd.Series(np.arange(len(values)), index=durations.index)
     pairs = members[[key, CASE]].drop_duplicates()
-    where = position.reindex(pairs[CASE].to_numpy()).to_numpy()
-    known = ~np.isnan(where)
-    index = where[known].astype(int)
+    where = durations.index.get_indexer(pairs[CASE])  # -1: a case without a duration
+    known = where >= 0
+    index = where[known]
     ranks = pd.Series(values).rank().to_numpy()
     frame = pd.DataFrame(
         {key: pairs[key].to_numpy()[known], "_d": values[index], "_r": ranks[index], "_i": index}

@@ -25,6 +25,7 @@ from robotale.discovery.graph import json_ready
 from robotale.enhancement.battery import battery_perspective
 from robotale.enhancement.bottlenecks import find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
+from robotale.enhancement.context import LogAnalysis
 from robotale.enhancement.performance import ARROW, performance_perspective
 from robotale.enhancement.result import Perspective
 from robotale.eventlog.schema import ROBOT, X, Y
@@ -81,12 +82,16 @@ class Findings:
 def find(log: pd.DataFrame, *, threshold: float = 20.0) -> Findings:
     """The answers to the five questions for ``log`` (``threshold``: the battery level, in
     percent, below which a robot's battery counts as low)."""
-    # the spatial perspective's figures are not needed: the areas are two numbers per robot
+    # one analysis for all: the activity instances, steps, case durations and the message
+    # table are built once; the messages come first so the bottlenecks' queueing reuses them.
+    # The spatial perspective is not needed: the areas are two numbers per robot.
+    analysis = LogAnalysis(log)
+    communication = communication_perspective(analysis)
     perspectives = {
-        "performance": performance_perspective(log),
-        "bottlenecks": find_bottlenecks(log),
-        "battery": battery_perspective(log, threshold=threshold),
-        "communication": communication_perspective(log),
+        "performance": performance_perspective(analysis),
+        "bottlenecks": find_bottlenecks(analysis),
+        "battery": battery_perspective(analysis, threshold=threshold),
+        "communication": communication,
     }
     performance = perspectives["performance"]
     runs = performance.tables.get("cases", pd.DataFrame(columns=["case", "duration"]))
@@ -333,7 +338,7 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
     first = lows.iloc[0]
     answer.sentences.append(
         f"{_count(len(lows), 'low-battery moment')} in {len(affected)} of {len(runs)} runs; "
-        f"the first: {first['robot']} in run {first['case']} at {_clock(first['time'])}"
+        f"the first: {_who(first)}run {first['case']} at {_clock(first['time'])}"
         + (f", after which it did {first['then']}." if _value(first.get("then")) else ".")
     )
     answer.sentences.append(_low_battery_effect(runs, affected, answer.facts))
@@ -341,6 +346,12 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         {"kind": "timeline", "label": f"run {first['case']}", "case": str(first["case"])}
     )
     return answer
+
+
+def _who(moment: pd.Series) -> str:
+    """The robot of a moment, for a sentence ('' when the log names no robot)."""
+    robot = _value(moment.get("robot"))
+    return f"{robot} in " if robot else ""
 
 
 def _low_battery_effect(runs: pd.DataFrame, affected: list[str], facts: dict) -> str:

@@ -18,7 +18,7 @@ import pandas as pd
 
 from robotale.discovery.instances import DURATION, FINISHED, START_KNOWN, START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
-from robotale.enhancement.result import Perspective, focus_label, no_data
+from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, CASE, MSG_ID, ROBOT, TIMESTAMP
 
 WAIT = "wait"
@@ -69,11 +69,13 @@ def performance_perspective(
     return Perspective(
         name="performance",
         tables=tables,
-        figures={
-            "durations": _durations_figure(chosen),
-            "waiting": _waiting_figure(waiting),
-            "cases": _cases_figure(cases),
-        },
+        figures=Figures(
+            {
+                "durations": lambda: _durations_figure(chosen),
+                "waiting": lambda: _waiting_figure(waiting),
+                "cases": lambda: _cases_figure(cases),
+            }
+        ),
         summary=_summary(cases, waiting, tables),
     )
 

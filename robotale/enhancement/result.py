@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -17,14 +18,15 @@ class Perspective:
     """One perspective of a log (or of one activity / class of it, for a drill-down).
 
     ``tables`` are pandas DataFrames (the first is the main one) whose log columns carry their
-    short names (``case``, ``activity``, ``time`` ...), ``figures`` plotly figures, ``summary`` a
+    short names (``case``, ``activity``, ``time`` ...), ``figures`` plotly figures (a
+    :class:`Figures` draws each when it is first read), ``summary`` a
     few headline figures. ``message`` says why a perspective has no data (a log
     without positions, say); then tables and figures are empty.
     """
 
     name: str
     tables: dict[str, pd.DataFrame] = field(default_factory=dict)
-    figures: dict[str, Any] = field(default_factory=dict)
+    figures: Mapping[str, Any] = field(default_factory=dict)
     summary: dict[str, Any] = field(default_factory=dict)
     message: str | None = None
 
@@ -54,6 +56,27 @@ class Perspective:
             "tables": {name: table_records(t) for name, t in self.tables.items()},
             "figures": {name: json.loads(f.to_json()) for name, f in self.figures.items()},
         }
+
+
+class Figures(Mapping[str, Any]):
+    """Figures by name, each drawn by its function the first time it is read: a caller that
+    wants the numbers only (the findings, a benchmark) never pays for drawing, which on a
+    large log takes longer than the numbers."""
+
+    def __init__(self, drawers: dict[str, Callable[[], Any]]) -> None:
+        self._drawers = drawers
+        self._drawn: dict[str, Any] = {}
+
+    def __getitem__(self, name: str) -> Any:
+        if name not in self._drawn:
+            self._drawn[name] = self._drawers[name]()
+        return self._drawn[name]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._drawers)
+
+    def __len__(self) -> int:
+        return len(self._drawers)
 
 
 def no_data(name: str, message: str) -> Perspective:

@@ -16,7 +16,13 @@ import numpy as np
 import pandas as pd
 
 from robotale.enhancement.context import LogAnalysis, analysis_of
-from robotale.enhancement.result import Perspective, focus_events, focus_label, no_data
+from robotale.enhancement.result import (
+    Figures,
+    Perspective,
+    focus_events,
+    focus_label,
+    no_data,
+)
 from robotale.errors import InputError
 from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, TIMESTAMP, X, Y, Z
 
@@ -83,7 +89,7 @@ def spatial_perspective(
     result = Perspective(
         name="spatial",
         tables={"occupancy": _occupancy(placed)},
-        figures={"scatter": _scatter(shown.sort_index())},
+        figures=Figures({"scatter": lambda: _scatter(shown.sort_index())}),
         summary={"positions": len(placed), "plotted": len(shown), "bounds": bounds(placed)},
     )
     if field is not None:

@@ -19,6 +19,7 @@ from robotale.enhancement import (
 )
 from robotale.enhancement.bottlenecks import _medians_with_zeros
 from robotale.enhancement.effects import _medians_without
+from robotale.enhancement.result import Figures
 from robotale.eventlog.schema import CASE, TIMESTAMP
 
 ALONE = {
@@ -90,3 +91,11 @@ def test_zero_padded_medians_equal_numpy():
             mine = values[ids == name]
             padded = np.pad(mine, (0, max(width - len(mine), 0)))
             assert got[name] == float(np.median(padded))
+
+
+def test_figures_are_drawn_once_and_only_when_read():
+    drawn = []
+    figures = Figures({"a": lambda: drawn.append("a") or "A", "b": lambda: "B"})
+    assert list(figures) == ["a", "b"] and drawn == []
+    assert figures["a"] == "A" and figures["a"] == "A" and drawn == ["a"]
+    assert dict(figures) == {"a": "A", "b": "B"} and drawn == ["a"]

@@ -1,6 +1,7 @@
 import pytest
 
 from robotale.enhancement import battery_perspective, low_battery_events
+from robotale.eventlog.readers import read_log
 from robotale.eventlog.schema import ACTIVITY, LIFECYCLE
 
 
@@ -145,3 +146,36 @@ def test_low_battery_tags_without_levels_say_so(thesis_log):
     summary = battery_perspective(thesis_log).summary
     assert summary["battery_levels"] == "the log has no battery levels"
     assert "energy_used" not in summary
+
+
+def test_what_followed_every_low_moment_of_the_thesis_days(thesis_csv):
+    """Per low-battery moment of the thesis' five days (one run each): the next three
+    activities its robot started in that run and the seconds to its last completion there,
+    counted from the events one moment at a time."""
+    log = read_log(thesis_csv, case_gap="1h")
+    lows = battery_perspective(log).tables["low_battery"]
+    assert lows["case"].nunique() > 1 and lows["robot"].nunique() > 1
+    for low in lows.to_dict("records"):
+        mine = log[(log["case:concept:name"] == low["case"]) & (log["robot"] == low["robot"])]
+        starts = mine[(mine[LIFECYCLE] == "start") & (mine["time:timestamp"] > low["time"])]
+        then = " -> ".join(starts.sort_values("time:timestamp", kind="stable")[ACTIVITY][:3])
+        last = mine.loc[mine[LIFECYCLE] == "complete", "time:timestamp"].max()
+        assert low["then"] == then
+        assert low["until_end"] == pytest.approx((last - low["time"]).total_seconds())
+
+
+def test_a_low_moment_after_its_robots_last_activity_is_followed_by_nothing(events):
+    rows = [
+        ("drone", "survey", "start", 0),
+        ("drone", "survey", "complete", 50),
+        ("rover", "dig", "start", 55),
+        ("drone", "low_battery", "none", 60),
+        ("rover", "dig", "complete", 90),
+    ]
+    log = events(
+        *[{"case": "1", "robot": r, "activity": a, "lifecycle": lc, "t": t} for r, a, lc, t in rows]
+    )
+    [low] = battery_perspective(log).tables["low_battery"].to_dict("records")
+    # the rover's dig, later, is another robot's work; the drone's last completion is the
+    # low_battery event itself, at 60 s
+    assert low["robot"] == "drone" and low["then"] == "" and low["until_end"] == 0.0

@@ -262,3 +262,15 @@ def test_a_lost_message_and_what_it_caused(events):
     assert lost.iloc[0]["until_end"] == 90 - 10
     assert lost.iloc[0]["receiver"] == "tractor"  # every other report went to the tractor
     assert result.summary["lost_cases_longer_by"] == seconds["1"] - seconds[["2", "3"]].mean()
+
+
+def test_every_received_message_names_its_receivers_in_order(thesis_log):
+    """A received message's receiver is the robots of its receive events, sorted and joined;
+    counted here one message at a time."""
+    messages = communication_perspective(thesis_log).tables["messages"]
+    events = thesis_log.dropna(subset=["msg_id"])
+    received = events[events[ACTIVITY].str.endswith("?")]
+    expected = received.groupby("msg_id")[ROBOT].agg(lambda r: ", ".join(sorted(set(r))))
+    got = messages[messages["received"]].set_index("msg_id")["receiver"]
+    assert (got.str.contains(", ")).sum() > 0  # some messages reach several robots
+    assert got.sort_index().to_dict() == expected.sort_index().to_dict()

@@ -204,3 +204,19 @@ def test_thesis_log_split_into_days(thesis_csv):
     messages = findings.answer("messages")
     sends = log[log["concept:name"].astype(str).str.endswith("!")]
     assert messages.facts["messages"] == sends["msg_id"].nunique()
+
+
+def test_a_log_without_a_robot_column(thesis_csv):
+    """Without robots the answers say so, and the messages are still counted: the thesis'
+    lost messages are the ids sent ('!') and never received ('?')."""
+    log = read_log(thesis_csv, case_gap="1h").drop(columns=["robot"])
+    findings = find(log)
+    assert findings.answer("robots").sentences == [
+        "The log does not say which robot did what (no robot column)."
+    ]
+    ids = log.dropna(subset=["msg_id"])
+    sent = set(ids.loc[ids["concept:name"].str.endswith("!"), "msg_id"])
+    received = set(ids.loc[ids["concept:name"].str.endswith("?"), "msg_id"])
+    assert findings.answer("messages").facts["lost"] == len(sent - received) > 0
+    # tagged low-battery moments but no levels: their markers and no level lines
+    assert [trace.name for trace in findings.perspectives["battery"].figure.data] == ["low battery"]
