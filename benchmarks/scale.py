@@ -15,9 +15,11 @@ figure docs/scale.md extrapolates from. Both kinds must give the same dataset: t
 run are compared.
 
     python benchmarks/scale.py [--runs 200] [--workers 1,2,4] [--time-limit 120]
+                               [--ingest-events 100000 | --ingest-events 0]
 
-The third scaling figure, one 100k-event ingest against ten appended 10k-event logs, belongs
-to ``ingest --append`` and is printed as not measured here (see :func:`ingest_figures`).
+Then, on a private Neo4j, one ingest of ``--ingest-events`` synthetic events (100k) against
+an ingest of a tenth of its runs and nine ``ingest --append`` of a tenth each
+(``compare_appends`` of benchmarks/ekg_build.py, the same synthetic log); 0 skips it.
 """
 
 from __future__ import annotations
@@ -42,6 +44,9 @@ def main() -> int:
     parser.add_argument(
         "--time-limit", type=float, help="simulated seconds a run may take (the world's)"
     )
+    parser.add_argument(
+        "--ingest-events", type=int, default=100_000, help="events of the ingest figure (0: none)"
+    )
     args = parser.parse_args()
     warnings.simplefilter("ignore")
     sizes = [int(n) for n in args.workers.split(",") if n.strip()]
@@ -59,7 +64,8 @@ def main() -> int:
             same = results["local", size]["rows"] == results["dask", size]["rows"]
             print(f"  {size} worker(s): same dataset from both: {same}")
     report(results, sizes, args.runs)
-    ingest_figures()
+    if args.ingest_events:
+        ingest_figures(args.ingest_events)
     return 0
 
 
@@ -126,12 +132,17 @@ def report(results: dict, sizes: list[int], runs: int) -> None:
                 )
 
 
-def ingest_figures() -> None:
-    """The place of the ingest figures: one 100k-event log against ten appended 10k logs."""
-    print(
-        "\ningest (one 100k-event log vs ten appended 10k-event logs): not measured here; "
-        "it needs `ingest --append` (see benchmarks/ekg_build.py)."
-    )
+def ingest_figures(events: int) -> None:
+    """One ingest of ``events`` against ten parts, the first ingested and the others appended,
+    on a Neo4j of its own (benchmarks/ekg_build.py owns the measurement)."""
+    import sys
+
+    sys.path.insert(0, str(Path(__file__).resolve().parent))
+    import ekg_build
+
+    print(f"\ningest: one log of {events:,} events vs ten parts, nine of them appended")
+    with ekg_build.private_neo4j("2g") as driver:
+        ekg_build.compare_appends(driver, events, parts=10)
 
 
 if __name__ == "__main__":
