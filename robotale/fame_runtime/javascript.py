@@ -32,6 +32,7 @@ import json
 import re
 import threading
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from typing import Any
 
 import quickjs
@@ -184,9 +185,14 @@ var __fame = (function () {
     return flat;
   }
   function fame_json(e) {
-    var w = {}, d = [], k;
-    for (k in dirty) if (store[k] === undefined) d.push(k); else w[k] = store[k];
-    return JSON.stringify({w: w, d: d, e: e});  // made in one piece: never a rope
+    var w = {}, d = [], o = [], k, t;
+    for (k in dirty) {
+      if (store[k] === undefined) { d.push(k); continue; }
+      w[k] = store[k];
+      t = typeof store[k];
+      if (t === 'function' || t === 'symbol') o.push(k);  // JSON leaves it out
+    }
+    return JSON.stringify({w: w, d: d, o: o, e: e});  // made in one piece: never a rope
   }
   function fame_next(run) {
     var settled = false;
@@ -220,6 +226,60 @@ var __fame = (function () {
     current = 0;
     return drained;
   }
+  // A quick script (see quick_source in Python) names every variable it touches and runs
+  // on a plain object of just those, handed over as arguments: no Proxy trap, no JSON, no
+  // store. It can call next only while it runs, so one next serves every quick call.
+  var quickSettled = false;
+  function fame_quick_call(ctx, run) {  // the head of the outbox, null: effects
+    current = run;
+    quickSettled = settledNow = false;  // what a call stopped by its time limit left
+    try { ctx.fame_body(fame_quick_next); } catch (e) { fame_fail(run, e); }
+    return out.length === 0 ? (settledNow ? fame_flat(valueNow) : '') : null;
+  }
+  function fame_quick_next(err, value) {
+    if (quickSettled) return;
+    quickSettled = true;
+    if (err == null && out.length === 0) { settledNow = true; valueNow = value; return; }
+    fame_settle();
+    out.push(['next', current, err == null ? null : String(err && err.message || err),
+              value === undefined ? null : value]);
+  }
+  function fame_same(a, b) { return a === b || (a !== a && b !== b); }  // NaN too
+  // The outbox of a quick call: 'Q<value passed to next, empty: not called>' then a field
+  // per variable it may write: empty when not written (a bit of mask clear), '-' when gone,
+  // else the flat value. When something cannot go so, the written variables go through the
+  // Proxy into the store and the outbox is fame_drain's. The most usual outcome of all,
+  // next() and one variable set to a finite number or a boolean, is that value itself.
+  function fame_quick_end(head, v, written, mask) {
+    var text = head, i, k, f;
+    if (head === 'z' && mask === 1 && written.length === 1) {
+      k = v[written[0]];
+      if ((typeof k === 'number' && isFinite(k)) || typeof k === 'boolean') {
+        settledNow = false;
+        current = 0;
+        return k;
+      }
+    }
+    for (i = 0; text !== null && i < written.length; i++) {
+      k = v[written[i]];
+      f = !(mask & (1 << i)) ? '' : k === undefined ? '-' : fame_flat(k);
+      text = f === null ? null : text + '\u001f' + f;
+    }
+    if (text === null) {
+      for (i = 0; i < written.length; i++) {
+        if (!(mask & (1 << i))) continue;
+        k = written[i];
+        if (v[k] === undefined) delete variables[k]; else variables[k] = v[k];
+      }
+      text = fame_drain();
+    } else {
+      settledNow = false;
+      // a long string built by += may be a rope, which the embedding cannot return
+      text = 'Q' + (text.length > 256 ? text.split('\u001f').join('\u001f') : text);
+    }
+    current = 0;
+    return text;
+  }
   function fame_deliver(table, id, msg, push, once) {
     fame_absorb(push);
     var callback = table[id];
@@ -232,6 +292,7 @@ var __fame = (function () {
   return {
     context: context, console: console, environment: environment, node: fame_node,
     hide: fame_hide, run: fame_run, drain: fame_drain,
+    quick_call: fame_quick_call, quick_end: fame_quick_end, same: fame_same,
     message: function fame_message(id, msg, push) {
       return fame_deliver(subs, id, msg, push, false);
     },
@@ -273,6 +334,101 @@ _LOOKS_LIKE_JAVASCRIPT = re.compile(
 )
 
 
+#: a variable named in full; anything else that can reach the variables object is refused
+_TOUCH = re.compile(
+    r"(?P<before>(?:\+\+|--)\s*)?(?:\bthis\s*\.\s*)?\benvironment\s*\.\s*variables\s*\.\s*"
+    r"(?P<name>[A-Za-z_$][\w$]*)"
+    # assigned: an assignment operator (not == or <=), ++ or --
+    r"(?P<assigned>\s*(?:(?:\*\*|<<|>>>?|&&|\|\||\?\?|[-+*/%&|^])?=(?!=)|\+\+|--))?"
+    # maybe assigned: the end of a destructuring pattern or of parentheses, a comment
+    # (which may hide an operator), the target of for-in/of
+    r"(?P<maybe>\s*(?:[\]),}]|/[/*])|\s+(?:in|of)\b)?"
+)
+#: what could reach the variables object other than by name, or run after the call: a
+#: function (also a method like ``{f() {...}}``), a promise, eval, or ``next`` other than
+#: called (kept, it could complete the run later)
+_DYNAMIC = re.compile(
+    r"\b(?:this|environment|variables|function|class|eval|Function|arguments|globalThis"
+    r"|with|delete|import|async|await|yield|Promise|then|__fame\w*)\b|=>"
+    r"|\bnext\b(?!\s*\()"
+    r"|(?<![\w$.])(?!(?:if|for|while|switch|catch|return|typeof|void|new|in|of)\b)"
+    r"[A-Za-z_$][\w$]*\s*\([^()]*\)\s*\{"
+)
+#: what a plain object inherits: its value is not the variable's
+_INHERITED = frozenset(
+    {"constructor", "hasOwnProperty", "isPrototypeOf", "propertyIsEnumerable"}
+    | {"toLocaleString", "toString", "valueOf"}
+)
+#: a quick script touches at most this many variables (one bit each of a 32-bit integer)
+QUICK_NAMES = 16
+
+
+@dataclass(frozen=True, slots=True)
+class Touches:
+    """The variables a script touches, in order; those it may assign (a superset), and of
+    these the ones it surely assigns where it runs (an assignment operator, ++, --)."""
+
+    names: tuple[str, ...]
+    written: tuple[str, ...]
+    assigned: frozenset[str]
+
+
+def touches(body: str) -> Touches | None:
+    """What a script body touches, when it names every variable in full
+    (``[this.]environment.variables.<name>``) and nothing else can reach them: then it may run
+    on just those values. None when it may use the variables object any other way (kept in a
+    variable, ``variables[name]``, passed to a function), defines a function or promise
+    callback that could run after the call, keeps ``next``, or touches the node shim."""
+    names: dict[str, None] = {}
+    written: dict[str, None] = {}
+    assigned = set()
+    for match in _TOUCH.finditer(body):
+        names[match["name"]] = None
+        if match["before"] or match["assigned"]:
+            assigned.add(match["name"])
+        if match["before"] or match["assigned"] or match["maybe"]:
+            written[match["name"]] = None
+    if _DYNAMIC.search(_TOUCH.sub(" ", body)) or len(names) > QUICK_NAMES:
+        return None
+    if any(n in NODE_NAMES or n in _INHERITED or n.startswith("__") for n in names):
+        return None
+    return Touches(tuple(names), tuple(written), frozenset(assigned))
+
+
+def quick_source(body: str, touched: Touches) -> str:
+    """A script body as ``fame_quick(run, present, value...)``: the variables' values (a bit
+    of ``present`` set for each the robot has) set on a plain object, the body run on it, the
+    outbox made (see the prelude's ``fame_quick_*``). A variable surely assigned counts as
+    written, as in a Python script; one maybe assigned only if its value changed. The body
+    stays on lines 2 and on, as in :func:`function_source`, so errors name its own lines."""
+    value = {
+        name: f"(__fame_present & {1 << i} ? __fame_{i} : undefined)"
+        for i, name in enumerate(touched.names)
+    }
+    sets = "".join(f"__fame_v[{json.dumps(name)}] = {value[name]}; " for name in touched.names)
+    mask = " | ".join(
+        [str(sum(1 << i for i, n in enumerate(touched.written) if n in touched.assigned))]
+        + [
+            f"(__fame_same(__fame_v[{json.dumps(name)}], {value[name]}) ? 0 : {1 << i})"
+            for i, name in enumerate(touched.written)
+            if name not in touched.assigned
+        ]
+    )
+    parameters = ", ".join(
+        ["__fame_run", "__fame_present", *(f"__fame_{i}" for i in range(len(touched.names)))]
+    )
+    return (
+        "(function () { var __fame_v = {}, __fame_ctx = {environment: {variables: __fame_v}}, "
+        "environment = __fame_ctx.environment, __fame_call = __fame.quick_call, "
+        "__fame_same = __fame.same, "
+        f"__fame_end = __fame.quick_end, __fame_written = {json.dumps(touched.written)}; "
+        f"__fame_ctx.fame_body = function (next) {{\n{body}\n}};\n"
+        f"return function fame_quick({parameters}) {{ {sets}"
+        "return __fame_end(__fame_call(__fame_ctx, __fame_run), __fame_v, __fame_written, "
+        f"{mask}); }}; }})()"
+    )
+
+
 def looks_like_javascript(text: str) -> bool:
     """A script or condition without a language is JavaScript when it uses what Python
     cannot (``next(``, ``this.environment``, ``var``/``let``/``const``, ``=>``, ``===``,
@@ -285,6 +441,33 @@ def member_names(text: str) -> frozenset[str]:
     reads, so a conditional event is re-evaluated when one of them changes."""
     return frozenset(a or b for a, b in _MEMBER.findall(text))
 
+
+_WRAP_HEAD, _WRAP_TAIL = _WRAP.split("%s")
+
+
+def _is_wrapped(source: str) -> bool:
+    return source.startswith(_WRAP_HEAD) and source.endswith(_WRAP_TAIL)
+
+
+@dataclass(slots=True)
+class _Script:
+    """A script's source compiled: ``quick`` when :func:`touches` found its variables,
+    ``full`` (on the whole of the variables) when first needed."""
+
+    source: str
+    touched: Touches | None
+    quick: Any = None
+    full: Any = None
+
+
+_ABSENT = object()
+#: what goes into JavaScript as an argument as it is (an int only within 32 bits)
+_PLAIN = frozenset({str, float, bool, type(None)})
+_INT32 = 1 << 31
+#: integers a double holds exactly
+_EXACT = 1 << 53
+#: from this magnitude on, JSON writes a whole number with an exponent: Python reads a float
+_JSON_INT = 1e21
 
 _checker_lock = threading.Lock()
 _checker: list[quickjs.Context] = []
@@ -368,7 +551,8 @@ class JavaScript:
         for name in NODE_NAMES:
             hide(name, node)
         self.context.set_time_limit(time_limit)
-        self._functions: dict[str, Any] = {}
+        self._scripts: dict[str, _Script] = {}
+        self._opaque: set[str] = set()  # variables JavaScript holds that JSON cannot carry
         self._promises = False  # a script that may queue promise jobs was compiled
         self._mirror: dict[str, Any] = {}  # what the JavaScript side holds, by identity
         self._runs: dict[int, Completion] = {}
@@ -383,12 +567,70 @@ class JavaScript:
         ScriptFailure when it throws."""
         self._run_ids += 1
         run = self._run_ids
+        script = self._scripts.get(source) or self._compile(source)
+        if script.touched is not None:
+            values = self._quick_values(script.touched.names)
+            if values is not None:
+                self._run_quick(script, run, values, done)
+                return
         self._runs[run] = done
         try:
-            self._apply(self._call(self._run, self._function(source), run), run)
+            self._apply(self._call(self._run, self._full(script), run, self._push()), run)
         except ScriptFailure:
             self._runs.pop(run, None)
             raise
+
+    def _run_quick(self, script: _Script, run: int, values: list[Any], done: Completion) -> None:
+        """Run a script on the values of the variables it names (see ``fame_quick``)."""
+        try:
+            outbox = script.quick(run, *values)
+            later = self._jobs() if self._promises else None
+        except quickjs.JSException as error:
+            raise self._failure(error) from None
+        kind = type(outbox)
+        if kind is str and outbox[:1] == "Q":
+            self._apply_quick(outbox, script.touched.written, run, done)
+        elif kind is str:  # what it did could not go flat: the usual outbox
+            self._runs[run] = done
+            try:
+                self._apply((outbox,), run)
+            except ScriptFailure:
+                self._runs.pop(run, None)
+                raise
+        else:  # next() and one variable set to a number or a boolean (see fame_quick_end)
+            if kind is float and outbox.is_integer() and -_JSON_INT < outbox < _JSON_INT:
+                outbox = int(outbox)  # what JSON would have made of it
+            name = script.touched.written[0]
+            self.variables[name] = outbox
+            self.changed(script.touched.written)
+            done(None, None)
+        if later:
+            self._apply((later,))
+
+    def _quick_values(self, names: tuple[str, ...]) -> list[Any] | None:
+        """A bit mask of the ``names`` the robot has, then their values; None when one of
+        them holds what only JSON carries (a list, an object, a huge integer) or a value
+        JavaScript holds that Python lacks."""
+        if self._opaque and not self._opaque.isdisjoint(names):
+            return None
+        variables = self.variables
+        values: list[Any] = [0]
+        present, bit = 0, 1
+        for name in names:
+            value = variables.get(name, _ABSENT)
+            if value is not _ABSENT:
+                kind = type(value)
+                if kind is int and not -_INT32 <= value < _INT32:
+                    if not -_EXACT <= value <= _EXACT:
+                        return None
+                    value = float(value)  # the embedding would cut an integer to 32 bits
+                elif kind is not int and kind not in _PLAIN:
+                    return None
+                present |= bit
+            values.append(None if value is _ABSENT else value)
+            bit <<= 1
+        values[0] = present
+        return values
 
     def condition(self, source: str) -> Any:
         """The value a condition passes to ``next`` (None when it never calls it)."""
@@ -411,36 +653,53 @@ class JavaScript:
         self._calls.clear()
         self._runs.clear()
 
-    def _function(self, source: str) -> Any:
-        function = self._functions.get(source)
-        if function is None:
-            function = self._functions[source] = self.context.eval(source)
-            self._promises = self._promises or bool(_PROMISES.search(source))
-        return function
+    def _compile(self, source: str) -> _Script:
+        body = source[len(_WRAP_HEAD) : -len(_WRAP_TAIL)] if _is_wrapped(source) else None
+        touched = None if body is None else touches(body)
+        script = _Script(source, touched)
+        if touched is not None:
+            script.quick = self.context.eval(quick_source(body, touched))
+        self._scripts[source] = script
+        return script
+
+    def _full(self, script: _Script) -> Any:
+        """The script as ``function (next)`` on the whole of the variables."""
+        if script.full is None:
+            script.full = self.context.eval(script.source)
+            self._promises = self._promises or bool(_PROMISES.search(script.source))
+        return script.full
 
     def _call(self, function: Any, *args: Any) -> tuple[str, ...]:
-        """Call into JavaScript with the variables Python changed: its drained outbox, and a
-        second one when it left promise jobs (they run before anything is applied)."""
+        """Call into JavaScript: its drained outbox, and a second one when it left promise
+        jobs (they run before anything is applied)."""
         try:
-            result = function(*args, self._push())
-            if self._promises and self.context.execute_pending_job():
-                while self.context.execute_pending_job():
-                    pass
-                return result, self._drain()
-            return (result,)
+            result = function(*args)
+            later = self._jobs() if self._promises else None
         except quickjs.JSException as error:
-            text = str(error)
-            if "interrupted" in text:
-                raise ScriptFailure(
-                    f"the script ran longer than its time limit of {self.time_limit:g} s of "
-                    "CPU time and was stopped"
-                ) from None
-            if "out of memory" in text:
-                raise ModelError(
-                    f"robot {self.robot}: JavaScript ran out of its {MEMORY_LIMIT >> 20} MiB "
-                    "of memory"
-                ) from None
-            raise ScriptFailure(f"{_first_line(text)} (line {_script_line(text)})") from None
+            raise self._failure(error) from None
+        return (result, later) if later else (result,)
+
+    def _jobs(self) -> str | None:
+        """Run the promise jobs calls left; the outbox of what they did (None: no job)."""
+        if not self.context.execute_pending_job():
+            return None
+        while self.context.execute_pending_job():
+            pass
+        return self._drain()
+
+    def _failure(self, error: quickjs.JSException) -> Exception:
+        """What a call that JavaScript stopped raises."""
+        text = str(error)
+        if "interrupted" in text:
+            return ScriptFailure(
+                f"the script ran longer than its time limit of {self.time_limit:g} s of "
+                "CPU time and was stopped"
+            )
+        if "out of memory" in text:
+            return ModelError(
+                f"robot {self.robot}: JavaScript ran out of its {MEMORY_LIMIT >> 20} MiB of memory"
+            )
+        return ScriptFailure(f"{_first_line(text)} (line {_script_line(text)})")
 
     def _push(self) -> str:
         """The variables that changed in Python since JavaScript last saw them, as JSON."""
@@ -526,7 +785,29 @@ class JavaScript:
         if written:
             self.changed(written)
 
+    def _apply_quick(self, outbox: str, names: tuple[str, ...], run: int, done: Completion) -> None:
+        """A quick script's outbox (see the prelude's ``fame_quick``). The values go to Python
+        only: JavaScript's store did not see them, so its mirror keeps the old ones and the
+        next call on the whole of the variables pushes them."""
+        fields = outbox.split("\x1f")
+        variables = self.variables
+        written = []
+        for name, field in zip(names, fields[1:], strict=True):  # empty: not written
+            if field:
+                if field == "-":
+                    variables.pop(name, None)
+                else:
+                    variables[name] = _flat(field)
+                written.append(name)
+        if written:
+            self.changed(written)
+        if len(fields[0]) > 1:
+            done(None, _flat(fields[0][1:]))
+        else:  # it may call next later (from a callback a former script set up)
+            self._runs[run] = done
+
     def _take_writes(self, outcome: dict[str, Any]) -> list[str]:
+        self._opaque.update(outcome.get("o", ()))
         mirror, variables = self._mirror, self.variables
         for name, value in outcome["w"].items():
             variables[name] = mirror[name] = value
@@ -591,7 +872,7 @@ class JavaScript:
         except (TypeError, ValueError):
             return  # not a ROS message (a tag): nothing a rclnodejs callback could read
         try:
-            self._apply(self._call(function, callback_id, message))
+            self._apply(self._call(function, callback_id, message, self._push()))
         except ScriptFailure as failure:
             raise ModelError(
                 f"robot {self.robot}: a JavaScript callback on {envelope.topic} failed: "
