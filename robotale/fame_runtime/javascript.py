@@ -129,9 +129,14 @@ var __fame = (function () {
   // next() -- goes back as flat text: 'C', then triples of fields separated by \x1f (w name
   // value | d name '' | n run value). JSON.stringify costs more than such a script itself.
   // Anything else goes as the JSON of an object.
+  // a number JSON writes without fraction or exponent (read back as an int) is 'i'
   function fame_flat(v) {
     var t = typeof v;
-    if (t === 'number') return isFinite(v) ? 'n' + v : null;
+    if (t === 'number') {
+      if ((v | 0) === v) return 'i' + v;  // the usual: a 32-bit integer, found without a call
+      if (!isFinite(v)) return null;
+      return (Number.isInteger(v) && v < 1e21 && v > -1e21 ? 'i' : 'n') + v;
+    }
     if (t === 'boolean') return v ? 't' : 'f';
     if (v === null || v === undefined) return 'z';
     if (t === 'string' && fame_plain(v)) return 's' + v;
@@ -790,19 +795,23 @@ class JavaScript:
         only: JavaScript's store did not see them, so its mirror keeps the old ones and the
         next call on the whole of the variables pushes them."""
         fields = outbox.split("\x1f")
-        variables = self.variables
-        written = []
-        for name, field in zip(names, fields[1:], strict=True):  # empty: not written
-            if field:
+        if len(fields) > 1:
+            values = fields[1:]
+            variables = self.variables
+            for name, field in zip(names, values, strict=True):
                 if field == "-":
                     variables.pop(name, None)
-                else:
+                elif field:  # empty: not written
                     variables[name] = _flat(field)
-                written.append(name)
-        if written:
-            self.changed(written)
-        if len(fields[0]) > 1:
-            done(None, _flat(fields[0][1:]))
+            if "" in values:
+                names = tuple(n for n, f in zip(names, values, strict=True) if f)
+            if names:
+                self.changed(names)
+        head = fields[0]
+        if head == "Qz":  # next() or next(null)
+            done(None, None)
+        elif len(head) > 1:
+            done(None, _flat(head[1:]))
         else:  # it may call next later (from a callback a former script set up)
             self._runs[run] = done
 
@@ -884,12 +893,13 @@ _FLAT_CONSTANTS = {"t": True, "f": False, "z": None}
 
 
 def _flat(text: str) -> Any:
-    """One flat value: n<number> (as JSON reads it: int without fraction or exponent),
-    s<string>, t, f, z (null)."""
+    """One flat value: i<integer>, n<number> (a float, as JSON reads a number with a fraction
+    or an exponent), s<string>, t, f, z (null)."""
     tag = text[0]
-    if tag == "n":
-        body = text[1:]
-        return int(body) if body.lstrip("-").isdigit() else float(body)
+    if tag == "i":
+        return int(text[1:])
     if tag == "s":
         return text[1:]
+    if tag == "n":
+        return float(text[1:])
     return _FLAT_CONSTANTS[tag]
