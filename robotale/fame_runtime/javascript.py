@@ -516,6 +516,22 @@ class ScriptFailure(Exception):
 
 #: called when a script calls ``next(err, value)``: err is None or the error's text
 Completion = Callable[[str | None, Any], None]
+#: what a script passed to ``next``: (err, value)
+Outcome = tuple[str | None, Any]
+_NEXT: Outcome = (None, None)
+
+
+class _Now:
+    """The completion of a run while it is called: it keeps what the run passed to
+    ``next``, for the caller to act on once the call has returned."""
+
+    __slots__ = ("outcome",)
+
+    def __init__(self) -> None:
+        self.outcome: Outcome | None = None
+
+    def __call__(self, error: str | None, value: Any) -> None:
+        self.outcome = (error, value)
 
 
 class JavaScript:
@@ -568,7 +584,15 @@ class JavaScript:
     # -- running ---------------------------------------------------------------------------
 
     def run_script(self, source: str, done: Completion) -> None:
-        """Run a script task's body; ``done`` is called when it calls ``next`` (maybe now).
+        """Run a script's body; ``done`` is called when it calls ``next`` (maybe now).
+        ScriptFailure when it throws."""
+        now = self.run_task(source, lambda: done)
+        if now is not None:
+            done(*now)
+
+    def run_task(self, source: str, later: Callable[[], Completion]) -> Outcome | None:
+        """Run a script task's body: ``(error, value)`` when it called ``next(error, value)``
+        while it ran; else None, and ``later()`` gives what its ``next`` calls when it does.
         ScriptFailure when it throws."""
         self._run_ids += 1
         run = self._run_ids
@@ -576,41 +600,51 @@ class JavaScript:
         if script.touched is not None:
             values = self._quick_values(script.touched.names)
             if values is not None:
-                self._run_quick(script, run, values, done)
-                return
-        self._runs[run] = done
+                return self._run_quick(script, run, values, later)
+        outboxes = self._call(self._run, self._full(script), run, self._push())
+        return self._settle(run, later, outboxes)
+
+    def _settle(
+        self, run: int, later: Callable[[], Completion], outboxes: tuple[str, ...]
+    ) -> Outcome | None:
+        """Apply a run's outboxes: what it passed to ``next`` if it called it, else None and
+        its later completion is waiting."""
+        now = _Now()
+        self._runs[run] = now
         try:
-            self._apply(self._call(self._run, self._full(script), run, self._push()), run)
+            self._apply(outboxes, run)
         except ScriptFailure:
             self._runs.pop(run, None)
             raise
+        if run in self._runs:
+            self._runs[run] = later()
+        return now.outcome
 
-    def _run_quick(self, script: _Script, run: int, values: list[Any], done: Completion) -> None:
+    def _run_quick(
+        self, script: _Script, run: int, values: list[Any], later: Callable[[], Completion]
+    ) -> Outcome | None:
         """Run a script on the values of the variables it names (see ``fame_quick``)."""
         try:
             outbox = script.quick(run, *values)
-            later = self._jobs() if self._promises else None
+            jobs = self._jobs() if self._promises else None
         except quickjs.JSException as error:
             raise self._failure(error) from None
         kind = type(outbox)
         if kind is str and outbox[:1] == "Q":
-            self._apply_quick(outbox, script.touched.written, run, done)
+            now = self._apply_quick(outbox, script.touched.written)
+            if now is None:  # it may call next later (from a callback a former script set up)
+                self._runs[run] = later()
         elif kind is str:  # what it did could not go flat: the usual outbox
-            self._runs[run] = done
-            try:
-                self._apply((outbox,), run)
-            except ScriptFailure:
-                self._runs.pop(run, None)
-                raise
+            now = self._settle(run, later, (outbox,))
         else:  # next() and one variable set to a number or a boolean (see fame_quick_end)
             if kind is float and outbox.is_integer() and -_JSON_INT < outbox < _JSON_INT:
                 outbox = int(outbox)  # what JSON would have made of it
-            name = script.touched.written[0]
-            self.variables[name] = outbox
+            self.variables[script.touched.written[0]] = outbox
             self.changed(script.touched.written)
-            done(None, None)
-        if later:
-            self._apply((later,))
+            now = _NEXT
+        if jobs:
+            self._apply((jobs,))
+        return now
 
     def _quick_values(self, names: tuple[str, ...]) -> list[Any] | None:
         """A bit mask of the ``names`` the robot has, then their values; None when one of
@@ -790,10 +824,11 @@ class JavaScript:
         if written:
             self.changed(written)
 
-    def _apply_quick(self, outbox: str, names: tuple[str, ...], run: int, done: Completion) -> None:
-        """A quick script's outbox (see the prelude's ``fame_quick``). The values go to Python
-        only: JavaScript's store did not see them, so its mirror keeps the old ones and the
-        next call on the whole of the variables pushes them."""
+    def _apply_quick(self, outbox: str, names: tuple[str, ...]) -> Outcome | None:
+        """A quick script's outbox (see the prelude's ``fame_quick_end``): what it passed to
+        ``next``, None when it did not call it. The values go to Python only: JavaScript's
+        store did not see them, so its mirror keeps the old ones and the next call on the
+        whole of the variables pushes them."""
         fields = outbox.split("\x1f")
         if len(fields) > 1:
             values = fields[1:]
@@ -809,11 +844,8 @@ class JavaScript:
                 self.changed(names)
         head = fields[0]
         if head == "Qz":  # next() or next(null)
-            done(None, None)
-        elif len(head) > 1:
-            done(None, _flat(head[1:]))
-        else:  # it may call next later (from a callback a former script set up)
-            self._runs[run] = done
+            return _NEXT
+        return (None, _flat(head[1:])) if len(head) > 1 else None
 
     def _take_writes(self, outcome: dict[str, Any]) -> list[str]:
         self._opaque.update(outcome.get("o", ()))

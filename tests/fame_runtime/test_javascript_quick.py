@@ -11,11 +11,12 @@ from typing import Any
 
 import pytest
 from fame_suite import pair, run, trace
+from test_engine_time import SENSED, Stopper
 from test_javascript import model
 
 from robotale.fame_runtime import javascript
 from robotale.fame_runtime.bus import InProcessBus
-from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.clock import EngineCost, SimClock
 
 V = "this.environment.variables."
 #: a value only Python has (a skill's object)
@@ -42,9 +43,9 @@ class Robot:
         )
         run_quick = self.runtime._run_quick
 
-        def counted(*args: Any) -> None:
+        def counted(*args: Any) -> Any:
             self.quick += 1
-            run_quick(*args)
+            return run_quick(*args)
 
         self.runtime._run_quick = counted
 
@@ -294,3 +295,24 @@ def test_a_gateway_condition_reads_what_quick_scripts_wrote(tmp_path):
     mission, tags = run(model(tmp_path, *scripts, condition=f"{V}x === 5"))
     assert mission.engines["rover"].variables["x"] == 5
     assert trace(tags)[-2:] == pair(0.0, "rover", "yes")
+
+
+@pytest.mark.parametrize(
+    "script",
+    [f"{V}command = 0.0; next();", "var v = environment.variables; v.command = 0; next();"],
+)
+def test_a_javascript_script_cost_delays_the_command_it_computes(models, tmp_path, script):
+    """The stopper of test_engine_time with its script in JavaScript, quick or not: the
+    script's cost passes on the clock before the command goes out."""
+    text = (models / "stopper.bpmn").read_text()
+    text = text.replace('scriptFormat="python"', 'scriptFormat="javascript"')
+    path = tmp_path / "stopper.bpmn"
+    path.write_text(
+        text.replace(
+            "<bpmn:script>command = 0.0</bpmn:script>", f"<bpmn:script>{script}</bpmn:script>"
+        )
+    )
+    stopper = Stopper(path, EngineCost(script=0.025))
+    stopper.reading(SENSED, 0.3)
+    assert stopper.run().sent == [pytest.approx(SENSED + 0.025, abs=1e-12)]
+    assert stopper.engine.variables["command"] == 0
