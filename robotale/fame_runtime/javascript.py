@@ -250,38 +250,30 @@ var __fame = (function () {
               value === undefined ? null : value]);
   }
   function fame_same(a, b) { return a === b || (a !== a && b !== b); }  // NaN too
-  // The outbox of a quick call: 'Q<value passed to next, empty: not called>' then a field
-  // per variable it may write: empty when not written (a bit of mask clear), '-' when gone,
-  // else the flat value. When something cannot go so, the written variables go through the
-  // Proxy into the store and the outbox is fame_drain's. The most usual outcome of all,
-  // next() and one variable set to a finite number or a boolean, is that value itself.
-  function fame_quick_end(head, v, written, mask) {
-    var text = head, i, k, f;
-    if (head === 'z' && mask === 1 && written.length === 1) {
-      k = v[written[0]];
-      if ((typeof k === 'number' && isFinite(k)) || typeof k === 'boolean') {
-        settledNow = false;
-        current = 0;
-        return k;
-      }
+  // A quick call's outbox is made by its own generated code (quick_source in Python):
+  // 'Q<value passed to next, empty: not called>' then a field per variable it may write:
+  // empty when not written, '-' when gone, else the flat value; or, the most usual outcome
+  // of all, next() and one variable set to a finite number or a boolean: that value itself.
+  function fame_quick_flat(v) { return v === undefined ? '-' : fame_flat(v); }
+  function fame_quick_finish(result) {
+    settledNow = false;
+    current = 0;
+    // a long string built by += may be a rope, which the embedding cannot return
+    if (typeof result === 'string' && result.length > 256) {
+      result = result.split('\u001f').join('\u001f');
     }
-    for (i = 0; text !== null && i < written.length; i++) {
-      k = v[written[i]];
-      f = !(mask & (1 << i)) ? '' : k === undefined ? '-' : fame_flat(k);
-      text = f === null ? null : text + '\u001f' + f;
+    return result;
+  }
+  // What cannot go so (an effect, an object): the written variables (bits of mask) go
+  // through the Proxy into the store, and the outbox is fame_drain's.
+  function fame_quick_merge(v, written, mask) {
+    var i, k, text;
+    for (i = 0; i < written.length; i++) {
+      if (!(mask & (1 << i))) continue;
+      k = written[i];
+      if (v[k] === undefined) delete variables[k]; else variables[k] = v[k];
     }
-    if (text === null) {
-      for (i = 0; i < written.length; i++) {
-        if (!(mask & (1 << i))) continue;
-        k = written[i];
-        if (v[k] === undefined) delete variables[k]; else variables[k] = v[k];
-      }
-      text = fame_drain();
-    } else {
-      settledNow = false;
-      // a long string built by += may be a rope, which the embedding cannot return
-      text = 'Q' + (text.length > 256 ? text.split('\u001f').join('\u001f') : text);
-    }
+    text = fame_drain();
     current = 0;
     return text;
   }
@@ -297,7 +289,8 @@ var __fame = (function () {
   return {
     context: context, console: console, environment: environment, node: fame_node,
     hide: fame_hide, run: fame_run, drain: fame_drain,
-    quick_call: fame_quick_call, quick_end: fame_quick_end, same: fame_same,
+    quick_call: fame_quick_call, quick_flat: fame_quick_flat, quick_finish: fame_quick_finish,
+    quick_merge: fame_quick_merge, same: fame_same,
     message: function fame_message(id, msg, push) {
       return fame_deliver(subs, id, msg, push, false);
     },
@@ -400,37 +393,67 @@ def touches(body: str) -> Touches | None:
     return Touches(tuple(names), tuple(written), frozenset(assigned))
 
 
+#: the prelude's functions a quick script's code uses, as locals of its closure
+_QUICK_LOCALS = (
+    "__fame_call = __fame.quick_call, __fame_flat = __fame.quick_flat, "
+    "__fame_finish = __fame.quick_finish, __fame_merge = __fame.quick_merge, "
+    "__fame_same = __fame.same"
+)
+#: one field of the outbox: the variable's value, flat (a 32-bit integer or a string inline:
+#: three calls deep, fame_flat costs more than the script)
+_QUICK_FIELD = (
+    "__fame_k = __fame_v[{key}]; __fame_f = typeof __fame_k === 'number' && "
+    "(__fame_k | 0) === __fame_k ? 'i' + __fame_k : typeof __fame_k === 'string' ? "
+    "(__fame_k.indexOf('\\u001f') < 0 ? 's' + __fame_k : null) : __fame_flat(__fame_k); "
+    "if (__fame_f === null) return __fame_merge(__fame_v, __fame_written, __fame_m); "
+    "__fame_h += '\\u001f' + __fame_f;"
+)
+#: next() or next(null) and only one variable, written: its value when a number or boolean
+_QUICK_DIRECT = (
+    "if (__fame_h === 'z' && __fame_m === 1) {{ __fame_k = __fame_v[{key}]; "
+    "if ((typeof __fame_k === 'number' && isFinite(__fame_k)) || typeof __fame_k === "
+    "'boolean') return __fame_finish(__fame_k); }}\n"
+)
+
+
 def quick_source(body: str, touched: Touches) -> str:
     """A script body as ``fame_quick(run, present, value...)``: the variables' values (a bit
     of ``present`` set for each the robot has) set on a plain object, the body run on it, the
     outbox made (see the prelude's ``fame_quick_*``). A variable surely assigned counts as
     written, as in a Python script; one maybe assigned only if its value changed. The body
     stays on lines 2 and on, as in :func:`function_source`, so errors name its own lines."""
+    key = {name: json.dumps(name) for name in touched.names}
     value = {
         name: f"(__fame_present & {1 << i} ? __fame_{i} : undefined)"
         for i, name in enumerate(touched.names)
     }
-    sets = "".join(f"__fame_v[{json.dumps(name)}] = {value[name]}; " for name in touched.names)
+    sets = "".join(f"__fame_v[{key[name]}] = {value[name]}; " for name in touched.names)
+    maybe = [(i, n) for i, n in enumerate(touched.written) if n not in touched.assigned]
     mask = " | ".join(
         [str(sum(1 << i for i, n in enumerate(touched.written) if n in touched.assigned))]
-        + [
-            f"(__fame_same(__fame_v[{json.dumps(name)}], {value[name]}) ? 0 : {1 << i})"
-            for i, name in enumerate(touched.written)
-            if name not in touched.assigned
-        ]
+        + [f"(__fame_same(__fame_v[{key[n]}], {value[n]}) ? 0 : {1 << i})" for i, n in maybe]
     )
+    fields = "\n".join(
+        _QUICK_FIELD.format(key=key[n])
+        if n in touched.assigned
+        else f"if (__fame_m & {1 << i}) {{ {_QUICK_FIELD.format(key=key[n])} }} "
+        "else __fame_h += '\\u001f';"
+        for i, n in enumerate(touched.written)
+    )
+    direct = _QUICK_DIRECT.format(key=key[touched.written[0]]) if len(touched.written) == 1 else ""
     parameters = ", ".join(
         ["__fame_run", "__fame_present", *(f"__fame_{i}" for i in range(len(touched.names)))]
     )
     return (
         "(function () { var __fame_v = {}, __fame_ctx = {environment: {variables: __fame_v}}, "
-        "environment = __fame_ctx.environment, __fame_call = __fame.quick_call, "
-        "__fame_same = __fame.same, "
-        f"__fame_end = __fame.quick_end, __fame_written = {json.dumps(touched.written)}; "
+        f"environment = __fame_ctx.environment, {_QUICK_LOCALS}, "
+        f"__fame_written = {json.dumps(touched.written)}; "
         f"__fame_ctx.fame_body = function (next) {{\n{body}\n}};\n"
-        f"return function fame_quick({parameters}) {{ {sets}"
-        "return __fame_end(__fame_call(__fame_ctx, __fame_run), __fame_v, __fame_written, "
-        f"{mask}); }}; }})()"
+        f"return function fame_quick({parameters}) {{ {sets}\n"
+        "var __fame_h = __fame_call(__fame_ctx, __fame_run), __fame_k, __fame_f, "
+        f"__fame_m = {mask};\n{direct}"
+        "if (__fame_h === null) return __fame_merge(__fame_v, __fame_written, __fame_m);\n"
+        f"__fame_h = 'Q' + __fame_h;\n{fields}\nreturn __fame_finish(__fame_h); }}; }})()"
     )
 
 
@@ -636,7 +659,7 @@ class JavaScript:
                 self._runs[run] = later()
         elif kind is str:  # what it did could not go flat: the usual outbox
             now = self._settle(run, later, (outbox,))
-        else:  # next() and one variable set to a number or a boolean (see fame_quick_end)
+        else:  # next() and one variable set to a number or a boolean (see _QUICK_DIRECT)
             if kind is float and outbox.is_integer() and -_JSON_INT < outbox < _JSON_INT:
                 outbox = int(outbox)  # what JSON would have made of it
             self.variables[script.touched.written[0]] = outbox
@@ -825,7 +848,7 @@ class JavaScript:
             self.changed(written)
 
     def _apply_quick(self, outbox: str, names: tuple[str, ...]) -> Outcome | None:
-        """A quick script's outbox (see the prelude's ``fame_quick_end``): what it passed to
+        """A quick script's outbox (see :func:`quick_source`): what it passed to
         ``next``, None when it did not call it. The values go to Python only: JavaScript's
         store did not see them, so its mirror keeps the old ones and the next call on the
         whole of the variables pushes them."""
@@ -834,9 +857,14 @@ class JavaScript:
             values = fields[1:]
             variables = self.variables
             for name, field in zip(names, values, strict=True):
-                if field == "-":
+                tag = field[:1]  # the usual tags inline: a call per value costs as much
+                if tag == "i":
+                    variables[name] = int(field[1:])
+                elif tag == "s":
+                    variables[name] = field[1:]
+                elif tag == "-":
                     variables.pop(name, None)
-                elif field:  # empty: not written
+                elif tag:  # empty: not written
                     variables[name] = _flat(field)
             if "" in values:
                 names = tuple(n for n, f in zip(names, values, strict=True) if f)
