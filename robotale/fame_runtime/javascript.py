@@ -232,8 +232,9 @@ var __fame = (function () {
     return drained;
   }
   // A quick script (see quick_source in Python) names every variable it touches and runs
-  // on a plain object of just those, handed over as arguments: no Proxy trap, no JSON, no
-  // store. It can call next only while it runs, so one next serves every quick call.
+  // on an object of just those, handed over as arguments, whose setters note what it
+  // writes: no Proxy trap, no JSON, no store. It can call next only while it runs, so one
+  // next serves every quick call.
   var quickSettled = false;
   function fame_quick_call(ctx, run) {  // the head of the outbox, null: effects
     current = run;
@@ -249,11 +250,10 @@ var __fame = (function () {
     out.push(['next', current, err == null ? null : String(err && err.message || err),
               value === undefined ? null : value]);
   }
-  function fame_same(a, b) { return a === b || (a !== a && b !== b); }  // NaN too
   // A quick call's outbox is made by its own generated code (quick_source in Python):
-  // 'Q<value passed to next, empty: not called>' then a field per variable it may write:
+  // 'Q<value passed to next, empty: not called>' then a field per variable it touches:
   // empty when not written, '-' when gone, else the flat value; or, the most usual outcome
-  // of all, next() and one variable set to a finite number or a boolean: that value itself.
+  // of all, next() and its one variable set to a finite number or a boolean: that value.
   function fame_quick_flat(v) { return v === undefined ? '-' : fame_flat(v); }
   function fame_quick_finish(result) {
     settledNow = false;
@@ -290,7 +290,7 @@ var __fame = (function () {
     context: context, console: console, environment: environment, node: fame_node,
     hide: fame_hide, run: fame_run, drain: fame_drain,
     quick_call: fame_quick_call, quick_flat: fame_quick_flat, quick_finish: fame_quick_finish,
-    quick_merge: fame_quick_merge, same: fame_same,
+    quick_merge: fame_quick_merge,
     message: function fame_message(id, msg, push) {
       return fame_deliver(subs, id, msg, push, false);
     },
@@ -334,13 +334,7 @@ _LOOKS_LIKE_JAVASCRIPT = re.compile(
 
 #: a variable named in full; anything else that can reach the variables object is refused
 _TOUCH = re.compile(
-    r"(?P<before>(?:\+\+|--)\s*)?(?:\bthis\s*\.\s*)?\benvironment\s*\.\s*variables\s*\.\s*"
-    r"(?P<name>[A-Za-z_$][\w$]*)"
-    # assigned: an assignment operator (not == or <=), ++ or --
-    r"(?P<assigned>\s*(?:(?:\*\*|<<|>>>?|&&|\|\||\?\?|[-+*/%&|^])?=(?!=)|\+\+|--))?"
-    # maybe assigned: the end of a destructuring pattern or of parentheses, a comment
-    # (which may hide an operator), the target of for-in/of
-    r"(?P<maybe>\s*(?:[\]),}]|/[/*])|\s+(?:in|of)\b)?"
+    r"(?:\bthis\s*\.\s*)?\benvironment\s*\.\s*variables\s*\.\s*(?P<name>[A-Za-z_$][\w$]*)"
 )
 #: what could reach the variables object other than by name, or run after the call: a
 #: function (also a method like ``{f() {...}}``), a promise, eval, or ``next`` other than
@@ -361,98 +355,72 @@ _INHERITED = frozenset(
 QUICK_NAMES = 16
 
 
-@dataclass(frozen=True, slots=True)
-class Touches:
-    """The variables a script touches, in order; those it may assign (a superset), and of
-    these the ones it surely assigns where it runs (an assignment operator, ++, --)."""
-
-    names: tuple[str, ...]
-    written: tuple[str, ...]
-    assigned: frozenset[str]
-
-
-def touches(body: str) -> Touches | None:
-    """What a script body touches, when it names every variable in full
+def touches(body: str) -> tuple[str, ...] | None:
+    """The variables a script body touches, in order, when it names every one in full
     (``[this.]environment.variables.<name>``) and nothing else can reach them: then it may run
     on just those values. None when it may use the variables object any other way (kept in a
     variable, ``variables[name]``, passed to a function), defines a function or promise
     callback that could run after the call, keeps ``next``, or touches the node shim."""
-    names: dict[str, None] = {}
-    written: dict[str, None] = {}
-    assigned = set()
-    for match in _TOUCH.finditer(body):
-        names[match["name"]] = None
-        if match["before"] or match["assigned"]:
-            assigned.add(match["name"])
-        if match["before"] or match["assigned"] or match["maybe"]:
-            written[match["name"]] = None
+    names = tuple(dict.fromkeys(match["name"] for match in _TOUCH.finditer(body)))
     if _DYNAMIC.search(_TOUCH.sub(" ", body)) or len(names) > QUICK_NAMES:
         return None
     if any(n in NODE_NAMES or n in _INHERITED or n.startswith("__") for n in names):
         return None
-    return Touches(tuple(names), tuple(written), frozenset(assigned))
+    return names
 
 
 #: the prelude's functions a quick script's code uses, as locals of its closure
 _QUICK_LOCALS = (
     "__fame_call = __fame.quick_call, __fame_flat = __fame.quick_flat, "
-    "__fame_finish = __fame.quick_finish, __fame_merge = __fame.quick_merge, "
-    "__fame_same = __fame.same"
+    "__fame_finish = __fame.quick_finish, __fame_merge = __fame.quick_merge"
 )
-#: one field of the outbox: the variable's value, flat (a 32-bit integer or a string inline:
-#: three calls deep, fame_flat costs more than the script)
+#: a variable as a property whose setter notes it was written (bit ``bit`` of __fame_w), as
+#: the Proxy's set trap does; its value lives in a local of the closure
+_QUICK_PROPERTY = (
+    "Object.defineProperty(__fame_v, {key}, {{get: function fame_get() {{ return __fame_{i}; "
+    "}}, set: function fame_set(x) {{ __fame_{i} = x; __fame_w |= {bit}; }}, enumerable: true}});"
+)
+#: one field of the outbox: empty when not written, else the value flat (a 32-bit integer or
+#: a string inline: three calls deep, fame_flat costs more than the script)
 _QUICK_FIELD = (
-    "__fame_k = __fame_v[{key}]; __fame_f = typeof __fame_k === 'number' && "
-    "(__fame_k | 0) === __fame_k ? 'i' + __fame_k : typeof __fame_k === 'string' ? "
+    "if (__fame_w & {bit}) {{ __fame_k = __fame_{i}; __fame_f = typeof __fame_k === 'number' "
+    "&& (__fame_k | 0) === __fame_k ? 'i' + __fame_k : typeof __fame_k === 'string' ? "
     "(__fame_k.indexOf('\\u001f') < 0 ? 's' + __fame_k : null) : __fame_flat(__fame_k); "
-    "if (__fame_f === null) return __fame_merge(__fame_v, __fame_written, __fame_m); "
-    "__fame_h += '\\u001f' + __fame_f;"
+    "if (__fame_f === null) return __fame_merge(__fame_v, __fame_names, __fame_w); "
+    "__fame_h += '\\u001f' + __fame_f; }} else __fame_h += '\\u001f';"
 )
-#: next() or next(null) and only one variable, written: its value when a number or boolean
+#: next() or next(null) and the one variable written: its value when a number or a boolean
 _QUICK_DIRECT = (
-    "if (__fame_h === 'z' && __fame_m === 1) {{ __fame_k = __fame_v[{key}]; "
-    "if ((typeof __fame_k === 'number' && isFinite(__fame_k)) || typeof __fame_k === "
-    "'boolean') return __fame_finish(__fame_k); }}\n"
+    "if (__fame_h === 'z' && __fame_w === 1 && ((typeof __fame_0 === 'number' && "
+    "isFinite(__fame_0)) || typeof __fame_0 === 'boolean')) return __fame_finish(__fame_0);\n"
 )
 
 
-def quick_source(body: str, touched: Touches) -> str:
+def quick_source(body: str, names: tuple[str, ...]) -> str:
     """A script body as ``fame_quick(run, present, value...)``: the variables' values (a bit
-    of ``present`` set for each the robot has) set on a plain object, the body run on it, the
-    outbox made (see the prelude's ``fame_quick_*``). A variable surely assigned counts as
-    written, as in a Python script; one maybe assigned only if its value changed. The body
-    stays on lines 2 and on, as in :func:`function_source`, so errors name its own lines."""
-    key = {name: json.dumps(name) for name in touched.names}
-    value = {
-        name: f"(__fame_present & {1 << i} ? __fame_{i} : undefined)"
-        for i, name in enumerate(touched.names)
-    }
-    sets = "".join(f"__fame_v[{key[name]}] = {value[name]}; " for name in touched.names)
-    maybe = [(i, n) for i, n in enumerate(touched.written) if n not in touched.assigned]
-    mask = " | ".join(
-        [str(sum(1 << i for i, n in enumerate(touched.written) if n in touched.assigned))]
-        + [f"(__fame_same(__fame_v[{key[n]}], {value[n]}) ? 0 : {1 << i})" for i, n in maybe]
+    of ``present`` set for each the robot has) on an object of just those, the body run on
+    it, the outbox made (see the prelude's ``fame_quick_*``). The body stays on lines 2 and
+    on, as in :func:`function_source`, so errors name its own lines."""
+    keys = [json.dumps(name) for name in names]
+    slots = "".join(f", __fame_{i}" for i in range(len(names)))
+    properties = "".join(
+        _QUICK_PROPERTY.format(key=key, i=i, bit=1 << i) for i, key in enumerate(keys)
     )
-    fields = "\n".join(
-        _QUICK_FIELD.format(key=key[n])
-        if n in touched.assigned
-        else f"if (__fame_m & {1 << i}) {{ {_QUICK_FIELD.format(key=key[n])} }} "
-        "else __fame_h += '\\u001f';"
-        for i, n in enumerate(touched.written)
+    values = "".join(
+        f"__fame_{i} = __fame_present & {1 << i} ? __fame_a{i} : undefined; "
+        for i in range(len(names))
     )
-    direct = _QUICK_DIRECT.format(key=key[touched.written[0]]) if len(touched.written) == 1 else ""
-    parameters = ", ".join(
-        ["__fame_run", "__fame_present", *(f"__fame_{i}" for i in range(len(touched.names)))]
-    )
+    fields = "\n".join(_QUICK_FIELD.format(i=i, bit=1 << i) for i in range(len(names)))
+    parameters = "".join(f", __fame_a{i}" for i in range(len(names)))
     return (
         "(function () { var __fame_v = {}, __fame_ctx = {environment: {variables: __fame_v}}, "
-        f"environment = __fame_ctx.environment, {_QUICK_LOCALS}, "
-        f"__fame_written = {json.dumps(touched.written)}; "
+        f"environment = __fame_ctx.environment, {_QUICK_LOCALS}, __fame_w = 0{slots}, "
+        f"__fame_names = {json.dumps(names)}; {properties} "
         f"__fame_ctx.fame_body = function (next) {{\n{body}\n}};\n"
-        f"return function fame_quick({parameters}) {{ {sets}\n"
-        "var __fame_h = __fame_call(__fame_ctx, __fame_run), __fame_k, __fame_f, "
-        f"__fame_m = {mask};\n{direct}"
-        "if (__fame_h === null) return __fame_merge(__fame_v, __fame_written, __fame_m);\n"
+        f"return function fame_quick(__fame_run, __fame_present{parameters}) {{ {values}"
+        "__fame_w = 0;\nvar __fame_h = __fame_call(__fame_ctx, __fame_run), __fame_k, __fame_f;\n"
+        f"{_QUICK_DIRECT if len(names) == 1 else ''}"
+        "if (__fame_h === null) return __fame_merge(__fame_v, __fame_names, __fame_w);\n"
         f"__fame_h = 'Q' + __fame_h;\n{fields}\nreturn __fame_finish(__fame_h); }}; }})()"
     )
 
@@ -483,7 +451,7 @@ class _Script:
     ``full`` (on the whole of the variables) when first needed."""
 
     source: str
-    touched: Touches | None
+    names: tuple[str, ...] | None
     quick: Any = None
     full: Any = None
 
@@ -620,8 +588,8 @@ class JavaScript:
         self._run_ids += 1
         run = self._run_ids
         script = self._scripts.get(source) or self._compile(source)
-        if script.touched is not None:
-            values = self._quick_values(script.touched.names)
+        if script.names is not None:
+            values = self._quick_values(script.names)
             if values is not None:
                 return self._run_quick(script, run, values, later)
         outboxes = self._call(self._run, self._full(script), run, self._push())
@@ -654,7 +622,7 @@ class JavaScript:
             raise self._failure(error) from None
         kind = type(outbox)
         if kind is str and outbox[:1] == "Q":
-            now = self._apply_quick(outbox, script.touched.written)
+            now = self._apply_quick(outbox, script.names)
             if now is None:  # it may call next later (from a callback a former script set up)
                 self._runs[run] = later()
         elif kind is str:  # what it did could not go flat: the usual outbox
@@ -662,8 +630,8 @@ class JavaScript:
         else:  # next() and one variable set to a number or a boolean (see _QUICK_DIRECT)
             if kind is float and outbox.is_integer() and -_JSON_INT < outbox < _JSON_INT:
                 outbox = int(outbox)  # what JSON would have made of it
-            self.variables[script.touched.written[0]] = outbox
-            self.changed(script.touched.written)
+            self.variables[script.names[0]] = outbox
+            self.changed(script.names)
             now = _NEXT
         if jobs:
             self._apply((jobs,))
@@ -717,10 +685,10 @@ class JavaScript:
 
     def _compile(self, source: str) -> _Script:
         body = source[len(_WRAP_HEAD) : -len(_WRAP_TAIL)] if _is_wrapped(source) else None
-        touched = None if body is None else touches(body)
-        script = _Script(source, touched)
-        if touched is not None:
-            script.quick = self.context.eval(quick_source(body, touched))
+        names = None if body is None else touches(body)
+        script = _Script(source, names)
+        if names is not None:
+            script.quick = self.context.eval(quick_source(body, names))
         self._scripts[source] = script
         return script
 
