@@ -22,6 +22,11 @@ JavaScript side only records what a script does (publish, subscribe, log, ``next
 variables it wrote; Python applies that after each call. The bus is used only through its
 public ``publish``/``subscribe``, so the same shim works on every bus.
 
+Why most scripts run quick: keeping a JavaScript copy of all the variables in step with
+Python's (a Proxy noting reads and writes, JSON both ways) cost more than a usual script
+itself. A script that names each variable it touches (see :func:`touches`) gets just those
+values as arguments and returns what it assigned as short text.
+
 QuickJS (``quickjs-ng`` on PyPI) is the embedding: no file, network or process access exists
 in it at all, and each runtime has a CPU-time and a memory limit.
 """
