@@ -8,7 +8,9 @@ SpiffWorkflow's measured in the same run (target: at least 10x). The sequence ru
 time with the same scripts in JavaScript (FAME's ``this.environment.variables.value_<i> = <i>
 * 2; next();``) in the embedded engine, in turns with the Python sequence and timed in CPU
 seconds of this process, so a busy machine slows both alike (target: at least half the
-Python throughput).
+Python throughput); and once more with two assignments per script, one of them a string
+(``last = 'task_<i>'``), whose outcome comes back from JavaScript as text instead of as the
+one number itself.
 
 Then the latency of a signal: one engine throws ``ping`` once a simulated second, another
 catches it; the wall time from the throw to the catching token moving, on the in-process bus
@@ -51,12 +53,20 @@ SCRIPTS = {
     "python": "value_{i} = {i} * 2",
     "javascript": "this.environment.variables.value_{i} = {i} * 2; next();",
 }
+#: two assignments, one of a string: JavaScript's outcome then travels as text
+TWO_WRITES = {
+    "python": "value_{i} = {i} * 2\nlast = 'task_{i}'",
+    "javascript": (
+        "this.environment.variables.value_{i} = {i} * 2; "
+        "this.environment.variables.last = 'task_{i}'; next();"
+    ),
+}
 
 
-def script_task(i: int, language: str = "python") -> str:
+def script_task(i: int, language: str = "python", scripts: dict[str, str] = SCRIPTS) -> str:
     return (
         f'<bpmn:scriptTask id="task_{i}" name="Task {i}" scriptFormat="{language}">'
-        f"<bpmn:script>{SCRIPTS[language].format(i=i)}</bpmn:script></bpmn:scriptTask>\n"
+        f"<bpmn:script>{scripts[language].format(i=i)}</bpmn:script></bpmn:scriptTask>\n"
     )
 
 
@@ -67,9 +77,9 @@ def flow(source: str, target: str) -> str:
     )
 
 
-def sequential(language: str = "python") -> str:
+def sequential(language: str = "python", scripts: dict[str, str] = SCRIPTS) -> str:
     chain = ["start", *[f"task_{i}" for i in range(TASKS)], "end"]
-    body = "".join(script_task(i, language) for i in range(TASKS))
+    body = "".join(script_task(i, language, scripts) for i in range(TASKS))
     return HEADER + body + "".join(flow(a, b) for a, b in itertools.pairwise(chain)) + FOOTER
 
 
@@ -169,13 +179,15 @@ def cpu_rate(run_once: Callable[[], None], seconds: float) -> float:
     return count / (time.process_time() - start)
 
 
-def javascript_ratio(folder: Path, seconds: float, rounds: int = 5) -> tuple[float, float]:
+def javascript_ratio(
+    folder: Path, seconds: float, rounds: int = 5, scripts: dict[str, str] = SCRIPTS
+) -> tuple[float, float]:
     """The JavaScript sequence's runs per CPU second and its median ratio to the Python
     sequence's, the two measured in turns so that both see the same machine."""
     runners = {}
     for language in ("python", "javascript"):
         path = folder / f"bench_{language}.bpmn"
-        path.write_text(sequential(language))
+        path.write_text(sequential(language, scripts))
         runners[language] = robotale_runner(path)
     pairs = [
         (
@@ -237,6 +249,11 @@ def main() -> int:
         print(
             f"{'sequential, JavaScript':32} {'robotale':12} {js:12.0f} {js * (TASKS + 2):12.0f} "
             f"{ratio:6.2f}x of Python (target >= 0.5)"
+        )
+        js, ratio = javascript_ratio(Path(folder), options.seconds, scripts=TWO_WRITES)
+        print(
+            f"{'sequential, JavaScript, 2 writes':32} {'robotale':12} {js:12.0f} "
+            f"{js * (TASKS + 2):12.0f} {ratio:6.2f}x of Python (the same, a number and a string)"
         )
         ping = Path(folder) / "ping.bpmn"
         ping.write_text(PING)

@@ -25,7 +25,7 @@ from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock, EngineTime
 from robotale.fame_runtime.data import Data
 from robotale.fame_runtime.expressions import BpmnError, Compiled
-from robotale.fame_runtime.javascript import JavaScript, ScriptFailure
+from robotale.fame_runtime.javascript import Completion, JavaScript, ScriptFailure
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import JAVASCRIPT, Process
 from robotale.fame_runtime.plan import (
@@ -586,25 +586,21 @@ class Engine:
         script, or later from a callback, its token waiting like a skill's meanwhile (with its
         boundary events armed)."""
         generation = token.generation
-        now: list[str | None] = []  # next() called during the run: its error (or None)
-        running = True
-
-        def done(error: str | None, _value: Any) -> None:
-            if running:
-                now.append(error)
-                return
-            outcome = None if error is None else BpmnError(error)
-            self._call(lambda: self._skill_done(token, generation, outcome))
-
+        javascript = self._javascript or self.javascript
         try:
-            with self._charged("script"):
-                self.javascript.run_script(node.script.source, done)
+            if self._time is None:  # nothing to charge: the hot path spares the with block
+                now = javascript.run_task(
+                    node.script.source, lambda: self._script_done(token, generation)
+                )
+            else:
+                with self._charged("script"):
+                    now = javascript.run_task(
+                        node.script.source, lambda: self._script_done(token, generation)
+                    )
         except ScriptFailure as failure:
             self._throw_error(token, f"script task {node.node.describe()}: {failure.text}")
             return None
-        finally:
-            running = False
-        if not now:
+        if now is None:
             self._arm_boundaries(token, node)
             return None
         if now[0] is not None:
@@ -613,6 +609,16 @@ class Engine:
         self._tag(node.label, "complete")
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
+
+    def _script_done(self, token: _Token, generation: int) -> Completion:
+        """What a script task's ``next`` calls once its run has returned: the task completes
+        (or throws) in a later step, as a skill's does."""
+
+        def done(error: str | None, _value: Any) -> None:
+            outcome = None if error is None else BpmnError(error)
+            self._call(lambda: self._skill_done(token, generation, outcome))
+
+        return done
 
     def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
         self._tag(node.label, "start")

@@ -22,6 +22,11 @@ JavaScript side only records what a script does (publish, subscribe, log, ``next
 variables it wrote; Python applies that after each call. The bus is used only through its
 public ``publish``/``subscribe``, so the same shim works on every bus.
 
+Why most scripts run quick: keeping a JavaScript copy of all the variables in step with
+Python's (a Proxy noting reads and writes, JSON both ways) cost more than a usual script
+itself. A script that names each variable it touches (see :func:`touches`) gets just those
+values as arguments and returns what it assigned as short text.
+
 QuickJS (``quickjs-ng`` on PyPI) is the embedding: no file, network or process access exists
 in it at all, and each runtime has a CPU-time and a memory limit.
 """
@@ -32,6 +37,7 @@ import json
 import re
 import threading
 from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from typing import Any
 
 import quickjs
@@ -128,9 +134,14 @@ var __fame = (function () {
   // next() -- goes back as flat text: 'C', then triples of fields separated by \x1f (w name
   // value | d name '' | n run value). JSON.stringify costs more than such a script itself.
   // Anything else goes as the JSON of an object.
+  // a number JSON writes without fraction or exponent (read back as an int) is 'i'
   function fame_flat(v) {
     var t = typeof v;
-    if (t === 'number') return isFinite(v) ? 'n' + v : null;
+    if (t === 'number') {
+      if ((v | 0) === v) return 'i' + v;  // the usual: a 32-bit integer, found without a call
+      if (!isFinite(v)) return null;
+      return (Number.isInteger(v) && v < 1e21 && v > -1e21 ? 'i' : 'n') + v;
+    }
     if (t === 'boolean') return v ? 't' : 'f';
     if (v === null || v === undefined) return 'z';
     if (t === 'string' && fame_plain(v)) return 's' + v;
@@ -184,9 +195,14 @@ var __fame = (function () {
     return flat;
   }
   function fame_json(e) {
-    var w = {}, d = [], k;
-    for (k in dirty) if (store[k] === undefined) d.push(k); else w[k] = store[k];
-    return JSON.stringify({w: w, d: d, e: e});  // made in one piece: never a rope
+    var w = {}, d = [], o = [], k, t;
+    for (k in dirty) {
+      if (store[k] === undefined) { d.push(k); continue; }
+      w[k] = store[k];
+      t = typeof store[k];
+      if (t === 'function' || t === 'symbol') o.push(k);  // JSON leaves it out
+    }
+    return JSON.stringify({w: w, d: d, o: o, e: e});  // made in one piece: never a rope
   }
   function fame_next(run) {
     var settled = false;
@@ -220,6 +236,52 @@ var __fame = (function () {
     current = 0;
     return drained;
   }
+  // A quick script (see quick_source in Python) names every variable it touches and runs
+  // on an object of just those, handed over as arguments, whose setters note what it
+  // writes: no Proxy trap, no JSON, no store. It can call next only while it runs, so one
+  // next serves every quick call.
+  var quickSettled = false;
+  function fame_quick_call(ctx, run) {  // the head of the outbox, null: effects
+    current = run;
+    quickSettled = settledNow = false;  // what a call stopped by its time limit left
+    try { ctx.fame_body(fame_quick_next); } catch (e) { fame_fail(run, e); }
+    return out.length === 0 ? (settledNow ? fame_flat(valueNow) : '') : null;
+  }
+  function fame_quick_next(err, value) {
+    if (quickSettled) return;
+    quickSettled = true;
+    if (err == null && out.length === 0) { settledNow = true; valueNow = value; return; }
+    fame_settle();
+    out.push(['next', current, err == null ? null : String(err && err.message || err),
+              value === undefined ? null : value]);
+  }
+  // A quick call's outbox is made by its own generated code (quick_source in Python):
+  // 'Q<value passed to next, empty: not called>' then a field per variable it touches:
+  // empty when not written, '-' when gone, else the flat value; or, the most usual outcome
+  // of all, next() and its one variable set to a finite number or a boolean: that value.
+  function fame_quick_flat(v) { return v === undefined ? '-' : fame_flat(v); }
+  function fame_quick_finish(result) {
+    settledNow = false;
+    current = 0;
+    // a long string built by += may be a rope, which the embedding cannot return
+    if (typeof result === 'string' && result.length > 256) {
+      result = result.split('\u001f').join('\u001f');
+    }
+    return result;
+  }
+  // What cannot go so (an effect, an object): the written variables (bits of mask) go
+  // through the Proxy into the store, and the outbox is fame_drain's.
+  function fame_quick_merge(v, written, mask) {
+    var i, k, text;
+    for (i = 0; i < written.length; i++) {
+      if (!(mask & (1 << i))) continue;
+      k = written[i];
+      if (v[k] === undefined) delete variables[k]; else variables[k] = v[k];
+    }
+    text = fame_drain();
+    current = 0;
+    return text;
+  }
   function fame_deliver(table, id, msg, push, once) {
     fame_absorb(push);
     var callback = table[id];
@@ -232,6 +294,8 @@ var __fame = (function () {
   return {
     context: context, console: console, environment: environment, node: fame_node,
     hide: fame_hide, run: fame_run, drain: fame_drain,
+    quick_call: fame_quick_call, quick_flat: fame_quick_flat, quick_finish: fame_quick_finish,
+    quick_merge: fame_quick_merge,
     message: function fame_message(id, msg, push) {
       return fame_deliver(subs, id, msg, push, false);
     },
@@ -273,6 +337,99 @@ _LOOKS_LIKE_JAVASCRIPT = re.compile(
 )
 
 
+#: a variable named in full; anything else that can reach the variables object is refused
+_TOUCH = re.compile(
+    r"(?:\bthis\s*\.\s*)?\benvironment\s*\.\s*variables\s*\.\s*(?P<name>[A-Za-z_$][\w$]*)"
+)
+#: what could reach the variables object other than by name, or run after the call: a
+#: function (also a method like ``{f() {...}}``), a promise, eval, or ``next`` other than
+#: called (kept, it could complete the run later)
+_DYNAMIC = re.compile(
+    r"\b(?:this|environment|variables|function|class|eval|Function|arguments|globalThis"
+    r"|with|delete|import|async|await|yield|Promise|then|__fame\w*)\b|=>"
+    r"|\bnext\b(?!\s*\()"
+    r"|(?<![\w$.])(?!(?:if|for|while|switch|catch|return|typeof|void|new|in|of)\b)"
+    r"[A-Za-z_$][\w$]*\s*\([^()]*\)\s*\{"
+)
+#: what a plain object inherits: its value is not the variable's
+_INHERITED = frozenset(
+    {"constructor", "hasOwnProperty", "isPrototypeOf", "propertyIsEnumerable"}
+    | {"toLocaleString", "toString", "valueOf"}
+)
+#: a quick script touches at most this many variables (one bit each of a 32-bit integer)
+QUICK_NAMES = 16
+
+
+def touches(body: str) -> tuple[str, ...] | None:
+    """The variables a script body touches, in order, when it names every one in full
+    (``[this.]environment.variables.<name>``) and nothing else can reach them: then it may run
+    on just those values. None when it may use the variables object any other way (kept in a
+    variable, ``variables[name]``, passed to a function), defines a function or promise
+    callback that could run after the call, keeps ``next``, or touches the node shim."""
+    names = tuple(dict.fromkeys(match["name"] for match in _TOUCH.finditer(body)))
+    if _DYNAMIC.search(_TOUCH.sub(" ", body)) or len(names) > QUICK_NAMES:
+        return None
+    if any(n in NODE_NAMES or n in _INHERITED or n.startswith("__") for n in names):
+        return None
+    return names
+
+
+#: the prelude's functions a quick script's code uses, as locals of its closure
+_QUICK_LOCALS = (
+    "__fame_call = __fame.quick_call, __fame_flat = __fame.quick_flat, "
+    "__fame_finish = __fame.quick_finish, __fame_merge = __fame.quick_merge"
+)
+#: a variable as a property whose setter notes it was written (bit ``bit`` of __fame_w), as
+#: the Proxy's set trap does; its value lives in a local of the closure
+_QUICK_PROPERTY = (
+    "Object.defineProperty(__fame_v, {key}, {{get: function fame_get() {{ return __fame_{i}; "
+    "}}, set: function fame_set(x) {{ __fame_{i} = x; __fame_w |= {bit}; }}, enumerable: true}});"
+)
+#: one field of the outbox: empty when not written, else the value flat (a 32-bit integer or
+#: a string inline: three calls deep, fame_flat costs more than the script)
+_QUICK_FIELD = (
+    "if (__fame_w & {bit}) {{ __fame_k = __fame_{i}; __fame_f = typeof __fame_k === 'number' "
+    "&& (__fame_k | 0) === __fame_k ? 'i' + __fame_k : typeof __fame_k === 'string' ? "
+    "(__fame_k.indexOf('\\u001f') < 0 ? 's' + __fame_k : null) : __fame_flat(__fame_k); "
+    "if (__fame_f === null) return __fame_merge(__fame_v, __fame_names, __fame_w); "
+    "__fame_h += '\\u001f' + __fame_f; }} else __fame_h += '\\u001f';"
+)
+#: next() or next(null) and the one variable written: its value when a number or a boolean
+_QUICK_DIRECT = (
+    "if (__fame_h === 'z' && __fame_w === 1 && ((typeof __fame_0 === 'number' && "
+    "isFinite(__fame_0)) || typeof __fame_0 === 'boolean')) return __fame_finish(__fame_0);\n"
+)
+
+
+def quick_source(body: str, names: tuple[str, ...]) -> str:
+    """A script body as ``fame_quick(run, present, value...)``: the variables' values (a bit
+    of ``present`` set for each the robot has) on an object of just those, the body run on
+    it, the outbox made (see the prelude's ``fame_quick_*``). The body stays on lines 2 and
+    on, as in :func:`function_source`, so errors name its own lines."""
+    keys = [json.dumps(name) for name in names]
+    slots = "".join(f", __fame_{i}" for i in range(len(names)))
+    properties = "".join(
+        _QUICK_PROPERTY.format(key=key, i=i, bit=1 << i) for i, key in enumerate(keys)
+    )
+    values = "".join(
+        f"__fame_{i} = __fame_present & {1 << i} ? __fame_a{i} : undefined; "
+        for i in range(len(names))
+    )
+    fields = "\n".join(_QUICK_FIELD.format(i=i, bit=1 << i) for i in range(len(names)))
+    parameters = "".join(f", __fame_a{i}" for i in range(len(names)))
+    return (
+        "(function () { var __fame_v = {}, __fame_ctx = {environment: {variables: __fame_v}}, "
+        f"environment = __fame_ctx.environment, {_QUICK_LOCALS}, __fame_w = 0{slots}, "
+        f"__fame_names = {json.dumps(names)}; {properties} "
+        f"__fame_ctx.fame_body = function (next) {{\n{body}\n}};\n"
+        f"return function fame_quick(__fame_run, __fame_present{parameters}) {{ {values}"
+        "__fame_w = 0;\nvar __fame_h = __fame_call(__fame_ctx, __fame_run), __fame_k, __fame_f;\n"
+        f"{_QUICK_DIRECT if len(names) == 1 else ''}"
+        "if (__fame_h === null) return __fame_merge(__fame_v, __fame_names, __fame_w);\n"
+        f"__fame_h = 'Q' + __fame_h;\n{fields}\nreturn __fame_finish(__fame_h); }}; }})()"
+    )
+
+
 def looks_like_javascript(text: str) -> bool:
     """A script or condition without a language is JavaScript when it uses what Python
     cannot (``next(``, ``this.environment``, ``var``/``let``/``const``, ``=>``, ``===``,
@@ -285,6 +442,33 @@ def member_names(text: str) -> frozenset[str]:
     reads, so a conditional event is re-evaluated when one of them changes."""
     return frozenset(a or b for a, b in _MEMBER.findall(text))
 
+
+_WRAP_HEAD, _WRAP_TAIL = _WRAP.split("%s")
+
+
+def _is_wrapped(source: str) -> bool:
+    return source.startswith(_WRAP_HEAD) and source.endswith(_WRAP_TAIL)
+
+
+@dataclass(slots=True)
+class _Script:
+    """A script's source compiled: ``quick`` when :func:`touches` found its variables,
+    ``full`` (on the whole of the variables) when first needed."""
+
+    source: str
+    names: tuple[str, ...] | None
+    quick: Any = None
+    full: Any = None
+
+
+_ABSENT = object()
+#: what goes into JavaScript as an argument as it is (an int only within 32 bits)
+_PLAIN = frozenset({str, float, bool, type(None)})
+_INT32 = 1 << 31
+#: integers a double holds exactly
+_EXACT = 1 << 53
+#: from this magnitude on, JSON writes a whole number with an exponent: Python reads a float
+_JSON_INT = 1e21
 
 _checker_lock = threading.Lock()
 _checker: list[quickjs.Context] = []
@@ -328,6 +512,22 @@ class ScriptFailure(Exception):
 
 #: called when a script calls ``next(err, value)``: err is None or the error's text
 Completion = Callable[[str | None, Any], None]
+#: what a script passed to ``next``: (err, value)
+Outcome = tuple[str | None, Any]
+_NEXT: Outcome = (None, None)
+
+
+class _Now:
+    """The completion of a run while it is called: it keeps what the run passed to
+    ``next``, for the caller to act on once the call has returned."""
+
+    __slots__ = ("outcome",)
+
+    def __init__(self) -> None:
+        self.outcome: Outcome | None = None
+
+    def __call__(self, error: str | None, value: Any) -> None:
+        self.outcome = (error, value)
 
 
 class JavaScript:
@@ -368,7 +568,8 @@ class JavaScript:
         for name in NODE_NAMES:
             hide(name, node)
         self.context.set_time_limit(time_limit)
-        self._functions: dict[str, Any] = {}
+        self._scripts: dict[str, _Script] = {}
+        self._opaque: set[str] = set()  # variables JavaScript holds that JSON cannot carry
         self._promises = False  # a script that may queue promise jobs was compiled
         self._mirror: dict[str, Any] = {}  # what the JavaScript side holds, by identity
         self._runs: dict[int, Completion] = {}
@@ -379,16 +580,92 @@ class JavaScript:
     # -- running ---------------------------------------------------------------------------
 
     def run_script(self, source: str, done: Completion) -> None:
-        """Run a script task's body; ``done`` is called when it calls ``next`` (maybe now).
+        """Run a script's body; ``done`` is called when it calls ``next`` (maybe now).
+        ScriptFailure when it throws."""
+        now = self.run_task(source, lambda: done)
+        if now is not None:
+            done(*now)
+
+    def run_task(self, source: str, later: Callable[[], Completion]) -> Outcome | None:
+        """Run a script task's body: ``(error, value)`` when it called ``next(error, value)``
+        while it ran; else None, and ``later()`` gives what its ``next`` calls when it does.
         ScriptFailure when it throws."""
         self._run_ids += 1
         run = self._run_ids
-        self._runs[run] = done
+        script = self._scripts.get(source) or self._compile(source)
+        if script.names is not None:
+            values = self._quick_values(script.names)
+            if values is not None:
+                return self._run_quick(script, run, values, later)
+        outboxes = self._call(self._run, self._full(script), run, self._push())
+        return self._settle(run, later, outboxes)
+
+    def _settle(
+        self, run: int, later: Callable[[], Completion], outboxes: tuple[str, ...]
+    ) -> Outcome | None:
+        """Apply a run's outboxes: what it passed to ``next`` if it called it, else None and
+        its later completion is waiting."""
+        now = _Now()
+        self._runs[run] = now
         try:
-            self._apply(self._call(self._run, self._function(source), run), run)
+            self._apply(outboxes, run)
         except ScriptFailure:
             self._runs.pop(run, None)
             raise
+        if run in self._runs:
+            self._runs[run] = later()
+        return now.outcome
+
+    def _run_quick(
+        self, script: _Script, run: int, values: list[Any], later: Callable[[], Completion]
+    ) -> Outcome | None:
+        """Run a script on the values of the variables it names (see ``fame_quick``)."""
+        try:
+            outbox = script.quick(run, *values)
+            jobs = self._jobs() if self._promises else None
+        except quickjs.JSException as error:
+            raise self._failure(error) from None
+        kind = type(outbox)
+        if kind is str and outbox[:1] == "Q":
+            now = self._apply_quick(outbox, script.names)
+            if now is None:  # it may call next later (from a callback a former script set up)
+                self._runs[run] = later()
+        elif kind is str:  # what it did could not go flat: the usual outbox
+            now = self._settle(run, later, (outbox,))
+        else:  # next() and one variable set to a number or a boolean (see _QUICK_DIRECT)
+            if kind is float and outbox.is_integer() and -_JSON_INT < outbox < _JSON_INT:
+                outbox = int(outbox)  # what JSON would have made of it
+            self.variables[script.names[0]] = outbox
+            self.changed(script.names)
+            now = _NEXT
+        if jobs:
+            self._apply((jobs,))
+        return now
+
+    def _quick_values(self, names: tuple[str, ...]) -> list[Any] | None:
+        """A bit mask of the ``names`` the robot has, then their values; None when one of
+        them holds what only JSON carries (a list, an object, a huge integer) or a value
+        JavaScript holds that Python lacks."""
+        if self._opaque and not self._opaque.isdisjoint(names):
+            return None
+        variables = self.variables
+        values: list[Any] = [0]
+        present, bit = 0, 1
+        for name in names:
+            value = variables.get(name, _ABSENT)
+            if value is not _ABSENT:
+                kind = type(value)
+                if kind is int and not -_INT32 <= value < _INT32:
+                    if not -_EXACT <= value <= _EXACT:
+                        return None
+                    value = float(value)  # the embedding would cut an integer to 32 bits
+                elif kind is not int and kind not in _PLAIN:
+                    return None
+                present |= bit
+            values.append(None if value is _ABSENT else value)
+            bit <<= 1
+        values[0] = present
+        return values
 
     def condition(self, source: str) -> Any:
         """The value a condition passes to ``next`` (None when it never calls it)."""
@@ -411,36 +688,53 @@ class JavaScript:
         self._calls.clear()
         self._runs.clear()
 
-    def _function(self, source: str) -> Any:
-        function = self._functions.get(source)
-        if function is None:
-            function = self._functions[source] = self.context.eval(source)
-            self._promises = self._promises or bool(_PROMISES.search(source))
-        return function
+    def _compile(self, source: str) -> _Script:
+        body = source[len(_WRAP_HEAD) : -len(_WRAP_TAIL)] if _is_wrapped(source) else None
+        names = None if body is None else touches(body)
+        script = _Script(source, names)
+        if names is not None:
+            script.quick = self.context.eval(quick_source(body, names))
+        self._scripts[source] = script
+        return script
+
+    def _full(self, script: _Script) -> Any:
+        """The script as ``function (next)`` on the whole of the variables."""
+        if script.full is None:
+            script.full = self.context.eval(script.source)
+            self._promises = self._promises or bool(_PROMISES.search(script.source))
+        return script.full
 
     def _call(self, function: Any, *args: Any) -> tuple[str, ...]:
-        """Call into JavaScript with the variables Python changed: its drained outbox, and a
-        second one when it left promise jobs (they run before anything is applied)."""
+        """Call into JavaScript: its drained outbox, and a second one when it left promise
+        jobs (they run before anything is applied)."""
         try:
-            result = function(*args, self._push())
-            if self._promises and self.context.execute_pending_job():
-                while self.context.execute_pending_job():
-                    pass
-                return result, self._drain()
-            return (result,)
+            result = function(*args)
+            later = self._jobs() if self._promises else None
         except quickjs.JSException as error:
-            text = str(error)
-            if "interrupted" in text:
-                raise ScriptFailure(
-                    f"the script ran longer than its time limit of {self.time_limit:g} s of "
-                    "CPU time and was stopped"
-                ) from None
-            if "out of memory" in text:
-                raise ModelError(
-                    f"robot {self.robot}: JavaScript ran out of its {MEMORY_LIMIT >> 20} MiB "
-                    "of memory"
-                ) from None
-            raise ScriptFailure(f"{_first_line(text)} (line {_script_line(text)})") from None
+            raise self._failure(error) from None
+        return (result, later) if later else (result,)
+
+    def _jobs(self) -> str | None:
+        """Run the promise jobs calls left; the outbox of what they did (None: no job)."""
+        if not self.context.execute_pending_job():
+            return None
+        while self.context.execute_pending_job():
+            pass
+        return self._drain()
+
+    def _failure(self, error: quickjs.JSException) -> Exception:
+        """What a call that JavaScript stopped raises."""
+        text = str(error)
+        if "interrupted" in text:
+            return ScriptFailure(
+                f"the script ran longer than its time limit of {self.time_limit:g} s of "
+                "CPU time and was stopped"
+            )
+        if "out of memory" in text:
+            return ModelError(
+                f"robot {self.robot}: JavaScript ran out of its {MEMORY_LIMIT >> 20} MiB of memory"
+            )
+        return ScriptFailure(f"{_first_line(text)} (line {_script_line(text)})")
 
     def _push(self) -> str:
         """The variables that changed in Python since JavaScript last saw them, as JSON."""
@@ -526,7 +820,36 @@ class JavaScript:
         if written:
             self.changed(written)
 
+    def _apply_quick(self, outbox: str, names: tuple[str, ...]) -> Outcome | None:
+        """A quick script's outbox (see :func:`quick_source`): what it passed to
+        ``next``, None when it did not call it. The values go to Python only: JavaScript's
+        store did not see them, so its mirror keeps the old ones and the next call on the
+        whole of the variables pushes them."""
+        fields = outbox.split("\x1f")
+        if len(fields) > 1:
+            values = fields[1:]
+            variables = self.variables
+            for name, field in zip(names, values, strict=True):
+                tag = field[:1]  # the usual tags inline: a call per value costs as much
+                if tag == "i":
+                    variables[name] = int(field[1:])
+                elif tag == "s":
+                    variables[name] = field[1:]
+                elif tag == "-":
+                    variables.pop(name, None)
+                elif tag:  # empty: not written
+                    variables[name] = _flat(field)
+            if "" in values:
+                names = tuple(n for n, f in zip(names, values, strict=True) if f)
+            if names:
+                self.changed(names)
+        head = fields[0]
+        if head == "Qz":  # next() or next(null)
+            return _NEXT
+        return (None, _flat(head[1:])) if len(head) > 1 else None
+
     def _take_writes(self, outcome: dict[str, Any]) -> list[str]:
+        self._opaque.update(outcome.get("o", ()))
         mirror, variables = self._mirror, self.variables
         for name, value in outcome["w"].items():
             variables[name] = mirror[name] = value
@@ -591,7 +914,7 @@ class JavaScript:
         except (TypeError, ValueError):
             return  # not a ROS message (a tag): nothing a rclnodejs callback could read
         try:
-            self._apply(self._call(function, callback_id, message))
+            self._apply(self._call(function, callback_id, message, self._push()))
         except ScriptFailure as failure:
             raise ModelError(
                 f"robot {self.robot}: a JavaScript callback on {envelope.topic} failed: "
@@ -603,12 +926,13 @@ _FLAT_CONSTANTS = {"t": True, "f": False, "z": None}
 
 
 def _flat(text: str) -> Any:
-    """One flat value: n<number> (as JSON reads it: int without fraction or exponent),
-    s<string>, t, f, z (null)."""
+    """One flat value: i<integer>, n<number> (a float, as JSON reads a number with a fraction
+    or an exponent), s<string>, t, f, z (null)."""
     tag = text[0]
-    if tag == "n":
-        body = text[1:]
-        return int(body) if body.lstrip("-").isdigit() else float(body)
+    if tag == "i":
+        return int(text[1:])
     if tag == "s":
         return text[1:]
+    if tag == "n":
+        return float(text[1:])
     return _FLAT_CONSTANTS[tag]
