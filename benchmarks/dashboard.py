@@ -222,7 +222,30 @@ def page_seconds(page, dashboard, which: str, log: str, repeat: int, cold: bool)
         timings.append(page.evaluate(f"performance.getEntriesByName('{mark}')[0].startTime") / 1000)
     answered = page.evaluate(_LAST_ANSWER) / 1000
     print(f"{'':>12}{which} of {log}: the last answer from the dashboard came at {answered:.2f} s")
+    print_breakdown(page)
     return statistics.median(timings)
+
+
+def print_breakdown(page) -> None:
+    """Where the last load's time went: the page's own measures (each section's request,
+    each figure's drawing, plotly.js's load and parse) and the size of what it fetched."""
+    for name, start, duration in page.evaluate(_MEASURES):
+        print(f"{'':>14}{name:<34} {start / 1000:6.2f} s → {(start + duration) / 1000:6.2f} s")
+    for name, size in page.evaluate(_SIZES):
+        print(f"{'':>14}{name:<34} {size / 1e6:6.2f} MB")
+
+
+#: the page's measures, in the order they started
+_MEASURES = (
+    "performance.getEntriesByType('measure').filter((m) => m.name.startsWith('robotale-'))"
+    ".sort((a, b) => a.startTime - b.startTime)"
+    ".map((m) => [m.name.slice(9), m.startTime, m.duration])"
+)
+#: the size of every script and answer the page fetched (decoded)
+_SIZES = (
+    "performance.getEntriesByType('resource').filter((r) => r.decodedBodySize > 100000)"
+    ".map((r) => [new URL(r.name).pathname, r.decodedBodySize])"
+)
 
 
 #: when the page's last request to /api/ was answered (what is left is the browser's drawing)
