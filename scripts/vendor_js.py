@@ -6,8 +6,10 @@
 The dashboard serves these files itself, so it works offline and on machines without npm: the
 copied files are committed under ``robotale/webapp/static/vendor/<package>/`` together with
 each package's licence, and ``vendor.json`` records every package's version, the registry's
-integrity hash of its tarball and the sha256 of every copied file. plotly.js is not vendored:
-the plotly Python package already ships it and the app serves that copy.
+integrity hash of its tarball and the sha256 of every copied file. The full plotly.js is not
+vendored (the plotly Python package ships it and the app serves that copy), only two of its
+partial bundles, of the same version, that draw the perspectives' figures with a third of the
+script to parse: cartesian (scatter, bar, box) and gl3d (scatter3d).
 
 To upgrade a library, change its version below, run the script, look at the dashboard, commit.
 """
@@ -62,6 +64,15 @@ PACKAGES = (
             "dist/assets/bpmn-js.css": "bpmn-js.css",
             "LICENSE": "LICENSE",
         },
+    ),
+    # Partial bundles of the plotly.js inside the plotly Python package, which writes the figures.
+    *(
+        Package(
+            f"plotly.js-{part}-dist-min",
+            "4.1.1",
+            {f"plotly-{part}.min.js": f"plotly-{part}.min.js", "LICENSE": "LICENSE"},
+        )
+        for part in ("cartesian", "gl3d")
     ),
 )
 

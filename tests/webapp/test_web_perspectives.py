@@ -1,0 +1,102 @@
+"""The Perspectives page draws every section's figures with the data of the log: the points and
+bars plotly holds once the page is fully drawn, against what pandas counts in the same log.
+The figures below the fold are drawn after the page's ``robotale-perspectives-drawn`` mark."""
+
+from __future__ import annotations
+
+import mission_findings as mission
+import pytest
+from browser import wait_for
+from test_web_findings import _store  # stored as the Findings tests store theirs
+
+from robotale.eventlog import schema
+
+pytestmark = pytest.mark.browser
+
+#: every figure of every section once drawn: its section and, per trace, what plotly drew
+DRAWN_FIGURES = """() => [...document.querySelectorAll('article.perspective .figure')]
+  .map((box) => ({
+    section: box.dataset.section,
+    plotted: box.dataset.plotted || null,
+    traces: (box._fullData || []).map((t) => ({
+        type: t.type, name: t.name, mode: t.mode || null, points: t._length,
+        x: t.type === 'bar' ? Array.from(t.x || [], String) : null,
+    })),
+}))"""
+ALL_DRAWN = "performance.getEntriesByName('robotale-perspectives-all-drawn').length > 0"
+
+
+@pytest.fixture(scope="module")
+def thesis_log(neo4j_driver, thesis_csv):
+    """The thesis' five runs (positions, messages, no battery): the log and its stored name."""
+    from robotale.ekg.logs import delete_log
+    from robotale.eventlog.readers import read_log
+
+    log = read_log(thesis_csv)
+    name = _store(neo4j_driver, log, "test_paint_thesis")
+    yield log, name
+    delete_log(neo4j_driver, name)
+
+
+@pytest.fixture(scope="module")
+def battery_log(neo4j_driver, tmp_path_factory):
+    """The injected mission (battery levels of every robot): the log and its stored name."""
+    from robotale.ekg.logs import delete_log
+    from robotale.eventlog.readers import read_log
+
+    path = mission.write_injected("robotale.csv", tmp_path_factory.mktemp("b") / "mission.csv")
+    log = read_log(path)
+    name = _store(neo4j_driver, log, "test_paint_battery")
+    yield log, name
+    delete_log(neo4j_driver, name)
+
+
+def drawn(page, log: str) -> list[dict]:
+    """Open the page of ``log``, wait until every figure is drawn; what plotly drew."""
+    page.goto(f"{page.base_url}/perspectives?log={log}")
+    wait_for(page, ALL_DRAWN, timeout=120)
+    return page.evaluate(DRAWN_FIGURES)
+
+
+def traces(figures: list[dict], section: str, kind: str) -> list[dict]:
+    return [t for f in figures if f["section"] == section for t in f["traces"] if t["type"] == kind]
+
+
+def test_every_figure_is_drawn_after_the_visible_ones(page, thesis_log):
+    _, name = thesis_log
+    figures = drawn(page, name)
+    sections = {f["section"] for f in figures}
+    assert {"bottlenecks", "spatial", "communication", "performance"} <= sections
+    assert all(f["plotted"] == str(len(f["traces"])) for f in figures), figures
+    marks = page.evaluate(
+        "['robotale-perspectives-drawn', 'robotale-perspectives-all-drawn']"
+        ".map((m) => performance.getEntriesByName(m)[0].startTime)"
+    )
+    assert marks[0] <= marks[1]
+
+
+def test_spatial_draws_every_placed_event_by_activity(page, thesis_log):
+    log, name = thesis_log
+    placed = log.dropna(subset=["x", "y"]).groupby(schema.ACTIVITY).size()
+    figures = drawn(page, name)
+    points = {t["name"]: t["points"] for t in traces(figures, "spatial", "scatter3d")}
+    assert points == {str(a): int(n) for a, n in placed.items()}
+
+
+def test_performance_draws_a_bar_for_every_case(page, thesis_log):
+    log, name = thesis_log
+    cases = set(log[schema.CASE].astype(str))
+    figures = drawn(page, name)
+    per_case = [f for f in figures if f["section"] == "performance"]
+    bars = [set(t["x"]) for f in per_case for t in f["traces"] if t["type"] == "bar"]
+    assert cases in bars, bars
+
+
+def test_battery_draws_every_level_of_every_robot(page, battery_log):
+    log, name = battery_log
+    levels = log.dropna(subset=[schema.BATTERY]).groupby(schema.ROBOT).size()
+    figures = drawn(page, name)
+    lines = traces(figures, "battery", "scatter")
+    assert {t["name"]: t["points"] for t in lines if t["mode"] == "lines"} == {
+        str(r): int(n) for r, n in levels.items()
+    }
