@@ -128,13 +128,11 @@ def thesis_runs(events: int):
 def store(driver, name: str, log) -> tuple[str, int]:
     """Store ``log`` as the dashboard's ingest does: the graph and the columnar copy."""
     from robotale.ekg.build import build_ekg
-    from robotale.ekg.columnar import store_copy
     from robotale.ekg.keys import built_keys
 
     entities = ["robot", "msg_id"]
     build_ekg(driver, log, name, entities=entities, aggregate=built_keys(entities),
               replace=True, progress=False)  # fmt: skip
-    store_copy(driver, name, log)
     return name, len(log)
 
 

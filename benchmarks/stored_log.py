@@ -58,7 +58,6 @@ def main() -> int:
 def store(driver, folder: Path, size: int) -> tuple[Path, str]:
     """The log of ``size`` events as a CSV file and stored as ``robotale ingest`` stores it."""
     from robotale.ekg.build import build_ekg
-    from robotale.ekg.columnar import store_copy
     from robotale.eventlog.readers import read_log
     from robotale.eventlog.writers import write_csv
 
@@ -66,7 +65,6 @@ def store(driver, folder: Path, size: int) -> tuple[Path, str]:
     write_csv(thesis_runs(size), csv)
     log, name = read_log(csv), f"bench_stored_{size}"
     build_ekg(driver, log, name, entities=["robot", "msg_id"], replace=True, progress=False)
-    store_copy(driver, name, log)
     return csv, name
 
 

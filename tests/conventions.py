@@ -117,6 +117,48 @@ class GroundTruth:
         return sorted(rows, key=lambda row: (row["case"], row["time"], row["order"]))
 
 
+class RunWriter:
+    """Writes one run's activity instances and weed_position messages into a ground truth, at
+    seconds after the run's beginning."""
+
+    def __init__(self, truth: GroundTruth, case: str, begin: pd.Timestamp) -> None:
+        self.truth, self.case, self.begin = truth, case, begin
+
+    def at(self, seconds: float) -> pd.Timestamp:
+        return self.begin + pd.Timedelta(seconds=seconds)
+
+    def instance(self, robot: str, activity: str, start: float, end: float, msg_id=None) -> None:
+        truth, case, at = self.truth, self.case, self.at
+        key = f"{case}-{len(truth.instances) + 1}"
+        truth.instances.append(Instance(case, robot, activity, at(start), at(end), key, msg_id))
+
+    def message(self, number: int, to: str, sent: float, received: float | None, resend_of=None):
+        """A weed_position from the drone to ``to``, lost when ``received`` is None."""
+        msg_id = f"{self.case}-m{number}"
+        got = self.at(received) if received is not None else None
+        self.truth.messages.append(
+            Message(self.case, msg_id, "weed_position", "drone", to, self.at(sent), got, resend_of)
+        )
+        self.instance("drone", "weed_position!", sent, sent + 1, msg_id)
+        if received is not None:
+            self.instance(to, "weed_position?", received, received + 0.5, msg_id)
+        return msg_id
+
+
+def busy_seconds(intervals: pd.DataFrame) -> float:
+    """Seconds covered by the union of [start, end] intervals (one robot in one case)."""
+    total, reach = 0.0, None
+    ordered = intervals.sort_values(["start", "end"])[["start", "end"]]
+    for start, end in ordered.itertuples(index=False):
+        if reach is None or start > reach:
+            total += (end - start).total_seconds()
+            reach = end
+        elif end > reach:
+            total += (end - reach).total_seconds()
+            reach = end
+    return total
+
+
 def _message_ends(truth: GroundTruth, instance: Instance) -> dict:
     """Sender, receiver and role of a message activity's events (nothing for others)."""
     if instance.msg_id is None:
@@ -147,23 +189,8 @@ def ground_truth() -> GroundTruth:
 
 
 def _one_run(truth: GroundTruth, case: str, begin: pd.Timestamp) -> None:
-    def at(seconds: float) -> pd.Timestamp:
-        return begin + pd.Timedelta(seconds=seconds)
-
-    def instance(robot: str, activity: str, start: float, end: float, msg_id=None) -> None:
-        key = f"{case}-{len(truth.instances) + 1}"
-        truth.instances.append(Instance(case, robot, activity, at(start), at(end), key, msg_id))
-
-    def message(number: int, to: str, sent: float, received: float | None, resend_of=None):
-        msg_id = f"{case}-m{number}"
-        got = at(received) if received is not None else None
-        truth.messages.append(
-            Message(case, msg_id, "weed_position", "drone", to, at(sent), got, resend_of)
-        )
-        instance("drone", "weed_position!", sent, sent + 1, msg_id)
-        if received is not None:
-            instance(to, "weed_position?", received, received + 0.5, msg_id)
-        return msg_id
+    run = RunWriter(truth, case, begin)
+    at, instance, message = run.at, run.instance, run.message
 
     instance("drone", "takeoff", 0, 5)
     instance("drone", "explore", 5, 40)

@@ -24,7 +24,7 @@ from pathlib import Path
 import conventions
 import pandas as pd
 import pytest
-from conventions import GroundTruth, Instance, Message, Sample
+from conventions import GroundTruth, RunWriter, Sample
 
 RUNS = [f"run{n:02d}" for n in range(1, 13)]
 REFILL_RUNS = {"run02", "run05", "run08", "run11"}
@@ -50,23 +50,8 @@ def injected_truth() -> GroundTruth:
 def _run(truth: GroundTruth, case: str, begin: pd.Timestamp) -> None:
     """One run; no two activities start at the same moment, so the order is unambiguous."""
 
-    def at(seconds: float) -> pd.Timestamp:
-        return begin + pd.Timedelta(seconds=seconds)
-
-    def instance(robot: str, activity: str, start: float, end: float, msg_id=None) -> None:
-        key = f"{case}-{len(truth.instances) + 1}"
-        truth.instances.append(Instance(case, robot, activity, at(start), at(end), key, msg_id))
-
-    def message(number: int, to: str, sent: float, received: float | None, resend_of=None):
-        msg_id = f"{case}-m{number}"
-        got = at(received) if received is not None else None
-        truth.messages.append(
-            Message(case, msg_id, "weed_position", "drone", to, at(sent), got, resend_of)
-        )
-        instance("drone", "weed_position!", sent, sent + 1, msg_id)
-        if received is not None:
-            instance(to, "weed_position?", received, received + 0.5, msg_id)
-        return msg_id
+    run = RunWriter(truth, case, begin)
+    at, instance, message = run.at, run.instance, run.message
 
     refill = REFILL_SECONDS if case in REFILL_RUNS else 0.0
     late = DELAYED_LATENCY if case == DELAYED_RUN else 1.5

@@ -12,7 +12,7 @@ import pandas as pd
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg
-from robotale.ekg.columnar import delete_copies, store_copy
+from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
@@ -88,7 +88,6 @@ def ingest_command(
                 source=str(path),
                 **names,
             )
-            store_copy(driver, summary.log, events)
     print(describe(summary, appended=append))
     return 0
 
@@ -97,7 +96,6 @@ def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> 
     """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
     with session_driver() as driver:
         summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
-        store_copy(driver, summary.log, log)
     print(describe(summary))
 
 

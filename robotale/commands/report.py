@@ -9,6 +9,7 @@ from pathlib import Path
 from robotale.commands.logsource import read_event_log
 from robotale.enhancement.findings import find
 from robotale.enhancement.findings_report import findings_text, write_findings
+from robotale.errors import require_range
 
 
 def report_command(
@@ -24,6 +25,8 @@ def report_command(
 ) -> int:
     """The findings of a log (a file or ``log_name``): printed, and written to ``out`` (HTML)
     and/or ``json_out``."""
+    if threshold is not None:
+        require_range(threshold, "--threshold", 0, 100, unit=" percent")
     events = read_event_log(
         log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
     )

@@ -24,6 +24,7 @@ from neo4j.exceptions import DriverError, Neo4jError
 from tqdm import tqdm
 
 from robotale.ekg.aggregate import aggregation_key
+from robotale.ekg.columnar import store_copy
 from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
@@ -93,6 +94,8 @@ def build_ekg(
         summary = _write_or_undo(driver, _Job(tables, classes, target, source, progress, run))
         if existing:
             _swap(driver, target, name)
+        # under the lock: no other build of this name can come between the graph and its copy
+        store_copy(driver, name, log)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
 
 

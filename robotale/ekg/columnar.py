@@ -3,13 +3,14 @@
 Every analysis of a stored log (perspectives, discovery, findings, the dashboard's pages) needs
 the log's whole event table; reading it back event by event from Neo4j costs more than the
 analysis itself. So the event table a log was built from is also written as a Parquet file
+(by :func:`~robotale.ekg.build.build_ekg`, under the log's write lock)
 under the robotale home, ``columnar/<log>/<build>/events.parquet``, with the reader's column
 types (pandas string dtype, timestamps in their zone and unit, categoricals), and read from
 there while it belongs to the log's current build. The graph stays the source of truth: a
-build is the Log node's creation time and run, so a rebuild (here or on another machine), a
-deleted or damaged file, or a log stored by another tool makes the copy be read again from
-the graph, in columns, and saved. The column types travel on the Log node (an Arrow schema),
-so a copy read back from the graph has the reader's types too.
+build is the Log node's creation time, run and last append, so a rebuild (here or on another
+machine), an append, a deleted or damaged file, or a log stored by another tool makes the
+copy be read again from the graph, in columns, and saved. The column types travel on the Log
+node (an Arrow schema), so a copy read back from the graph has the reader's types too.
 
 Results computed from one build (the dashboard's perspectives and findings) live in the same
 build folder, ``results/``, so a new build leaves them behind with the old copy.

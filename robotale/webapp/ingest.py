@@ -20,7 +20,6 @@ import pandas as pd
 from neo4j import Driver
 
 from robotale.ekg.build import build_ekg
-from robotale.ekg.columnar import store_copy
 from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
 from robotale.ekg.logs import stored_events
 from robotale.errors import InputError, RobotaleError
@@ -219,7 +218,6 @@ def ingest(
                 source=pending.upload.filename,
                 progress=False,
             )
-        store_copy(driver, summary.log, log)
     finally:
         uploads.discard(pending.upload)
     if pending.model_id:

@@ -77,12 +77,16 @@ def test_a_stored_logs_analysis_is_that_of_its_file(neo4j_driver, log_name, thes
     assert discover_dfg(stored).to_dict() == discover_dfg(original).to_dict()
 
 
-def test_a_copy_of_an_earlier_build_is_not_used(neo4j_driver, log_name, thesis_csv):
+def test_a_copy_of_an_earlier_build_is_not_used(
+    neo4j_driver, log_name, thesis_csv, tmp_path, monkeypatch
+):
     first = read_log(thesis_csv)
     old_path = ingest(neo4j_driver, first, log_name)
-    # rebuilt by a tool that keeps no copy (another machine, an older robotale)
+    # rebuilt on another machine: its copy is kept in that machine's robotale home
     second = first[first["robot"] == "drone"].reset_index(drop=True)
-    build_ekg(neo4j_driver, second, log_name, entities=ENTITIES, replace=True, progress=False)
+    with monkeypatch.context() as elsewhere:
+        elsewhere.setenv("ROBOTALE_HOME", str(tmp_path / "other-machine"))
+        build_ekg(neo4j_driver, second, log_name, entities=ENTITIES, replace=True, progress=False)
     assert old_path.is_file()
     back = stored_table(neo4j_driver, log_name)
     assert len(back) == len(second) < len(first)

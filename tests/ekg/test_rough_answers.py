@@ -91,11 +91,14 @@ def test_a_value_too_long_for_an_index(tmp_path, capsys, graph_counts, log_name)
     assert graph_counts() == before
 
 
+@pytest.mark.parametrize("command", ["perspectives", "report"])
 @pytest.mark.parametrize("threshold", ["nan", "-5", "120", "inf"])
-def test_a_battery_threshold_that_is_no_percentage(tmp_path, capsys, thesis_csv, threshold):
+def test_a_battery_threshold_that_is_no_percentage(
+    tmp_path, capsys, thesis_csv, threshold, command
+):
     report = tmp_path / "report.json"
     code, message = run(
-        capsys, "perspectives", str(thesis_csv), "--json", str(report), "--threshold", threshold
+        capsys, command, str(thesis_csv), "--json", str(report), "--threshold", threshold
     )
     assert code == 1 and one_sentence(message), message
     shown = f"{float(threshold):g}"

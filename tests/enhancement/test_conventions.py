@@ -8,9 +8,9 @@ pandas, never by the code under test.
 
 from __future__ import annotations
 
-import pandas as pd
 import pytest
 from conventions import (
+    busy_seconds,
     ground_truth,
     write_inprogress_xes,
     write_robot_id_csv,
@@ -34,28 +34,13 @@ def perspectives(request, tmp_path_factory):
     return all_perspectives(read_log(path))
 
 
-def _busy_seconds(intervals: pd.DataFrame) -> float:
-    """Seconds covered by the union of [start, end] intervals (one robot in one case)."""
-    total, reach = 0.0, None
-    for start, end in intervals.sort_values(["start", "end"])[["start", "end"]].itertuples(
-        index=False
-    ):
-        if reach is None or start > reach:
-            total += (end - start).total_seconds()
-            reach = end
-        elif end > reach:
-            total += (end - reach).total_seconds()
-            reach = end
-    return total
-
-
 def _truth_working_and_waiting() -> tuple[float, float]:
     """Working time: the time each robot is doing at least one activity; waiting: the gaps
     between its first start and last end in a case, summed over robots and cases."""
     table = TRUTH.instance_table()
     working = waiting = 0.0
     for _, own in table.groupby(["case", "robot"]):
-        busy = _busy_seconds(own)
+        busy = busy_seconds(own)
         working += busy
         waiting += (own["end"].max() - own["start"].min()).total_seconds() - busy
     return working, waiting

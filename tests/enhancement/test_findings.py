@@ -9,6 +9,7 @@ import json
 import mission_findings as mission
 import pandas as pd
 import pytest
+from conventions import busy_seconds
 
 from robotale.enhancement.findings import area_overlaps, find, robot_areas, seconds_text
 from robotale.enhancement.findings_report import (
@@ -76,24 +77,11 @@ def test_the_injected_bottleneck_comes_first(logged):
     assert slowest["case"] in mission.REFILL_RUNS
 
 
-def _busy(group: pd.DataFrame) -> float:
-    """Seconds covered by the union of one robot's intervals in one run."""
-    total, reach = 0.0, None
-    for start, end in group.sort_values(["start", "end"])[["start", "end"]].itertuples(index=False):
-        if reach is None or start > reach:
-            total += (end - start).total_seconds()
-            reach = end
-        elif end > reach:
-            total += (end - reach).total_seconds()
-            reach = end
-    return total
-
-
 def test_where_each_robot_worked(logged):
     _, findings = logged
     answer = findings.answer("robots")
     table = _instances()
-    working = table.groupby(["case", "robot"]).apply(_busy).groupby("robot").sum()
+    working = table.groupby(["case", "robot"]).apply(busy_seconds).groupby("robot").sum()
     main = table.groupby(["robot", "activity"])["seconds"].sum().groupby("robot").idxmax()
     facts = {r["robot"]: r for r in answer.facts["robots"]}
     assert set(facts) == set(TRUTH.robots)
