@@ -9,8 +9,11 @@ folder, then moved to its own (a rename wherever the filesystem has one).
 
 from __future__ import annotations
 
+import ftplib
 import posixpath
 import uuid
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -62,6 +65,10 @@ class Place:
 
     def write_whole(self, data: str | bytes) -> None:
         """``data`` (text as UTF-8) at this place, whole or not at all."""
+        with writing(self):
+            self._write_whole(data)
+
+    def _write_whole(self, data: str | bytes) -> None:
         folder = posixpath.dirname(self.path)
         self.fs.makedirs(folder, exist_ok=True)
         if self.local:
@@ -112,10 +119,33 @@ def local_path(target: str | Path) -> Path | None:
     return Path(found.path) if found.local else None
 
 
+#: what a filesystem of fsspec raises when its destination refuses or drops a write (ftp://
+#: passes on ftplib's own errors)
+REFUSALS = (OSError, EOFError, ftplib.Error)
+
+
+@contextmanager
+def writing(target: Place) -> Iterator[None]:
+    """Writes to ``target`` whose refusal (permissions, a lost connection, a full disk) is one
+    sentence naming it rather than the filesystem's traceback."""
+    try:
+        yield
+    except InputError:
+        raise
+    except REFUSALS as error:
+        why = str(error).strip() or type(error).__name__
+        raise InputError(f"{target.text} could not be written: {why}.") from None
+
+
 def upload_folder(folder: Path, target: Place) -> None:
     """Copy the files of the local ``folder`` to ``target`` through a hidden folder next to
     it, which is then moved to ``target``'s name: ``target`` appears complete or not at all
     (on a filesystem without a rename, fsspec's move copies; see docs/scale.md)."""
+    with writing(target):
+        _upload_folder(folder, target)
+
+
+def _upload_folder(folder: Path, target: Place) -> None:
     parent = posixpath.dirname(target.path)
     hidden = posixpath.join(parent, f".{target.name}.partial")
     fs = target.fs

@@ -38,7 +38,7 @@ from robotale.fame_runtime.manifest import MANIFEST, RunManifest, read_manifest,
 from robotale.files import write_file
 from robotale.sim import scenarios
 from robotale.sim.run import CRASHED, RunPlan, simulate_run
-from robotale.storage import Place, local_path, place, upload_folder
+from robotale.storage import Place, local_path, place, upload_folder, writing
 
 SUMMARY = "robotale-batch.json"
 
@@ -230,6 +230,11 @@ def _prepare_destination(where: Path | Place, overwrite: bool) -> None:
     """Refuse a destination holding an earlier batch unless ``overwrite`` (then remove its
     runs); create it; remove the partial runs an interrupted batch left."""
     out = where if isinstance(where, Place) else place(where)
+    with writing(out):
+        _empty_destination(out, overwrite)
+
+
+def _empty_destination(out: Place, overwrite: bool) -> None:
     if out.exists() and not out.is_dir():
         raise InputError(f"{out.text} is a file; --out needs a folder for the runs")
     earlier = _earlier_runs(out)

@@ -158,6 +158,7 @@ def ftp(tmp_path_factory):
     home = tmp_path_factory.mktemp("ftp")
     users = DummyAuthorizer()
     users.add_user("robot", "secret", str(home), perm="elradfmwMT")
+    users.add_user("reader", "secret", str(home), perm="elr")  # may list and read, not write
     handler = type("Handler", (FTPHandler,), {"authorizer": users})
     server = ThreadedFTPServer(("127.0.0.1", 0), handler)
     serving = threading.Thread(target=server.serve_forever, kwargs={"timeout": 0.2}, daemon=True)
@@ -196,3 +197,16 @@ def test_runs_and_a_dataset_written_to_an_ftp_url_are_the_local_ones(
     pd.testing.assert_frame_equal(read_log(tmp_path / "agri.csv"), read_log(home / "agri.parquet"))
     assert main(["prepare", str(uploaded), "--out", f"{url}/agri.csv"]) == 0
     assert (home / "agri.csv").read_bytes() == (tmp_path / "agri.csv").read_bytes()
+
+
+def test_a_destination_that_refuses_writes_is_one_sentence(tmp_path, short_agri, ftp):
+    url, home = ftp
+    reader = url.replace("robot:secret", "reader:secret")
+    batch = plans(adjust(short_agri, time_limit=30), "agri", runs=1, seed=3)
+    before = sorted(home.rglob("*"))
+    with pytest.raises(InputError) as refused:
+        simulate_batch(batch, f"{reader}/refused/agri", executor="local:1")
+    message = str(refused.value)
+    assert message.startswith(f"{reader}/refused/agri could not be written: ")
+    assert "\n" not in message and "550" in message  # the FTP server's own refusal
+    assert sorted(home.rglob("*")) == before
