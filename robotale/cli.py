@@ -293,7 +293,8 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         dest="msg_files",
         action="append",
         metavar="PATH",
-        help="a .msg/.idl file or a folder of them, for types the bags do not define. Repeatable",
+        help="a .msg/.idl/.action file or a folder of them, for types the bags do not define. "
+        "Repeatable",
     )
     parser.add_argument(
         "--bag-time",

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import contextlib
 import functools
+import re
 import struct
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -61,18 +62,21 @@ def is_bag(path: Path) -> bool:
 
 
 def message_types(paths: Sequence[Path]) -> dict:
-    """Type definitions from ``.msg`` / ``.idl`` files, or folders holding them.
+    """Type definitions from ``.msg`` / ``.idl`` / ``.action`` files, or folders holding them.
 
     A ``.msg`` file's type is named by where it lives, as in a ROS package:
-    ``my_pkg/msg/Event.msg`` defines ``my_pkg/msg/Event``.
+    ``my_pkg/msg/Event.msg`` defines ``my_pkg/msg/Event``; ``my_pkg/action/Dock.action``
+    defines the types of the action's topics (:func:`action_types`).
     """
     typs: dict = {}
     for path in paths:
         files = (
-            sorted(path.rglob("*.msg")) + sorted(path.rglob("*.idl")) if path.is_dir() else [path]
+            [f for ext in ("msg", "idl", "action") for f in sorted(path.rglob(f"*.{ext}"))]
+            if path.is_dir()
+            else [path]
         )
         if not files:
-            raise InputError(f"{path} holds no .msg or .idl files.")
+            raise InputError(f"{path} holds no .msg, .idl or .action files.")
         for file in files:
             typs.update(_types_from_file(file))
     return typs
@@ -85,14 +89,54 @@ def _types_from_file(file: Path) -> dict:
         text = file.read_text(encoding="utf-8")
         if file.suffix == ".idl":
             return get_types_from_idl(text)
+        if file.suffix == ".action" and file.parent.name == "action":
+            return action_types(text, file.parent.parent.name, file.stem)
         if file.suffix != ".msg" or file.parent.name != "msg":
             raise InputError(
-                f"Cannot tell the type name of {file}: put it at <package>/msg/<Type>.msg."
+                f"Cannot tell the type name of {file}: put it at <package>/msg/<Type>.msg "
+                "(or <package>/action/<Action>.action)."
             )
         return get_types_from_msg(text, f"{file.parent.parent.name}/msg/{file.stem}")
     except (TypesysError, UnicodeDecodeError) as error:
         reason = " ".join(str(error).split())
         raise InputError(f"Message definition {file} cannot be parsed: {reason}") from None
+
+
+def action_types(text: str, package: str, action: str) -> dict:
+    """The types of an action's ``.action`` file (goal, result and feedback, split by ``---``)
+    and of the feedback topic's message, which wraps the feedback with the goal's id, as
+    rosidl generates them: ``<package>/action/<action>_Goal`` ... ``_FeedbackMessage``.
+
+    rosbag2 stores no definition for these (its search for them knows ``msg`` and ``srv``
+    only), so a bag's action feedback is read with the action's own file.
+    """
+    parts = re.split(r"^---[ \t]*$", text, flags=re.MULTILINE)
+    if len(parts) != 3:
+        raise TypesysError(f"an action has a goal, a result and a feedback, not {len(parts)} parts")
+    prefix = f"{package}/action/{action}"
+    typs: dict = {}
+    for suffix, part in zip(("_Goal", "_Result", "_Feedback"), parts, strict=True):
+        typs.update(get_types_from_msg(part, prefix + suffix))
+    wrapper = f"unique_identifier_msgs/UUID goal_id\n{prefix}_Feedback feedback\n"
+    typs.update(get_types_from_msg(wrapper, f"{prefix}_FeedbackMessage"))
+    return {name: _in_msg_folder(spec, package, set(typs)) for name, spec in typs.items()}
+
+
+def _in_msg_folder(spec: tuple, package: str, own: set[str]) -> tuple:
+    """``spec`` with its references to types of the package that are not the action's own
+    (written without a package in the file, read as ``<package>/action/X``) made
+    ``<package>/msg/X``, where ROS looks for them."""
+
+    def moved(desc: tuple) -> tuple:
+        nodetype, detail = desc
+        if nodetype == _NAME and detail.startswith(f"{package}/action/") and detail not in own:
+            return nodetype, detail.replace("/action/", "/msg/", 1)
+        if nodetype in (_ARRAY, _SEQUENCE):
+            return nodetype, (moved(detail[0]), *detail[1:])
+        return desc
+
+    consts, fields = spec
+    return consts, [(name, moved(desc)) for name, desc in fields]
 
 
 @dataclass
@@ -236,12 +280,11 @@ class Bag:
             )
         if msgtype not in self.typestore.fielddefs:
             missing = _missing(self._definitions, msgtype) or msgtype
-            package, _, name = missing.rpartition("/msg/")
             part = "" if missing == msgtype else f", which {msgtype} contains,"
             raise InputError(
                 f"{self.path}: cannot decode {topic}: the message type {missing}{part} is not "
-                f"defined in the bag; register it with --msg {package or 'my_pkg'}/msg/{name}.msg "
-                "(or a folder of .msg files)."
+                f"defined in the bag; register it with --msg {_definition_file(missing)} (or a "
+                "folder of .msg files)."
             )
         return msgtype
 
@@ -404,6 +447,17 @@ def read_bag(
         return bag.tables(columns, bag_time=bag_time)
 
 
+def _definition_file(msgtype: str) -> str:
+    """Where a ROS package keeps the definition of ``msgtype``: an action's types come from its
+    ``.action`` file."""
+    package, _, rest = msgtype.partition("/") if "/" in msgtype else ("my_pkg", "", msgtype)
+    kind, _, name = rest.rpartition("/")
+    if kind == "action":
+        stem = re.sub(r"_(Goal|Result|Feedback|FeedbackMessage)$", "", name)
+        return f"{package}/action/{stem}.action"
+    return f"{package}/msg/{name}.msg"
+
+
 def _extractor(paths: list[str]):
     """A function from a message to the tuple of its values at ``paths``."""
     if not paths:
@@ -523,6 +577,8 @@ def _references(desc: tuple) -> list[str]:
 
 def _embedded_types(connection: Connection) -> dict:
     definition = connection.msgdef
+    if not definition.data.strip():  # what rosbag2 stores for a type it found no file of
+        return {}
     try:
         return dict(_parsed(definition.format, definition.data, connection.msgtype))
     except (KeyError, IndexError, ValueError) as error:  # malformed IDL the parser trips on

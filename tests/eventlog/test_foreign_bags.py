@@ -25,6 +25,11 @@ from robotale.sim import bagmeta
 STATUS = "/r1/navigate_to_pose/_action/status"
 EVENT_TYPE, EVENT_DEF = "my_msgs/msg/Event", "string action\n"
 SERVICE_EVENT = "test_msgs/srv/BasicTypes_Event"
+#: what rosbag2 (Jazzy) stores for a service-event topic: the service's .srv text
+SERVICE_DEF = (
+    "=" * 80 + "\nSRV: test_msgs/srv/BasicTypes\nbool bool_value\nstring string_value\n---\n"
+    "bool bool_value\nstring string_value\n"
+)
 COLUMNS = ["time:timestamp", "concept:name", "lifecycle:transition", "robot"]
 NO_TIME = QosTime(0, 0)
 
@@ -105,14 +110,14 @@ class Nav2Bag:
                     stored = definitions.get(msgtype)
                     connections[topic] = w.add_connection(
                         topic, msgtype, offered_qos_profiles=[qos(Reliability.RELIABLE)],
-                        **({"msgdef": stored, "rihs01": "RIHS01_" + "0" * 64} if stored
+                        **({"msgdef": stored, "rihs01": "RIHS01_" + "0" * 64} if stored is not None
                            else {"typestore": self.store}),
                     )  # fmt: skip
                 data = self.store.serialize_cdr(message, msgtype)
                 w.write(connections[topic], nanos(seconds), data)
             service = w.add_connection(
                 "/r1/get_plan/_service_event", SERVICE_EVENT,
-                msgdef="service_msgs/ServiceEventInfo info\nBasicTypes_Request[<=1] request\n---\n",
+                msgdef=SERVICE_DEF,
                 rihs01="RIHS01_" + "1" * 64,
             )  # fmt: skip
             w.write(service, nanos(2), b"\x00\x01\x00\x00" + bytes(40))
@@ -152,14 +157,19 @@ GOALS = [
     (at(9), "navigate_to_pose", "start", "r1"),
     (at(10), "navigate_to_pose", "cancelled", "r1"),
 ]
-MODES = [
-    (at(0), "idle", "start", "r1"),
-    (at(1), "idle", "complete", "r1"),
-    (at(1), "navigating", "start", "r1"),
-    (at(5), "navigating", "complete", "r1"),
-    (at(5), "idle", "start", "r1"),
-    (at(10), "idle", "complete", "r1"),  # the end of the recording
-]
+
+
+def one_after_another(*spans: tuple[str, float, float]) -> list[tuple]:
+    """The events of r1's activities (name, start, end), each ending when the next starts."""
+    return [
+        event
+        for name, start, end in spans
+        for event in ((at(start), name, "start", "r1"), (at(end), name, "complete", "r1"))
+    ]
+
+
+# the last value lasts until the end of the recording (10 s)
+MODES = one_after_another(("idle", 0, 1), ("navigating", 1, 5), ("idle", 5, 10))
 STORAGES_AND_DISTROS = [(s, d) for s in ("sqlite3", "mcap") for d in ("humble", "iron", "jazzy")]
 
 
@@ -193,8 +203,9 @@ def test_a_mode_topic_becomes_activities_that_end_when_the_next_begins(tmp_path,
     assert rows(log) == MODES
 
 
-def test_tags_without_lifecycle_are_events_or_implicit_activities(tmp_path):
-    bag = Nav2Bag().write(tmp_path / "nav")
+@pytest.mark.parametrize(("storage", "distro"), STORAGES_AND_DISTROS)
+def test_tags_without_lifecycle_are_events_or_implicit_activities(tmp_path, storage, distro):
+    bag = Nav2Bag().write(tmp_path / "nav", storage, distro)
     fields = TagFields.parse(["activity=action", "lifecycle=", "robot="])
     log, warned = quiet_prepare(bag, tags="/r1/events", tag_fields=fields)
     assert rows(log) == [(at(0.5), "boot", "complete", "r1"), (at(4), "check", "complete", "r1")]
@@ -217,9 +228,10 @@ def test_auto_finds_actions_and_modes_and_says_so(tmp_path):
     assert said == ["nav: activities from --actions /*/_action/status, --state-topic /r1/mode:data"]
 
 
-@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
-def test_a_qos_mismatch_in_the_metadata_is_read_around(tmp_path, storage):
-    bag = Nav2Bag().write(tmp_path / "nav", storage, "jazzy", qos_of={"/r1/mode": "best_effort"})
+@pytest.mark.parametrize(("storage", "distro"), STORAGES_AND_DISTROS)
+def test_a_qos_mismatch_in_the_metadata_is_read_around(tmp_path, storage, distro):
+    best_effort = 2 if distro in ("humble", "iron") else "best_effort"  # as each one writes it
+    bag = Nav2Bag().write(tmp_path / "nav", storage, distro, qos_of={"/r1/mode": best_effort})
     with Reader(bag) as reader:  # rosbags alone sees no message on it
         mode = [c for c in reader.connections if c.topic == "/r1/mode"]
         assert list(reader.messages(connections=mode)) == []
@@ -228,11 +240,14 @@ def test_a_qos_mismatch_in_the_metadata_is_read_around(tmp_path, storage):
     assert any("metadata.yaml describes /r1/mode with other QoS" in w for w in warned)
 
 
-@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
-def test_a_wrong_stored_definition_is_refused_naming_the_topic(tmp_path, storage):
+@pytest.mark.parametrize(("storage", "distro"), STORAGES_AND_DISTROS)
+def test_a_wrong_stored_definition_is_refused_naming_the_topic(tmp_path, storage, distro):
     bag = Nav2Bag().write(
-        tmp_path / "nav", storage, definitions={"rcl_interfaces/msg/Log": "uint8 level\n"}
+        tmp_path / "nav", storage, distro, definitions={"rcl_interfaces/msg/Log": "uint8 level\n"}
     )
+    # only the topics asked for are decoded: the goals are read, /rosout is not
+    log, _ = quiet_prepare(bag, tags="/none", actions="/*/_action/status")
+    assert rows(log) == GOALS
     with pytest.raises(InputError) as error:
         prepare(bag, tags="/none", states=["/rosout:level"], perspectives=[])
     assert str(error.value).startswith(
@@ -250,8 +265,9 @@ def test_a_wrong_stored_definition_is_refused_naming_the_topic(tmp_path, storage
     assert rows(log) == [(at(3), "nav", "start", ""), (at(10), "nav", "complete", "")]
 
 
-def test_a_service_event_topic_asked_for_is_named(tmp_path):
-    bag = Nav2Bag().write(tmp_path / "nav")
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_a_service_event_topic_asked_for_is_named(tmp_path, storage):
+    bag = Nav2Bag().write(tmp_path / "nav", storage)
     with pytest.raises(InputError) as error:
         prepare(bag, tags="/none", states=["/r1/get_plan/_service_event"], perspectives=[])
     assert str(error.value).startswith(
@@ -312,3 +328,117 @@ def test_behaviour_tree_transitions_become_activities(tmp_path):
     said = []
     quiet_prepare(bag, tags="/none", auto=True, report=said.append)
     assert "--bt-log /r1/behavior_tree_log" in said[0]
+
+
+FEEDBACK = "/r1/navigate_to_pose/_action/feedback"
+FEEDBACK_TYPE = "nav2_msgs/action/NavigateToPose_FeedbackMessage"
+#: the action's definition as nav2_msgs ships it (the parts that matter here)
+NAVIGATE_ACTION = (
+    "geometry_msgs/PoseStamped pose\nstring behavior_tree\n---\nstd_msgs/Empty result\n---\n"
+    "float32 distance_remaining\nint16 number_of_recoveries\n"
+)
+SEPARATOR = "=" * 80 + "\n"
+#: the feedback message's full text, as a recorder that resolves action types stores it
+FEEDBACK_DEF = (
+    "unique_identifier_msgs/UUID goal_id\nnav2_msgs/action/NavigateToPose_Feedback feedback\n"
+    f"{SEPARATOR}MSG: nav2_msgs/action/NavigateToPose_Feedback\n"
+    "float32 distance_remaining\nint16 number_of_recoveries\n"
+    f"{SEPARATOR}MSG: unique_identifier_msgs/UUID\nuint8[16] uuid\n"
+)
+
+
+def with_feedback(stored: str) -> Nav2Bag:
+    """The navigation with feedback on goals 1 and 2, its definition stored as ``stored``."""
+    b = Nav2Bag()
+    b.store.register(get_types_from_msg(FEEDBACK_DEF, FEEDBACK_TYPE))
+    t = b.t
+    for seconds, goal, left in ((2, 1, 8.0), (3, 1, 6.0), (4, 1, 2.5), (6, 2, 7.0), (7, 2, 3.0)):
+        uuid = t["unique_identifier_msgs/msg/UUID"](uuid=np.full(16, goal, np.uint8))
+        feedback = t["nav2_msgs/action/NavigateToPose_Feedback"](
+            distance_remaining=left, number_of_recoveries=0
+        )
+        b.add(seconds, FEEDBACK, FEEDBACK_TYPE, t[FEEDBACK_TYPE](goal_id=uuid, feedback=feedback))
+    b.stored = {FEEDBACK_TYPE: stored}
+    return b
+
+
+LEFT = "left=/*/navigate_to_pose/_action/feedback:feedback.distance_remaining"
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_action_feedback_is_a_perspective_of_the_actions_robot(tmp_path, storage):
+    b = with_feedback(FEEDBACK_DEF)
+    bag = b.write(tmp_path / "nav", storage, "jazzy", definitions=b.stored)
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always", PreparationWarning)
+        log = prepare(bag, tags="/none", actions="/*/_action/status", rate=0, perspectives=[LEFT])
+    assert not [str(w.message) for w in caught if "left" in str(w.message)]
+    assert rows(log) == GOALS
+    # each event takes the first sample at or after it, of robot r1 (the action's namespace);
+    # after the last sample (7 s), that last one
+    assert log["left"].tolist() == [8.0, 7.0, 7.0, 3.0, 3.0, 3.0]
+
+
+def test_an_action_file_defines_the_feedback_a_bag_leaves_undefined(tmp_path):
+    """rosbag2 stores no definition for action types (its search knows msg/ and srv/ only)."""
+    b = with_feedback("")
+    bag = b.write(tmp_path / "nav", "mcap", "jazzy", definitions=b.stored)
+    with pytest.raises(InputError) as error:
+        prepare(bag, tags="/none", actions="/*/_action/status", rate=0, perspectives=[LEFT])
+    assert "--msg nav2_msgs/action/NavigateToPose.action" in str(error.value)
+    action = tmp_path / "nav2_msgs" / "action" / "NavigateToPose.action"
+    action.parent.mkdir(parents=True)
+    action.write_text(NAVIGATE_ACTION)
+    log = prepare(
+        bag, tags="/none", actions="/*/_action/status", rate=0, perspectives=[LEFT],
+        msg_files=[action],
+    )  # fmt: skip
+    assert log["left"].tolist() == [8.0, 7.0, 7.0, 3.0, 3.0, 3.0]
+
+
+DOCK_TYPE = "my_msgs/msg/DockState"
+
+
+def test_an_enum_state_topic_names_its_activities_after_the_constants(tmp_path):
+    b = Nav2Bag()
+    enum = "uint8 IDLE=0\nuint8 DOCKING=1\nuint8 CHARGING=2\nuint8 mode\n"
+    b.store.register(get_types_from_msg(enum, DOCK_TYPE))
+    for seconds, mode in ((0, 0), (2, 1), (4, 1), (6, 2)):
+        b.add(seconds, "/r1/dock_state", DOCK_TYPE, b.t[DOCK_TYPE](mode=mode))
+    bag = b.write(tmp_path / "nav", "sqlite3", "iron")
+    log, _ = quiet_prepare(bag, tags="/none", states=["/r1/dock_state:mode"])
+    assert rows(log) == one_after_another(("IDLE", 0, 2), ("DOCKING", 2, 6), ("CHARGING", 6, 10))
+    assert log["source_index"].tolist() == [0, 1, 1, 3, 3, 3]
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_tags_with_only_starts_end_at_the_robots_next_tag(tmp_path, storage):
+    from robotale.fame_runtime.tags import TAG_TYPE, register_tag_type
+
+    b = Nav2Bag()
+    register_tag_type(b.store)
+    for seconds, activity, lifecycle in (
+        (0.5, "boot", "start"),
+        (4, "check", "start"),
+        (6, "check", "complete"),  # one the robot does end: kept as it is
+        (7, "dock", "start"),
+    ):
+        tag = b.t[TAG_TYPE](
+            stamp=b.time(seconds), robot="r1", activity=activity, lifecycle=lifecycle,
+            msg_id="", msg_role="", payload="",
+        )  # fmt: skip
+        b.add(seconds, "/r1/tag", TAG_TYPE, tag)
+    bag = b.write(tmp_path / "nav", storage, "humble")
+    log, _ = quiet_prepare(bag, lifecycle="implicit")
+    assert rows(log) == [
+        (at(0.5), "boot", "start", "r1"),
+        (at(4), "boot", "complete", "r1"),  # the next tag ends it
+        (at(4), "check", "start", "r1"),
+        (at(6), "check", "complete", "r1"),
+        (at(7), "dock", "start", "r1"),
+        (at(10), "dock", "complete", "r1"),  # the end of the recording
+    ]
+    # an added complete comes from the tag that started the activity
+    assert log["source_index"].tolist() == [0, 0, 1, 2, 3, 3]
+    explicit, _ = quiet_prepare(bag)  # as recorded: starts without completes
+    assert rows(explicit) == [row for row in rows(log) if row[1:3] != ("boot", "complete")][:-1]

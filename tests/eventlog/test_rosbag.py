@@ -11,7 +11,7 @@ from bagbuilder import at, nanos
 
 from robotale.errors import InputError
 from robotale.eventlog.prepare import TagFields, prepare
-from robotale.eventlog.rosbag import Bag, read_bag
+from robotale.eventlog.rosbag import Bag, message_types, read_bag
 
 EVENT_TYPE = "turtle_msgs/msg/Event"
 EVENT_MSG = "builtin_interfaces/Time stamp\nstring action\nstring status\n"
@@ -136,6 +136,32 @@ def test_msg_files_must_say_their_package(tmp_path):
     broken.write_text("int32[ x\n")
     with pytest.raises(InputError, match=r"Broken.msg cannot be parsed"):
         read_bag(tmp_path, msg_files=[broken])
+
+
+def test_an_action_file_defines_its_parts_and_its_feedback_message(tmp_path):
+    from rosbags.typesys.base import Nodetype
+
+    action = tmp_path / "dock_msgs" / "action" / "Dock.action"
+    action.parent.mkdir(parents=True)
+    # Station is the package's own message, as rosidl reads a bare name in an .action file
+    action.write_text("Station station\n---\nbool docked\n---\nfloat32 left\nStation[] near\n")
+    typs = message_types([action])
+    parts = ("Feedback", "FeedbackMessage", "Goal", "Result")
+    assert sorted(typs) == [f"dock_msgs/action/Dock_{part}" for part in parts]
+    assert typs["dock_msgs/action/Dock_Goal"][1] == [
+        ("station", (Nodetype.NAME, "dock_msgs/msg/Station"))
+    ]
+    assert typs["dock_msgs/action/Dock_Feedback"][1][1] == (
+        "near",
+        (Nodetype.SEQUENCE, ((Nodetype.NAME, "dock_msgs/msg/Station"), 0)),
+    )
+    assert typs["dock_msgs/action/Dock_FeedbackMessage"][1] == [
+        ("goal_id", (Nodetype.NAME, "unique_identifier_msgs/msg/UUID")),
+        ("feedback", (Nodetype.NAME, "dock_msgs/action/Dock_Feedback")),
+    ]
+    action.write_text("bool go\n---\nbool done\n")
+    with pytest.raises(InputError, match=r"Dock.action cannot be parsed: an action has a goal"):
+        message_types([action])
 
 
 def split_bag(tmp_path, first, second):
