@@ -2,8 +2,9 @@
 
 What each distribution's reader requires of metadata.yaml is written here from rosbag2's
 ``rosbag2_storage`` YAML decoding (``metadata_io.cpp`` on the humble branch,
-``include/rosbag2_storage/yaml.hpp`` on iron and jazzy; branches as of October 2024): the keys it
-reads for the version it finds, and the YAML kind each must have.
+``include/rosbag2_storage/yaml.hpp`` on iron and jazzy; releases 0.15.12, 0.22.7 and 0.26.5, the
+same as the branches of October 2024): the keys it reads for the version it finds, and the YAML
+kind each must have.
 """
 
 from __future__ import annotations
@@ -165,3 +166,48 @@ def test_the_metadata_inside_an_mcap_file_is_the_distributions(tmp_path, distro)
     assert_kinds(inside, bag_keys, "serialized_metadata")
     for entry in inside["topics_with_message_count"]:
         assert_kinds(entry["topic_metadata"], topic_keys, entry["topic_metadata"]["name"])
+
+
+def read_back(bag) -> dict[str, int]:
+    """Messages per topic of a bag's storage files, read without robotale or rosbags."""
+    seen: dict[str, int] = {}
+    for database in bag.glob("*.db3"):
+        with sqlite3.connect(database) as connection:
+            counted = connection.execute(
+                "SELECT topics.name, COUNT(*) FROM messages "
+                "JOIN topics ON topics.id = messages.topic_id GROUP BY topics.name"
+            ).fetchall()
+        connection.close()
+        for name, n in counted:
+            seen[name] = seen.get(name, 0) + n
+    for file in bag.glob("*.mcap"):
+        with open(file, "rb") as stream:
+            for _, channel, _ in make_reader(stream).iter_messages():
+                seen[channel.topic] = seen.get(channel.topic, 0) + 1
+    return seen
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize(
+    ("distro", "storage"), [(None, "sqlite3"), ("iron", "mcap"), ("jazzy", "sqlite3")]
+)
+def test_robotale_simulate_writes_each_distributions_bags(tmp_path, capsys, distro, storage):
+    """The command a user runs, with and without --distro (Humble's metadata by default)."""
+    from robotale.cli import main
+
+    given = ["--distro", distro] if distro else []
+    code = main(
+        ["simulate", "agri", "--runs", "1", "--time-limit", "20", "--workers", "0", "--quiet",
+         "--storage", storage, "--out", str(tmp_path / "runs"), *given]
+    )  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    [bag] = [p.parent for p in (tmp_path / "runs").glob("*/metadata.yaml")]
+    info = yaml.safe_load((bag / "metadata.yaml").read_text())["rosbag2_bagfile_information"]
+    assert info["version"] == WRITES[distro or "humble"]
+    listed = {
+        e["topic_metadata"]["name"]: e["message_count"] for e in info["topics_with_message_count"]
+    }
+    seen = read_back(bag)
+    assert seen == {topic: n for topic, n in listed.items() if n}
+    assert sum(seen.values()) == info["message_count"] > 0
+    assert {"/drone/tag", "/drone/odom"} <= set(seen)
