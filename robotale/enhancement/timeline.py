@@ -15,11 +15,21 @@ from typing import Any
 import pandas as pd
 import plotly.graph_objects as go
 
-from robotale.discovery.instances import START_TIMESTAMP
+from robotale.discovery.instances import FINISHED, START_TIMESTAMP
 from robotale.enhancement.communication import message_table
+from robotale.enhancement.context import LogAnalysis
 from robotale.enhancement.performance import case_durations, finished_instances
 from robotale.errors import InputError
-from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, MSG_ID, ROBOT, TIMESTAMP
+from robotale.eventlog.schema import (
+    ACTIVITY,
+    BATTERY,
+    CASE,
+    MSG_ID,
+    ROBOT,
+    SOURCE_INDEX,
+    SOURCE_TOPIC,
+    TIMESTAMP,
+)
 
 #: the lane of events whose robot the log does not name
 NO_ROBOT = "(no robot)"
@@ -29,7 +39,8 @@ MESSAGE_COLOUR = "#555555"
 
 @dataclass(slots=True)
 class Timeline:
-    """The data of one run's timeline: ``bars`` (robot, activity, start, end, seconds),
+    """The data of one run's timeline: ``bars`` (robot, activity, start, end, source: where
+    its events were recorded, seconds),
     ``messages`` (msg_id, sender, receiver, sent, received, lost, delayed) and ``battery``
     (robot, time, level)."""
 
@@ -90,17 +101,50 @@ def _robots(events: pd.DataFrame) -> pd.Series:
 
 
 def _bars(events: pd.DataFrame) -> pd.DataFrame:
-    instances = finished_instances(events)
+    sourced = [c for c in (SOURCE_TOPIC, SOURCE_INDEX) if c in events.columns]
+    if len(sourced) == 2:  # a log prepared from bags says which message each event came from
+        instances = LogAnalysis(events).instances(sourced)
+        instances = instances[instances[FINISHED]]
+    else:
+        instances = finished_instances(events)
     bars = pd.DataFrame(
         {
             "robot": instances[ROBOT].astype(str),
             "activity": instances[ACTIVITY].astype(str),
             "start": instances[START_TIMESTAMP],
             "end": instances[TIMESTAMP],
+            "source": _sources(instances) if len(sourced) == 2 else "",
         }
     )
     bars["seconds"] = (bars["end"] - bars["start"]).dt.total_seconds()
     return bars.sort_values(["start", "robot"], kind="stable").reset_index(drop=True)
+
+
+def _sources(instances: pd.DataFrame) -> list[str]:
+    """Where each instance's start and end were recorded: ``/r1/mode #3 to #5`` (the topic
+    and the messages' positions on it), ``""`` where the log does not say."""
+    ends = zip(
+        instances[f"start_{SOURCE_TOPIC}"],
+        instances[f"start_{SOURCE_INDEX}"],
+        instances[SOURCE_TOPIC],
+        instances[SOURCE_INDEX],
+        strict=True,
+    )
+    return [_source(*where) for where in ends]
+
+
+def _source(topic: Any, index: Any, end_topic: Any, end_index: Any) -> str:
+    if not _known(topic, index):
+        return ""
+    start = f"{topic} #{int(float(index))}"
+    if not _known(end_topic, end_index):
+        return start
+    end = f"#{int(float(end_index))}"
+    return f"{start} to {end}" if end_topic == topic else f"{start} to {end_topic} {end}"
+
+
+def _known(topic: Any, index: Any) -> bool:
+    return isinstance(topic, str) and bool(topic) and bool(pd.notna(index))
 
 
 def _messages(events: pd.DataFrame) -> pd.DataFrame:
@@ -177,10 +221,18 @@ def _bar_trace(activity: str, bars: pd.DataFrame) -> go.Bar:
         text=[activity] * len(bars),
         textposition="inside",
         insidetextanchor="start",
-        customdata=bars["seconds"],
-        hovertemplate=f"{activity}<br>%{{base}}<br>%{{customdata:.1f}} s<extra></extra>",
+        customdata=list(zip(bars["seconds"], _from(bars), strict=True)),
+        hovertemplate=(
+            f"{activity}<br>%{{base}}<br>%{{customdata[0]:.1f}} s%{{customdata[1]}}<extra></extra>"
+        ),
         opacity=0.75,
     )
+
+
+def _from(bars: pd.DataFrame) -> list[str]:
+    """The hover's line saying where each bar's events were recorded, if the log says."""
+    sources = bars["source"] if "source" in bars else pd.Series("", index=bars.index)
+    return [f"<br>from {source}" if source else "" for source in sources]
 
 
 def _message_traces(messages: pd.DataFrame, lanes: set[str]) -> list[go.Scatter]:

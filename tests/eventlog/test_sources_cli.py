@@ -7,6 +7,7 @@ the log must hold; the log is read back from the CSV, or from Neo4j for ``ingest
 
 from __future__ import annotations
 
+import json
 import sqlite3
 from dataclasses import dataclass, field
 
@@ -18,6 +19,8 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.cli import main
+from robotale.webapp.findings_data import stored_timeline
+from robotale.webapp.logdata import LogData
 
 ACTION = "navigate_to_pose"
 STATUS = f"/{{robot}}/{ACTION}/_action/status"
@@ -338,3 +341,12 @@ def test_ingest_auto_stores_the_events_of_every_source(tmp_path, capsys, neo4j_d
         for x in records
     )
     assert stored == sorted(goal_events(r) + runs(r, r.modes) + node_events(r))
+    # the dashboard's timeline says where each goal's events were recorded: goal k of a robot
+    # is seen first in its status topic's message 3k and ends in 3k + 1 (numbered from 0)
+    timeline = json.loads(stored_timeline(neo4j_driver, LogData(), log_name, "run"))
+    bars = [t for t in timeline["figure"]["data"] if t["type"] == "bar" and t["name"] == ACTION]
+    assert sorted(hover for bar in bars for _, hover in bar["customdata"]) == sorted(
+        f"<br>from {STATUS.format(robot=robot)} #{3 * k} to #{3 * k + 1}"
+        for robot in ROBOTS
+        for k in range(4)
+    )
