@@ -70,8 +70,20 @@ def write_csv(log: pd.DataFrame, path: str | Path) -> None:
     """The log as CSV with the short column names (``case``, ``time``, ``activity`` ...)."""
     table = schema.to_csv_names(log)
     table["time"] = _utc_text(log[TIME]).to_numpy()
+    if schema.SOURCE_INDEX in table:
+        table[schema.SOURCE_INDEX] = _positions(table[schema.SOURCE_INDEX])
     with atomic_file(_target(path)) as file:
         table.to_csv(file, index=False, lineterminator="\n")
+
+
+def _positions(index: pd.Series) -> pd.Series:
+    """Message positions as whole numbers (``3``, not ``3.0``; the column is float only for
+    the events that have none), unchanged if they are not positions."""
+    numbers = pd.to_numeric(index, errors="coerce")
+    known = numbers.dropna()
+    if len(known) != index.notna().sum() or not (known == known.round()).all():
+        return index
+    return numbers.astype("Int64")
 
 
 # --------------------------------------------------------------------------------------- XES

@@ -220,6 +220,14 @@ def test_actions_give_one_activity_per_goal_ended_by_its_outcome(tmp_path, capsy
     assert code == 0, err
     assert logged(tmp_path / "log.csv") == sorted(goal_events(r))
     assert len(r.goals) == 8 and {c for *_, c, _ in r.goals} > {4}  # more than successes
+    # goal k of a robot is first seen in its status topic's message 3k, ended in 3k + 1
+    text = pd.read_csv(tmp_path / "log.csv", dtype=str)
+    assert sorted(zip(text["source_topic"], text["source_index"], strict=True)) == sorted(
+        (STATUS.format(robot=robot), str(3 * k + end))
+        for robot in ROBOTS
+        for k in range(4)
+        for end in (0, 1)
+    )
 
 
 def test_state_topics_give_one_activity_per_value(tmp_path, capsys):
