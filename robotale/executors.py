@@ -77,7 +77,7 @@ def open_executor(spec: ExecutorSpec, tasks: int) -> Iterator[tuple[Executor, in
 
 @contextmanager
 def _dask_executor(spec: ExecutorSpec) -> Iterator[tuple[Executor, int]]:
-    try:
+    try:  # Dask is an optional extra (robotale[dask]) and 2.7 s to import: dask:// only
         from distributed import Client
     except ImportError:
         raise InputError(
@@ -108,7 +108,7 @@ def worker_lost(error: BaseException) -> bool:
     raising): a broken local pool, or a task Dask gave up on after it killed its workers."""
     if isinstance(error, BrokenProcessPool):
         return True
-    try:
+    try:  # loaded already when a Dask cluster ran the task; absent without the extra
         from distributed import KilledWorker
     except ImportError:
         return False

@@ -91,7 +91,7 @@ def demo_command(
     _step("Building the event knowledge graphs")
     _ingest(log, AGRI_LOG, bags)
     _ingest(read_log(thesis), THESIS_LOG_NAME, thesis)
-    _attach_models(thesis)
+    _attach_models()
     _explain()
     if dashboard is not None:
         _serve(dashboard)
@@ -142,7 +142,7 @@ def _ingest(log: pd.DataFrame, name: str, source: Path) -> None:
     store(log, name, source, entities=ENTITIES, aggregate=built_keys(ENTITIES))
 
 
-def _attach_models(thesis: Path) -> None:
+def _attach_models() -> None:
     attach_model(AGRI_LOG, scenarios.model_file("agri"))
     attach_model(THESIS_LOG_NAME, source_file(THESIS_MODEL))
 

@@ -49,7 +49,8 @@ def check_command(
 
 
 def _simulation_lacks(definitions, model: Path, world: Path, library: Library | None):
-    from robotale.sim.provides import lacks  # the simulator only when a world is named
+    # the simulator (0.8 s to import) only when a world is named
+    from robotale.sim.provides import lacks
     from robotale.sim.worldspec import load_world
 
     return lacks(definitions, load_world(world, model), library)
@@ -131,6 +132,7 @@ def run_command(
     require_range(latency, "--latency", 0, unit=" seconds")
     refuse_duplicate_ids(model)
     if bus == "dds":
+        # Cyclone DDS is an optional extra (robotale[dds]) and 0.9 s to import: --bus dds only
         from robotale.commands.fame_dds import run_processes
 
         return run_processes(
@@ -146,7 +148,7 @@ def run_command(
             err=err,
         )
     if bus != "inprocess" or record is not None:
-        raise InputError(_bus_problem(bus, record))
+        raise InputError(_bus_problem(bus))
     definitions = parse(model)
     begin = start_time(start)
     clock = SimClock(start=begin)
@@ -177,7 +179,7 @@ def refuse_duplicate_ids(model: Path) -> None:
         raise ModelError(f"{model}: {shared[0]}{more}")
 
 
-def _bus_problem(bus: str, record: Path | None) -> str:
+def _bus_problem(bus: str) -> str:
     if bus != "inprocess":
         return f"--bus {bus!r} is not one of inprocess, dds"
     return "--record needs --bus dds (a simulation records with robotale simulate)"

@@ -14,6 +14,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import TextIO
 
+from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
+from cyclonedds.core import Policy
+
+from robotale.commands.fame import parse_assignments, robot_list, start_time, tag_line
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope
 from robotale.fame_runtime.clock import WallClock
@@ -51,8 +55,6 @@ def node_command(
     """Run ``robot``'s engine in this process on DDS until the mission is over, printing its
     tags; 1 when an error went uncaught or the robot was still working at ``until``, 130
     after Ctrl-C (the robot's safe-state handler ran)."""
-    from robotale.commands.fame import parse_assignments, robot_list, start_time, tag_line
-
     out, err = out or sys.stdout, err or sys.stderr
     definitions = parse(model)
     if clock_offset is None:
@@ -130,8 +132,6 @@ def run_processes(
 ) -> int:
     """``fame run --bus dds``: one ``fame node`` process per robot, their tags printed as
     they come, recorded into a rosbag2 with every other topic when ``record`` is given."""
-    from robotale.commands.fame import robot_list, start_time
-
     definitions = parse(model)
     names = [a.robot for a in split(definitions, robot_list(robots))]
     begin = start_time(start)
@@ -205,6 +205,8 @@ class _Recording:
     """A rosbag2 of everything robotale can read on the domain, written as it arrives."""
 
     def __init__(self, path: Path, robots: list[str], offset: float) -> None:
+        # A node process never records: the simulator's recorder (1.2 s to import) is loaded
+        # by a recording only.
         from robotale.sim.recorder import Recorder
 
         if path.exists():
@@ -251,16 +253,12 @@ class _Recording:
 
 
 def _publication_reader(bus: DdsBus):
-    from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
-
     return BuiltinDataReader(bus.participant, BuiltinTopicDcpsPublication)
 
 
 def _asking(offered):
     """A reader QoS every publisher offering ``offered`` serves: its reliability and
     durability, everything kept, no deadline or liveliness demands."""
-    from cyclonedds.core import Policy
-
     reliable = isinstance(offered[Policy.Reliability], Policy.Reliability.Reliable)
     latched = offered[Policy.Durability] == Policy.Durability.TransientLocal
     return replace(
@@ -280,8 +278,6 @@ def record_command(
 ) -> int:
     """Record every ROS-typed topic on the domain into a rosbag2 until Ctrl-C or
     ``duration`` seconds; ``robots`` names the robot namespaces (their tags, odometry ...)."""
-    from robotale.commands.fame import robot_list
-
     err = err or sys.stderr
     names = robot_list(robots)
     if not names:

@@ -5,6 +5,7 @@ and aggregation into Class graphs. Every query is a file in ``cypher/``.
 driver for the configured server; ``aggregate(driver, name, key)`` (re)builds a Class graph.
 """
 
+import importlib
 from typing import Any
 
 _EXPORTS = {
@@ -22,7 +23,5 @@ __all__ = sorted(_EXPORTS)
 def __getattr__(name: str) -> Any:
     # Imported on first use, so `robotale neo4j status` does not load pandas (half a second).
     if name in _EXPORTS:
-        import importlib
-
         return getattr(importlib.import_module(_EXPORTS[name]), name)
     raise AttributeError(f"module 'robotale.ekg' has no attribute {name!r}")

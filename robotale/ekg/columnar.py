@@ -35,9 +35,10 @@ from neo4j import Driver
 
 from robotale.config import robotale_home
 from robotale.ekg.connection import database, read_rows
+from robotale.ekg.logs import log_build_row
 from robotale.ekg.queries import cypher
 from robotale.ekg.tables import EVENT_PROPERTIES, property_name
-from robotale.errors import InputError, LogNotFound, RobotaleError
+from robotale.errors import InputError, RobotaleError
 from robotale.eventlog import schema
 from robotale.files import atomic_file
 
@@ -78,10 +79,7 @@ class Build:
 
 def log_build(driver: Driver, name: str, hint: str | None = None) -> Build:
     """The current build of the stored log ``name`` (a :class:`LogNotFound` if none)."""
-    records = read_rows(driver, cypher("ekg_log_build"), log=name)
-    if not records:
-        raise LogNotFound(name, hint)
-    row = records[0]
+    row = log_build_row(driver, name, hint)
     return Build(
         name=name,
         status=str(row["status"]),

@@ -20,11 +20,13 @@ from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from dataclasses import dataclass
 from pathlib import Path
+from typing import IO
 
 from tqdm import tqdm
 
 from robotale.config import cache_dir
 from robotale.errors import ServerError
+from robotale.files import atomic_file
 
 NEO4J_VERSION = "5.26.30"
 BROWSER_VERSION = "5.24.0"
@@ -184,31 +186,28 @@ def _download_all(
 def _download(jar: Jar, lib: Path, repository: str, progress: tqdm) -> None:
     url = jar.url(repository)
     for attempt in range(1, _ATTEMPTS + 1):
-        part = lib / f".{jar.filename}.{os.getpid()}.part"
         try:
-            digest = _fetch(url, part, progress)
-            if digest != jar.sha1:
-                raise ServerError(
-                    f"The Neo4j jar {url} has sha1 {digest}, not the pinned {jar.sha1}; "
-                    "check ROBOTALE_MAVEN_REPO or your network proxy."
-                )
-            os.replace(part, lib / jar.filename)
+            # a jar whose checksum is wrong, or whose download broke off, never reaches lib
+            with atomic_file(lib / jar.filename, "wb") as out:
+                digest = _fetch(url, out, progress)
+                if digest != jar.sha1:
+                    raise ServerError(
+                        f"The Neo4j jar {url} has sha1 {digest}, not the pinned {jar.sha1}; "
+                        "check ROBOTALE_MAVEN_REPO or your network proxy."
+                    )
             return
         except (urllib.error.URLError, OSError) as error:
-            part.unlink(missing_ok=True)
             if attempt == _ATTEMPTS:
                 raise ServerError(
                     f"Could not download the Neo4j jar {url} ({error}); "
                     "check the network or set ROBOTALE_MAVEN_REPO to a Maven Central mirror."
                 ) from error
             time.sleep(attempt)
-        finally:
-            part.unlink(missing_ok=True)
 
 
-def _fetch(url: str, target: Path, progress: tqdm) -> str:
+def _fetch(url: str, out: IO[bytes], progress: tqdm) -> str:
     digest = hashlib.sha1()
-    with urllib.request.urlopen(url, timeout=60) as response, target.open("wb") as out:
+    with urllib.request.urlopen(url, timeout=60) as response:
         for block in iter(lambda: response.read(1 << 16), b""):
             digest.update(block)
             out.write(block)

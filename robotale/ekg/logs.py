@@ -57,6 +57,15 @@ def log_run(driver: Driver, name: str) -> str | None:
     return rows[0]["run"] if rows else None
 
 
+def log_build_row(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
+    """What the Log node of ``name`` records of its current build (``status``, ``created``,
+    ``run``, ``appended``, ``properties``, ``columns``), for its columnar copy."""
+    rows = _rows(driver, "ekg_log_build", log=name)
+    if not rows:
+        raise LogNotFound(name, hint)
+    return rows[0]
+
+
 def log_summary(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
     """:func:`log_info` plus counts taken from the graph.
 

@@ -35,6 +35,7 @@ from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError, ServiceUnavailable, SessionExpired
 from neo4j.graph import Node, Path, Relationship
 
+from robotale.ekg.connection import Settings, connect, unreachable_message
 from robotale.ekg.connection import database as default_database
 from robotale.ekg.queries import code_only, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
@@ -338,8 +339,6 @@ def _path_elements(path: Path) -> list[Node | Relationship]:
 def answer(request: Mapping[str, Any]) -> dict[str, Any]:
     """Run one console request (connection, text, parameters, limits) and say how it went:
     ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``."""
-    from robotale.ekg.connection import Settings, connect, unreachable_message
-
     where = Settings(request["uri"], request["user"], request["password"], True)
     try:
         with connect(where) as driver:

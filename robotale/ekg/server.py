@@ -47,6 +47,7 @@ from robotale.ekg.server_config import (
     render,
 )
 from robotale.errors import ServerError
+from robotale.files import write_file
 
 HOST = "127.0.0.1"
 USER = "neo4j"
@@ -258,7 +259,7 @@ class LocalServer:
         classpath = f"{lib}/*:{plugins}/*" if plugins else f"{lib}/*"
         process = self._launch(java, classpath, options, overlay.jvm_options)
         state = RunningServer(process.pid, options.bolt_port, options.http_port)
-        self.state_file.write_text(json.dumps(asdict(state)))
+        write_file(self.state_file, json.dumps(asdict(state)))
         self._record(state, stopped=False)
         try:
             self._wait_until_answering(process, state, timeout)
@@ -286,7 +287,7 @@ class LocalServer:
         return state
 
     def _record(self, state: RunningServer, stopped: bool) -> None:
-        self.ports_file.write_text(json.dumps(asdict(state) | {"stopped": stopped}))
+        write_file(self.ports_file, json.dumps(asdict(state) | {"stopped": stopped}))
 
     # -- helpers -------------------------------------------------------------------------
 

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import numpy as np
 import pandas as pd
+import plotly.graph_objects as go
 
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
 from robotale.enhancement.context import LogAnalysis, analysis_of
@@ -278,8 +279,6 @@ def _level_table(levels: pd.DataFrame) -> pd.DataFrame:
 
 
 def _levels_figure(levels: pd.DataFrame, lows: pd.DataFrame):
-    import plotly.graph_objects as go
-
     figure = go.Figure()
     robots = levels.groupby(ROBOT, sort=True) if ROBOT in levels.columns else [("all", levels)]
     for name, mine in robots if BATTERY in levels.columns else []:  # tagged lows, no levels

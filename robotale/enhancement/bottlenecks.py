@@ -513,7 +513,7 @@ def _short(text: str, limit: int = 80) -> str:
 
 
 def _figure(ranking: pd.DataFrame):
-    import plotly.express as px
+    import plotly.express as px  # 0.6 s to import: only a figure needs it
 
     shown = ranking.head(15).assign(
         candidate=lambda t: (

@@ -138,7 +138,7 @@ def message_tables(
     deliveries["delayed"] = _delayed(deliveries, delay_threshold)
     delayed = deliveries.groupby(keys)["delayed"].any()
     table["delayed"] = _lookup(table, keys, delayed).fillna(False).astype(bool)
-    return _with_resends(table, keys), deliveries
+    return _with_resends(table), deliveries
 
 
 def shared_latencies(analysis: LogAnalysis) -> pd.DataFrame:
@@ -336,7 +336,7 @@ def _delayed(deliveries: pd.DataFrame, threshold: float | None) -> pd.Series:
     return latency.gt(p95) & enough
 
 
-def _with_resends(table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
+def _with_resends(table: pd.DataFrame) -> pd.DataFrame:
     """Adds which messages were sent again under a new id (``resent_as``), the resends by id
     reuse and by new id, and ``recovered``: lost, but a resend got through."""
     group = [k for k in (CASE, "sender", TYPE, "payload") if k in table.columns]
@@ -514,7 +514,7 @@ def _summary(messages: pd.DataFrame, channels: pd.DataFrame, lost_effect: dict) 
 
 
 def _figure(types: pd.DataFrame):
-    from plotly.subplots import make_subplots
+    from plotly.subplots import make_subplots  # 0.25 s to import: only a figure needs it
 
     figure = make_subplots(
         rows=1, cols=2, subplot_titles=("Messages", "Latency, first send to first receive (s)")

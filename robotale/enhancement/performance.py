@@ -15,6 +15,7 @@ where working is the time at least one of its activities ran.
 from __future__ import annotations
 
 import pandas as pd
+import plotly.graph_objects as go
 
 from robotale.discovery.instances import DURATION, FINISHED, START_KNOWN, START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
@@ -299,8 +300,6 @@ def _durations_figure(instances: pd.DataFrame):
     """Box plots of working time per activity, one colour per robot (plain traces: plotly
     express spends seconds preparing a large frame; fixed-width text arrays, which plotly
     copies whole rather than string by string)."""
-    import plotly.graph_objects as go
-
     figure = go.Figure()
     robots = (
         instances.groupby(ROBOT, sort=True) if ROBOT in instances.columns else [("", instances)]
@@ -315,14 +314,14 @@ def _durations_figure(instances: pd.DataFrame):
 
 
 def _waiting_figure(waiting: pd.DataFrame):
-    import plotly.express as px
+    import plotly.express as px  # 0.6 s to import: only a figure needs it
 
     top = waiting.head(15).assign(transition=lambda t: t.apply(_transition_name, axis=1))
     return px.bar(top, x="transition", y="mean", title="Slowest transitions: mean wait (s)")
 
 
 def _cases_figure(cases: pd.DataFrame):
-    import plotly.express as px
+    import plotly.express as px  # 0.6 s to import: only a figure needs it
 
     parts = cases.astype({CASE: str}).melt(
         id_vars=[CASE], value_vars=["working", "waiting", "unsplit"], var_name="time"

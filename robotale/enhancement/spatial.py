@@ -14,6 +14,7 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+import plotly.graph_objects as go
 
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.result import (
@@ -200,8 +201,6 @@ SYMBOLS = (
 
 def _scatter(placed: pd.DataFrame):
     """One trace per activity (its colour), one marker symbol per robot."""
-    import plotly.graph_objects as go
-
     robots = placed[ROBOT].astype("string").fillna("") if ROBOT in placed.columns else None
     names = sorted(set(robots)) if robots is not None else []
     symbol_of = {r: SYMBOLS[i % len(SYMBOLS)] for i, r in enumerate(names)}

@@ -21,9 +21,15 @@ from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 from pathlib import Path
 
+import lz4.frame
 import numpy as np
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
+
+try:  # the standard library's zstd from Python 3.14 on; rosbags' backport before
+    from compression import zstd
+except ImportError:
+    from backports import zstd
 
 _MESSAGE, _MESSAGE_INDEX = 0x05, 0x07
 #: a message record: opcode, record length, channel id, sequence, log time, publish time
@@ -105,22 +111,16 @@ def _records(whole: np.ndarray, chunk) -> np.ndarray:
         return stored
     crc_at = chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8
     crc = int(whole[crc_at : crc_at + 4].view("<u4")[0])
-    records = _decompress(chunk.compression, stored.tobytes(), chunk.uncompressed_size)
+    records = _decompress(chunk.compression, stored.tobytes())
     if len(records) != chunk.uncompressed_size or (crc and zlib.crc32(records) != crc):
         raise MalformedMcap(f"the chunk at byte {chunk.chunk_start_offset} is corrupt")
     return np.frombuffer(records, dtype=np.uint8)
 
 
-def _decompress(compression: str, data: bytes, size: int) -> bytes:
+def _decompress(compression: str, data: bytes) -> bytes:
     if compression == "zstd":
-        try:
-            from compression import zstd
-        except ImportError:
-            from backports import zstd
         return zstd.decompress(data)
     if compression == "lz4":
-        import lz4.frame
-
         return lz4.frame.decompress(data)
     raise MalformedMcap(f"its chunks are compressed with {compression!r}, which is not supported")
 

@@ -50,6 +50,7 @@ from robotale.eventlog.rosbag import (
     namespace,
 )
 from robotale.eventlog.sources import Sources
+from robotale.executors import open_executor, parse_executor, worker_lost
 from robotale.fame_runtime.manifest import RunManifest, read_manifests
 from robotale.storage import Place, place
 
@@ -368,8 +369,6 @@ def _on_executor(
 ) -> list[Any]:
     """``task(run, *arguments)`` for every run on the executor's workers (each run given as
     an absolute path), the bar counting runs as they finish; the results in run order."""
-    from robotale.executors import open_executor, parse_executor, worker_lost
-
     done: dict[Path, Any] = {}
     with open_executor(parse_executor(executor), len(runs)) as (pool, _):
         futures = {pool.submit(task, run.resolve(), *arguments): run for run in runs}

@@ -30,6 +30,7 @@ import pandas as pd
 import pyarrow as pa
 import pyarrow.dataset as pads
 import pyarrow.parquet as pq
+from lxml import etree
 
 from robotale.errors import InputError
 from robotale.eventlog import dataset, reading, schema
@@ -259,8 +260,6 @@ _XES_VALUES = {
 
 def _parse_xes(path: Path) -> tuple[pd.DataFrame, pd.Series]:
     """Events as rows (trace attributes as ``case:<key>``) and each event's line in the file."""
-    from lxml import etree
-
     rows: list[dict[str, object]] = []
     lines: list[int] = []
     parser = etree.iterparse(
@@ -342,7 +341,7 @@ def canonical_log(
     log = table.rename(columns=dict(renames))
     if case is not None:
         log[schema.CASE] = table[case].astype("string")
-    _check_columns(path, log, renames)
+    _check_columns(path, log)
     log[schema.TIMESTAMP] = parse_timestamps(path, log[schema.TIMESTAMP], lines)
     _require_values(path, log, schema.ACTIVITY, lines)
     kinds = reading.event_kinds(log)
@@ -456,7 +455,7 @@ def _to_datetime(text: pd.Series) -> pd.Series:
         return pd.to_datetime(text, format="ISO8601", errors="coerce", utc=True)
 
 
-def _check_columns(path: Path, log: pd.DataFrame, renames: Mapping[str, str]) -> None:
+def _check_columns(path: Path, log: pd.DataFrame) -> None:
     for required in (schema.ACTIVITY, schema.TIMESTAMP):
         if required not in log.columns:
             names = ", ".join(SYNONYMS[required])

@@ -45,7 +45,7 @@ from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
 from robotale.eventlog.cdrlayout import Layout, columns
-from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches
+from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches, zstd
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
 
 TIME = "time"
@@ -695,12 +695,7 @@ def _file_batches(storage, mine: Mapping[int, Connection], compressed: bool):
 
 
 def _decompressed(raw: bytes) -> bytes:
-    # rosbags' own zstd (the standard library's from Python 3.14 on)
-    try:
-        from compression import zstd
-    except ImportError:
-        from backports import zstd
-    return zstd.decompress(raw)
+    return zstd.decompress(raw)  # the zstd rosbags compresses with
 
 
 def all_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:

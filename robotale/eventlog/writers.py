@@ -229,7 +229,7 @@ def write_ocel(
     )
     events, event_types = _ocel_events(log)
     document = {
-        "objectTypes": _ocel_object_types(log, runs or {}),
+        "objectTypes": _ocel_object_types(runs or {}),
         "eventTypes": event_types,
         "objects": _ocel_robots(log) + _ocel_messages(log) + _ocel_runs(log, runs or {}),
         "events": events,
@@ -296,7 +296,7 @@ def _json_values(series: pd.Series, kind: str) -> list:
     return [None if v is None else bool(v) for v in values]
 
 
-def _ocel_object_types(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> list[dict]:
+def _ocel_object_types(runs: Mapping[str, RunManifest]) -> list[dict]:
     run_attributes = sorted({key for manifest in runs.values() for key in _flat(manifest)})
     string = lambda names: [{"name": n, "type": "string"} for n in names]  # noqa: E731
     return [

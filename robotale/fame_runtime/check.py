@@ -14,6 +14,8 @@ from collections.abc import Collection
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from lxml import etree
+
 from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Node, Process, Scope
@@ -282,8 +284,6 @@ def duplicate_ids(file: Path | None) -> list[str]:
     them, so a model with two ``start`` ids would look as if it had none."""
     if file is None or not Path(file).is_file():
         return []
-    from lxml import etree
-
     lines: dict[str, list[int]] = defaultdict(list)
     try:
         tree = etree.parse(str(file), etree.XMLParser(resolve_entities=False, no_network=True))

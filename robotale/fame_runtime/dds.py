@@ -29,6 +29,14 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from cyclonedds.core import Listener, Policy, Qos
+from cyclonedds.domain import DomainParticipant
+from cyclonedds.pub import DataWriter
+from cyclonedds.sub import DataReader
+from cyclonedds.topic import Topic
+from cyclonedds.util import duration
+
+from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope, Subscription
 from robotale.fame_runtime.clock import Clock
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
@@ -51,9 +59,6 @@ _POLICIES = {
 def dds_qos(qos: QoS, *, userdata: str = "") -> Any:
     """Cyclone QoS with the model's reliability, durability, history, deadline, lifespan,
     liveliness and lease duration."""
-    from cyclonedds.core import Policy, Qos
-    from cyclonedds.util import duration
-
     policies = [
         Policy.Reliability.Reliable(duration(seconds=1))
         if qos.reliability == "reliable"
@@ -86,8 +91,6 @@ def domain_id() -> int:
     """The DDS domain: ``ROS_DOMAIN_ID`` as ROS 2 reads it (0 when unset)."""
     text = os.environ.get("ROS_DOMAIN_ID", "0").strip() or "0"
     if not text.isdigit() or int(text) > 232:
-        from robotale.errors import InputError
-
         raise InputError(f"ROS_DOMAIN_ID {text!r} is not a DDS domain id from 0 to 232")
     return int(text)
 
@@ -96,9 +99,6 @@ class _Reader:
     """One DDS data reader and the bus subscriptions it feeds."""
 
     def __init__(self, bus: DdsBus, topic: str, msgtype: str, qos: QoS) -> None:
-        from cyclonedds.core import Listener
-        from cyclonedds.sub import DataReader
-
         self.bus, self.topic, self.msgtype, self.qos = bus, topic, msgtype, qos
         self.subscriptions: list[Subscription] = []
         self.kept: deque[Envelope] = deque(maxlen=qos.depth if qos.history == "keep_last" else None)
@@ -161,8 +161,6 @@ class DdsBus:
         domain: int | None = None,
         on_warning: Callable[[str], None] | None = None,
     ) -> None:
-        from cyclonedds.domain import DomainParticipant
-
         self.clock = clock
         self.node = node or uuid.uuid4().hex[:8]
         self.participant = DomainParticipant(domain_id() if domain is None else domain)
@@ -180,8 +178,6 @@ class DdsBus:
     # -- declaring endpoints -------------------------------------------------------------------
 
     def topic(self, topic: str, msgtype: str) -> Any:
-        from cyclonedds.topic import Topic
-
         key = (topic, msgtype)
         if key not in self._topics:
             self._topics[key] = Topic(self.participant, dds_topic(topic), idl_type(msgtype))
@@ -189,8 +185,6 @@ class DdsBus:
 
     def writer(self, topic: str, msgtype: str, qos: QoS | None = None, sender: str = "") -> Any:
         """The data writer for ``topic`` in ``sender``'s name (made on first use)."""
-        from cyclonedds.pub import DataWriter
-
         qos = qos or DEFAULT_QOS
         key = (topic, msgtype, qos, sender)
         if key not in self._writers:
@@ -210,8 +204,6 @@ class DdsBus:
 
     def raw_reader(self, topic: str, msgtype: str, qos: QoS) -> Any:
         """A plain DDS reader (no listener) for what the caller polls itself."""
-        from cyclonedds.sub import DataReader
-
         return DataReader(self.participant, self.topic(topic, msgtype), qos=dds_qos(qos))
 
     def matched(self) -> list[tuple[str, int]]:
@@ -314,8 +306,6 @@ class DdsBus:
 
     def close(self) -> None:
         """Wait (a little) for reliable readers to acknowledge, then leave the domain."""
-        from cyclonedds.util import duration
-
         for writer in self._writers.values():
             # a reader that left does not acknowledge: there is nothing to wait for then
             with contextlib.suppress(Exception):
@@ -327,8 +317,6 @@ class DdsBus:
 
 
 def _parse_userdata(qos: Any) -> tuple[str, str]:
-    from cyclonedds.core import Policy
-
     try:
         data = qos[Policy.Userdata].data.decode()
     except (KeyError, AttributeError, UnicodeDecodeError):

@@ -57,10 +57,26 @@ class RunManifest(TypedDict, total=False):
     topics: dict[str, dict[str, Any]]
 
 
+def manifest_text(manifest: RunManifest) -> str:
+    """The manifest as its file holds it (also for a run uploaded to a remote place)."""
+    return json.dumps(manifest, indent=2) + "\n"
+
+
+def parse_manifest(data: str | bytes, where: object) -> RunManifest:
+    """A manifest file's content; ``where`` (its path or URL) names it in the error."""
+    try:
+        manifest = json.loads(data)
+    except (ValueError, UnicodeDecodeError) as error:
+        raise InputError(f"{where} is not valid JSON: {error}.") from None
+    if not isinstance(manifest, dict):
+        raise InputError(f"{where} holds no JSON object, so it is no run manifest.")
+    return manifest
+
+
 def write_manifest(folder: Path, manifest: RunManifest) -> Path:
     """Write ``manifest`` into the run folder ``folder`` (whole, or not at all)."""
     path = folder / MANIFEST
-    write_file(path, json.dumps(manifest, indent=2) + "\n")
+    write_file(path, manifest_text(manifest))
     return path
 
 
@@ -69,13 +85,7 @@ def read_manifest(folder: Path) -> RunManifest | None:
     path = folder / MANIFEST
     if not path.is_file():
         return None
-    try:
-        manifest = json.loads(path.read_text(encoding="utf-8"))
-    except (ValueError, UnicodeDecodeError) as error:
-        raise InputError(f"{path} is not valid JSON: {error}.") from None
-    if not isinstance(manifest, dict):
-        raise InputError(f"{path} holds no JSON object, so it is no run manifest.")
-    return manifest
+    return parse_manifest(path.read_bytes(), path)
 
 
 def read_manifests(runs: Iterable[Path]) -> dict[str, RunManifest]:

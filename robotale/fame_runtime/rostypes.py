@@ -17,8 +17,11 @@ from collections.abc import Mapping
 from functools import cache
 from typing import Any
 
+from cyclonedds.idl import make_idl_struct, types
+from rosbags.typesys import Stores, get_types_from_msg, get_typestore
+
 from robotale.errors import ModelError
-from robotale.fame_runtime.tags import TAG_TYPE, Tag
+from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type
 
 _BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4  # rosbags' Nodetype values
 
@@ -60,11 +63,6 @@ def _parts(msgtype: str) -> tuple[str, str, str]:
 
 @cache
 def _store():
-    # rosbags is imported here, by those who talk DDS, not with the module (see tags.py)
-    from rosbags.typesys import Stores, get_types_from_msg, get_typestore
-
-    from robotale.fame_runtime.tags import register_tag_type
-
     store = get_typestore(Stores.ROS2_HUMBLE)
     register_tag_type(store)
     if STATUS_TYPE not in store.fielddefs:
@@ -79,8 +77,6 @@ def known(msgtype: str) -> bool:
 @cache
 def idl_type(msgtype: str) -> type:
     """The ``cyclonedds`` IDL struct of a ROS 2 message type (one class per type)."""
-    from cyclonedds.idl import make_idl_struct
-
     store = _store()
     if msgtype not in store.fielddefs:
         raise ModelError(f"the message type {msgtype} is not a ROS 2 Humble type robotale knows")
@@ -91,8 +87,6 @@ def idl_type(msgtype: str) -> type:
 
 
 def _field_type(desc) -> Any:
-    from cyclonedds.idl import types
-
     kind, rest = desc
     if kind == _NAME:
         return idl_type(rest)
@@ -106,8 +100,6 @@ def _field_type(desc) -> Any:
 
 
 def _base_type(name: str, bound: int) -> Any:
-    from cyclonedds.idl import types
-
     if name == "string":
         return types.bounded_str[bound] if bound else str
     scalars = {

@@ -34,7 +34,14 @@ from tqdm import tqdm
 
 from robotale.errors import InputError
 from robotale.executors import ExecutorSpec, open_executor, parse_executor, worker_lost
-from robotale.fame_runtime.manifest import MANIFEST, RunManifest, read_manifest, write_manifest
+from robotale.fame_runtime.manifest import (
+    MANIFEST,
+    RunManifest,
+    manifest_text,
+    parse_manifest,
+    read_manifest,
+    write_manifest,
+)
 from robotale.files import write_file
 from robotale.sim import scenarios
 from robotale.sim.run import CRASHED, RunPlan, simulate_run
@@ -131,7 +138,7 @@ def run_uploaded(
 
 def _remote_manifest(run: Place) -> RunManifest | None:
     found = run.child(MANIFEST)
-    return json.loads(found.read_bytes()) if found.exists() else None
+    return parse_manifest(found.read_bytes(), found.text) if found.exists() else None
 
 
 def run_into(
@@ -217,7 +224,7 @@ def _died(plan: RunPlan, out: Path | Place) -> RunManifest:
     }
     if isinstance(out, Place):
         out.child(f".{plan.case}.partial").remove()
-        out.child(plan.case, MANIFEST).write_whole(json.dumps(manifest, indent=2) + "\n")
+        out.child(plan.case, MANIFEST).write_whole(manifest_text(manifest))
         return manifest
     shutil.rmtree(out / f".{plan.case}.partial", ignore_errors=True)
     folder = out / plan.case

@@ -15,9 +15,9 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from robotale.errors import ModelError
+from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import JAVASCRIPT, Definitions, Process
-from robotale.fame_runtime.plan import signal_topic
 from robotale.fame_runtime.splitter import split
 from robotale.sim.robots import BATTERY, COLOR, EMPTY, FLOAT64, ODOM, TELLO_ACTION, TWIST
 from robotale.sim.sensors import DETECTION, RANGE
@@ -98,7 +98,7 @@ def needs(
         for _, pool in definitions.pools()
         for process in _with_blocks(pool, library)
         for node in process.walk()
-        if node.event_kind == "signal" and node.kind in ("intermediateThrowEvent", "endEvent")
+        if node.event_kind == "signal" and node.kind in THROWING
     }
     try:
         assignments = split(definitions, robots)
@@ -109,8 +109,7 @@ def needs(
             for node in process.walk():
                 yield from _script_needs(node, assignment.robot)
                 topic = signal_topic(node) if node.event_kind == "signal" else ""
-                catches = node.kind in ("startEvent", "intermediateCatchEvent", "boundaryEvent")
-                if topic and catches and topic not in thrown:
+                if topic and catches(node) and topic not in thrown:
                     msgtype = node.message.msgtype if node.message else "std_msgs/msg/Empty"
                     by = f"{node.kind} {node.describe()}"
                     yield Need(assignment.robot, "publish", topic, msgtype, by)

@@ -21,7 +21,7 @@ from typing import Any
 
 from robotale.fame_runtime.bus import InProcessBus, Network
 from robotale.fame_runtime.clock import SimClock
-from robotale.fame_runtime.labels import error_name, signal_topic
+from robotale.fame_runtime.labels import THROWING, error_name, signal_topic
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.manifest import RunManifest, write_manifest
 from robotale.fame_runtime.mission import Mission
@@ -200,7 +200,7 @@ def model_topics(definitions: Definitions) -> tuple[dict[str, str], set[str]]:
             if node.event_kind != "signal" or not signal_topic(node):
                 continue
             msgtype = node.message.msgtype if node.message else ""
-            throws = node.kind in ("intermediateThrowEvent", "endEvent")
+            throws = node.kind in THROWING
             topic = signal_topic(node)
             if msgtype and (throws or topic not in signals):
                 signals[topic] = msgtype

@@ -143,7 +143,7 @@ def phantoms(
     return [(pose.x + rng.uniform(-half, half), pose.y + rng.uniform(-half, half))]
 
 
-def detection_message(now: float, robot: SimRobot, object_id: str, x: float, y: float):
+def detection_message(now: float, object_id: str, x: float, y: float):
     """A ``geometry_msgs/msg/PointStamped`` naming the object seen."""
     return {
         "header": header(now, object_id),

@@ -282,7 +282,7 @@ class SimWorld:
         self._phantoms += 1
         name = f"phantom_{self._phantoms}"
         self._publish(
-            robot, "detection", sensors.detection_message(now, robot, name, x, y), sensors.DETECTION
+            robot, "detection", sensors.detection_message(now, name, x, y), sensors.DETECTION
         )
         if camera.signal and camera.signal not in self.silent:
             point = {"x": round(x, 4), "y": round(y, 4), "z": 0.0}
@@ -308,7 +308,7 @@ class SimWorld:
                 continue
             if not thing.found_by:
                 thing.found_by, thing.found_at = robot.name, now
-            message = sensors.detection_message(now, robot, thing.id, thing.x, thing.y)
+            message = sensors.detection_message(now, thing.id, thing.x, thing.y)
             self._publish(robot, "detection", message, sensors.DETECTION)
 
     def _act(self, robot: SimRobot, now: float) -> None:

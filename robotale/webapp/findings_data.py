@@ -14,7 +14,7 @@ from robotale.enhancement.findings import find, trusted_first
 from robotale.enhancement.result import Perspective
 from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import RobotaleError
-from robotale.webapp.logdata import LogData, log_info
+from robotale.webapp.logdata import LogData, first_key, log_info
 
 #: the Perspectives page's sections, in the order it shows them
 PERSPECTIVES: dict[str, Callable[..., Perspective]] = {
@@ -85,9 +85,7 @@ def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict:
     """The class graph the Perspectives page draws beside its sections: by activity and
     robot when the log has robots as entities (``perspectives.js`` asks for the same)."""
     types = log_info(driver, name).get("entityTypes") or []
-    return logs.class_graph(
-        driver, name, ("activity", "robot") if "robot" in types else ("activity",)
-    )
+    return logs.class_graph(driver, name, first_key(types))
 
 
 def prepare(driver: Driver, logs: LogData, name: str) -> None:
