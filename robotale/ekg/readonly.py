@@ -4,8 +4,10 @@ The dashboard's console runs its queries here. Four fences, each enough against 
 covers, checked in this order:
 
 1. The text, before anything is sent: ``LOAD CSV`` (files and URLs), administration commands
-   (``SHOW``, ``TERMINATE``, users, databases), ``USE`` and ``CALL ... IN TRANSACTIONS`` are
-   refused, as are integers Neo4j cannot hold.
+   (``SHOW``, ``TERMINATE``, users, databases), ``USE``, ``CALL ... IN TRANSACTIONS`` and
+   functions that are not Neo4j's own (a plugin's: APOC's ``apoc.cypher.runFirstColumn``
+   would run a ``LOAD CSV`` given to it as a string) are refused, as are integers Neo4j
+   cannot hold.
 2. The plan (``EXPLAIN``, which runs nothing): every operator must work on robotale's database,
    read no file, administer nothing, and call only the procedures of
    :data:`ALLOWED_PROCEDURES`.
@@ -36,7 +38,7 @@ from neo4j.exceptions import DriverError, Neo4jError, ServiceUnavailable, Sessio
 from neo4j.graph import Node, Path, Relationship
 
 from robotale.ekg.connection import database as default_database
-from robotale.ekg.queries import code_only, split_statements
+from robotale.ekg.queries import code_only, dotted_calls, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
 
 #: procedures the console may call: they describe the graph and the server, and change nothing
@@ -51,6 +53,12 @@ ALLOWED_PROCEDURES = frozenset(
         "dbms.components",
         "dbms.showCurrentUser",
     }
+)
+#: the namespaces of Neo4j's own functions (``duration.between``, ``point.distance``); a dotted
+#: function of any other namespace is a plugin's, and the console calls none
+BUILT_IN_FUNCTION_NAMESPACES = frozenset(
+    {"date", "datetime", "localdatetime", "localtime", "time", "duration", "point", "vector"}
+    | {"db", "graph", "coll"}
 )
 #: rows counted at most (shown or not): past that the total is "at least"
 COUNTED = 100_000
@@ -128,6 +136,16 @@ def refuse_text(statement: str) -> None:
         )
     if _USE.search(code):
         raise QueryRefused(f"{_ONLY_READS} of robotale's database: USE is refused.")
+    for before, name in dotted_calls(statement):
+        if before.upper() != "CALL" and not _built_in_function(name):
+            raise QueryRefused(
+                f"{_ONLY_READS}: the function {name} is not one of Neo4j's own, and a "
+                "plugin's functions are refused."
+            )
+
+
+def _built_in_function(name: str) -> bool:
+    return name.split(".", 1)[0].lower() in BUILT_IN_FUNCTION_NAMESPACES
 
 
 def checked_parameters(parameters: Mapping[str, Any] | None) -> dict[str, Any]:
