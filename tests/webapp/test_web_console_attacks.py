@@ -342,3 +342,42 @@ def test_the_local_server_caps_a_transaction_and_reads_no_file_urls(neo4j_driver
     values = {record["name"]: record["value"] for record in records}
     assert values["dbms.security.allow_csv_import_from_file_urls"] == "false"
     assert values["db.memory.transaction.max"] != "0B"
+
+
+@pytest.mark.slow
+def test_with_apoc_installed_cypher_given_as_text_reads_no_url(
+    neo4j_server, tmp_path, loopback_service
+):
+    """APOC's functions run Cypher handed to them as a string, where the text check sees no
+    LOAD CSV and the plan shows none: on a server with APOC that fetches a loopback service
+    even in a READ transaction. The console refuses the function."""
+    from neo4j import READ_ACCESS, GraphDatabase
+
+    from robotale.ekg import jars
+    from robotale.ekg.readonly import QueryRefused, run_read_only
+    from robotale.ekg.server import ServerOptions, free_port
+
+    plugins = tmp_path / "plugins"
+    plugins.mkdir()
+    for jar in jars.apoc_with_file_access():  # APOC opens URLs with what these bring
+        (plugins / jar.name).symlink_to(jar)
+    server = LocalServer(tmp_path / "home")
+    options = ServerOptions(free_port(), free_port(), "512m", "64m", plugins)
+    running = server.start(options)
+    attack = (
+        "RETURN apoc.cypher.runFirstColumnSingle('LOAD CSV FROM $url AS l RETURN l', "
+        "{url: $url}) AS line"
+    )
+    url = loopback_service["url"]
+    try:
+        auth = ("neo4j", server.password() or "")
+        with GraphDatabase.driver(running.bolt_uri, auth=auth) as driver:
+            # The threat is real: without the console's check the service is read.
+            with driver.session(default_access_mode=READ_ACCESS) as session:
+                line = session.run(attack, url=url).single()["line"]
+            assert line == ["secret"] and loopback_service["hits"] == 1
+            with pytest.raises(QueryRefused, match=r"function apoc\.cypher\.runFirstColumnSingle"):
+                run_read_only(driver, attack, {"url": url}, database="neo4j")
+            assert loopback_service["hits"] == 1
+    finally:
+        server.stop()
