@@ -71,9 +71,13 @@ _ONLY_READS = "The console only reads the graph"
 
 _LOAD_CSV = re.compile(r"\bLOAD\s+CSV\b", re.IGNORECASE)
 _IN_TRANSACTIONS = re.compile(r"\bIN\s+(?:\d+\s+)?(?:CONCURRENT\s+)?TRANSACTIONS\b", re.I)
+#: what may lead a statement: EXPLAIN, PROFILE and query options (``CYPHER 5 runtime=slotted``)
+_LEADING_OPTIONS = re.compile(
+    r"^\s*(?:(?:EXPLAIN|PROFILE|CYPHER(?:\s+(?:\d+(?:\.\d+)?|\w+\s*=\s*\w+))*)\s+)*",
+    re.IGNORECASE,
+)
 _ADMIN_START = re.compile(
-    r"^\s*(?:(?:EXPLAIN|PROFILE)\s+)?"
-    r"(SHOW|TERMINATE|GRANT|DENY|REVOKE|ALTER|START|STOP|ENABLE|DRYRUN|RENAME)\b",
+    r"^(SHOW|TERMINATE|GRANT|DENY|REVOKE|ALTER|START|STOP|ENABLE|DRYRUN|RENAME)\b",
     re.IGNORECASE,
 )
 _ADMIN_OBJECT = re.compile(
@@ -122,6 +126,7 @@ class StatementResult:
 def refuse_text(statement: str) -> None:
     """Raise :class:`QueryRefused` for what the console never sends to Neo4j."""
     code = code_only(statement)
+    body = code[_LEADING_OPTIONS.match(code).end() :]
     if _LOAD_CSV.search(code):
         raise QueryRefused(f"{_ONLY_READS}: LOAD CSV (reading files and URLs) is refused.")
     if _IN_TRANSACTIONS.search(code):
@@ -129,12 +134,12 @@ def refuse_text(statement: str) -> None:
             f"{_ONLY_READS}, one transaction per statement: CALL {{ ... }} IN TRANSACTIONS "
             "is refused."
         )
-    if _ADMIN_START.search(code) or _ADMIN_OBJECT.search(code):
+    if _ADMIN_START.search(body) or _ADMIN_OBJECT.search(code):
         raise QueryRefused(
             f"{_ONLY_READS}: administration commands (SHOW, TERMINATE, users, roles, "
             "databases) are refused."
         )
-    if _USE.search(code):
+    if _USE.search(body):
         raise QueryRefused(f"{_ONLY_READS} of robotale's database: USE is refused.")
     for before, name in dotted_calls(statement):
         if before.upper() != "CALL" and not _built_in_function(name):

@@ -110,6 +110,11 @@ def test_load_csv_fetches_no_loopback_service(client, loopback_service):
         "ALTER USER neo4j SET PASSWORD 'secret-secret'",
         "STOP DATABASE neo4j",
         "GRANT ROLE admin TO mallory",
+        # behind the query options that may lead a statement
+        "CYPHER 5 SHOW USERS",
+        "cypher runtime = slotted SHOW TRANSACTIONS YIELD currentQuery RETURN currentQuery",
+        "PROFILE CYPHER 5 planner=cost TERMINATE TRANSACTIONS 'neo4j-transaction-1'",
+        "CYPHER 5 USE system SHOW USERS",
     ],
 )
 def test_administration_commands_are_refused(client, query):
@@ -126,6 +131,7 @@ def test_administration_commands_are_refused(client, query):
         "CALL `db`.`clearQueryCaches`()",
         "call db.clearQueryCaches",
         "MATCH (n) WITH count(n) AS c CALL dbms.listConnections() YIELD connectionId RETURN *",
+        "CYPHER 5 CALL dbms.listConfig() YIELD name RETURN name",
     ],
 )
 def test_procedures_outside_the_allow_list_are_refused(client, query):
@@ -162,6 +168,12 @@ def test_neo4j_own_dotted_functions_still_run(client):
     )
     assert response.status_code == 200, response.get_data(as_text=True)
     assert response.json["results"][0]["rows"] == [[2, 5.0, "2024-05-01"]]
+
+
+def test_a_read_behind_query_options_still_runs(client):
+    response = run(client, "CYPHER 5 runtime=slotted UNWIND [1, 2] AS i RETURN sum(i) AS total")
+    assert response.status_code == 200, response.get_data(as_text=True)
+    assert response.json["results"][0]["rows"] == [[3]]
 
 
 def test_every_dotted_function_neo4j_lists_as_its_own_is_allowed(neo4j_driver):
