@@ -182,31 +182,44 @@ def test_start_after_a_crash_waits_for_its_port_and_says_why_it_gave_up(tmp_path
 def test_start_after_a_crash_waits_with_a_progress_line_until_its_port_is_free(tmp_path, env):
     server = LocalServer(tmp_path / "home")
     bolt, _ = _crashed_record(server)
-    # The port is let go of three seconds after `start` begins waiting for it.
+    # Holds the port (bound, not listening) until its stdin closes.
     holder = subprocess.Popen(
         [
             sys.executable,
             "-c",
-            "import socket, sys, time\n"
+            "import socket, sys\n"
             f"s = socket.socket(); s.bind(('127.0.0.1', {bolt})); print('held', flush=True)\n"
-            "time.sleep(3)",
+            "sys.stdin.read()",
         ],
+        stdin=subprocess.PIPE,
         stdout=subprocess.PIPE,
         text=True,
     )
     assert holder.stdout.readline().strip() == "held"
+    start = subprocess.Popen(
+        [*ROBOTALE, "neo4j", "start"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
     try:
-        started = subprocess.run(
-            [*ROBOTALE, "neo4j", "start"], env=env, capture_output=True, text=True, timeout=300
-        )
-        assert started.returncode == 0, started.stderr
-        assert "The local Neo4j had crashed; starting it again." in started.stdout
-        assert f"Waiting for the bolt port {bolt} to be free" in started.stderr
-        assert f"is running at bolt://127.0.0.1:{bolt}" in started.stdout
+        waiting = start.stderr.readline()
+        assert f"Waiting for the bolt port {bolt} to be free" in waiting, waiting
+        holder.stdin.close()  # the port is let go of while start waits for it
+        out, error = start.communicate(timeout=300)
+        assert start.returncode == 0, error
+        assert "The local Neo4j had crashed; starting it again." in out
+        assert f"is running at bolt://127.0.0.1:{bolt}" in out
         status = subprocess.run(
             [*ROBOTALE, "neo4j", "status"], env=env, capture_output=True, text=True, timeout=60
         )
         assert status.returncode == 0, status.stdout
     finally:
+        if holder.stdin and not holder.stdin.closed:
+            holder.stdin.close()
         holder.wait(timeout=30)
+        if start.poll() is None:
+            start.kill()
+            start.wait()
         subprocess.run([*ROBOTALE, "neo4j", "stop"], env=env, capture_output=True, timeout=300)
