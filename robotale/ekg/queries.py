@@ -60,6 +60,34 @@ def code_only(text: str) -> str:
     )
 
 
+def dotted_calls(text: str) -> list[tuple[str, str]]:
+    """Every call of a dotted name in ``text`` (``apoc.cypher.run(``, `` `db`.labels ( ``),
+    outside strings and comments, as (the word before it, the name with its quotes taken off):
+    the word is ``CALL`` for a procedure."""
+    # (is a name, text): words and quoted names are names; strings and punctuation are not
+    tokens: list[tuple[bool, str]] = []
+    for kind, piece in _pieces(text):
+        if kind == "quoted":
+            tokens.append((piece.startswith("`"), piece.strip("`")))
+        elif kind in ("code", "end"):
+            tokens += [(bool(_WORD.fullmatch(t)), t) for t in _TOKEN.findall(piece)]
+    calls = []
+    for start, (is_name, _) in enumerate(tokens):
+        if not is_name or (start and tokens[start - 1][1] == "."):
+            continue
+        end = start
+        while end + 2 < len(tokens) and tokens[end + 1][1] == "." and tokens[end + 2][0]:
+            end += 2
+        if end > start and end + 1 < len(tokens) and tokens[end + 1][1] == "(":
+            before = tokens[start - 1][1] if start else ""
+            calls.append((before, "".join(text for _, text in tokens[start : end + 1])))
+    return calls
+
+
+_TOKEN = re.compile(r"\w+|\S")
+_WORD = re.compile(r"\w+")
+
+
 def _pieces(text: str) -> Iterator[tuple[str, str]]:
     # An unterminated string or comment runs to the end of the text, as Neo4j reads it.
     for match in _PIECE.finditer(text):

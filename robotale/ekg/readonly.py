@@ -4,8 +4,10 @@ The dashboard's console runs its queries here. Four fences, each enough against 
 covers, checked in this order:
 
 1. The text, before anything is sent: ``LOAD CSV`` (files and URLs), administration commands
-   (``SHOW``, ``TERMINATE``, users, databases), ``USE`` and ``CALL ... IN TRANSACTIONS`` are
-   refused, as are integers Neo4j cannot hold.
+   (``SHOW``, ``TERMINATE``, users, databases), ``USE``, ``CALL ... IN TRANSACTIONS`` and
+   functions that are not Neo4j's own (a plugin's: APOC's ``apoc.cypher.runFirstColumn``
+   would run a ``LOAD CSV`` given to it as a string) are refused, as are integers Neo4j
+   cannot hold.
 2. The plan (``EXPLAIN``, which runs nothing): every operator must work on robotale's database,
    read no file, administer nothing, and call only the procedures of
    :data:`ALLOWED_PROCEDURES`.
@@ -37,7 +39,7 @@ from neo4j.graph import Node, Path, Relationship
 
 from robotale.ekg.connection import Settings, connect, unreachable_message
 from robotale.ekg.connection import database as default_database
-from robotale.ekg.queries import code_only, split_statements
+from robotale.ekg.queries import code_only, dotted_calls, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
 
 #: procedures the console may call: they describe the graph and the server, and change nothing
@@ -53,6 +55,12 @@ ALLOWED_PROCEDURES = frozenset(
         "dbms.showCurrentUser",
     }
 )
+#: the namespaces of Neo4j's own functions (``duration.between``, ``point.distance``); a dotted
+#: function of any other namespace is a plugin's, and the console calls none
+BUILT_IN_FUNCTION_NAMESPACES = frozenset(
+    {"date", "datetime", "localdatetime", "localtime", "time", "duration", "point", "vector"}
+    | {"db", "graph", "coll"}
+)
 #: rows counted at most (shown or not): past that the total is "at least"
 COUNTED = 100_000
 #: JavaScript's numbers hold integers exactly up to here; larger ones are sent as text
@@ -64,9 +72,13 @@ _ONLY_READS = "The console only reads the graph"
 
 _LOAD_CSV = re.compile(r"\bLOAD\s+CSV\b", re.IGNORECASE)
 _IN_TRANSACTIONS = re.compile(r"\bIN\s+(?:\d+\s+)?(?:CONCURRENT\s+)?TRANSACTIONS\b", re.I)
+#: what may lead a statement: EXPLAIN, PROFILE and query options (``CYPHER 5 runtime=slotted``)
+_LEADING_OPTIONS = re.compile(
+    r"^\s*(?:(?:EXPLAIN|PROFILE|CYPHER(?:\s+(?:\d+(?:\.\d+)?|\w+\s*=\s*\w+))*)\s+)*",
+    re.IGNORECASE,
+)
 _ADMIN_START = re.compile(
-    r"^\s*(?:(?:EXPLAIN|PROFILE)\s+)?"
-    r"(SHOW|TERMINATE|GRANT|DENY|REVOKE|ALTER|START|STOP|ENABLE|DRYRUN|RENAME)\b",
+    r"^(SHOW|TERMINATE|GRANT|DENY|REVOKE|ALTER|START|STOP|ENABLE|DRYRUN|RENAME)\b",
     re.IGNORECASE,
 )
 _ADMIN_OBJECT = re.compile(
@@ -115,6 +127,7 @@ class StatementResult:
 def refuse_text(statement: str) -> None:
     """Raise :class:`QueryRefused` for what the console never sends to Neo4j."""
     code = code_only(statement)
+    body = code[_LEADING_OPTIONS.match(code).end() :]
     if _LOAD_CSV.search(code):
         raise QueryRefused(f"{_ONLY_READS}: LOAD CSV (reading files and URLs) is refused.")
     if _IN_TRANSACTIONS.search(code):
@@ -122,13 +135,23 @@ def refuse_text(statement: str) -> None:
             f"{_ONLY_READS}, one transaction per statement: CALL {{ ... }} IN TRANSACTIONS "
             "is refused."
         )
-    if _ADMIN_START.search(code) or _ADMIN_OBJECT.search(code):
+    if _ADMIN_START.search(body) or _ADMIN_OBJECT.search(code):
         raise QueryRefused(
             f"{_ONLY_READS}: administration commands (SHOW, TERMINATE, users, roles, "
             "databases) are refused."
         )
-    if _USE.search(code):
+    if _USE.search(body):
         raise QueryRefused(f"{_ONLY_READS} of robotale's database: USE is refused.")
+    for before, name in dotted_calls(statement):
+        if before.upper() != "CALL" and not _built_in_function(name):
+            raise QueryRefused(
+                f"{_ONLY_READS}: the function {name} is not one of Neo4j's own, and a "
+                "plugin's functions are refused."
+            )
+
+
+def _built_in_function(name: str) -> bool:
+    return name.split(".", 1)[0].lower() in BUILT_IN_FUNCTION_NAMESPACES
 
 
 def checked_parameters(parameters: Mapping[str, Any] | None) -> dict[str, Any]:

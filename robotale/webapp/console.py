@@ -80,11 +80,19 @@ def login() -> Login:
     if not main.from_env:
         user, password = LocalServer().console_credentials()
         return Login(Settings(main.uri, user, password, False))
-    return Login(
-        main,
+    return Login(main, own_user_notice(main))
+
+
+def own_user_notice(main: Settings | None = None) -> str:
+    """How to give the console a reader of its own, when it would log in as robotale's own
+    user (a server of ``NEO4J_URI`` without ``ROBOTALE_CONSOLE_USER``); "" otherwise."""
+    main = main or settings()
+    if os.environ.get("ROBOTALE_CONSOLE_USER") or not main.from_env:
+        return ""
+    return (
         f"The console logs in as {main.user!r}, robotale's own user: on a server with roles, "
         "create a reader (CREATE USER console SET PASSWORD '…'; GRANT ROLE reader TO console) "
-        "and set ROBOTALE_CONSOLE_USER and ROBOTALE_CONSOLE_PASSWORD.",
+        "and set ROBOTALE_CONSOLE_USER and ROBOTALE_CONSOLE_PASSWORD."
     )
 
 

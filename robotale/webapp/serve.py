@@ -14,6 +14,7 @@ from flask import Flask
 from werkzeug.serving import BaseWSGIServer, make_server
 
 from robotale.errors import ServerError
+from robotale.webapp import console
 from robotale.webapp.app import create_app
 from robotale.webapp.settings import DEFAULT_HOST, DEFAULT_PORT
 from robotale.webapp.state import state
@@ -87,6 +88,8 @@ def serve_until_interrupted(dashboard: Dashboard, log: str | None = None) -> Non
             "to ROBOTALE_ALLOWED_HOSTS.",
             file=sys.stderr,
         )
+    if notice := console.own_user_notice():
+        print(notice, file=sys.stderr)
     try:
         dashboard.server.serve_forever()
     finally:

@@ -4,6 +4,7 @@ Also: a stopped server whose port something else answers on is not talked to."""
 
 from __future__ import annotations
 
+import json
 import os
 import re
 import signal
@@ -18,7 +19,8 @@ import pandas as pd
 import pytest
 from neo4j import GraphDatabase
 
-from robotale.ekg.server import LocalServer, free_port
+from robotale.ekg import server as server_module
+from robotale.ekg.server import CRASHED, LocalServer, PortInUse, free_port
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
 EVENTS = 150_000
@@ -133,3 +135,91 @@ def test_a_stopped_servers_port_answered_by_something_else(tmp_path, env):
             rf"port {bolt} on 127\.0\.0\.1 is held by (something else|\S+ \(pid {os.getpid()}\))"
         )
         assert re.search(holder, restart.stderr), restart.stderr
+
+
+def _crashed_record(server: LocalServer) -> tuple[int, int]:
+    """Record a server of ``server``'s home that crashed: its process is gone, it was never
+    stopped. Returns its bolt and http ports."""
+    gone = subprocess.run(
+        [sys.executable, "-c", "import os; print(os.getpid())"],
+        capture_output=True,
+        text=True,
+        check=True,
+    )
+    bolt, http_port = free_port(), free_port()
+    server.home.mkdir(parents=True, exist_ok=True)
+    record = {"pid": int(gone.stdout), "bolt_port": bolt, "http_port": http_port}
+    server.ports_file.write_text(json.dumps(record | {"stopped": False}))
+    assert server.condition().condition == CRASHED
+    return bolt, http_port
+
+
+def test_start_after_a_crash_waits_for_its_port_and_says_why_it_gave_up(tmp_path, monkeypatch):
+    server = LocalServer(tmp_path)
+    bolt, _ = _crashed_record(server)
+    lines: list[str] = []
+    # Bound but not listening, as a dead server's socket the kernel has not let go of yet:
+    # the port is not free, and nothing answers there.
+    with socket.socket() as lingering:
+        lingering.bind(("127.0.0.1", bolt))
+        monkeypatch.setattr(server_module, "PORT_WAIT", 3.0)
+        with pytest.raises(PortInUse) as refused:
+            server.start(progress=lines.append)
+    assert lines, "no progress line while waiting"
+    for line in lines:
+        assert re.fullmatch(
+            rf"Waiting for the bolt port {bolt} to be free \(\d+ s left\) \.\.\.", line
+        )
+    message = str(refused.value)
+    assert message.startswith(
+        f"The bolt port {bolt} on 127.0.0.1 of the last local Neo4j was still not free after 3 s"
+    )
+    assert "\n" not in message and "--bolt-port" in message
+    assert server.running() is None
+
+
+@pytest.mark.slow
+def test_start_after_a_crash_waits_with_a_progress_line_until_its_port_is_free(tmp_path, env):
+    server = LocalServer(tmp_path / "home")
+    bolt, _ = _crashed_record(server)
+    # Holds the port (bound, not listening) until its stdin closes.
+    holder = subprocess.Popen(
+        [
+            sys.executable,
+            "-c",
+            "import socket, sys\n"
+            f"s = socket.socket(); s.bind(('127.0.0.1', {bolt})); print('held', flush=True)\n"
+            "sys.stdin.read()",
+        ],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    assert holder.stdout.readline().strip() == "held"
+    start = subprocess.Popen(
+        [*ROBOTALE, "neo4j", "start"],
+        env=env,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        waiting = start.stderr.readline()
+        assert f"Waiting for the bolt port {bolt} to be free" in waiting, waiting
+        holder.stdin.close()  # the port is let go of while start waits for it
+        out, error = start.communicate(timeout=300)
+        assert start.returncode == 0, error
+        assert "The local Neo4j had crashed; starting it again." in out
+        assert f"is running at bolt://127.0.0.1:{bolt}" in out
+        status = subprocess.run(
+            [*ROBOTALE, "neo4j", "status"], env=env, capture_output=True, text=True, timeout=60
+        )
+        assert status.returncode == 0, status.stdout
+    finally:
+        if holder.stdin and not holder.stdin.closed:
+            holder.stdin.close()
+        holder.wait(timeout=30)
+        if start.poll() is None:
+            start.kill()
+            start.wait()
+        subprocess.run([*ROBOTALE, "neo4j", "stop"], env=env, capture_output=True, timeout=300)

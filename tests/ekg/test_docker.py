@@ -3,10 +3,14 @@
 from __future__ import annotations
 
 import fnmatch
+import http.client
+import json
 import os
 import re
 import shutil
 import subprocess
+import sys
+import time
 from pathlib import Path
 
 import yaml
@@ -75,3 +79,54 @@ def test_dockerfile_copies_only_what_exists_and_is_not_ignored():
     words = command.replace('"', "").split(", ")
     assert words[0] == "waitress-serve" and words[-1] == "robotale.webapp:create_app"
     assert "--call" in words and "--listen=0.0.0.0:5000" in words
+
+
+def _image_command() -> list[str]:
+    dockerfile = (REPO / "Dockerfile").read_text()
+    return json.loads(re.search(r"^CMD (\[.*\])$", dockerfile, re.M).group(1))
+
+
+def _get(port: int, path: str, host: str) -> http.client.HTTPResponse:
+    connection = http.client.HTTPConnection("127.0.0.1", port, timeout=30)
+    connection.request("GET", path, headers={"Host": host})
+    response = connection.getresponse()
+    response.read()
+    connection.close()
+    return response
+
+
+def test_the_images_command_serves_the_dashboard_with_waitress(tmp_path):
+    from robotale.ekg.server import free_port
+
+    port = free_port()
+    command = [
+        f"--listen=127.0.0.1:{port}" if word.startswith("--listen=") else word
+        for word in _image_command()
+    ]
+    command[0] = str(Path(sys.executable).with_name(command[0]))  # the venv's waitress-serve
+    environment = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")} | {
+        "ROBOTALE_HOME": str(tmp_path),
+        "ROBOTALE_ALLOWED_HOSTS": "dash.example",
+    }
+    served = subprocess.Popen(command, env=environment, stderr=subprocess.PIPE, text=True)
+    try:
+        deadline = time.monotonic() + 120
+        while True:
+            try:
+                response = _get(port, "/static/js/common.js", f"127.0.0.1:{port}")
+                break
+            except OSError:
+                assert served.poll() is None, served.communicate()[1]
+                assert time.monotonic() < deadline, "waitress did not answer"
+                time.sleep(0.5)
+        assert response.status == 200
+        assert response.getheader("Server") == "waitress"  # not werkzeug's development server
+        assert _get(port, "/static/js/common.js", "dash.example").status == 200
+        refused = _get(port, "/static/js/common.js", "attacker.example")
+        assert refused.status == 403
+        page = _get(port, "/cypher", f"localhost:{port}")
+        assert "script-src 'self'" in page.getheader("Content-Security-Policy")
+        assert page.getheader("X-Frame-Options") == "DENY"
+    finally:
+        served.terminate()
+        served.wait(timeout=30)

@@ -143,6 +143,8 @@ def test_robotale_serve_answers(neo4j_server, tmp_path):
         process.terminate()
         _, stderr = process.communicate(timeout=20)
     assert f"robotale dashboard at http://127.0.0.1:{port}/discover?log=agri+runs" in stderr
+    # NEO4J_URI names the server: the console would log in as robotale's own user
+    assert "ROBOTALE_CONSOLE_USER and ROBOTALE_CONSOLE_PASSWORD" in stderr
 
 
 def _wait_for(url: str, process: subprocess.Popen, timeout: float = 60) -> str:
@@ -152,7 +154,7 @@ def _wait_for(url: str, process: subprocess.Popen, timeout: float = 60) -> str:
         try:
             with urllib.request.urlopen(url, timeout=5) as response:
                 return response.read().decode()
-        except (urllib.error.URLError, ConnectionError):
+        except OSError:  # not listening yet, or too busy to answer within 5 s
             time.sleep(0.3)
     raise AssertionError(f"{url} did not answer within {timeout} s")
 

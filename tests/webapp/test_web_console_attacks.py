@@ -8,14 +8,22 @@ import http.server
 import json
 import os
 import resource
+import stat
 import threading
 import time
 import uuid
 from collections.abc import Iterator
+from pathlib import Path
 
 import pytest
 
-from robotale.ekg.server import create_console_user, security_settings
+from robotale.ekg import readonly
+from robotale.ekg.server import (
+    CONSOLE_USER,
+    LocalServer,
+    create_console_user,
+    security_settings,
+)
 from robotale.webapp import console
 
 #: the session's Neo4j is robotale's local server unless the run was pointed at another
@@ -102,6 +110,11 @@ def test_load_csv_fetches_no_loopback_service(client, loopback_service):
         "ALTER USER neo4j SET PASSWORD 'secret-secret'",
         "STOP DATABASE neo4j",
         "GRANT ROLE admin TO mallory",
+        # behind the query options that may lead a statement
+        "CYPHER 5 SHOW USERS",
+        "cypher runtime = slotted SHOW TRANSACTIONS YIELD currentQuery RETURN currentQuery",
+        "PROFILE CYPHER 5 planner=cost TERMINATE TRANSACTIONS 'neo4j-transaction-1'",
+        "CYPHER 5 USE system SHOW USERS",
     ],
 )
 def test_administration_commands_are_refused(client, query):
@@ -118,11 +131,58 @@ def test_administration_commands_are_refused(client, query):
         "CALL `db`.`clearQueryCaches`()",
         "call db.clearQueryCaches",
         "MATCH (n) WITH count(n) AS c CALL dbms.listConnections() YIELD connectionId RETURN *",
+        "CYPHER 5 CALL dbms.listConfig() YIELD name RETURN name",
     ],
 )
 def test_procedures_outside_the_allow_list_are_refused(client, query):
     message = refused(run(client, query))
     assert message.startswith(f"{ONLY_READS} the graph: the procedure "), message
+
+
+@pytest.mark.parametrize(
+    "query",
+    [
+        # APOC's functions run the Cypher they are given as text: LOAD CSV inside a string
+        "RETURN apoc.cypher.runFirstColumnSingle('LOAD CSV FROM $url AS l RETURN l', "
+        "{url: $url}) AS line",
+        "RETURN `apoc`.`cypher`.runFirstColumnMany($text, {url: $url}) AS lines",
+        "MATCH (n) WITH count(n) AS c RETURN apoc . util . md5([c]) AS hash",
+        "RETURN [x IN [1] | mine.secret(x)] AS values",
+    ],
+)
+def test_functions_of_plugins_are_refused(client, loopback_service, query):
+    text = "LOAD CSV FROM $url AS l RETURN l"
+    response = run(client, query, {"url": loopback_service["url"], "text": text})
+    message = refused(response)
+    assert message.startswith(f"{ONLY_READS} the graph: the function "), message
+    assert "is not one of Neo4j's own" in message
+    assert loopback_service["hits"] == 0
+
+
+def test_neo4j_own_dotted_functions_still_run(client):
+    response = run(
+        client,
+        "RETURN duration.between(date('2024-01-01'), date('2024-01-03')).days AS days, "
+        "point.distance(point({x: 0, y: 0}), point({x: 3, y: 4})) AS distance, "
+        "date.truncate('month', date('2024-05-17')) AS month",
+    )
+    assert response.status_code == 200, response.get_data(as_text=True)
+    assert response.json["results"][0]["rows"] == [[2, 5.0, "2024-05-01"]]
+
+
+def test_a_read_behind_query_options_still_runs(client):
+    response = run(client, "CYPHER 5 runtime=slotted UNWIND [1, 2] AS i RETURN sum(i) AS total")
+    assert response.status_code == 200, response.get_data(as_text=True)
+    assert response.json["results"][0]["rows"] == [[3]]
+
+
+def test_every_dotted_function_neo4j_lists_as_its_own_is_allowed(neo4j_driver):
+    records, _, _ = neo4j_driver.execute_query(
+        "SHOW FUNCTIONS YIELD name, isBuiltIn WHERE isBuiltIn AND name CONTAINS '.' RETURN name"
+    )
+    namespaces = {record["name"].split(".")[0].lower() for record in records}
+    assert {"duration", "point", "datetime"} <= namespaces
+    assert namespaces <= readonly.BUILT_IN_FUNCTION_NAMESPACES
 
 
 def test_allowed_procedures_answer_as_neo4j_does(client, neo4j_driver, log_name):
@@ -233,6 +293,48 @@ def test_the_console_logs_in_as_its_own_user(client, neo4j_driver, monkeypatch):
         neo4j_driver.execute_query("DROP USER $user", user=user, database_="system")
 
 
+def _session_server_home(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """The robotale home of the local server this test session started."""
+    for root in tmp_path_factory.getbasetemp().glob("robotale-home*"):
+        running = LocalServer(root).running()
+        if running is not None and running.bolt_uri == os.environ["NEO4J_URI"]:
+            return root
+    raise AssertionError("the session's local server was not found")
+
+
+def test_the_local_server_gives_the_console_a_user_of_its_own(
+    client, neo4j_driver, monkeypatch, tmp_path_factory
+):
+    if not LOCAL_SERVER:
+        pytest.skip("the tests run against a server robotale did not start")
+    home = _session_server_home(tmp_path_factory)
+    for name in ("NEO4J_URI", "NEO4J_USER", "NEO4J_PASSWORD", "ROBOTALE_CONSOLE_USER"):
+        monkeypatch.delenv(name, raising=False)
+    monkeypatch.setenv("ROBOTALE_HOME", str(home))  # robotale's own server, as after `start`
+    server = LocalServer()
+    server.console_password_file.unlink(missing_ok=True)
+    try:
+        for _ in range(2):  # created by the first request, logged in as by the second
+            response = run(client, "CALL dbms.showCurrentUser() YIELD username RETURN username")
+            assert response.json["results"][0]["rows"] == [[CONSOLE_USER]]
+        assert stat.S_IMODE(server.console_password_file.stat().st_mode) == 0o600
+        users, _, _ = neo4j_driver.execute_query(
+            "SHOW USERS YIELD user WHERE user = $user RETURN user",
+            user=CONSOLE_USER,
+            database_="system",
+        )
+        assert [record["user"] for record in users] == [CONSOLE_USER]
+        assert "GRANT ROLE reader" not in client.get("/cypher").get_data(as_text=True)
+        assert "LOAD CSV" in refused(
+            run(client, "LOAD CSV FROM 'file:///etc/passwd' AS l RETURN l")
+        )
+    finally:
+        server.console_password_file.unlink(missing_ok=True)
+        neo4j_driver.execute_query(
+            "DROP USER $user IF EXISTS", user=CONSOLE_USER, database_="system"
+        )
+
+
 def test_with_robotales_own_user_the_page_says_how_to_give_it_a_reader(client, monkeypatch):
     monkeypatch.delenv("ROBOTALE_CONSOLE_USER", raising=False)
     page = client.get("/cypher").get_data(as_text=True)
@@ -252,3 +354,42 @@ def test_the_local_server_caps_a_transaction_and_reads_no_file_urls(neo4j_driver
     values = {record["name"]: record["value"] for record in records}
     assert values["dbms.security.allow_csv_import_from_file_urls"] == "false"
     assert values["db.memory.transaction.max"] != "0B"
+
+
+@pytest.mark.slow
+def test_with_apoc_installed_cypher_given_as_text_reads_no_url(
+    neo4j_server, tmp_path, loopback_service
+):
+    """APOC's functions run Cypher handed to them as a string, where the text check sees no
+    LOAD CSV and the plan shows none: on a server with APOC that fetches a loopback service
+    even in a READ transaction. The console refuses the function."""
+    from neo4j import READ_ACCESS, GraphDatabase
+
+    from robotale.ekg import jars
+    from robotale.ekg.readonly import QueryRefused, run_read_only
+    from robotale.ekg.server import ServerOptions, free_port
+
+    plugins = tmp_path / "plugins"
+    plugins.mkdir()
+    for jar in jars.apoc_with_file_access():  # APOC opens URLs with what these bring
+        (plugins / jar.name).symlink_to(jar)
+    server = LocalServer(tmp_path / "home")
+    options = ServerOptions(free_port(), free_port(), "512m", "64m", plugins)
+    running = server.start(options)
+    attack = (
+        "RETURN apoc.cypher.runFirstColumnSingle('LOAD CSV FROM $url AS l RETURN l', "
+        "{url: $url}) AS line"
+    )
+    url = loopback_service["url"]
+    try:
+        auth = ("neo4j", server.password() or "")
+        with GraphDatabase.driver(running.bolt_uri, auth=auth) as driver:
+            # The threat is real: without the console's check the service is read.
+            with driver.session(default_access_mode=READ_ACCESS) as session:
+                line = session.run(attack, url=url).single()["line"]
+            assert line == ["secret"] and loopback_service["hits"] == 1
+            with pytest.raises(QueryRefused, match=r"function apoc\.cypher\.runFirstColumnSingle"):
+                run_read_only(driver, attack, {"url": url}, database="neo4j")
+            assert loopback_service["hits"] == 1
+    finally:
+        server.stop()

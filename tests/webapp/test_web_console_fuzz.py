@@ -1,11 +1,14 @@
 """Fuzz the console's JSON encoder (hypothesis): any value Neo4j can hand back becomes strict
 JSON (no NaN or Infinity tokens, integers a browser holds exactly), both as a Python value and
-after a round trip through the session's real Neo4j."""
+after a round trip through the session's real Neo4j.
+
+A few hundred examples per run; `make fuzz` runs many more (ROBOTALE_FUZZ_EXAMPLES)."""
 
 from __future__ import annotations
 
 import json
 import math
+import os
 from typing import Any
 
 import pytest
@@ -53,7 +56,7 @@ def strict(text: str) -> Any:
 
 
 @given(VALUES | st.binary(max_size=20))
-@settings(max_examples=400)
+@settings(max_examples=int(os.environ.get("ROBOTALE_FUZZ_EXAMPLES", "400")))
 def test_any_value_becomes_strict_json(value):
     encoded = json.dumps(console.cell(value), allow_nan=False)
     decoded = strict(encoded)
@@ -65,7 +68,7 @@ def test_any_value_becomes_strict_json(value):
 
 @given(VALUES)
 @settings(
-    max_examples=150,
+    max_examples=int(os.environ.get("ROBOTALE_FUZZ_EXAMPLES", "150")),
     deadline=None,
     suppress_health_check=[HealthCheck.function_scoped_fixture, HealthCheck.too_slow],
 )

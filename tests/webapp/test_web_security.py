@@ -13,7 +13,7 @@ from lxml import etree, html
 from robotale.webapp import create_app
 from robotale.webapp.settings import WebSettings
 
-PAGES = ["/logs", "/discover", "/perspectives", "/model", "/cypher"]
+PAGES = ["/findings", "/logs", "/discover", "/perspectives", "/timeline", "/model", "/cypher"]
 XHTML = "http://www.w3.org/1999/xhtml"
 
 
