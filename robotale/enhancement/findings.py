@@ -23,7 +23,7 @@ import pandas as pd
 
 from robotale.discovery.graph import json_ready
 from robotale.enhancement.battery import battery_perspective
-from robotale.enhancement.bottlenecks import find_bottlenecks
+from robotale.enhancement.bottlenecks import ALPHA, find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
 from robotale.enhancement.context import LogAnalysis
 from robotale.enhancement.performance import ARROW, performance_perspective
@@ -32,8 +32,6 @@ from robotale.eventlog.schema import ROBOT, X, Y
 
 #: how many variants and bottlenecks an answer names
 MAIN = 3
-#: a case-duration effect with a p-value at least this large may be chance
-ALPHA = 0.05
 
 
 @dataclass(slots=True)
@@ -335,7 +333,8 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         return answer
     affected = sorted(lows["case"].astype(str).unique()) if "case" in lows else []
     answer.facts["runs_with_low_battery"] = len(affected)
-    first = lows.iloc[0]
+    # the earliest moment, not the first row: runs numbered 1..12 sort "10" before "4"
+    first = lows.sort_values("time", kind="stable").iloc[0] if "time" in lows else lows.iloc[0]
     answer.sentences.append(
         f"{_count(len(lows), 'low-battery moment')} in {len(affected)} of {len(runs)} runs; "
         f"the first: {_who(first)}run {first['case']} at {_clock(first['time'])}"

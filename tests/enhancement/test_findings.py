@@ -59,18 +59,18 @@ def test_sequence(logged):
     # the runs with the refill are the most common variant; the others differ by not having it
     refill_runs = _variants()[sorted(mission.REFILL_RUNS)]
     assert refill_runs.nunique() == 1 and counts.index[0] == refill_runs.iloc[0]
-    assert "without refill" in answer.sentences[1]
+    assert f"without {mission.REFILL}" in answer.sentences[1]
 
 
 def test_the_injected_bottleneck_comes_first(logged):
     _, findings = logged
     answer = findings.answer("delays")
     first = answer.facts["bottlenecks"][0]
-    assert (first["activity"], first["robot"]) == ("refill", "tractor_1")
+    assert (first["activity"], first["robot"]) == (mission.REFILL, "tractor_1")
     assert first["runs"] == len(mission.REFILL_RUNS)
-    assert "refill" in answer.sentences[0] and "tractor_1" in answer.sentences[0]
+    assert mission.REFILL in answer.sentences[0] and "tractor_1" in answer.sentences[0]
     node = answer.evidence[0]
-    assert (node["kind"], node["activity"], node["robot"]) == ("node", "refill", "tractor_1")
+    assert (node["kind"], node["activity"], node["robot"]) == ("node", mission.REFILL, "tractor_1")
     durations = _durations()
     slowest = next(e for e in answer.evidence if e["kind"] == "timeline")
     assert slowest["case"] == durations.idxmax()
