@@ -127,6 +127,8 @@ KINDS = ("start", "complete", "instant", "sample")
 OUTCOMES = (schema.ABORTED, schema.CANCELLED)
 #: a dropped row's lines are listed up to this many.
 SHOWN_LINES = 5
+#: the pause offered as the end of a session when a log without cases spans several days
+SESSION_GAP = "1h"
 
 
 @dataclass
@@ -153,6 +155,9 @@ class Reading:
     #: decisions worth knowing that are not problems
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    #: the case gap offered for a log without a case column that spans several days (its runs
+    #: are then sessions apart, and one case would count the nights as waiting); else None
+    session_gap: str | None = None
 
     @property
     def kept(self) -> int:
@@ -503,8 +508,8 @@ def days_warning(path: Path, log: pd.DataFrame) -> list[str]:
         return []
     return [
         f"{path.name} has no case column and spans {len(days)} days ({days[0]} to {days[-1]}), "
-        "so it is read as one case: --case-gap 1h starts a new case after every pause of an "
-        "hour or more (or name the column that tells runs apart)."
+        f"so it is read as one case: --case-gap {SESSION_GAP} starts a new case after every "
+        "pause of an hour or more (or name the column that tells runs apart)."
     ]
 
 
