@@ -162,6 +162,7 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
     if not bottlenecks.has_data:
         answer.sentences.append(_sentence(bottlenecks.message))
         return answer
+    _one_run_of_days(runs, answer)
     ranking = trusted_first(bottlenecks.table).head(MAIN)
     answer.facts["bottlenecks"] = [
         {
@@ -194,6 +195,23 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
             f"Between activities the robots wait {share:.0%} of their time in the runs."
         )
     return answer
+
+
+def _one_run_of_days(runs: pd.DataFrame, answer: Answer) -> None:
+    """A log read as one run that lasts several days (no case column) counts the nights
+    between its sessions as waiting: the answer says so before its ranking."""
+    if len(runs) != 1 or not {"start", "end"} <= set(runs.columns):
+        return
+    start, end = pd.Timestamp(runs["start"].iloc[0]), pd.Timestamp(runs["end"].iloc[0])
+    days = (end.normalize() - start.normalize()).days + 1
+    if days < 2:
+        return
+    answer.facts["one_run_days"] = days
+    answer.sentences.append(
+        f"The log is one run of {days} days ({start:%Y-%m-%d} to {end:%Y-%m-%d}), so the "
+        "pauses between its sessions count as waiting below: split it into runs "
+        "(--case-gap 1h, or Split into runs when uploading it)."
+    )
 
 
 def trusted_first(ranking: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:

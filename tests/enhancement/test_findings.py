@@ -192,6 +192,20 @@ def test_thesis_log_split_into_days(thesis_csv):
     messages = findings.answer("messages")
     sends = log[log["concept:name"].astype(str).str.endswith("!")]
     assert messages.facts["messages"] == sends["msg_id"].nunique()
+    assert "one_run_days" not in findings.answer("delays").facts
+
+
+def test_thesis_log_read_as_one_run_says_its_nights_count_as_waiting(thesis_csv):
+    """Without a case gap the five days are one run: the delays answer says so first."""
+    times = pd.to_datetime(pd.read_csv(thesis_csv)["time"], format="ISO8601")
+    days = (times.max().normalize() - times.min().normalize()).days + 1
+    delays = find(read_log(thesis_csv)).answer("delays")
+    assert delays.facts["one_run_days"] == days == 5
+    assert delays.sentences[0].startswith(
+        f"The log is one run of {days} days ({times.min():%Y-%m-%d} to {times.max():%Y-%m-%d})"
+    )
+    assert "--case-gap 1h" in delays.sentences[0]
+    assert delays.sentences[1].startswith("1. ")
 
 
 def test_a_log_without_a_robot_column(thesis_csv):
