@@ -166,6 +166,17 @@ def test_a_log_without_battery_or_model_says_so(page, stranger_log):
     expect(page.locator("#model-picker option")).to_have_text(["none binds this log"])
 
 
+def test_the_model_page_offers_only_models_that_bind_the_robots(client, mission_log):
+    """The mission's drone and tractors are the pools of the shipped agri mission; the
+    rexdingo mission's pools (rex, dingo) bind none of them."""
+    import re
+
+    page = client.get(f"/model?log={mission_log}").get_data(as_text=True)
+    offered = re.findall(r'<option value="\w+"[^>]*>([^<(]+) \(', page)
+    assert [name.strip() for name in offered] == ["agri.bpmn"]
+    assert "rexdingo.bpmn" not in page and "none binds this log" not in page
+
+
 # -- the console's analyst questions -----------------------------------------------------------
 
 
