@@ -27,6 +27,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from robotale.errors import InputError
@@ -480,26 +481,41 @@ def _looks_like_id(column: str) -> bool:
     return name.endswith("id") and len(name) > 2 and not name.startswith("case:")
 
 
-def pairs_found(log: pd.DataFrame) -> bool:
-    """Whether some start has a complete of the same case, robot, activity and pairing key."""
+def paired_seconds(log: pd.DataFrame) -> pd.Series:
+    """The seconds from each start to the completion it pairs with: within the same case,
+    robot, activity and pairing key, the n-th start with the n-th completion (a rough pairing,
+    enough to tell whether any activity lasts at all)."""
     keys = [c for c in (schema.CASE, schema.ROBOT, schema.ACTIVITY) if c in log.columns]
     if schema.EXECUTION_ID in log.columns:
         keys.append(schema.EXECUTION_ID)
+    # one integer per group, so the pairs are matched on numbers, not on names
+    group = np.zeros(len(log), dtype=np.int64)
+    for key in keys:
+        codes, uniques = pd.factorize(log[key], use_na_sentinel=False)
+        group, _ = pd.factorize(group * (len(uniques) + 1) + codes)
     lifecycle = log[schema.LIFECYCLE]
-    flags = pd.DataFrame(
-        {"start": lifecycle == schema.START, "complete": lifecycle == schema.COMPLETE}
-    )
-    both = flags.groupby([log[k].fillna("") for k in keys]).any()
-    return bool((both["start"] & both["complete"]).any())
+    ends = []
+    for kind in (schema.START, schema.COMPLETE):
+        chosen = (lifecycle == kind).fillna(False).to_numpy(bool)
+        rows = pd.DataFrame({"_g": group[chosen], "_t": log[schema.TIMESTAMP].array[chosen]})
+        ends.append(rows.assign(_n=rows.groupby("_g", sort=False).cumcount()))
+    pairs = ends[0].merge(ends[1], on=["_g", "_n"], suffixes=("_start", "_end"))
+    return (pairs["_t_end"] - pairs["_t_start"]).dt.total_seconds()
 
 
 def no_pairs_warning(log: pd.DataFrame) -> list[str]:
-    if pairs_found(log):
-        return []
-    return [
-        "No start/complete pairs found: every activity lasts 0 s (map the column that says "
-        "start and complete with --map COLUMN=lifecycle if there is one)."
-    ]
+    seconds = paired_seconds(log)
+    if seconds.empty:
+        return [
+            "No start/complete pairs found: every activity lasts 0 s (map the column that says "
+            "start and complete with --map COLUMN=lifecycle if there is one)."
+        ]
+    if (seconds == 0).all():
+        return [
+            f"Every one of the {len(seconds):,} start/complete pairs has one time for both: "
+            "every activity lasts 0 s (are the starts stamped with the completion's time?)."
+        ]
+    return []
 
 
 def days_warning(path: Path, log: pd.DataFrame) -> list[str]:
