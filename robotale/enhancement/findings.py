@@ -427,9 +427,26 @@ def _message_example(kind: str, row: pd.Series, communication: Perspective) -> s
         how = f"under the new id {new}" if new else "under the same id"
         return f"Resent, for example: {where}, {how}."
     lost = communication.tables.get("lost", pd.DataFrame())
-    then = lost.loc[lost["msg_id"] == row["msg_id"], "then"] if "then" in lost else pd.Series()
-    followed = f"; then the sender did {then.iloc[0]}" if len(then) and _value(then.iloc[0]) else ""
-    return f"Lost, for example: {where}, sent at {_clock(row['sent_at'])}{followed}."
+    # the lost table's row of this message (by the keys it has: a log may lack the case)
+    keys = [key for key in ("case", "msg_id") if key in lost.columns and key in row.index]
+    mine = lost[(lost[keys] == row[keys]).all(axis=1)] if keys else lost.iloc[:0]
+    then = _value(mine["then"].iloc[0]) if "then" in mine and len(mine) else None
+    followed = f"; then the sender did {then}" if then else ""
+    return (
+        f"Lost, for example: {where}, sent at {_clock(row['sent_at'])}{followed}"
+        f"{_ended_later(mine)}."
+    )
+
+
+def _ended_later(lost: pd.DataFrame) -> str:
+    """How much later a lost message's run ended than the median run without one."""
+    later = _value(lost["ended_later_by"].iloc[0]) if "ended_later_by" in lost else None
+    if later is None or not len(lost):
+        return ""
+    if later == 0:
+        return "; its run took as long as the median run without a lost message"
+    how = "longer" if later > 0 else "shorter"
+    return f"; its run took {seconds_text(abs(later))} {how} than the median run without one"
 
 
 def _timeline(row: pd.Series, label: str) -> dict[str, Any]:

@@ -139,6 +139,13 @@ def test_messages(logged):
     assert f"after {seconds_text(mission.DELAYED_LATENCY)}" in examples["Delayed"]
     first_lost = lost.sort_values("case").iloc[0]
     assert first_lost["msg_id"] in examples["Lost"]
+    durations = _durations()
+    calm = durations[~durations.index.isin(lost["case"])].median()
+    shorter = calm - durations[first_lost["case"]]  # the refill runs make the calm ones long
+    assert shorter > 0
+    assert examples["Lost"].endswith(
+        f"; its run took {seconds_text(shorter)} shorter than the median run without one."
+    )
     assert f"under the new id {resent.sort_values('case').iloc[0]['msg_id']}" in examples["Resent"]
     cases = [e["case"] for e in answer.evidence]
     assert cases == [delayed_row["case"], first_lost["case"], first_lost["case"]]
