@@ -558,6 +558,12 @@ def format_reading(reading: Reading, *, short: bool = False) -> str:
     return "\n".join(lines)
 
 
+def marker_listing() -> str:
+    """The markers read as no value, in words: 'empty cells and null, NULL, None ...'."""
+    shown = sorted((m for m in MISSING_MARKERS if m), key=lambda m: (m.lower(), m))
+    return "empty cells and " + ", ".join(shown)
+
+
 def _details(reading: Reading) -> list[str]:
     width = max((len(column) for column in reading.columns), default=0)
     columns = [f"    {column:<{width}} -> {role}" for column, role in reading.columns.items()]
@@ -575,6 +581,7 @@ def _details(reading: Reading) -> list[str]:
         f"  events:    {events}",
         f"  lifecycle: {reading.lifecycle}; pairs {reading.pairing}",
         f"  missing:   {missing or '-'}",
+        f"  no value:  {marker_listing()}",
         f"  rows:      {reading.rows:,} read, {reading.kept:,} kept, "
         f"{reading.rows - reading.kept:,} dropped",
     ]
