@@ -440,8 +440,10 @@ def _message_example(kind: str, row: pd.Series, communication: Perspective) -> s
 
 def _ended_later(lost: pd.DataFrame) -> str:
     """How much later a lost message's run ended than the median run without one."""
-    later = _value(lost["ended_later_by"].iloc[0]) if "ended_later_by" in lost else None
-    if later is None or not len(lost):
+    if "ended_later_by" not in lost or lost.empty:
+        return ""
+    later = _value(lost["ended_later_by"].iloc[0])
+    if later is None:
         return ""
     if later == 0:
         return "; its run took as long as the median run without a lost message"
