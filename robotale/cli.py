@@ -660,6 +660,13 @@ def _add_perspectives(commands: argparse._SubParsersAction) -> None:
         metavar="PERCENT",
         help="battery level counted as low (default: 20)",
     )
+    perspectives.add_argument(
+        "--delay",
+        type=float,
+        metavar="SECONDS",
+        help="a message is delayed when its latency is above this (default: above its "
+        "channel's own 95th percentile)",
+    )
     _handled_by(perspectives, "perspectives.perspectives_command")
 
 

@@ -15,8 +15,12 @@ writes it, so a test can read the file back and compare with the truth:
   pairing key, and ``null``, ``-``, ``N/A``, ``None``, ``NaN`` and empty cells for no value;
   its battery is on the events, not in samples.
 
-The thesis' own CSV (``examples/thesis/robotic_data.csv``) is the fourth convention; it is a
-real recording, so its truth is counted from the file itself in the tests.
+- :func:`write_thesis_csv`: the thesis' own CSV (``examples/thesis/robotic_data.csv``): no
+  case column (runs are hours apart, so ``--case-gap 1h`` tells them apart), ``resource`` for
+  the robot, ``msg_role`` on message events, a position on every event, times at +01:00, no
+  battery and no samples.
+
+The thesis' real recording is read as well in the tests; its truth is counted from the file.
 """
 
 from __future__ import annotations
@@ -320,6 +324,40 @@ def write_robot_id_csv(truth: GroundTruth, path: Path) -> Path:
                 event.get("sender", "-"),
                 event.get("receiver", ""),
                 missing if number % 3 == 2 else reading,
+            ]
+        )
+    return _write_csv(path, header, rows)
+
+
+#: where each robot is on every event of :func:`write_thesis_csv` (x, y, z)
+THESIS_POSITIONS = {
+    "drone": (2.0, 8.0, 1.5),
+    "tractor_1": (1.0, 1.0, 0.0),
+    "tractor_2": (9.0, 1.0, 0.0),
+}
+
+
+def write_thesis_csv(truth: GroundTruth, path: Path) -> Path:
+    """The thesis' CSV: one file of all runs without a case column, every event a start or a
+    complete (an instant event a lone complete), as its recorder writes them."""
+    header = ["time", "activity", "lifecycle", "msg_id", "msg_payload", "msg_role"]
+    header += ["x", "y", "z", "field", "resource", "event_id"]
+    rows = []
+    events = [e for e in truth.events() if e["lifecycle"] != "sample"]
+    for number, event in enumerate(sorted(events, key=lambda e: (e["time"], e["order"]))):
+        message = event.get("msg_id")
+        rows.append(
+            [
+                event["time"].tz_convert("+01:00").isoformat(timespec="milliseconds"),
+                event["activity"],
+                "complete" if event["lifecycle"] == "none" else event["lifecycle"],
+                message or "",
+                "weed at 3,4" if message else "",
+                event.get("role", ""),
+                *THESIS_POSITIONS[event["robot"]],
+                "f1",
+                event["robot"],
+                f"e{number}",
             ]
         )
     return _write_csv(path, header, rows)

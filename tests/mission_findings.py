@@ -4,8 +4,11 @@
 The injections (every expected answer is counted from this truth in the tests, never taken
 from the code under test):
 
-- **bottleneck**: in :data:`REFILL_RUNS` tractor_1 refills for :data:`REFILL_SECONDS` before it
-  moves to the weed, and those runs end that much later (so they are also the second variant);
+- **bottleneck**: in :data:`REFILL_RUNS` (a third of the runs) tractor_1 waits for a refill
+  (:data:`REFILL`, an optional waiting activity) for :data:`REFILL_SECONDS` before it moves to
+  the weed, and those runs end that much later (so they are also the most common variant). Its
+  name says it waits, as does tractor_2's ``wait`` of every run: only the measured effect may
+  rank it first;
 - **delayed message**: in run :data:`DELAYED_RUN` the second weed position reaches tractor_1
   after :data:`DELAYED_LATENCY` seconds instead of 1.5 (the last to tractor_1, so nothing
   sent after it can pass for a resend);
@@ -29,6 +32,7 @@ from conventions import GroundTruth, RunWriter, Sample
 RUNS = [f"run{n:02d}" for n in range(1, 13)]
 REFILL_RUNS = {"run02", "run05", "run08", "run11"}
 REFILL_SECONDS = 300.0
+REFILL = "wait_for_refill"
 DELAYED_RUN = "run07"
 DELAYED_LATENCY = 30.0
 LOST_RUNS = {"run03", "run09"}
@@ -66,7 +70,7 @@ def _run(truth: GroundTruth, case: str, begin: pd.Timestamp) -> None:
     else:
         message(3, "tractor_2", 44, 46.5)
     if refill:
-        instance("tractor_1", "refill", 52, 52 + refill)
+        instance("tractor_1", REFILL, 52, 52 + refill)
     instance("tractor_1", "move_to_weed", 53 + refill, 80 + refill)
     instance("tractor_2", "move_to_weed", 48, 70)
     land = 90.0  # the drone's own work never waits for tractor_1's refill

@@ -24,17 +24,20 @@ def perspectives_command(
     robot: str | None = None,
     field: str | None = None,
     threshold: float | None = None,
+    delay: float | None = None,
 ) -> int:
     """The perspectives of a log (a file or ``log_name``) as HTML (``out``) and/or JSON."""
     if not out and not json_out:
         raise InputError("say where the report goes: --out report.html and/or --json report.json.")
     if threshold is not None:
         require_range(threshold, "--threshold", 0, 100, unit=" percent")
+    if delay is not None:
+        require_range(delay, "--delay", 0, unit=" seconds")
     area = Field.parse(field) if field else None
     events = read_event_log(
         log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
     )
-    options = {} if threshold is None else {"threshold": threshold}
+    options = {"delay_threshold": delay} | ({} if threshold is None else {"threshold": threshold})
     results = all_perspectives(events, activity=activity, robot=robot, field=area, **options)
     title = f"robotale perspectives: {log_name or Path(log or '').name}"
     write_report(results, html_path=out, json_path=json_out, title=title)

@@ -150,19 +150,48 @@ def case_energy(levels: pd.DataFrame) -> pd.DataFrame:
 
 def _fill_levels(instances: pd.DataFrame, levels: pd.DataFrame) -> pd.DataFrame:
     """Levels at an instance's start and completion where its events carry none: the robot's
-    last sample at or before that time."""
+    last sample at or before that time; for a start before the robot's first sample, its
+    first sample up to the completion (samples often begin once the first activity runs, and
+    that activity's use would otherwise go uncounted)."""
     keys = [k for k in (CASE, ROBOT) if k in instances.columns and k in levels.columns]
     samples = levels[[*keys, TIMESTAMP, BATTERY]].dropna().sort_values(TIMESTAMP, kind="stable")
     filled = instances.copy()
     for when, column in ((START_TIMESTAMP, f"start_{BATTERY}"), (TIMESTAMP, BATTERY)):
         missing = filled[column].isna() & filled[when].notna()
-        if not missing.any():
-            continue
-        wanted = filled.loc[missing, [*keys, when]].rename(columns={when: TIMESTAMP})
-        wanted = wanted.reset_index().sort_values(TIMESTAMP, kind="stable")
-        found = pd.merge_asof(wanted, samples, on=TIMESTAMP, by=keys or None)
-        filled.loc[found["index"], column] = found[BATTERY].to_numpy()
+        if missing.any():
+            filled.loc[missing, column] = _sample_at(filled[missing], when, samples, keys)
+    start = f"start_{BATTERY}"
+    missing = filled[start].isna() & filled[START_TIMESTAMP].notna()
+    if missing.any():
+        first = _sample_at(filled[missing], START_TIMESTAMP, samples, keys, "forward")
+        filled.loc[missing, start] = first
     return filled
+
+
+def _sample_at(
+    rows: pd.DataFrame,
+    when: str,
+    samples: pd.DataFrame,
+    keys: list[str],
+    direction: str = "backward",
+) -> np.ndarray:
+    """Per row, the robot's level at ``when``: its last sample at or before (``backward``), or
+    its first sample at or after that is no later than the row's completion (``forward``)."""
+    wanted = rows[[*keys, when]].rename(columns={when: TIMESTAMP})
+    wanted = wanted.assign(_row=np.arange(len(rows)), _end=rows[TIMESTAMP].to_numpy())
+    wanted = wanted.sort_values(TIMESTAMP, kind="stable")
+    found = pd.merge_asof(
+        wanted,
+        samples.assign(_at=samples[TIMESTAMP]),
+        on=TIMESTAMP,
+        by=keys or None,
+        direction=direction,
+    )
+    if direction == "forward":
+        found.loc[~(found["_at"] <= found["_end"]), BATTERY] = np.nan
+    values = np.full(len(rows), np.nan)
+    values[found["_row"].to_numpy()] = found[BATTERY].to_numpy(float)
+    return values
 
 
 def _idle_use(analysis: LogAnalysis, levels: pd.DataFrame) -> pd.DataFrame:

@@ -30,6 +30,10 @@ Their cost is their excess summed over the cases and divided by the number of ca
 row ``longer_by`` / ``extra_median`` say how much longer (mean / median) the cases with it (for
 a steady cost: the cases it hits hardest, above its median case) take than the others, and
 ``p_value`` how sure that is (Mann-Whitney U, see :mod:`robotale.enhancement.effects`).
+
+Rows whose p-value is :data:`ALPHA` or more come after all others: the cases with them may be
+longer by chance. A step found in all cases but one is "present" in every slow case, and
+without this its chance difference to that one case would outrank a real cause.
 """
 
 from __future__ import annotations
@@ -62,6 +66,8 @@ EFFECTS = ("activity", "loop", "transition", "variant")
 STEADY = ("waiting", "resource", "rework", "delay", "queueing")
 KINDS = EFFECTS + STEADY
 KEY = ["kind", "activity", "robot"]
+#: an effect with a p-value at least this large may be chance: it is ranked after the others
+ALPHA = 0.05
 
 
 def find_bottlenecks(
@@ -448,9 +454,12 @@ def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
         share=ranking["total"] / (total_time or float("nan")),
         longer_by=ranking["extra_mean"],
         _kind=ranking["kind"].map(KINDS.index),
+        _chance=pd.to_numeric(ranking["p_value"], errors="coerce").ge(ALPHA),
     )
     ranking = ranking.sort_values(
-        ["delay_per_case", "_kind", "occurrences"], ascending=[False, True, False], kind="stable"
+        ["_chance", "delay_per_case", "_kind", "occurrences"],
+        ascending=[True, False, True, False],
+        kind="stable",
     ).reset_index(drop=True)
     ranking.insert(0, "rank", range(1, len(ranking) + 1))
     ranking["explanation"] = [_explain(row) for row in ranking.to_dict("records")]

@@ -23,7 +23,7 @@ import pandas as pd
 
 from robotale.discovery.graph import json_ready
 from robotale.enhancement.battery import battery_perspective
-from robotale.enhancement.bottlenecks import find_bottlenecks
+from robotale.enhancement.bottlenecks import ALPHA, find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
 from robotale.enhancement.context import LogAnalysis
 from robotale.enhancement.performance import ARROW, performance_perspective
@@ -32,8 +32,6 @@ from robotale.eventlog.schema import ROBOT, X, Y
 
 #: how many variants and bottlenecks an answer names
 MAIN = 3
-#: a case-duration effect with a p-value at least this large may be chance
-ALPHA = 0.05
 
 
 @dataclass(slots=True)
@@ -164,6 +162,7 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
     if not bottlenecks.has_data:
         answer.sentences.append(_sentence(bottlenecks.message))
         return answer
+    _one_run_of_days(runs, answer)
     ranking = trusted_first(bottlenecks.table).head(MAIN)
     answer.facts["bottlenecks"] = [
         {
@@ -196,6 +195,23 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
             f"Between activities the robots wait {share:.0%} of their time in the runs."
         )
     return answer
+
+
+def _one_run_of_days(runs: pd.DataFrame, answer: Answer) -> None:
+    """A log read as one run that lasts several days (no case column) counts the nights
+    between its sessions as waiting: the answer says so before its ranking."""
+    if len(runs) != 1 or not {"start", "end"} <= set(runs.columns):
+        return
+    start, end = pd.Timestamp(runs["start"].iloc[0]), pd.Timestamp(runs["end"].iloc[0])
+    days = (end.normalize() - start.normalize()).days + 1
+    if days < 2:
+        return
+    answer.facts["one_run_days"] = days
+    answer.sentences.append(
+        f"The log is one run of {days} days ({start:%Y-%m-%d} to {end:%Y-%m-%d}), so the "
+        "pauses between its sessions count as waiting below: split it into runs "
+        "(--case-gap 1h, or Split into runs when uploading it)."
+    )
 
 
 def trusted_first(ranking: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
@@ -335,7 +351,8 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         return answer
     affected = sorted(lows["case"].astype(str).unique()) if "case" in lows else []
     answer.facts["runs_with_low_battery"] = len(affected)
-    first = lows.iloc[0]
+    # the earliest moment, not the first row: runs numbered 1..12 sort "10" before "4"
+    first = lows.sort_values("time", kind="stable").iloc[0] if "time" in lows else lows.iloc[0]
     answer.sentences.append(
         f"{_count(len(lows), 'low-battery moment')} in {len(affected)} of {len(runs)} runs; "
         f"the first: {_who(first)}run {first['case']} at {_clock(first['time'])}"
@@ -410,9 +427,28 @@ def _message_example(kind: str, row: pd.Series, communication: Perspective) -> s
         how = f"under the new id {new}" if new else "under the same id"
         return f"Resent, for example: {where}, {how}."
     lost = communication.tables.get("lost", pd.DataFrame())
-    then = lost.loc[lost["msg_id"] == row["msg_id"], "then"] if "then" in lost else pd.Series()
-    followed = f"; then the sender did {then.iloc[0]}" if len(then) and _value(then.iloc[0]) else ""
-    return f"Lost, for example: {where}, sent at {_clock(row['sent_at'])}{followed}."
+    # the lost table's row of this message (by the keys it has: a log may lack the case)
+    keys = [key for key in ("case", "msg_id") if key in lost.columns and key in row.index]
+    mine = lost[(lost[keys] == row[keys]).all(axis=1)] if keys else lost.iloc[:0]
+    then = _value(mine["then"].iloc[0]) if "then" in mine and len(mine) else None
+    followed = f"; then the sender did {then}" if then else ""
+    return (
+        f"Lost, for example: {where}, sent at {_clock(row['sent_at'])}{followed}"
+        f"{_ended_later(mine)}."
+    )
+
+
+def _ended_later(lost: pd.DataFrame) -> str:
+    """How much later a lost message's run ended than the median run without one."""
+    if "ended_later_by" not in lost or lost.empty:
+        return ""
+    later = _value(lost["ended_later_by"].iloc[0])
+    if later is None:
+        return ""
+    if later == 0:
+        return "; its run took as long as the median run without a lost message"
+    how = "longer" if later > 0 else "shorter"
+    return f"; its run took {seconds_text(abs(later))} {how} than the median run without one"
 
 
 def _timeline(row: pd.Series, label: str) -> dict[str, Any]:

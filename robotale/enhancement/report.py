@@ -25,14 +25,18 @@ def all_perspectives(
     robot: str | None = None,
     field: Field | None = None,
     threshold: float = 20.0,
+    delay_threshold: float | None = None,
 ) -> dict[str, Perspective]:
     """Spatial, communication, battery, performance and bottlenecks, for the whole log or for
-    one activity and/or robot."""
+    one activity and/or robot; a message is delayed above ``delay_threshold`` seconds (else
+    above its channel's own 95th percentile)."""
     focus = {"activity": activity, "robot": robot}
     analysis = analysis_of(log)  # instances, steps, cases and messages built once for all
     return {
         "spatial": spatial_perspective(analysis, field=field, **focus),
-        "communication": communication_perspective(analysis, **focus),
+        "communication": communication_perspective(
+            analysis, delay_threshold=delay_threshold, **focus
+        ),
         "battery": battery_perspective(analysis, threshold=threshold, **focus),
         "performance": performance_perspective(analysis, **focus),
         "bottlenecks": find_bottlenecks(analysis, **focus),

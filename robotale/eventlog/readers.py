@@ -378,6 +378,8 @@ def canonical_log(
         + robot_warnings
         + reading.single_value_warnings(log, renames)
         + reading.no_pairs_warning(log),
+        # the only warning _cases gives is that of a log of several days without cases
+        session_gap=reading.SESSION_GAP if warnings else None,
     )
     return log, found
 

@@ -27,6 +27,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 
 from robotale.errors import InputError
@@ -127,6 +128,8 @@ KINDS = ("start", "complete", "instant", "sample")
 OUTCOMES = (schema.ABORTED, schema.CANCELLED)
 #: a dropped row's lines are listed up to this many.
 SHOWN_LINES = 5
+#: the pause offered as the end of a session when a log without cases spans several days
+SESSION_GAP = "1h"
 
 
 @dataclass
@@ -153,6 +156,9 @@ class Reading:
     #: decisions worth knowing that are not problems
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)
+    #: the case gap offered for a log without a case column that spans several days (its runs
+    #: are then sessions apart, and one case would count the nights as waiting); else None
+    session_gap: str | None = None
 
     @property
     def kept(self) -> int:
@@ -475,26 +481,41 @@ def _looks_like_id(column: str) -> bool:
     return name.endswith("id") and len(name) > 2 and not name.startswith("case:")
 
 
-def pairs_found(log: pd.DataFrame) -> bool:
-    """Whether some start has a complete of the same case, robot, activity and pairing key."""
+def paired_seconds(log: pd.DataFrame) -> pd.Series:
+    """The seconds from each start to the completion it pairs with: within the same case,
+    robot, activity and pairing key, the n-th start with the n-th completion (a rough pairing,
+    enough to tell whether any activity lasts at all)."""
     keys = [c for c in (schema.CASE, schema.ROBOT, schema.ACTIVITY) if c in log.columns]
     if schema.EXECUTION_ID in log.columns:
         keys.append(schema.EXECUTION_ID)
+    # one integer per group, so the pairs are matched on numbers, not on names
+    group = np.zeros(len(log), dtype=np.int64)
+    for key in keys:
+        codes, uniques = pd.factorize(log[key], use_na_sentinel=False)
+        group, _ = pd.factorize(group * (len(uniques) + 1) + codes)
     lifecycle = log[schema.LIFECYCLE]
-    flags = pd.DataFrame(
-        {"start": lifecycle == schema.START, "complete": lifecycle == schema.COMPLETE}
-    )
-    both = flags.groupby([log[k].fillna("") for k in keys]).any()
-    return bool((both["start"] & both["complete"]).any())
+    ends = []
+    for kind in (schema.START, schema.COMPLETE):
+        chosen = (lifecycle == kind).fillna(False).to_numpy(bool)
+        rows = pd.DataFrame({"_g": group[chosen], "_t": log[schema.TIMESTAMP].array[chosen]})
+        ends.append(rows.assign(_n=rows.groupby("_g", sort=False).cumcount()))
+    pairs = ends[0].merge(ends[1], on=["_g", "_n"], suffixes=("_start", "_end"))
+    return (pairs["_t_end"] - pairs["_t_start"]).dt.total_seconds()
 
 
 def no_pairs_warning(log: pd.DataFrame) -> list[str]:
-    if pairs_found(log):
-        return []
-    return [
-        "No start/complete pairs found: every activity lasts 0 s (map the column that says "
-        "start and complete with --map COLUMN=lifecycle if there is one)."
-    ]
+    seconds = paired_seconds(log)
+    if seconds.empty:
+        return [
+            "No start/complete pairs found: every activity lasts 0 s (map the column that says "
+            "start and complete with --map COLUMN=lifecycle if there is one)."
+        ]
+    if (seconds == 0).all():
+        return [
+            f"Every one of the {len(seconds):,} start/complete pairs has one time for both: "
+            "every activity lasts 0 s (are the starts stamped with the completion's time?)."
+        ]
+    return []
 
 
 def days_warning(path: Path, log: pd.DataFrame) -> list[str]:
@@ -503,8 +524,8 @@ def days_warning(path: Path, log: pd.DataFrame) -> list[str]:
         return []
     return [
         f"{path.name} has no case column and spans {len(days)} days ({days[0]} to {days[-1]}), "
-        "so it is read as one case: --case-gap 1h starts a new case after every pause of an "
-        "hour or more (or name the column that tells runs apart)."
+        f"so it is read as one case: --case-gap {SESSION_GAP} starts a new case after every "
+        "pause of an hour or more (or name the column that tells runs apart)."
     ]
 
 
@@ -537,6 +558,12 @@ def format_reading(reading: Reading, *, short: bool = False) -> str:
     return "\n".join(lines)
 
 
+def marker_listing() -> str:
+    """The markers read as no value, in words: 'empty cells and null, NULL, None ...'."""
+    shown = sorted((m for m in MISSING_MARKERS if m), key=lambda m: (m.lower(), m))
+    return "empty cells and " + ", ".join(shown)
+
+
 def _details(reading: Reading) -> list[str]:
     width = max((len(column) for column in reading.columns), default=0)
     columns = [f"    {column:<{width}} -> {role}" for column, role in reading.columns.items()]
@@ -554,6 +581,7 @@ def _details(reading: Reading) -> list[str]:
         f"  events:    {events}",
         f"  lifecycle: {reading.lifecycle}; pairs {reading.pairing}",
         f"  missing:   {missing or '-'}",
+        f"  no value:  {marker_listing()}",
         f"  rows:      {reading.rows:,} read, {reading.kept:,} kept, "
         f"{reading.rows - reading.kept:,} dropped",
     ]

@@ -52,6 +52,8 @@ class Pending:
     case_gap: str | None = None
     #: how the file was read (``format_reading``), for the column-choice page
     reading: str = ""
+    #: the case gap the column-choice page offers (a log of several days without cases)
+    session_gap: str | None = None
 
 
 @dataclass(frozen=True)
@@ -113,6 +115,7 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
             )
             # the reading names our stored copy; the user knows the file by its own name
             pending.reading = format_reading(reading).replace(str(upload.path), upload.filename)
+            pending.session_gap = reading.session_gap
     except RobotaleError as error:
         # The message names our stored copy; the user knows the file by its own name.
         raise type(error)(str(error).replace(str(upload.path), repr(upload.filename))) from None

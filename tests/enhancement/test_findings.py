@@ -59,18 +59,18 @@ def test_sequence(logged):
     # the runs with the refill are the most common variant; the others differ by not having it
     refill_runs = _variants()[sorted(mission.REFILL_RUNS)]
     assert refill_runs.nunique() == 1 and counts.index[0] == refill_runs.iloc[0]
-    assert "without refill" in answer.sentences[1]
+    assert f"without {mission.REFILL}" in answer.sentences[1]
 
 
 def test_the_injected_bottleneck_comes_first(logged):
     _, findings = logged
     answer = findings.answer("delays")
     first = answer.facts["bottlenecks"][0]
-    assert (first["activity"], first["robot"]) == ("refill", "tractor_1")
+    assert (first["activity"], first["robot"]) == (mission.REFILL, "tractor_1")
     assert first["runs"] == len(mission.REFILL_RUNS)
-    assert "refill" in answer.sentences[0] and "tractor_1" in answer.sentences[0]
+    assert mission.REFILL in answer.sentences[0] and "tractor_1" in answer.sentences[0]
     node = answer.evidence[0]
-    assert (node["kind"], node["activity"], node["robot"]) == ("node", "refill", "tractor_1")
+    assert (node["kind"], node["activity"], node["robot"]) == ("node", mission.REFILL, "tractor_1")
     durations = _durations()
     slowest = next(e for e in answer.evidence if e["kind"] == "timeline")
     assert slowest["case"] == durations.idxmax()
@@ -139,6 +139,13 @@ def test_messages(logged):
     assert f"after {seconds_text(mission.DELAYED_LATENCY)}" in examples["Delayed"]
     first_lost = lost.sort_values("case").iloc[0]
     assert first_lost["msg_id"] in examples["Lost"]
+    durations = _durations()
+    calm = durations[~durations.index.isin(lost["case"])].median()
+    shorter = calm - durations[first_lost["case"]]  # the refill runs make the calm ones long
+    assert shorter > 0
+    assert examples["Lost"].endswith(
+        f"; its run took {seconds_text(shorter)} shorter than the median run without one."
+    )
     assert f"under the new id {resent.sort_values('case').iloc[0]['msg_id']}" in examples["Resent"]
     cases = [e["case"] for e in answer.evidence]
     assert cases == [delayed_row["case"], first_lost["case"], first_lost["case"]]
@@ -192,6 +199,20 @@ def test_thesis_log_split_into_days(thesis_csv):
     messages = findings.answer("messages")
     sends = log[log["concept:name"].astype(str).str.endswith("!")]
     assert messages.facts["messages"] == sends["msg_id"].nunique()
+    assert "one_run_days" not in findings.answer("delays").facts
+
+
+def test_thesis_log_read_as_one_run_says_its_nights_count_as_waiting(thesis_csv):
+    """Without a case gap the five days are one run: the delays answer says so first."""
+    times = pd.to_datetime(pd.read_csv(thesis_csv)["time"], format="ISO8601")
+    days = (times.max().normalize() - times.min().normalize()).days + 1
+    delays = find(read_log(thesis_csv)).answer("delays")
+    assert delays.facts["one_run_days"] == days == 5
+    assert delays.sentences[0].startswith(
+        f"The log is one run of {days} days ({times.min():%Y-%m-%d} to {times.max():%Y-%m-%d})"
+    )
+    assert "--case-gap 1h" in delays.sentences[0]
+    assert delays.sentences[1].startswith("1. ")
 
 
 def test_a_log_without_a_robot_column(thesis_csv):

@@ -26,9 +26,9 @@ def test_report_of_a_file(tmp_path, capsys):
         assert answer["question"] in printed
         for sentence in answer["sentences"]:
             assert sentence in printed
-    assert report["answers"][1]["facts"]["bottlenecks"][0]["activity"] == "refill"
+    assert report["answers"][1]["facts"]["bottlenecks"][0]["activity"] == mission.REFILL
     html = page.read_text()
-    assert "Cases with refill by tractor_1" in html
+    assert f"Cases with {mission.REFILL} by tractor_1" in html
     assert html.count("<script") >= 1 and "lost message" in html
 
 

@@ -40,3 +40,22 @@ def test_perspectives_of_a_stored_log_drilled_down(
 def test_perspectives_need_somewhere_to_write(thesis_csv, capsys):
     assert main(["perspectives", str(thesis_csv)]) == 1
     assert "--out report.html" in capsys.readouterr().err
+
+
+def test_messages_delayed_above_a_given_latency(tmp_path, capsys):
+    import mission_findings as mission
+    import pandas as pd
+
+    log = mission.write_injected("robot_id.csv", tmp_path / "mission.csv")
+    data = tmp_path / "report.json"
+    assert main(["perspectives", str(log), "--json", str(data), "--delay", "2"]) == 0
+    communication = json.loads(data.read_text())["communication"]
+    truth = pd.DataFrame([vars(m) for m in mission.injected_truth().messages])
+    latency = (truth["received"] - truth["sent"]).dt.total_seconds()
+    assert communication["summary"]["delayed"] == (latency > 2).sum() == 13
+    channels = pd.DataFrame(communication["tables"]["channels"]).set_index("receiver")
+    late = truth[latency > 2].groupby("receiver").size()
+    assert channels["delayed"].to_dict() == late.to_dict()
+    assert "13 delayed" in capsys.readouterr().out
+    assert main(["perspectives", str(log), "--json", str(data), "--delay", "-1"]) == 1
+    assert "--delay -1 is not usable" in capsys.readouterr().err

@@ -31,6 +31,9 @@ def test_inspect_shows_roles_cases_robots_and_counts(tmp_path, capsys):
     assert "  cases:     2 (the column 'case_id')\n" in out
     assert "  robots:    drone (Drone), tractor_1 (Tractor), tractor_2 (Tractor)\n" in out
     assert f"  rows:      {rows} read, {rows} kept, 0 dropped\n" in out
+    # the markers this file writes for no value are among those named as such
+    named = out.split("  no value:  empty cells and ")[1].splitlines()[0].split(", ")
+    assert {"null", "-", "N/A", "None", "NaN"} <= set(named) and "NA" not in named
     assert "pairs by concept:instance within case, robot, activity" in out
     assert "warning" not in out
 

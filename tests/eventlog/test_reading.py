@@ -362,3 +362,21 @@ def test_aborted_and_cancelled_ends_keep_their_outcome_and_close_their_activity(
     found = activity_instances(log)
     assert found["duration"].tolist() == [30.0, 5.0, 20.0, 10.0]
     assert found[schema.LIFECYCLE].tolist() == ["aborted", "cancelled", "aborted", "complete"]
+
+
+def test_pairs_that_all_last_nothing_are_warned_of(tmp_path):
+    rows = ["case,time,activity,lifecycle"]
+    for case in ("1", "2"):
+        for second, activity in ((0, "takeoff"), (5, "explore")):
+            for lifecycle in ("start", "complete"):
+                rows.append(f"{case},2024-01-01T10:00:0{second}Z,{activity},{lifecycle}")
+    _, reading = read_log_with_reading(write(tmp_path, "flat.csv", "\n".join(rows) + "\n"))
+    pairs = sum(row.endswith(",start") for row in rows)  # counted by hand: 4
+    assert reading.warnings == [
+        f"Every one of the {pairs} start/complete pairs has one time for both: every activity "
+        "lasts 0 s (are the starts stamped with the completion's time?)."
+    ]
+    # one pair that lasts is enough for no warning
+    rows[-1] = rows[-1].replace("10:00:05", "10:00:07")
+    _, reading = read_log_with_reading(write(tmp_path, "lasting.csv", "\n".join(rows) + "\n"))
+    assert reading.warnings == []

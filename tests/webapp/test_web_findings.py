@@ -67,7 +67,7 @@ def test_findings_api_names_the_injected_findings(client, mission_log):
     data = client.get(f"/api/findings?log={mission_log}").json
     answers = {a["key"]: a for a in data["answers"]}
     first = answers["delays"]["facts"]["bottlenecks"][0]
-    assert (first["activity"], first["robot"]) == ("refill", "tractor_1")
+    assert (first["activity"], first["robot"]) == (mission.REFILL, "tractor_1")
     spans = TRUTH.instance_table().groupby("case").agg(first=("start", "min"))
     assert [run["case"] for run in data["runs"]] == spans.sort_values("first").index.tolist()
     lost = _lost_by_run()
@@ -97,10 +97,10 @@ def test_findings_page_names_the_injected_bottleneck_first(page, mission_log, sc
     page.goto(f"{page.base_url}/findings?log={mission_log}")
     delays = page.locator("article.answer[data-key=delays]")
     first = delays.locator("li").first
-    expect(first).to_contain_text("refill by tractor_1")
+    expect(first).to_contain_text(f"{mission.REFILL} by tractor_1")
     assert first.inner_text().startswith("1.")
     node = delays.locator("a.node-link").first
-    target = f"/perspectives?log={mission_log}&activity=refill&robot=tractor_1"
+    target = f"/perspectives?log={mission_log}&activity={mission.REFILL}&robot=tractor_1"
     expect(node).to_have_attribute("href", target)
     messages = page.locator("article.answer[data-key=messages]")
     expect(messages.locator("li").first).to_contain_text(f"{_lost_by_run().sum()} lost")
@@ -137,7 +137,9 @@ def test_perspectives_page_ranks_bottlenecks_and_shows_variants(page, mission_lo
     page.goto(f"{page.base_url}/perspectives?log={mission_log}")
     bottlenecks = page.locator("article.perspective[data-name=bottlenecks]")
     expect(bottlenecks).to_have_attribute("data-state", "shown")
-    expect(bottlenecks.locator("ol.ranking li").first).to_contain_text("refill by tractor_1")
+    expect(bottlenecks.locator("ol.ranking li").first).to_contain_text(
+        f"{mission.REFILL} by tractor_1"
+    )
     performance = page.locator("article.perspective[data-name=performance]")
     expect(performance).to_have_attribute("data-state", "shown")
     variants = TRUTH.instance_table().sort_values(["case", "start"])
@@ -162,6 +164,17 @@ def test_a_log_without_battery_or_model_says_so(page, stranger_log):
     expect(page.locator("#model-none")).to_contain_text("No stored model has pools that bind")
     expect(page.locator("#model-none")).to_contain_text(robots)
     expect(page.locator("#model-picker option")).to_have_text(["none binds this log"])
+
+
+def test_the_model_page_offers_only_models_that_bind_the_robots(client, mission_log):
+    """The mission's drone and tractors are the pools of the shipped agri mission; the
+    rexdingo mission's pools (rex, dingo) bind none of them."""
+    import re
+
+    page = client.get(f"/model?log={mission_log}").get_data(as_text=True)
+    offered = re.findall(r'<option value="\w+"[^>]*>([^<(]+) \(', page)
+    assert [name.strip() for name in offered] == ["agri.bpmn"]
+    assert "rexdingo.bpmn" not in page and "none binds this log" not in page
 
 
 # -- the console's analyst questions -----------------------------------------------------------
@@ -238,6 +251,6 @@ def test_slowest_steps_stay_within_a_run(neo4j_driver, mission_log):
     assert rows["median_seconds"].max() < 3 * 3600
     first = rows.iloc[0]
     # tractor_1's refill: from its start to its completion, REFILL_SECONDS in every refill run
-    assert (first["source"], first["target"]) == ("refill|tractor_1", "refill|tractor_1")
+    assert (first["source"], first["target"]) == (f"{mission.REFILL}|tractor_1",) * 2
     assert first["median_seconds"] == mission.REFILL_SECONDS
     assert first["count"] == len(mission.REFILL_RUNS)

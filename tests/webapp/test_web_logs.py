@@ -305,3 +305,33 @@ def test_a_csv_of_only_a_byte_order_mark_is_one_sentence(client):
     response = upload(client, "bom.csv", "\ufeff".encode())
     assert response.status_code == 400
     assert "'bom.csv' holds nothing but a byte order mark: it has no header line." in text(response)
+
+
+def test_a_log_of_several_days_without_cases_is_offered_a_split_into_runs(
+    client, thesis_csv, log_name
+):
+    import pandas as pd
+
+    raw = pd.read_csv(thesis_csv)
+    times = pd.to_datetime(raw["time"], format="ISO8601").sort_values()
+    runs = int((times.diff() >= pd.Timedelta("1h")).sum()) + 1  # counted here, by hand
+    token, page = read_step(client, "robotic_data.csv", thesis_csv.read_bytes())
+    assert "1 case (no case column: one case)" in page and "spans 5 days" in page
+    offer = re.search(r'<form[^>]*id="split-form".*?</form>', page, re.S).group(0)
+    assert f'action="/logs/upload/{token}/split"' in offer and 'value="1h"' in offer
+    response = client.post(
+        f"/logs/upload/{token}/split", data={"csrf_token": client.csrf, "case_gap": "1h"}
+    )
+    assert response.status_code == 302, text(response)
+    job_id = re.search(r"\?job=(\w+)", response.location).group(1)
+    assert wait(client, job_id)["error"] is None
+    page = text(client.get(response.location))
+    assert f"{runs} cases (a new case after every pause of 1h or more)" in page
+    assert 'id="split-form"' not in page
+    job, _ = ingest(client, token, {"name": log_name, "entity": ["robot", "msg_id"]})
+    assert job["error"] is None, job["error"]
+    performance = client.get(f"/api/perspectives/performance?log={log_name}").json
+    assert performance["summary"]["cases"] == runs == 5
+    # the nights (pauses of 1 h or more between runs) no longer count as waiting
+    assert performance["summary"]["slowest_transition"] != "land -> takeoff (drone)"
+    assert max(row["max"] for row in performance["tables"]["waiting"]) < 3600

@@ -66,13 +66,30 @@ def upload():
     saved = uploads.save(file.stream, file.filename, settings().upload_dir)
     case_gap = request.form.get("case_gap", "").strip() or None
     pending = pending_logs().add(saved, mapping, case_gap)
+    return _read(pending)
+
+
+@blueprint.post("/logs/upload/<token>/split")
+def split(token: str):
+    """Read the upload again as runs split at every pause of the given length: the offer the
+    column page makes for a log of several days without a case column."""
+    pending = pending_logs().get(token)
+    case_gap = request.form.get("case_gap", "").strip()
+    if not case_gap:
+        raise InputError("Give the pause that ends a run, e.g. 1h or 30min.")
+    pending.case_gap = case_gap
+    return _read(pending)
+
+
+def _read(pending: ingest.Pending):
+    """Read the pending upload in a job; its column page shows when it is done."""
     limit = settings().upload_limit_mb * 1024 * 1024
     models = state().models
     job = jobs().submit(
-        f"Reading {saved.filename}",
+        f"Reading {pending.upload.filename}",
         lambda job: ingest.read_upload(pending, limit, models, job) or {},
     )
-    return redirect(url_for("logs.choose", token=saved.token, job=job.id))
+    return redirect(url_for("logs.choose", token=pending.upload.token, job=job.id))
 
 
 @blueprint.get("/logs/upload/<token>")
@@ -91,6 +108,7 @@ def choose(token: str):
         name=pending.upload.suggested_name,
         events=len(pending.log),
         reading=pending.reading,
+        session_gap=pending.session_gap,
         columns=ingest.columns(pending.log),
         **context,
     )
