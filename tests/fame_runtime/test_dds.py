@@ -3,8 +3,10 @@ two engine processes run the agri mission into one bag, plain DDS code that know
 ROS 2 names talks to robotale, and DDS itself keeps QoS-incompatible pairs apart."""
 
 import gc
+import itertools
 import os
 import time
+from collections import Counter
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -21,10 +23,11 @@ from fame_suite import MODELS  # noqa: E402
 
 from robotale.cli import main  # noqa: E402
 from robotale.fame_runtime.clock import WallClock  # noqa: E402
-from robotale.fame_runtime.dds import DdsBus  # noqa: E402
+from robotale.fame_runtime.dds import DdsBus, dds_qos  # noqa: E402
 from robotale.fame_runtime.engine import Engine  # noqa: E402
 from robotale.fame_runtime.parser import parse  # noqa: E402
-from robotale.fame_runtime.qos import DEFAULT_QOS  # noqa: E402
+from robotale.fame_runtime.qos import DEFAULT_QOS, incompatibilities  # noqa: E402
+from robotale.fame_runtime.rostypes import idl_type  # noqa: E402
 
 pytestmark = pytest.mark.timeout(180)
 
@@ -225,3 +228,131 @@ def test_a_transient_local_late_joiner_gets_the_stored_samples_over_dds():
     assert [e.data["x"] for e in got] == [2.0, 3.0]  # the writer keeps depth 2
     assert {e.sender for e in got} == {"talker"}
     assert volatile == []  # a volatile reader asks for no history
+
+
+#: every value a model can give the policies that decide a match (None: infinite)
+MATCHING = {
+    "reliability": ("reliable", "best_effort"),
+    "durability": ("volatile", "transient_local"),
+    "liveliness": ("automatic", "manual_by_topic"),
+    "deadline": (None, 1.0, 2.0),
+    "lease_duration": (None, 1.0, 2.0),
+}
+#: policies that never prevent a match, spread over the pairs
+OTHERS = (
+    {},
+    {"history": "keep_all", "lifespan": 1.0},
+    {"history": "keep_last", "depth": 1, "lifespan": 5.0},
+)
+
+
+@pytest.mark.slow
+def test_fame_checks_verdict_is_cyclone_ddss_matching_on_every_policy_combination():
+    """Each of the 72 x 72 offered/requested profiles as a real Cyclone writer and reader
+    (local endpoints of one participant match at once): they match exactly when the C-QoS
+    rules find no incompatibility, and Cyclone reports the others as incompatible."""
+    profiles = [
+        replace(DEFAULT_QOS, **dict(zip(MATCHING, values, strict=True)))
+        for values in itertools.product(*MATCHING.values())
+    ]
+    participant = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    string = idl_type("std_msgs/msg/String")
+    disagreements, blocked = [], 0
+    for n, (offered, requested) in enumerate(itertools.product(profiles, profiles)):
+        offered = replace(offered, **OTHERS[n % 3])
+        requested = replace(requested, **OTHERS[n // 3 % 3])
+        topic = Topic(participant, f"rt/pair_{n}", string)
+        writer = DataWriter(participant, topic, qos=dds_qos(offered))
+        reader = DataReader(participant, topic, qos=dds_qos(requested))
+        talks = writer.get_publication_matched_status().current_count == 1
+        refused = reader.get_requested_incompatible_qos_status().total_count > 0
+        compatible = not incompatibilities(offered, requested)
+        blocked += not compatible
+        if (talks, refused) != (compatible, not compatible):
+            disagreements.append((offered, requested, talks, refused))
+    assert disagreements == []
+    # by hand: 3 of the 4 pairs of each two-valued policy match, 6 of the 9 of each period
+    assert blocked == 72 * 72 - 3**3 * 6**2
+
+
+PATROL = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="patrol_forever">
+  <bpmn:collaboration id="c">
+    <bpmn:participant id="p_rover" name="Rover" processRef="Rover" />
+    <bpmn:participant id="p_drone" name="Drone" processRef="Drone" />
+  </bpmn:collaboration>
+  {processes}
+</bpmn:definitions>
+"""
+PATROLLER = """<bpmn:process id="{pool}">
+    <bpmn:startEvent id="{pool}_start" />
+    <bpmn:task id="{pool}_patrol" name="Patrol" />
+    <bpmn:intermediateCatchEvent id="{pool}_pause" name="pause">
+      <bpmn:timerEventDefinition><bpmn:timeDuration>PT0.2S</bpmn:timeDuration>
+      </bpmn:timerEventDefinition>
+    </bpmn:intermediateCatchEvent>
+    <bpmn:sequenceFlow id="{pool}_f1" sourceRef="{pool}_start" targetRef="{pool}_patrol" />
+    <bpmn:sequenceFlow id="{pool}_f2" sourceRef="{pool}_patrol" targetRef="{pool}_pause" />
+    <bpmn:sequenceFlow id="{pool}_f3" sourceRef="{pool}_pause" targetRef="{pool}_patrol" />
+    <bpmn:subProcess id="{pool}_safe" name="Safe State" triggeredByEvent="true">
+      <bpmn:startEvent id="{pool}_s_start" name="emergency">
+        <bpmn:errorEventDefinition /></bpmn:startEvent>
+      <bpmn:task id="{pool}_stop_motors" name="Stop Motors" />
+      <bpmn:endEvent id="{pool}_s_end" />
+      <bpmn:sequenceFlow id="{pool}_s1" sourceRef="{pool}_s_start" targetRef="{pool}_stop_motors" />
+      <bpmn:sequenceFlow id="{pool}_s2" sourceRef="{pool}_stop_motors" targetRef="{pool}_s_end" />
+    </bpmn:subProcess>
+  </bpmn:process>"""
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_every_robot_through_its_safe_state_and_closes_the_bag(tmp_path):
+    """As a terminal's Ctrl-C does: SIGINT to the whole process group of a DDS run."""
+    import signal
+    import subprocess
+    import sys
+
+    from robotale.commands.prepare import prepare_recordings
+
+    model = tmp_path / "patrol.bpmn"
+    processes = "\n  ".join(PATROLLER.format(pool=pool) for pool in ("Rover", "Drone"))
+    model.write_text(PATROL.format(processes=processes))
+    bag = tmp_path / "run"
+    command = [sys.executable, "-m", "robotale", "fame", "run", str(model)]
+    command += ["--robots", "rover,drone", "--bus", "dds", "--record", str(bag), "--until", "600"]
+    environment = {**os.environ, "PYTHONUNBUFFERED": "1"}  # tags reach us as they happen
+    run = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        env=environment,
+    )
+    try:
+        seen: list[str] = []
+        for line in run.stdout:  # wait until both robots patrol (so the recorder listens)
+            seen.append(line)
+            if all(patrols(seen, robot) >= 3 for robot in ("rover", "drone")):
+                break
+        os.killpg(run.pid, signal.SIGINT)
+        rest, errors = run.communicate(timeout=90)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    printed = rows("".join(seen) + rest)
+    assert run.returncode == 130, errors
+    for robot in ("rover", "drone"):
+        assert [robot, "stop_motors", "complete"] in [r[1:4] for r in printed], errors
+        assert f"# {robot}: stopped (interrupted)" in errors
+    assert "# recorded " in errors
+    # the bag was closed whole: it prepares, and holds every tag the robots printed
+    log = prepare_recordings(bag)
+    recorded = Counter(
+        log[["robot", "concept:name", "lifecycle:transition"]].itertuples(index=False, name=None)
+    )
+    assert recorded == Counter(tuple(r[1:4]) for r in printed)
+
+
+def patrols(lines: list[str], robot: str) -> int:
+    return sum(f"\t{robot}\tpatrol\tcomplete" in line for line in lines)
