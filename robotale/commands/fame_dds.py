@@ -210,7 +210,7 @@ class _Recording:
         if path.exists():
             raise InputError(f"{path} exists already: record into a new folder")
         self.clock = WallClock(offset=offset)
-        self.bus = DdsBus(self.clock, node="recorder")
+        self.bus = DdsBus(self.clock, node="recorder", recorder=True)
         self.recorder = Recorder(path, robots=robots, announced={})
         self.path = path
         self._seen: set[str] = set()
@@ -220,6 +220,9 @@ class _Recording:
     def _discover(self) -> None:
         """Subscribe to each new ROS-typed topic, asking what its publisher offers."""
         for sample in self._publications.take(N=256):
+            # a publication that ended comes as a sample without data (no topic, no type)
+            if not sample.sample_info.valid_data or sample.type_name is None:
+                continue
             msgtype = type_of(sample.type_name)
             topic = ros_topic(sample.topic_name)
             if not sample.topic_name.startswith("rt/") or topic == STATUS_TOPIC:
@@ -288,11 +291,13 @@ def record_command(
         raise InputError("--robots names no robot (for example drone,tractor_1)")
     recording = _Recording(out_dir, names, 0.0)
     deadline = time.monotonic() + duration if duration is not None else float("inf")
-    try:
-        while time.monotonic() < deadline:
-            recording.pump(min(0.2, max(0.0, deadline - time.monotonic())))
-    except KeyboardInterrupt:
-        pass  # Ctrl-C ends a recording: the bag is closed below
-    finally:
-        recording.close(err)
+    stopped = threading.Event()
+    # Ctrl-C or SIGTERM ends a recording: the bag is closed whole below
+    with _interrupts(stopped.set):
+        print(f"# recording {out_dir} (Ctrl-C stops)", file=err, flush=True)
+        try:
+            while time.monotonic() < deadline and not stopped.is_set():
+                recording.pump(min(0.2, max(0.0, deadline - time.monotonic())))
+        finally:
+            recording.close(err)
     return 0

@@ -37,6 +37,8 @@ from robotale.fame_runtime.rostypes import dds_topic, dds_type_name, idl_type, t
 #: seconds a closing bus waits for reliable readers to acknowledge what it published
 ACK_TIMEOUT = 2.0
 _USERDATA = "robotale;sender={sender};ids={ids}"
+#: the user data of a recorder's participant, so robots wait until it reads their topics
+RECORDER_MARK = b"robotale;recorder"
 #: DDS QoS policy ids (DDS 1.4, 2.2.3) of the policies a model can set
 _POLICIES = {
     2: "durability",
@@ -160,12 +162,15 @@ class DdsBus:
         node: str = "",
         domain: int | None = None,
         on_warning: Callable[[str], None] | None = None,
+        recorder: bool = False,
     ) -> None:
+        from cyclonedds.core import Policy, Qos
         from cyclonedds.domain import DomainParticipant
 
         self.clock = clock
         self.node = node or uuid.uuid4().hex[:8]
-        self.participant = DomainParticipant(domain_id() if domain is None else domain)
+        mark = Qos(Policy.Userdata(RECORDER_MARK)) if recorder else None
+        self.participant = DomainParticipant(domain_id() if domain is None else domain, qos=mark)
         self.on_warning = on_warning or (lambda text: None)
         self.warnings: list[str] = []
         self._topics: dict[tuple[str, str], Any] = {}
@@ -225,6 +230,19 @@ class DdsBus:
             for r in self._readers.values()
         ]
         return counts
+
+    def unrecorded(self, recorders: set[Any]) -> list[str]:
+        """The topics this bus writes that a recorder (by participant key) does not read yet."""
+        missing = set()
+        for (topic, *_), writer in self._writers.items():
+            readers = set()
+            for handle in writer.get_matched_subscriptions():
+                found = writer.get_matched_subscription_data(handle)
+                if found is not None:
+                    readers.add(found.participant_key)
+            if not recorders <= readers:
+                missing.add(topic)
+        return sorted(missing)
 
     # -- the Bus interface ---------------------------------------------------------------------
 
@@ -324,6 +342,32 @@ class DdsBus:
             reader.detach()
         self._taps.clear()
         self.participant = None
+
+
+class Recorders:
+    """The recorders on the domain (participants with :data:`RECORDER_MARK`), as they come
+    and go."""
+
+    def __init__(self, bus: DdsBus) -> None:
+        from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsParticipant
+
+        self.keys: set[Any] = set()
+        self._reader = BuiltinDataReader(bus.participant, BuiltinTopicDcpsParticipant)
+
+    def update(self) -> set[Any]:
+        from cyclonedds.core import Policy
+
+        for sample in self._reader.take(N=256):
+            if not sample.sample_info.valid_data:  # a participant that left
+                self.keys.discard(sample.key)
+                continue
+            try:
+                mark = sample.qos[Policy.Userdata].data
+            except (KeyError, AttributeError):
+                continue
+            if mark == RECORDER_MARK:
+                self.keys.add(sample.key)
+        return self.keys
 
 
 def _parse_userdata(qos: Any) -> tuple[str, str]:

@@ -5,7 +5,9 @@ A :class:`Node` runs the process its robot gets from the collaboration on a
 ``/<robot>/tag`` (reliable, transient local, every tag kept: a recorder that joins late
 still gets them all). Before its robot starts it declares a DDS writer or reader for every
 signal its pool throws or catches and waits until the other robots of the mission are up and
-those endpoints are matched, so a signal thrown at once is not lost to discovery.
+those endpoints are matched, so a signal thrown at once is not lost to discovery; when a
+recorder is on the domain (``robotale record``, ``fame run --record``) it also waits until
+the recorder reads every topic the robot writes, so the bag has the first message too.
 
 Robots say how they are on ``/robotale/status``; the mission is over for a node when every
 robot has been idle (no instance running, no timer armed, nothing in flight) for ``settle``
@@ -22,7 +24,7 @@ from typing import Any
 
 from robotale.errors import InputError
 from robotale.fame_runtime.check import endpoints
-from robotale.fame_runtime.dds import DdsBus
+from robotale.fame_runtime.dds import DdsBus, Recorders
 from robotale.fame_runtime.engine import Engine
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import Definitions
@@ -101,6 +103,7 @@ class Node:
         self._quiet_since: float | None = None
         self.interrupted = False
         self._status_reader = bus.raw_reader(STATUS_TOPIC, STATUS_TYPE, KEEP_ALL)
+        self._recorders = Recorders(bus)
 
     @property
     def robot(self) -> str:
@@ -149,7 +152,8 @@ class Node:
             self._take_statuses()
             missing = [r for r in self.robots if r not in self.statuses]
             lonely = sorted({t for t, status in self.peered if not status().current_count})
-            if not missing and not lonely:
+            unrecorded = self._unrecorded()
+            if not missing and not lonely and not unrecorded:
                 return
             time.sleep(0.01)
         if self.interrupted:
@@ -158,6 +162,16 @@ class Node:
             warn(f"{self.robot} starts without {', '.join(missing)} (not up after {wait:g} s)")
         if lonely:
             warn(f"{self.robot} starts with no peer yet on {', '.join(lonely)}")
+        if unrecorded:
+            warn(f"{self.robot} starts before the recorder reads {', '.join(unrecorded)}")
+
+    def _unrecorded(self) -> list[str]:
+        """Topics this robot writes that a recorder on the domain does not read yet (a
+        recorder subscribes to a topic only once it has seen a writer of it)."""
+        recorders = self._recorders.update()
+        if not recorders:
+            return []
+        return [t for t in self.bus.unrecorded(recorders) if t != STATUS_TOPIC]
 
     def _take_statuses(self) -> None:
         """Read what robots said (polled: statuses must be seen before the clock runs)."""

@@ -356,3 +356,66 @@ def test_ctrl_c_stops_every_robot_through_its_safe_state_and_closes_the_bag(tmp_
 
 def patrols(lines: list[str], robot: str) -> int:
     return sum(f"\t{robot}\tpatrol\tcomplete" in line for line in lines)
+
+
+@pytest.mark.slow
+def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
+    """``robotale record`` first, then one ``fame node`` per robot (as on two machines): the
+    caller throws the moment the listener is up, and the bag still has that message, because
+    robots wait until a recorder on the domain reads their topics; Ctrl-C closes the bag."""
+    import signal
+    import subprocess
+    import sys
+
+    from rosbags.highlevel import AnyReader
+
+    from robotale.commands.prepare import prepare_recordings
+
+    model = MODELS / "hello_at_once.bpmn"
+    bag = tmp_path / "bag"
+    robotale = [sys.executable, "-m", "robotale"]
+    recorder = subprocess.Popen(
+        [*robotale, "record", str(bag), "--robots", "caller,listener"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert recorder.stderr.readline().startswith("# recording ")  # it listens: start the robots
+    node = [*robotale, "fame", "node", str(model), "--robots", "caller,listener"]
+    nodes = {
+        robot: subprocess.Popen(
+            [*node, "--robot", robot, "--until", "60"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for robot in ("caller", "listener")
+    }
+    try:
+        said = {robot: run.communicate(timeout=120) for robot, run in nodes.items()}
+        recorder.send_signal(signal.SIGINT)
+        recorded = recorder.communicate(timeout=60)[1]
+    finally:
+        for run in [recorder, *nodes.values()]:
+            if run.poll() is None:
+                run.kill()
+    assert {robot: run.returncode for robot, run in nodes.items()} == {
+        "caller": 0,
+        "listener": 0,
+    }, said
+    assert recorder.returncode == 0, recorded
+    printed = [row for out, _ in said.values() for row in rows(out)]
+    sent = [r for r in printed if r[2] == "hello!" and r[3] == "complete"]
+    heard = [r for r in printed if r[2] == "hello?" and r[3] == "complete"]
+    assert len(sent) == 1 and [r[4] for r in heard] == [sent[0][4]]
+    with AnyReader([bag]) as reader:
+        messages = [
+            reader.deserialize(raw, c.msgtype).data
+            for c, _, raw in reader.messages()
+            if c.topic == "/hello"
+        ]
+    assert messages == ["hi"]
+    log = prepare_recordings(bag)
+    in_bag = Counter(
+        log[["robot", "concept:name", "lifecycle:transition"]].itertuples(index=False, name=None)
+    )
+    assert in_bag == Counter(tuple(r[1:4]) for r in printed)
