@@ -107,7 +107,8 @@ def _node_verdict(node: Node, begin: float, err: TextIO) -> int:
         file=err,
     )
     if not engine.idle:
-        print(f"# {node.robot} is at {', '.join(engine.where())}", file=err)
+        where = ", ".join(engine.where()) or "the start of an instance"
+        print(f"# {node.robot} is at {where}", file=err)
     for failure in engine.failures:
         print(f"# {failure}", file=err)
     if node.interrupted:

@@ -419,3 +419,53 @@ def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
         log[["robot", "concept:name", "lifecycle:transition"]].itertuples(index=False, name=None)
     )
     assert in_bag == Counter(tuple(r[1:4]) for r in printed)
+
+
+@pytest.mark.slow
+def test_a_live_run_ingests_with_its_comm_edges(tmp_path, capsys, neo4j_driver, log_name):
+    """``fame run --bus dds --record`` then ``robotale ingest`` of the bag, as of a simulated
+    run: the stored COMM edge joins the send and the receive the robots printed."""
+    from robotale.commands.prepare import prepare_recordings
+    from robotale.ekg.connection import database
+    from robotale.ekg.logs import log_summary
+    from robotale.ekg.queries import cypher
+
+    bag = tmp_path / "live"
+    model = str(MODELS / "hello_at_once.bpmn")
+    run = ["fame", "run", model, "--robots", "caller,listener", "--bus", "dds"]
+    assert main([*run, "--record", str(bag), "--until", "60"]) == 0
+    printed = rows(capsys.readouterr().out)
+    sent = {r[4]: r[1:3] for r in printed if r[5:6] == ["send"] and r[3] == "complete"}
+    heard = {r[4]: r[1:3] for r in printed if r[5:6] == ["receive"] and r[3] == "complete"}
+    expected = sorted((*sent[m], *heard[m], m) for m in heard)
+    assert len(expected) == 1
+
+    code = main(["ingest", str(bag), "--log", log_name, "--entities", "robot,msg_id"])
+    assert code == 0, capsys.readouterr().err
+    records, _, _ = neo4j_driver.execute_query(
+        cypher("ekg_comm_edges"), {"log": log_name}, database_=database()
+    )
+    # an edge from each event of the send (start, complete) to each of the receive
+    stored = sorted(
+        {(r["fromRobot"], r["sender"], r["toRobot"], r["receiver"], r["msgId"]) for r in records}
+    )
+    assert stored == expected and len(records) == 4
+    assert log_summary(neo4j_driver, log_name)["counts"]["events"] == len(prepare_recordings(bag))
+
+
+def test_a_dds_run_stopped_at_until_with_a_robot_working_exits_1_saying_where(tmp_path, capsys):
+    model = tmp_path / "patrol.bpmn"
+    model.write_text(
+        PATROL.format(processes=PATROLLER.format(pool="Rover")).replace(
+            '<bpmn:participant id="p_drone" name="Drone" processRef="Drone" />', ""
+        )
+    )
+    run = ["fame", "run", str(model), "--robots", "rover", "--bus", "dds", "--until", "5"]
+    assert main(run) == 1
+    captured = capsys.readouterr()
+    assert "# rover: still running at " in captured.err
+    place = captured.err.split("# rover is at ", 1)[1].splitlines()[0]
+    if rows(captured.out):  # it patrols, or pauses between two patrols
+        assert place in ("task Rover_patrol (Patrol)", "intermediateCatchEvent Rover_pause (pause)")
+    else:  # a slow machine: its first instance had not run when the time was up
+        assert place == "the start of an instance"
