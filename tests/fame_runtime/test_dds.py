@@ -469,3 +469,11 @@ def test_a_dds_run_stopped_at_until_with_a_robot_working_exits_1_saying_where(tm
         assert place in ("task Rover_patrol (Patrol)", "intermediateCatchEvent Rover_pause (pause)")
     else:  # a slow machine: its first instance had not run when the time was up
         assert place == "the start of an instance"
+
+
+def test_a_dds_run_ending_with_an_uncaught_error_exits_1_naming_it(capsys, models):
+    run = ["fame", "run", str(models / "errors.bpmn"), "--robots", "tractor_1", "--bus", "dds"]
+    run += ["--set", "tractor_1.jammed=false", "--set", 'tractor_1.fail_loudly="overheat"']
+    assert main(run) == 1
+    err = capsys.readouterr().err
+    assert "error 'overheat' thrown at check (Check Blade) was not caught" in err
