@@ -477,3 +477,34 @@ def test_a_dds_run_ending_with_an_uncaught_error_exits_1_naming_it(capsys, model
     assert main(run) == 1
     err = capsys.readouterr().err
     assert "error 'overheat' thrown at check (Check Blade) was not caught" in err
+
+
+@pytest.mark.slow
+def test_timer_start_events_start_their_robots_over_dds_and_keep_the_mission_going(capsys, models):
+    """One process per robot on the wall clock, which starts 20 s before the alarm's date:
+    each timer start event starts its process (a duration, a date, a cycle), and no robot calls
+    the mission over while the alarm clock's timers are still armed."""
+    model = str(models / "timer_starts.bpmn")
+    run = ["fame", "run", model, "--bus", "dds", "--start", "2024-05-01T07:59:40Z"]
+    run += ["--until", "60"]
+    assert main(run) == 0
+    captured = capsys.readouterr()
+    starts = {}
+    for r in rows(captured.out):
+        if r[3] == "start":
+            starts.setdefault((r[1], r[2]), []).append(float(r[0]))
+    assert {("waiter", "serve"), ("alarm_clock", "ring"), ("ticker", "tick")} <= set(starts)
+    # each robot's process starts a little after the shared origin and its duration counts
+    # from then; the date is 08:00:00 on the shared clock, 20 s after the origin
+    assert 3.0 <= starts["waiter", "serve"][0] < 20
+    ring = starts["alarm_clock", "ring"][0]
+    assert 20.0 <= ring < 21.0
+    first, second = starts["ticker", "tick"]
+    assert second - first == pytest.approx(2.0, abs=0.3)  # R2/PT2S: twice, 2 s apart
+    done = {
+        line.split(":")[0][2:]: float(line.split(" at ")[1].split(" s")[0])
+        for line in captured.err.splitlines()
+        if ": done at " in line
+    }
+    assert set(done) == {"waiter", "alarm_clock", "ticker"}
+    assert min(done.values()) >= ring + 5.0  # nobody left while the snooze was armed
