@@ -17,7 +17,7 @@ from typing import TextIO
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope
 from robotale.fame_runtime.clock import WallClock
-from robotale.fame_runtime.dds import DdsBus, type_of
+from robotale.fame_runtime.dds import DdsBus, require_cyclonedds, type_of
 from robotale.fame_runtime.node import STATUS_TOPIC, Node
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.qos import DEFAULT_QOS
@@ -133,6 +133,7 @@ def run_processes(
     they come, recorded into a rosbag2 with every other topic when ``record`` is given."""
     from robotale.commands.fame import robot_list, start_time
 
+    require_cyclonedds()  # before any robot's process is started
     definitions = parse(model)
     names = [a.robot for a in split(definitions, robot_list(robots))]
     begin = start_time(start)

@@ -84,6 +84,19 @@ def dds_qos(qos: QoS, *, userdata: str = "") -> Any:
     return Qos(*policies)
 
 
+def require_cyclonedds() -> None:
+    """Cyclone DDS is an optional extra: its absence is one sentence, not a traceback."""
+    try:
+        import cyclonedds.core  # noqa: F401
+    except ImportError:
+        from robotale.errors import InputError
+
+        raise InputError(
+            "one process per robot (--bus dds, fame node, record) needs Cyclone DDS: "
+            "pip install 'robotale[dds]'"
+        ) from None
+
+
 def domain_id() -> int:
     """The DDS domain: ``ROS_DOMAIN_ID`` as ROS 2 reads it (0 when unset)."""
     text = os.environ.get("ROS_DOMAIN_ID", "0").strip() or "0"
@@ -164,6 +177,7 @@ class DdsBus:
         on_warning: Callable[[str], None] | None = None,
         recorder: bool = False,
     ) -> None:
+        require_cyclonedds()
         from cyclonedds.core import Policy, Qos
         from cyclonedds.domain import DomainParticipant
 
