@@ -213,7 +213,7 @@ class _Recording:
             raise InputError(f"{path} exists already: record into a new folder")
         self.clock = WallClock(offset=offset)
         self.bus = DdsBus(self.clock, node="recorder", recorder=True)
-        self.recorder = Recorder(path, robots=robots, announced={})
+        self.recorder = Recorder(path, robots=robots, announced={}, rate=None)
         self.path = path
         self._seen: set[str] = set()
         self._publications = _publication_reader(self.bus)

@@ -27,12 +27,13 @@ from robotale.fame_runtime.dds import DdsBus, dds_qos  # noqa: E402
 from robotale.fame_runtime.engine import Engine  # noqa: E402
 from robotale.fame_runtime.parser import parse  # noqa: E402
 from robotale.fame_runtime.qos import DEFAULT_QOS, incompatibilities  # noqa: E402
-from robotale.fame_runtime.rostypes import idl_type  # noqa: E402
+from robotale.fame_runtime.rostypes import idl_type, to_sample  # noqa: E402
 
 pytestmark = pytest.mark.timeout(180)
 
 AGRI = Path(__file__).resolve().parents[2] / "robotale" / "sim" / "scenarios" / "agri.bpmn"
 POINT = "geometry_msgs/msg/Point"
+RANGE, ODOMETRY = "sensor_msgs/msg/Range", "nav_msgs/msg/Odometry"
 LOOPBACK = """<CycloneDDS><Domain><General><Interfaces>
 <NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast>
 </General><Discovery><ParticipantIndex>auto</ParticipantIndex>
@@ -362,7 +363,9 @@ def patrols(lines: list[str], robot: str) -> int:
 def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
     """``robotale record`` first, then one ``fame node`` per robot (as on two machines): the
     caller throws the moment the listener is up, and the bag still has that message, because
-    robots wait until a recorder on the domain reads their topics; Ctrl-C closes the bag."""
+    robots wait until a recorder on the domain reads their topics; Ctrl-C closes the bag.
+    A robot's own topics that are not robotale's (a range sensor, odometry at full rate),
+    written here with plain cyclonedds, are in the bag message for message."""
     import signal
     import subprocess
     import sys
@@ -380,6 +383,17 @@ def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
         text=True,
     )
     assert recorder.stderr.readline().startswith("# recording ")  # it listens: start the robots
+    sensors = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    own = {
+        "/caller/range": (RANGE, [{"range": 0.1 * k, "max_range": 4.0} for k in range(5)]),
+        "/caller/odom": (ODOMETRY, [{"pose": {"pose": {"position": {"x": k}}}} for k in range(40)]),
+    }
+    for topic, (msgtype, samples) in own.items():
+        kept = dds_qos(replace(DEFAULT_QOS, history="keep_all"))  # none overwritten unsent
+        writer = DataWriter(sensors, Topic(sensors, "rt" + topic, idl_type(msgtype)), qos=kept)
+        matched(writer, 30.0)  # the recorder found the topic and reads it
+        for sample in samples:
+            writer.write(to_sample(msgtype, sample))
     node = [*robotale, "fame", "node", str(model), "--robots", "caller,listener"]
     nodes = {
         robot: subprocess.Popen(
@@ -408,12 +422,13 @@ def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
     heard = [r for r in printed if r[2] == "hello?" and r[3] == "complete"]
     assert len(sent) == 1 and [r[4] for r in heard] == [sent[0][4]]
     with AnyReader([bag]) as reader:
-        messages = [
-            reader.deserialize(raw, c.msgtype).data
-            for c, _, raw in reader.messages()
-            if c.topic == "/hello"
-        ]
-    assert messages == ["hi"]
+        found: dict[str, list] = {}
+        for connection, _, raw in reader.messages():
+            message = reader.deserialize(raw, connection.msgtype)
+            found.setdefault(connection.topic, []).append(message)
+    assert [m.data for m in found["/hello"]] == ["hi"]
+    assert [m.range for m in found["/caller/range"]] == pytest.approx([0.1 * k for k in range(5)])
+    assert [m.pose.pose.position.x for m in found["/caller/odom"]] == list(range(40))
     log = prepare_recordings(bag)
     in_bag = Counter(
         log[["robot", "concept:name", "lifecycle:transition"]].itertuples(index=False, name=None)
