@@ -523,3 +523,23 @@ def test_timer_start_events_start_their_robots_over_dds_and_keep_the_mission_goi
     }
     assert set(done) == {"waiter", "alarm_clock", "ticker"}
     assert min(done.values()) >= ring + 5.0  # nobody left while the snooze was armed
+
+
+def test_the_models_qos_is_live_a_pair_fame_check_refuses_never_talks_over_dds(capsys, models):
+    """qos.bpmn as one process per robot: the drone's best-effort weed_position never reaches
+    the tractor's reliable catch (as ``fame check`` says); nobody waits to meet that pair, the
+    readers' buses name it, and the run ends at --until with the drone waiting."""
+    run = ["fame", "run", str(models / "qos.bpmn"), "--robots", "drone,tractor_1"]
+    assert main([*run, "--bus", "dds", "--until", "20"]) == 1
+    captured = capsys.readouterr()
+    printed = rows(captured.out)
+    assert [r[1:4] for r in printed] == [
+        ["drone", "weed_position!", "start"],
+        ["drone", "weed_position!", "complete"],
+    ]
+    assert (
+        "# warning: /weed_position: a publisher and tractor_1's subscriber cannot talk "
+        "(reliability does not match; see robotale fame check)"
+    ) in captured.err
+    assert "# drone is at intermediateCatchEvent d_position (tractor_position)" in captured.err
+    assert "starts with no peer" not in captured.err
