@@ -183,6 +183,7 @@ class DdsBus:
 
         self.clock = clock
         self.node = node or uuid.uuid4().hex[:8]
+        self.recorder = recorder
         mark = Qos(Policy.Userdata(RECORDER_MARK)) if recorder else None
         self.participant = DomainParticipant(domain_id() if domain is None else domain, qos=mark)
         self.on_warning = on_warning or (lambda text: None)
@@ -355,6 +356,11 @@ class DdsBus:
         for reader in self._readers.values():
             reader.detach()
         self._taps.clear()
+        if self.recorder:  # robots must not wait for it any more, even while this process lives
+            from cyclonedds.core import Policy, Qos
+
+            with contextlib.suppress(Exception):
+                self.participant.set_qos(Qos(Policy.Userdata(b"")))
         self.participant = None
 
 
@@ -378,9 +384,11 @@ class Recorders:
             try:
                 mark = sample.qos[Policy.Userdata].data
             except (KeyError, AttributeError):
-                continue
+                mark = b""
             if mark == RECORDER_MARK:
                 self.keys.add(sample.key)
+            else:  # a recording that was closed
+                self.keys.discard(sample.key)
         return self.keys
 
 
