@@ -71,10 +71,11 @@ def node_command(
         tag_sink=lambda tag: print(tag_line(tag, begin), file=out, flush=True),
         wait_for_recorder=recorder,
     )
+    # a second Ctrl-C (a terminal's and fame run's own) must not cut the closing short
     with _interrupts(node.interrupt):
         node.run(until=begin + until, wait=wait, warn=lambda text: print(f"# {text}", file=err))
-    bus.close()
-    return _node_verdict(node, begin, err)
+        bus.close()
+        return _node_verdict(node, begin, err)
 
 
 class _interrupts:
@@ -156,13 +157,16 @@ def run_processes(
         for robot in names
     ]
     relays = [_relay(c.stdout, out) for c in children] + [_relay(c.stderr, err) for c in children]
+    # Ctrl-C (or SIGTERM) sets a flag: an exception could cut the recording mid-write
+    interrupted = threading.Event()
     try:
-        _wait(children, recording, time.monotonic() + until + GRACE)
-    except KeyboardInterrupt:
-        for child in children:  # each robot runs its safe-state handler, then ends
-            with suppress(ProcessLookupError):
-                child.send_signal(signal.SIGINT)
-        _wait(children, recording, time.monotonic() + GRACE)
+        with _interrupts(interrupted.set):
+            _wait(children, recording, time.monotonic() + until + GRACE, interrupted)
+            if interrupted.is_set():
+                for child in children:  # each robot runs its safe-state handler, then ends
+                    with suppress(ProcessLookupError):
+                        child.send_signal(signal.SIGINT)
+                _wait(children, recording, time.monotonic() + GRACE)
     finally:
         for child in children:
             if child.poll() is None:
@@ -194,9 +198,17 @@ def _relay(stream, sink: TextIO) -> threading.Thread:
 _SINK_LOCKS: dict[int, threading.Lock] = {}
 
 
-def _wait(children, recording: _Recording | None, deadline: float) -> None:
-    """Until every child ended (or ``deadline``), recording what arrives meanwhile."""
+def _wait(
+    children,
+    recording: _Recording | None,
+    deadline: float,
+    interrupted: threading.Event | None = None,
+) -> None:
+    """Until every child ended (or ``deadline``, or an interrupt), recording what arrives
+    meanwhile."""
     while any(c.poll() is None for c in children) and time.monotonic() < deadline:
+        if interrupted is not None and interrupted.is_set():
+            return
         if recording is not None:
             recording.pump(0.05)
         else:
@@ -245,7 +257,8 @@ class _Recording:
         """Write what is still on its way, then close the bag."""
         quiet_until = time.monotonic() + 0.3
         while time.monotonic() < quiet_until:
-            pending = self.bus.pending
+            # what the readers hold already, even if Cyclone has not called their listeners
+            pending = self.bus.drain() + self.bus.pending
             self.pump(0.05)
             if pending:
                 quiet_until = time.monotonic() + 0.3

@@ -137,14 +137,17 @@ class _Reader:
             self.reader.set_listener(None)
         del old
 
-    def _arrived(self, _reader=None) -> None:
-        # a Cyclone thread: take the samples, hand them to the clock's thread
+    def _arrived(self, _reader=None) -> int:
+        # a Cyclone thread (or a drain): take the samples, hand them to the clock's thread
+        taken = 0
         for sample in self.reader.take(N=256):
             info = sample.sample_info
             if not info.valid_data:
                 continue
             envelope = self.bus.envelope(self.reader, self.topic, self.msgtype, sample, info)
             self.bus.hand_over(lambda envelope=envelope: self.dispatch(envelope))
+            taken += 1
+        return taken
 
     def dispatch(self, envelope: Envelope) -> None:
         if self.qos.durability == "transient_local":
@@ -339,6 +342,11 @@ class DdsBus:
                 return "", ""  # not matched (any more): ask again next time
             self._senders[handle] = _parse_userdata(found.qos)
         return self._senders[handle]
+
+    def drain(self) -> int:
+        """Hand over what the readers hold now, not waiting for Cyclone to call their listeners
+        (a recording that closes); returns how many samples that was."""
+        return sum(reader._arrived() for reader in list(self._readers.values()))
 
     def warn(self, text: str) -> None:
         if text not in self.warnings:
