@@ -18,9 +18,11 @@ from pathlib import Path
 
 from robotale import __version__
 from robotale.errors import RobotaleError
+from robotale.extras import require
 
 #: the namespace key holding the handler's dotted name; subparser keys begin with "_" too
 _HANDLER = "_handler"
+_EXTRA = "_extra"
 
 
 def build_parser() -> argparse.ArgumentParser:
@@ -48,14 +50,17 @@ def build_parser() -> argparse.ArgumentParser:
     return parser
 
 
-def _handled_by(parser: argparse.ArgumentParser, target: str) -> None:
-    """``target`` (``module.function`` below ``robotale.commands``) handles ``parser``."""
-    parser.set_defaults(**{_HANDLER: f"robotale.commands.{target}"})
+def _handled_by(parser: argparse.ArgumentParser, target: str, *, extra: str = "") -> None:
+    """``target`` (``module.function`` below ``robotale.commands``) handles ``parser``; its
+    module needs the optional ``extra`` installed."""
+    parser.set_defaults(**{_HANDLER: f"robotale.commands.{target}", _EXTRA: extra})
 
 
 def run_handler(args: argparse.Namespace) -> int:
     """Import the command's handler and call it with the arguments the user gave."""
     module, _, name = getattr(args, _HANDLER).rpartition(".")
+    if getattr(args, _EXTRA, ""):
+        require(getattr(args, _EXTRA))
     handler = getattr(importlib.import_module(module), name)
     given = {k: v for k, v in vars(args).items() if not k.startswith("_") and v is not None}
     return int(handler(**given) or 0)
@@ -213,7 +218,7 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         const=True,
         help=argparse.SUPPRESS,
     )
-    _handled_by(node, "fame_dds.node_command")
+    _handled_by(node, "fame_dds.node_command", extra="dds")
 
 
 def _add_record(commands: argparse._SubParsersAction) -> None:
@@ -228,7 +233,7 @@ def _add_record(commands: argparse._SubParsersAction) -> None:
         "--robots", required=True, help="the robots' namespaces, e.g. drone,tractor_1"
     )
     record.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
-    _handled_by(record, "fame_dds.record_command")
+    _handled_by(record, "fame_dds.record_command", extra="dds")
 
 
 def _add_prepare(commands: argparse._SubParsersAction) -> None:

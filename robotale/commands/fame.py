@@ -10,6 +10,7 @@ from pathlib import Path
 from typing import Any, TextIO
 
 from robotale.errors import InputError, ModelError, require_range
+from robotale.extras import require
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.check import Report, check, duplicate_ids
 from robotale.fame_runtime.clock import SimClock
@@ -132,6 +133,7 @@ def run_command(
     require_range(latency, "--latency", 0, unit=" seconds")
     refuse_duplicate_ids(model)
     if bus == "dds":
+        require("dds")  # before any robot's process is started
         # Cyclone DDS is an optional extra (robotale[dds]) and 0.9 s to import: --bus dds only
         from robotale.commands.fame_dds import run_processes
 

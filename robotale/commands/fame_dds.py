@@ -73,10 +73,11 @@ def node_command(
         tag_sink=lambda tag: print(tag_line(tag, begin), file=out, flush=True),
         wait_for_recorder=recorder,
     )
+    # a second Ctrl-C (a terminal's and fame run's own) must not cut the closing short
     with _interrupts(node.interrupt):
         node.run(until=begin + until, wait=wait, warn=lambda text: print(f"# {text}", file=err))
-    bus.close()
-    return _node_verdict(node, begin, err)
+        bus.close()
+        return _node_verdict(node, begin, err)
 
 
 class _interrupts:
@@ -109,7 +110,8 @@ def _node_verdict(node: Node, begin: float, err: TextIO) -> int:
         file=err,
     )
     if not engine.idle:
-        print(f"# {node.robot} is at {', '.join(engine.where())}", file=err)
+        where = ", ".join(engine.where()) or "the start of an instance"
+        print(f"# {node.robot} is at {where}", file=err)
     for failure in engine.failures:
         print(f"# {failure}", file=err)
     if node.interrupted:
@@ -154,13 +156,16 @@ def run_processes(
         for robot in names
     ]
     relays = [_relay(c.stdout, out) for c in children] + [_relay(c.stderr, err) for c in children]
+    # Ctrl-C (or SIGTERM) sets a flag: an exception could cut the recording mid-write
+    interrupted = threading.Event()
     try:
-        _wait(children, recording, time.monotonic() + until + GRACE)
-    except KeyboardInterrupt:
-        for child in children:  # each robot runs its safe-state handler, then ends
-            with suppress(ProcessLookupError):
-                child.send_signal(signal.SIGINT)
-        _wait(children, recording, time.monotonic() + GRACE)
+        with _interrupts(interrupted.set):
+            _wait(children, recording, time.monotonic() + until + GRACE, interrupted)
+            if interrupted.is_set():
+                for child in children:  # each robot runs its safe-state handler, then ends
+                    with suppress(ProcessLookupError):
+                        child.send_signal(signal.SIGINT)
+                _wait(children, recording, time.monotonic() + GRACE)
     finally:
         for child in children:
             if child.poll() is None:
@@ -192,9 +197,17 @@ def _relay(stream, sink: TextIO) -> threading.Thread:
 _SINK_LOCKS: dict[int, threading.Lock] = {}
 
 
-def _wait(children, recording: _Recording | None, deadline: float) -> None:
-    """Until every child ended (or ``deadline``), recording what arrives meanwhile."""
+def _wait(
+    children,
+    recording: _Recording | None,
+    deadline: float,
+    interrupted: threading.Event | None = None,
+) -> None:
+    """Until every child ended (or ``deadline``, or an interrupt), recording what arrives
+    meanwhile."""
     while any(c.poll() is None for c in children) and time.monotonic() < deadline:
+        if interrupted is not None and interrupted.is_set():
+            return
         if recording is not None:
             recording.pump(0.05)
         else:
@@ -212,8 +225,8 @@ class _Recording:
         if path.exists():
             raise InputError(f"{path} exists already: record into a new folder")
         self.clock = WallClock(offset=offset)
-        self.bus = DdsBus(self.clock, node="recorder")
-        self.recorder = Recorder(path, robots=robots, announced={})
+        self.bus = DdsBus(self.clock, node="recorder", recorder=True)
+        self.recorder = Recorder(path, robots=robots, announced={}, rate=None)
         self.path = path
         self._seen: set[str] = set()
         self._publications = _publication_reader(self.bus)
@@ -222,6 +235,9 @@ class _Recording:
     def _discover(self) -> None:
         """Subscribe to each new ROS-typed topic, asking what its publisher offers."""
         for sample in self._publications.take(N=256):
+            # a publication that ended comes as a sample without data (no topic, no type)
+            if not sample.sample_info.valid_data or sample.type_name is None:
+                continue
             msgtype = type_of(sample.type_name)
             topic = ros_topic(sample.topic_name)
             if not sample.topic_name.startswith("rt/") or topic == STATUS_TOPIC:
@@ -242,7 +258,8 @@ class _Recording:
         """Write what is still on its way, then close the bag."""
         quiet_until = time.monotonic() + 0.3
         while time.monotonic() < quiet_until:
-            pending = self.bus.pending
+            # what the readers hold already, even if Cyclone has not called their listeners
+            pending = self.bus.drain() + self.bus.pending
             self.pump(0.05)
             if pending:
                 quiet_until = time.monotonic() + 0.3
@@ -284,11 +301,13 @@ def record_command(
         raise InputError("--robots names no robot (for example drone,tractor_1)")
     recording = _Recording(out_dir, names, 0.0)
     deadline = time.monotonic() + duration if duration is not None else float("inf")
-    try:
-        while time.monotonic() < deadline:
-            recording.pump(min(0.2, max(0.0, deadline - time.monotonic())))
-    except KeyboardInterrupt:
-        pass  # Ctrl-C ends a recording: the bag is closed below
-    finally:
-        recording.close(err)
+    stopped = threading.Event()
+    # Ctrl-C or SIGTERM ends a recording: the bag is closed whole below
+    with _interrupts(stopped.set):
+        print(f"# recording {out_dir} (Ctrl-C stops)", file=err, flush=True)
+        try:
+            while time.monotonic() < deadline and not stopped.is_set():
+                recording.pump(min(0.2, max(0.0, deadline - time.monotonic())))
+        finally:
+            recording.close(err)
     return 0

@@ -29,6 +29,7 @@ from collections import deque
 from collections.abc import Callable
 from typing import Any
 
+from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsParticipant
 from cyclonedds.core import Listener, Policy, Qos
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.pub import DataWriter
@@ -45,6 +46,8 @@ from robotale.fame_runtime.rostypes import dds_topic, dds_type_name, idl_type, t
 #: seconds a closing bus waits for reliable readers to acknowledge what it published
 ACK_TIMEOUT = 2.0
 _USERDATA = "robotale;sender={sender};ids={ids}"
+#: the user data of a recorder's participant, so robots wait until it reads their topics
+RECORDER_MARK = b"robotale;recorder"
 #: DDS QoS policy ids (DDS 1.4, 2.2.3) of the policies a model can set
 _POLICIES = {
     2: "durability",
@@ -122,14 +125,17 @@ class _Reader:
             self.reader.set_listener(None)
         del old
 
-    def _arrived(self, _reader=None) -> None:
-        # a Cyclone thread: take the samples, hand them to the clock's thread
+    def _arrived(self, _reader=None) -> int:
+        # a Cyclone thread (or a drain): take the samples, hand them to the clock's thread
+        taken = 0
         for sample in self.reader.take(N=256):
             info = sample.sample_info
             if not info.valid_data:
                 continue
             envelope = self.bus.envelope(self.reader, self.topic, self.msgtype, sample, info)
             self.bus.hand_over(lambda envelope=envelope: self.dispatch(envelope))
+            taken += 1
+        return taken
 
     def dispatch(self, envelope: Envelope) -> None:
         if self.qos.durability == "transient_local":
@@ -160,10 +166,13 @@ class DdsBus:
         node: str = "",
         domain: int | None = None,
         on_warning: Callable[[str], None] | None = None,
+        recorder: bool = False,
     ) -> None:
         self.clock = clock
         self.node = node or uuid.uuid4().hex[:8]
-        self.participant = DomainParticipant(domain_id() if domain is None else domain)
+        self.recorder = recorder
+        mark = Qos(Policy.Userdata(RECORDER_MARK)) if recorder else None
+        self.participant = DomainParticipant(domain_id() if domain is None else domain, qos=mark)
         self.on_warning = on_warning or (lambda text: None)
         self.warnings: list[str] = []
         self._topics: dict[tuple[str, str], Any] = {}
@@ -217,6 +226,19 @@ class DdsBus:
             for r in self._readers.values()
         ]
         return counts
+
+    def unrecorded(self, recorders: set[Any]) -> list[str]:
+        """The topics this bus writes that a recorder (by participant key) does not read yet."""
+        missing = set()
+        for (topic, *_), writer in self._writers.items():
+            readers = set()
+            for handle in writer.get_matched_subscriptions():
+                found = writer.get_matched_subscription_data(handle)
+                if found is not None:
+                    readers.add(found.participant_key)
+            if not recorders <= readers:
+                missing.add(topic)
+        return sorted(missing)
 
     # -- the Bus interface ---------------------------------------------------------------------
 
@@ -299,6 +321,11 @@ class DdsBus:
             self._senders[handle] = _parse_userdata(found.qos)
         return self._senders[handle]
 
+    def drain(self) -> int:
+        """Hand over what the readers hold now, not waiting for Cyclone to call their listeners
+        (a recording that closes); returns how many samples that was."""
+        return sum(reader._arrived() for reader in list(self._readers.values()))
+
     def warn(self, text: str) -> None:
         if text not in self.warnings:
             self.warnings.append(text)
@@ -313,7 +340,34 @@ class DdsBus:
         for reader in self._readers.values():
             reader.detach()
         self._taps.clear()
+        if self.recorder:  # robots must not wait for it any more, even while this process lives
+            with contextlib.suppress(Exception):
+                self.participant.set_qos(Qos(Policy.Userdata(b"")))
         self.participant = None
+
+
+class Recorders:
+    """The recorders on the domain (participants with :data:`RECORDER_MARK`), as they come
+    and go."""
+
+    def __init__(self, bus: DdsBus) -> None:
+        self.keys: set[Any] = set()
+        self._reader = BuiltinDataReader(bus.participant, BuiltinTopicDcpsParticipant)
+
+    def update(self) -> set[Any]:
+        for sample in self._reader.take(N=256):
+            if not sample.sample_info.valid_data:  # a participant that left
+                self.keys.discard(sample.key)
+                continue
+            try:
+                mark = sample.qos[Policy.Userdata].data
+            except (KeyError, AttributeError):
+                mark = b""
+            if mark == RECORDER_MARK:
+                self.keys.add(sample.key)
+            else:  # a recording that was closed
+                self.keys.discard(sample.key)
+        return self.keys
 
 
 def _parse_userdata(qos: Any) -> tuple[str, str]:

@@ -5,7 +5,9 @@ A :class:`Node` runs the process its robot gets from the collaboration on a
 ``/<robot>/tag`` (reliable, transient local, every tag kept: a recorder that joins late
 still gets them all). Before its robot starts it declares a DDS writer or reader for every
 signal its pool throws or catches and waits until the other robots of the mission are up and
-those endpoints are matched, so a signal thrown at once is not lost to discovery.
+those endpoints are matched, so a signal thrown at once is not lost to discovery; when a
+recorder is on the domain (``robotale record``, ``fame run --record``) it also waits until
+the recorder reads every topic the robot writes, so the bag has the first message too.
 
 Robots say how they are on ``/robotale/status``; the mission is over for a node when every
 robot has been idle (no instance running, no timer armed, nothing in flight) for ``settle``
@@ -21,12 +23,12 @@ from pathlib import Path
 from typing import Any
 
 from robotale.errors import InputError
-from robotale.fame_runtime.check import endpoints
-from robotale.fame_runtime.dds import DdsBus
+from robotale.fame_runtime.check import Endpoint, endpoints
+from robotale.fame_runtime.dds import DdsBus, Recorders
 from robotale.fame_runtime.engine import Engine
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import Definitions
-from robotale.fame_runtime.qos import DEFAULT_QOS
+from robotale.fame_runtime.qos import DEFAULT_QOS, pair_problems
 from robotale.fame_runtime.rostypes import STATUS_TYPE, to_data
 from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.splitter import split
@@ -101,6 +103,7 @@ class Node:
         self._quiet_since: float | None = None
         self.interrupted = False
         self._status_reader = bus.raw_reader(STATUS_TOPIC, STATUS_TYPE, KEEP_ALL)
+        self._recorders = Recorders(bus)
 
     @property
     def robot(self) -> str:
@@ -115,12 +118,12 @@ class Node:
         for topic, mine in publishers.items():
             for endpoint in (e for e in mine if e.pool == pool):
                 writer = self.bus.writer(topic, endpoint.msgtype, endpoint.qos, self.robot)
-                if any(e.pool != pool for e in subscribers.get(topic, ())):
+                if any(_talk(endpoint, e) for e in subscribers.get(topic, ()) if e.pool != pool):
                     self.peered.append((topic, writer.get_publication_matched_status))
         for topic, mine in subscribers.items():
             for endpoint in (e for e in mine if e.pool == pool):
                 reader = self.bus.reader(topic, endpoint.msgtype, endpoint.qos).reader
-                if any(e.pool != pool for e in publishers.get(topic, ())):
+                if any(_talk(e, endpoint) for e in publishers.get(topic, ()) if e.pool != pool):
                     self.peered.append((topic, reader.get_subscription_matched_status))
         self.bus.writer(tag_topic(self.robot), TAG_TYPE, KEEP_ALL, self.robot)
 
@@ -138,26 +141,37 @@ class Node:
         (absolute time) or an interrupt; returns the time reached."""
         self.engine.start()  # arms the start events; the first instance runs on the clock
         self._say(ready=True)
-        self._meet(wait, warn)
+        self._meet(min(wait, max(0.0, until - self.clock.now())), warn)
         self._poll()
         return self.clock.run(until=until, stop_when=self._over)
 
     def _meet(self, wait: float, warn: Callable[[str], None]) -> None:
         """Wait until every robot said it is ready and the shared topics are matched."""
         deadline = time.monotonic() + wait
-        while time.monotonic() < deadline and not self.interrupted:
+        while True:  # looks at least once, even with no time to wait
             self._take_statuses()
             missing = [r for r in self.robots if r not in self.statuses]
             lonely = sorted({t for t, status in self.peered if not status().current_count})
-            if not missing and not lonely:
+            unrecorded = self._unrecorded()
+            if (not missing and not lonely and not unrecorded) or self.interrupted:
                 return
+            if time.monotonic() >= deadline:
+                break
             time.sleep(0.01)
-        if self.interrupted:
-            return
         if missing:
             warn(f"{self.robot} starts without {', '.join(missing)} (not up after {wait:g} s)")
         if lonely:
             warn(f"{self.robot} starts with no peer yet on {', '.join(lonely)}")
+        if unrecorded:
+            warn(f"{self.robot} starts before the recorder reads {', '.join(unrecorded)}")
+
+    def _unrecorded(self) -> list[str]:
+        """Topics this robot writes that a recorder on the domain does not read yet (a
+        recorder subscribes to a topic only once it has seen a writer of it)."""
+        recorders = self._recorders.update()
+        if not recorders:
+            return []
+        return [t for t in self.bus.unrecorded(recorders) if t != STATUS_TOPIC]
 
     def _take_statuses(self) -> None:
         """Read what robots said (polled: statuses must be seen before the clock runs)."""
@@ -210,3 +224,8 @@ class Node:
         """Ctrl-C: stop the robot through its safe-state handler (from a signal handler)."""
         self.interrupted = True
         self.clock.call_soon(lambda: self.engine.stop(safe=True))
+
+
+def _talk(publisher: Endpoint, subscriber: Endpoint) -> bool:
+    """Whether DDS will match the pair (a pair fame check refuses never will: no waiting)."""
+    return not pair_problems(publisher.qos, subscriber.qos, publisher.msgtype, subscriber.msgtype)

@@ -11,6 +11,9 @@ is still in the bag, as ``ros2 bag record`` on the sender's side would have it).
   detections, collisions;
 - any other robot topic named in ``extra`` (``range``, ``cmd_vel`` ...), at ``rate``.
 
+With ``rate=None`` it keeps every message of every topic (a live run's recording: what
+arrives is what the robots really sent).
+
 The connections of the topics the mission is known to use are announced when the bag opens;
 others are added when their first message arrives. Message timestamps are simulated time. Each
 topic offers rclcpp's default QoS, and the metadata is written as the chosen ROS 2
@@ -45,7 +48,7 @@ class Recorder:
         robots: Iterable[str],
         announced: Mapping[str, str],
         storage: str = "sqlite3",
-        rate: float = 2.0,
+        rate: float | None = 2.0,
         errors: Iterable[str] = (),
         extra: Iterable[str] = (),
         distro: str = bagmeta.DEFAULT_DISTRO,
@@ -56,7 +59,8 @@ class Recorder:
             raise InputError(f"distro {distro!r} is not one of {', '.join(bagmeta.VERSIONS)}")
         self.path, self.distro = Path(path), distro
         self.robots = frozenset(robots)
-        self.period = 1.0 / rate
+        self.period = 1.0 / rate if rate else 0.0
+        self.keep_all = rate is None
         self.errors = frozenset(errors)
         self.extra = frozenset(extra)
         self._policies: dict[str, str] = {}
@@ -104,6 +108,8 @@ class Recorder:
         self.counts[topic] += 1
 
     def _policy(self, topic: str) -> str:
+        if self.keep_all:
+            return KEEP
         parts = topic.strip("/").split("/")
         if len(parts) < 2 or parts[0] not in self.robots:
             return KEEP  # a signal

@@ -93,3 +93,26 @@ def test_only_best_effort_deliveries_are_lost(seed):
     clock.run()
     assert len(reliable) == 400
     assert 120 < len(lossy) < 280  # about half of 400 (binomial, 7 standard deviations)
+
+
+def test_fame_run_delivers_nothing_across_a_pair_fame_check_refuses(capsys):
+    from robotale.cli import main
+
+    model = str(MODELS / "qos.bpmn")
+    assert main(["fame", "check", model]) == 1
+    refused = [line for line in capsys.readouterr().out.splitlines() if "INCOMPATIBLE" in line]
+    code = main(["fame", "run", model, "--robots", "drone,tractor_1", "--until", "60"])
+    captured = capsys.readouterr()
+    rows = [line.split("\t") for line in captured.out.splitlines()]
+    warnings = [line for line in captured.err.splitlines() if line.startswith("# warning:")]
+    # the drone's best-effort weed_position is one of the pairs fame check refuses
+    assert any(line.lstrip().startswith("/weed_position: Drone d_weed") for line in refused)
+    assert [r[2:4] for r in rows if r[1] == "drone"] == [
+        ["weed_position!", "start"],
+        ["weed_position!", "complete"],
+    ]
+    assert not [r for r in rows if r[1] == "tractor_1"]  # never received, never started
+    assert len(warnings) == 1 and warnings[0].startswith("# warning: /weed_position: drone")
+    # as ROS 2 would: the drone waits for an answer that never comes, and the run says so
+    assert code == 1
+    assert "# drone is at intermediateCatchEvent d_position (tractor_position)" in captured.err

@@ -3,8 +3,10 @@ two engine processes run the agri mission into one bag, plain DDS code that know
 ROS 2 names talks to robotale, and DDS itself keeps QoS-incompatible pairs apart."""
 
 import gc
+import itertools
 import os
 import time
+from collections import Counter
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -21,15 +23,17 @@ from fame_suite import MODELS  # noqa: E402
 
 from robotale.cli import main  # noqa: E402
 from robotale.fame_runtime.clock import WallClock  # noqa: E402
-from robotale.fame_runtime.dds import DdsBus  # noqa: E402
+from robotale.fame_runtime.dds import DdsBus, dds_qos  # noqa: E402
 from robotale.fame_runtime.engine import Engine  # noqa: E402
 from robotale.fame_runtime.parser import parse  # noqa: E402
-from robotale.fame_runtime.qos import DEFAULT_QOS  # noqa: E402
+from robotale.fame_runtime.qos import DEFAULT_QOS, incompatibilities  # noqa: E402
+from robotale.fame_runtime.rostypes import idl_type, to_sample  # noqa: E402
 
 pytestmark = pytest.mark.timeout(180)
 
 AGRI = Path(__file__).resolve().parents[2] / "robotale" / "sim" / "scenarios" / "agri.bpmn"
 POINT = "geometry_msgs/msg/Point"
+RANGE, ODOMETRY = "sensor_msgs/msg/Range", "nav_msgs/msg/Odometry"
 LOOPBACK = """<CycloneDDS><Domain><General><Interfaces>
 <NetworkInterface address="127.0.0.1"/></Interfaces><AllowMulticast>false</AllowMulticast>
 </General><Discovery><ParticipantIndex>auto</ParticipantIndex>
@@ -225,3 +229,317 @@ def test_a_transient_local_late_joiner_gets_the_stored_samples_over_dds():
     assert [e.data["x"] for e in got] == [2.0, 3.0]  # the writer keeps depth 2
     assert {e.sender for e in got} == {"talker"}
     assert volatile == []  # a volatile reader asks for no history
+
+
+#: every value a model can give the policies that decide a match (None: infinite)
+MATCHING = {
+    "reliability": ("reliable", "best_effort"),
+    "durability": ("volatile", "transient_local"),
+    "liveliness": ("automatic", "manual_by_topic"),
+    "deadline": (None, 1.0, 2.0),
+    "lease_duration": (None, 1.0, 2.0),
+}
+#: policies that never prevent a match, spread over the pairs
+OTHERS = (
+    {},
+    {"history": "keep_all", "lifespan": 1.0},
+    {"history": "keep_last", "depth": 1, "lifespan": 5.0},
+)
+
+
+@pytest.mark.slow
+def test_fame_checks_verdict_is_cyclone_ddss_matching_on_every_policy_combination():
+    """Each of the 72 x 72 offered/requested profiles as a real Cyclone writer and reader
+    (local endpoints of one participant match at once): they match exactly when the C-QoS
+    rules find no incompatibility, and Cyclone reports the others as incompatible."""
+    profiles = [
+        replace(DEFAULT_QOS, **dict(zip(MATCHING, values, strict=True)))
+        for values in itertools.product(*MATCHING.values())
+    ]
+    participant = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    string = idl_type("std_msgs/msg/String")
+    disagreements, blocked = [], 0
+    for n, (offered, requested) in enumerate(itertools.product(profiles, profiles)):
+        offered = replace(offered, **OTHERS[n % 3])
+        requested = replace(requested, **OTHERS[n // 3 % 3])
+        topic = Topic(participant, f"rt/pair_{n}", string)
+        writer = DataWriter(participant, topic, qos=dds_qos(offered))
+        reader = DataReader(participant, topic, qos=dds_qos(requested))
+        talks = writer.get_publication_matched_status().current_count == 1
+        refused = reader.get_requested_incompatible_qos_status().total_count > 0
+        compatible = not incompatibilities(offered, requested)
+        blocked += not compatible
+        if (talks, refused) != (compatible, not compatible):
+            disagreements.append((offered, requested, talks, refused))
+    assert disagreements == []
+    # by hand: 3 of the 4 pairs of each two-valued policy match, 6 of the 9 of each period
+    assert blocked == 72 * 72 - 3**3 * 6**2
+
+
+PATROL = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="patrol_forever">
+  <bpmn:collaboration id="c">
+    <bpmn:participant id="p_rover" name="Rover" processRef="Rover" />
+    <bpmn:participant id="p_drone" name="Drone" processRef="Drone" />
+  </bpmn:collaboration>
+  {processes}
+</bpmn:definitions>
+"""
+PATROLLER = """<bpmn:process id="{pool}">
+    <bpmn:startEvent id="{pool}_start" />
+    <bpmn:task id="{pool}_patrol" name="Patrol" />
+    <bpmn:intermediateCatchEvent id="{pool}_pause" name="pause">
+      <bpmn:timerEventDefinition><bpmn:timeDuration>PT0.2S</bpmn:timeDuration>
+      </bpmn:timerEventDefinition>
+    </bpmn:intermediateCatchEvent>
+    <bpmn:sequenceFlow id="{pool}_f1" sourceRef="{pool}_start" targetRef="{pool}_patrol" />
+    <bpmn:sequenceFlow id="{pool}_f2" sourceRef="{pool}_patrol" targetRef="{pool}_pause" />
+    <bpmn:sequenceFlow id="{pool}_f3" sourceRef="{pool}_pause" targetRef="{pool}_patrol" />
+    <bpmn:subProcess id="{pool}_safe" name="Safe State" triggeredByEvent="true">
+      <bpmn:startEvent id="{pool}_s_start" name="emergency">
+        <bpmn:errorEventDefinition /></bpmn:startEvent>
+      <bpmn:task id="{pool}_stop_motors" name="Stop Motors" />
+      <bpmn:endEvent id="{pool}_s_end" />
+      <bpmn:sequenceFlow id="{pool}_s1" sourceRef="{pool}_s_start" targetRef="{pool}_stop_motors" />
+      <bpmn:sequenceFlow id="{pool}_s2" sourceRef="{pool}_stop_motors" targetRef="{pool}_s_end" />
+    </bpmn:subProcess>
+  </bpmn:process>"""
+
+
+@pytest.mark.slow
+def test_ctrl_c_stops_every_robot_through_its_safe_state_and_closes_the_bag(tmp_path):
+    """As a terminal's Ctrl-C does: SIGINT to the whole process group of a DDS run."""
+    import signal
+    import subprocess
+    import sys
+
+    from robotale.commands.prepare import prepare_recordings
+
+    model = tmp_path / "patrol.bpmn"
+    processes = "\n  ".join(PATROLLER.format(pool=pool) for pool in ("Rover", "Drone"))
+    model.write_text(PATROL.format(processes=processes))
+    bag = tmp_path / "run"
+    command = [sys.executable, "-m", "robotale", "fame", "run", str(model)]
+    command += ["--robots", "rover,drone", "--bus", "dds", "--record", str(bag), "--until", "600"]
+    environment = {**os.environ, "PYTHONUNBUFFERED": "1"}  # tags reach us as they happen
+    run = subprocess.Popen(
+        command,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        start_new_session=True,
+        env=environment,
+    )
+    try:
+        seen: list[str] = []
+        for line in run.stdout:  # wait until both robots patrol (so the recorder listens)
+            seen.append(line)
+            if all(patrols(seen, robot) >= 3 for robot in ("rover", "drone")):
+                break
+        os.killpg(run.pid, signal.SIGINT)
+        rest, errors = run.communicate(timeout=90)
+    finally:
+        if run.poll() is None:
+            os.killpg(run.pid, signal.SIGKILL)
+    printed = rows("".join(seen) + rest)
+    assert run.returncode == 130, errors
+    for robot in ("rover", "drone"):
+        assert [robot, "stop_motors", "complete"] in [r[1:4] for r in printed], errors
+        assert f"# {robot}: stopped (interrupted)" in errors
+    assert "# recorded " in errors
+    # the bag was closed whole: it prepares, and holds every tag the robots printed
+    log = prepare_recordings(bag)
+    recorded = Counter(
+        log[["robot", "concept:name", "lifecycle:transition"]].itertuples(index=False, name=None)
+    )
+    assert recorded == Counter(tuple(r[1:4]) for r in printed)
+
+
+def patrols(lines: list[str], robot: str) -> int:
+    return sum(f"\t{robot}\tpatrol\tcomplete" in line for line in lines)
+
+
+@pytest.mark.slow
+def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
+    """``robotale record`` first, then one ``fame node`` per robot (as on two machines): the
+    caller throws the moment the listener is up, and the bag still has that message, because
+    robots wait until a recorder on the domain reads their topics; Ctrl-C closes the bag.
+    A robot's own topics that are not robotale's (a range sensor, odometry at full rate),
+    written here with plain cyclonedds, are in the bag message for message."""
+    import signal
+    import subprocess
+    import sys
+
+    from rosbags.highlevel import AnyReader
+
+    from robotale.commands.prepare import prepare_recordings
+
+    model = MODELS / "hello_at_once.bpmn"
+    bag = tmp_path / "bag"
+    robotale = [sys.executable, "-m", "robotale"]
+    recorder = subprocess.Popen(
+        [*robotale, "record", str(bag), "--robots", "caller,listener"],
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    assert recorder.stderr.readline().startswith("# recording ")  # it listens: start the robots
+    sensors = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    own = {
+        "/caller/range": (RANGE, [{"range": 0.1 * k, "max_range": 4.0} for k in range(5)]),
+        "/caller/odom": (ODOMETRY, [{"pose": {"pose": {"position": {"x": k}}}} for k in range(40)]),
+    }
+    for topic, (msgtype, samples) in own.items():
+        kept = dds_qos(replace(DEFAULT_QOS, history="keep_all"))  # none overwritten unsent
+        writer = DataWriter(sensors, Topic(sensors, "rt" + topic, idl_type(msgtype)), qos=kept)
+        matched(writer, 30.0)  # the recorder found the topic and reads it
+        for sample in samples:
+            writer.write(to_sample(msgtype, sample))
+    node = [*robotale, "fame", "node", str(model), "--robots", "caller,listener"]
+    nodes = {
+        robot: subprocess.Popen(
+            [*node, "--robot", robot, "--until", "60"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            text=True,
+        )
+        for robot in ("caller", "listener")
+    }
+    try:
+        said = {robot: run.communicate(timeout=120) for robot, run in nodes.items()}
+        recorder.send_signal(signal.SIGINT)
+        recorded = recorder.communicate(timeout=60)[1]
+    finally:
+        for run in [recorder, *nodes.values()]:
+            if run.poll() is None:
+                run.kill()
+    assert {robot: run.returncode for robot, run in nodes.items()} == {
+        "caller": 0,
+        "listener": 0,
+    }, said
+    assert recorder.returncode == 0, recorded
+    printed = [row for out, _ in said.values() for row in rows(out)]
+    sent = [r for r in printed if r[2] == "hello!" and r[3] == "complete"]
+    heard = [r for r in printed if r[2] == "hello?" and r[3] == "complete"]
+    assert len(sent) == 1 and [r[4] for r in heard] == [sent[0][4]]
+    with AnyReader([bag]) as reader:
+        found: dict[str, list] = {}
+        for connection, _, raw in reader.messages():
+            message = reader.deserialize(raw, connection.msgtype)
+            found.setdefault(connection.topic, []).append(message)
+    assert [m.data for m in found["/hello"]] == ["hi"]
+    assert [m.range for m in found["/caller/range"]] == pytest.approx([0.1 * k for k in range(5)])
+    assert [m.pose.pose.position.x for m in found["/caller/odom"]] == list(range(40))
+    log = prepare_recordings(bag)
+    in_bag = Counter(
+        log[["robot", "concept:name", "lifecycle:transition"]].itertuples(index=False, name=None)
+    )
+    assert in_bag == Counter(tuple(r[1:4]) for r in printed)
+
+
+@pytest.mark.slow
+def test_a_live_run_ingests_with_its_comm_edges(tmp_path, capsys, neo4j_driver, log_name):
+    """``fame run --bus dds --record`` then ``robotale ingest`` of the bag, as of a simulated
+    run: the stored COMM edge joins the send and the receive the robots printed."""
+    from robotale.commands.prepare import prepare_recordings
+    from robotale.ekg.connection import database
+    from robotale.ekg.logs import log_summary
+    from robotale.ekg.queries import cypher
+
+    bag = tmp_path / "live"
+    model = str(MODELS / "hello_at_once.bpmn")
+    run = ["fame", "run", model, "--robots", "caller,listener", "--bus", "dds"]
+    assert main([*run, "--record", str(bag), "--until", "60"]) == 0
+    printed = rows(capsys.readouterr().out)
+    sent = {r[4]: r[1:3] for r in printed if r[5:6] == ["send"] and r[3] == "complete"}
+    heard = {r[4]: r[1:3] for r in printed if r[5:6] == ["receive"] and r[3] == "complete"}
+    expected = sorted((*sent[m], *heard[m], m) for m in heard)
+    assert len(expected) == 1
+
+    code = main(["ingest", str(bag), "--log", log_name, "--entities", "robot,msg_id"])
+    assert code == 0, capsys.readouterr().err
+    records, _, _ = neo4j_driver.execute_query(
+        cypher("ekg_comm_edges"), {"log": log_name}, database_=database()
+    )
+    # an edge from each event of the send (start, complete) to each of the receive
+    stored = sorted(
+        {(r["fromRobot"], r["sender"], r["toRobot"], r["receiver"], r["msgId"]) for r in records}
+    )
+    assert stored == expected and len(records) == 4
+    assert log_summary(neo4j_driver, log_name)["counts"]["events"] == len(prepare_recordings(bag))
+
+
+def test_a_dds_run_stopped_at_until_with_a_robot_working_exits_1_saying_where(tmp_path, capsys):
+    model = tmp_path / "patrol.bpmn"
+    model.write_text(
+        PATROL.format(processes=PATROLLER.format(pool="Rover")).replace(
+            '<bpmn:participant id="p_drone" name="Drone" processRef="Drone" />', ""
+        )
+    )
+    run = ["fame", "run", str(model), "--robots", "rover", "--bus", "dds", "--until", "5"]
+    assert main(run) == 1
+    captured = capsys.readouterr()
+    assert "# rover: still running at " in captured.err
+    place = captured.err.split("# rover is at ", 1)[1].splitlines()[0]
+    if rows(captured.out):  # it patrols, or pauses between two patrols
+        assert place in ("task Rover_patrol (Patrol)", "intermediateCatchEvent Rover_pause (pause)")
+    else:  # a slow machine: its first instance had not run when the time was up
+        assert place == "the start of an instance"
+
+
+def test_a_dds_run_ending_with_an_uncaught_error_exits_1_naming_it(capsys, models):
+    run = ["fame", "run", str(models / "errors.bpmn"), "--robots", "tractor_1", "--bus", "dds"]
+    run += ["--set", "tractor_1.jammed=false", "--set", 'tractor_1.fail_loudly="overheat"']
+    assert main(run) == 1
+    err = capsys.readouterr().err
+    assert "error 'overheat' thrown at check (Check Blade) was not caught" in err
+
+
+@pytest.mark.slow
+def test_timer_start_events_start_their_robots_over_dds_and_keep_the_mission_going(capsys, models):
+    """One process per robot on the wall clock, which starts 20 s before the alarm's date:
+    each timer start event starts its process (a duration, a date, a cycle), and no robot calls
+    the mission over while the alarm clock's timers are still armed."""
+    model = str(models / "timer_starts.bpmn")
+    run = ["fame", "run", model, "--bus", "dds", "--start", "2024-05-01T07:59:40Z"]
+    run += ["--until", "60"]
+    assert main(run) == 0
+    captured = capsys.readouterr()
+    starts = {}
+    for r in rows(captured.out):
+        if r[3] == "start":
+            starts.setdefault((r[1], r[2]), []).append(float(r[0]))
+    assert {("waiter", "serve"), ("alarm_clock", "ring"), ("ticker", "tick")} <= set(starts)
+    # each robot's process starts a little after the shared origin and its duration counts
+    # from then; the date is 08:00:00 on the shared clock, 20 s after the origin
+    assert 3.0 <= starts["waiter", "serve"][0] < 20
+    ring = starts["alarm_clock", "ring"][0]
+    assert 20.0 <= ring < 21.0
+    first, second = starts["ticker", "tick"]
+    assert second - first == pytest.approx(2.0, abs=0.3)  # R2/PT2S: twice, 2 s apart
+    done = {
+        line.split(":")[0][2:]: float(line.split(" at ")[1].split(" s")[0])
+        for line in captured.err.splitlines()
+        if ": done at " in line
+    }
+    assert set(done) == {"waiter", "alarm_clock", "ticker"}
+    assert min(done.values()) >= ring + 5.0  # nobody left while the snooze was armed
+
+
+def test_the_models_qos_is_live_a_pair_fame_check_refuses_never_talks_over_dds(capsys, models):
+    """qos.bpmn as one process per robot: the drone's best-effort weed_position never reaches
+    the tractor's reliable catch (as ``fame check`` says); nobody waits to meet that pair, the
+    readers' buses name it, and the run ends at --until with the drone waiting."""
+    run = ["fame", "run", str(models / "qos.bpmn"), "--robots", "drone,tractor_1"]
+    assert main([*run, "--bus", "dds", "--until", "20"]) == 1
+    captured = capsys.readouterr()
+    printed = rows(captured.out)
+    assert [r[1:4] for r in printed] == [
+        ["drone", "weed_position!", "start"],
+        ["drone", "weed_position!", "complete"],
+    ]
+    assert (
+        "# warning: /weed_position: a publisher and tractor_1's subscriber cannot talk "
+        "(reliability does not match; see robotale fame check)"
+    ) in captured.err
+    assert "# drone is at intermediateCatchEvent d_position (tractor_position)" in captured.err
+    assert "starts with no peer" not in captured.err

@@ -170,3 +170,23 @@ def test_a_skills_module_without_skills_is_one_sentence(models, tmp_path, capsys
     assert capsys.readouterr().err == (
         f"robotale: the skills module {str(empty)!r} has no SKILLS mapping of name to skill\n"
     )
+
+
+@pytest.mark.parametrize("command", ["fame run", "fame node", "record"])
+def test_dds_commands_without_cyclone_dds_say_so_in_one_sentence(
+    command, models, tmp_path, monkeypatch, capsys
+):
+    # the package cannot be uninstalled from the shared environment: hide it from imports
+    monkeypatch.setitem(sys.modules, "cyclonedds.core", None)
+    bag, model = tmp_path / "bag", str(models / "hello_at_once.bpmn")
+    arguments = {
+        "fame run": ["fame", "run", model, "--bus", "dds", "--record", str(bag)],
+        "fame node": ["fame", "node", model, "--robot", "caller"],
+        "record": ["record", str(bag), "--robots", "caller"],
+    }[command]
+    assert main(arguments) == 1
+    assert capsys.readouterr().err == (
+        "robotale: one process per robot (--bus dds, fame node, record) needs Cyclone DDS: "
+        "pip install 'robotale[dds]'\n"
+    )
+    assert not bag.exists()

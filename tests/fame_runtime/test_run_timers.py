@@ -42,6 +42,11 @@ def test_fame_run_starts_its_clock_at_start_and_fires_dates(capsys):
     rows = [line.split("\t") for line in captured.out.splitlines()]
     assert ["    10.000", "alarm_clock", "ring", "start"] in rows
     assert ["     3.000", "waiter", "serve", "complete"] in rows
+    # R2/PT2S: the cycle starts the ticker twice, 2 s apart
+    assert [r[0] for r in rows if r[1:4] == ["ticker", "tick", "start"]] == [
+        "     2.000",
+        "     4.000",
+    ]
     assert "# done at 15.000 s" in captured.err
 
 
