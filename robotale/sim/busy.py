@@ -1,11 +1,12 @@
 """Robots that do not hear a signal while they are busy (a world's ``busy_ignores``).
 
 robotale's engine starts a new instance for every signal a start event hears, however many
-instances already run. The thesis' tractors did not (7.2.2): the `weed_position` messages no
-tractor received were lost "due to tractors being busy at the moment the drone transmitted the
-message" -- FAME's engine runs a robot's process one instance at a time, so a tractor that is
-still handling a weed has no start event listening. ``busy_ignores: [weed_position]`` in a
-robot group of the world file gives its robots that behaviour: a message on one of those
+instances already run. The thesis' tractors apparently did not: 7.2.2 puts the
+`weed_position` messages no tractor received down to "tractors being busy at the moment the
+drone transmitted the message", as if their engine ran a robot's process one instance at a
+time, so that a tractor still handling a weed had no start event listening.
+``busy_ignores: [weed_position]`` in a robot group of the world file gives its robots that
+behaviour: a message on one of those
 signals that arrives while an instance of the robot's process runs is not delivered to it,
 so no instance starts, no ``weed_position?`` is tagged and nobody answers it.
 
