@@ -6,9 +6,9 @@ instances already run. The thesis' tractors apparently did not: 7.2.2 puts the
 drone transmitted the message", as if their engine ran a robot's process one instance at a
 time, so that a tractor still handling a weed had no start event listening.
 ``busy_ignores: [weed_position]`` in a robot group of the world file gives its robots that
-behaviour: a message on one of those
-signals that arrives while an instance of the robot's process runs is not delivered to it,
-so no instance starts, no ``weed_position?`` is tagged and nobody answers it.
+behaviour: a message on one of those signals that arrives while an instance of the robot's
+process runs is not delivered to it, so no instance starts, no ``weed_position?`` is tagged
+and nobody answers it.
 
 It acts on the deliveries to the robot's engine only: the message was sent (the recorder sees
 every publish) and other robots still hear it.
