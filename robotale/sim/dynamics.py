@@ -29,14 +29,15 @@ jumping to the commanded speed; told to stop at speed v it still travels about
 from __future__ import annotations
 
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 
-from robotale.sim.physics import GRAVITY, Physics
+from robotale.sim.physics import GRAVITY, Motion, Physics
 from robotale.sim.robots import SimRobot
 
 COLLISION = "std_msgs/msg/String"
 FLIGHT_SUBSTEPS = 5  # integration steps of a drone's flight per control step
+STANDING = 1e-6  # m/s and rad/s: slower than this a body stands still
 
 
 @dataclass(frozen=True)
@@ -46,29 +47,56 @@ class Collision:
     other: str  # a robot's name or an obstacle's
 
 
-def drive(physics: Physics, robot: SimRobot, dt: float) -> None:
-    """Push ``robot``'s body for one physics step of ``dt`` seconds towards its command."""
-    spec = robot.spec
-    _, yaw, velocity, yaw_rate = physics.motion(robot.body)
+@dataclass(frozen=True)
+class Drive:
+    """A ground robot's drive, worked out once from its spec rather than every physics step."""
+
+    mass: float
+    max_force: float
+    max_torque: float
+    grip: float  # N: the most force the tyres pass on, forward and sideways together
+    inertia: float  # kg m2: the box's moment of inertia about its vertical axis
+
+    @classmethod
+    def of(cls, robot: SimRobot) -> Drive:
+        spec = robot.spec
+        length, width, _ = spec.size
+        return cls(
+            mass=spec.mass,
+            max_force=spec.max_force,
+            max_torque=spec.max_torque,
+            grip=spec.friction * spec.mass * GRAVITY,
+            inertia=spec.mass * (length**2 + width**2) / 12,
+        )
+
+
+def drive(physics: Physics, robot: SimRobot, motors: Drive, motion: Motion, dt: float) -> bool:
+    """Push ``robot``'s body for one physics step of ``dt`` seconds towards its command, from
+    its ``motion`` after the last step; False if it stands and is told to stand (no push)."""
+    position, yaw, velocity, yaw_rate = motion
     forward, turn = robot.wanted()
-    heading, side = (math.cos(yaw), math.sin(yaw)), (-math.sin(yaw), math.cos(yaw))
-    along = velocity[0] * heading[0] + velocity[1] * heading[1]
-    across = velocity[0] * side[0] + velocity[1] * side[1]
-    push = _clip(spec.mass * (forward - along) / dt, spec.max_force)
-    hold = -spec.mass * across / dt
-    grip = spec.friction * spec.mass * GRAVITY
+    if forward == 0.0 and turn == 0.0 and standing(motion):
+        # nothing slides a standing body (no friction, no damping): it needs no force until
+        # something moves it, and then the drive holds it again at the next step
+        return False
+    cos, sin = math.cos(yaw), math.sin(yaw)
+    along = velocity[0] * cos + velocity[1] * sin
+    across = velocity[1] * cos - velocity[0] * sin
+    push = _clip(motors.mass * (forward - along) / dt, motors.max_force)
+    hold = -motors.mass * across / dt
     total = math.hypot(push, hold)
-    if total > grip:  # the tyres slip: the force they pass on is capped by friction
-        push, hold = push * grip / total, hold * grip / total
-    force = (
-        push * heading[0] + hold * side[0],
-        push * heading[1] + hold * side[1],
-        0.0,
-    )
-    length, width, _ = spec.size
-    inertia = spec.mass * (length**2 + width**2) / 12
-    torque = _clip(inertia * (turn - yaw_rate) / dt, spec.max_torque)
-    physics.push(robot.body, force, torque)
+    if total > motors.grip:  # the tyres slip: the force they pass on is capped by friction
+        push, hold = push * motors.grip / total, hold * motors.grip / total
+    force = (push * cos - hold * sin, push * sin + hold * cos, 0.0)
+    torque = _clip(motors.inertia * (turn - yaw_rate) / dt, motors.max_torque)
+    physics.push(robot.body, position, force, torque)
+    return True
+
+
+def standing(motion: Motion) -> bool:
+    """The body neither moves nor turns."""
+    _, _, velocity, yaw_rate = motion
+    return max(abs(velocity[0]), abs(velocity[1]), abs(velocity[2]), abs(yaw_rate)) < STANDING
 
 
 def fly(robot: SimRobot, dt: float) -> None:
@@ -99,9 +127,9 @@ def _limited(force: tuple[float, float], limit: float) -> tuple[float, float]:
     return force if size <= limit else (force[0] * limit / size, force[1] * limit / size)
 
 
-def follow(physics: Physics, robot: SimRobot) -> None:
-    """Take the robot's pose and speed from its body after a step."""
-    position, yaw, velocity, _ = physics.motion(robot.body)
+def follow(robot: SimRobot, motion: Motion) -> None:
+    """Take the robot's pose and speed from its body's ``motion`` after a step."""
+    position, yaw, velocity, _ = motion
     robot.pose.x, robot.pose.y, robot.pose.yaw = position[0], position[1], yaw
     robot.speed = math.hypot(velocity[0], velocity[1])
 
@@ -109,18 +137,22 @@ def follow(physics: Physics, robot: SimRobot) -> None:
 class Contacts:
     """Which robot touches which body, to report each contact once, when it begins."""
 
-    def __init__(self, names: Mapping[int, str]) -> None:
+    def __init__(self, names: Mapping[int, str], robots: Iterable[int] = ()) -> None:
         self.names = names  # body -> name, for robots and obstacles (others are ignored)
+        self.robots = frozenset(robots)  # the driven robots' bodies
         self._touching: set[tuple[int, int]] = set()
         self.collisions: list[Collision] = []
 
-    def update(self, physics: Physics, robots: Mapping[str, SimRobot], now: float):
-        """The collisions that began in the last step."""
+    def update(self, pairs: Iterable[tuple[int, int]], now: float) -> list[Collision]:
+        """The collisions that began in the last step, from every pair of bodies in contact
+        (:meth:`Physics.contacts`): a robot's contact is reported for the robot, and a contact
+        of two robots for each of them."""
         touching = set()
-        for robot in robots.values():
-            for other in physics.touching(robot.body):
-                if other in self.names:
-                    touching.add((robot.body, other))
+        for a, b in pairs:
+            if a in self.robots and b in self.names:
+                touching.add((a, b))
+            if b in self.robots and a in self.names:
+                touching.add((b, a))
         began = [
             Collision(round(now, 6), self.names[a], self.names[b])
             for a, b in sorted(touching - self._touching)

@@ -47,6 +47,8 @@ with _quiet():
     import pybullet
 
 Color = tuple[float, float, float, float]
+#: a body's position, yaw, linear velocity and yaw rate
+Motion = tuple[tuple[float, float, float], float, tuple[float, float, float], float]
 GRAVITY = 9.81  # m/s2
 _ROBOTS = 4  # the collision group of driven robots (bit 1 is the rays' group)
 
@@ -204,8 +206,8 @@ class Physics:
         of :meth:`ghost` do not keep a static body off a dynamic one, a pair filter does."""
         pybullet.setCollisionFilterPair(body, other, -1, -1, 0, physicsClientId=self.client)
 
-    def motion(self, body: int) -> tuple[tuple[float, float, float], float, tuple, float]:
-        """Position, yaw, linear velocity and yaw rate of a body."""
+    def motion(self, body: int) -> Motion:
+        """Position, yaw, linear velocity and yaw rate of a body (two reads of pybullet)."""
         position, orientation = pybullet.getBasePositionAndOrientation(
             body, physicsClientId=self.client
         )
@@ -214,9 +216,11 @@ class Physics:
         yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
         return position, yaw, linear, angular[2]
 
-    def push(self, body: int, force: Sequence[float], torque: float) -> None:
-        """Apply a force (world frame, at the centre of mass) and a yaw torque for one step."""
-        position, _ = pybullet.getBasePositionAndOrientation(body, physicsClientId=self.client)
+    def push(
+        self, body: int, position: Sequence[float], force: Sequence[float], torque: float
+    ) -> None:
+        """Apply a force (world frame, at the centre of mass, which is at ``position``) and a
+        yaw torque for one step."""
         pybullet.applyExternalForce(
             body, -1, force, position, pybullet.WORLD_FRAME, physicsClientId=self.client
         )
@@ -224,10 +228,11 @@ class Physics:
             body, -1, (0.0, 0.0, torque), pybullet.WORLD_FRAME, physicsClientId=self.client
         )
 
-    def touching(self, body: int) -> set[int]:
-        """The bodies in contact with ``body`` after the last step."""
-        contacts = pybullet.getContactPoints(bodyA=body, physicsClientId=self.client)
-        return {contact[2] for contact in contacts or ()}
+    def contacts(self) -> list[tuple[int, int]]:
+        """The pairs of bodies in contact after the last step, each as pybullet reports it:
+        one query for the whole world rather than one per body."""
+        points = pybullet.getContactPoints(physicsClientId=self.client)
+        return [(point[1], point[2]) for point in points or ()]
 
     def recolor(self, body: int, color: Color) -> None:
         pybullet.changeVisualShape(body, -1, rgbaColor=color, physicsClientId=self.client)

@@ -31,6 +31,7 @@ from robotale.fame_runtime.skills import Skill, load_skills
 from robotale.fame_runtime.tags import bus_sink
 from robotale.sim import faults as fault_model
 from robotale.sim import scenarios
+from robotale.sim.busy import BusyDeaf, ignores_of
 from robotale.sim.faults import Fault, Planned
 from robotale.sim.recorder import Recorder
 from robotale.sim.setup import Setup, draw, run_seed
@@ -176,16 +177,20 @@ def _mission(world: World, definitions: Definitions, setup: Setup, clock, bus) -
             "x_base": start.home[0],
             "y_base": start.home[1],
         }
-    return Mission(
+    groups = {spec.name: spec.busy_ignores for spec in world.robots}
+    engines_bus = BusyDeaf(bus, ignores_of(groups, {s.name: s.group for s in setup.robots}))
+    mission = Mission(
         definitions,
         robots=[r.name for r in setup.robots],
         clock=clock,
-        bus=bus,
+        bus=engines_bus,
         skills=skills_of(world),
         library=world.library,
         tag_sink=bus_sink(bus),
         variables=variables,
     )
+    engines_bus.engines = mission.engines
+    return mission
 
 
 def model_topics(definitions: Definitions) -> tuple[dict[str, str], set[str]]:

@@ -104,7 +104,7 @@ class SimWorld:
         if world.dynamics:
             physics.dynamics(world.physics_rate)
             physics.floor()
-        physics.ground(world.field, FIELD_COLOR)
+        field = physics.ground(world.field, FIELD_COLOR)
         names = {}
         for obstacle in world.obstacles:
             half = [size / 2 for size in obstacle.size]
@@ -116,7 +116,11 @@ class SimWorld:
         specs = {name: spec for spec in world.robots for name in spec.names()}
         self.robots = {s.name: self._robot(s, specs[s.name]) for s in self.setup.robots}
         names.update({robot.body: name for name, robot in self.robots.items()})
-        self.contacts = dynamics.Contacts(names)
+        for robot in self.robots.values():
+            if robot.driven:  # the floor carries it: one resting contact to solve, not two
+                physics.pass_through(robot.body, field)
+        driven = [robot.body for robot in self.robots.values() if robot.driven]
+        self.contacts = dynamics.Contacts(names, driven)
         looks = {o.kind: o for o in world.objects}
         self.things: dict[int, Thing] = {}
         for placed in self.setup.objects:
@@ -204,19 +208,33 @@ class SimWorld:
         return tick
 
     def _physics_loop(self):
-        """Step pybullet at the world's physics rate: drives push, bodies move and collide."""
+        """Step pybullet at the world's physics rate: drives push, bodies move and collide.
+        Each body's motion is read once a step and serves both the robot's pose and the
+        next step's drive; contacts are one query for the world. A step in which every
+        driven body stands and is told to stand is skipped: it would change nothing (the
+        other bodies are static or placed, and nothing stands on them to fall)."""
         step = 1.0 / self.spec.physics_rate
-        driven = {name: robot for name, robot in self.robots.items() if robot.driven}
+        driven = [robot for robot in self.robots.values() if robot.driven]
+        motors = [dynamics.Drive.of(robot) for robot in driven]
+        physics = self.physics
+        motions = [physics.motion(robot.body) for robot in driven]
 
         def tick() -> None:
-            for robot in driven.values():
-                dynamics.drive(self.physics, robot, step)
-            self.physics.step()
-            for robot in driven.values():
-                dynamics.follow(self.physics, robot)
-            for collision in self.contacts.update(self.physics, driven, self.clock.now()):
-                self._collided(collision)
+            pushed = [
+                dynamics.drive(physics, robot, drive, motion, step)
+                for robot, drive, motion in zip(driven, motors, motions, strict=True)
+            ]
+            if any(pushed) or not all(map(dynamics.standing, motions)):
+                integrate()
             self.clock.call_later(step, tick)
+
+        def integrate() -> None:
+            physics.step()
+            for index, robot in enumerate(driven):
+                motions[index] = physics.motion(robot.body)
+                dynamics.follow(robot, motions[index])
+            for collision in self.contacts.update(physics.contacts(), self.clock.now()):
+                self._collided(collision)
 
         return tick
 

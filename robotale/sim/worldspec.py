@@ -99,6 +99,8 @@ class RobotSpec:
     spacing: tuple[float, float] = (0.0, 1.0)  # start offset between instances of a group
     start_jitter: float = 0.0  # metres, drawn per run
     variables: Mapping[str, Any] = field(default_factory=dict)
+    # signals its start events do not hear while an instance of its process runs
+    busy_ignores: tuple[str, ...] = ()
 
     def names(self) -> list[str]:
         if self.count is None:
@@ -382,6 +384,7 @@ class _Reader:
             start_jitter=self.number(data.get("start_jitter", 0.0), f"{where}.start_jitter"),
             odom_drift=self.number(data.get("odom_drift", 0.0), f"{where}.odom_drift"),
             variables=self.mapping(data.get("variables", {}), f"{where}.variables"),
+            busy_ignores=self.signals(data.get("busy_ignores", []), f"{where}.busy_ignores"),
             **numbers,
         )
 
@@ -510,6 +513,13 @@ class _Reader:
             raise self.fail(where, f"must be a mapping of names to values, not {value!r}")
         return value
 
+    def signals(self, value: Any, where: str) -> tuple[str, ...]:
+        names = self.sequence(value, where)
+        for name in names:
+            if not isinstance(name, str) or not name.strip("/"):
+                raise self.fail(where, f"holds {name!r}; it must list signal names")
+        return tuple(name.strip("/") for name in names)
+
     def sequence(self, value: Any, where: str) -> list[Any]:
         if not isinstance(value, list):
             raise self.fail(where, f"must be a list, not {value!r}")
@@ -606,4 +616,5 @@ _ROBOT_KEYS = {
     "spacing",
     "start_jitter",
     "variables",
+    "busy_ignores",
 }

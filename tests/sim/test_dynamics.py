@@ -198,6 +198,8 @@ def test_a_robot_stops_at_an_obstacle_and_the_collision_is_recorded(tmp_path):
         (("physics_rate: 240", "physics_rate: 0"), "physics_rate is 0; it must be positive"),
         (("size: [0.4, 4, 0.5]", "size: [0, 4, 0.5]"), "obstacles.wall.size is [0.0, 4.0, 0.5]"),
         (("max_force: 40.0", "max_force: -1"), "robots.rover.max_force is -1; it must be"),
+        (("count: 2,", "count: 2, busy_ignores: [3],"), "robots.rover.busy_ignores holds 3;"),
+        (("count: 2,", "count: 2, busy_ignores: job,"), "robots.rover.busy_ignores must be a list"),
         (("model:", "network: {loss: 1.5}\nmodel:"), "network.loss is 1.5; it must be at most 1"),
         (("model:", "network: {lose: 0.1}\nmodel:"), "network has unknown key 'lose'"),
         (("model:", "network: {links: {drone: {}}}\nmodel:"), "'sender -> receiver'"),
