@@ -158,8 +158,12 @@ def pm4py_same_work(log: pd.DataFrame, rework: bool = False) -> dict:
         "dfg": frequency,
         "performance_dfg": performance,
         "variants": pm4py.get_variants(intervals, timestamp_key=START),
+        # pm4py's DataFrame variants read each case's rows as one run of the frame: the
+        # intervals come case by case, so a robot's must be brought together first
         "robot_variants": pm4py.get_variants(
-            intervals, timestamp_key=START, case_id_key=ROBOT_CASE
+            intervals.sort_values([ROBOT_CASE, START], kind="stable"),
+            timestamp_key=START,
+            case_id_key=ROBOT_CASE,
         ),
         "durations": pm4py.get_all_case_durations(rows),
         "spans": pm4py.get_all_case_durations(rows, case_id_key=ROBOT_CASE),
