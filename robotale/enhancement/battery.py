@@ -50,8 +50,8 @@ def battery_perspective(
     ``following`` activities the robot performed next."""
     analysis = analysis_of(log)
     log = analysis.log
-    levels = _levels(log)
-    lows = low_battery_events(log, threshold=threshold, low_activity=low_activity)
+    levels = shared_levels(analysis)
+    lows = _low_battery_events(log, levels, threshold, low_activity)
     if levels.empty and lows.empty:
         return no_data("battery", f"the log has {NO_LEVELS} and no low-battery events.")
     lows = _with_what_followed(lows, analysis, following)
@@ -84,7 +84,13 @@ def low_battery_events(
     log: pd.DataFrame, *, threshold: float = 20.0, low_activity: str | None = LOW_ACTIVITY
 ) -> pd.DataFrame:
     """When each robot's battery fell below ``threshold``, and the events of ``low_activity``."""
-    found = [_threshold_crossings(_levels(log), threshold)]
+    return _low_battery_events(log, _levels(log), threshold, low_activity)
+
+
+def _low_battery_events(
+    log: pd.DataFrame, levels: pd.DataFrame, threshold: float, low_activity: str | None
+) -> pd.DataFrame:
+    found = [_threshold_crossings(levels, threshold)]
     if low_activity is not None:
         tagged = log[log[ACTIVITY].astype("string").eq(low_activity).fillna(False)]
         found.append(_low_rows(_tagged_moments(tagged), f"activity {low_activity}"))
@@ -101,7 +107,7 @@ def activity_consumption(
     working time, in total, per instance and per minute, and the level at their starts; a
     ``(waiting)`` row per robot for what it used while idle between activities."""
     analysis = analysis_of(log)
-    levels = _levels(analysis.log)
+    levels = shared_levels(analysis)
     if levels.empty:
         return pd.DataFrame()
     instances = analysis.instances(carry=[BATTERY])
@@ -235,6 +241,12 @@ def _energy_summary(consumption: pd.DataFrame, energy: pd.DataFrame) -> dict:
         summary["most_used_by"] = None if work.empty else str(work["activity"].iloc[0])
         summary["used_while_waiting"] = float(consumption.loc[idle, "used"].sum())
     return summary
+
+
+def shared_levels(analysis: LogAnalysis) -> pd.DataFrame:
+    """:func:`_levels` of the analysed log, sorted once per analysis (a copy of the log's rows
+    with a level)."""
+    return analysis.shared("levels", lambda: _levels(analysis.log))
 
 
 def _levels(log: pd.DataFrame) -> pd.DataFrame:

@@ -52,6 +52,9 @@ from robotale.eventlog.schema import (
 )
 
 TYPE = "message_type"
+#: a message's number (its row in the message table): one integer key instead of case and id,
+#: so each per-message step groups and looks up integers rather than pairs of texts
+MESSAGE = "_message"
 UNKNOWN = "unknown"
 #: the fewest received messages on a channel for its own 95th percentile to mean anything
 MIN_FOR_P95 = 20
@@ -121,24 +124,32 @@ def message_tables(
     if core is None:
         return pd.DataFrame(), pd.DataFrame()
     table, events, sends, receives = core
-    keys = _keys(events)
+    ids = [MESSAGE]
     if MSG_PAYLOAD in events.columns:
-        payload = _first(events, keys, MSG_PAYLOAD).reindex(table.index)
+        payload = _first(events, ids, MSG_PAYLOAD).reindex(table.index)
         table.insert(table.columns.get_loc("sent_at"), "payload", payload)
-    table["attempts"] = _attempts(sends, keys).reindex(table.index).fillna(0).astype(int)
-    table["receivers"] = _distinct(receives, keys, ROBOT).reindex(table.index).fillna(0)
+    table["attempts"] = _attempts(sends, ids).reindex(table.index).fillna(0).astype(int)
+    table["receivers"] = _distinct(receives, ids, ROBOT).reindex(table.index).fillna(0)
     table["receivers"] = table["receivers"].astype(int)
     table["sent"] = table["attempts"] > 0
     table["received"] = table["received_at"].notna()
     table["lost"] = table["sent"] & ~table["received"]
     table["latency"] = (table["received_at"] - table["sent_at"]).dt.total_seconds()
-    table = table.drop(columns="first_event").reset_index()
-    deliveries = _deliveries(table, events, receives, keys)
-    table["receiver"] = _lookup(table, keys, _joined(deliveries, keys, "receiver"))
+    table = table.drop(columns="first_event")
+    numbered = table.assign(**{MESSAGE: np.arange(len(table))})
+    deliveries = _deliveries(numbered, events, receives, ids)
+    table["receiver"] = _lookup(numbered, ids, _joined(deliveries, ids, "receiver"))
     deliveries["delayed"] = _delayed(deliveries, delay_threshold)
-    delayed = deliveries.groupby(keys)["delayed"].any()
-    table["delayed"] = _lookup(table, keys, delayed).fillna(False).astype(bool)
-    return _with_resends(table), deliveries
+    delayed = deliveries.groupby(MESSAGE)["delayed"].any()
+    table["delayed"] = _lookup(numbered, ids, delayed).fillna(False).astype(bool)
+    keys = _keys(table)
+    return _with_resends(table), _with_keys(deliveries, table, keys)
+
+
+def _with_keys(rows: pd.DataFrame, table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
+    """``rows`` with their message's case and id (``keys``) in place of its number."""
+    named = table[keys].iloc[rows[MESSAGE].to_numpy()].reset_index(drop=True)
+    return pd.concat([named, rows.drop(columns=MESSAGE).reset_index(drop=True)], axis=1)
 
 
 def shared_latencies(analysis: LogAnalysis) -> pd.DataFrame:
@@ -153,27 +164,32 @@ def shared_latencies(analysis: LogAnalysis) -> pd.DataFrame:
             return pd.DataFrame()
         table = core[0]
         table["latency"] = (table["received_at"] - table["sent_at"]).dt.total_seconds()
-        return table.reset_index()
+        return table
 
     return analysis.shared("latencies", build)
 
 
 def _message_core(log: pd.DataFrame):
     """The message events, the sends performed by the activity each message is named after,
-    the receives, and per message (indexed by case and id): type, sender, first send and
-    first receive; ``None`` when the log has no messages."""
+    the receives (each with its message's number, ``_message``), and per message (in case and
+    id order, its number the row): case, id, type, sender, first send and first receive;
+    ``None`` when the log has no messages."""
     events = _message_events(log)
     if events.empty:
         return None
-    keys = _keys(events)
+    grouped = events.groupby(_keys(events), sort=True)  # the one grouping by case and id
+    table = grouped.agg(first_event=(TIMESTAMP, "min")).reset_index()
+    number = grouped.ngroup()
+    known = number.notna().to_numpy()  # an event without a case belongs to no message
+    events = events[known].assign(**{MESSAGE: number[known].astype(np.int64)})
+    ids = [MESSAGE]
     sends = events[events["_role"] == SEND]
     receives = events[events["_role"] == RECEIVE]
-    table = events.groupby(keys, sort=True).agg(first_event=(TIMESTAMP, "min"))
-    table[TYPE] = _types(sends, receives, keys).reindex(table.index)
-    sends = _sends_of_type(sends, table[TYPE], keys)
-    table["sender"] = _sender(events, sends, keys).reindex(table.index)
-    table["sent_at"] = sends.groupby(keys)[TIMESTAMP].min().reindex(table.index)
-    table["received_at"] = receives.groupby(keys)[TIMESTAMP].min().reindex(table.index)
+    table[TYPE] = _types(sends, receives, ids).reindex(table.index)
+    sends = _sends_of_type(sends, table[TYPE])
+    table["sender"] = _sender(events, sends, ids).reindex(table.index)
+    table["sent_at"] = sends.groupby(MESSAGE)[TIMESTAMP].min().reindex(table.index)
+    table["received_at"] = receives.groupby(MESSAGE)[TIMESTAMP].min().reindex(table.index)
     return table, events, sends, receives
 
 
@@ -220,10 +236,17 @@ MESSAGE_COLUMNS = (
 def _message_events(log: pd.DataFrame) -> pd.DataFrame:
     if MSG_ID not in log.columns:
         return pd.DataFrame()
-    wanted = log[[c for c in log.columns if c in MESSAGE_COLUMNS]]
-    events = wanted[log[MSG_ID].notna().to_numpy(bool)]
-    roles = event_roles(events)
-    return events.assign(_role=roles)[roles.notna().to_numpy(bool)]
+    with_id = np.flatnonzero(log[MSG_ID].notna().to_numpy(bool))
+    # the roles of the rows with an id first, so the wanted rows and columns are copied once
+    roles = event_roles(_rows(log, with_id, (ACTIVITY, MSG_ROLE)))
+    role = roles.notna().to_numpy(bool)
+    events = _rows(log, with_id[role], MESSAGE_COLUMNS)
+    return events.assign(_role=roles.to_numpy(object)[role])
+
+
+def _rows(log: pd.DataFrame, rows: np.ndarray, wanted: tuple[str, ...]) -> pd.DataFrame:
+    """The ``rows`` (positions) of the log's columns named in ``wanted``, in one copy."""
+    return log.iloc[rows, [i for i, c in enumerate(log.columns) if c in wanted]]
 
 
 def event_roles(events: pd.DataFrame) -> pd.Series:
@@ -263,11 +286,10 @@ def _types(sends: pd.DataFrame, receives: pd.DataFrame, keys: list[str]) -> pd.S
     return named.combine_first(from_receive)
 
 
-def _sends_of_type(sends: pd.DataFrame, types: pd.Series, keys: list[str]) -> pd.DataFrame:
+def _sends_of_type(sends: pd.DataFrame, types: pd.Series) -> pd.DataFrame:
     """The sends performed by the activity a message is named after (the attempts)."""
-    named = types.rename("_type").reset_index()
-    joined = sends.merge(named, on=keys, how="left")
-    return joined[joined[ACTIVITY].astype(object) == joined["_type"].astype(object)]
+    named = pd.Series(types.to_numpy(object)[sends[MESSAGE].to_numpy()], index=sends.index)
+    return sends[sends[ACTIVITY].astype(object) == named]
 
 
 def _sender(events: pd.DataFrame, sends: pd.DataFrame, keys: list[str]) -> pd.Series:
@@ -289,7 +311,11 @@ def _deliveries(
     else:
         seen = pd.DataFrame(columns=[*keys, "receiver", "received_at"])
     reached = base.merge(seen, on=keys)
-    missing = base[~_in(base, reached, keys)].assign(received_at=pd.NaT)
+    missing = base[~_in(base, reached, keys)]
+    # a missing time of the received times' own type: times of mixed types would be parsed
+    # one by one below
+    unknown = reached["received_at"].dtype if len(reached) else object
+    missing = missing.assign(received_at=pd.Series(pd.NaT, index=missing.index, dtype=unknown))
     missing["receiver"] = _meant_for(missing, events, reached, keys)
     deliveries = pd.concat([reached, missing], ignore_index=True)
     deliveries["received_at"] = pd.to_datetime(deliveries["received_at"], utc=True)
@@ -478,9 +504,9 @@ def _by_type(messages: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:
     )
     table = table.join(_latency_figures(grouped))
     table["loss_rate"] = table["lost"] / table["sent"].where(table["sent"] > 0)
-    table["channels"] = deliveries.groupby(TYPE)[["sender", "receiver"]].apply(
-        lambda pairs: len(pairs.drop_duplicates())
-    )
+    # the distinct sender -> receiver pairs of each type, counted at once (no call per type)
+    pairs = deliveries[[TYPE, "sender", "receiver"]].drop_duplicates()
+    table["channels"] = pairs.groupby(TYPE).size()
     return table.reset_index()
 
 

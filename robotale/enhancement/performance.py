@@ -115,9 +115,15 @@ def shared_cases(analysis: LogAnalysis) -> pd.DataFrame:
 
 def shared_case_variants(analysis: LogAnalysis) -> pd.DataFrame:
     """:func:`case_variant_table` of the finished instances, built once per analysis."""
-    return analysis.shared(
-        "case_variants", lambda: case_variant_table(finished_instances(analysis))
-    )
+
+    def build() -> pd.DataFrame:
+        # the case table has each case's start, end and duration: only the paths are new
+        instances, cases = finished_instances(analysis), shared_cases(analysis)
+        paths = _paths(instances, [CASE]).reindex(cases[CASE]).to_numpy()
+        table = cases[[CASE, "start", "end"]].assign(**{VARIANT: paths})
+        return table.assign(duration=cases["duration"])
+
+    return analysis.shared("case_variants", build)
 
 
 def robot_steps(instances: pd.DataFrame) -> pd.DataFrame:
