@@ -27,11 +27,11 @@ figures in the 1400 x 900 window and the class graph drawn; the figures below th
 drawn after it, while the browser is idle, until ``robotale-perspectives-all-drawn``, printed
 too), *Findings first paint* to ``robotale-findings-shown``. After each page the page's own
 measures are printed: each section's request, each figure's drawing, plotly.js's bundles.
-Cold: the dashboard's memory emptied and the results it keeps of the log removed (a log stored
-by ``robotale ingest``: its columnar copy is there, nothing is computed yet); warm: after the
-computation the dashboard runs when it stores a log. Targets: under 1 s at 10,000 events and
-under 3 s at 100,000, warm, and for the Findings page cold too. The baseline of these is the
-warm Findings page of the thesis' own log.
+Cold: the dashboard's memory emptied and the results it keeps of the log removed (its
+columnar copy is there, nothing is computed yet); warm: after the computation that storing a
+log runs, in the dashboard and in ``robotale ingest`` alike, so the first visit after an
+ingest is warm. Targets: under 1 s at 10,000 events and under 3 s at 100,000, warm. The
+baseline of these is the warm Findings page of the thesis' own log.
 """
 
 from __future__ import annotations
@@ -191,8 +191,9 @@ def measure_pages(page, dashboard, logs: dict, repeat: int, pages: list[str], th
             for cold in (True, False):
                 seconds = page_seconds(page, dashboard, which, name, repeat, cold)
                 verdict = f"target < {target:.0f} s: {'met' if seconds < target else 'MISSED'}"
-                # the Findings page's target holds cold too: the first visit after an ingest
-                judged = target and (which == "findings" or not cold)
+                # the first visit after an ingest (the dashboard's or `robotale ingest`) is
+                # warm: both prepare the pages; cold is a log whose kept results were removed
+                judged = target and not cold
                 print(f"{events:>9,} events ({'cold' if cold else 'warm'}): {PAGES[which][0]} "
                       f"in {seconds:.2f} s ({seconds / baseline:.2f}x the baseline; "
                       f"{verdict if judged else 'no target'})")  # fmt: skip

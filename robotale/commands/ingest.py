@@ -11,7 +11,7 @@ import pandas as pd
 
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.append import append_ekg
-from robotale.ekg.build import BuildSummary, build_ekg
+from robotale.ekg.build import BuildSummary, build_ekg, why
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
@@ -19,6 +19,8 @@ from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary,
 from robotale.errors import InputError
 from robotale.eventlog.readers import is_parquet, parse_mapping, read_log_with_reading
 from robotale.eventlog.reading import format_reading
+from robotale.webapp.findings_data import prepare
+from robotale.webapp.logdata import LogData
 
 
 def ingest_command(
@@ -89,7 +91,20 @@ def ingest_command(
                 **names,
             )
     print(describe(summary, appended=append))
+    prepare_pages(name)
     return 0
+
+
+def prepare_pages(name: str) -> None:
+    """Compute what the dashboard shows first of the stored log ``name`` (its findings,
+    perspectives, runs and first timeline), kept with its build, so the first visit computes
+    nothing. The log is stored already: a failure here only leaves that work to the visit."""
+    print("preparing the dashboard's findings, perspectives and timeline ...", flush=True)
+    try:
+        with session_driver() as driver:
+            prepare(driver, LogData(), name)
+    except Exception as error:  # the log is stored: a page's failure is said, not raised
+        print(f"  not prepared ({why(error)}): the dashboard computes them on the first visit")
 
 
 def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> None:
@@ -97,6 +112,7 @@ def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> 
     with session_driver() as driver:
         summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
     print(describe(summary))
+    prepare_pages(name)
 
 
 def log_name(path: Path) -> str:

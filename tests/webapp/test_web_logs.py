@@ -335,3 +335,22 @@ def test_a_log_of_several_days_without_cases_is_offered_a_split_into_runs(
     # the nights (pauses of 1 h or more between runs) no longer count as waiting
     assert performance["summary"]["slowest_transition"] != "land -> takeoff (drone)"
     assert max(row["max"] for row in performance["tables"]["waiting"]) < 3600
+
+
+def test_a_log_stored_with_robotale_ingest_is_ready_for_its_first_visit(
+    client, app, thesis_csv, log_name, capsys
+):
+    import pandas as pd
+
+    from robotale.cli import main
+    from robotale.webapp.state import state
+
+    assert main(["ingest", str(thesis_csv), "--log", log_name, "--case-gap", "1h"]) == 0
+    assert "preparing the dashboard's findings" in capsys.readouterr().out
+    days = pd.to_datetime(pd.read_csv(thesis_csv)["time"]).dt.date.nunique()
+    findings = client.get(f"/api/findings?log={log_name}").json
+    assert findings["answers"][0]["facts"]["runs"] == days
+    computed = state(app).logs.computed
+    assert computed[(log_name, "findings")] == 0  # read from what the ingest kept
+    assert client.get(f"/api/timeline/runs?log={log_name}").status_code == 200
+    assert computed[(log_name, "runs")] == 0
