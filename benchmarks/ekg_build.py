@@ -8,7 +8,9 @@ usual cache) and, in the same run:
 1. builds synthetic logs of the given sizes with three entity types (case, robot, msg_id) and
    an activity aggregation, and reports events/s for the whole build (events, entities, CORR,
    DF, COMM, Class, OBSERVED, DF_C, BEGINS). Targets on a 2-core machine: 100k events in
-   under 10 s, 1M in under 90 s;
+   under 10 s, 1M in under 90 s. Beside each, Neo4j's own write rate on the same machine in the
+   same run: as many nodes (with as many properties as an event) and relationships written by
+   trivial ``UNWIND ... CREATE`` batches (``cypher/ekg_bound_*``), the bound of any build;
 2. builds logs of the ``--baseline-sizes`` once with the thesis' own Cypher (section 7.1.2:
    one query creating every event, per-event MERGE of entities and CORR edges, DF edges by
    collecting each entity's events) and once with robotale, and prints robotale's speed as a
@@ -177,6 +179,45 @@ def measure_build(driver, size: int, repeat: int) -> None:
         f"{seconds:6.1f} s, {len(log) / seconds:,.0f} events/s "
         f"(best of {repeat}{target})"
     )
+    nodes = len(log) + sum(summary.entities.values())
+    bound = min(server_bound(driver, nodes, event_properties(log), edges) for _ in range(repeat))
+    print(
+        f"  Neo4j's own write rate, same run: {nodes:,} nodes with "
+        f"{event_properties(log)} properties each and {edges:,} relationships by trivial "
+        f"UNWIND ... CREATE batches: {bound:6.1f} s; the build takes {seconds / bound:.2f}x that"
+    )
+
+
+def event_properties(log: pd.DataFrame) -> int:
+    """The properties an event node gets on average: its non-null cells, log and order."""
+    return round(log.notna().to_numpy().sum() / len(log)) + 2
+
+
+def server_bound(driver, nodes: int, properties: int, edges: int) -> float:
+    """Seconds Neo4j takes to write ``nodes`` nodes of ``properties`` properties and ``edges``
+    relationships between them in the build's batches, with nothing to compute, look up or
+    index: the fastest any build of that graph can be on this server."""
+    from robotale.ekg.load import Loader
+    from robotale.ekg.queries import cypher
+
+    values = {f"p{k}": k for k in range(properties)}
+    loader = Loader(driver, "bound")
+    started = time.perf_counter()
+    created = np.asarray(
+        loader.run("ekg_bound_nodes", {"rows": [0] * nodes}, properties=values), dtype=np.int64
+    )
+    at = np.arange(edges)
+    loader.run(
+        "ekg_bound_edges",
+        {
+            "sources": created[at % nodes].tolist(),
+            "targets": created[(at * 7 + 1) % nodes].tolist(),
+        },
+    )
+    seconds = time.perf_counter() - started
+    with driver.session() as session:
+        session.run(cypher("ekg_bound_cleanup")).consume()
+    return seconds
 
 
 def compare_with_thesis(
