@@ -40,6 +40,12 @@ def wait_for_line(process: subprocess.Popen, marker: str, seconds: float) -> lis
     pytest.fail(f"no {marker!r} from the demo; it printed:\n{''.join(lines)}")
 
 
+def _as_from_a_terminal() -> None:
+    # A process started in the background by a non-interactive shell inherits SIGINT ignored,
+    # and Python then installs no KeyboardInterrupt: give the demo what a terminal gives it.
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 @pytest.fixture
 def demo_logs(neo4j_driver):
     for name in DEMO_LOGS:
@@ -63,6 +69,7 @@ def test_make_demo_serves_the_dashboard_with_the_ingested_logs(tmp_path, neo4j_d
         stderr=subprocess.STDOUT,
         text=True,
         start_new_session=True,
+        preexec_fn=_as_from_a_terminal,
     )
     try:
         printed = "".join(wait_for_line(process, "robotale dashboard at ", 600))
