@@ -8,6 +8,7 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
+from neo4j import Driver
 
 from robotale.commands.prepare import prepare_recordings
 from robotale.ekg.append import append_ekg
@@ -90,19 +91,18 @@ def ingest_command(
                 source=str(path),
                 **names,
             )
-    print(describe(summary, appended=append))
-    prepare_pages(name)
+        print(describe(summary, appended=append))
+        prepare_pages(driver, name)
     return 0
 
 
-def prepare_pages(name: str) -> None:
+def prepare_pages(driver: Driver, name: str) -> None:
     """Compute what the dashboard shows first of the stored log ``name`` (its findings,
     perspectives, runs and first timeline), kept with its build, so the first visit computes
     nothing. The log is stored already: a failure here only leaves that work to the visit."""
     print("preparing the dashboard's findings, perspectives and timeline ...", flush=True)
     try:
-        with session_driver() as driver:
-            prepare(driver, LogData(), name)
+        prepare(driver, LogData(), name)
     except Exception as error:  # the log is stored: a page's failure is said, not raised
         print(f"  not prepared ({why(error)}): the dashboard computes them on the first visit")
 
@@ -111,8 +111,8 @@ def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> 
     """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
     with session_driver() as driver:
         summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
-    print(describe(summary))
-    prepare_pages(name)
+        print(describe(summary))
+        prepare_pages(driver, name)
 
 
 def log_name(path: Path) -> str:
