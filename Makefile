@@ -15,10 +15,10 @@ SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
 install: $(STAMP)
 
-$(STAMP): pyproject.toml constraints.txt
+$(STAMP): pyproject.toml constraints.txt Makefile
 	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
 	$(BIN)/pip install --quiet --upgrade pip
-	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev,dds,dask]'
+	$(BIN)/pip install --quiet -c constraints.txt -e '.[dev,dds,dask,server]'
 	touch $(STAMP)
 
 # Installs the missing Debian packages when we are allowed to (root or passwordless sudo);
