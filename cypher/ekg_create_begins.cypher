@@ -1,9 +1,7 @@
-// Where entities begin: BEGINS edges from entities (node ids $entities[i]) to the classes of
-// the first event of their chain in a case ($classes[i]), with the number of $cases in which
-// they began there. Appended runs add their cases to an edge that exists.
+// Where entities begin in a new log: BEGINS edges from entities (node ids $entities[i]) to
+// the classes of the first event of their chain in a case ($classes[i]), with the number of
+// $cases in which they began there (appends use ekg_merge_begins).
 UNWIND range(0, size($entities) - 1) AS i
 MATCH (n) WHERE id(n) = $entities[i]
 MATCH (c) WHERE id(c) = $classes[i]
-MERGE (n)-[b:BEGINS]->(c)
-ON CREATE SET b.cases = $cases[i]
-ON MATCH SET b.cases = b.cases + $cases[i]
+CREATE (n)-[:BEGINS {cases: $cases[i]}]->(c)

@@ -1,8 +1,12 @@
-// One batch of events of log $log with their CORR and OBSERVED edges, given as columns: $ids,
+// One batch of events of log $log with the edges that start at them, given as columns: $ids,
 // $orders (position in the log), the time as Unix $seconds + $nanos shown in the zone
 // $timezone, $properties {key: [values]} for every other property (null values are not
-// stored), $entities, the node ids of each event's entities, and $classes, the node ids of
-// each event's classes (one per aggregation key). Returns [row, node id] pairs.
+// stored), $entities, the node ids of each event's entities (CORR), $classes, the node ids
+// of each event's classes, one per aggregation key (OBSERVED), and the DF and COMM edges
+// between two events of this batch, by position in it: $df {sources, targets, entityTypes,
+// entityIds}, $comm {sources, targets, msgIds}. An edge created in the transaction that
+// creates both its ends needs no lookup and no lock of a stored node. Returns
+// [position, node id] pairs.
 UNWIND range(0, size($ids) - 1) AS i
 CREATE (e:Event {log: $log, id: $ids[i], order: $orders[i],
                  timestamp: datetime({epochSeconds: $seconds[i], nanosecond: $nanos[i],
@@ -19,4 +23,16 @@ CALL (e, i) {
   MATCH (c) WHERE id(c) = class
   CREATE (e)-[:OBSERVED]->(c)
 }
-RETURN collect([i, id(e)]) AS nodes
+WITH e ORDER BY i
+WITH collect(e) AS events
+CALL (events) {
+  UNWIND range(0, size($df.sources) - 1) AS j
+  WITH events[$df.sources[j]] AS a, events[$df.targets[j]] AS b, j
+  CREATE (a)-[:DF {entityType: $df.entityTypes[j], entityId: $df.entityIds[j]}]->(b)
+}
+CALL (events) {
+  UNWIND range(0, size($comm.sources) - 1) AS j
+  WITH events[$comm.sources[j]] AS a, events[$comm.targets[j]] AS b, j
+  CREATE (a)-[:COMM {msgId: $comm.msgIds[j]}]->(b)
+}
+RETURN [k IN range(0, size(events) - 1) | [k, id(events[k])]] AS nodes

@@ -209,7 +209,7 @@ def _append(
     between_batches: Callable[[], None],
 ) -> None:
     loader = Loader(None, name, None, between_batches, tx=tx)
-    class_nodes = write_graph(loader, tables, classes)
+    class_nodes = write_graph(loader, tables, classes, new_log=False)
     for kind, nodes in zip(classes, class_nodes, strict=True):
         between_batches()
         sources = np.unique(nodes[kind.df_c["source"].to_numpy()]).tolist()

@@ -28,7 +28,7 @@ from robotale.ekg.columnar import store_copy
 from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
-from robotale.ekg.load import Loader, neo4j_values
+from robotale.ekg.load import Loader, neo4j_values, within_batches
 from robotale.ekg.logs import delete_log, log_exists, log_run
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import (
@@ -136,7 +136,11 @@ def check_key_sizes(tables: GraphTables, keys: list[list[str]]) -> None:
     columns = {"id"} | {column for key in keys for column in key}
     columns |= set(tables.entities["type"].unique())  # entity types are event columns
     for column in sorted(c for c in columns if c in events.columns):
-        sizes = events[column].astype("string").fillna("").str.encode("utf-8").str.len()
+        text = events[column].astype("string").fillna("")
+        # A character takes at most 4 bytes: only longer values need encoding to be measured.
+        if not (text.str.len() > KEY_BYTES // 4).any():
+            continue
+        sizes = text.str.encode("utf-8").str.len()
         if (sizes > KEY_BYTES).any():
             row = int(sizes.to_numpy().argmax())
             raise InputError(
@@ -229,7 +233,7 @@ def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> Bu
     )
     with _progress(tables, job.classes, target, job.progress) as bar:
         loader = Loader(driver, target, bar, between_batches)
-        class_nodes = write_graph(loader, tables, job.classes)
+        class_nodes = write_graph(loader, tables, job.classes, new_log=True)
         for classes, nodes in zip(job.classes, class_nodes, strict=True):
             write_df_c(loader, classes, nodes)
     for classes in job.classes:
@@ -270,16 +274,22 @@ def _progress(
 
 
 def write_graph(
-    loader: Loader, tables: GraphTables, classes: Sequence[ClassTables]
+    loader: Loader, tables: GraphTables, classes: Sequence[ClassTables], *, new_log: bool
 ) -> list[np.ndarray]:
-    """Entities and classes, then events with their CORR and OBSERVED edges, then DF, COMM
-    and BEGINS edges. Returns the node ids of each key's classes, by class row."""
-    entity_nodes = _write_entities(loader, tables.entities)
+    """Entities and classes, then events with their CORR, OBSERVED, DF and COMM edges, then
+    the DF and COMM edges between batches, and BEGINS edges. ``new_log``: nothing of the
+    log is stored yet (an append finds the entities and BEGINS edges the log has). Returns
+    the node ids of each key's classes, by class row."""
+    entity_nodes = _write_entities(loader, tables.entities, new_log)
     class_nodes = [_write_classes(loader, c) for c in classes]
     per_event = _per_event(tables.corr, entity_nodes, len(tables.events))
     observed = _observed(classes, class_nodes, len(tables.events))
-    event_nodes = loader.events(tables.events, per_event, observed, tables.first)
-    for entity_type, part in tables.df.groupby("entityType", sort=True):
+    df, comm = tables.df, tables.comm
+    df_within, comm_within = within_batches(df), within_batches(comm)
+    event_nodes = loader.events(
+        tables.events, per_event, observed, df[df_within], comm[comm_within], tables.first
+    )
+    for entity_type, part in df[~df_within].groupby("entityType", sort=True):
         loader.run(
             "ekg_create_df",
             {
@@ -289,17 +299,18 @@ def write_graph(
             },
             entityType=entity_type,
         )
-    if len(tables.comm):
+    between = comm[~comm_within]
+    if len(between):
         loader.run(
             "ekg_create_comm",
             {
-                "sources": event_nodes[tables.comm["source"]].tolist(),
-                "targets": event_nodes[tables.comm["target"]].tolist(),
-                "msgIds": tables.comm["msgId"].tolist(),
+                "sources": event_nodes[between["source"]].tolist(),
+                "targets": event_nodes[between["target"]].tolist(),
+                "msgIds": between["msgId"].tolist(),
             },
         )
     for kind, nodes in zip(classes, class_nodes, strict=True):
-        _write_begins(loader, kind.entries, entity_nodes, nodes)
+        _write_begins(loader, kind.entries, entity_nodes, nodes, new_log)
     return class_nodes
 
 
@@ -321,10 +332,12 @@ def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:
     )
 
 
-def _write_entities(loader: Loader, entities: pd.DataFrame) -> np.ndarray:
+def _write_entities(loader: Loader, entities: pd.DataFrame, new_log: bool) -> np.ndarray:
+    # CREATE rather than MERGE where the log has no entity yet: no index lookup per entity
+    query = "ekg_create_entities" if new_log else "ekg_merge_entities"
     nodes = np.zeros(len(entities), dtype=np.int64)
     for entity_type, part in entities.groupby("type", sort=False):
-        created = loader.run("ekg_create_entities", {"ids": part["id"].tolist()}, type=entity_type)
+        created = loader.run(query, {"ids": part["id"].tolist()}, type=entity_type)
         nodes[part.index.to_numpy()] = created
     return nodes
 
@@ -343,12 +356,16 @@ def _write_classes(loader: Loader, classes: ClassTables) -> np.ndarray:
 
 
 def _write_begins(
-    loader: Loader, entries: pd.DataFrame, entity_nodes: np.ndarray, class_nodes: np.ndarray
+    loader: Loader,
+    entries: pd.DataFrame,
+    entity_nodes: np.ndarray,
+    class_nodes: np.ndarray,
+    new_log: bool,
 ) -> None:
     if entries.empty:
         return
     loader.run(
-        "ekg_create_begins",
+        "ekg_create_begins" if new_log else "ekg_merge_begins",
         {
             "entities": entity_nodes[entries["entity"].to_numpy()].tolist(),
             "classes": class_nodes[entries["class"].to_numpy()].tolist(),

@@ -24,7 +24,7 @@ from tqdm import tqdm
 from robotale.ekg.connection import database
 from robotale.ekg.queries import cypher
 
-BATCH = 10_000
+BATCH = 5_000
 WORKERS = 2
 
 
@@ -52,12 +52,15 @@ class Loader:
         query: str,
         columns: Mapping[str, Sequence[Any]],
         maps: Mapping[str, Mapping[str, Sequence[Any]]] | None = None,
+        batches: Mapping[str, Sequence[Any]] | None = None,
         **constants: Any,
     ) -> list[int]:
         """Run ``cypher/<query>.cypher`` once per batch of ``columns``.
 
         ``maps`` are parameters that are maps of columns ({key: [values]}); they are cut into
-        the same batches. Returns the node ids of the queries' ``nodes`` results in row order.
+        the same batches. ``batches`` are parameters given whole for each batch: item k of
+        each goes with batch k. Returns the node ids of the queries' ``nodes`` results in
+        row order.
         """
         text = cypher(query)
         size = len(next(iter(columns.values())))
@@ -67,6 +70,8 @@ class Loader:
             params = {name: _slice(values, start) for name, values in columns.items()}
             for name, columns_of_map in (maps or {}).items():
                 params[name] = {k: _slice(v, start) for k, v in columns_of_map.items()}
+            for name, values in (batches or {}).items():
+                params[name] = values[start // BATCH]
             records = self._execute(text, params | constants | {"log": self.log})
             if self.progress is not None:
                 self.progress.update(min(BATCH, size - start))
@@ -89,10 +94,14 @@ class Loader:
         events: pd.DataFrame,
         entities: list[list[int]],
         classes: list[list[int]],
+        df: pd.DataFrame,
+        comm: pd.DataFrame,
         first: int = 0,
     ) -> np.ndarray:
         """Create the events with their CORR and OBSERVED edges (``entities``, ``classes``:
-        node ids per event); ``first`` is the first event's position in the stored log.
+        node ids per event) and the rows of ``df`` and ``comm`` (event positions) that lie
+        within one batch (:func:`within_batches`); ``first`` is the first event's position
+        in the stored log.
 
         Returns the events' node ids by row.
         """
@@ -108,10 +117,40 @@ class Loader:
         }
         others = [c for c in events.columns if c not in ("id", "timestamp")]
         properties = {name: neo4j_values(events[name]) for name in others}
+        count = -(-len(events) // BATCH)
+        batches = {
+            "df": _per_batch(df, count, entityTypes="entityType", entityIds="entityId"),
+            "comm": _per_batch(comm, count, msgIds="msgId"),
+        }
         nodes = self.run(
-            "ekg_create_events", columns, {"properties": properties}, timezone=timezone_name(times)
+            "ekg_create_events",
+            columns,
+            {"properties": properties},
+            batches,
+            timezone=timezone_name(times),
         )
         return np.asarray(nodes, dtype=np.int64)
+
+
+def within_batches(edges: pd.DataFrame) -> np.ndarray:
+    """Which rows of ``edges`` (``source``, ``target``: event positions) join two events of
+    the same batch, so that :meth:`Loader.events` writes them with their events."""
+    return (edges["source"].to_numpy() // BATCH) == (edges["target"].to_numpy() // BATCH)
+
+
+def _per_batch(edges: pd.DataFrame, count: int, **properties: str) -> list[dict[str, list]]:
+    """For each of ``count`` batches, its edges of ``edges`` as columns: ``sources`` and
+    ``targets`` by position in the batch, and each of ``properties`` (parameter: column)."""
+    batch = edges["source"].to_numpy() // BATCH
+    parts = []
+    for k in range(count):
+        part = edges[batch == k]
+        columns = {
+            "sources": (part["source"].to_numpy() % BATCH).tolist(),
+            "targets": (part["target"].to_numpy() % BATCH).tolist(),
+        }
+        parts.append(columns | {name: part[c].tolist() for name, c in properties.items()})
+    return parts
 
 
 def _in_flight(write: Callable[[int], list[int]], starts: range) -> list[int]:
@@ -145,6 +184,8 @@ def neo4j_values(column: pd.Series) -> list[Any]:
         return [None if math.isnan(v) else v for v in column.to_numpy(float).tolist()]
     if pd.api.types.is_datetime64_any_dtype(column):
         return [None if pd.isna(v) else v.to_pydatetime() for v in column]
+    if pd.api.types.infer_dtype(column, skipna=True) == "string":  # the usual log's columns
+        return column.astype(object).where(column.notna(), None).tolist()
     return [_storable(v) for v in column.astype(object).tolist()]
 
 

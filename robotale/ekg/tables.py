@@ -168,12 +168,25 @@ def entity_ids(values: pd.Series) -> pd.Series:
     values = values.dropna()
     if values.empty:
         return pd.Series([], dtype="string")
-    if values.map(lambda v: isinstance(v, list | tuple | set | np.ndarray)).any():
+    if _may_hold_lists(values):
         values = values.explode().dropna()
     text = values.astype("string").str.strip()
     if text.str.contains(_SEPARATOR, regex=False).any():
         text = text.str.split(_SEPARATOR).explode().str.strip()
     return text[text != ""]
+
+
+def _may_hold_lists(values: pd.Series) -> bool:
+    """Whether some cell of ``values`` is a list of ids. Asking each cell costs a Python call
+    per event; a column pandas infers to hold plain strings or numbers (the usual log)
+    holds no list."""
+    if pd.api.types.infer_dtype(values, skipna=True) in _SCALARS:
+        return False
+    return bool(values.map(lambda v: isinstance(v, list | tuple | set | np.ndarray)).any())
+
+
+#: what :func:`pandas.api.types.infer_dtype` says of a column of plain values
+_SCALARS = frozenset({"string", "integer", "floating", "mixed-integer-float", "boolean"})
 
 
 def _check_timestamps(times: pd.Series) -> None:
@@ -208,7 +221,8 @@ def _directly_follows(
     events: pd.DataFrame, corr: pd.DataFrame
 ) -> tuple[pd.DataFrame, pd.DataFrame]:
     """DF edges, and the events that begin each entity's chain in each case."""
-    times = events["timestamp"].dt.tz_convert("UTC")
+    # as naive UTC datetime64: a zone-aware column's to_numpy() is one object per event
+    times = events["timestamp"].dt.tz_convert("UTC").dt.tz_localize(None)
     at = corr["event"].to_numpy()
     ordered = corr.assign(
         time=times.to_numpy()[at], case=events["case"].astype("string").to_numpy()[at]
