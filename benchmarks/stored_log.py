@@ -11,7 +11,8 @@ imports what the command needs):
 - ``perspectives FILE.csv --json`` against ``perspectives --log NAME --json``;
 - ``discover dfg FILE.csv`` against ``discover dfg --log NAME`` (the DFG from the event table);
 - ``discover ekg --log NAME``, the class graph aggregated in Neo4j, which reads no event table
-  (its time beside the CSV's DFG, for reference).
+  (its time beside the CSV's DFG, for reference): its first call, which aggregates a key the
+  ingest did not and stores it, and the calls after it.
 
 A stored log is timed *warm* (its columnar copy is there: every analysis after the ingest)
 and *cold* (the copy removed before each run: a log built on another machine, or by an older
@@ -98,9 +99,14 @@ def measure(driver, folder: Path, csv: Path, name: str, size: int, repeat: int) 
               f"({warm / baseline:.2f}x; {verdict}) | stored, cold {colder:6.2f} s "
               f"({colder / baseline:.2f}x)")  # fmt: skip
         if what == "discover dfg":
-            ekg = timed(run("discover", "ekg", "--log", name, "--out", out), repeat)
-            print(f"  {'discover ekg':<13} stored (Neo4j aggregation) {ekg:6.2f} s "
-                  f"({ekg / baseline:.2f}x the CSV's discover dfg)")  # fmt: skip
+            command = run("discover", "ekg", "--log", name, "--out", out)
+            # The first call aggregates the key (activity,robot) the ingest did not, in
+            # Neo4j, and stores its classes; later calls read them.
+            first = timed(command, 1)
+            ekg = timed(command, repeat)
+            print(f"  {'discover ekg':<13} stored, its key's classes stored {ekg:6.2f} s "
+                  f"({ekg / baseline:.2f}x the CSV's discover dfg) | first call, aggregating "
+                  f"the key in Neo4j {first:6.2f} s")  # fmt: skip
 
 
 def timed(work: Callable[[], object], repeat: int) -> float:
