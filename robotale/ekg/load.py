@@ -144,8 +144,9 @@ def _per_batch(edges: pd.DataFrame, count: int, **properties: str) -> list[dict[
     ``targets`` by position in the batch, and each of ``properties`` (parameter: column)."""
     batch = edges["source"].to_numpy() // BATCH
     # one sort, then a slice per batch: a mask per batch would read every edge once per batch
-    edges = edges.iloc[np.argsort(batch, kind="stable")]
-    bounds = np.searchsorted(np.sort(batch), np.arange(count + 1)).tolist()
+    order = np.argsort(batch, kind="stable")
+    edges = edges.iloc[order]
+    bounds = np.searchsorted(batch[order], np.arange(count + 1)).tolist()
     parts = []
     for start, end in itertools.pairwise(bounds):
         part = edges.iloc[start:end]

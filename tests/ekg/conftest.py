@@ -4,7 +4,10 @@ from __future__ import annotations
 
 import os
 
+import pandas as pd
 import pytest
+
+from robotale.eventlog.readers import read_csv
 
 
 @pytest.fixture
@@ -20,3 +23,9 @@ def env(tmp_path, neo4j_server) -> dict[str, str]:
         "ROBOTALE_NEO4J_HEAP": "512m",
         "ROBOTALE_NEO4J_PAGECACHE": "64m",
     }
+
+
+@pytest.fixture(scope="module")
+def thesis_log(thesis_csv) -> pd.DataFrame:
+    """The thesis' CSV as robotale reads it (one case: it has no case column)."""
+    return read_csv(thesis_csv)

@@ -6,7 +6,6 @@ from __future__ import annotations
 
 import uuid
 
-import pandas as pd
 import pytest
 
 from robotale.ekg import build_ekg, load
@@ -14,15 +13,9 @@ from robotale.ekg.connection import database
 from robotale.ekg.logs import delete_log
 from robotale.ekg.tables import graph_tables
 from robotale.eventlog import schema
-from robotale.eventlog.readers import read_csv
 
 # prime, so that batch boundaries fall at every distance from a message's send and receives
 SMALL_BATCH = 101
-
-
-@pytest.fixture(scope="module")
-def thesis_log(thesis_csv) -> pd.DataFrame:
-    return read_csv(thesis_csv)
 
 
 @pytest.fixture(scope="module")

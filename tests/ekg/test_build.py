@@ -15,12 +15,6 @@ from robotale.ekg.logs import delete_log, list_logs, log_summary
 from robotale.ekg.queries import cypher
 from robotale.errors import InputError
 from robotale.eventlog import schema
-from robotale.eventlog.readers import read_csv
-
-
-@pytest.fixture(scope="module")
-def thesis_log(thesis_csv) -> pd.DataFrame:
-    return read_csv(thesis_csv)
 
 
 @pytest.fixture(scope="module")
