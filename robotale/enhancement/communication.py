@@ -379,10 +379,10 @@ def _split_lost(table, deliveries, numbered, ids) -> None:
     receiver, when named); else it is ``unobserved``: it may have arrived untagged."""
     reached = deliveries[deliveries["received"]]
     tagged_types = set(table.loc[table["received"], TYPE].dropna())
-    tagged_pairs = set(zip(reached[TYPE], reached["receiver"], strict=True))
+    known = pd.MultiIndex.from_arrays([reached[TYPE], reached["receiver"].astype(object)])
     receiver = deliveries["receiver"].astype(object)
-    pairs = pd.Series(list(zip(deliveries[TYPE], receiver, strict=True)), index=deliveries.index)
-    tagged = deliveries[TYPE].isin(tagged_types) & (receiver.eq(UNKNOWN) | pairs.isin(tagged_pairs))
+    pairs = pd.MultiIndex.from_arrays([deliveries[TYPE], receiver]).isin(known)
+    tagged = deliveries[TYPE].isin(tagged_types) & (receiver.eq(UNKNOWN) | pairs)
     # a message received by a robot the log does not name has a delivery without a receiver
     arrived = table["received"].to_numpy(bool)[deliveries[MESSAGE].to_numpy()]
     missing = deliveries["sent_at"].notna() & ~deliveries["received"] & ~arrived
@@ -443,17 +443,19 @@ def _repeated(table: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
     sent = table["sent"].to_numpy(bool) & table["sent_at"].notna().to_numpy(bool)
     if not sent.any():
         return pd.Series(resent_as, index=table.index), pd.Series(repeats, index=table.index)
-    cases = table[CASE].astype(object).to_numpy() if CASE in table.columns else np.zeros(n)
-    times = table["sent_at"]
-    order = np.flatnonzero(sent)[np.argsort(times.to_numpy()[sent], kind="stable")]
-    sent_at = times.to_numpy()
-    received_at = table["received_at"].to_numpy()
+    cases = table[CASE].astype(object).tolist() if CASE in table.columns else [0] * n
+    # times as integers; a message never received is received never (the largest time)
+    sent_at = _integer_times(table["sent_at"])
+    never = np.iinfo(np.int64).max
     received = table["received"].to_numpy(bool)
-    senders = table["sender"].astype(object).to_numpy()
-    types = table[TYPE].astype(object).to_numpy()
-    ids = table[MSG_ID].astype(object).to_numpy()
-    receivers = [_receiver_set(r) for r in table["receiver"].astype(object).to_numpy()]
-    payloads = table["payload"].astype(object).to_numpy() if "payload" in table else None
+    received_at = np.where(received, _integer_times(table["received_at"]), never)
+    order = np.flatnonzero(sent)[np.argsort(sent_at[sent], kind="stable")].tolist()
+    sent_at, received_at = sent_at.tolist(), received_at.tolist()
+    senders = table["sender"].astype(object).tolist()
+    types = table[TYPE].astype(object).tolist()
+    ids = table[MSG_ID].astype(object).tolist()
+    receivers = [_receiver_set(r) for r in table["receiver"].astype(object).tolist()]
+    payloads = table["payload"].astype(object).tolist() if "payload" in table else None
     # case -> sender -> the sender's unanswered messages (rows), oldest first
     waiting: dict[object, dict[object, list[int]]] = {}
     for row in order:
@@ -461,13 +463,16 @@ def _repeated(table: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
         in_case = waiting.setdefault(case, {})
         _answer(in_case, sender, receivers[row], receivers)
         mine = in_case.setdefault(sender, [])
-        mine[:] = [a for a in mine if not (received[a] and received_at[a] <= at)]
-        same = [
-            a for a in mine if payloads is not None and _same_payload(payloads[a], payloads[row])
-        ]
+        if mine:
+            mine[:] = [a for a in mine if received_at[a] > at]
         candidates = [a for a in mine if _may_repeat(a, row, types, receivers)]
         if candidates:
-            chosen = ([a for a in candidates if a in same] or candidates)[-1]
+            same = [
+                a
+                for a in candidates
+                if payloads is not None and _same_payload(payloads[a], payloads[row])
+            ]
+            chosen = (same or candidates)[-1]
             mine.remove(chosen)
             resent_as[chosen], repeats[row] = ids[row], ids[chosen]
         mine.append(row)
@@ -492,9 +497,16 @@ def _answer(waiting: dict, sender, to: frozenset, receivers: list[frozenset]) ->
     """A message from ``sender`` to ``to`` (empty: unknown) answers the unanswered messages
     of its case sent to ``sender`` (or to nobody known) by the robots it may be for."""
     for other, theirs in waiting.items():
-        if other == sender or (to and other not in to):
+        if not theirs or other == sender or (to and other not in to):
             continue
         theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+
+
+def _integer_times(times: pd.Series) -> np.ndarray:
+    """Times as integers of their own unit (missing ones as the smallest), comparable as the
+    times are, without a Python object per time."""
+    values = pd.to_datetime(times, utc=True).array.as_unit("ns")
+    return np.asarray(values.asi8, dtype=np.int64)
 
 
 def _receiver_set(receiver) -> frozenset:

@@ -51,7 +51,7 @@ def encounters(
     columns = ["robot", "other", CASE, "start", "end", "closest", *AXES]
     rows = []
     robots = sorted(placed[ROBOT].unique()) if not placed.empty else []
-    by_robot = {name: mine.sort_values(TIMESTAMP, kind="stable") for name, mine in
+    by_robot = {name: mine.sort_values([CASE, TIMESTAMP], kind="stable") for name, mine in
                 placed.groupby(ROBOT, sort=True)}  # fmt: skip
     for i, first in enumerate(robots):
         for second in robots[i + 1 :]:
@@ -63,22 +63,20 @@ def encounters(
 
 
 def _pair(mine: pd.DataFrame, theirs: pd.DataFrame, metres: float, seconds: float):
-    right = theirs[[CASE, TIMESTAMP, *AXES]].rename(columns={a: f"_{a}" for a in AXES})
-    right = right.assign(_at=right[TIMESTAMP])
-    near = pd.merge_asof(
-        mine[[CASE, ROBOT, TIMESTAMP, *AXES]],
-        right,
-        on=TIMESTAMP,
-        by=CASE,
-        tolerance=pd.Timedelta(seconds=seconds),
-        direction="nearest",
-    )
-    gaps = np.stack([near[a].to_numpy() - near[f"_{a}"].to_numpy() for a in AXES])
-    distance = np.sqrt((gaps**2).sum(axis=0))
-    met = np.nan_to_num(distance, nan=np.inf) <= metres
+    """The encounters of two robots: for each position of the first, the second's position
+    nearest in time in the same run (at most ``seconds`` away), compared in 3D."""
+    mine_key, theirs_key = _run_time_keys(mine, theirs, seconds)
+    after = np.clip(np.searchsorted(theirs_key, mine_key), 0, len(theirs_key) - 1)
+    before = np.clip(after - 1, 0, len(theirs_key) - 1)
+    nearer = np.abs(theirs_key[before] - mine_key) <= np.abs(theirs_key[after] - mine_key)
+    nearest = np.where(nearer, before, after)
+    close_in_time = np.abs(theirs_key[nearest] - mine_key) <= int(seconds * 1e9)
+    gaps = [mine[a].to_numpy(float) - theirs[a].to_numpy(float)[nearest] for a in AXES]
+    distance = np.sqrt(sum(gap**2 for gap in gaps))
+    met = close_in_time & (distance <= metres)
     if not met.any():
         return pd.DataFrame()
-    near = near.assign(_distance=distance)
+    near = mine[[CASE, TIMESTAMP, *AXES]].assign(_distance=distance)
     # a new encounter wherever a meeting position follows one that did not meet (or a new run)
     cases = near[CASE].to_numpy(object)
     new_run = np.r_[True, cases[1:] != cases[:-1]]
@@ -95,6 +93,21 @@ def _pair(mine: pd.DataFrame, theirs: pd.DataFrame, metres: float, seconds: floa
     return table.reset_index(drop=True).assign(
         robot=str(mine[ROBOT].iloc[0]), other=str(theirs[ROBOT].iloc[0])
     )
+
+
+def _run_time_keys(mine: pd.DataFrame, theirs: pd.DataFrame, seconds: float):
+    """One integer per position that orders by run, then time: the run's number times the
+    longest run (plus twice ``seconds``) plus nanoseconds since the run's first position, so
+    no two positions of different runs are ever ``seconds`` apart. Both frames are in run
+    and time order (runs as text), as the keys are."""
+    both = pd.concat([t[[CASE, TIMESTAMP]] for t in (mine, theirs)], ignore_index=True)
+    ticks = np.asarray(pd.to_datetime(both[TIMESTAMP], utc=True).array.as_unit("ns").asi8)
+    run = pd.factorize(both[CASE], sort=True)[0]
+    first = pd.Series(ticks).groupby(run).transform("min").to_numpy()
+    since = ticks - first
+    span = int(since.max()) + 2 * int(seconds * 1e9) + 1
+    keys = run.astype(np.int64) * span + since
+    return keys[: len(mine)], keys[len(mine) :]
 
 
 def run_regions(placed: pd.DataFrame) -> pd.DataFrame:
