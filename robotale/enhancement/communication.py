@@ -395,9 +395,9 @@ def _split_lost(table, deliveries, numbered, ids) -> None:
 
 
 def _channel_of(rows: pd.DataFrame) -> pd.Series:
-    """Each row's channel (sender, receiver and type) as one value, to group by."""
-    parts = [rows[c].astype(object).where(rows[c].notna(), "") for c in CHANNEL]
-    return pd.Series(list(zip(*parts, strict=True)), index=rows.index, dtype=object)
+    """Each row's channel (sender, receiver and type) as one text, to group by."""
+    parts = [rows[c].astype(object).where(rows[c].notna(), "").astype(str) for c in CHANNEL]
+    return parts[0] + "\x1f" + parts[1] + "\x1f" + parts[2]
 
 
 def untagged_types(messages: pd.DataFrame) -> list[str]:

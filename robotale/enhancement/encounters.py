@@ -33,12 +33,11 @@ def positions(log: pd.DataFrame) -> pd.DataFrame:
         return pd.DataFrame(columns=[CASE, ROBOT, TIMESTAMP, *AXES])
     columns = [c for c in (CASE, ROBOT, TIMESTAMP, X, Y, Z) if c in log.columns]
     placed = log[columns].dropna(subset=[ROBOT, X, Y])
+    # the run and robot columns keep their own values: turned into text once per distinct
+    # value where a name is written, not once per position
     placed = placed.assign(
-        **{
-            Z: placed[Z].fillna(0.0) if Z in placed.columns else 0.0,
-            CASE: placed[CASE].astype(str) if CASE in placed.columns else "",
-            ROBOT: placed[ROBOT].astype(str),
-        }
+        **{Z: placed[Z].fillna(0.0) if Z in placed.columns else 0.0}
+        | ({} if CASE in placed.columns else {CASE: ""})
     )
     return placed.astype({X: float, Y: float, Z: float})
 
@@ -49,34 +48,43 @@ def encounters(
     """One row per encounter of two robots (see the module): robots, case, start, end,
     closest distance and the first robot's place then."""
     columns = ["robot", "other", CASE, "start", "end", "closest", *AXES]
-    rows = []
-    robots = sorted(placed[ROBOT].unique()) if not placed.empty else []
-    by_robot = {name: mine.sort_values([CASE, TIMESTAMP], kind="stable") for name, mine in
-                placed.groupby(ROBOT, sort=True)}  # fmt: skip
-    for i, first in enumerate(robots):
-        for second in robots[i + 1 :]:
-            rows.append(_pair(by_robot[first], by_robot[second], metres, seconds))
-    found = [r for r in rows if not r.empty]
+    if placed.empty:
+        return pd.DataFrame(columns=columns)
+    # one sort of all positions by robot, run and time; each robot's rows then a slice
+    keys = _run_time_keys(placed, seconds)
+    robot_code, names = pd.factorize(placed[ROBOT], sort=True)
+    order = np.lexsort((keys, robot_code))
+    bounds = np.searchsorted(robot_code[order], np.arange(len(names) + 1))
+    xyz = placed[list(AXES)].to_numpy(float)[order]
+    key = keys[order]
+    found = []
+    for i in range(len(names)):
+        for j in range(i + 1, len(names)):
+            mine, theirs = slice(bounds[i], bounds[i + 1]), slice(bounds[j], bounds[j + 1])
+            met, distance = _meet(key[mine], xyz[mine], key[theirs], xyz[theirs], metres, seconds)
+            if met.any():
+                rows = placed.iloc[order[mine]]
+                found.append(_episodes(rows, met, distance, str(names[i]), str(names[j])))
     if not found:
         return pd.DataFrame(columns=columns)
     return pd.concat(found, ignore_index=True)[columns]
 
 
-def _pair(mine: pd.DataFrame, theirs: pd.DataFrame, metres: float, seconds: float):
-    """The encounters of two robots: for each position of the first, the second's position
-    nearest in time in the same run (at most ``seconds`` away), compared in 3D."""
-    mine_key, theirs_key = _run_time_keys(mine, theirs, seconds)
+def _meet(mine_key, mine_xyz, theirs_key, theirs_xyz, metres: float, seconds: float):
+    """For each position of the first robot, whether the second's position nearest in time
+    in the same run (at most ``seconds`` away) is within ``metres`` in 3D, and how far."""
     after = np.clip(np.searchsorted(theirs_key, mine_key), 0, len(theirs_key) - 1)
     before = np.clip(after - 1, 0, len(theirs_key) - 1)
     nearer = np.abs(theirs_key[before] - mine_key) <= np.abs(theirs_key[after] - mine_key)
     nearest = np.where(nearer, before, after)
     close_in_time = np.abs(theirs_key[nearest] - mine_key) <= int(seconds * 1e9)
-    gaps = [mine[a].to_numpy(float) - theirs[a].to_numpy(float)[nearest] for a in AXES]
-    distance = np.sqrt(sum(gap**2 for gap in gaps))
-    met = close_in_time & (distance <= metres)
-    if not met.any():
-        return pd.DataFrame()
-    near = mine[[CASE, TIMESTAMP, *AXES]].assign(_distance=distance)
+    distance = np.sqrt(((mine_xyz - theirs_xyz[nearest]) ** 2).sum(axis=1))
+    return close_in_time & (distance <= metres), distance
+
+
+def _episodes(rows: pd.DataFrame, met: np.ndarray, distance: np.ndarray, robot: str, other: str):
+    """Consecutive meeting positions of ``robot`` (in run and time order) as encounters."""
+    near = rows[[CASE, TIMESTAMP, *AXES]].reset_index(drop=True).assign(_distance=distance)
     # a new encounter wherever a meeting position follows one that did not meet (or a new run)
     cases = near[CASE].to_numpy(object)
     new_run = np.r_[True, cases[1:] != cases[:-1]]
@@ -88,26 +96,22 @@ def _pair(mine: pd.DataFrame, theirs: pd.DataFrame, metres: float, seconds: floa
         **{CASE: (CASE, "first"), "start": (TIMESTAMP, "min"), "end": (TIMESTAMP, "max")},
         closest=("_distance", "min"),
     )
-    closest = meeting.loc[grouped["_distance"].idxmin(), list(AXES)].to_numpy()
-    table[list(AXES)] = closest
-    return table.reset_index(drop=True).assign(
-        robot=str(mine[ROBOT].iloc[0]), other=str(theirs[ROBOT].iloc[0])
-    )
+    table[list(AXES)] = meeting.loc[grouped["_distance"].idxmin(), list(AXES)].to_numpy()
+    return table.reset_index(drop=True).assign(robot=robot, other=other)
 
 
-def _run_time_keys(mine: pd.DataFrame, theirs: pd.DataFrame, seconds: float):
+def _run_time_keys(placed: pd.DataFrame, seconds: float) -> np.ndarray:
     """One integer per position that orders by run, then time: the run's number times the
     longest run (plus twice ``seconds``) plus nanoseconds since the run's first position, so
-    no two positions of different runs are ever ``seconds`` apart. Both frames are in run
-    and time order (runs as text), as the keys are."""
-    both = pd.concat([t[[CASE, TIMESTAMP]] for t in (mine, theirs)], ignore_index=True)
-    ticks = np.asarray(pd.to_datetime(both[TIMESTAMP], utc=True).array.as_unit("ns").asi8)
-    run = pd.factorize(both[CASE], sort=True)[0]
+    no two positions of different runs are ever ``seconds`` apart."""
+    if placed.empty:
+        return np.zeros(0, dtype=np.int64)
+    ticks = np.asarray(pd.to_datetime(placed[TIMESTAMP], utc=True).array.as_unit("ns").asi8)
+    run = pd.factorize(placed[CASE], sort=True)[0]
     first = pd.Series(ticks).groupby(run).transform("min").to_numpy()
     since = ticks - first
     span = int(since.max()) + 2 * int(seconds * 1e9) + 1
-    keys = run.astype(np.int64) * span + since
-    return keys[: len(mine)], keys[len(mine) :]
+    return run.astype(np.int64) * span + since
 
 
 def run_regions(placed: pd.DataFrame) -> pd.DataFrame:
@@ -122,20 +126,23 @@ def run_regions(placed: pd.DataFrame) -> pd.DataFrame:
 def region_overlaps(regions: pd.DataFrame) -> list[dict[str, Any]]:
     """Per run, every pair of robots whose boxes intersect on x, y and z, with the shared
     box."""
-    found = []
-    for case, boxes in regions.groupby(CASE, sort=True):
-        rows = boxes.sort_values(ROBOT).to_dict("records")
-        for i, first in enumerate(rows):
-            for second in rows[i + 1 :]:
-                shared = {
-                    axis: [
-                        max(first[f"{axis}_min"], second[f"{axis}_min"]),
-                        min(first[f"{axis}_max"], second[f"{axis}_max"]),
-                    ]
-                    for axis in AXES
-                }
-                if all(low <= high for low, high in shared.values()):
-                    found.append(
-                        {"case": str(case), "robots": [first[ROBOT], second[ROBOT]], **shared}
-                    )
-    return found
+    if regions.empty:
+        return []
+    pairs = regions.merge(regions, on=CASE, suffixes=("", "_other"))
+    pairs = pairs[pairs[ROBOT].astype(str) < pairs[f"{ROBOT}_other"].astype(str)]
+    shared = {}
+    overlap = pd.Series(True, index=pairs.index)
+    for axis in AXES:
+        low = np.maximum(pairs[f"{axis}_min"], pairs[f"{axis}_min_other"])
+        high = np.minimum(pairs[f"{axis}_max"], pairs[f"{axis}_max_other"])
+        shared[axis] = (low, high)
+        overlap &= low <= high
+    pairs = pairs[overlap].sort_values([CASE, ROBOT, f"{ROBOT}_other"], kind="stable")
+    return [
+        {
+            "case": str(row[CASE]),
+            "robots": [str(row[ROBOT]), str(row[f"{ROBOT}_other"])],
+            **{axis: [float(shared[axis][0][i]), float(shared[axis][1][i])] for axis in AXES},
+        }
+        for i, row in pairs.iterrows()
+    ]
