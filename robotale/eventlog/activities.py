@@ -188,7 +188,7 @@ def implicit(tags: pd.DataFrame, ends: dict[str, pd.Timestamp]) -> pd.DataFrame:
     at the end of its run (``ends``: case -> time). The added completes keep their start's
     source.
     """
-    closing = {schema.COMPLETE, schema.ABORTED, schema.CANCELLED}
+    closing = schema.ENDINGS
     tags = tags.sort_values([schema.CASE, schema.ROBOT, schema.TIMESTAMP], kind="stable")
     tags = tags.assign(**{schema.LIFECYCLE: tags[schema.LIFECYCLE].where(
         tags[schema.LIFECYCLE].isin(closing), schema.START
