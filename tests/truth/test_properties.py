@@ -34,11 +34,30 @@ def test_the_generated_missions_exercise_what_they_should(generated):
     assert {len(s.mission.pools) for s in generated} >= {2, 3, 4}
 
 
-@pytest.mark.parametrize("subject", ["messages", "activities", "durations"])
+#: subjects on which robotale's analysis still disagrees with the truth, and how
+NOT_YET = {
+    "durations": "an activity ended by ate_abort is paired with a later start's end, so a "
+    "Go To a timer interrupted lasts 8.2 s instead of 3.2 s",
+    "delayed": "with --delay 0.1 a message whose true latency is under 0.1 s is called delayed",
+    "resends": "a robot answering the same task twice (same sender, type and payload) is not "
+    "counted as a resend",
+    "dfg": "an activity interrupted by a boundary timer or an event sub-process (ate_abort) is "
+    "not counted in the DFG",
+    "battery": "battery use per robot and run is below the true drops (charging offsets use) "
+    "and 'used while waiting' is negative",
+}
+
+
+def _subject(name: str):
+    if name not in NOT_YET:
+        return name
+    return pytest.param(name, marks=pytest.mark.xfail(strict=True, reason=NOT_YET[name]))
+
+
+@pytest.mark.parametrize(
+    "subject",
+    [_subject(s) for s in ("messages", "lost", "activities", "durations", "delayed")]
+    + [_subject(s) for s in ("resends", "dfg", "battery")],
+)
 def test_robotale_agrees_with_the_truth(generated, subject):
-    _check(generated, subject)
-
-
-@pytest.mark.parametrize("subject", ["lost", "delayed", "resends", "dfg", "battery"])
-def test_robotale_agrees_with_the_truth_on_the_analysis(generated, subject):
     _check(generated, subject)
