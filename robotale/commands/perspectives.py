@@ -54,7 +54,8 @@ def _headline(name: str, summary: dict) -> str:
     if name == "communication":
         return (
             f"{summary['messages']} messages, {summary['received']} received, "
-            f"{summary['lost']} lost, {summary['resends']} resends "
+            f"{summary['lost']} lost, {summary.get('unobserved', 0)} not observed as received, "
+            f"{summary['resends']} resends "
             f"({summary.get('resends_new_id', 0)} under a new id), "
             f"{summary.get('delayed', 0)} delayed, {summary.get('channels', 0)} channels"
         )

@@ -77,14 +77,18 @@ class Findings:
         return {"answers": [a.to_dict() for a in self.answers]}
 
 
-def find(log: pd.DataFrame, *, threshold: float = 20.0) -> Findings:
+def find(
+    log: pd.DataFrame, *, threshold: float = 20.0, delay_threshold: float | None = None
+) -> Findings:
     """The answers to the five questions for ``log`` (``threshold``: the battery level, in
-    percent, below which a robot's battery counts as low)."""
+    percent, below which a robot's battery counts as low; ``delay_threshold``: the latency in
+    seconds above which a message is delayed, else the rule of
+    :mod:`robotale.enhancement.delays`)."""
     # one analysis for all: the activity instances, steps, case durations and the message
     # table are built once; the messages come first so the bottlenecks' queueing reuses them.
     # The spatial perspective is not needed: the areas are two numbers per robot.
     analysis = LogAnalysis(log)
-    communication = communication_perspective(analysis)
+    communication = communication_perspective(analysis, delay_threshold=delay_threshold)
     perspectives = {
         "performance": performance_perspective(analysis),
         "bottlenecks": find_bottlenecks(analysis),
@@ -398,14 +402,35 @@ def message_answer(communication: Perspective) -> Answer:
         return answer
     summary = communication.summary
     messages = communication.tables["messages"]
-    keys = ("messages", "received", "lost", "delayed", "resends", "resends_new_id", "recovered")
+    keys = (
+        "messages",
+        "received",
+        "lost",
+        "unobserved",
+        "delayed",
+        "resends",
+        "resends_new_id",
+        "recovered",
+    )
     answer.facts = {key: int(summary.get(key, 0)) for key in keys}
+    answer.facts["untagged_types"] = list(summary.get("untagged_types", []))
+    answer.facts["delay_rule"] = summary.get("delay_rule")
+    unobserved = int(summary.get("unobserved", 0))
+    not_seen = f", {unobserved} not observed as received" if unobserved else ""
     answer.sentences.append(
         f"{_count(summary['messages'], 'message')} sent: {summary['received']} received, "
-        f"{summary['lost']} lost, {summary.get('delayed', 0)} delayed, "
+        f"{summary['lost']} lost{not_seen}, {summary.get('delayed', 0)} delayed, "
         f"{_count(summary['resends'], 'resend')} "
         f"({summary.get('resends_new_id', 0)} under a new id)."
     )
+    untagged = answer.facts["untagged_types"]
+    if untagged:
+        answer.sentences.append(
+            f"The log tags no receive of {', '.join(untagged)}: whether those messages "
+            "arrived is unknown, so none of them is called lost."
+        )
+    if summary.get("delay_rule"):
+        answer.sentences.append(f"Delayed means {summary['delay_rule']}.")
     for kind, rows in (
         ("delayed", messages[messages["delayed"]]),
         ("lost", messages[messages["lost"]]),
@@ -423,9 +448,9 @@ def _message_example(kind: str, row: pd.Series, communication: Perspective) -> s
         late = seconds_text(row["latency"])
         return f"Delayed, for example: {where} reached {row['receiver']} after {late}."
     if kind == "resent":
-        new = _value(row.get("resent_as"))
-        how = f"under the new id {new}" if new else "under the same id"
-        return f"Resent, for example: {where}, {how}."
+        repeated = _value(row.get("repeats"))
+        how = f"repeats {repeated}, which had no answer" if repeated else "sent again under its id"
+        return f"Resent, for example: {where} {how}."
     lost = communication.tables.get("lost", pd.DataFrame())
     # the lost table's row of this message (by the keys it has: a log may lack the case)
     keys = [key for key in ("case", "msg_id") if key in lost.columns and key in row.index]

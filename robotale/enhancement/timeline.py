@@ -1,5 +1,6 @@
 """One run at a glance: a lane per robot with its activity instances as bars, the messages
-between robots as arrows from sender to receiver (a lost message marked where it was sent) and
+between robots as arrows from sender to receiver (a lost message marked where it was sent, a
+message whose type the log tags no receive of marked apart: it may have arrived) and
 each robot's battery as a line.
 
 The figure is plain plotly JSON, so the HTML report embeds it and the dashboard draws the same
@@ -40,9 +41,8 @@ MESSAGE_COLOUR = "#555555"
 @dataclass(slots=True)
 class Timeline:
     """The data of one run's timeline: ``bars`` (robot, activity, start, end, source: where
-    its events were recorded, seconds),
-    ``messages`` (msg_id, sender, receiver, sent, received, lost, delayed) and ``battery``
-    (robot, time, level)."""
+    its events were recorded, seconds), ``messages`` (msg_id, sender, receiver, sent,
+    received, lost, unobserved, delayed) and ``battery`` (robot, time, level)."""
 
     case: str
     robots: list[str]
@@ -148,7 +148,7 @@ def _known(topic: Any, index: Any) -> bool:
 
 
 def _messages(events: pd.DataFrame) -> pd.DataFrame:
-    columns = ["msg_id", "sender", "receiver", "sent", "received", "lost", "delayed"]
+    columns = ["msg_id", "sender", "receiver", "sent", "received", "lost", "unobserved", "delayed"]
     table = message_table(events)
     if table.empty:
         return pd.DataFrame(columns=columns)
@@ -238,7 +238,7 @@ def _from(bars: pd.DataFrame) -> list[str]:
 def _message_traces(messages: pd.DataFrame, lanes: set[str]) -> list[go.Scatter]:
     """One line per delivered message (ending in an arrow head at the receiver) and a cross on
     the sender's lane for each lost one."""
-    delivered = messages[~messages["lost"] & messages["receiver"].isin(lanes)]
+    delivered = messages[messages["received"].notna() & messages["receiver"].isin(lanes)]
     xs: list = []
     ys: list = []
     for row in delivered.itertuples(index=False):
@@ -256,15 +256,25 @@ def _message_traces(messages: pd.DataFrame, lanes: set[str]) -> list[go.Scatter]
         )
     ]
     lost = messages[messages["lost"]]
-    traces.append(
-        go.Scatter(
-            x=lost["sent"],
-            y=lost["sender"],
-            mode="markers",
-            name="lost message",
-            marker={"symbol": "x", "size": 12, "color": LOST_COLOUR},
-            text=lost["msg_id"],
-            hovertemplate="lost message %{text}<extra></extra>",
-        )
-    )
+    marker = {"symbol": "x", "size": 12, "color": LOST_COLOUR}
+    traces.append(_marker_trace(lost, "lost message", marker, "lost message %{text}"))
+    if "unobserved" in messages:
+        # sent, but the log tags no receive of its type: it may have arrived
+        unseen = messages[messages["unobserved"]]
+        marker = {"symbol": "circle-open", "size": 10, "color": MESSAGE_COLOUR}
+        hover = "%{text}: no receive tag of its type in the log"
+        traces.append(_marker_trace(unseen, "not observed as received", marker, hover))
     return traces
+
+
+def _marker_trace(messages: pd.DataFrame, name: str, marker: dict, hover: str) -> go.Scatter:
+    """A marker on the sender's lane where each of ``messages`` was sent."""
+    return go.Scatter(
+        x=messages["sent"],
+        y=messages["sender"],
+        mode="markers",
+        name=name,
+        marker=marker,
+        text=messages["msg_id"],
+        hovertemplate=f"{hover}<extra></extra>",
+    )

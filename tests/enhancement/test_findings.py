@@ -134,6 +134,9 @@ def test_messages(logged):
     assert first.startswith(f"{len(messages)} messages sent: {messages['received'].notna().sum()}")
     assert f"{len(lost)} lost, {len(delayed)} delayed" in first
     examples = {s.split(",")[0]: s for s in answer.sentences[1:]}
+    # every message type is receive-tagged in this mission; the delay rule is stated
+    assert answer.facts["untagged_types"] == [] and answer.facts["unobserved"] == 0
+    assert any(s.startswith("Delayed means a latency in the slow mode") for s in answer.sentences)
     delayed_row = delayed.iloc[0]
     assert delayed_row["msg_id"] in examples["Delayed"]
     assert f"after {seconds_text(mission.DELAYED_LATENCY)}" in examples["Delayed"]
@@ -146,7 +149,9 @@ def test_messages(logged):
     assert examples["Lost"].endswith(
         f"; its run took {seconds_text(shorter)} shorter than the median run without one."
     )
-    assert f"under the new id {resent.sort_values('case').iloc[0]['msg_id']}" in examples["Resent"]
+    first_resent = resent.sort_values("case").iloc[0]
+    assert examples["Resent"].startswith(f"Resent, for example: {first_resent['msg_id']} ")
+    assert f"repeats {first_resent['resend_of']}, which had no answer" in examples["Resent"]
     cases = [e["case"] for e in answer.evidence]
     assert cases == [delayed_row["case"], first_lost["case"], first_lost["case"]]
 
