@@ -35,14 +35,14 @@ def check(seed: int, root: Path, runs: int) -> tuple[int, list[list[str]], float
     # imported here: each worker process imports the simulator once, the parent never needs it
     from robotale.sim.batch import simulate_batch
     from robotale.sim.generate import DELAY_THRESHOLD, generate
-    from robotale.sim.run import RunPlan
+    from robotale.sim.plans import plans
     from robotale.sim.worldspec import load_world
 
     folder = root / f"seed_{seed}"
     began = time.perf_counter()
     mission = generate(seed, folder)
-    plans = [RunPlan(load_world(mission.world), i, seed) for i in range(1, runs + 1)]
-    summary = simulate_batch(plans, folder / "runs", workers=0, overwrite=True)
+    batch = plans(load_world(mission.world), "generated", runs=runs, seed=seed)
+    summary = simulate_batch(batch, folder / "runs", workers=0, overwrite=True)
     crashed = [c["reason"] for c in summary["cases"] if c["status"] == "crashed"]
     log = compare.prepared(folder / "runs")
     simulated = time.perf_counter() - began

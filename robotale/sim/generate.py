@@ -9,16 +9,18 @@ pools, drawn from three roles:
   (``resume_on``: a skill consuming a signal without a catch event), or ``resume_after``
   seconds. An interrupting timer on Explore cuts a long exploration short; an interrupting
   event sub-process on the ``low_battery`` error flies it home;
-- **workers** (ground robots, one pool each): a ``job`` starts an instance that drives to the
+- **workers** (ground robots, one pool each, deaf to ``job`` and ``ping`` while busy,
+  ``busy_ignores``): a ``job`` starts an instance that drives to the
   weed (an interrupting timer on *GoTo* gives up), cuts (a loop or a multi-instance
   activity of random durations) and throws ``job_done`` with the weed's position; a ``ping``
-  starts another that waits a random time and answers ``pong`` with the task number;
+  starts another that answers ``pong`` with the task number at once;
 - a **coordinator** (a ground robot that stays at its base): for each of its tasks it throws
   ``ping`` and races ``pong`` against a timer, resending the same task on a timeout at most
   twice, then gives the task up; a multi-instance *Check* precedes the tasks.
 
 Faults are drawn too: a network with jitter (delays) and losses on best-effort readers, a
-worker that dies, a scout whose battery drains fast, a dropped ``job_done``. A message's
+worker that dies, a scout whose battery drains fast, a dropped ``job_done``, the answers of
+the first seconds lost (``pong``), so that the coordinator asks again. A message's
 payload names its task (a weed's position, or a coordinator's task number), so a resend is
 the same sender, topic and payload as an earlier send of the run; the tests' oracle relies on
 that, robotale's analysis must not.
@@ -84,6 +86,9 @@ def generate(seed: int, folder: str | Path, *, time_limit: float | None = None) 
         processes.append(_worker(rng, name, scout, coordinator, best_effort))
         bases[f"{name}_base"] = {"position": [0.0, (number - 1) * 0.8], "radius": 0.4}
         robots[name] = _ground(f"{name}_base", rng, blade=True)
+        # one task at a time: a robot's instances share its variables, so a second job
+        # taken while one runs would overwrite the first one's target
+        robots[name]["busy_ignores"] = ["job", "ping"]
     mission.pools = [p.name for p in processes]
     mission.network = _network(rng)
     mission.faults = _faults(rng, mission)
@@ -166,6 +171,9 @@ def _faults(rng: random.Random, mission: Mission) -> list[str]:
         faults.append(f"battery:scout@{rng.randint(2, 20)},rate=0.05")
     if mission.scout and rng.random() < 0.2:
         faults.append("drop:/job_done,nth=1")
+    if mission.coordinator and rng.random() < 0.5:
+        # the answers of the first seconds are lost: the coordinator asks again
+        faults.append(f"drop:/pong@0-{rng.randint(1, 8)}")
     return faults
 
 
@@ -316,7 +324,7 @@ def _battery_handler(p: _Process, *, land: bool) -> str:
         last = i("low_land")
     p.flow(last, i("low_end"), into=inner)
     return (
-        f'<bpmn:subProcess id="{i("low_battery")}" name="Low Battery" triggeredByEvent="true">'
+        f'<bpmn:subProcess id="{i("low_battery")}" name="Battery Handler" triggeredByEvent="true">'
         + "".join(inner)
         + "</bpmn:subProcess>"
     )
@@ -362,7 +370,12 @@ def _worker(
         out = _data(p, "ping_data", "Ping", asked="${x}")
         extra = _properties(type=VECTOR3, reliability=reliability) + out
         p.add(_signal_event("startEvent", i("ping"), "ping", extra))
-        p.add(_timer("intermediateCatchEvent", i("think"), rng.choice([0.5, 1, 2, 5])))
+        # answered at once: a robot's instances share its variables, so an answer that waited
+        # could carry the task of a later question
+        p.add(
+            f'<bpmn:scriptTask id="{i("think")}" name="Look Up" scriptFormat="python">'
+            "<bpmn:script>answer = asked</bpmn:script></bpmn:scriptTask>"
+        )
         p.add(
             _signal_event(
                 "endEvent", i("pong"), "pong",

@@ -144,7 +144,7 @@ def _delayed(runs, table, delay) -> list[Disagreement]:
                         round(float(latency), 4),
                     )
                 )
-            truly = message.latency > delay
+            truly = message.slowest > delay
             if bool(row.get("delayed", False)) != truly:
                 found.append(
                     Disagreement(
@@ -255,7 +255,7 @@ def _durations(runs, log) -> list[Disagreement]:
 
 
 def _dfg(runs, log) -> list[Disagreement]:
-    """Each robot's DFG counts every instance that ended, interrupted and cancelled included."""
+    """Each robot's DFG counts every instance: interrupted, cancelled and cut short included."""
     from robotale.discovery.dfg import discover_dfg
 
     found = []

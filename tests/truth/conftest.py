@@ -12,12 +12,13 @@ from compare import prepared
 
 from robotale.sim.batch import simulate_batch
 from robotale.sim.generate import Mission, generate
-from robotale.sim.run import RunPlan
+from robotale.sim.plans import plans
 from robotale.sim.worldspec import load_world
 
-#: the seeds ``make test`` checks (each a mission and world of its own, one run each); the
+#: the seeds ``make test`` checks (each a mission and world of its own, one run each; chosen
+#: to cover 2 to 6 pools, interrupted activities, a robot dying, busy robots and resends); the
 #: verify-findings target runs many more
-SEEDS = tuple(range(1, 9))
+SEEDS = (1, 5, 7, 9, 12, 17, 18, 19)
 
 
 @dataclass(frozen=True)
@@ -32,9 +33,8 @@ def simulate_generated(seed: int, folder: Path, runs: int = 1) -> Simulated:
     """Generate the mission of ``seed``, simulate ``runs`` runs of it and prepare their log."""
     mission = generate(seed, folder)
     world = load_world(mission.world)
-    plans = [RunPlan(world, index, seed) for index in range(1, runs + 1)]
     batch = folder / "runs"
-    simulate_batch(plans, batch, workers=0, overwrite=True)
+    simulate_batch(plans(world, "generated", runs=runs, seed=seed), batch, workers=0)
     return Simulated(seed, mission, batch, prepared(batch))
 
 

@@ -11,9 +11,11 @@ Definitions (what "true" means here):
   fault, by QoS, ignored by a busy robot, arrived after its receiver left or died, or nobody
   waited for it;
 - its **latency** is the time from its publication to its first delivery; it is **delayed**
-  when the latency exceeds a given threshold;
-- a **resend** repeats an earlier send of the run: same sender, topic and payload (the
-  generated missions' payloads name their task, so this is true by construction there);
+  when any of its deliveries took longer than a given threshold (a receiver got it late);
+- a **resend** repeats an earlier send of the run (same sender, topic and payload: the
+  generated missions' payloads name their task) on the sender's own account: a repeat that
+  answers a message with that payload delivered to the sender in between (a worker answering
+  a coordinator's resent question again) is an answer, not a resend;
 - an activity instance's **duration** is its true interval; its **outcome** says whether it
   completed, was interrupted or cancelled, or its robot died;
 - a robot's **battery use** in a run is the sum of the drops of its true battery level
@@ -89,6 +91,7 @@ class Message:
     sent: float
     receivers: tuple[str, ...]  # the robots it was delivered to
     latency: float | None  # to its first delivery
+    slowest: float | None  # to its last delivery
     resend_of: str | None  # the earlier send it repeats
     drops: tuple[str, ...]  # why subscribers did not get it
 
@@ -109,10 +112,20 @@ def messages(run: Run) -> list[Message]:
             delivered[delivery["msg_id"]].append((delivery["t"], delivery["receiver"]))
         else:
             drops[delivery["msg_id"]].append(delivery["outcome"])
-    seen: dict[tuple, str] = {}
+    payloads = {send["msg_id"]: _text(send["payload"]) for send in run.sends}
+    heard: dict[str, list[tuple[float, str]]] = defaultdict(list)  # robot -> (time, payload)
+    for delivery in run.deliveries:
+        if delivery["outcome"] == "delivered":
+            heard[delivery["receiver"]].append((delivery["t"], payloads[delivery["msg_id"]]))
+    seen: dict[tuple, dict] = {}
     found = []
     for send in run.sends:
-        key = (send["sender"], send["topic"], json.dumps(send["payload"], sort_keys=True))
+        key = (send["sender"], send["topic"], _text(send["payload"]))
+        earlier = seen.get(key)
+        answer = earlier is not None and any(
+            earlier["t"] < t <= send["t"] and payload == key[2]
+            for t, payload in heard[send["sender"]]
+        )
         arrivals = sorted(delivered.get(send["msg_id"], ()))
         found.append(
             Message(
@@ -123,12 +136,17 @@ def messages(run: Run) -> list[Message]:
                 send["t"],
                 tuple(sorted({robot for _, robot in arrivals})),
                 arrivals[0][0] - send["t"] if arrivals else None,
-                seen.get(key),
+                arrivals[-1][0] - send["t"] if arrivals else None,
+                None if earlier is None or answer else earlier["msg_id"],
                 tuple(drops.get(send["msg_id"], ())),
             )
         )
-        seen.setdefault(key, send["msg_id"])
+        seen[key] = send
     return found
+
+
+def _text(payload: Any) -> str:
+    return json.dumps(payload, sort_keys=True)
 
 
 def message_counts(runs: list[Run], delay: float) -> Counter:
@@ -138,7 +156,7 @@ def message_counts(runs: list[Run], delay: float) -> Counter:
         for message in messages(run):
             counts["sent"] += 1
             counts["delivered" if message.delivered else "lost"] += 1
-            counts["delayed"] += message.latency is not None and message.latency > delay
+            counts["delayed"] += message.slowest is not None and message.slowest > delay
             counts["resent"] += message.resend_of is not None
     return counts
 
@@ -167,12 +185,9 @@ def activity_instances(runs: list[Run]) -> list[dict[str, Any]]:
 
 
 def activity_counts(runs: list[Run]) -> Counter:
-    """Instances per (robot, activity) that ended (completed, interrupted or cancelled)."""
-    return Counter(
-        (row["robot"], row["activity"])
-        for row in activity_instances(runs)
-        if row["outcome"] in ("completed", "interrupted", "cancelled")
-    )
+    """Instances per (robot, activity), whatever their outcome (one its robot's death or the
+    run's end cut short is an instance too)."""
+    return Counter((row["robot"], row["activity"]) for row in activity_instances(runs))
 
 
 def mean_durations(runs: list[Run]) -> dict[tuple[str, str], float]:

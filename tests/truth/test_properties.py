@@ -38,9 +38,8 @@ def test_the_generated_missions_exercise_what_they_should(generated):
 NOT_YET = {
     "durations": "an activity ended by ate_abort is paired with a later start's end, so a "
     "Go To a timer interrupted lasts 8.2 s instead of 3.2 s",
-    "delayed": "with --delay 0.1 a message whose true latency is under 0.1 s is called delayed",
-    "resends": "a robot answering the same task twice (same sender, type and payload) is not "
-    "counted as a resend",
+    "resends": "a worker's answers to two different questions that arrived out of order (the "
+    "second answer's payload names another task) are called a resend of each other",
     "dfg": "an activity interrupted by a boundary timer or an event sub-process (ate_abort) is "
     "not counted in the DFG",
     "battery": "battery use per robot and run is below the true drops (charging offsets use) "
