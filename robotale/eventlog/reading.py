@@ -93,7 +93,7 @@ LIFECYCLE_VALUES: dict[str, str] = {
     # and the outcome stays in the log
     "aborted": schema.ABORTED,
     "abort": schema.ABORTED,
-    "ate_abort": schema.ATE_ABORT,
+    "ate_abort": schema.ABORTED,
     "pi_abort": schema.ABORTED,
     "cancelled": schema.CANCELLED,
     "canceled": schema.CANCELLED,
@@ -125,7 +125,7 @@ ROLE_NAMES: dict[str, str] = {
 #: event kinds of :func:`event_kinds`, in the order a reading lists them.
 KINDS = ("start", "complete", "instant", "sample")
 #: ends of an activity that failed or was called off: completions that keep their outcome
-OUTCOMES = (schema.ABORTED, schema.CANCELLED, schema.ATE_ABORT)
+OUTCOMES = (schema.ABORTED, schema.CANCELLED)
 #: a dropped row's lines are listed up to this many.
 SHOWN_LINES = 5
 #: the pause offered as the end of a session when a log without cases spans several days
