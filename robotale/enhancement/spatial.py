@@ -2,10 +2,11 @@
 
 The main table gives, per activity and robot, how many positions were recorded and their
 bounds; the figure is the 3D scatter of all positions, coloured by activity, one symbol per
-robot. Given a field (x and y bounds), the covered fraction says how much of it the robots
-passed over: the field is cut into square cells and a cell counts as covered when a robot's
-path crosses it. Between two recorded positions a robot is taken to move in a straight line,
-since positions are sampled while it moves continuously.
+robot; the ``encounters`` table says when two robots were at the same place at the same moment
+(:mod:`robotale.enhancement.encounters`). Given a field (x and y bounds), the covered
+fraction says how much of it the robots passed over: the field is cut into square cells and a
+cell counts as covered when a robot's path crosses it. Between two recorded positions a robot
+is taken to move in a straight line, since positions are sampled while it moves continuously.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import pandas as pd
 import plotly.graph_objects as go
 
 from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.encounters import encounters, positions
 from robotale.enhancement.result import (
     Figures,
     Perspective,
@@ -89,7 +91,11 @@ def spatial_perspective(
     )
     result = Perspective(
         name="spatial",
-        tables={"occupancy": _occupancy(placed)},
+        tables={
+            "occupancy": _occupancy(placed),
+            # the same place at the same moment (in 3D and time), of the focused events
+            "encounters": encounters(positions(placed)),
+        },
         figures=Figures({"scatter": lambda: _scatter(shown.sort_index())}),
         summary={"positions": len(placed), "plotted": len(shown), "bounds": bounds(placed)},
     )

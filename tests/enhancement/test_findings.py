@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 from conventions import busy_seconds
 
-from robotale.enhancement.findings import area_overlaps, find, robot_areas, seconds_text
+from robotale.enhancement.findings import find, robot_areas, seconds_text
 from robotale.enhancement.findings_report import (
     findings_dict,
     findings_html,
@@ -173,7 +173,7 @@ def test_report_outputs_carry_the_same_sentences(logged):
     assert "lost message" in page
 
 
-def test_areas_and_overlaps_against_pandas():
+def test_areas_against_pandas():
     log = pd.DataFrame(
         {
             "robot": ["a", "a", "b", "b", "c", "c"],
@@ -185,8 +185,7 @@ def test_areas_and_overlaps_against_pandas():
     areas = robot_areas(log)
     for robot in "abc":
         assert areas[robot]["x"] == [boxes.loc[robot, ("x", "min")], boxes.loc[robot, ("x", "max")]]
-    # a spans x 0-4, y 0-2 and b x 3-6, y 1-5: they share x 3-4, y 1-2; c is apart
-    assert area_overlaps(areas) == [{"robots": ["a", "b"], "x": [3.0, 4.0], "y": [1.0, 2.0]}]
+        assert "z" not in areas[robot]
 
 
 def test_thesis_log_split_into_days(thesis_csv):
