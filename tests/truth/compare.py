@@ -9,9 +9,11 @@ from __future__ import annotations
 
 import json
 import warnings
+from collections import Counter
 from dataclasses import dataclass
 from pathlib import Path
 
+import numpy as np
 import oracle
 import pandas as pd
 
@@ -20,7 +22,21 @@ SECONDS = 0.002
 BATTERY_POINTS = 1.0  # percentage points
 BATTERY_SHARE = 0.1  # or this share of the use, whichever is larger
 
-SUBJECTS = ("messages", "lost", "delayed", "resends", "activities", "durations", "dfg", "battery")
+SUBJECTS = (
+    "messages",
+    "lost",
+    "delayed",
+    "resends",
+    "activities",
+    "durations",
+    "dfg",
+    "battery",
+    "overlap",
+)
+#: robots this close (metres, 3D) at one moment met; the truth's samples and the log's
+#: positions are up to half a sample period apart, so a pair counts as met or apart for sure
+#: only under NEAR or over FAR
+MEET, NEAR, FAR = 1.0, 0.7, 1.3
 
 
 @dataclass(frozen=True)
@@ -58,6 +74,7 @@ def disagreements(
         "durations": _durations,
         "dfg": _dfg,
         "battery": _battery,
+        "overlap": _overlap,
     }
     table = None
     for subject in subjects:
@@ -259,15 +276,27 @@ def _dfg(runs, log) -> list[Disagreement]:
     from robotale.discovery.dfg import discover_dfg
 
     found = []
-    truth = oracle.activity_counts(runs)
-    for robot in sorted({robot for robot, _ in truth}):
+    rows = oracle.activity_instances(runs)
+    ended = Counter((r["robot"], r["activity"]) for r in rows if r["outcome"] in ENDED)
+    cut = Counter((r["robot"], r["activity"]) for r in rows if r["outcome"] not in ENDED)
+    for robot in sorted({robot for robot, _ in ended + cut}):
         graph = discover_dfg(log[log["robot"] == robot])
-        counts = {node.id: node.count for node in graph.nodes if node.kind == "activity"}
-        for (owner, activity), count in sorted(truth.items()):
-            if owner == robot and counts.get(activity, 0) != count:
-                item = f"{robot} {activity}"
-                found.append(Disagreement("dfg", "all", item, count, counts.get(activity, 0)))
+        nodes = {node.id: node for node in graph.nodes if node.kind == "activity"}
+        for owner, activity in sorted(set(ended) | set(cut)):
+            if owner != robot:
+                continue
+            node = nodes.get(activity)
+            count = node.count if node is not None else 0
+            unfinished = (node.properties or {}).get("unfinished", 0) if node is not None else 0
+            truth = (ended[(robot, activity)], cut[(robot, activity)])
+            if (count, unfinished) != truth:
+                item = f"{robot} {activity} (ended, unfinished)"
+                found.append(Disagreement("dfg", "all", item, truth, (count, unfinished)))
     return found
+
+
+#: the outcomes of an activity instance that ended (the others: its robot died, the run ended)
+ENDED = ("completed", "interrupted", "cancelled")
 
 
 # -- battery -------------------------------------------------------------------------------------
@@ -300,6 +329,45 @@ def _battery(runs, log) -> list[Disagreement]:
         if isinstance(summary.get(name), int | float) and summary[name] < 0:
             found.append(Disagreement("battery", "all", name, ">= 0", summary[name]))
     return found
+
+
+# -- space ---------------------------------------------------------------------------------------
+
+
+def _overlap(runs, log) -> list[Disagreement]:
+    """Robots robotale says were at the same place at the same moment (in 3D) were there, and
+    those that truly were are found."""
+    from robotale.enhancement.encounters import encounters, positions
+
+    placed = positions(log)
+    met = encounters(placed, metres=MEET, seconds=0.5)
+    said = {(str(r[CASE_COLUMN]), *sorted((r["robot"], r["other"]))) for _, r in met.iterrows()}
+    # a log has positions only around its events (a robot standing idle before its first tag
+    # has none): the truth is judged at the moments the log could show
+    stamps = {
+        key: np.sort(group["time:timestamp"].map(pd.Timestamp.timestamp).to_numpy())
+        for key, group in placed.groupby([CASE_COLUMN, "robot"])
+    }
+
+    def seen(case: str, robot: str, t: float) -> bool:
+        times = stamps.get((case, robot))
+        if times is None or not len(times):
+            return False
+        i = np.searchsorted(times, t)
+        near = [times[j] for j in (i - 1, i) if 0 <= j < len(times)]
+        return min(abs(t - n) for n in near) <= 0.25
+
+    found = []
+    for key, apart in sorted(oracle.closest(runs, seen).items()):
+        item = f"{key[1]} and {key[2]}"
+        if apart <= NEAR and key not in said:
+            found.append(Disagreement("overlap", key[0], item, f"met ({apart:.2f} m)", "not"))
+        elif apart > FAR and key in said:
+            found.append(Disagreement("overlap", key[0], item, f"apart ({apart:.2f} m)", "met"))
+    return found
+
+
+CASE_COLUMN = "case:concept:name"
 
 
 def _rounded(value: float | None, digits: int) -> float | None:

@@ -247,6 +247,24 @@ def meetings(runs: list[Run], distance: float) -> Counter:
     return met
 
 
+def closest(runs: list[Run], seen=None) -> dict[tuple[str, str, str], float]:
+    """Per (case, robot, robot): the smallest 3D distance between the two at one sample
+    instant (with ``seen(case, robot, t)``, only at instants it accepts for both)."""
+    nearest: dict[tuple[str, str, str], float] = {}
+    for run in runs:
+        by_time: dict[float, list[dict]] = defaultdict(list)
+        for sample in run.samples:
+            if seen is None or seen(run.case, sample["robot"], sample["t"]):
+                by_time[round(sample["t"], 3)].append(sample)
+        for together in by_time.values():
+            for i, a in enumerate(together):
+                for b in together[i + 1 :]:
+                    apart = math.dist((a["x"], a["y"], a["z"]), (b["x"], b["y"], b["z"]))
+                    key = (run.case, *sorted((a["robot"], b["robot"])))
+                    nearest[key] = min(apart, nearest.get(key, math.inf))
+    return nearest
+
+
 def flat_meetings(runs: list[Run], distance: float) -> Counter:
     """As :func:`meetings`, on the ground plan only (x, y): what a flat overlap would claim."""
     flattened = [
