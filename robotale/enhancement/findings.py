@@ -175,6 +175,13 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
         answer.sentences.append(_sentence(bottlenecks.message))
         return answer
     _one_run_of_days(runs, answer)
+    left_out = int(bottlenecks.summary.get("aborted_runs_left_out", 0))
+    if left_out:
+        answer.facts["aborted_runs_left_out"] = left_out
+        answer.sentences.append(
+            f"Runs are compared with runs of the same outcome: the completed runs against each "
+            f"other, leaving out {_count(left_out, 'run')} that did not complete."
+        )
     ranking = trusted_first(bottlenecks.table).head(MAIN)
     answer.facts["bottlenecks"] = [
         {
@@ -227,12 +234,18 @@ def _one_run_of_days(runs: pd.DataFrame, answer: Answer) -> None:
 
 
 def trusted_first(ranking: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
-    """The bottleneck ranking with the effects the runs do not show for certain (a p-value of
-    ``alpha`` or more: the runs with it may be longer by chance) after the others, each part
-    still by delay per case; ``rank`` numbers the new order."""
-    if ranking.empty or "p_value" not in ranking.columns:
+    """The bottleneck ranking with the rows that are not ``ranked`` (an effect that may be
+    chance, has no test result or adds under 1 % of a run; or, in a table without that column,
+    a p-value of ``alpha`` or more) after the others, each part still by delay per case;
+    ``rank`` numbers the new order."""
+    if ranking.empty:
         return ranking
-    uncertain = pd.to_numeric(ranking["p_value"], errors="coerce").ge(alpha).to_numpy(bool)
+    if "ranked" in ranking.columns:
+        uncertain = ~ranking["ranked"].astype(bool).to_numpy()
+    elif "p_value" in ranking.columns:
+        uncertain = pd.to_numeric(ranking["p_value"], errors="coerce").ge(alpha).to_numpy(bool)
+    else:
+        return ranking
     ordered = pd.concat([ranking[~uncertain], ranking[uncertain]]).reset_index(drop=True)
     return ordered.assign(rank=range(1, len(ordered) + 1))
 

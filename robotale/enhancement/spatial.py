@@ -17,6 +17,7 @@ import numpy as np
 import pandas as pd
 import plotly.graph_objects as go
 
+from robotale.enhancement.colours import log_colours
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.encounters import encounters, positions
 from robotale.enhancement.result import (
@@ -96,7 +97,7 @@ def spatial_perspective(
             # the same place at the same moment (in 3D and time), of the focused events
             "encounters": encounters(positions(placed)),
         },
-        figures=Figures({"scatter": lambda: _scatter(shown.sort_index())}),
+        figures=Figures({"scatter": lambda: _scatter(shown.sort_index(), log_colours(log))}),
         summary={"positions": len(placed), "plotted": len(shown), "bounds": bounds(placed)},
     )
     if field is not None:
@@ -205,8 +206,9 @@ SYMBOLS = (
 )
 
 
-def _scatter(placed: pd.DataFrame):
-    """One trace per activity (its colour), one marker symbol per robot."""
+def _scatter(placed: pd.DataFrame, colours: dict[str, str]):
+    """One trace per activity (its colour, the log's: the same on every page), one marker
+    symbol per robot."""
     robots = placed[ROBOT].astype("string").fillna("") if ROBOT in placed.columns else None
     names = sorted(set(robots)) if robots is not None else []
     symbol_of = {r: SYMBOLS[i % len(SYMBOLS)] for i, r in enumerate(names)}
@@ -220,7 +222,11 @@ def _scatter(placed: pd.DataFrame):
             mode="markers",
             name=str(activity),
             # fixed-width text arrays: plotly copies them whole, not string by string
-            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).to_numpy(str)},
+            marker={
+                "size": 3,
+                "color": colours.get(str(activity)),
+                "symbol": None if who is None else who.map(symbol_of).to_numpy(str),
+            },
             text=None if who is None else who.to_numpy(str),
             hovertemplate="%{text}<br>x %{x:.2f}, y %{y:.2f}, z %{z:.2f}",
         )

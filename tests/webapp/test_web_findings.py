@@ -74,6 +74,25 @@ def test_findings_api_names_the_injected_findings(client, mission_log):
     assert answers["messages"]["facts"]["lost"] == lost.sum()
 
 
+def test_findings_and_communication_take_a_delay_threshold(client, mission_log):
+    """The truth's latencies: 1.5 s to tractor_1, 2.5 s to tractor_2, one of 30 s. Above 2 s:
+    every delivery to tractor_2 and the 30 s one; the default rule finds the 30 s one only."""
+    messages = pd.DataFrame([m.__dict__ for m in TRUTH.messages])
+    latency = (messages["received"] - messages["sent"]).dt.total_seconds()
+    data = client.get(f"/api/findings?log={mission_log}&delay=2").json
+    facts = {a["key"]: a for a in data["answers"]}["messages"]["facts"]
+    assert facts["delayed"] == int((latency > 2).sum())
+    assert facts["delay_rule"] == "a latency above 2 s (the threshold given)"
+    default = client.get(f"/api/findings?log={mission_log}").json
+    facts = {a["key"]: a for a in default["answers"]}["messages"]["facts"]
+    assert facts["delayed"] == int((latency == mission.DELAYED_LATENCY).sum()) == 1
+    part = client.get(f"/api/perspectives/communication?log={mission_log}&delay=2").json
+    assert part["summary"]["delayed"] == int((latency > 2).sum())
+    bad = client.get(f"/api/findings?log={mission_log}&delay=soon")
+    assert bad.status_code == 400
+    assert bad.json["error"] == "the delay 'soon' is not a number of seconds of 0 or more."
+
+
 def test_timeline_api_has_the_lost_message(client, mission_log):
     run = sorted(mission.LOST_RUNS)[0]
     data = client.get(f"/api/timeline?log={mission_log}&case={run}").json
@@ -130,6 +149,37 @@ def test_timeline_shows_the_lost_message(page, mission_log, screenshot):
     page.select_option("#run-picker", "run01")
     expect(box).to_have_attribute("data-case", "run01")
     expect(box).to_have_attribute("data-lost", "0")
+
+
+@browser
+def test_timeline_draws_battery_on_its_own_axis_one_colour_per_activity(page, mission_log):
+    """In the drawn page: the battery axis lies below the lanes (pixels apart), and each
+    activity has its own colour, the one its name's place among the log's activities (in
+    text order) picks from the palette."""
+    from robotale.enhancement.colours import PALETTE
+
+    run = sorted(mission.LOW_BATTERY_RUNS)[0]
+    page.goto(f"{page.base_url}/timeline?log={mission_log}&case={run}")
+    expect(page.locator("#timeline")).to_have_attribute("data-state", "shown")
+    drawn = page.evaluate(
+        """() => {
+          const el = document.getElementById('timeline');
+          const lanes = el._fullLayout.yaxis, battery = el._fullLayout.yaxis2;
+          return {
+            lanes: [lanes._offset, lanes._offset + lanes._length],
+            battery: [battery._offset, battery._offset + battery._length],
+            levels: el.data.filter(t => t.name.startsWith('battery ')).map(t => t.yaxis),
+            colours: Object.fromEntries(
+              el.data.filter(t => t.type === 'bar').map(t => [t.name, t.marker.color])),
+          };
+        }"""
+    )
+    assert drawn["battery"][0] > drawn["lanes"][1]  # pixels from the top: below the lanes
+    assert drawn["levels"] and set(drawn["levels"]) == {"y2"}
+    names = sorted({i.activity for i in TRUTH.instances})
+    expected = {name: PALETTE[n % len(PALETTE)] for n, name in enumerate(names)}
+    assert drawn["colours"] == {name: expected[name] for name in drawn["colours"]}
+    assert len(set(drawn["colours"].values())) == len(drawn["colours"]) >= 5
 
 
 @browser
