@@ -33,10 +33,10 @@ SUBJECTS = (
     "battery",
     "overlap",
 )
-#: robots this close (metres, 3D) at one moment met; the truth's samples and the log's
-#: positions are up to half a sample period apart, so a pair counts as met or apart for sure
-#: only under NEAR or over FAR
-MEET, NEAR, FAR = 1.0, 0.7, 1.3
+#: robots this close (metres, 3D) at one moment met; robotale pairs positions up to a quarter
+#: second apart (half the 2 Hz sample period) and robots move up to 1.2 m/s, so a pair counts
+#: as met or apart for sure only under NEAR or over FAR
+MEET, NEAR, FAR = 1.0, 0.6, 1.6
 
 
 @dataclass(frozen=True)
@@ -340,7 +340,7 @@ def _overlap(runs, log) -> list[Disagreement]:
     from robotale.enhancement.encounters import encounters, positions
 
     placed = positions(log)
-    met = encounters(placed, metres=MEET, seconds=0.5)
+    met = encounters(placed, metres=MEET, seconds=0.26)
     said = {(str(r[CASE_COLUMN]), *sorted((r["robot"], r["other"]))) for _, r in met.iterrows()}
     # a log has positions only around its events (a robot standing idle before its first tag
     # has none): the truth is judged at the moments the log could show
