@@ -34,6 +34,7 @@ from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.config import robotale_home
 from robotale.ekg.jars import ensure_jars
+from robotale.ekg.plan_check import ALLOWED_FUNCTIONS
 from robotale.ekg.port_holder import port_holder
 from robotale.ekg.queries import statements
 from robotale.ekg.server_config import (
@@ -593,6 +594,9 @@ def security_settings(heap: str) -> dict[str, str]:
         # LOAD CSV may not read files (the console also refuses the clause before sending it).
         "dbms.security.allow_csv_import_from_file_urls": "false",
         "server.directories.import": "import",
+        # No plugin's procedures or functions load unless the overlay names them: the
+        # console's queries then cannot reach them whatever their spelling.
+        "dbms.security.procedures.allowlist": ",".join(sorted(ALLOWED_FUNCTIONS)),
     }
     limit = _share_of(heap, _TRANSACTION_SHARE)
     if limit is not None:
