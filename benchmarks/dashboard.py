@@ -168,7 +168,7 @@ def measure_clients(driver, log: str, clients: int, rounds: int) -> int:
 
     questions = _questions(log)
     expected = {
-        name: [r.rows for r in run_read_only(driver, text, parameters)]
+        name: [r.rows for r in run_read_only(driver, text, parameters, timeout=600)]
         for name, (text, parameters) in questions.items()
     }
     times: dict[str, list[float]] = {"console": [], "discover": []}

@@ -10,7 +10,7 @@ from typing import Any
 import pandas as pd
 from neo4j import Driver
 
-from robotale.commands.prepare import prepare_recordings
+from robotale.commands.prepare import kept_runs, prepare_recordings
 from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg, why
 from robotale.ekg.columnar import delete_copies
@@ -41,6 +41,7 @@ def ingest_command(
     rate: float | None = None,
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
+    skip_bad: bool = False,
     **recording: Any,
 ) -> int:
     """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
@@ -49,6 +50,12 @@ def ingest_command(
     With ``append`` its runs are added to the stored log of that name."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
+    if log is not None and not log.strip():
+        raise InputError(
+            f"--log {log!r} names no log: give it a name, or leave --log out to use "
+            f"{log_name(path)!r}."
+        )
+    skipped: list[Path] | None = None
     if path.is_dir() and not is_parquet(path):
         if mapping or case:
             raise InputError(
@@ -60,6 +67,7 @@ def ingest_command(
                 f"{path} holds recordings: --case-gap applies to CSV and XES files "
                 "(each run of a recording is its own case)."
             )
+        skipped = [] if skip_bad else None
         events = prepare_recordings(
             path,
             tags=tags,
@@ -68,6 +76,7 @@ def ingest_command(
             rate=rate,
             msg_files=msg_files,
             bag_time=bag_time,
+            skipped=skipped,
             **recording,
         )
     else:
@@ -93,6 +102,8 @@ def ingest_command(
             )
         print(describe(summary, appended=append))
         prepare_pages(driver, name)
+    if skipped is not None:
+        print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
 
 
