@@ -47,6 +47,7 @@ from robotale.ekg.plan_check import (
     WriteRefused,
     check_plan,
 )
+from robotale.ekg.plan_check import ONLY_READS as _ONLY_READS
 from robotale.ekg.queries import code_only, cypher, dotted_calls, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
 
@@ -65,7 +66,6 @@ _EXACT_IN_JSON = 2**53 - 1
 _INT64 = (-(2**63), 2**63 - 1)
 _ACCESS_MODE = "Neo.ClientError.Statement.AccessMode"
 _TIMED_OUT = ("TransactionTimedOut", "TransactionTimedOutClientConfiguration")
-_ONLY_READS = "The console only reads the graph"
 
 _LOAD_CSV = re.compile(r"\bLOAD\s+CSV\b", re.IGNORECASE)
 _IN_TRANSACTIONS = re.compile(r"\bIN\s+(?:\d+\s+)?(?:CONCURRENT\s+)?TRANSACTIONS\b", re.I)
@@ -84,7 +84,6 @@ _ADMIN_OBJECT = re.compile(
 )
 _USE = re.compile(r"(?:^|\{)\s*USE\b", re.IGNORECASE)
 _LEADING_MODE = re.compile(r"^\s*(?:EXPLAIN|PROFILE)\b", re.IGNORECASE)
-_PROCEDURE_NAME = re.compile(r"\s*([\w.]+)\s*\(")
 
 
 @dataclass(frozen=True)
