@@ -42,6 +42,7 @@ from robotale.eventlog.enrich import (
     robots_without_samples,
 )
 from robotale.eventlog.rosbag import (
+    RECORDED,
     TIME,
     Bag,
     check_distro,
@@ -469,15 +470,17 @@ def _read_run(
         for p in reading.perspectives:
             for topic in sample_topics[p.name]:
                 columns[topic] = {**columns.get(topic, {}), **p.columns}
-        tables = bag.tables(columns, bag_time=reading.bag_time, progress=bar)
+        tables = bag.tables(columns, bag_time=reading.bag_time, recorded=True, progress=bar)
+        recorded = {topic: table.pop(RECORDED).to_numpy() for topic, table in tables.items()}
         tables = {topic: sources.numbered(table) for topic, table in tables.items()}
         end = pd.Timestamp(max(bag.reader.end_time - 1, 0), unit="ns", tz="UTC")
         _warn_foreign(bag, columns)
         parts = [_tag_rows(tables[t], t, run, reading, bag.topics[t]) for t in tag_topics]
-        if reading.lifecycle == "implicit" and parts:
-            parts = [activities.implicit(pd.concat(parts, ignore_index=True), {run.name: end})]
         parts += sources.activity_rows(bag, tables, chosen, run.name, end)
-    tag_rows = pd.concat(parts, ignore_index=True)
+    tag_rows = activities.in_order(parts, recorded)
+    if reading.lifecycle == "implicit" and tag_topics:
+        tag_rows = activities.implicit(tag_rows, {run.name: end}, tag_topics)
+    tag_rows = tag_rows.drop(columns=activities.SEQUENCE)
     robots = sorted(set(tag_rows[schema.ROBOT]))
     samples = {
         p.name: _samples(run, [(t, tables[t]) for t in sample_topics[p.name]], p, robots)
@@ -723,8 +726,8 @@ def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.Dat
     for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
         if column not in log:
             log[column] = None
-    # the written formats hold microseconds; the log should equal what is written
-    log[schema.TIMESTAMP] = log[schema.TIMESTAMP].dt.floor("us")
+    # nanoseconds, as the bag records them (every written format but XES keeps them)
+    log[schema.TIMESTAMP] = log[schema.TIMESTAMP].dt.as_unit("ns")
     position = log.groupby(schema.CASE, sort=False).cumcount().astype(str)
     log[schema.EVENT_ID] = log[schema.CASE].astype(str) + ":" + position
     known = [c for c in schema.CSV_NAMES if c in log]

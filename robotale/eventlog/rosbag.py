@@ -49,6 +49,9 @@ from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batc
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
 
 TIME = "time"
+#: the column of a table holding when the bag recorded each message (ns since the epoch), when
+#: asked for: the recording's order of messages from different topics
+RECORDED = "_recorded"
 HEADER_TYPE = "std_msgs/msg/Header"
 TIME_TYPE = "builtin_interfaces/msg/Time"
 
@@ -227,12 +230,14 @@ class Bag:
         columns: Mapping[str, Mapping[str, str]],
         *,
         bag_time: bool = False,
+        recorded: bool = False,
         progress=None,
     ) -> dict[str, pd.DataFrame]:
         """One table per topic: ``time`` plus ``columns[topic]`` (column name -> field path).
 
-        ``bag_time`` uses the recording time instead of the message stamps. ``progress`` is a
-        tqdm bar to advance by one per message read.
+        ``bag_time`` uses the recording time instead of the message stamps; ``recorded`` adds
+        the :data:`RECORDED` column. ``progress`` is a tqdm bar to advance by one per message
+        read.
         """
         unknown = [topic for topic in columns if topic not in self.topics]
         if unknown:
@@ -243,7 +248,7 @@ class Bag:
             rows[topic].add(batch)
         tables = {}
         for topic, topic_rows in rows.items():
-            table = topic_rows.table(list(columns[topic]), bag_time)
+            table = topic_rows.table(list(columns[topic]), bag_time, recorded)
             msgtype = self.topics[topic]
             for column, path in columns[topic].items():
                 if field_type(msgtype, path, self.typestore) == "float32":
@@ -409,7 +414,7 @@ class _TopicRows:
         same = all(a == b or (a != a and b != b) for a, b in zip(bulk, decoded, strict=True))
         return layout if same else None
 
-    def table(self, names: list[str], bag_time: bool) -> pd.DataFrame:
+    def table(self, names: list[str], bag_time: bool, with_recorded: bool = False) -> pd.DataFrame:
         count = self.count
         recorded = np.concatenate(self.recorded) if self.recorded else np.zeros(0, np.int64)
         bulk = columns(self.layout, np.concatenate(self.bulk)) if self.bulk_at else None
@@ -429,7 +434,10 @@ class _TopicRows:
         if (order != np.arange(count)).any():
             recorded = recorded[order]
             values = {name: column[order] for name, column in values.items()}
-        return _table(recorded, values, names, bag_time)
+        table = _table(recorded, values, names, bag_time)
+        if with_recorded:
+            table[RECORDED] = recorded.astype(np.int64, copy=False)
+        return table
 
 
 def read_bag(
