@@ -298,8 +298,8 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         dest="msg_files",
         action="append",
         metavar="PATH",
-        help="a .msg/.idl/.action file or a folder of them, for types the bags do not define. "
-        "Repeatable",
+        help="a .msg/.srv/.action/.idl file or a folder of them, for types the bags do not "
+        "define. Repeatable",
     )
     parser.add_argument(
         "--bag-time",
@@ -333,6 +333,13 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         metavar="GLOB",
         default=None,
         help="behaviour-tree transition logs whose nodes are activities, e.g. /behavior_tree_log",
+    )
+    parser.add_argument(
+        "--robot",
+        metavar="NAME",
+        default=None,
+        help="the robot of tags and activities on topics without a namespace "
+        "(default: the bag's only namespace, else robot)",
     )
     parser.add_argument(
         "--auto",

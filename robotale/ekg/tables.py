@@ -94,6 +94,12 @@ def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> 
     events = event_table(log, first)
     types = entity_types([property_name(c) for c in log.columns], entities)
     corr_ids = _correlations(events, types)
+    if len(events) and corr_ids.empty:
+        raise InputError(
+            f"None of the log's {len(events)} events has a value in its entity column(s) "
+            f"{', '.join(types)}, so no entity and no DF edge would be built; name the columns "
+            "that identify what the events belong to with --entities (e.g. --entities case)."
+        )
     entity_table = corr_ids[["type", "id"]].drop_duplicates().reset_index(drop=True)
     position = pd.MultiIndex.from_frame(entity_table).get_indexer(
         pd.MultiIndex.from_frame(corr_ids[["type", "id"]])
