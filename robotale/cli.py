@@ -38,6 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_record(commands)
     _add_simulate(commands)
     _add_prepare(commands)
+    _add_annotate(commands)
     _add_neo4j(commands)
     _add_inspect(commands)
     _add_ingest(commands)
@@ -258,6 +259,31 @@ def _add_prepare(commands: argparse._SubParsersAction) -> None:
     _add_preparation_options(prepare)
     _add_executor(prepare)
     _handled_by(prepare, "prepare.prepare_command")
+
+
+def _add_annotate(commands: argparse._SubParsersAction) -> None:
+    annotate = commands.add_parser(
+        "annotate",
+        help="copy recordings as MCAP with their activities, messages and findings added",
+        description="Copy a rosbag2 directory, or each run of a folder of them, as an MCAP "
+        "rosbag2 directory under --out with added topics: each robot's current activity "
+        "(/robotale/<robot>/activity, std_msgs/String, and activity_index, std_msgs/Int32) "
+        "and, on /robotale/log (rcl_interfaces/Log), every message exchange, lost message, "
+        "bottleneck instance and, with --model, deviation from the model. The original "
+        "messages are copied byte for byte. Open it in Foxglove, Lichtblick or PlotJuggler "
+        "(docs/annotate.md).",
+    )
+    annotate.add_argument(
+        "source", type=Path, help="a rosbag2 directory or a folder of run directories"
+    )
+    annotate.add_argument(
+        "--out", type=Path, required=True, metavar="DIR", help="the folder the copies go to"
+    )
+    annotate.add_argument(
+        "--model", type=Path, metavar="BPMN", help="a BPMN collaboration to check the runs against"
+    )
+    _add_preparation_options(annotate)
+    _handled_by(annotate, "annotate.annotate_command")
 
 
 def _add_executor(parser: argparse.ArgumentParser) -> None:
