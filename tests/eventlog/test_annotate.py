@@ -8,6 +8,7 @@ what the hand count of the recording says.
 from __future__ import annotations
 
 from collections import defaultdict
+from pathlib import Path
 
 import pytest
 from bagbuilder import agri_like, nanos
@@ -138,3 +139,20 @@ def test_the_slow_instance_of_a_bottleneck_is_a_finding_of_its_run(tmp_path, bag
     time, text = found[2][0]
     assert time == nanos(11)
     assert text.startswith("bottleneck instance: move of tractor_1 took 8.000 s (median 2.200 s)")
+
+
+def test_with_a_model_a_deviation_is_a_finding_at_its_start(tmp_path, bag_builder):
+    """The rover's sequence model has no dance between prepare and measure."""
+    model = Path(__file__).resolve().parents[1] / "fame_runtime" / "models" / "sequence.bpmn"
+    b = bag_builder()
+    for k, activity in enumerate(["prepare", "dance", "measure", "carry_on"]):
+        b.tag(k + 1, "rover", activity, "start").tag(k + 1.5, "rover", activity, "complete")
+    b.write(tmp_path / "run")
+    out = tmp_path / "out"
+    assert main(["annotate", str(tmp_path / "run"), "--out", str(out), "--model", str(model)]) == 0
+    store = get_typestore(Stores.ROS2_HUMBLE)
+    logged = messages_by_rosbags(out / "run")["/robotale/log"]
+    texts = [
+        (time, store.deserialize_cdr(raw, "rcl_interfaces/msg/Log").msg) for time, raw in logged
+    ]
+    assert texts == [(nanos(2), "deviation: dance of rover is not where the model allows it")]
