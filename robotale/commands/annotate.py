@@ -47,7 +47,10 @@ def annotate_command(
         raise InputError(f"{taken[0]} exists already: give --out a folder without it.")
     if model is not None and not Path(model).is_file():
         raise InputError(f"The model {model} does not exist.")
-    log = prepare_recordings(source, msg_files=msg_files, distro=distro, **{**options, "rate": 0.0})
+    # the added topics need activities and messages only: no perspective (the odometry a
+    # bag is mostly made of) is read unless one is asked for
+    options = {"perspectives": "", **options, "rate": 0.0}
+    log = prepare_recordings(source, msg_files=msg_files, distro=distro, **options)
     names = sorted(log[ACTIVITY].dropna().astype(str).unique())
     extra = message_types([Path(p) for p in msg_files])
     slow = bottleneck_instances(log)  # ranked over every run: one run has no baseline
