@@ -126,11 +126,12 @@ def bottleneck_instances(log: pd.DataFrame) -> dict[str, list[Entry]]:
     )
     instances["seconds"] = (instances["end"] - instances["start"]) / 1e9
     entries: dict[str, list[Entry]] = {}
+    by_activity = dict(tuple(instances.groupby("activity", sort=False)))
     for row in ranking.to_dict("records"):
         activity, robot = row.get("activity"), row.get("robot")
-        if not isinstance(activity, str):
+        if not isinstance(activity, str) or activity not in by_activity:
             continue
-        mine = instances[instances["activity"] == activity]
+        mine = by_activity[activity]
         if isinstance(robot, str):
             mine = mine[mine["robot"] == robot]
         median = mine["seconds"].median()

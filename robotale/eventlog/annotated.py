@@ -14,8 +14,7 @@ and added topics that bag viewers read without a plugin:
 
 from __future__ import annotations
 
-import heapq
-from collections.abc import Iterator, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
@@ -101,16 +100,23 @@ def write_annotated(
             added += [(e.time, log, _log(store, e)) for e in entries]
             written[LOG_TOPIC] = len(entries)
         added.sort(key=lambda item: item[0])
-        for time, connection, raw in heapq.merge(
-            _originals(bag.reader, copies), iter(added), key=lambda item: item[0]
-        ):
-            writer.write(connection, time, raw)
+        _merged_write(writer, bag.reader, copies, added)
     return written
 
 
-def _originals(reader: Reader, copies: dict) -> Iterator[tuple[int, object, bytes]]:
+def _merged_write(writer: Writer, reader: Reader, copies: dict, added: list) -> None:
+    """The recording's messages and the added ones (sorted) written in time order, an added
+    message after the recording's of its instant; one comparison per message."""
+    write, k, count = writer.write, 0, len(added)
+    upcoming = added[0][0] if count else None
     for connection, time, raw in reader.messages():
-        yield time, copies[connection.id], raw
+        while upcoming is not None and upcoming < time:
+            write(added[k][1], upcoming, added[k][2])
+            k += 1
+            upcoming = added[k][0] if k < count else None
+        write(copies[connection.id], time, raw)
+    for when, target, raw in added[k:]:
+        write(target, when, raw)
 
 
 def _copy_connection(writer: Writer, bag: Bag, connection):
