@@ -233,7 +233,7 @@ def _read_nodes(
             values.append(record["values"])
             if resolved:
                 entities.append(
-                    [",".join(sorted(map(str, found))) or None for found in record["entities"]]
+                    [",".join(sorted(set(map(str, found)))) or None for found in record["entities"]]
                 )
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
     for position, name in enumerate(resolved):
