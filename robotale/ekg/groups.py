@@ -1,18 +1,20 @@
 """The aggregates of one step, computed in pandas from the nodes it collapses.
 
 :func:`aggregate_table` takes one row per node (its node id and the properties the step reads;
-times as Unix milliseconds) and returns one row per aggregate: its id and name, how many
+times as Unix nanoseconds) and returns one row per aggregate: its id and name, how many
 nodes it replaces and which, the group-by values and the attribute aggregations. The
 derived keys of robot logs (grid cell, region, time window, value band) are computed here.
 """
 
 from __future__ import annotations
 
+import datetime as dt
 from collections import Counter
 from collections.abc import Callable, Sequence
 
 import numpy as np
 import pandas as pd
+from neo4j.time import DateTime
 
 from robotale.ekg.spec import AggrStep, AttrAggr, GroupKey
 from robotale.errors import InputError
@@ -27,7 +29,7 @@ def aggregate_table(
     step: AggrStep, number: int, nodes: pd.DataFrame, times: set[str]
 ) -> pd.DataFrame:
     """One row per aggregate of ``nodes`` (columns ``node`` and the properties the step reads;
-    the properties in ``times`` hold Unix milliseconds): ``id``, ``name``, ``count``,
+    the properties in ``times`` hold Unix nanoseconds): ``id``, ``name``, ``count``,
     ``members`` (node ids), a column per group key and per attribute output."""
     keys = pd.DataFrame({key.name: group_values(key, nodes, times) for key in step.group_by})
     names = keys.astype(object).where(keys.notna(), UNKNOWN).astype(str)
@@ -74,11 +76,11 @@ def _band(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
 
 
 def _window(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
-    values = _numbers(nodes[key.inputs[0]])
-    if key.inputs[0] in times:  # milliseconds: the window starts as ISO times
-        width = key.size * 1000
-        return _iso(pd.Series(np.floor(values / width) * width, index=nodes.index))
-    lower = np.floor(values / key.size) * key.size
+    if key.inputs[0] in times:  # nanoseconds, in integers: floats would blur the bounds
+        values = pd.to_numeric(nodes[key.inputs[0]]).astype("Int64")
+        width = round(key.size * 1_000_000_000)
+        return _iso((values // width) * width)
+    lower = np.floor(_numbers(nodes[key.inputs[0]]) / key.size) * key.size
     return pd.Series(lower, index=nodes.index).astype(object).where(~np.isnan(lower), None)
 
 
@@ -111,8 +113,8 @@ def _numbers(values: pd.Series) -> np.ndarray:
     return pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
 
 
-def _iso(milliseconds: pd.Series) -> pd.Series:
-    moments = pd.to_datetime(pd.to_numeric(milliseconds, errors="coerce"), unit="ms", utc=True)
+def _iso(nanoseconds: pd.Series) -> pd.Series:
+    moments = pd.to_datetime(pd.to_numeric(nanoseconds).astype("Int64"), unit="ns", utc=True)
     text = moments.dt.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
     return text.astype(object).where(moments.notna(), None)
 
@@ -154,9 +156,15 @@ def attribute_values(
 def _extreme(found: pd.Series, is_time: bool) -> list[object]:
     values = [None if _missing(v) else _plain(v) for v in found]
     if is_time:  # the earliest or latest time, as a time again
-        return [None if v is None else pd.Timestamp(v, unit="ms", tz="UTC").to_pydatetime()
-                for v in values]  # fmt: skip
+        return [None if v is None else _moment(int(v)) for v in values]
     return values
+
+
+def _moment(nanoseconds: int) -> DateTime:
+    """A Unix time in nanoseconds as a Neo4j time in UTC (Python's own stops at microseconds)."""
+    t = pd.Timestamp(nanoseconds, unit="ns", tz="UTC")
+    return DateTime(t.year, t.month, t.day, t.hour, t.minute, t.second,
+                    t.microsecond * 1000 + t.nanosecond, tzinfo=dt.UTC)  # fmt: skip
 
 
 def multiset(values: Sequence[object] | pd.Series) -> list[str]:

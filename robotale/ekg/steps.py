@@ -23,6 +23,7 @@ from typing import Any
 
 import pandas as pd
 from neo4j import Driver
+from neo4j.time import DateTime
 
 from robotale.ekg.build import ensure_schema, undo_after_failure
 from robotale.ekg.connection import database
@@ -223,21 +224,17 @@ def _read_nodes(
         "entityTypes": resolved,
         "type": step.ent_type,
     }
-    nodes: list[int] = []
-    values: list[list[Any]] = []
-    entities: list[list[str]] = []
-    with driver.session(database=database()) as session:
-        result = session.run(text, {**condition.parameters, **parameters})
-        for record in result:
-            nodes.append(record["node"])
-            values.append(record["values"])
-            if resolved:
-                entities.append(
-                    [",".join(sorted(set(map(str, found)))) or None for found in record["entities"]]
-                )
+    records, _, _ = driver.execute_query(
+        text, {**condition.parameters, **parameters}, database_=database()
+    )
+    row = records[0]
+    values = row["values"]
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
-    for position, name in enumerate(resolved):
-        frame[name] = [row[position] for row in entities]
+    if resolved:
+        found = row["entities"]
+        for position, name in enumerate(resolved):
+            frame[name] = [",".join(sorted(set(map(str, e[position])))) or None for e in found]
+    nodes = row["nodes"]
     frame.insert(0, "node", nodes)
     return frame
 
@@ -264,7 +261,7 @@ def _write(
                 "names": table["name"].tolist(),
                 "counts": table["count"].astype(int).tolist(),
             },
-            {"properties": {c: neo4j_values(table[c]) for c in stored}},
+            {"properties": {c: _storable(table[c]) for c in stored}},
             step=number,
             origin=step.origin,
             type=step.ent_type,
@@ -282,6 +279,13 @@ def _write(
         counts={"aggregates": len(table), "members": int(table["count"].sum())},
         database_=database(),
     )
+
+
+def _storable(column: pd.Series) -> list[Any]:
+    """An aggregate column as values Neo4j stores; times stay Neo4j times (nanoseconds)."""
+    if any(isinstance(v, DateTime) for v in column):
+        return [v if isinstance(v, DateTime) else None for v in column]
+    return neo4j_values(column)
 
 
 def _lift(

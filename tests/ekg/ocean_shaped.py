@@ -34,20 +34,24 @@ def _objects(rng: np.random.Generator, prefix: str, count: int) -> np.ndarray:
 
 
 def _cells(rng: np.random.Generator, pool: np.ndarray, n: int, share: float, most: int) -> list:
-    """One cell per event: empty for about 1 - ``share`` of them, else 1 .. ``most`` objects
-    of ``pool`` joined by commas."""
-    cells: list[str | None] = []
-    present = rng.random(n) < share
+    """One cell per event: empty for about 1 - ``share`` of them, else 1 .. ``most`` distinct
+    objects of ``pool`` joined by commas."""
     sizes = rng.integers(1, most + 1, n)
-    for has, size in zip(present, sizes, strict=True):
-        cells.append(",".join(rng.choice(pool, size, replace=False)) if has else None)
-    return cells
+    first = rng.integers(0, len(pool), n)
+    stride = rng.integers(1, max(len(pool) // most, 1) + 1, n)  # keeps the objects distinct
+    cells = pd.Series(pool[first], dtype=object)
+    for extra in range(1, most):
+        more = sizes > extra
+        others = pd.Series(pool[(first + extra * stride) % len(pool)], dtype=object)
+        cells[more] = cells[more] + "," + others[more]
+    cells[rng.random(n) >= share] = None
+    return cells.tolist()
 
 
 def _frame(rng: np.random.Generator, n: int, activities: list[str], span_days: int) -> dict:
     seconds = np.sort(rng.integers(0, span_days * 86400, n))
     return {
-        "time": [(START + pd.Timedelta(seconds=int(s))).isoformat() for s in seconds],
+        "time": (START + pd.to_timedelta(seconds, unit="s")).strftime("%Y-%m-%dT%H:%M:%SZ"),
         "activity": rng.choice(activities, n),
         "event_id": [f"ev{i}" for i in range(n)],
     }
