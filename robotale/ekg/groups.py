@@ -33,7 +33,9 @@ def aggregate_table(
     ``members`` (node ids), a column per group key and per attribute output."""
     keys = pd.DataFrame({key.name: group_values(key, nodes, times) for key in step.group_by})
     names = keys.astype(object).where(keys.notna(), UNKNOWN).astype(str)
-    label = names.iloc[:, 0] if len(keys.columns) == 1 else names.agg("|".join, axis=1)
+    label = names.iloc[:, 0]
+    for column in names.columns[1:]:
+        label = label.str.cat(names[column], sep="|")
     frame = pd.DataFrame({"name": label.to_numpy(), "node": nodes["node"].to_numpy()})
     grouped = frame.groupby("name", sort=True)
     table = pd.DataFrame({"count": grouped.size(), "members": grouped["node"].agg(list)})
@@ -146,6 +148,8 @@ def attribute_values(
             )
         found = numbers.groupby(labels, sort=True).agg("sum" if attr.function == "SUM" else "mean")
         return [(outputs[0], [None if pd.isna(v) else _plain(v) for v in found])]
+    if is_time:  # nanoseconds as integers: grouped as numbers, not as Python objects
+        values = pd.to_numeric(values).astype("Int64")
     hows = ["min", "max"] if attr.function == "MINMAX" else [attr.function.lower()]
     grouped = values.groupby(labels, sort=True)
     return [
