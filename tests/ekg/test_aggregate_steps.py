@@ -262,3 +262,22 @@ def test_a_deleted_log_takes_its_aggregates_along(neo4j_driver, small, graph_cou
     after = graph_counts()
     for kind in ("node:Aggregate", "node:AggregationStep", "relationship:AGGREGATED_IN"):
         assert after.get(kind, 0) <= before.get(kind, 0)
+
+
+def test_a_step_that_fails_while_writing_leaves_nothing(neo4j_driver, small, graph_counts):
+    from robotale.errors import ServerError
+
+    before = graph_counts()
+    # A node in the way of the step's second aggregate: Neo4j refuses to create that one
+    # (the aggregate key is unique) after the first is written.
+    neo4j_driver.execute_query(
+        "CREATE (:Aggregate {log: $log, step: 1, id: '1:spray'})", log=small, database_=database()
+    )
+    spec = steps({"aggr_type": "EVENTS", "group_by": ["activity"]})
+    with pytest.raises(
+        ServerError, match=r"Aggregation step 1 of .* failed .*nothing of it was kept"
+    ):
+        run_spec(neo4j_driver, small, spec)
+    # the undo takes the node in the way along: it stood where step 1's aggregates go
+    assert graph_counts() == before
+    assert list_steps(neo4j_driver, small) == []
