@@ -39,6 +39,8 @@ from robotale.errors import InputError
 
 #: the properties every aggregate has; a group-by key of one of these names is only in ``name``
 OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")
+#: how many events tell which properties hold times
+KEY_SAMPLE = 10_000
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
 #: aggregates per lifting transaction: few enough that a batch of large ones stays small
@@ -169,6 +171,8 @@ def _aggregates(
             f"{', '.join(entity_types) or 'none'}."
         )
     keys, times = _node_keys(driver, log, step.ent_type)
+    if step.origin == "Event":  # a property the sampled events lack may be on later ones
+        keys |= set(info.get("properties") or []) | {"id", "order", "timestamp"}
     if step.origin == "Event":
         resolved = [
             k.inputs[0]
@@ -195,8 +199,10 @@ def _aggregates(
 
 
 def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[str], list[str]]:
+    # Events: a sample tells the types (their keys are on the Log node); entities: all.
+    limit = KEY_SAMPLE if entity_type is None else 2**62
     records, _, _ = driver.execute_query(
-        cypher("aggr_node_keys"), log=log, type=entity_type, database_=database()
+        cypher("aggr_node_keys"), log=log, type=entity_type, limit=limit, database_=database()
     )
     row = records[0] if records else None
     if row is None:
