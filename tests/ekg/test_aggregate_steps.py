@@ -219,6 +219,10 @@ def test_bad_steps_are_refused_before_anything_is_written(neo4j_driver, small, g
     for step, message in cases:
         with pytest.raises(InputError, match=message):
             run_spec(neo4j_driver, small, steps(step))
+    # a good first step is not run when a later one is refused
+    good = {"aggr_type": "EVENTS", "group_by": ["activity"]}
+    with pytest.raises(InputError, match="step 2"):
+        run_spec(neo4j_driver, small, steps(good, cases[0][0]))
     assert graph_counts() == before
 
 
