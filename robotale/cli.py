@@ -129,6 +129,12 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         metavar="YAML",
         help="a simulation's world file: also list what its robots do not provide",
     )
+    check.add_argument(
+        "--json",
+        dest="as_json",
+        action="store_true",
+        help="the report as JSON (each problem with element, file, line, column, sentence)",
+    )
     _handled_by(check, "fame.check_command")
 
     split = sub.add_parser("split", help="one process per robot")

@@ -16,7 +16,8 @@ from robotale.fame_runtime.check import Report, check, duplicate_ids
 from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
-from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.model import Problem
+from robotale.fame_runtime.parser import ReadError, parse, parse_all
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split, unbound_pools, write_split
 from robotale.fame_runtime.tags import Tag
@@ -34,19 +35,71 @@ def check_command(
     library: Path | None = None,
     skills: str | None = None,
     world: Path | None = None,
+    as_json: bool = False,
     out: TextIO | None = None,
 ) -> int:
-    """Print the structure and QoS report; with ``world`` (a simulation's world file) also
-    what the model needs that the world's robots do not provide. 1 when something is wrong."""
+    """Print the structure and QoS report -- every problem of reading and of deploying the
+    file at once; with ``world`` (a simulation's world file) also what the model needs that
+    the world's robots do not provide; with ``as_json`` as one JSON object. 1 when something
+    is wrong."""
     out = out or sys.stdout
     names = load_skills(skills) if skills else {}
-    definitions = parse(model)
+    try:
+        definitions = parse_all(model)
+    except ReadError as error:
+        if not as_json:
+            raise
+        print(json.dumps(unreadable_json(model, error.problems), indent=2), file=out)
+        return 1
     blocks = Library(library) if library else None
     report = check(definitions, skills=names, library=blocks)
-    missing = _simulation_lacks(definitions, model, world, blocks) if world is not None else []
-    print_report(report, out)
-    print_lacks(missing, out)
+    missing = []
+    if world is not None and not definitions.problems:
+        missing = _simulation_lacks(definitions, model, world, blocks)
+    if as_json:
+        print(json.dumps(report_json(report, missing), indent=2), file=out)
+    else:
+        print_report(report, out)
+        print_lacks(missing, out)
     return 0 if report.ok and not missing else 1
+
+
+def unreadable_json(model: Path, problems: Sequence[Problem]) -> dict[str, Any]:
+    """The JSON report of a file that is no BPMN at all."""
+    return {
+        "file": str(model),
+        "ok": False,
+        "pools": [],
+        "problems": [{**p.as_dict(), "pool": ""} for p in problems],
+        "qos": [],
+        "notes": [],
+        "warnings": [],
+        "lacks": [],
+    }
+
+
+def report_json(report: Report, missing: Sequence[str]) -> dict[str, Any]:
+    """The report as data: what ``print_report`` prints, each problem with its element id,
+    file, line, column (0: unknown) and sentence."""
+    return {
+        "file": report.file,
+        "ok": report.ok and not missing,
+        "pools": report.pools,
+        "problems": [{**p.as_dict(), "pool": pool} for pool, p in report.found],
+        "qos": [
+            {
+                "topic": pair.publisher.topic,
+                "publisher": pair.publisher.describe(),
+                "subscriber": pair.subscriber.describe(),
+                "compatible": pair.compatible,
+                "reasons": list(pair.reasons),
+            }
+            for pair in report.pairs
+        ],
+        "notes": report.notes,
+        "warnings": report.warnings,
+        "lacks": list(missing),
+    }
 
 
 def _simulation_lacks(definitions, model: Path, world: Path, library: Library | None):
@@ -67,9 +120,10 @@ def print_lacks(missing: Sequence[str], out: TextIO) -> None:
 
 def print_report(report: Report, out: TextIO) -> None:
     print(f"{report.file}: pools {', '.join(report.pools)}", file=out)
-    print(f"structure: {'ok' if not report.problems else 'the engine cannot run'}", file=out)
-    for problem in report.problems:
-        print(f"  {problem}", file=out)
+    print(f"structure: {'ok' if not report.found else 'the engine cannot run'}", file=out)
+    for pool, problem in report.found:
+        where = f"{problem.file}:{problem.line}:" + (f"{problem.column}:" if problem.column else "")
+        print(f"  {where} {pool + ': ' if pool else ''}{problem.sentence}", file=out)
     incompatible = sum(not p.compatible for p in report.pairs)
     print(
         f"QoS: {len(report.pairs)} publisher/subscriber pairs, {incompatible} incompatible",

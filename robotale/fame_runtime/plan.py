@@ -3,7 +3,8 @@
 :func:`deploy` checks every element once -- scripts and conditions compiled, signal topics and
 timers resolved, call activities bound to a skill or a process -- and refuses the process with
 one :class:`~robotale.errors.ModelError` naming every element the engine cannot run.
-:func:`problems` lists the same without raising, for ``robotale fame check``.
+:func:`problems` lists the same without raising, for ``robotale fame check``, and
+:func:`findings` as :class:`~robotale.fame_runtime.model.Problem` (file, line, element).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from robotale.fame_runtime.model import (
     Definitions,
     Loop,
     Node,
+    Problem,
     Process,
     RosMessage,
     Scope,
@@ -66,12 +68,28 @@ _ROLES = {
 #: the event kinds each kind of event may have ("none" = no event definition)
 ALLOWED = {
     "start": {"none", "signal", "timer", "conditional", "message"},
-    "event_start": {"signal", "timer", "conditional", "error", "message", "escalation"},
+    "event_start": {
+        "signal",
+        "timer",
+        "conditional",
+        "error",
+        "message",
+        "escalation",
+        "compensate",
+    },
     "sub_start": {"none"},
     "intermediateCatchEvent": {"signal", "timer", "conditional", "message"},
-    "intermediateThrowEvent": {"none", "signal", "message", "escalation"},
-    "endEvent": {"none", "terminate", "signal", "error", "message", "escalation"},
-    "boundaryEvent": {"signal", "timer", "conditional", "error", "message", "escalation"},
+    "intermediateThrowEvent": {"none", "signal", "message", "escalation", "compensate"},
+    "endEvent": {"none", "terminate", "signal", "error", "message", "escalation", "compensate"},
+    "boundaryEvent": {
+        "signal",
+        "timer",
+        "conditional",
+        "error",
+        "message",
+        "escalation",
+        "compensate",
+    },
 }
 _SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
 
@@ -93,12 +111,13 @@ class Trigger:
 class Throw:
     """What a throwing event publishes or raises."""
 
-    kind: str  # signal | message | error | escalation
+    kind: str  # signal | message | error | escalation | compensate
     label: str
-    topic: str
+    topic: str  # compensate: the activity to compensate ("" every completed one)
     msgtype: str = EMPTY_MSGTYPE
     payload: dict[str, str] | str | None = None
     qos: QoS = DEFAULT_QOS
+    wait: bool = True  # compensate: the thrower waits until the compensation is done
 
 
 @dataclass(slots=True, eq=False)
@@ -155,6 +174,10 @@ class ScopePlan:
     event_subprocesses: list[NodePlan] = field(default_factory=list)
     data_objects: list[DataObject] = field(default_factory=list)  # initialised on entry
     safe_state: NodePlan | None = None
+    #: activity id -> the compensation handler its compensation boundary event names
+    compensations: dict[str, NodePlan] = field(default_factory=dict)
+    #: the event sub-process whose start is a compensation event (compensates this scope)
+    compensation_handler: NodePlan | None = None
 
 
 def deploy(
@@ -166,11 +189,11 @@ def deploy(
     """The process ready to run, or a ModelError naming every element the engine cannot run."""
     planner = _Planner(skills, library)
     plan = planner.process(process, top=True)
-    if planner.problems:
+    if planner.found:
         file = f"{process.file}: " if process.file else ""
         raise ModelError(
             f"{file}the engine cannot run process {process.describe()}: "
-            + "; ".join(planner.problems)
+            + "; ".join(f"{p.sentence} (line {p.line})" for p in planner.found)
         )
     return plan
 
@@ -179,9 +202,16 @@ def problems(
     process: Process, *, skills: Collection[str] = (), library: Library | None = None
 ) -> list[str]:
     """What :func:`deploy` would refuse in ``process``, one phrase per element."""
+    return [p.sentence for p in findings(process, skills=skills, library=library)]
+
+
+def findings(
+    process: Process, *, skills: Collection[str] = (), library: Library | None = None
+) -> list[Problem]:
+    """What :func:`deploy` would refuse in ``process``, with file, line and element id."""
     planner = _Planner(skills, library)
     planner.process(process, top=True)
-    return planner.problems
+    return planner.found
 
 
 def speaks_javascript(plan: ScopePlan) -> bool:
@@ -231,14 +261,22 @@ class _Planner:
     def __init__(self, skills: Collection[str], library: Library | None) -> None:
         self.skills = skills
         self.library = library
-        self.problems: list[str] = []
+        self.found: list[Problem] = []
+        self.file = ""  # the file of the process being planned (a called one has its own)
         self.called: dict[int, ScopePlan] = {}
         self.where = ""  # which called process the planner is in, for messages
         self.definitions: Definitions | None = None  # the top process's file (messages)
         self.pool = ""  # the namespace of the top process's pool (its messages' topics)
 
     def refuse(self, node: Node, reason: str) -> None:
-        self.problems.append(f"{node.kind} {node.describe()}{self.where} {reason}")
+        self.found.append(
+            Problem(
+                self.file, node.line, node.id, f"{node.kind} {node.describe()}{self.where} {reason}"
+            )
+        )
+
+    def problem(self, line: int, element: str, sentence: str) -> None:
+        self.found.append(Problem(self.file, line, element, sentence))
 
     def process(self, process: Process, *, top: bool = False) -> ScopePlan:
         if id(process) in self.called:  # recursive calls share one plan
@@ -248,14 +286,20 @@ class _Planner:
         if top:
             self.definitions = process.definitions
             self.pool = _pool_namespace(process.definitions, process.id)
-        outer = self.where
+        outer, outer_file = self.where, self.file
+        self.file = str(process.file or "")
         if not top:
             file = f" ({process.file.name})" if process.file else ""
             self.where = f" of called process {process.describe()}{file}"
         self.scope(process, plan, top=top)
         self.where = outer
         if top and not plan.starts and not plan.triggered_starts:
-            self.problems.append(f"process {process.describe()} has no start event")
+            self.problem(
+                process.line,
+                process.id,
+                f"process {process.describe()} has no start event (add a bpmn:startEvent)",
+            )
+        self.file = outer_file
         return plan
 
     def scope(self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False):
@@ -266,6 +310,7 @@ class _Planner:
         self.flows(scope, plan)
         for node_plan in plan.nodes.values():
             self.gateway(node_plan)
+            self.compensation(node_plan, plan)
         plan.safe_state = next(
             (n for n in plan.event_subprocesses if _SAFE_STATE.search(n.node.name)), None
         )
@@ -278,9 +323,11 @@ class _Planner:
                 try:
                     condition = compile_condition(flow.condition)
                 except ValueError as error:
-                    self.problems.append(
+                    self.problem(
+                        flow.line,
+                        flow.id,
                         f"sequence flow {flow.id}{self.where} has a condition the engine "
-                        f"cannot run: {error}"
+                        f"cannot run: {error}",
                     )
             flow_plan = FlowPlan(flow.id, target, condition)
             source.outgoing.append(flow_plan)
@@ -301,6 +348,28 @@ class _Planner:
             self.refuse(node, "has incoming sequence flows")
         if node.kind == "endEvent" and plan.outgoing:
             self.refuse(node, "has outgoing sequence flows")
+
+    def compensation(self, plan: NodePlan, scope: ScopePlan) -> None:
+        """A compensation boundary event binds its handler to its activity; the handler runs
+        only to compensate, never by a sequence flow (BPMN 2.0 section 10.6.5)."""
+        node = plan.node
+        if node.for_compensation and (plan.incoming or plan.outgoing):
+            self.refuse(
+                node,
+                "is a compensation handler (isForCompensation) with sequence flows: it runs "
+                "only when its activity is compensated (remove its incoming and outgoing flows)",
+            )
+        if node.kind != "boundaryEvent" or node.event_kind != "compensate":
+            return
+        handler = scope.nodes.get(node.compensation_handler)
+        if handler is not None and node.attached_to in scope.nodes:
+            scope.compensations[node.attached_to] = handler
+        if plan.outgoing:
+            self.refuse(
+                node,
+                "is a compensation boundary event with outgoing sequence flows (its handler is "
+                "joined by an association, not a flow)",
+            )
 
     def node(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
@@ -350,6 +419,13 @@ class _Planner:
                 self.refuse(plan.node, f"has a loop {name} the engine cannot run: {error}")
         if loop.kind == "standard" and loop.condition is None and loop.maximum is None:
             self.refuse(plan.node, "has a standard loop without loopCondition or loopMaximum")
+        if loop.kind != "standard" and loop.cardinality is None and not loop.collection:
+            self.refuse(
+                plan.node,
+                "has a multi-instance marker with neither a loopCardinality nor a collection "
+                "(loopDataInputRef or camunda:collection), so robotale cannot tell how many "
+                "instances to run: give one, e.g. <bpmn:loopCardinality>3</bpmn:loopCardinality>",
+            )
         plan.behaviour, plan.loop = "loop", looped
 
     def activity(self, plan: NodePlan, scope: ScopePlan) -> None:
@@ -395,10 +471,24 @@ class _Planner:
             return None
         topic = message_topic(targets[0], node)
         if not topic:
-            self.refuse(node, "names no message (give the element or its message a name)")
+            self.refuse(node, self.no_message(node))
         message = node.message or RosMessage()
         msgtype = message.msgtype or EMPTY_MSGTYPE
         return Throw("message", plan.label, topic, msgtype, message.payload, message.qos)
+
+    def no_message(self, node: Node) -> str:
+        """Why a message event or task has no topic: a messageRef to nothing, or no name."""
+        ref = node.event.ref if node.event else ""
+        declared = self.definitions.messages if self.definitions else {}
+        if ref and ref not in declared:
+            known = ", ".join(sorted(declared)) or "none"
+            return (
+                f"refers to message {ref}, which the file does not declare (messages: {known}; "
+                f'declare <bpmn:message id="{ref}" name="..."/> or name the element)'
+            )
+        if ref:
+            return f"refers to message {ref}, which has no name (give it or the element one)"
+        return "names no message (give the element a name or a messageRef to a named message)"
 
     def call(self, plan: NodePlan) -> None:
         node = plan.node
@@ -430,9 +520,22 @@ class _Planner:
             plan.behaviour = "subprocess"
         self.scope(node.scope or Scope(), child, event=node.triggered_by_event)
         if node.triggered_by_event and len(child.triggered_starts) != 1:
-            self.refuse(node, "needs exactly one start event with a trigger")
+            found = len(child.triggered_starts) or "no"
+            self.refuse(
+                node,
+                f"is an event sub-process with {found} start events with a trigger: it needs "
+                "exactly one (a signal, timer, conditional, error, message, escalation or "
+                "compensation start event)",
+            )
+        elif node.triggered_by_event and child.triggered_starts[0].node.event_kind == "compensate":
+            scope.compensation_handler = plan
         if not node.triggered_by_event and len(child.starts) != 1:
-            self.refuse(node, "needs exactly one none start event")
+            found = len(child.starts) or "no"
+            self.refuse(
+                node,
+                f"is a sub-process with {found} none start events: it needs exactly one "
+                "(a start event without a trigger)",
+            )
 
     def event(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
@@ -440,9 +543,11 @@ class _Planner:
         if node.kind == "startEvent":
             role = "start" if top else ("event_start" if event else "sub_start")
         if node.event_kind not in ALLOWED[role]:
-            hint = " (use a signal event, guideline G3)" if node.event_kind == "message" else ""
+            runs = ", ".join(sorted(ALLOWED[role]))
             self.refuse(
-                node, f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run{hint}"
+                node,
+                f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run (it runs "
+                f"a {_ROLES[role]} of these kinds: {runs})",
             )
             return
         if catches(node):
@@ -452,6 +557,9 @@ class _Planner:
 
     def catching(self, plan: NodePlan, scope: ScopePlan) -> None:
         node = plan.node
+        if node.kind == "boundaryEvent" and node.event_kind == "compensate":
+            plan.behaviour = "boundary"  # never armed: compensation runs its handler instead
+            return
         if node.kind == "boundaryEvent":
             plan.behaviour = "boundary"
             host = scope.nodes.get(node.attached_to)
@@ -485,22 +593,32 @@ class _Planner:
         if kind == "message":
             topic = message_topic(self.pool, node)
             if not topic:
-                self.refuse(node, "names no message (give the element or its message a name)")
+                self.refuse(node, self.no_message(node))
             return Trigger("signal", plan.label, topic, message.msgtype, message.qos)
         if kind == "escalation":
             return Trigger("escalation", plan.label, escalation_name(node))
         if kind == "timer":
             timer = node.event.timer if node.event else None
             if timer is None:
-                self.refuse(node, "is a timer without a date, duration or cycle")
+                self.refuse(
+                    node,
+                    "is a timer without a date, duration or cycle (give a timeDate, "
+                    "timeDuration or timeCycle with a value, e.g. PT10S)",
+                )
             return Trigger("timer", plan.label, timer=timer)
+        if kind == "compensate":  # an event sub-process's start: run by compensation only
+            return Trigger("compensate", plan.label)
         return self.conditional(plan)
 
     def conditional(self, plan: NodePlan) -> Trigger | None:
         node = plan.node
         expression = node.event.condition if node.event else None
         if expression is None:
-            self.refuse(node, "is a conditional event without a condition")
+            self.refuse(
+                node,
+                "is a conditional event without a condition (give its "
+                "conditionalEventDefinition a bpmn:condition)",
+            )
             return None
         try:
             return Trigger("conditional", plan.label, condition=compile_condition(expression))
@@ -528,6 +646,24 @@ class _Planner:
             plan.throw = Throw("escalation", plan.label, escalation_name(node))
         elif kind == "message":
             plan.throw = self.message_throw(plan)
+        elif kind == "compensate":
+            plan.throw = self.compensation_throw(plan)
+
+    def compensation_throw(self, plan: NodePlan) -> Throw:
+        """A compensation throw names one activity (``activityRef``) or every completed one
+        of its scope; the activity must be in the process."""
+        node = plan.node
+        event = node.event
+        ref = event.ref if event else ""
+        activities = {n.id for n in plan.scope.process.walk() if not n.kind.endswith("Event")}
+        if ref and ref not in activities:
+            self.refuse(
+                node,
+                f"compensates activity {ref}, which is no activity of process "
+                f"{plan.scope.process.describe()} (name an activity beside the event, or none "
+                "to compensate every completed one)",
+            )
+        return Throw("compensate", plan.label, ref, wait=event.wait if event else True)
 
 
 def _pool_namespace(definitions: Definitions | None, process_id: str) -> str:

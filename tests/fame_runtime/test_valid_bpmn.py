@@ -6,6 +6,8 @@ from pathlib import Path
 import pytest
 
 from robotale.cli import main
+from robotale.errors import ModelError
+from robotale.fame_runtime.parser import parse
 
 HEAD = (
     '<?xml version="1.0" encoding="UTF-8"?>\n'
@@ -151,20 +153,23 @@ def test_every_gap_of_a_file_is_named_at_once(tmp_path, capsys):
     path = write(tmp_path, "gaps.bpmn", body, attributes)
     assert main(["fame", "check", str(path)]) == 1
     out = capsys.readouterr().out
-    problems = [line.strip() for line in out.splitlines() if line.startswith("  gappy")]
+    problems = [line.strip() for line in out.splitlines() if line.startswith(f"  {path}")]
+    not_evaluated = (
+        "an expression language robotale does not evaluate (it evaluates python or javascript)"
+    )
+    # the language URIs are quoted as the file writes them
     assert problems == [
-        "gappy: intermediateCatchEvent wait (Wait) is a timer without a date, duration or cycle",
-        "gappy: sequence flow f3 has a condition the engine cannot run: it is in "
-        "'https://www.omg.org/spec/dmn/20191111/feel/', an expression language robotale does "
-        "not evaluate (it evaluates python or javascript)",
-        "gappy: sequence flow f4 has a condition the engine cannot run: it is in "
-        "'http://www.w3.org/1999/xpath', an expression language robotale does not evaluate "
-        "(it evaluates python or javascript)",
+        f"{path}:8:5: gappy: intermediateCatchEvent wait (Wait) is a timer without a date, "
+        "duration or cycle (give a timeDate, timeDuration or timeCycle with a value, e.g. PT10S)",
+        f"{path}:16:5: gappy: sequence flow f3 has a condition the engine cannot run: it is in "
+        f"'https://www.omg.org/spec/DMN/20191111/FEEL/', {not_evaluated}",
+        f"{path}:21:5: gappy: sequence flow f4 has a condition the engine cannot run: it is in "
+        f"'http://www.w3.org/1999/XPath', {not_evaluated}",
     ]
     assert "Python syntax error" not in out
 
 
-def test_several_broken_references_are_reported_together(tmp_path, capsys):
+def test_several_broken_references_are_reported_together_with_what_cannot_run(tmp_path, capsys):
     body = """
   <bpmn:collaboration id="c"><bpmn:participant id="p" processRef="ghost" /></bpmn:collaboration>
   <bpmn:process id="real">
@@ -172,18 +177,25 @@ def test_several_broken_references_are_reported_together(tmp_path, capsys):
     <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="nowhere" />
     <bpmn:task id="t"><bpmn:dataInputAssociation id="a">
       <bpmn:sourceRef>missing</bpmn:sourceRef></bpmn:dataInputAssociation></bpmn:task>
+    <bpmn:userTask id="ask" name="Ask" />
   </bpmn:process>"""
     path = write(tmp_path, "broken.bpmn", body)
     assert main(["fame", "check", str(path)]) == 1
-    err = capsys.readouterr().err
-    assert err.splitlines() == [
-        f"robotale: {path}: 3 problems:",
-        f"{path}:9: sequence flow f1 is dangling: its target (nowhere) is not an element of "
+    out = capsys.readouterr().out
+    problems = [line.strip() for line in out.splitlines() if line.startswith(f"  {path}")]
+    # reading and deploying at once: the reader's three and the deployer's user task
+    assert problems == [
+        f"{path}:9:5: sequence flow f1 is dangling: its target (nowhere) is not an element of "
         "the same process or sub-process",
-        f"{path}:10: task t has a data association with missing, which is no data object, "
-        "data store, input, output or property of process real",
-        f"{path}:6: pool p refers to process ghost, which is not in the file (processes: real)",
+        f"{path}:10:5: task t has a data association with missing, which is no data object, "
+        "data object reference, data store reference, input, output or property of process real",
+        f"{path}:6:30: pool p refers to process ghost, which is not in the file (processes: real)",
+        f"{path}:12:5: real: userTask ask (Ask) needs a person",
     ]
+    # parse (what fame run uses) refuses the file with the reader's three
+    with pytest.raises(ModelError) as error:
+        parse(path)
+    assert str(error.value).splitlines()[0] == f"{path}: 3 problems:"
 
 
 def test_run_prints_the_warnings_before_the_tags(tmp_path, capsys):
