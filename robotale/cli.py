@@ -133,6 +133,7 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         "--json",
         dest="as_json",
         action="store_true",
+        default=None,
         help="the report as JSON (each problem with element, file, line, column, sentence)",
     )
     _handled_by(check, "fame.check_command")

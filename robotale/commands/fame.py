@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -14,6 +14,7 @@ from robotale.extras import require
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.check import Report, check, duplicate_ids
 from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.engine import Engine
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.model import Problem
@@ -260,13 +261,20 @@ def run_verdict(mission: Mission, begin: float, err: TextIO) -> int:
         state = "waiting for a timer"
     else:
         state = "still running"
-    counts = ", ".join(f"{r} {e.completed}" for r, e in mission.engines.items())
-    print(f"# {state} at {reached:.3f} s; instances completed: {counts}", file=err)
+    print(f"# {state} at {reached:.3f} s; {instance_counts(mission.engines)}", file=err)
     for place in mission.whereabouts():
         print(f"# {place}", file=err)
     for failure in mission.failures:
         print(f"# {failure}", file=err)
     return 1 if mission.failures or not mission.idle else 0
+
+
+def instance_counts(engines: Mapping[str, Engine]) -> str:
+    """``instances completed: drone 1, tractor 0; failed: tractor 1`` (failed only when some
+    instance failed)."""
+    completed = ", ".join(f"{r} {e.completed}" for r, e in engines.items())
+    failed = ", ".join(f"{r} {e.failed}" for r, e in engines.items() if e.failed)
+    return f"instances completed: {completed}" + (f"; failed: {failed}" if failed else "")
 
 
 def tag_line(tag: Tag, begin: float = 0.0) -> str:

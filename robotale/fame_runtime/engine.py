@@ -25,7 +25,7 @@ from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock, EngineTime
 from robotale.fame_runtime.data import Data
 from robotale.fame_runtime.expressions import BpmnError, Compiled
-from robotale.fame_runtime.javascript import Completion, JavaScript, ScriptFailure
+from robotale.fame_runtime.javascript import Completion, JavaScript, ScriptFailure, ScriptLimit
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import JAVASCRIPT, Process
 from robotale.fame_runtime.plan import (
@@ -55,12 +55,39 @@ _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 _FREE = contextlib.nullcontext()
 
 
+_ABSENT = object()  # a variable a frame shadows that had no value outside it
+
+
+class _Frame:
+    """The variables of one multi-instance instance that are its own (BPMN 2.0 section
+    10.3.8: every instance has its own ``loopCounter``, input item and output item). The
+    engine keeps one variables dict for a robot; before it runs a token of an instance it
+    installs that instance's frame (its values in, the outer ones kept aside) and takes it
+    out again afterwards, so instances running side by side never see each other's item."""
+
+    __slots__ = ("outer", "parent", "values")
+
+    def __init__(self, parent: _Frame | None, values: dict[str, Any]) -> None:
+        self.parent = parent
+        self.values = values  # the instance's own values while it is not installed
+        self.outer: dict[str, Any] = {}  # what the variables held before it was installed
+
+    def chain(self) -> list[_Frame]:
+        """This frame and the frames around it, outermost first."""
+        frames, frame = [], self
+        while frame is not None:
+            frames.append(frame)
+            frame = frame.parent
+        return frames[::-1]
+
+
 class _Token:
     __slots__ = (
         "alive",
         "boundaries",
         "child",
         "flow",
+        "frame",
         "generation",
         "instance",
         "node",
@@ -69,6 +96,7 @@ class _Token:
     )
 
     def __init__(self, scope: _Scope, node: NodePlan) -> None:
+        self.frame: _Frame | None = scope.frame  # the instance variables it runs with
         self.scope = scope
         self.node = node
         self.flow = ""  # the sequence flow it arrived by (joins count them)
@@ -99,17 +127,31 @@ class _Loop:
 class _Scope:
     """A running process, called process, sub-process or event sub-process."""
 
-    __slots__ = ("armed", "depth", "ended", "holder", "joins", "parent", "plan", "safe", "tokens")
+    __slots__ = (
+        "armed",
+        "depth",
+        "ended",
+        "failed",
+        "frame",
+        "holder",
+        "joins",
+        "parent",
+        "plan",
+        "safe",
+        "tokens",
+    )
 
     def __init__(self, plan: ScopePlan, parent: _Scope | None, holder: _Token | None) -> None:
         self.plan = plan
         self.parent = parent
         self.holder = holder  # the token of the activity this scope runs inside
+        self.frame = holder.frame if holder is not None else None
         self.depth = parent.depth + 1 if parent else 0
         self.tokens: set[_Token] = set()
         self.joins: dict[str, list[_Token]] = {}
         self.armed: dict[str, Callable[[], Any]] = {}  # event sub-process id -> disarm
         self.ended = False
+        self.failed = False  # a top-level scope ended by an uncaught error or a model error
         self.safe = False  # its safe-state handler runs before it ends
 
 
@@ -168,11 +210,13 @@ class Engine:
         self._starting = 0  # none-start instances scheduled but not begun
         self.started = False
         self.stopped = False
-        self.completed = 0  # process instances that ended
-        self.failures: list[str] = []  # BPMN errors nobody caught
+        self.completed = 0  # process instances that ended normally
+        self.failed = 0  # process instances an uncaught error or a script's limit ended
+        self.failures: list[str] = []  # why each failed instance ended, one sentence each
         self.output = output or (lambda line: print(f"[{robot}] {line}", flush=True))
         self._javascript: JavaScript | None = None  # made when a first script needs it
         self._time = EngineTime.of(clock)  # None: computing takes no simulated time
+        self._frame: _Frame | None = None  # the instance frame installed in the variables
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -307,6 +351,8 @@ class Engine:
                 if self._time is not None and self._time.wait(self._drain):
                     computing = True  # what is queued waits until the clock catches up
                     break
+                if self._frame is not None:
+                    self._enter(None)  # work runs on the process's variables unless it says
                 self._work.popleft()()
                 if not self._work and self._inclusive:
                     self._recheck_joins()
@@ -328,6 +374,8 @@ class Engine:
     def _advance(self, token: _Token, node: NodePlan | None) -> None:
         """Move ``token`` from ``node`` on until it has to wait."""
         behaviours = self._BEHAVIOURS  # a local: this loop is the engine's hot path
+        if token.frame is not self._frame:
+            self._enter(token.frame)
         while node is not None and token.alive:
             token.node = node
             self._steps += 1
@@ -357,6 +405,40 @@ class Engine:
     def _charged(self, kind: str) -> contextlib.AbstractContextManager[None]:
         """A ``with`` block of work of ``kind`` (script, condition) charged to the clock."""
         return _FREE if self._time is None else self._time.work(kind)
+
+    # -- instance frames ---------------------------------------------------------------------
+
+    def _enter(self, frame: _Frame | None) -> None:
+        """Install ``frame`` (and the frames around it) in the variables; None: only the
+        process's own variables."""
+        if frame is self._frame:
+            return
+        current = self._frame.chain() if self._frame is not None else []
+        wanted = frame.chain() if frame is not None else []
+        common = 0
+        while common < min(len(current), len(wanted)) and current[common] is wanted[common]:
+            common += 1
+        variables = self.variables
+        for leaving in reversed(current[common:]):
+            for name in leaving.values:
+                leaving.values[name] = variables.get(name, _ABSENT)
+                outer = leaving.outer.pop(name)
+                if outer is _ABSENT:
+                    variables.pop(name, None)
+                else:
+                    variables[name] = outer
+        for entering in wanted[common:]:
+            for name, value in entering.values.items():
+                entering.outer[name] = variables.get(name, _ABSENT)
+                if value is _ABSENT:
+                    variables.pop(name, None)
+                else:
+                    variables[name] = value
+        self._frame = frame
+
+    def _enter_token(self, token: _Token) -> None:
+        if token.frame is not self._frame:
+            self._enter(token.frame)
 
     # -- tokens and scopes ---------------------------------------------------------------------
 
@@ -419,7 +501,10 @@ class Engine:
         self._cancel_scope(scope)
         if scope.holder is None:
             self._roots.remove(scope)
-            self.completed += 1
+            if scope.failed:
+                self.failed += 1
+            else:
+                self.completed += 1
         elif scope.holder.alive:
             self._activity_done(scope.holder)
 
@@ -560,6 +645,9 @@ class Engine:
             except BpmnError as error:
                 self._throw_error(token, error.name)
                 return None
+            except MemoryError:
+                self._script_limit(token, node, "ran out of the memory of the Python process")
+                return None
         self._tag(node.label, "complete")
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
@@ -569,7 +657,7 @@ class Engine:
         try:
             with self._charged("script"):
                 exec(script.code, self.env, self.variables)
-        except BpmnError:
+        except (BpmnError, MemoryError):
             raise
         except Exception as error:
             raise ModelError(
@@ -599,6 +687,9 @@ class Engine:
                     )
         except ScriptFailure as failure:
             self._throw_error(token, f"script task {node.node.describe()}: {failure.text}")
+            return None
+        except ScriptLimit as limit:
+            self._script_limit(token, node, limit.what)
             return None
         if now is None:
             self._arm_boundaries(token, node)
@@ -646,6 +737,7 @@ class Engine:
     def _skill_done(self, token: _Token, generation: int, outputs: Any) -> None:
         if not token.alive or token.generation != generation:
             return  # cancelled meanwhile, or called twice
+        self._enter_token(token)
         token.waits.clear()  # the skill ended: nothing to cancel any more
         if isinstance(outputs, BpmnError):
             self._throw_error(token, outputs.name)
@@ -667,6 +759,7 @@ class Engine:
 
     def _activity_done(self, token: _Token, outputs: Mapping[str, Any] | None = None) -> None:
         """A waiting activity (skill, call, sub-process, event sub-process) completed."""
+        self._enter_token(token)
         node = token.node
         token.child = None
         self._disarm(token)
@@ -700,6 +793,7 @@ class Engine:
 
     def _caught(self, token: _Token, node: NodePlan, envelope: Envelope | None) -> None:
         """A catching event fired for ``token``: tag it, store the message, move on."""
+        self._enter_token(token)
         values = self._received(node, envelope)
         self.data.outputs(node, values)
         token.node = node
@@ -844,13 +938,26 @@ class Engine:
         token = self._new_token(run.holder.scope, body)
         token.instance = run
         run.active[token] = index
+        if run.items is not None:  # a multi-instance activity: each instance its own frame
+            token.frame = _Frame(run.holder.frame, self._own_variables(run, index))
 
         def begin() -> None:
             if token.alive:
+                self._enter_token(token)
                 self.data.set(self._instance_variables(run, index))
                 self._advance(token, body)
 
         self._call(begin)
+
+    def _own_variables(self, run: _Loop, index: int) -> dict[str, Any]:
+        """The variables an instance of a multi-instance activity has for itself."""
+        marker = run.node.loop.loop
+        own: dict[str, Any] = {"loopCounter": index}
+        if marker.element:
+            own[marker.element] = run.items[index]
+        if marker.output_element:
+            own[marker.output_element] = _ABSENT
+        return own
 
     def _instance_variables(self, run: _Loop, index: int) -> dict[str, Any]:
         """What an instance finds in the variables as it starts (Camunda's names)."""
@@ -871,15 +978,19 @@ class Engine:
         index = run.active.pop(token)
         run.completed += 1
         marker = run.node.loop.loop
+        self._enter_token(token)  # its output item is in its own frame
         if marker.output_collection and run.items is not None:
-            # the outputs of the instances that completed, in instance order (as SpiffWorkflow)
             run.outputs[index] = self.variables.get(marker.output_element)
-            self.data.set({marker.output_collection: [run.outputs[i] for i in sorted(run.outputs)]})
         if run.items is not None:
             self.data.set(
                 {"nrOfCompletedInstances": run.completed, "nrOfActiveInstances": len(run.active)}
             )
-        if self._loop_finished(run, before=False):
+        completion = self._loop_finished(run, before=False)  # may read the instance's item
+        self._enter(run.holder.frame)
+        if marker.output_collection and run.items is not None:
+            # the outputs of the instances that completed, in instance order (as SpiffWorkflow)
+            self.data.set({marker.output_collection: [run.outputs[i] for i in sorted(run.outputs)]})
+        if completion:
             holder = run.holder
             self._disarm(holder)  # cancels the instances a completion condition cut short
             self._go_on(holder, run.node)
@@ -1063,14 +1174,29 @@ class Engine:
         return None
 
     def _uncaught(self, token: _Token, name: str) -> None:
+        self._fail(
+            token,
+            f"robot {self.robot.name}: error {name!r} thrown at {token.node.node.describe()} "
+            "was not caught; the process instance ended",
+        )
+
+    def _fail(self, token: _Token, sentence: str) -> None:
+        """End ``token``'s process instance as failed, saying why."""
         root = token.scope
         while root.parent is not None:
             root = root.parent
-        self.failures.append(
-            f"robot {self.robot.name}: error {name!r} thrown at {token.node.node.describe()} "
-            "was not caught; the process instance ended"
-        )
+        self.failures.append(sentence)
+        root.failed = True
         self._kill(root, safe=False)
+
+    def _script_limit(self, token: _Token, node: NodePlan, what: str) -> None:
+        """A script ran out of time or memory: a model error, not a BPMN error (no boundary
+        event may catch it), that ends the robot's instance."""
+        self._fail(
+            token,
+            f"robot {self.robot.name}: script task {node.node.describe()} {what}; the process "
+            "instance ended (a model error: no boundary event catches it)",
+        )
 
     # -- messages ------------------------------------------------------------------------------
 
