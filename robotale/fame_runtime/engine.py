@@ -124,17 +124,30 @@ class _Loop:
         self.outputs: dict[int, Any] = {}  # instance index -> its output item
 
 
+class _Done:
+    """An activity that completed and may be compensated (BPMN 2.0 section 10.6.5): the
+    scope it completed in, its instance frame, and for a sub-process its finished content."""
+
+    __slots__ = ("child", "frame", "node", "scope")
+
+    def __init__(self, node: NodePlan, scope: _Scope, frame: _Frame | None, child) -> None:
+        self.node, self.scope, self.frame = node, scope, frame
+        self.child: _Scope | None = child
+
+
 class _Scope:
     """A running process, called process, sub-process or event sub-process."""
 
     __slots__ = (
         "armed",
         "depth",
+        "done",
         "ended",
         "failed",
         "frame",
         "holder",
         "joins",
+        "on_close",
         "parent",
         "plan",
         "safe",
@@ -153,6 +166,8 @@ class _Scope:
         self.ended = False
         self.failed = False  # a top-level scope ended by an uncaught error or a model error
         self.safe = False  # its safe-state handler runs before it ends
+        self.done: list[_Done] = []  # its completed activities to compensate, oldest first
+        self.on_close: Callable[[], Any] | None = None  # a compensation's: what comes next
 
 
 class Engine:
@@ -499,6 +514,9 @@ class Engine:
     def _close(self, scope: _Scope) -> None:
         """``scope`` has no token left: it completes."""
         self._cancel_scope(scope)
+        if scope.on_close is not None:  # a compensation ran in it
+            scope.on_close()
+            return
         if scope.holder is None:
             self._roots.remove(scope)
             if scope.failed:
@@ -604,7 +622,10 @@ class Engine:
         return self._follow(token, self._taken(node, first=False))
 
     def _run_pass(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        if node.throw is not None and node.throw.kind == "escalation":
+        if node.throw is not None and node.throw.kind == "compensate":
+            if not self._throw_compensation(token, node, lambda: self._go_on(token, node)):
+                return None  # it goes on once the compensation is done
+        elif node.throw is not None and node.throw.kind == "escalation":
             if not self._escalate(token, node):
                 return None  # an interrupting catcher cancelled the thrower
         elif node.throw is not None:
@@ -620,6 +641,10 @@ class Engine:
             return None
         if kind == "escalation" and not self._escalate(token, node):
             return None
+        if kind == "compensate" and not self._throw_compensation(
+            token, node, lambda: self._consume(token)
+        ):
+            return None  # it ends once the compensation is done
         self._consume(token)
         return None
 
@@ -631,6 +656,7 @@ class Engine:
         self._tag(node.label, "start")
         self.data.inputs(node)
         self._tag(node.label, "complete")
+        self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
@@ -649,6 +675,7 @@ class Engine:
                 self._script_limit(token, node, "ran out of the memory of the Python process")
                 return None
         self._tag(node.label, "complete")
+        self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
@@ -698,6 +725,7 @@ class Engine:
             self._throw_error(token, now[0])
             return None
         self._tag(node.label, "complete")
+        self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
@@ -761,12 +789,13 @@ class Engine:
         """A waiting activity (skill, call, sub-process, event sub-process) completed."""
         self._enter_token(token)
         node = token.node
-        token.child = None
+        child, token.child = token.child, None
         self._disarm(token)
         self._tag(node.label, "complete")
         if node.behaviour == "event_subprocess":
             self._consume(token)
             return
+        self._compensable(token, node, child)
         self.data.outputs(node, outputs or {})
         self._go_on(token, node)
 
@@ -1080,6 +1109,8 @@ class Engine:
     def _arm_event_subprocess(self, scope: _Scope, esp: NodePlan) -> None:
         start = esp.child.triggered_starts[0]
         interrupting = start.node.interrupting
+        if start.trigger.kind == "compensate":
+            return  # it runs when its scope is compensated (see _compensate_one)
         if start.trigger.kind == "escalation":  # nothing to wait for outside the engine
             scope.armed[esp.id] = _nothing
             return
@@ -1118,6 +1149,78 @@ class Engine:
             self._caught(token, start, envelope)
         else:
             self._go_on(token, start)
+
+    # -- compensation (BPMN 2.0 sections 10.6.5 and 13.5.5) ----------------------------------------
+
+    def _compensable(self, token: _Token, node: NodePlan, child: _Scope | None = None) -> None:
+        """Remember a completed activity that has something to compensate: a compensation
+        handler, or (a sub-process) a compensation event sub-process or completed content."""
+        scope = token.scope
+        if child is not None and not child.done and child.plan.compensation_handler is None:
+            child = None
+        if child is None and node.id not in scope.plan.compensations:
+            return
+        scope.done.append(_Done(node, scope, token.frame, child))
+
+    def _throw_compensation(self, token: _Token, node: NodePlan, then: Callable[[], Any]) -> bool:
+        """Compensate the activity the event names, or every completed one of its scope (of
+        the scope around, thrown in an event sub-process), the last completed first. True
+        when the thrower goes on now; else ``then`` runs once the compensation is done."""
+        self._tag.pair(node.throw.label)
+        scope = token.scope
+        if scope.holder is not None and scope.holder.node.behaviour == "event_subprocess":
+            scope = scope.parent
+        records = _take_done(scope, node.throw.topic)
+        if not node.throw.wait or not records:
+            self._compensate_all(records, _nothing)
+            return True
+        generation = token.generation
+
+        def resume() -> None:
+            if token.alive and token.generation == generation:
+                self._enter_token(token)
+                then()
+
+        self._compensate_all(records, resume)
+        return False
+
+    def _compensate_all(self, records: list[_Done], then: Callable[[], Any]) -> None:
+        """Compensate ``records`` one after the other, then call ``then``."""
+        if not records:
+            then()
+            return
+        first, rest = records[0], records[1:]
+        self._compensate_one(first, lambda: self._compensate_all(rest, then))
+
+    def _compensate_one(self, record: _Done, then: Callable[[], Any]) -> None:
+        """Run one activity's compensation: its handler; for a sub-process without one, its
+        compensation event sub-process, else its own completed activities in reverse."""
+        handler = record.scope.plan.compensations.get(record.node.id)
+        if handler is not None:
+            place = self._compensation_scope(record.scope, record.frame, then)
+            self._push(self._new_token(place, handler), handler)
+            return
+        child = record.child
+        esp = child.plan.compensation_handler if child is not None else None
+        if esp is None:
+            self._compensate_all(_take_done(child, "") if child is not None else [], then)
+            return
+        place = self._compensation_scope(child, child.frame, then)
+        place.done = child.done  # what a compensation throw inside the handler compensates
+        holder = self._new_token(place, esp)
+        self._tag(esp.label, "start")
+        inner = self._open(esp.child, place, holder)
+        start = esp.child.triggered_starts[0]
+        self._caught(self._new_token(inner, start), start, None)
+
+    def _compensation_scope(
+        self, scope: _Scope, frame: _Frame | None, then: Callable[[], Any]
+    ) -> _Scope:
+        """A scope beside ``scope`` (its plan, its frame) for a compensation to run in;
+        ``then`` runs when its last token is gone."""
+        place = _Scope(scope.plan, scope, None)
+        place.frame, place.on_close = frame, then
+        return place
 
     # -- errors ------------------------------------------------------------------------------------
 
@@ -1232,6 +1335,14 @@ class Engine:
 
 def _nothing() -> None:
     return None
+
+
+def _take_done(scope: _Scope, activity: str) -> list[_Done]:
+    """The completed activities of ``scope`` to compensate (``activity``'s instances only,
+    when named), the last completed first; they are compensated once, so they leave it."""
+    taken = [d for d in scope.done if not activity or d.node.id == activity]
+    scope.done = [d for d in scope.done if d not in taken]
+    return taken[::-1]
 
 
 def _outer(token: _Token) -> _Token:

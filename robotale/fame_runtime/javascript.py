@@ -578,6 +578,7 @@ class JavaScript:
             hide(name, node)
         self.context.set_time_limit(time_limit)
         self._scripts: dict[str, _Script] = {}
+        self._source = ""  # the script running (what a failure is read against)
         self._opaque: set[str] = set()  # variables JavaScript holds that JSON cannot carry
         self._promises = False  # a script that may queue promise jobs was compiled
         self._mirror: dict[str, Any] = {}  # what the JavaScript side holds, by identity
@@ -601,6 +602,7 @@ class JavaScript:
         ScriptFailure when it throws."""
         self._run_ids += 1
         run = self._run_ids
+        self._source = source
         script = self._scripts.get(source) or self._compile(source)
         if script.names is not None:
             values = self._quick_values(script.names)
@@ -748,10 +750,11 @@ class JavaScript:
 
     def _exhausted(self, text: str | None) -> bool:
         """Whether a script's caught failure is running out of memory: QuickJS throws null
-        when it cannot even make the error object, so a null thrown near the limit is it."""
+        when it cannot even make the error object, so a null that the script itself does not
+        throw is that."""
         if text is not None and text != "null":
             return _out_of_memory(text)
-        return self.context.memory()["malloc_size"] > self.memory_limit * 0.9
+        return "throw null" not in self._source
 
     def _push(self) -> str:
         """The variables that changed in Python since JavaScript last saw them, as JSON."""
