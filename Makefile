@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 # Graphviz to draw discovered process models as SVG.
 SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
-.PHONY: install system-deps test demo bench lint format constraints clean fuzz
+.PHONY: install system-deps test demo bench lint format constraints clean fuzz bpmn-engine
 
 install: $(STAMP)
 
@@ -34,9 +34,22 @@ system-deps:
 	  $$sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -qq $$missing >/dev/null; \
 	fi
 
-test: install system-deps
+test: install system-deps bpmn-engine
 	$(BIN)/ruff check .
 	$(BIN)/pytest
+
+# bpmn-engine (FAME's own engine), pinned in the harness's package-lock.json, for the
+# differential semantics suite (tests/fame_runtime/test_differential.py). Without node and npm
+# the suite says so and leaves that engine out.
+HARNESS := tests/fame_runtime/bpmn_engine
+bpmn-engine: $(HARNESS)/node_modules/.package-lock.json
+
+$(HARNESS)/node_modules/.package-lock.json: $(HARNESS)/package.json $(HARNESS)/package-lock.json
+	@if command -v npm >/dev/null 2>&1; then \
+	  npm ci --prefix $(HARNESS) --no-audit --no-fund --silent; \
+	else \
+	  echo "node and npm are not installed: the differential suite will leave bpmn-engine out"; \
+	fi
 
 # The fuzz suite with many more examples than `make test` runs (FUZZ_EXAMPLES per test):
 # nothing but robotale's own errors may come out of the log readers, the bag reader and the

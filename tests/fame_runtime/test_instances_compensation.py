@@ -28,15 +28,18 @@ def test_parallel_instances_each_see_their_own_item_and_loop_counter():
 
 def test_an_error_raised_by_the_instance_whose_loop_counter_is_one_is_caught_around_all():
     mission, tags = run(CASES / "mi_parallel_error.bpmn", variables=ITEMS)
-    # three instances start; the first completes (fine), the second throws "second", which
-    # the boundary around the whole activity catches: the third is cancelled
+    # three instances start; the first completes (fine), the second notes its item and
+    # throws "second", which the boundary around the whole activity catches: the third is
+    # cancelled and the activity's normal way on (after) is never taken
     assert trace(tags) == [
         *[(0, "rover", "each", "start")] * 3,
         *pair(0, "rover", "fine"),
         (0, "rover", "each", "complete"),
+        *pair(0, "rover", "mark"),
         *pair(0, "rover", "second"),
         *pair(0, "rover", "handle"),
     ]
+    assert mission.engines["rover"].variables["raised_by"] == 20
     assert not mission.failures and mission.done
 
 
