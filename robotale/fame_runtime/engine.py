@@ -232,6 +232,7 @@ class Engine:
         self._javascript: JavaScript | None = None  # made when a first script needs it
         self._time = EngineTime.of(clock)  # None: computing takes no simulated time
         self._frame: _Frame | None = None  # the instance frame installed in the variables
+        self._compensating: set[_Scope] = set()  # compensations running (see _compensate_one)
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -503,6 +504,8 @@ class Engine:
         token.boundaries.clear()
 
     def _cancel_scope(self, scope: _Scope) -> None:
+        if self._compensating:
+            self._cancel_compensations(scope)
         scope.ended = True
         for disarm in scope.armed.values():
             disarm()
@@ -510,6 +513,17 @@ class Engine:
         for token in list(scope.tokens):
             self._cancel(token)
         self._inclusive.discard(scope)
+
+    def _cancel_compensations(self, scope: _Scope) -> None:
+        """A scope that ends takes the compensations running inside it along."""
+        for place in list(self._compensating):
+            outer = place.parent
+            while outer is not None and outer is not scope:
+                outer = outer.parent
+            if outer is scope:
+                self._compensating.discard(place)
+                place.on_close = None  # cancelled: nothing waits for it any more
+                self._cancel_scope(place)
 
     def _close(self, scope: _Scope) -> None:
         """``scope`` has no token left: it completes."""
@@ -1219,7 +1233,13 @@ class Engine:
         """A scope beside ``scope`` (its plan, its frame) for a compensation to run in;
         ``then`` runs when its last token is gone."""
         place = _Scope(scope.plan, scope, None)
-        place.frame, place.on_close = frame, then
+        self._compensating.add(place)
+
+        def closed() -> None:
+            self._compensating.discard(place)
+            then()
+
+        place.frame, place.on_close = frame, closed
         return place
 
     # -- errors ------------------------------------------------------------------------------------

@@ -692,11 +692,12 @@ class _Extensions:
         if element is not None:
             for child in element.iter():
                 self.read(child)
-            self.ignored = [
+            ignored = [
                 f"{child.prefix or 'extension'}:{_local(child)}"
                 for child in element
                 if isinstance(child.tag, str) and _local(child) not in _READ_EXTENSIONS
             ]
+            self.ignored = list(dict.fromkeys(ignored))  # each kind once
 
     def read(self, child: etree._Element) -> None:
         kind, parent = _local(child), _local(child.getparent())

@@ -1,6 +1,7 @@
 """Valid BPMN 2.0 as different modellers write it: ``fame check`` reads every file, reports
 every problem of a file at once, names each correctly and never crashes."""
 
+import json
 from pathlib import Path
 
 import pytest
@@ -207,3 +208,135 @@ def test_run_prints_the_warnings_before_the_tags(tmp_path, capsys):
     err = capsys.readouterr().err.splitlines()
     assert len(checked) == 2
     assert err[: len(checked)] == [f"# {line}" for line in checked]
+
+
+# -- the folder of valid files, as several modellers write them ---------------------------------
+
+VALID = Path(__file__).resolve().parent / "valid"
+
+#: what each file of ``valid/`` holds that robotale cannot run (file, line, column, element,
+#: sentence): all of it, named right; nothing else
+CANNOT_RUN = {
+    "adonis_vendor_ids.bpmn": [],
+    "bizagi_data.bpmn": [],
+    "camunda_compensation.bpmn": [],
+    "signavio_gaps.bpmn": [
+        (
+            10,
+            5,
+            "check",
+            "task check (Check each) has a multi-instance marker with neither a "
+            "loopCardinality nor a collection (loopDataInputRef or camunda:collection), so "
+            "robotale cannot tell how many instances to run: give one, e.g. "
+            "<bpmn:loopCardinality>3</bpmn:loopCardinality>",
+        ),
+        (13, 5, "approve", "userTask approve (Approve) needs a person"),
+        (
+            22,
+            5,
+            "f4",
+            "sequence flow f4 has a condition the engine cannot run: it is no Python or "
+            "JavaScript, so it is read in 'http://www.w3.org/1999/XPath', the standard's default "
+            "expression language when neither the element nor the file names one, which "
+            "robotale does not evaluate (it evaluates python or javascript: give "
+            'language="python" or language="javascript")',
+        ),
+    ],
+}
+
+
+def test_the_folder_holds_the_files_the_expectations_name():
+    assert sorted(p.name for p in VALID.glob("*.bpmn")) == sorted(CANNOT_RUN)
+
+
+@pytest.mark.parametrize("name", sorted(CANNOT_RUN))
+def test_each_valid_file_is_read_and_every_gap_named_right(name, capsys):
+    path = VALID / name
+    code = main(["fame", "check", "--json", str(path)])
+    report = json.loads(capsys.readouterr().out)
+    found = [(p["line"], p["column"], p["element"], p["sentence"]) for p in report["problems"]]
+    assert found == CANNOT_RUN[name]
+    assert all(p["file"] == str(path) for p in report["problems"])
+    assert code == (1 if CANNOT_RUN[name] else 0) and report["ok"] is (not CANNOT_RUN[name])
+    assert "syntax error" not in json.dumps(report)
+
+
+def test_vendor_ids_are_no_duplicates_and_names_print_on_one_line(capsys):
+    path = VALID / "adonis_vendor_ids.bpmn"
+    assert main(["fame", "check", str(path)]) == 0
+    out = capsys.readouterr().out
+    assert "is given to" not in out
+    # the name's line break is one space; the ignored vendor element is named once
+    assert out.splitlines()[-1] == (
+        f"warning: {path}:11: task pick (Pick up parts): adonis:target is ignored (not run)"
+    )
+    assert len([line for line in out.splitlines() if "adonis:target" in line]) == 1
+
+
+def test_a_standard_id_given_twice_is_still_named(tmp_path, capsys):
+    text = (VALID / "adonis_vendor_ids.bpmn").read_text()
+    path = tmp_path / "twice.bpmn"
+    path.write_text(
+        text.replace('<endEvent id="end" />', '<endEvent id="end" /><task id="pick" />')
+    )
+    assert main(["fame", "check", "--json", str(path)]) == 1
+    problems = json.loads(capsys.readouterr().out)["problems"]
+    assert [p["sentence"] for p in problems if p["element"] == "pick"] == [
+        "the id 'pick' is given to 2 elements (lines 11, 17); each element needs its own id"
+    ]
+
+
+def test_the_files_run_as_the_specification_says(capsys):
+    # the compensation file: book, pay (charge), then the end event compensates both, the
+    # last completed first: pay by its compensation event sub-process, then book by its handler
+    path = VALID / "camunda_compensation.bpmn"
+    assert main(["fame", "run", str(path), "--until", "1"]) == 0
+    steps = [tuple(line.split("\t")[2:4]) for line in capsys.readouterr().out.splitlines()]
+    assert steps == [
+        ("book", "start"),
+        ("book", "complete"),
+        ("pay", "start"),
+        ("charge", "start"),
+        ("charge", "complete"),
+        ("pay", "complete"),
+        ("undo_all", "start"),
+        ("undo_all", "complete"),
+        ("refund_payment", "start"),
+        ("refund_start", "start"),
+        ("refund_start", "complete"),
+        ("refund", "start"),
+        ("refund", "complete"),
+        ("refund_payment", "complete"),
+        ("cancel_booking", "start"),
+        ("cancel_booking", "complete"),
+    ]
+
+
+def test_a_dangling_message_ref_is_named_as_such(tmp_path, capsys):
+    body = """
+  <bpmn:message id="Msg_known" name="known" />
+  <bpmn:process id="p" isExecutable="true">
+    <bpmn:startEvent id="start" />
+    <bpmn:intermediateCatchEvent id="wait">
+      <bpmn:messageEventDefinition messageRef="Msg_gone" />
+    </bpmn:intermediateCatchEvent>
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="wait" />
+  </bpmn:process>"""
+    path = write(tmp_path, "dangling.bpmn", body)
+    assert main(["fame", "check", "--json", str(path)]) == 1
+    (problem,) = json.loads(capsys.readouterr().out)["problems"]
+    assert (problem["element"], problem["line"]) == ("wait", 9)
+    assert problem["sentence"] == (
+        "intermediateCatchEvent wait refers to message Msg_gone, which the file does not "
+        'declare (messages: Msg_known; declare <bpmn:message id="Msg_gone" name="..."/> or '
+        "name the element)"
+    )
+
+
+def test_a_file_that_is_no_xml_is_one_problem_in_json(tmp_path, capsys):
+    path = tmp_path / "broken.bpmn"
+    path.write_text("<bpmn:definitions>\n<oops")
+    assert main(["fame", "check", "--json", str(path)]) == 1
+    (problem,) = json.loads(capsys.readouterr().out)["problems"]
+    assert (problem["file"], problem["line"], problem["element"]) == (str(path), 1, "")
+    assert problem["sentence"].startswith("malformed XML: ")
