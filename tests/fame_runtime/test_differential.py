@@ -30,7 +30,12 @@ TABLE = HERE.parents[1] / "docs" / "semantics.md"
 AS_SPECIFIED = "as specified"
 
 #: FAME's dialect of a Python case: what to replace, with what
-CAMUNDA = 'xmlns:camunda="http://camunda.org/schema/1.0/bpmn" id='
+CAMUNDA = (
+    'xmlns:camunda="http://camunda.org/schema/1.0/bpmn" '
+    'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" id='
+)
+#: a condition with a language is a tFormalExpression (the schema's tExpression has none)
+FORMAL = '<bpmn:conditionExpression xsi:type="bpmn:tFormalExpression" language="javascript">'
 MI_CAMUNDA = (
     "<bpmn:multiInstanceLoopCharacteristics>",
     '<bpmn:multiInstanceLoopCharacteristics camunda:collection="${environment.variables.items}"'
@@ -57,6 +62,7 @@ class Case:
     #: the specification's verdict on an outcome: the ways it departs ([]: as specified)
     judge: Callable[[Outcome], list[str]]
     javascript: tuple[tuple[str, str], ...] = ()  # Python dialect -> FAME's dialect
+    spiff: tuple[tuple[str, str], ...] = ()  # Python dialect -> SpiffWorkflow's
     described: str = ""
     exact: list[str] = field(default_factory=list)
 
@@ -64,10 +70,18 @@ class Case:
         text = (CASES_DIR / f"{self.name}.bpmn").read_text()
         if dialect == "javascript":
             text = text.replace(' id="', f' {CAMUNDA}"', 1)
-            for old, new in self.javascript:
-                assert old in text, (self.name, old)
-                text = text.replace(old, new)
+        for old, new in {"javascript": self.javascript, "spiff": self.spiff}.get(dialect, ()):
+            assert old in text, (self.name, old)
+            text = text.replace(old, new)
         return text
+
+
+def js_condition(python: str) -> tuple[str, str]:
+    """A Python condition ``name op value`` as FAME's dialect writes it."""
+    return (
+        f"<bpmn:conditionExpression>{python}</bpmn:conditionExpression>",
+        f"{FORMAL}next(null, this.environment.variables.{python});</bpmn:conditionExpression>",
+    )
 
 
 def in_order(expected: list[str]) -> Callable[[Outcome], list[str]]:
@@ -120,6 +134,18 @@ def error_judge(outcome: Outcome) -> list[str]:
     return found
 
 
+def inclusive_judge(outcome: Outcome) -> list[str]:
+    # 13.3.3: a and b run in parallel (either first), c does not; the join waits for both
+    found = []
+    if sorted(outcome.completed[:2]) != ["a", "b"] or outcome.completed[2:] != ["after"]:
+        found.append(
+            f"completes {', '.join(outcome.completed) or 'nothing'}, not a and b then after"
+        )
+    if not outcome.ended:
+        found.append("does not end")
+    return found
+
+
 CASES = [
     Case(
         "mi_parallel_items",
@@ -152,8 +178,7 @@ CASES = [
             ),
             (
                 "<bpmn:conditionExpression>loopCounter == 1</bpmn:conditionExpression>",
-                '<bpmn:conditionExpression language="javascript">'
-                "next(null, this.environment.variables.loopCounter === 1);"
+                f"{FORMAL}next(null, this.environment.variables.loopCounter === 1);"
                 "</bpmn:conditionExpression>",
             ),
         ),
@@ -172,6 +197,57 @@ CASES = [
         # 10.6.5: compensating a sub-process runs its compensation event sub-process, whose
         # throw compensates the sub-process's own activities; the throw waits for it
         in_order(["pick", "place", "work", "tidy", "unpick", "undo_work", "after"]),
+    ),
+]
+CASES += [
+    Case(
+        "mi_sequential_items",
+        {"items": [10, 20, 30]},
+        frozenset({"visit"}),
+        items_judge,
+        javascript=(
+            CASES[0].javascript[0],
+            (
+                '<bpmn:multiInstanceLoopCharacteristics isSequential="true">',
+                MI_CAMUNDA[1].replace(">", ' isSequential="true">'),
+            ),
+            CASES[0].javascript[2],
+        ),
+    ),
+    Case(
+        "inclusive_join",
+        {"amount": 50},
+        frozenset({"a", "b", "c", "after"}),
+        inclusive_judge,
+        javascript=tuple(js_condition(f"amount &gt; {n}") for n in (5, 10, 100)),
+    ),
+    # 13.5.6: a terminate end event ends every token of the instance at once
+    Case(
+        "terminate_branch",
+        {},
+        frozenset({"quick", "late"}),
+        in_order(["quick"]),
+        # SpiffWorkflow reads a timer's text as a Python expression
+        spiff=(("<bpmn:timeDuration>PT1S<", '<bpmn:timeDuration>"PT1S"<'),),
+    ),
+    # 10.5.4: the error leaves the sub-process through its boundary event, nothing else
+    Case(
+        "error_subprocess",
+        {},
+        frozenset({"work", "job", "repair", "after"}),
+        in_order(["work", "repair"]),
+    ),
+    Case(
+        "exclusive_default",
+        {"amount": 1, "bigger": 50},
+        frozenset({"big", "small", "over_ten", "over_five", "none"}),
+        # 13.3.2: no condition holds: the default flow; several hold: the first in order only
+        in_order(["small", "over_ten"]),
+        javascript=(
+            js_condition("amount &gt; 100"),
+            js_condition("bigger &gt; 10"),
+            js_condition("bigger &gt; 5"),
+        ),
     ),
 ]
 BY_NAME = {case.name: case for case in CASES}
@@ -198,13 +274,19 @@ def spiffworkflow(case: Case, tmp_path: Path) -> Outcome:
     from SpiffWorkflow.util.task import TaskState
 
     path = tmp_path / f"{case.name}.spiff.bpmn"
-    path.write_text(case.text("python"))
+    path.write_text(case.text("spiff"))
     parser = BpmnParser()
     try:
         parser.add_bpmn_file(str(path))
         workflow = BpmnWorkflow(parser.get_spec("rover"), parser.get_subprocess_specs("rover"))
         workflow.get_tasks()[0].data.update(case.variables)
         workflow.do_engine_steps()
+        # SpiffWorkflow leaves a task without a type to a person: complete those as its
+        # users do, until nothing is ready
+        while ready := [t for t in workflow.get_tasks(state=TaskState.READY) if t.task_spec.manual]:
+            for task in ready:
+                task.run()
+            workflow.do_engine_steps()
     except Exception as error:  # what the engine says is the finding: any error it raises
         return Outcome([], {}, False, f"{type(error).__name__}: {error}")
     done = sorted(workflow.get_tasks(state=TaskState.COMPLETED), key=lambda t: t.last_state_change)
