@@ -146,15 +146,16 @@ def inclusive_judge(outcome: Outcome) -> list[str]:
     return found
 
 
-CASES = [
-    Case(
-        "mi_parallel_items",
+def items_case(name: str, marker: str) -> Case:
+    """A multi-instance script task over [10, 20, 30] writing its item and loopCounter."""
+    return Case(
+        name,
         {"items": [10, 20, 30]},
         frozenset({"visit"}),
         items_judge,
         javascript=(
             ('scriptFormat="python"', 'scriptFormat="javascript"'),
-            MI_CAMUNDA,
+            (marker, MI_CAMUNDA[1].replace(">", marker.removeprefix(MI_CAMUNDA[0][:-1]))),
             (
                 '<bpmn:script>line = f"item {item} loopCounter {loopCounter}"</bpmn:script>',
                 "<bpmn:script>var v = this.environment.variables;\n"
@@ -162,7 +163,11 @@ CASES = [
                 "</bpmn:script>",
             ),
         ),
-    ),
+    )
+
+
+CASES = [
+    items_case("mi_parallel_items", MI_CAMUNDA[0]),
     Case(
         "mi_parallel_error",
         {"items": [10, 20, 30]},
@@ -200,19 +205,8 @@ CASES = [
     ),
 ]
 CASES += [
-    Case(
-        "mi_sequential_items",
-        {"items": [10, 20, 30]},
-        frozenset({"visit"}),
-        items_judge,
-        javascript=(
-            CASES[0].javascript[0],
-            (
-                '<bpmn:multiInstanceLoopCharacteristics isSequential="true">',
-                MI_CAMUNDA[1].replace(">", ' isSequential="true">'),
-            ),
-            CASES[0].javascript[2],
-        ),
+    items_case(
+        "mi_sequential_items", '<bpmn:multiInstanceLoopCharacteristics isSequential="true">'
     ),
     Case(
         "inclusive_join",
