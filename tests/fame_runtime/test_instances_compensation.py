@@ -126,3 +126,46 @@ def test_a_script_exhausting_its_memory_ends_the_instance_as_a_model_error(
         "instance ended (a model error: no boundary event catches it)",
     ]
     assert "instances completed: rover 0; failed: rover 1" in err
+
+
+MI_COMPENSATION = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="mi_comp">
+  <bpmn:process id="rover" isExecutable="true">
+    <bpmn:startEvent id="start" />
+    <bpmn:scriptTask id="load" name="load" scriptFormat="python">
+      <bpmn:multiInstanceLoopCharacteristics>
+        <bpmn:loopDataInputRef>items</bpmn:loopDataInputRef>
+        <bpmn:inputDataItem id="item" />
+      </bpmn:multiInstanceLoopCharacteristics>
+      <bpmn:script>loaded = loaded + [item]</bpmn:script>
+    </bpmn:scriptTask>
+    <bpmn:boundaryEvent id="load_comp" attachedToRef="load"><bpmn:compensateEventDefinition />
+    </bpmn:boundaryEvent>
+    <bpmn:scriptTask id="unload" name="unload" scriptFormat="python" isForCompensation="true">
+      <bpmn:script>unloaded = unloaded + [(item, loopCounter)]</bpmn:script>
+    </bpmn:scriptTask>
+    <bpmn:association id="a1" sourceRef="load_comp" targetRef="unload" />
+    <bpmn:intermediateThrowEvent id="undo" name="undo">
+      <bpmn:compensateEventDefinition activityRef="load" />
+    </bpmn:intermediateThrowEvent>
+    <bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="load" />
+    <bpmn:sequenceFlow id="f2" sourceRef="load" targetRef="undo" />
+    <bpmn:sequenceFlow id="f3" sourceRef="undo" targetRef="end" />
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+
+def test_each_instance_is_compensated_with_its_own_data_the_last_completed_first(tmp_path):
+    path = tmp_path / "mi_comp.bpmn"
+    path.write_text(MI_COMPENSATION)
+    variables = {"rover": {"items": [10, 20, 30], "loaded": [], "unloaded": []}}
+    mission, tags = run(path, variables=variables)
+    rover = mission.engines["rover"].variables
+    assert rover["loaded"] == [10, 20, 30]
+    # the handler of each instance sees that instance's item and loopCounter
+    assert rover["unloaded"] == [(30, 2), (20, 1), (10, 0)]
+    names = [t.activity for t in tags if t.lifecycle == "complete"]
+    assert names == ["load"] * 3 + ["undo"] + ["unload"] * 3
+    assert mission.done
