@@ -43,16 +43,22 @@ from robotale.fame_runtime.timers import TimerSpec
 
 EMPTY_MSGTYPE = "std_msgs/msg/Empty"
 
-#: elements of BPMN the engine does not run, and why
+#: what a robot runs instead of a task kind it does not run
+_TASKS = "a task, script task, send or receive task, or a call activity bound to a skill"
+
+#: elements of BPMN the engine does not run, why, and what it would run instead
 OUTSIDE = {
-    "userTask": "needs a person",
-    "manualTask": "needs a person",
+    "userTask": f"needs a person (robotale runs {_TASKS})",
+    "manualTask": f"needs a person (robotale runs {_TASKS})",
     "serviceTask": "is a service call (use a call activity bound to a skill)",
-    "businessRuleTask": "needs a rule engine",
-    "transaction": "is a transaction",
-    "adHocSubProcess": "is an ad-hoc sub-process",
-    "complexGateway": "is a complex gateway",
-    "implicitThrowEvent": "is an implicit throw event",
+    "businessRuleTask": f"needs a rule engine (robotale runs {_TASKS})",
+    "transaction": "is a transaction (robotale runs a plain sub-process)",
+    "adHocSubProcess": "is an ad-hoc sub-process (robotale runs a plain sub-process)",
+    "complexGateway": (
+        "is a complex gateway (robotale runs exclusive, parallel, inclusive and event-based "
+        "gateways)"
+    ),
+    "implicitThrowEvent": "is an implicit throw event (robotale runs intermediate throw events)",
 }
 
 _ROLES = {
@@ -338,16 +344,20 @@ class _Planner:
     def gateway(self, plan: NodePlan) -> None:
         node = plan.node
         if node.kind.endswith("Gateway") and not plan.outgoing:
-            self.refuse(node, "has no outgoing sequence flow")
+            self.refuse(node, "has no outgoing sequence flow (give it at least one)")
         if node.kind == "eventBasedGateway":
             for flow in plan.outgoing:
                 target = flow.target.node
                 if target.kind != "intermediateCatchEvent":
-                    self.refuse(node, f"leads to {target.describe()}, which is no catching event")
+                    self.refuse(
+                        node,
+                        f"leads to {target.describe()}, which is no catching event (an "
+                        "event-based gateway leads to intermediate catch events)",
+                    )
         if node.kind.startswith("start") and plan.incoming:
-            self.refuse(node, "has incoming sequence flows")
+            self.refuse(node, "has incoming sequence flows (a start event has none)")
         if node.kind == "endEvent" and plan.outgoing:
-            self.refuse(node, "has outgoing sequence flows")
+            self.refuse(node, "has outgoing sequence flows (an end event has none)")
 
     def compensation(self, plan: NodePlan, scope: ScopePlan) -> None:
         """A compensation boundary event binds its handler to its activity; the handler runs
@@ -382,7 +392,7 @@ class _Planner:
             self.refuse(node, OUTSIDE[node.kind])
             return
         if len(node.events) > 1:
-            self.refuse(node, "has several event definitions")
+            self.refuse(node, "has several event definitions (robotale runs events with one)")
             return
         if node.kind.endswith("Event"):
             self.event(plan, scope, top=top, event=event)
@@ -418,7 +428,11 @@ class _Planner:
             except ValueError as error:
                 self.refuse(plan.node, f"has a loop {name} the engine cannot run: {error}")
         if loop.kind == "standard" and loop.condition is None and loop.maximum is None:
-            self.refuse(plan.node, "has a standard loop without loopCondition or loopMaximum")
+            self.refuse(
+                plan.node,
+                "has a standard loop without loopCondition or loopMaximum (give one, e.g. "
+                'loopMaximum="5")',
+            )
         if loop.kind != "standard" and loop.cardinality is None and not loop.collection:
             self.refuse(
                 plan.node,
@@ -502,7 +516,9 @@ class _Planner:
                 f" and no building block in {self.library.folder}" if self.library else ""
             )
             what = (
-                f"calls {name!r}, which is {where}" if name else "calls nothing (no calledElement)"
+                f"calls {name!r}, which is {where} (name one of those)"
+                if name
+                else "calls nothing (give it a calledElement naming a skill or a process)"
             )
             self.refuse(node, what)
             return
@@ -564,7 +580,7 @@ class _Planner:
             plan.behaviour = "boundary"
             host = scope.nodes.get(node.attached_to)
             if host is None or host.node.kind.endswith(("Event", "Gateway")):
-                self.refuse(node, "is attached to something that is no activity")
+                self.refuse(node, "is attached to something that is no activity (attach it to one)")
             else:
                 host.boundaries.append(plan)
             if node.event_kind == "error" and not node.cancel_activity:

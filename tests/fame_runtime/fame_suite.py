@@ -6,6 +6,12 @@ from robotale.fame_runtime.mission import Mission
 
 MODELS = Path(__file__).resolve().parent / "models"
 
+#: how a refusal of a user or manual task ends: what robotale runs instead
+PERSON = (
+    " (robotale runs a task, script task, send or receive task, or a call activity bound to a "
+    "skill)"
+)
+
 
 def trace(tags, *, messages: bool = False) -> list[tuple]:
     """Tags as (time, robot, activity, lifecycle[, msg_id, msg_role]) tuples."""
