@@ -377,6 +377,8 @@ class Engine:
             raise
         finally:
             self._busy = computing
+            if self._frame is not None:
+                self._enter(None)  # what reads the variables from outside sees the robot's
         if not computing:
             self._idle_check()
 
