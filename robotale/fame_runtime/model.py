@@ -228,6 +228,7 @@ class Definitions:
     errors: dict[str, str] = field(default_factory=dict)  # id -> name (or errorCode)
     messages: dict[str, str] = field(default_factory=dict)  # id -> name
     escalations: dict[str, str] = field(default_factory=dict)  # id -> name (or code)
+    global_tasks: dict[str, str] = field(default_factory=dict)  # id -> globalUserTask ...
     message_flows: list[tuple[str, str, str]] = field(default_factory=list)
     #: silent choices made visible: "<file>:<line>: <element> <what happens>"
     warnings: list[str] = field(default_factory=list)

@@ -226,11 +226,23 @@ class _Reader:
             for e in root.iter(f"{_B}error")
         }
         self.messages = _names(root, "message", "name")
+        self.data_stores = {
+            e.get("id", "")
+            for e in root.iter(f"{_B}dataStoreReference", f"{_B}dataStore")
+            if e.get("id")
+        }
+        #: global tasks (10.2.4) a call activity may call: id -> their kind, as written
+        global_tasks = {
+            e.get("id", ""): _local(e)
+            for e in root
+            if isinstance(e.tag, str) and _local(e).startswith("global")
+        }
         self.escalations = _names(root, "escalation", "escalationCode")
         self.language = (root.get("expressionLanguage") or "").strip()
         definitions = Definitions(self.file, root.get("id", ""), signals=dict(self.signals))
         definitions.errors = dict(self.errors)
         definitions.messages, definitions.escalations = self.messages, self.escalations
+        definitions.global_tasks = global_tasks
         for element in _bpmn_children(root, "process"):
             process = self.process(element)
             process.definitions = definitions
@@ -257,7 +269,7 @@ class _Reader:
 
     def collaboration(self, element: etree._Element, definitions: Definitions) -> None:
         for pool in _bpmn_children(element, "participant"):
-            ref = pool.get("processRef", "")
+            ref = _ref(pool, "processRef")
             if not ref:
                 continue  # a black-box pool: nobody runs it
             if ref not in definitions.processes:
@@ -271,7 +283,7 @@ class _Reader:
             definitions.participants.append(self.participant(pool, definitions.processes[ref]))
         for flow in _bpmn_children(element, "messageFlow"):
             definitions.message_flows.append(
-                (flow.get("id", ""), flow.get("sourceRef", ""), flow.get("targetRef", ""))
+                (flow.get("id", ""), _ref(flow, "sourceRef"), _ref(flow, "targetRef"))
             )
 
     def participant(self, pool: etree._Element, process: Process) -> Participant:
@@ -305,6 +317,12 @@ class _Reader:
             for e in element.iter()
             if isinstance(e.tag, str) and _local(e) in _NOT_DATA_OBJECTS
         }
+        self.not_data_objects |= self.data_stores  # a store is the file's, whichever process
+        # an association is an artifact of the process, wherever the elements it joins are
+        self.associations: dict[str, list[str]] = {}
+        for association in element.iter(f"{_B}association"):
+            source, target = _ref(association, "sourceRef"), _ref(association, "targetRef")
+            self.associations.setdefault(source, []).append(target)
         self.scope(element, process, process)
         self.check_data_associations(process)
         return process
@@ -331,7 +349,7 @@ class _Reader:
                 data_object = self.data_object(child, element)
                 process.data_objects[data_object.id] = data_object
             elif kind == "association":
-                source, target = child.get("sourceRef", ""), child.get("targetRef", "")
+                source, target = _ref(child, "sourceRef"), _ref(child, "targetRef")
                 scope.associations.setdefault(source, []).append(target)
         self.check_flows(scope)
         self.compensation_handlers(scope)
@@ -381,7 +399,7 @@ class _Reader:
         for node in scope.nodes.values():
             if node.kind != "boundaryEvent" or node.event_kind != "compensate":
                 continue
-            targets = [t for t in scope.associations.get(node.id, ()) if t in scope.nodes]
+            targets = [t for t in self.associations.get(node.id, ()) if t in scope.nodes]
             handlers = [t for t in targets if scope.nodes[t].for_compensation]
             if len(handlers) == 1:
                 node.compensation_handler = handlers[0]
@@ -418,16 +436,16 @@ class _Reader:
             kind=kind,
             name=one_line(element.get("name")),
             line=element.sourceline or 0,
-            attached_to=element.get("attachedToRef", ""),
+            attached_to=_ref(element, "attachedToRef"),
             cancel_activity=element.get("cancelActivity", "true") != "false",
             interrupting=element.get("isInterrupting", "true") != "false",
             default_flow=element.get("default", ""),
-            called_element=(element.get("calledElement") or "").strip(),
+            called_element=_ref(element, "calledElement"),
             triggered_by_event=element.get("triggeredByEvent") == "true",
         )
         node.events = [self.event_definition(d, node) for d in element if _is_definition(d)]
         if kind in ("sendTask", "receiveTask"):  # its message, like a message event's
-            ref = element.get("messageRef", "")
+            ref = _ref(element, "messageRef")
             node.events = [EventDefinition("message", ref, self.messages.get(ref, ""))]
         self.data_associations(element, node)
         self.markers(element, node)
@@ -455,7 +473,7 @@ class _Reader:
         node.for_compensation = element.get("isForCompensation") == "true"
 
     def standard_loop(self, element: etree._Element, node: Node) -> Loop:
-        maximum = element.get("loopMaximum")
+        maximum = (element.get("loopMaximum") or "").strip() or None  # "" is as good as none
         if maximum is not None and _int_or_none(maximum) is None:
             self.problem(
                 element.sourceline,
@@ -504,28 +522,28 @@ class _Reader:
     def event_definition(self, element: etree._Element, node: Node) -> EventDefinition:
         kind = _local(element).removesuffix("EventDefinition")
         if kind == "signal":
-            ref = element.get("signalRef", "")
+            ref = _ref(element, "signalRef")
             return EventDefinition("signal", ref, self.signals.get(ref, ""))
         if kind == "error":
-            ref = element.get("errorRef", "")
+            ref = _ref(element, "errorRef")
             return EventDefinition("error", ref, self.errors.get(ref, ""))
         if kind == "timer":
             return EventDefinition("timer", timer=self.timer(element, node))
         if kind == "message":
-            ref = element.get("messageRef", "")
+            ref = _ref(element, "messageRef")
             return EventDefinition("message", ref, self.messages.get(ref, ""))
         if kind == "compensate":
             wait = element.get("waitForCompletion", "true") != "false"
-            return EventDefinition("compensate", element.get("activityRef", ""), wait=wait)
+            return EventDefinition("compensate", _ref(element, "activityRef"), wait=wait)
         if kind == "escalation":
-            ref = element.get("escalationRef", "")
+            ref = _ref(element, "escalationRef")
             return EventDefinition("escalation", ref, self.escalations.get(ref, ""))
         if kind == "conditional":
             condition = element.find(f"{_B}condition")
             text = _text(condition)
             expression = self.expression(condition, text, node.id) if text else None
             return EventDefinition("conditional", condition=expression)
-        return EventDefinition(kind, element.get("messageRef", ""))
+        return EventDefinition(kind, _ref(element, "messageRef"))
 
     def timer(self, element: etree._Element, node: Node):
         for child in element:
@@ -581,7 +599,7 @@ class _Reader:
         return Expression(text, language, node.id, body.sourceline if body is not None else 0)
 
     def data_object(self, element: etree._Element, container: etree._Element) -> DataObject:
-        ref = element.get("dataObjectRef", "")
+        ref = _ref(element, "dataObjectRef")
         target = next(
             (d for d in _bpmn_children(container, "dataObject") if d.get("id") == ref), None
         )
@@ -648,6 +666,14 @@ def _names(root: etree._Element, tag: str, fallback: str) -> dict[str, str]:
     return {
         e.get("id", ""): one_line(e.get("name") or e.get(fallback)) for e in root.iter(f"{_B}{tag}")
     }
+
+
+def _ref(element: etree._Element, attribute: str) -> str:
+    """A reference as written, without the namespace prefix a QName reference may carry
+    (``processRef="bpmn2:Process_1"``, the prefix declared in the file)."""
+    value = (element.get(attribute) or "").strip()
+    prefix, colon, local = value.partition(":")
+    return local if colon and prefix in (element.nsmap or {}) else value
 
 
 def _unwrap(text: str) -> str:

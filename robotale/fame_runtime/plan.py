@@ -65,6 +65,7 @@ _ROLES = {
     "start": "process start event",
     "event_start": "event sub-process start event",
     "sub_start": "sub-process start event",
+    "called_start": "called process start event",
     "intermediateCatchEvent": "catching intermediate event",
     "intermediateThrowEvent": "throwing intermediate event",
     "endEvent": "end event",
@@ -84,6 +85,7 @@ ALLOWED = {
         "compensate",
     },
     "sub_start": {"none"},
+    "called_start": {"none"},
     "intermediateCatchEvent": {"signal", "timer", "conditional", "message"},
     "intermediateThrowEvent": {"none", "signal", "message", "escalation", "compensate"},
     "endEvent": {"none", "terminate", "signal", "error", "message", "escalation", "compensate"},
@@ -299,11 +301,14 @@ class _Planner:
             self.where = f" of called process {process.describe()}{file}"
         self.scope(process, plan, top=top)
         self.where = outer
+        if not plan.starts and not plan.triggered_starts:
+            plan.starts = _implicit_starts(plan)
         if top and not plan.starts and not plan.triggered_starts:
             self.problem(
                 process.line,
                 process.id,
-                f"process {process.describe()} has no start event (add a bpmn:startEvent)",
+                f"process {process.describe()} has no start event and nothing else to start "
+                "(add a bpmn:startEvent)",
             )
         self.file = outer_file
         return plan
@@ -511,6 +516,15 @@ class _Planner:
             plan.behaviour, plan.skill = "skill", name
             return
         process = node.embedded_process or resolve_call(name, plan.scope.process, self.library)
+        definitions = plan.scope.process.definitions
+        global_kind = definitions.global_tasks.get(name) if definitions else None
+        if process is None and global_kind:
+            self.refuse(
+                node,
+                f"calls the global task {name} (a bpmn:{global_kind}), which robotale does not "
+                "run (call a process of the file, a building block or a skill)",
+            )
+            return
         if process is None:
             where = "no skill, no process of the file" + (
                 f" and no building block in {self.library.folder}" if self.library else ""
@@ -545,19 +559,22 @@ class _Planner:
             )
         elif node.triggered_by_event and child.triggered_starts[0].node.event_kind == "compensate":
             scope.compensation_handler = plan
-        if not node.triggered_by_event and len(child.starts) != 1:
-            found = len(child.starts) or "no"
+        if not node.triggered_by_event and len(child.starts) > 1:
             self.refuse(
                 node,
-                f"is a sub-process with {found} none start events: it needs exactly one "
-                "(a start event without a trigger)",
+                f"is a sub-process with {len(child.starts)} none start events: it needs one "
+                "(or none: then every element without an incoming flow starts)",
             )
+        if not node.triggered_by_event and not child.starts:
+            child.starts = _implicit_starts(child)  # none (an empty sub-process): it completes
 
     def event(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
         role = node.kind
         if node.kind == "startEvent":
             role = "start" if top else ("event_start" if event else "sub_start")
+            if role == "sub_start" and self.called.get(id(scope.process)) is scope:
+                role = "called_start"  # the called process itself, not a sub-process of it
         if node.event_kind not in ALLOWED[role]:
             runs = ", ".join(sorted(ALLOWED[role]))
             self.refuse(
@@ -680,6 +697,20 @@ class _Planner:
                 "to compensate every completed one)",
             )
         return Throw("compensate", plan.label, ref, wait=event.wait if event else True)
+
+
+def _implicit_starts(plan: ScopePlan) -> list[NodePlan]:
+    """Where a process or sub-process without start events begins (BPMN 2.0 10.5.2): at
+    every activity, gateway and intermediate event without an incoming sequence flow (not a
+    boundary event, an event sub-process or a compensation handler)."""
+    return [
+        node
+        for node in plan.nodes.values()
+        if not node.incoming
+        and node.node.kind not in ("boundaryEvent", "startEvent")
+        and node.behaviour != "event_subprocess"
+        and not node.node.for_compensation
+    ]
 
 
 def _pool_namespace(definitions: Definitions | None, process_id: str) -> str:

@@ -166,6 +166,21 @@ def items_case(name: str, marker: str) -> Case:
     )
 
 
+def implicit_judge(outcome: Outcome) -> list[str]:
+    # 10.5.2: left and right start together (either first), then the sub-processes complete
+    found = []
+    if sorted(outcome.completed[:2]) != ["left", "right"] or outcome.completed[2:] != [
+        "group",
+        "empty",
+        "after",
+    ]:
+        done = ", ".join(outcome.completed) or "nothing"
+        found.append(f"completes {done}, not left and right, then group, empty, after")
+    if not outcome.ended:
+        found.append("does not end")
+    return found
+
+
 CASES = [
     items_case("mi_parallel_items", MI_CAMUNDA[0]),
     Case(
@@ -244,6 +259,14 @@ CASES += [
         ),
     ),
 ]
+CASES.append(
+    Case(
+        "implicit_start",
+        {},
+        frozenset({"left", "right", "group", "empty", "after"}),
+        implicit_judge,
+    )
+)
 BY_NAME = {case.name: case for case in CASES}
 
 
