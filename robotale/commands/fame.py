@@ -17,7 +17,7 @@ from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.engine import Engine
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
-from robotale.fame_runtime.model import Problem
+from robotale.fame_runtime.model import Definitions, Problem
 from robotale.fame_runtime.parser import ReadError, parse, parse_all
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split, unbound_pools, write_split
@@ -206,7 +206,8 @@ def run_command(
         )
     if bus != "inprocess" or record is not None:
         raise InputError(_bus_problem(bus))
-    definitions = parse(model)
+    names = load_skills(skills) if skills else None
+    definitions = readable(model, names, library)
     begin = start_time(start)
     clock = SimClock(start=begin)
     mission = Mission(
@@ -216,7 +217,7 @@ def run_command(
         bus=InProcessBus(
             clock, latency=latency, on_warning=lambda text: print(f"# warning: {text}", file=err)
         ),
-        skills=load_skills(skills) if skills else None,
+        skills=names,
         library=library,
         tag_sink=lambda tag: print(tag_line(tag, begin), file=out),
         variables=parse_assignments(assignments),
@@ -225,6 +226,19 @@ def run_command(
         print(f"# warning: {warning}", file=err)
     mission.run(until=begin + until)
     return run_verdict(mission, begin, err)
+
+
+def readable(model: Path, skills: Mapping[str, Any] | None, library: Path | None) -> Definitions:
+    """The model, or one ModelError naming every problem of reading it together with what
+    deploying its pools would refuse (as ``fame check`` lists them)."""
+    definitions = parse_all(model)
+    if not definitions.problems:
+        return definitions
+    report = check(definitions, skills=skills or {}, library=Library(library) if library else None)
+    lines = "\n".join(
+        f"{p.file}:{p.line}: {pool + ': ' if pool else ''}{p.sentence}" for pool, p in report.found
+    )
+    raise ModelError(f"{model}: {len(report.found)} problems:\n{lines}")
 
 
 def refuse_duplicate_ids(model: Path) -> None:

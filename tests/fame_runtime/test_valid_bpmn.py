@@ -343,3 +343,21 @@ def test_a_file_that_is_no_xml_is_one_problem_in_json(tmp_path, capsys):
     (problem,) = json.loads(capsys.readouterr().out)["problems"]
     assert (problem["file"], problem["line"], problem["element"]) == (str(path), 1, "")
     assert problem["sentence"].startswith("malformed XML: ")
+
+
+def test_run_names_the_reading_and_the_deploying_problems_together(tmp_path, capsys):
+    body = """
+  <bpmn:process id="p" isExecutable="true">
+    <bpmn:startEvent id="start" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="nowhere" />
+    <bpmn:userTask id="ask" name="Ask" />
+  </bpmn:process>"""
+    path = write(tmp_path, "both.bpmn", body)
+    assert main(["fame", "run", str(path), "--until", "1"]) == 1
+    err = capsys.readouterr().err.splitlines()
+    assert err == [
+        f"robotale: {path}: 2 problems:",
+        f"{path}:8: sequence flow f1 is dangling: its target (nowhere) is not an element of "
+        "the same process or sub-process",
+        f"{path}:9: p: userTask ask (Ask) needs a person" + PERSON,
+    ]
