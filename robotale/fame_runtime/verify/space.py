@@ -1,0 +1,960 @@
+"""The collaboration's states and the steps between them, as the verifier abstracts them.
+
+A state holds, for every robot, its running instances (the tokens of each scope, nested
+through sub-processes, called processes and loop bodies), the variables it tracks (see
+:mod:`.values`) and whether its first instance has begun. Everything is immutable and
+hashable (:class:`State`), so the explorer can tell a state it has seen before.
+
+A step starts from one thing that can happen in a state -- a robot's first instance begins, a
+timer fires, a skill ends, a conditional event whose condition may hold fires, a signal from
+outside arrives -- and runs every robot it touches as far as they go without waiting, as the
+engines do. Signals are broadcast as on the bus: a throw reaches the catchers armed at that
+moment, in every robot, and only those. A test whose value is unknown is a choice; the step is
+run once per combination of choices (:class:`Choices`), each giving its own next state.
+"""
+
+from __future__ import annotations
+
+import ast
+from collections import deque
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass, field
+from itertools import combinations
+from typing import Any
+
+from robotale.fame_runtime.model import Expression, Process
+from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, reachable_flows
+from robotale.fame_runtime.tags import Tag
+from robotale.fame_runtime.verify.values import (
+    UNKNOWN,
+    condition_tree,
+    evaluate,
+    script_effect,
+    truth,
+)
+
+#: tokens one scope may hold: a non-interrupting event firing again beyond it is not explored
+TOKEN_CAP = 8
+#: steps one macro step may take: more is a loop that never waits
+STEP_CAP = 10_000
+
+#: what one robot's tokens may wait for that no robot throws: fires whenever it may
+SPONTANEOUS = ("timer", "conditional")
+
+ElementKey = tuple[str, str]  # (process, element id)
+
+
+def element_key(node: NodePlan) -> ElementKey:
+    return (node.scope.process.id, node.node.id)
+
+
+class NeedChoice(Exception):
+    """A step met a choice beyond the ones it was given: ``options`` ways to go on."""
+
+    def __init__(self, options: int) -> None:
+        super().__init__(options)
+        self.options = options
+
+
+class Choices:
+    """The answers a step is run with; asking beyond them raises :class:`NeedChoice`."""
+
+    def __init__(self, answers: tuple[int, ...]) -> None:
+        self.answers, self.used = answers, 0
+
+    def pick(self, options: int) -> int:
+        if options == 1:
+            return 0
+        if self.used < len(self.answers):
+            self.used += 1
+            return self.answers[self.used - 1]
+        raise NeedChoice(options)
+
+
+# -- the registry: plans <-> numbers -------------------------------------------------------------
+
+
+class Registry:
+    """Numbers for every node and scope plan of the robots' plans (states hold numbers)."""
+
+    def __init__(self) -> None:
+        self.nodes: list[NodePlan] = []
+        self.scopes: list[ScopePlan] = []
+        self._node_ids: dict[int, int] = {}
+        self._scope_ids: dict[int, int] = {}
+        self._conditions: dict[tuple[str, str], Expression | None] = {}
+        self._processes: set[int] = set()
+
+    def add_scope(self, plan: ScopePlan) -> None:
+        if id(plan) in self._scope_ids:
+            return
+        self._add_conditions(plan.process)
+        self._scope_ids[id(plan)] = len(self.scopes)
+        self.scopes.append(plan)
+        for node in [*plan.nodes.values(), *plan.event_subprocesses]:
+            self.add_node(node)
+
+    def add_node(self, node: NodePlan) -> None:
+        if id(node) in self._node_ids:
+            return
+        self._node_ids[id(node)] = len(self.nodes)
+        self.nodes.append(node)
+        for boundary in node.boundaries:
+            self.add_node(boundary)
+        if node.child is not None:
+            self.add_scope(node.child)
+        if node.loop is not None:
+            self.add_node(node.loop.body)
+
+    def _add_conditions(self, process: Process) -> None:
+        """The conditions of the process's sequence flows as written (the plan keeps them
+        compiled, and a JavaScript one wrapped in a function)."""
+        if id(process) in self._processes:
+            return
+        self._processes.add(id(process))
+        scopes = [process, *(n.scope for n in process.walk() if n.scope is not None)]
+        for scope in scopes:
+            for flow in scope.flows.values():
+                self._conditions[(process.id, flow.id)] = flow.condition
+
+    def condition(self, flow: FlowPlan) -> Expression | None:
+        """The condition of ``flow`` as written (None: it always holds)."""
+        if flow.condition is None:
+            return None
+        process = flow.target.scope.process
+        written = self._conditions.get((process.id, flow.id))
+        return written or Expression("", flow.condition.language, flow.id)  # unknown
+
+    def node_id(self, node: NodePlan) -> int:
+        return self._node_ids[id(node)]
+
+    def scope_id(self, plan: ScopePlan | None) -> int:
+        return -1 if plan is None else self._scope_ids[id(plan)]
+
+
+# -- the working state of one step ---------------------------------------------------------------
+
+
+class Tok:
+    __slots__ = ("alive", "child", "flow", "node", "scope", "waiting")
+
+    def __init__(self, scope: Scope, node: NodePlan, flow: str = "", waiting: str = "") -> None:
+        self.scope, self.node, self.flow = scope, node, flow
+        self.waiting = waiting  # "" running; "wait" at its node; "join" at a join
+        self.child: Scope | None = None
+        self.alive = True
+
+
+class Scope:
+    __slots__ = ("closed", "fired", "holder", "plan", "robot", "tokens")
+
+    def __init__(self, robot: Robot, plan: ScopePlan | None, holder: Tok | None) -> None:
+        self.robot, self.plan, self.holder = robot, plan, holder  # plan None: a loop body
+        self.tokens: list[Tok] = []
+        self.fired: set[int] = set()  # interrupting event sub-processes that fired
+        self.closed = False
+
+
+@dataclass
+class Robot:
+    name: str
+    plan: ScopePlan
+    begun: bool = False
+    instances: list[Scope] = field(default_factory=list)
+    variables: dict[str, tuple[Any, str]] = field(default_factory=dict)  # value, who set it
+    later: set[str] = field(default_factory=set)  # written by callbacks
+
+
+#: a robot as the state holds it
+RobotKey = tuple[bool, tuple, tuple, tuple]
+State = tuple[RobotKey, ...]
+
+
+@dataclass
+class Decision:
+    """A gateway's choice in a step: which flows it took, and the values it read."""
+
+    robot: str
+    node: NodePlan
+    taken: tuple[str, ...]
+    #: variable, value, the element that set it, whether it did so in this same step
+    reads: tuple[tuple[str, Any, str, bool], ...]
+
+
+@dataclass
+class Outcome:
+    """What one step did."""
+
+    state: State
+    tags: list[Tag]
+    reached: set[ElementKey]
+    armed: set[ElementKey]
+    decisions: list[Decision]
+    lost: list[tuple[str, NodePlan, str]]  # robot, thrower, topic: thrown, nobody caught it
+    failures: list[tuple[str, str, NodePlan, str]]  # kind, robot, element, sentence
+
+
+class Space:
+    """The robots of a collaboration, each with its deployed plan; states and steps."""
+
+    def __init__(self, robots: list[tuple[str, ScopePlan]], outside: frozenset[str]) -> None:
+        self.registry = Registry()
+        self.robots = robots
+        self.outside = outside  # signal topics the world may throw at any time
+        for _, plan in robots:
+            self.registry.add_scope(plan)
+            for start in plan.triggered_starts:
+                self.registry.add_node(start)
+
+    def initial(self) -> State:
+        return tuple((False, (), (), ()) for _ in self.robots)
+
+    # -- thaw and freeze -------------------------------------------------------------------------
+
+    def thaw(self, state: State) -> list[Robot]:
+        robots = []
+        for (name, plan), (begun, instances, variables, later) in zip(
+            self.robots, state, strict=True
+        ):
+            robot = Robot(name, plan, begun, variables=dict(variables), later=set(later))
+            robot.instances = [self._thaw_scope(robot, key, None) for key in instances]
+            robots.append(robot)
+        return robots
+
+    def _thaw_scope(self, robot: Robot, key: tuple, holder: Tok | None) -> Scope:
+        scope_id, fired, tokens = key
+        plan = None if scope_id < 0 else self.registry.scopes[scope_id]
+        scope = Scope(robot, plan, holder)
+        scope.fired = set(fired)
+        for node_id, flow, waiting, child in tokens:
+            token = Tok(scope, self.registry.nodes[node_id], flow, waiting)
+            if child:
+                token.child = self._thaw_scope(robot, child, token)
+            scope.tokens.append(token)
+        return scope
+
+    def freeze(self, robots: list[Robot]) -> State:
+        return tuple(
+            (
+                r.begun,
+                tuple(sorted(self._freeze_scope(s) for s in r.instances)),
+                tuple(sorted(r.variables.items(), key=lambda item: item[0])),
+                tuple(sorted(r.later)),
+            )
+            for r in robots
+        )
+
+    def _freeze_scope(self, scope: Scope) -> tuple:
+        tokens = sorted(
+            (
+                self.registry.node_id(t.node),
+                t.flow,
+                t.waiting,
+                self._freeze_scope(t.child) if t.child is not None else (),
+            )
+            for t in scope.tokens
+        )
+        return (self.registry.scope_id(scope.plan), tuple(sorted(scope.fired)), tuple(tokens))
+
+    # -- what can happen -------------------------------------------------------------------------
+
+    def events(self, robots: list[Robot]) -> list[tuple[str, Callable[[Step], None]]]:
+        """Everything that can happen in a state, each with a name and what it does."""
+        found: list[tuple[str, Callable[[Step], None]]] = []
+        for robot in robots:
+            if not robot.begun:
+                found.append((f"{robot.name} begins", lambda step, r=robot: step.begin(r)))
+            for scope in robot.instances:
+                found += self._scope_events(robot, scope)
+            if not robot.instances:
+                for start in robot.plan.triggered_starts:
+                    if self._may_fire(robot, start):
+                        found.append(
+                            (
+                                f"{robot.name}: {start.label}",
+                                lambda step, r=robot, s=start: step.start_instance(r, s, ""),
+                            )
+                        )
+        return found
+
+    def _scope_events(self, robot: Robot, scope: Scope) -> list:
+        found: list = []
+        if scope.plan is not None:
+            for esp in scope.plan.event_subprocesses:
+                start = esp.child.triggered_starts[0] if esp.child.triggered_starts else None
+                if start is None or not self._may_fire(robot, start):
+                    continue
+                if self.registry.node_id(esp) in scope.fired or len(scope.tokens) >= TOKEN_CAP:
+                    continue
+                found.append(
+                    (
+                        f"{robot.name}: {start.label}",
+                        lambda step, s=scope, e=esp: step.fire_esp(s, e, ""),
+                    )
+                )
+        for token in scope.tokens:
+            found += self._token_events(robot, token)
+            if token.child is not None:
+                found += self._scope_events(robot, token.child)
+        return found
+
+    def _token_events(self, robot: Robot, token: Tok) -> list:
+        found: list = []
+        node = token.node
+        if token.waiting == "wait":
+            if node.behaviour == "catch" and self._may_fire(robot, node):
+                found.append(
+                    (f"{robot.name}: {node.label}", lambda step, t=token: step.fire(t, t.node, ""))
+                )
+            elif node.behaviour in ("skill", "script"):
+                found.append(
+                    (f"{robot.name}: {node.label} ends", lambda step, t=token: step.finished(t))
+                )
+            elif node.behaviour == "eventBasedGateway":
+                for flow in node.outgoing:
+                    if self._may_fire(robot, flow.target):
+                        found.append(
+                            (
+                                f"{robot.name}: {flow.target.label}",
+                                lambda step, t=token, c=flow.target: step.fire(t, c, ""),
+                            )
+                        )
+        if token.waiting == "wait" or token.child is not None:
+            for boundary in node.boundaries:
+                if not self._may_fire(robot, boundary):
+                    continue
+                if not boundary.node.cancel_activity and len(token.scope.tokens) >= TOKEN_CAP:
+                    continue
+                found.append(
+                    (
+                        f"{robot.name}: {boundary.label}",
+                        lambda step, t=token, b=boundary: step.fire_boundary(t, b, ""),
+                    )
+                )
+        return found
+
+    def _may_fire(self, robot: Robot, catcher: NodePlan) -> bool:
+        """Whether ``catcher`` may fire on its own: a timer, a conditional event whose
+        condition may hold, a signal the world throws."""
+        trigger = catcher.trigger
+        if trigger is None:
+            return False
+        if trigger.kind == "timer":
+            return True
+        if trigger.kind == "conditional":
+            return condition_holds(_event_condition(catcher), robot) is not False
+        return trigger.kind == "signal" and trigger.topic in self.outside
+
+
+def condition_holds(expression: Expression | None, robot: Robot) -> Any:
+    """True, False or UNKNOWN: ``expression`` over ``robot``'s tracked variables."""
+    if expression is None:
+        return True
+    tree = condition_tree(expression.text, expression.language)
+    values = {name: value for name, (value, _) in robot.variables.items()}
+    return truth(evaluate(tree, values))
+
+
+# -- one step ------------------------------------------------------------------------------------
+
+
+class Step:
+    """Runs one event and everything it sets off, with the choices given."""
+
+    def __init__(self, space: Space, state: State, choices: Choices, stamp: float) -> None:
+        self.space = space
+        self.robots = space.thaw(state)
+        self.choices = choices
+        self.stamp = stamp
+        self.work: deque[Callable[[], None]] = deque()
+        self.tags: list[Tag] = []
+        self.reached: set[ElementKey] = set()
+        self.armed: set[ElementKey] = set()
+        self.decisions: list[Decision] = []
+        self.lost: list[tuple[str, NodePlan, str]] = []
+        self.failures: list[tuple[str, str, NodePlan, str]] = []
+        self.messages = 0
+        self.set_now: set[tuple[str, str]] = set()  # (robot, variable) set in this step
+
+    def run(self, event: Callable[[Step], None]) -> Outcome:
+        event(self)
+        steps = 0
+        while self.work:
+            steps += 1
+            if steps > STEP_CAP:
+                raise RuntimeError("a loop that never waits")
+            self.work.popleft()()
+            if not self.work:
+                self._inclusive_joins()
+        for robot in self.robots:
+            for name in robot.later:  # a callback may have written it while the robot waits
+                robot.variables.pop(name, None)
+        return Outcome(
+            self.space.freeze(self.robots),
+            self.tags,
+            self.reached,
+            self.armed,
+            self.decisions,
+            self.lost,
+            self.failures,
+        )
+
+    def tag(self, robot: Robot, label: str, lifecycle: str, msg_id: str = "", role: str = ""):
+        self.tags.append(Tag(self.stamp, robot.name, label, lifecycle, msg_id, role))
+
+    def pair(self, robot: Robot, label: str, msg_id: str = "", role: str = "") -> None:
+        self.tag(robot, label, "start", msg_id, role)
+        self.tag(robot, label, "complete", msg_id, role)
+
+    # -- events ----------------------------------------------------------------------------------
+
+    def begin(self, robot: Robot) -> None:
+        robot.begun = True
+        if not robot.plan.starts:
+            return
+        scope = Scope(robot, robot.plan, None)
+        robot.instances.append(scope)
+        for start in robot.plan.starts:
+            self._go(Tok(scope, start), start)
+
+    def start_instance(self, robot: Robot, start: NodePlan, msg_id: str) -> None:
+        scope = Scope(robot, robot.plan, None)
+        robot.instances.append(scope)
+        token = Tok(scope, start)
+        scope.tokens.append(token)
+        self._caught(token, start, msg_id)
+
+    def fire(self, token: Tok, catcher: NodePlan, msg_id: str) -> None:
+        """A waiting catch event (or an event-based gateway's ``catcher``) fires."""
+        if not token.alive:
+            return
+        token.waiting = ""
+        self._caught(token, catcher, msg_id)
+
+    def fire_boundary(self, token: Tok, boundary: NodePlan, msg_id: str) -> None:
+        if not token.alive:
+            return
+        scope = token.scope
+        if boundary.node.cancel_activity:
+            self._cancel(token)
+        new = Tok(scope, boundary)
+        scope.tokens.append(new)
+        self._caught(new, boundary, msg_id)
+
+    def fire_esp(self, scope: Scope, esp: NodePlan, msg_id: str) -> None:
+        if scope.closed:
+            return
+        start = esp.child.triggered_starts[0]
+        interrupting = start.node.interrupting or start.trigger.kind == "error"
+        if interrupting:
+            scope.fired.add(self.space.registry.node_id(esp))
+            for token in list(scope.tokens):
+                self._cancel(token)
+        holder = Tok(scope, esp, waiting="wait")
+        scope.tokens.append(holder)
+        self.reached.add(element_key(esp))
+        self.tag(scope.robot, esp.label, "start")
+        child = Scope(scope.robot, esp.child, holder)
+        holder.child = child
+        token = Tok(child, start)
+        child.tokens.append(token)
+        self._caught(token, start, msg_id)
+
+    def finished(self, token: Tok) -> None:
+        """A skill, or a script completing from a callback, ends."""
+        if not token.alive:
+            return
+        token.waiting = ""
+        self.tag(token.scope.robot, token.node.label, "complete")
+        self._leave(token, token.node)
+
+    # -- moving tokens ---------------------------------------------------------------------------
+
+    def _go(self, token: Tok, node: NodePlan) -> None:
+        if token not in token.scope.tokens:
+            token.scope.tokens.append(token)
+        self.work.append(lambda: self._enter(token, node))
+
+    def _caught(self, token: Tok, catcher: NodePlan, msg_id: str) -> None:
+        robot = token.scope.robot
+        token.node = catcher
+        self.reached.add(element_key(catcher))
+        self.pair(robot, catcher.label, msg_id, "receive" if msg_id else "")
+        self._leave(token, catcher)
+
+    def _enter(self, token: Tok, node: NodePlan) -> None:
+        if not token.alive:
+            return
+        token.node = node
+        self.reached.add(element_key(node))
+        _BEHAVIOURS.get(node.behaviour, Step._run_pass)(self, token, node)
+
+    def _leave(self, token: Tok, node: NodePlan) -> None:
+        self._follow(token, self._taken(token, node, first=False))
+
+    def _follow(self, token: Tok, flows: list[FlowPlan]) -> None:
+        if not flows:
+            self._consume(token)
+            return
+        for flow in flows[1:]:
+            other = Tok(token.scope, flow.target, flow.id)
+            self._go(other, flow.target)
+        token.flow = flows[0].id
+        self._go(token, flows[0].target)
+
+    def _taken(self, token: Tok, node: NodePlan, *, first: bool) -> list[FlowPlan]:
+        """The flows to take, a choice among the possible ones when a condition is unknown."""
+        robot = token.scope.robot
+        conditional = [f for f in node.outgoing if f is not node.default]
+        if all(f.condition is None for f in conditional):
+            taken = conditional[:1] if first else conditional
+            return taken or ([node.default] if node.default is not None else [])
+        values = [condition_holds(self.space.registry.condition(f), robot) for f in conditional]
+        options = _first_options(values) if first else _all_options(values)
+        options = [o or ([node.default] if node.default is not None else []) for o in options]
+        options = [[conditional[i] if isinstance(i, int) else i for i in o] for o in options]
+        chosen = options[self.choices.pick(len(options))]
+        self.decisions.append(
+            Decision(
+                robot.name,
+                node,
+                tuple(f.id for f in chosen),
+                _reads(
+                    [self.space.registry.condition(f) for f in conditional], robot, self.set_now
+                ),
+            )
+        )
+        return chosen
+
+    def _consume(self, token: Tok) -> None:
+        token.alive = False
+        scope = token.scope
+        if token in scope.tokens:
+            scope.tokens.remove(token)
+        if not scope.tokens and not scope.closed:
+            self._close(scope)
+
+    def _cancel(self, token: Tok) -> None:
+        token.alive = False
+        if token in token.scope.tokens:
+            token.scope.tokens.remove(token)
+        if token.child is not None:
+            self._cancel_scope(token.child)
+            token.child = None
+
+    def _cancel_scope(self, scope: Scope) -> None:
+        scope.closed = True
+        for token in list(scope.tokens):
+            self._cancel(token)
+
+    def _close(self, scope: Scope) -> None:
+        """``scope`` has no token left: its holder goes on (a top scope: the instance ends)."""
+        self._cancel_scope(scope)
+        holder = scope.holder
+        robot = scope.robot
+        if holder is None:
+            if scope in robot.instances:
+                robot.instances.remove(scope)
+            return
+        if not holder.alive:
+            return
+        holder.child = None
+        holder.waiting = ""
+        node = holder.node
+        if node.behaviour == "loop":
+            self._loop_round(holder, node)
+            return
+        self.tag(robot, node.label, "complete")
+        if node.behaviour == "event_subprocess":
+            self._consume(holder)
+            return
+        self._leave(holder, node)
+
+    def _kill(self, scope: Scope) -> None:
+        for token in list(scope.tokens):
+            self._cancel(token)
+        if not scope.closed:
+            self._close(scope)
+
+    # -- behaviours ------------------------------------------------------------------------------
+
+    def _run_pass(self, token: Tok, node: NodePlan) -> None:
+        throw = node.throw
+        if throw is not None and throw.kind in ("signal", "message"):
+            self._publish(token.scope.robot, node)
+        elif throw is not None:
+            self.pair(token.scope.robot, throw.label)
+        self._leave(token, node)
+
+    def _run_end(self, token: Tok, node: NodePlan) -> None:
+        throw = node.throw
+        robot = token.scope.robot
+        if throw is not None and throw.kind in ("signal", "message"):
+            self._publish(robot, node)
+        elif throw is not None and throw.kind == "error":
+            self.pair(robot, throw.label)
+            self._throw_error(token, throw.topic)
+            return
+        elif throw is not None:
+            self.pair(robot, throw.label)
+        self._consume(token)
+
+    def _run_terminate(self, token: Tok, node: NodePlan) -> None:
+        self._kill(token.scope)
+
+    def _run_task(self, token: Tok, node: NodePlan) -> None:
+        self.pair(token.scope.robot, node.label)
+        self._leave(token, node)
+
+    def _run_script(self, token: Tok, node: NodePlan) -> None:
+        robot = token.scope.robot
+        self.tag(robot, node.label, "start")
+        script = node.node.script
+        effect = script_effect(script.text, script.language) if script is not None else None
+        if effect is not None:
+            values = {name: value for name, (value, _) in robot.variables.items()}
+            for name, tree in effect.sets:
+                value = evaluate(tree, values)
+                values[name] = value
+                if value is UNKNOWN:
+                    robot.variables.pop(name, None)
+                else:
+                    robot.variables[name] = (value, node.node.describe())
+                    self.set_now.add((robot.name, name))
+            for name in effect.havoc:
+                robot.variables.pop(name, None)
+            robot.later |= effect.later
+            if effect.waits:
+                token.waiting = "wait"
+                self._armed(token)
+                return
+        self.tag(robot, node.label, "complete")
+        self._leave(token, node)
+
+    def _run_skill(self, token: Tok, node: NodePlan) -> None:
+        self.tag(token.scope.robot, node.label, "start")
+        token.waiting = "wait"
+        self._armed(token)
+
+    def _run_call(self, token: Tok, node: NodePlan) -> None:
+        robot = token.scope.robot
+        self.tag(robot, node.label, "start")
+        token.waiting = "wait"
+        self._armed(token)
+        child = Scope(robot, node.child, token)
+        token.child = child
+        if not node.child.starts:
+            self._close(child)
+            return
+        for start in node.child.starts:
+            self._go(Tok(child, start), start)
+
+    def _run_loop(self, token: Tok, node: NodePlan) -> None:
+        token.waiting = "wait"
+        self._armed(token)
+        self._loop_body(token, node)
+
+    def _loop_body(self, token: Tok, node: NodePlan) -> None:
+        child = Scope(token.scope.robot, None, token)
+        token.child = child
+        body = node.loop.body
+        self._go(Tok(child, body), body)
+
+    def _loop_round(self, token: Tok, node: NodePlan) -> None:
+        """A round of a loop ended: a standard loop goes round again while its condition may
+        hold (a multi-instance activity's instances are alike: one round stands for all)."""
+        marker = node.loop
+        again = False
+        if marker.loop.kind == "standard":
+            holds = condition_holds(marker.loop.condition, token.scope.robot)
+            if marker.condition is None:
+                holds = UNKNOWN  # only loopMaximum ends it: some number of rounds
+            again = holds if holds is not UNKNOWN else self.choices.pick(2) == 1
+        if again:
+            token.waiting = "wait"
+            self._loop_body(token, node)
+            return
+        self.tag(token.scope.robot, node.label, "complete")
+        self._leave(token, node)
+
+    def _run_catch(self, token: Tok, node: NodePlan) -> None:
+        trigger = node.trigger
+        conditional = trigger is not None and trigger.kind == "conditional"
+        if conditional and condition_holds(_event_condition(node), token.scope.robot) is True:
+            self._caught(token, node, "")
+            return
+        token.waiting = "wait"
+        self._armed(token)
+
+    def _run_event_gateway(self, token: Tok, node: NodePlan) -> None:
+        token.waiting = "wait"
+        for flow in node.outgoing:
+            self.armed.add(element_key(flow.target))
+
+    def _run_exclusive(self, token: Tok, node: NodePlan) -> None:
+        flows = self._taken(token, node, first=True)
+        if not flows:
+            self._stuck(token, node)
+            return
+        self._follow(token, flows)
+
+    def _run_inclusive(self, token: Tok, node: NodePlan) -> None:
+        if len(node.incoming) > 1:
+            token.waiting = "join"
+            return
+        flows = self._taken(token, node, first=False)
+        if not flows:
+            self._stuck(token, node)
+            return
+        self._follow(token, flows)
+
+    def _run_parallel(self, token: Tok, node: NodePlan) -> None:
+        if len(node.incoming) <= 1:
+            self._follow(token, list(node.outgoing))
+            return
+        token.waiting = "join"
+        waiting = [t for t in token.scope.tokens if t.node is node and t.waiting == "join"]
+        arrived = {t.flow for t in waiting}
+        if not arrived.issuperset(node.incoming):
+            return
+        for flow_id in node.incoming:
+            first = next(t for t in waiting if t.flow == flow_id)
+            if first is not token:
+                first.alive = False
+                token.scope.tokens.remove(first)
+        token.waiting = ""
+        self._follow(token, list(node.outgoing))
+
+    def _inclusive_joins(self) -> None:
+        for robot in self.robots:
+            for scope in scopes(robot):
+                for node in {
+                    id(t.node): t.node for t in scope.tokens if t.waiting == "join"
+                }.values():
+                    if node.behaviour == "inclusiveGateway" and _may_merge(scope, node):
+                        self._merge(scope, node)
+
+    def _merge(self, scope: Scope, node: NodePlan) -> None:
+        survivor, *others = [t for t in scope.tokens if t.node is node and t.waiting == "join"]
+        for other in others:
+            other.alive = False
+            scope.tokens.remove(other)
+        survivor.waiting = ""
+        flows = self._taken(survivor, node, first=False)
+        if not flows:
+            self._stuck(survivor, node)
+            return
+        self._follow(survivor, flows)
+
+    def _stuck(self, token: Tok, node: NodePlan) -> None:
+        robot = token.scope.robot
+        self.failures.append(
+            (
+                "stuck",
+                robot.name,
+                node,
+                f"{node.node.kind} {node.node.describe()} has no outgoing flow whose condition "
+                "holds and no default flow: the engine stops the robot with a model error",
+            )
+        )
+        self._kill_instance(token)
+
+    # -- signals and errors ----------------------------------------------------------------------
+
+    def _publish(self, robot: Robot, node: NodePlan) -> None:
+        throw = node.throw
+        self.messages += 1
+        msg_id = f"m{int(self.stamp)}.{self.messages}"  # unique in a trace: one step a stamp
+        self.tag(robot, throw.label, "start", msg_id, "send")
+        receivers = list(self._receivers(throw.topic))
+        if not receivers:
+            self.lost.append((robot.name, node, throw.topic))
+        for receive in receivers:
+            self.work.append(lambda r=receive, m=msg_id: r(m))
+        self.tag(robot, throw.label, "complete", msg_id, "send")
+
+    def _receivers(self, topic: str) -> Iterator[Callable[[str], None]]:
+        """Everything armed for ``topic`` now, in every robot (a broadcast)."""
+        for robot in self.robots:
+            for scope in scopes(robot):
+                yield from self._scope_receivers(scope, topic)
+            if len(robot.instances) < TOKEN_CAP:
+                for start in robot.plan.triggered_starts:
+                    if _listens(start, topic):
+                        yield lambda m, r=robot, s=start: self.start_instance(r, s, m)
+
+    def _scope_receivers(self, scope: Scope, topic: str) -> Iterator[Callable[[str], None]]:
+        if scope.plan is not None and len(scope.tokens) < TOKEN_CAP:
+            for esp in scope.plan.event_subprocesses:
+                starts = esp.child.triggered_starts
+                fired = self.space.registry.node_id(esp) in scope.fired
+                if starts and _listens(starts[0], topic) and not fired:
+                    yield lambda m, s=scope, e=esp: self.fire_esp(s, e, m)
+        for token in list(scope.tokens):
+            node = token.node
+            if token.waiting == "wait" and node.behaviour == "catch" and _listens(node, topic):
+                yield lambda m, t=token: self.fire(t, t.node, m)
+            if token.waiting == "wait" and node.behaviour == "eventBasedGateway":
+                for flow in node.outgoing:
+                    if _listens(flow.target, topic):
+                        yield lambda m, t=token, c=flow.target: self.fire(t, c, m)
+            if token.waiting == "wait" or token.child is not None:
+                for boundary in node.boundaries:
+                    if _listens(boundary, topic):
+                        yield lambda m, t=token, b=boundary: self.fire_boundary(t, b, m)
+
+    def _throw_error(self, token: Tok, name: str) -> None:
+        """To the nearest catcher: event sub-processes of each scope and boundary events of
+        the activity holding it, innermost first; nobody: the instance fails."""
+        scope: Scope | None = token.scope
+        self._consume_quietly(token)
+        while scope is not None:
+            if scope.plan is not None:
+                for esp in scope.plan.event_subprocesses:
+                    starts = esp.child.triggered_starts
+                    if starts and _catches_error(starts[0], name):
+                        self.fire_esp(scope, esp, "")
+                        return
+            holder = scope.holder
+            if holder is None:
+                break
+            for boundary in holder.node.boundaries:
+                if _catches_error(boundary, name):
+                    self.fire_boundary(holder, boundary, "")
+                    return
+            scope = holder.scope
+        robot = token.scope.robot
+        self.failures.append(
+            (
+                "uncaught",
+                robot.name,
+                token.node,
+                f"error {name!r} thrown at {token.node.node.describe()} is caught by nobody: "
+                "the robot's instance ends",
+            )
+        )
+        self._kill_instance(token)
+
+    def _consume_quietly(self, token: Tok) -> None:
+        token.alive = False
+        if token in token.scope.tokens:
+            token.scope.tokens.remove(token)
+
+    def _kill_instance(self, token: Tok) -> None:
+        scope = token.scope
+        while scope.holder is not None:
+            scope = scope.holder.scope
+        self._cancel_scope(scope)
+        if scope in scope.robot.instances:
+            scope.robot.instances.remove(scope)
+
+    def _armed(self, token: Tok) -> None:
+        """Note the catchers ``token`` arms (for catches that never fire)."""
+        node = token.node
+        if node.trigger is not None:
+            self.armed.add(element_key(node))
+        for boundary in node.boundaries:
+            self.armed.add(element_key(boundary))
+
+
+def _listens(node: NodePlan, topic: str) -> bool:
+    trigger = node.trigger
+    return trigger is not None and trigger.kind == "signal" and trigger.topic == topic
+
+
+def _catches_error(node: NodePlan, name: str) -> bool:
+    trigger = node.trigger
+    return trigger is not None and trigger.kind == "error" and trigger.topic in ("", name)
+
+
+def scopes(robot: Robot) -> Iterator[Scope]:
+    stack = list(robot.instances)
+    while stack:
+        scope = stack.pop()
+        yield scope
+        stack.extend(t.child for t in scope.tokens if t.child is not None)
+
+
+def _may_merge(scope: Scope, node: NodePlan) -> bool:
+    """An inclusive join goes on when no other token of its scope can still reach an incoming
+    flow that has no token yet (as the engine decides)."""
+    waiting = [t for t in scope.tokens if t.node is node and t.waiting == "join"]
+    missing = set(node.incoming) - {t.flow for t in waiting}
+    return not any(
+        missing & reachable_flows(t.node)
+        for t in scope.tokens
+        if not (t.node is node and t.waiting == "join")
+    )
+
+
+def _first_options(values: list[Any]) -> list[list[Any]]:
+    """An exclusive split: the first flow whose condition holds; an unknown one may or may
+    not (the index list of each possible outcome). With an unknown condition one of the flows
+    is taken (the modeller's conditions are taken to cover every case): [] = none holds is an
+    outcome only when the tracked values decide every condition."""
+    options: list[list[Any]] = []
+    for index, value in enumerate(values):
+        if value is True:
+            options.append([index])
+            return options
+        if value is UNKNOWN:
+            options.append([index])
+    return options or [[]]
+
+
+def _all_options(values: list[Any]) -> list[list[Any]]:
+    """An inclusive split (or a node's conditional flows): every flow whose condition holds,
+    and each combination of the unknown ones that takes at least one."""
+    sure = [i for i, v in enumerate(values) if v is True]
+    unsure = [i for i, v in enumerate(values) if v is UNKNOWN]
+    options = [
+        sorted(sure + list(extra))
+        for size in range(len(unsure) + 1)
+        for extra in combinations(unsure, size)
+    ]
+    return [o for o in options if o] or [[]]
+
+
+def _event_condition(node: NodePlan) -> Expression | None:
+    event = node.node.event
+    return event.condition if event is not None else None
+
+
+def _reads(
+    conditions: list[Expression | None], robot: Robot, set_now: set[tuple[str, str]]
+) -> tuple[tuple[str, Any, str, bool], ...]:
+    """The tracked variables the conditions read: value and who set it."""
+    reads = []
+    for condition in conditions:
+        if condition is None:
+            continue
+        tree = condition_tree(condition.text, condition.language)
+        for name in sorted(_names(tree)):
+            value, setter = robot.variables.get(name, (UNKNOWN, ""))
+            reads.append((name, value, setter, (robot.name, name) in set_now))
+    return tuple(dict.fromkeys(reads))
+
+
+def _names(tree: ast.expr | None) -> set[str]:
+    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} if tree is not None else set()
+
+
+_BEHAVIOURS: dict[str, Callable[[Step, Tok, NodePlan], None]] = {
+    "start": Step._leave,
+    "boundary": Step._leave,
+    "pass": Step._run_pass,
+    "end": Step._run_end,
+    "terminate": Step._run_terminate,
+    "task": Step._run_task,
+    "script": Step._run_script,
+    "skill": Step._run_skill,
+    "call": Step._run_call,
+    "subprocess": Step._run_call,
+    "loop": Step._run_loop,
+    "catch": Step._run_catch,
+    "exclusiveGateway": Step._run_exclusive,
+    "inclusiveGateway": Step._run_inclusive,
+    "parallelGateway": Step._run_parallel,
+    "eventBasedGateway": Step._run_event_gateway,
+    "event_subprocess": lambda step, token, node: None,
+}
