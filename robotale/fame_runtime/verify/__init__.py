@@ -36,6 +36,7 @@ class Verdict:
     seconds: float
     bound: str  # "" when every reachable state was explored
     findings: list[Finding] = field(default_factory=list)
+    reached: list[str] = field(default_factory=list)  # ids of the elements some token reached
 
     @property
     def complete(self) -> bool:
@@ -80,4 +81,5 @@ def verify(
         graph.seconds,
         graph.bound,
         findings(graph),
+        sorted({element for _, element in graph.reached}),
     )

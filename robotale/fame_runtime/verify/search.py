@@ -71,6 +71,7 @@ class Exploration:
     edges: list[list[tuple[int, Outcome]]] = field(default_factory=list)
     waiting: dict[int, list[str]] = field(default_factory=dict)  # deadlocks: who waits
     reached: set[ElementKey] = field(default_factory=set)
+    fired: set[ElementKey] = field(default_factory=set)
     first_armed: dict[ElementKey, int] = field(default_factory=dict)  # state it is armed in
     firsts: dict[tuple, tuple[int, Outcome, object]] = field(default_factory=dict)
     frontier: set[int] = field(default_factory=set)  # not expanded (a bound was hit)
@@ -149,6 +150,7 @@ def _successors(space: Space, state: State, stamp: int, graph: Exploration):
 def _note(graph: Exploration, source: int, outcome: Outcome) -> None:
     """Keep what a step shows: elements reached and armed, signals lost, errors uncaught."""
     graph.reached |= outcome.reached
+    graph.fired |= outcome.fired
     for key in outcome.armed:
         graph.first_armed.setdefault(key, source)
     for robot, node, topic in outcome.lost:
@@ -440,10 +442,13 @@ def _unreached(graph: Exploration) -> list[Finding]:
     seen: set[ElementKey] = set()
     for node in graph.space.registry.nodes:
         key = element_key(node)
-        if key in graph.reached or key in seen or node.behaviour == "event_subprocess":
+        if key in seen or node.behaviour == "event_subprocess":
+            continue
+        catching = node.trigger is not None and node.behaviour != "skill"
+        if (key in graph.fired) or (key in graph.reached and not catching):
             continue
         seen.add(key)
-        if node.trigger is not None and (key in graph.first_armed or _always_armed(node)):
+        if catching and (key in graph.first_armed or _always_armed(node)):
             state = graph.first_armed.get(key, 0)
             found.append(
                 Finding(

@@ -189,6 +189,7 @@ class Outcome:
     tags: list[Tag]
     reached: set[ElementKey]
     armed: set[ElementKey]
+    fired: set[ElementKey]
     decisions: list[Decision]
     lost: list[tuple[str, NodePlan, str]]  # robot, thrower, topic: thrown, nobody caught it
     failures: list[tuple[str, str, NodePlan, str]]  # kind, robot, element, sentence
@@ -261,9 +262,10 @@ class Space:
     def events(self, robots: list[Robot]) -> list[tuple[str, Callable[[Step], None]]]:
         """Everything that can happen in a state, each with a name and what it does."""
         found: list[tuple[str, Callable[[Step], None]]] = []
+        if not all(robot.begun for robot in robots):
+            # the engines start together: every first instance runs before any timer fires
+            return [("the mission begins", lambda step: [step.begin(r) for r in step.robots])]
         for robot in robots:
-            if not robot.begun:
-                found.append((f"{robot.name} begins", lambda step, r=robot: step.begin(r)))
             for scope in robot.instances:
                 found += self._scope_events(robot, scope)
             if not robot.instances:
@@ -370,6 +372,7 @@ class Step:
         self.tags: list[Tag] = []
         self.reached: set[ElementKey] = set()
         self.armed: set[ElementKey] = set()
+        self.fired: set[ElementKey] = set()
         self.decisions: list[Decision] = []
         self.lost: list[tuple[str, NodePlan, str]] = []
         self.failures: list[tuple[str, str, NodePlan, str]] = []
@@ -394,6 +397,7 @@ class Step:
             self.tags,
             self.reached,
             self.armed,
+            self.fired,
             self.decisions,
             self.lost,
             self.failures,
@@ -465,6 +469,8 @@ class Step:
         if not token.alive:
             return
         token.waiting = ""
+        if token.node.behaviour == "skill":
+            self.forget_assumptions(token.scope.robot)
         self.tag(token.scope.robot, token.node.label, "complete")
         self._leave(token, token.node)
 
@@ -477,8 +483,11 @@ class Step:
 
     def _caught(self, token: Tok, catcher: NodePlan, msg_id: str) -> None:
         robot = token.scope.robot
+        if msg_id:
+            self.forget_assumptions(robot)
         token.node = catcher
         self.reached.add(element_key(catcher))
+        self.fired.add(element_key(catcher))
         self.pair(robot, catcher.label, msg_id, "receive" if msg_id else "")
         self._leave(token, catcher)
 
@@ -513,7 +522,9 @@ class Step:
         options = _first_options(values) if first else _all_options(values)
         options = [o or ([node.default] if node.default is not None else []) for o in options]
         options = [[conditional[i] if isinstance(i, int) else i for i in o] for o in options]
-        chosen = options[self.choices.pick(len(options))]
+        pick = self.choices.pick(len(options))
+        chosen = options[pick]
+        self._assume(robot, node, conditional, values, chosen, first=first)
         self.decisions.append(
             Decision(
                 robot.name,
@@ -525,6 +536,30 @@ class Step:
             )
         )
         return chosen
+
+    def _assume(self, robot, node, flows, values, chosen, *, first: bool) -> None:
+        """An unknown variable a condition tested keeps the value the choice implies until
+        something writes it (``a`` taken: a is true), so a later test of it agrees."""
+        taken = {id(f) for f in chosen}
+        for flow, value in zip(flows, values, strict=True):
+            if value is not UNKNOWN:
+                continue
+            if id(flow) in taken:
+                outcome = True
+            elif not first or (chosen and flows.index(chosen[0]) > flows.index(flow)):
+                outcome = False
+            else:
+                continue
+            expression = self.space.registry.condition(flow)
+            implied = _implied(condition_tree(expression.text, expression.language), outcome)
+            if implied is not None and implied[0] not in robot.later:
+                robot.variables[implied[0]] = (implied[1], f"assumed at {node.node.describe()}")
+
+    def forget_assumptions(self, robot: Robot) -> None:
+        """A skill's outputs or a message's data may have written any variable."""
+        for name, (_, setter) in list(robot.variables.items()):
+            if setter.startswith("assumed"):
+                del robot.variables[name]
 
     def _consume(self, token: Tok) -> None:
         token.alive = False
@@ -855,6 +890,25 @@ class Step:
             self.armed.add(element_key(node))
         for boundary in node.boundaries:
             self.armed.add(element_key(boundary))
+
+
+def _implied(tree: ast.expr | None, outcome: bool) -> tuple[str, Any] | None:
+    """The variable value a test's outcome implies: ``a`` / ``not a`` / ``a == 3``."""
+    if isinstance(tree, ast.Name):
+        return (tree.id, outcome)
+    if isinstance(tree, ast.UnaryOp) and isinstance(tree.op, ast.Not):
+        inner = _implied(tree.operand, not outcome)
+        return inner
+    if (
+        outcome
+        and isinstance(tree, ast.Compare)
+        and isinstance(tree.left, ast.Name)
+        and len(tree.ops) == 1
+        and isinstance(tree.ops[0], ast.Eq)
+        and isinstance(tree.comparators[0], ast.Constant)
+    ):
+        return (tree.left.id, tree.comparators[0].value)
+    return None
 
 
 def _listens(node: NodePlan, topic: str) -> bool:
