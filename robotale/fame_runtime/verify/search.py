@@ -76,6 +76,7 @@ class Exploration:
     firsts: dict[tuple, tuple[int, Outcome, object]] = field(default_factory=dict)
     frontier: set[int] = field(default_factory=set)  # not expanded (a bound was hit)
     bound: str = ""
+    capped: bool = False  # some step left a catcher out (TOKEN_CAP, INSTANCE_CAP)
     steps: int = 0
     seconds: float = 0.0
 
@@ -150,6 +151,7 @@ def _successors(space: Space, state: State, stamp: int, graph: Exploration):
 def _note(graph: Exploration, source: int, outcome: Outcome) -> None:
     """Keep what a step shows: elements reached and armed, signals lost, errors uncaught."""
     graph.reached |= outcome.reached
+    graph.capped |= outcome.capped
     graph.fired |= outcome.fired
     for key in outcome.armed:
         graph.first_armed.setdefault(key, source)

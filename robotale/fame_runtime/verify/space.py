@@ -22,6 +22,7 @@ from dataclasses import dataclass, field
 from itertools import combinations
 from typing import Any
 
+from robotale.fame_runtime.expressions import self_reference
 from robotale.fame_runtime.model import Expression, Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, reachable_flows
 from robotale.fame_runtime.tags import Tag
@@ -29,17 +30,20 @@ from robotale.fame_runtime.verify.values import (
     UNKNOWN,
     condition_tree,
     evaluate,
+    parameter_value,
     script_effect,
     truth,
 )
 
 #: tokens one scope may hold: a non-interrupting event firing again beyond it is not explored
 TOKEN_CAP = 8
+#: instances one robot may run at once: a start event firing beyond it is not explored
+INSTANCE_CAP = 2
 #: steps one macro step may take: more is a loop that never waits
 STEP_CAP = 10_000
 
-#: what one robot's tokens may wait for that no robot throws: fires whenever it may
-SPONTANEOUS = ("timer", "conditional")
+#: the arming time of the timers a step arms: after all those of the state before it
+NOW = 1 << 30
 
 ElementKey = tuple[str, str]  # (process, element id)
 
@@ -136,13 +140,15 @@ class Registry:
 
 
 class Tok:
-    __slots__ = ("alive", "child", "flow", "node", "scope", "waiting")
+    __slots__ = ("alive", "child", "flow", "node", "scope", "since", "waiting")
 
     def __init__(self, scope: Scope, node: NodePlan, flow: str = "", waiting: str = "") -> None:
         self.scope, self.node, self.flow = scope, node, flow
         self.waiting = waiting  # "" running; "wait" at its node; "join" at a join
         self.child: Scope | None = None
         self.alive = True
+        #: when its timers were armed, as a rank among the state's timers (their order)
+        self.since = 0
 
 
 class Scope:
@@ -192,6 +198,7 @@ class Outcome:
     fired: set[ElementKey]
     decisions: list[Decision]
     lost: list[tuple[str, NodePlan, str]]  # robot, thrower, topic: thrown, nobody caught it
+    capped: bool  # a catcher was left out by TOKEN_CAP or INSTANCE_CAP
     failures: list[tuple[str, str, NodePlan, str]]  # kind, robot, element, sentence
 
 
@@ -227,31 +234,36 @@ class Space:
         plan = None if scope_id < 0 else self.registry.scopes[scope_id]
         scope = Scope(robot, plan, holder)
         scope.fired = set(fired)
-        for node_id, flow, waiting, child in tokens:
+        for node_id, flow, waiting, since, child in tokens:
             token = Tok(scope, self.registry.nodes[node_id], flow, waiting)
+            token.since = since
             if child:
                 token.child = self._thaw_scope(robot, child, token)
             scope.tokens.append(token)
         return scope
 
     def freeze(self, robots: list[Robot]) -> State:
+        # the timers' arming order is all that is kept of time: ranks 1, 2 ... (0: no timer)
+        arms = {t.since for r in robots for s in scopes(r) for t in s.tokens if _timed(t)}
+        ranks = {since: rank for rank, since in enumerate(sorted(arms), start=1)}
         return tuple(
             (
                 r.begun,
-                tuple(sorted(self._freeze_scope(s) for s in r.instances)),
+                tuple(sorted(self._freeze_scope(s, ranks) for s in r.instances)),
                 tuple(sorted(r.variables.items(), key=lambda item: item[0])),
                 tuple(sorted(r.later)),
             )
             for r in robots
         )
 
-    def _freeze_scope(self, scope: Scope) -> tuple:
+    def _freeze_scope(self, scope: Scope, ranks: dict[int, int]) -> tuple:
         tokens = sorted(
             (
                 self.registry.node_id(t.node),
                 t.flow,
                 t.waiting,
-                self._freeze_scope(t.child) if t.child is not None else (),
+                ranks[t.since] if _timed(t) else 0,
+                self._freeze_scope(t.child, ranks) if t.child is not None else (),
             )
             for t in scope.tokens
         )
@@ -262,6 +274,13 @@ class Space:
     def events(self, robots: list[Robot]) -> list[tuple[str, Callable[[Step], None]]]:
         """Everything that can happen in a state, each with a name and what it does."""
         found: list[tuple[str, Callable[[Step], None]]] = []
+        self._timers = [
+            (t.since, duration, t, catcher)
+            for r in robots
+            for s in scopes(r)
+            for t in s.tokens
+            for catcher, duration in _timers(t)
+        ]
         if not all(robot.begun for robot in robots):
             # the engines start together: every first instance runs before any timer fires
             return [("the mission begins", lambda step: [step.begin(r) for r in step.robots])]
@@ -286,8 +305,10 @@ class Space:
                 start = esp.child.triggered_starts[0] if esp.child.triggered_starts else None
                 if start is None or not self._may_fire(robot, start):
                     continue
-                if self.registry.node_id(esp) in scope.fired or len(scope.tokens) >= TOKEN_CAP:
-                    continue
+                if self.registry.node_id(esp) in scope.fired or any(
+                    t.node is esp for t in scope.tokens
+                ):
+                    continue  # a handler the world starts runs once at a time
                 found.append(
                     (
                         f"{robot.name}: {start.label}",
@@ -304,7 +325,7 @@ class Space:
         found: list = []
         node = token.node
         if token.waiting == "wait":
-            if node.behaviour == "catch" and self._may_fire(robot, node):
+            if node.behaviour == "catch" and self._may_fire(robot, node, token):
                 found.append(
                     (f"{robot.name}: {node.label}", lambda step, t=token: step.fire(t, t.node, ""))
                 )
@@ -314,7 +335,7 @@ class Space:
                 )
             elif node.behaviour == "eventBasedGateway":
                 for flow in node.outgoing:
-                    if self._may_fire(robot, flow.target):
+                    if self._may_fire(robot, flow.target, token):
                         found.append(
                             (
                                 f"{robot.name}: {flow.target.label}",
@@ -323,10 +344,12 @@ class Space:
                         )
         if token.waiting == "wait" or token.child is not None:
             for boundary in node.boundaries:
-                if not self._may_fire(robot, boundary):
+                if not self._may_fire(robot, boundary, token):
                     continue
-                if not boundary.node.cancel_activity and len(token.scope.tokens) >= TOKEN_CAP:
-                    continue
+                if not boundary.node.cancel_activity and any(
+                    t.node is boundary or t.flow in _out(boundary) for t in token.scope.tokens
+                ):
+                    continue  # a non-interrupting event of the world: once at a time
                 found.append(
                     (
                         f"{robot.name}: {boundary.label}",
@@ -335,17 +358,63 @@ class Space:
                 )
         return found
 
-    def _may_fire(self, robot: Robot, catcher: NodePlan) -> bool:
-        """Whether ``catcher`` may fire on its own: a timer, a conditional event whose
-        condition may hold, a signal the world throws."""
+    def _may_fire(self, robot: Robot, catcher: NodePlan, token: Tok | None = None) -> bool:
+        """Whether ``catcher`` may fire on its own: a timer no earlier deadline comes before,
+        a conditional event whose condition may hold, a signal or error the world throws."""
         trigger = catcher.trigger
         if trigger is None:
             return False
         if trigger.kind == "timer":
-            return True
+            return token is None or self._first_due(token, catcher)
         if trigger.kind == "conditional":
             return condition_holds(_event_condition(catcher), robot) is not False
+        if trigger.kind == "error":  # a battery monitor, a skill: errors the world raises
+            return f"/{trigger.topic}" in self.outside
         return trigger.kind == "signal" and trigger.topic in self.outside
+
+    def _first_due(self, token: Tok, catcher: NodePlan) -> bool:
+        """A timer armed at or before this one with a shorter duration is due first: the
+        others' durations, not the skills' unknown ones, order timers."""
+        duration = timer_seconds(catcher)
+        if duration is None:
+            return True
+        return not any(
+            other is not None and since <= token.since and other < duration
+            for since, other, holder, timer in self._timers
+            if not (holder is token and timer is catcher)
+        )
+
+
+def timer_seconds(catcher: NodePlan) -> float | None:
+    """How long after arming a timer first fires (None: a date, or not known before)."""
+    spec = catcher.trigger.timer if catcher.trigger is not None else None
+    if spec is None or "${" in spec.text or spec.kind == "timeDate":
+        return None
+    if getattr(spec, "at", None) is not None:
+        return None
+    return spec.interval
+
+
+def _timers(token: Tok) -> list[tuple[NodePlan, float | None]]:
+    """The timers ``token`` waits on: its catch event, an event-based gateway's, its
+    activity's boundary events."""
+    if token.waiting != "wait" and token.child is None:
+        return []
+    node = token.node
+    catchers = list(node.boundaries)
+    if token.waiting == "wait" and node.behaviour == "catch":
+        catchers.append(node)
+    if token.waiting == "wait" and node.behaviour == "eventBasedGateway":
+        catchers += [f.target for f in node.outgoing]
+    return [
+        (c, timer_seconds(c))
+        for c in catchers
+        if c.trigger is not None and c.trigger.kind == "timer"
+    ]
+
+
+def _timed(token: Tok) -> bool:
+    return bool(_timers(token))
 
 
 def condition_holds(expression: Expression | None, robot: Robot) -> Any:
@@ -377,6 +446,7 @@ class Step:
         self.lost: list[tuple[str, NodePlan, str]] = []
         self.failures: list[tuple[str, str, NodePlan, str]] = []
         self.messages = 0
+        self.capped = False  # a catcher was left out by TOKEN_CAP
         self.set_now: set[tuple[str, str]] = set()  # (robot, variable) set in this step
 
     def run(self, event: Callable[[Step], None]) -> Outcome:
@@ -400,6 +470,7 @@ class Step:
             self.fired,
             self.decisions,
             self.lost,
+            self.capped,
             self.failures,
         )
 
@@ -414,6 +485,7 @@ class Step:
 
     def begin(self, robot: Robot) -> None:
         robot.begun = True
+        self.declare(robot, robot.plan, first=True)
         if not robot.plan.starts:
             return
         scope = Scope(robot, robot.plan, None)
@@ -424,6 +496,7 @@ class Step:
     def start_instance(self, robot: Robot, start: NodePlan, msg_id: str) -> None:
         scope = Scope(robot, robot.plan, None)
         robot.instances.append(scope)
+        self.declare(robot, robot.plan)
         token = Tok(scope, start)
         scope.tokens.append(token)
         self._caught(token, start, msg_id)
@@ -460,6 +533,7 @@ class Step:
         self.tag(scope.robot, esp.label, "start")
         child = Scope(scope.robot, esp.child, holder)
         holder.child = child
+        self.declare(scope.robot, esp.child)
         token = Tok(child, start)
         child.tokens.append(token)
         self._caught(token, start, msg_id)
@@ -472,6 +546,7 @@ class Step:
         if token.node.behaviour == "skill":
             self.forget_assumptions(token.scope.robot)
         self.tag(token.scope.robot, token.node.label, "complete")
+        self.data_out(token.scope.robot, token.node)
         self._leave(token, token.node)
 
     # -- moving tokens ---------------------------------------------------------------------------
@@ -489,6 +564,10 @@ class Step:
         self.reached.add(element_key(catcher))
         self.fired.add(element_key(catcher))
         self.pair(robot, catcher.label, msg_id, "receive" if msg_id else "")
+        if msg_id:  # the message becomes the variable named after its signal
+            topic = catcher.trigger.topic if catcher.trigger is not None else ""
+            robot.variables.pop(topic.strip("/").replace("/", "_"), None)
+        self.data_out(robot, catcher)
         self._leave(token, catcher)
 
     def _enter(self, token: Tok, node: NodePlan) -> None:
@@ -555,6 +634,62 @@ class Step:
             if implied is not None and implied[0] not in robot.later:
                 robot.variables[implied[0]] = (implied[1], f"assumed at {node.node.describe()}")
 
+    def _set(self, robot: Robot, values: dict[str, Any], setter: str) -> None:
+        for name, value in values.items():
+            if value is UNKNOWN:
+                robot.variables.pop(name, None)
+            else:
+                robot.variables[name] = (value, setter)
+                self.set_now.add((robot.name, name))
+
+    def _known(self, robot: Robot) -> dict[str, Any]:
+        return {name: value for name, (value, _) in robot.variables.items()}
+
+    def data_in(self, robot: Robot, node: NodePlan) -> None:
+        """Before an activity: its data inputs and input parameters become variables."""
+        known = self._known(robot)
+        values = {
+            name: parameter_value(text, known)
+            for data_object in node.data_inputs
+            for name, text in data_object.parameters.items()
+        }
+        values |= {n: parameter_value(v, known) for n, v in node.node.inputs.items()}
+        self._set(robot, values, node.node.describe())
+
+    def data_out(self, robot: Robot, node: NodePlan) -> None:
+        """After an activity or a catch: output parameters and data outputs (what reads the
+        activity's outputs or the message's fields, which are not tracked, is unknown)."""
+        known = self._known(robot)
+        values = {n: parameter_value(v, known) for n, v in node.node.outputs.items() if v}
+        values |= {
+            name: parameter_value(text, known)
+            for data_object in node.data_outputs
+            for name, text in data_object.parameters.items()
+        }
+        self._set(robot, values, node.node.describe())
+
+    def declare(self, robot: Robot, plan: ScopePlan | None, *, first: bool = False) -> None:
+        """A scope opens: its data objects' literal values become variables; ``${name}``
+        declares ``name`` (None when the robot's first instance begins, when nothing can have
+        set it yet)."""
+        if plan is None:
+            return
+        literal = {
+            name: parameter_value(text, {})
+            for data_object in plan.data_objects
+            for name, text in data_object.parameters.items()
+            if "${" not in text
+        }
+        if first:
+            declared = {
+                name: None
+                for data_object in plan.data_objects
+                for name, text in data_object.parameters.items()
+                if self_reference(text) == name and name not in robot.variables
+            }
+            literal = declared | literal
+        self._set(robot, literal, f"a data object of {plan.process.describe()}")
+
     def forget_assumptions(self, robot: Robot) -> None:
         """A skill's outputs or a message's data may have written any variable."""
         for name, (_, setter) in list(robot.variables.items()):
@@ -603,6 +738,7 @@ class Step:
         if node.behaviour == "event_subprocess":
             self._consume(holder)
             return
+        self.data_out(robot, node)
         self._leave(holder, node)
 
     def _kill(self, scope: Scope) -> None:
@@ -638,12 +774,17 @@ class Step:
         self._kill(token.scope)
 
     def _run_task(self, token: Tok, node: NodePlan) -> None:
-        self.pair(token.scope.robot, node.label)
+        robot = token.scope.robot
+        self.tag(robot, node.label, "start")
+        self.data_in(robot, node)
+        self.tag(robot, node.label, "complete")
+        self.data_out(robot, node)
         self._leave(token, node)
 
     def _run_script(self, token: Tok, node: NodePlan) -> None:
         robot = token.scope.robot
         self.tag(robot, node.label, "start")
+        self.data_in(robot, node)
         script = node.node.script
         effect = script_effect(script.text, script.language) if script is not None else None
         if effect is not None:
@@ -658,26 +799,32 @@ class Step:
                     self.set_now.add((robot.name, name))
             for name in effect.havoc:
                 robot.variables.pop(name, None)
+            if effect.unreadable:
+                robot.variables.clear()
             robot.later |= effect.later
             if effect.waits:
                 token.waiting = "wait"
                 self._armed(token)
                 return
         self.tag(robot, node.label, "complete")
+        self.data_out(robot, node)
         self._leave(token, node)
 
     def _run_skill(self, token: Tok, node: NodePlan) -> None:
         self.tag(token.scope.robot, node.label, "start")
+        self.data_in(token.scope.robot, node)
         token.waiting = "wait"
         self._armed(token)
 
     def _run_call(self, token: Tok, node: NodePlan) -> None:
         robot = token.scope.robot
         self.tag(robot, node.label, "start")
+        self.data_in(robot, node)
         token.waiting = "wait"
         self._armed(token)
         child = Scope(robot, node.child, token)
         token.child = child
+        self.declare(robot, node.child)
         if not node.child.starts:
             self._close(child)
             return
@@ -723,6 +870,7 @@ class Step:
 
     def _run_event_gateway(self, token: Tok, node: NodePlan) -> None:
         token.waiting = "wait"
+        token.since = NOW
         for flow in node.outgoing:
             self.armed.add(element_key(flow.target))
 
@@ -802,7 +950,7 @@ class Step:
         msg_id = f"m{int(self.stamp)}.{self.messages}"  # unique in a trace: one step a stamp
         self.tag(robot, throw.label, "start", msg_id, "send")
         receivers = list(self._receivers(throw.topic))
-        if not receivers:
+        if not receivers and not self.capped:
             self.lost.append((robot.name, node, throw.topic))
         for receive in receivers:
             self.work.append(lambda r=receive, m=msg_id: r(m))
@@ -813,18 +961,25 @@ class Step:
         for robot in self.robots:
             for scope in scopes(robot):
                 yield from self._scope_receivers(scope, topic)
-            if len(robot.instances) < TOKEN_CAP:
-                for start in robot.plan.triggered_starts:
-                    if _listens(start, topic):
-                        yield lambda m, r=robot, s=start: self.start_instance(r, s, m)
+            for start in robot.plan.triggered_starts:
+                if not _listens(start, topic):
+                    continue
+                if len(robot.instances) >= INSTANCE_CAP:
+                    self.capped = True  # not lost: more instances than the bound keeps
+                    continue
+                yield lambda m, r=robot, s=start: self.start_instance(r, s, m)
 
     def _scope_receivers(self, scope: Scope, topic: str) -> Iterator[Callable[[str], None]]:
-        if scope.plan is not None and len(scope.tokens) < TOKEN_CAP:
+        if scope.plan is not None:
             for esp in scope.plan.event_subprocesses:
                 starts = esp.child.triggered_starts
                 fired = self.space.registry.node_id(esp) in scope.fired
-                if starts and _listens(starts[0], topic) and not fired:
-                    yield lambda m, s=scope, e=esp: self.fire_esp(s, e, m)
+                if not starts or not _listens(starts[0], topic) or fired:
+                    continue
+                if len(scope.tokens) >= TOKEN_CAP:
+                    self.capped = True
+                    continue
+                yield lambda m, s=scope, e=esp: self.fire_esp(s, e, m)
         for token in list(scope.tokens):
             node = token.node
             if token.waiting == "wait" and node.behaviour == "catch" and _listens(node, topic):
@@ -884,7 +1039,9 @@ class Step:
             scope.robot.instances.remove(scope)
 
     def _armed(self, token: Tok) -> None:
-        """Note the catchers ``token`` arms (for catches that never fire)."""
+        """Note the catchers ``token`` arms (for catches that never fire); its timers start
+        now, after every timer of the state."""
+        token.since = NOW
         node = token.node
         if node.trigger is not None:
             self.armed.add(element_key(node))
@@ -909,6 +1066,10 @@ def _implied(tree: ast.expr | None, outcome: bool) -> tuple[str, Any] | None:
     ):
         return (tree.left.id, tree.comparators[0].value)
     return None
+
+
+def _out(node: NodePlan) -> set[str]:
+    return {f.id for f in node.outgoing}
 
 
 def _listens(node: NodePlan, topic: str) -> bool:

@@ -11,6 +11,9 @@ A script is never run here. Its text is read for writes the verifier can follow:
 - any other write (inside an ``if``, a loop, ``+=``, a value the verifier cannot compute)
   makes the variable unknown at once.
 
+Data objects and parameters are followed the same way: a literal or ``${expression}`` the
+verifier can compute sets the variable, anything else makes it unknown.
+
 A condition is computed from the tracked values when it uses only literals, variables,
 ``not``/``!``, ``and``/``&&``, ``or``/``||``, comparisons and arithmetic; anything else, or an
 unknown variable, is :data:`UNKNOWN`, and the explorer then follows both outcomes.
@@ -19,7 +22,9 @@ unknown variable, is :data:`UNKNOWN`, and the explorer then follows both outcome
 from __future__ import annotations
 
 import ast
+import json
 import re
+import textwrap
 from collections.abc import Mapping
 from dataclasses import dataclass
 from functools import lru_cache
@@ -53,6 +58,7 @@ class Effect:
     havoc: frozenset[str] = frozenset()  # unknown at once
     later: frozenset[str] = frozenset()  # written by callbacks: unknown at every wait
     waits: bool = False  # completes later (JavaScript ``next()`` only inside a callback)
+    unreadable: bool = False  # the verifier cannot read it: every variable may have changed
 
 
 # -- conditions ----------------------------------------------------------------------------------
@@ -158,6 +164,10 @@ _COMPARE = {
     ast.LtE: lambda a, b: a <= b,
     ast.Gt: lambda a, b: a > b,
     ast.GtE: lambda a, b: a >= b,
+    ast.Is: lambda a, b: a is b,
+    ast.IsNot: lambda a, b: a is not b,
+    ast.In: lambda a, b: a in b,
+    ast.NotIn: lambda a, b: a not in b,
 }
 _BINARY = {
     ast.Add: lambda a, b: a + b,
@@ -181,9 +191,9 @@ def script_effect(text: str, language: str) -> Effect:
 
 def _python_effect(text: str) -> Effect:
     try:
-        tree = ast.parse(text)
+        tree = ast.parse(textwrap.dedent(text))
     except SyntaxError:
-        return Effect()
+        return Effect(unreadable=True)
     sets: list[tuple[str, ast.expr]] = []
     havoc: set[str] = set()
     later: set[str] = set()
@@ -270,3 +280,24 @@ def _kind(stack: list[str]) -> str:
     if not stack:
         return "top"
     return "callback" if "callback" in stack else "block"
+
+
+# -- data objects and parameters -----------------------------------------------------------------
+
+_PLACEHOLDER = re.compile(r"\$\{(.*)\}", re.DOTALL)
+
+
+def parameter_value(template: object, variables: Mapping[str, Any]) -> Any:
+    """A data object's or a parameter's value as the engine computes it (``${expr}`` alone:
+    the expression's value; a literal: JSON or the text), or :data:`UNKNOWN`."""
+    if not isinstance(template, str):
+        return UNKNOWN
+    whole = _PLACEHOLDER.fullmatch(template.strip())
+    if whole:
+        return evaluate(condition_tree(whole.group(1), "python"), variables)
+    if "${" in template:
+        return UNKNOWN  # text with a value formatted in: not a value a condition tests
+    try:
+        return json.loads(template)
+    except ValueError:
+        return template
