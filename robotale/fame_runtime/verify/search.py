@@ -143,7 +143,7 @@ def _successors(space: Space, state: State, stamp: int, graph: Exploration):
             answers = pending.pop()
             step = Step(space, state, Choices(answers), float(stamp))
             try:
-                yield step.run(space.events(step.robots)[number][1])
+                yield step.run(space.event(step.robots, number))
             except NeedChoice as need:
                 pending += [(*answers, option) for option in range(need.options)]
 

@@ -16,6 +16,7 @@ run once per combination of choices (:class:`Choices`), each giving its own next
 from __future__ import annotations
 
 import ast
+import itertools
 from collections import deque
 from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
@@ -28,6 +29,7 @@ from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, reachable_
 from robotale.fame_runtime.tags import Tag
 from robotale.fame_runtime.verify.values import (
     UNKNOWN,
+    condition_names,
     condition_tree,
     evaluate,
     parameter_value,
@@ -121,6 +123,10 @@ class Registry:
             for flow in scope.flows.values():
                 self._conditions[(process.id, flow.id)] = flow.condition
 
+    def conditions(self) -> list[Expression | None]:
+        """Every sequence flow condition as written."""
+        return list(self._conditions.values())
+
     def condition(self, flow: FlowPlan) -> Expression | None:
         """The condition of ``flow`` as written (None: it always holds)."""
         if flow.condition is None:
@@ -209,10 +215,25 @@ class Space:
         self.registry = Registry()
         self.robots = robots
         self.outside = outside  # signal topics the world may throw at any time
+        #: node plan id -> its timers (the plans live as long as the space)
+        self._timer_cache: dict[int, tuple[list, list]] = {}
         for _, plan in robots:
             self.registry.add_scope(plan)
             for start in plan.triggered_starts:
                 self.registry.add_node(start)
+        self.inclusive = any(n.behaviour == "inclusiveGateway" for n in self.registry.nodes)
+        self.relevant = relevant_names(self.registry)
+
+    def timers(self, token: Tok) -> list[tuple[NodePlan, float | None]]:
+        """The timers ``token`` waits on: its catch event, an event-based gateway's, its
+        activity's boundary events."""
+        waiting = token.waiting == "wait"
+        if not waiting and token.child is None:
+            return []
+        cached = self._timer_cache.get(id(token.node))
+        if cached is None:  # the same for every token at this node: computed once
+            cached = self._timer_cache[id(token.node)] = node_timers(token.node)
+        return cached[waiting]
 
     def initial(self) -> State:
         return tuple((False, (), (), ()) for _ in self.robots)
@@ -244,7 +265,7 @@ class Space:
 
     def freeze(self, robots: list[Robot]) -> State:
         # the timers' arming order is all that is kept of time: ranks 1, 2 ... (0: no timer)
-        arms = {t.since for r in robots for s in scopes(r) for t in s.tokens if _timed(t)}
+        arms = {t.since for r in robots for s in scopes(r) for t in s.tokens if self.timers(t)}
         ranks = {since: rank for rank, since in enumerate(sorted(arms), start=1)}
         return tuple(
             (
@@ -262,7 +283,7 @@ class Space:
                 self.registry.node_id(t.node),
                 t.flow,
                 t.waiting,
-                ranks[t.since] if _timed(t) else 0,
+                ranks[t.since] if self.timers(t) else 0,
                 self._freeze_scope(t.child, ranks) if t.child is not None else (),
             )
             for t in scope.tokens
@@ -273,33 +294,37 @@ class Space:
 
     def events(self, robots: list[Robot]) -> list[tuple[str, Callable[[Step], None]]]:
         """Everything that can happen in a state, each with a name and what it does."""
-        found: list[tuple[str, Callable[[Step], None]]] = []
-        self._timers = [
+        return list(self._events(robots))
+
+    def event(self, robots: list[Robot], number: int) -> Callable[[Step], None]:
+        """What the ``number``-th of :meth:`events` does (without building the others)."""
+        return next(itertools.islice(self._events(robots), number, None))[1]
+
+    def _events(self, robots: list[Robot]) -> Iterator[tuple[str, Callable[[Step], None]]]:
+        self._armed_timers = [
             (t.since, duration, t, catcher)
             for r in robots
             for s in scopes(r)
             for t in s.tokens
-            for catcher, duration in _timers(t)
+            for catcher, duration in self.timers(t)
         ]
         if not all(robot.begun for robot in robots):
             # the engines start together: every first instance runs before any timer fires
-            return [("the mission begins", lambda step: [step.begin(r) for r in step.robots])]
+            yield ("the mission begins", lambda step: [step.begin(r) for r in step.robots])
+            return
         for robot in robots:
             for scope in robot.instances:
-                found += self._scope_events(robot, scope)
-            if not robot.instances:
-                for start in robot.plan.triggered_starts:
-                    if self._may_fire(robot, start):
-                        found.append(
-                            (
-                                f"{robot.name}: {start.label}",
-                                lambda step, r=robot, s=start: step.start_instance(r, s, ""),
-                            )
-                        )
-        return found
+                yield from self._scope_events(robot, scope)
+            if robot.instances:
+                continue
+            for start in robot.plan.triggered_starts:
+                if self._may_fire(robot, start):
+                    yield (
+                        f"{robot.name}: {start.label}",
+                        lambda step, r=robot, s=start: step.start_instance(r, s, ""),
+                    )
 
-    def _scope_events(self, robot: Robot, scope: Scope) -> list:
-        found: list = []
+    def _scope_events(self, robot: Robot, scope: Scope) -> Iterator[tuple[str, Callable]]:
         if scope.plan is not None:
             for esp in scope.plan.event_subprocesses:
                 start = esp.child.triggered_starts[0] if esp.child.triggered_starts else None
@@ -309,38 +334,31 @@ class Space:
                     t.node is esp for t in scope.tokens
                 ):
                     continue  # a handler the world starts runs once at a time
-                found.append(
-                    (
-                        f"{robot.name}: {start.label}",
-                        lambda step, s=scope, e=esp: step.fire_esp(s, e, ""),
-                    )
+                yield (
+                    f"{robot.name}: {start.label}",
+                    lambda step, s=scope, e=esp: step.fire_esp(s, e, ""),
                 )
         for token in scope.tokens:
-            found += self._token_events(robot, token)
+            yield from self._token_events(robot, token)
             if token.child is not None:
-                found += self._scope_events(robot, token.child)
-        return found
+                yield from self._scope_events(robot, token.child)
 
-    def _token_events(self, robot: Robot, token: Tok) -> list:
-        found: list = []
+    def _token_events(self, robot: Robot, token: Tok) -> Iterator[tuple[str, Callable]]:
         node = token.node
         if token.waiting == "wait":
             if node.behaviour == "catch" and self._may_fire(robot, node, token):
-                found.append(
-                    (f"{robot.name}: {node.label}", lambda step, t=token: step.fire(t, t.node, ""))
+                yield (
+                    f"{robot.name}: {node.label}",
+                    lambda step, t=token: step.fire(t, t.node, ""),
                 )
             elif node.behaviour in ("skill", "script"):
-                found.append(
-                    (f"{robot.name}: {node.label} ends", lambda step, t=token: step.finished(t))
-                )
+                yield (f"{robot.name}: {node.label} ends", lambda step, t=token: step.finished(t))
             elif node.behaviour == "eventBasedGateway":
                 for flow in node.outgoing:
                     if self._may_fire(robot, flow.target, token):
-                        found.append(
-                            (
-                                f"{robot.name}: {flow.target.label}",
-                                lambda step, t=token, c=flow.target: step.fire(t, c, ""),
-                            )
+                        yield (
+                            f"{robot.name}: {flow.target.label}",
+                            lambda step, t=token, c=flow.target: step.fire(t, c, ""),
                         )
         if token.waiting == "wait" or token.child is not None:
             for boundary in node.boundaries:
@@ -350,13 +368,10 @@ class Space:
                     t.node is boundary or t.flow in _out(boundary) for t in token.scope.tokens
                 ):
                     continue  # a non-interrupting event of the world: once at a time
-                found.append(
-                    (
-                        f"{robot.name}: {boundary.label}",
-                        lambda step, t=token, b=boundary: step.fire_boundary(t, b, ""),
-                    )
+                yield (
+                    f"{robot.name}: {boundary.label}",
+                    lambda step, t=token, b=boundary: step.fire_boundary(t, b, ""),
                 )
-        return found
 
     def _may_fire(self, robot: Robot, catcher: NodePlan, token: Tok | None = None) -> bool:
         """Whether ``catcher`` may fire on its own: a timer no earlier deadline comes before,
@@ -380,9 +395,53 @@ class Space:
             return True
         return not any(
             other is not None and since <= token.since and other < duration
-            for since, other, holder, timer in self._timers
+            for since, other, holder, timer in self._armed_timers
             if not (holder is token and timer is catcher)
         )
+
+
+def relevant_names(registry: Registry) -> frozenset[str]:
+    """The variables a test can depend on: those conditions read, and those the values
+    assigned to them read, and so on. Only these are kept in a state: the others cannot tell
+    two states apart."""
+    reads: set[str] = set()
+    feeds: dict[str, set[str]] = {}  # variable -> the variables its assigned values read
+
+    def condition(expression: Expression | None) -> None:
+        if expression is not None:
+            reads.update(condition_names(expression.text, expression.language))
+
+    def assigned(name: str, text: object) -> None:
+        if isinstance(text, str):
+            inner = text.strip().removeprefix("${").removesuffix("}")
+            feeds.setdefault(name, set()).update(condition_names(inner, "python"))
+
+    for expression in registry.conditions():
+        condition(expression)
+    for node in registry.nodes:
+        event = node.node.event
+        condition(event.condition if event is not None else None)
+        if node.node.loop is not None:
+            condition(node.node.loop.condition)
+        for data_object in [*node.data_inputs, *node.data_outputs]:
+            for name, text in data_object.parameters.items():
+                assigned(name, text)
+        for name, text in {**node.node.inputs, **node.node.outputs}.items():
+            assigned(name, text)
+        script = node.node.script
+        if script is not None:
+            for name, tree in script_effect(script.text, script.language).sets:
+                feeds.setdefault(name, set()).update(
+                    n.id for n in ast.walk(tree) if isinstance(n, ast.Name)
+                )
+    relevant: set[str] = set()
+    pending = list(reads)
+    while pending:
+        name = pending.pop()
+        if name not in relevant:
+            relevant.add(name)
+            pending.extend(feeds.get(name, ()))
+    return frozenset(relevant)
 
 
 def timer_seconds(catcher: NodePlan) -> float | None:
@@ -395,26 +454,20 @@ def timer_seconds(catcher: NodePlan) -> float | None:
     return spec.interval
 
 
-def _timers(token: Tok) -> list[tuple[NodePlan, float | None]]:
-    """The timers ``token`` waits on: its catch event, an event-based gateway's, its
-    activity's boundary events."""
-    if token.waiting != "wait" and token.child is None:
-        return []
-    node = token.node
+def node_timers(node: NodePlan) -> tuple[list, list]:
+    """The timers a token at ``node`` waits on while the node runs (its boundary events)
+    and while it waits there (a catch event's or an event-based gateway's too)."""
     catchers = list(node.boundaries)
-    if token.waiting == "wait" and node.behaviour == "catch":
+    running = [(c, timer_seconds(c)) for c in catchers if _is_timer(c)]
+    if node.behaviour == "catch":
         catchers.append(node)
-    if token.waiting == "wait" and node.behaviour == "eventBasedGateway":
+    if node.behaviour == "eventBasedGateway":
         catchers += [f.target for f in node.outgoing]
-    return [
-        (c, timer_seconds(c))
-        for c in catchers
-        if c.trigger is not None and c.trigger.kind == "timer"
-    ]
+    return running, [(c, timer_seconds(c)) for c in catchers if _is_timer(c)]
 
 
-def _timed(token: Tok) -> bool:
-    return bool(_timers(token))
+def _is_timer(node: NodePlan) -> bool:
+    return node.trigger is not None and node.trigger.kind == "timer"
 
 
 def condition_holds(expression: Expression | None, robot: Robot) -> Any:
@@ -457,7 +510,7 @@ class Step:
             if steps > STEP_CAP:
                 raise RuntimeError("a loop that never waits")
             self.work.popleft()()
-            if not self.work:
+            if not self.work and self.space.inclusive:
                 self._inclusive_joins()
         for robot in self.robots:
             for name in robot.later:  # a callback may have written it while the robot waits
@@ -636,6 +689,8 @@ class Step:
 
     def _set(self, robot: Robot, values: dict[str, Any], setter: str) -> None:
         for name, value in values.items():
+            if name not in self.space.relevant:
+                continue
             if value is UNKNOWN:
                 robot.variables.pop(name, None)
             else:
@@ -795,13 +850,14 @@ class Step:
                 if value is UNKNOWN:
                     robot.variables.pop(name, None)
                 else:
-                    robot.variables[name] = (value, node.node.describe())
+                    if name in self.space.relevant:
+                        robot.variables[name] = (value, node.node.describe())
                     self.set_now.add((robot.name, name))
             for name in effect.havoc:
                 robot.variables.pop(name, None)
             if effect.unreadable:
                 robot.variables.clear()
-            robot.later |= effect.later
+            robot.later |= effect.later & self.space.relevant
             if effect.waits:
                 token.waiting = "wait"
                 self._armed(token)
@@ -1143,15 +1199,10 @@ def _reads(
     for condition in conditions:
         if condition is None:
             continue
-        tree = condition_tree(condition.text, condition.language)
-        for name in sorted(_names(tree)):
+        for name in condition_names(condition.text, condition.language):
             value, setter = robot.variables.get(name, (UNKNOWN, ""))
             reads.append((name, value, setter, (robot.name, name) in set_now))
     return tuple(dict.fromkeys(reads))
-
-
-def _names(tree: ast.expr | None) -> set[str]:
-    return {n.id for n in ast.walk(tree) if isinstance(n, ast.Name)} if tree is not None else set()
 
 
 _BEHAVIOURS: dict[str, Callable[[Step, Tok, NodePlan], None]] = {

@@ -96,6 +96,15 @@ def condition_tree(text: str, language: str) -> ast.expr | None:
         return None
 
 
+@lru_cache(maxsize=4096)
+def condition_names(text: str, language: str) -> tuple[str, ...]:
+    """The variables a condition reads, sorted."""
+    tree = condition_tree(text, language)
+    if tree is None:
+        return ()
+    return tuple(sorted({n.id for n in ast.walk(tree) if isinstance(n, ast.Name)}))
+
+
 def evaluate(tree: ast.expr | None, variables: Mapping[str, Any]) -> Any:
     """The value of ``tree`` over the tracked variables, or :data:`UNKNOWN`."""
     if tree is None:
