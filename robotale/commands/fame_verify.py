@@ -59,16 +59,16 @@ def verify_command(
         json.dump(verdict.as_dict(), out, indent=2)
         print(file=out)
     else:
-        print_verdict(verdict, out)
+        print_verdict(verdict, model, out)
     return FOUND if verdict.findings else CLEAN
 
 
-def print_verdict(verdict: Verdict, out: TextIO) -> None:
+def print_verdict(verdict: Verdict, model: Path, out: TextIO) -> None:
     """The summary line, then each finding with its trace as tag lines (step numbers as
     stamps)."""
     explored = f"{verdict.states} states, {verdict.steps} steps explored in {verdict.seconds:.2f} s"
     bound = f"; stopped early: {verdict.bound}" if verdict.bound else ""
-    print(f"{verdict.file}: robots {', '.join(verdict.robots)}; {explored}{bound}", file=out)
+    print(f"{model}: robots {', '.join(verdict.robots)}; {explored}{bound}", file=out)
     if verdict.bound:
         print(
             "note: the exploration is incomplete: elements never reached are not listed, and "

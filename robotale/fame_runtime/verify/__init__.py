@@ -12,8 +12,8 @@ from __future__ import annotations
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
 
-from robotale.fame_runtime.library import Library
-from robotale.fame_runtime.model import Definitions
+from robotale.fame_runtime.library import Library, resolve_call
+from robotale.fame_runtime.model import Definitions, Process
 from robotale.fame_runtime.plan import deploy
 from robotale.fame_runtime.splitter import split
 from robotale.fame_runtime.verify.search import KINDS, Finding, explore, findings
@@ -64,17 +64,22 @@ def verify(
     outside: Collection[str] = (),
     max_states: int = MAX_STATES,
     timeout: float = TIMEOUT,
+    opaque_calls: bool = False,
 ) -> Verdict:
-    """Explore the mission of ``definitions``; ``outside`` names the signals the world (a
-    camera, a skill) may throw at any time. A process the engine cannot run raises the
-    deployer's ModelError."""
+    """Explore the mission of ``definitions``; ``outside`` names the signals and errors the
+    world (a camera, a skill, a battery monitor) may raise at any time. With ``opaque_calls``
+    a call activity that calls nothing known runs like a skill (it ends, some time later),
+    as when a model is verified without its building blocks. A process the engine cannot run
+    raises the deployer's ModelError."""
+    if opaque_calls:
+        skills = {*skills, *unresolved_calls(definitions, skills, library)}
     assignments = split(definitions, robots)
     plans = [(a.robot, deploy(a.process, skills=skills, library=library)) for a in assignments]
     topics = frozenset(t if t.startswith("/") else f"/{t}" for t in outside)
     space = Space(plans, topics)
     graph = explore(space, max_states=max_states, timeout=timeout)
     return Verdict(
-        str(definitions.file),
+        definitions.file.name,
         [name for name, _ in plans],
         len(graph.states),
         graph.steps,
@@ -83,3 +88,30 @@ def verify(
         findings(graph),
         sorted({element for _, element in graph.reached}),
     )
+
+
+def unresolved_calls(
+    definitions: Definitions, skills: Collection[str], library: Library | None
+) -> set[str]:
+    """The called elements that are no skill, no process of the file and no building block
+    (of the file's processes and the processes they call)."""
+    found: set[str] = set()
+    pending: list[Process] = list(definitions.processes.values())
+    seen: set[int] = set()
+    while pending:
+        process = pending.pop()
+        if id(process) in seen:
+            continue
+        seen.add(id(process))
+        for node in process.walk():
+            name = node.called_element
+            if node.kind != "callActivity" or node.embedded_process or name in skills:
+                if node.embedded_process is not None:
+                    pending.append(node.embedded_process)
+                continue
+            called = resolve_call(name, process, library)
+            if called is None:
+                found.add(name)
+            else:
+                pending.append(called)
+    return found

@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tags import Tag
 from robotale.fame_runtime.verify.space import (
+    ASSUMED,
     Choices,
     Decision,
     ElementKey,
@@ -403,6 +404,9 @@ def _read(read: tuple) -> str:
     shown = {True: "true", False: "false", None: "null"}.get(value, repr(value))
     if not setter:
         return f"{name} = {shown}"
+    if setter.startswith(ASSUMED):
+        where = setter.removeprefix(ASSUMED)
+        return f"{name} = {shown}, as {where} found it before, and nothing has set it since"
     when = (
         " in the same step, with no wait between, so no callback can change it first"
         if same_step

@@ -44,6 +44,8 @@ INSTANCE_CAP = 2
 #: steps one macro step may take: more is a loop that never waits
 STEP_CAP = 10_000
 
+#: how the setter of a value a test implied begins (see Step._assume)
+ASSUMED = "assumed at "
 #: the arming time of the timers a step arms: after all those of the state before it
 NOW = 1 << 30
 
@@ -685,7 +687,7 @@ class Step:
             expression = self.space.registry.condition(flow)
             implied = _implied(condition_tree(expression.text, expression.language), outcome)
             if implied is not None and implied[0] not in robot.later:
-                robot.variables[implied[0]] = (implied[1], f"assumed at {node.node.describe()}")
+                robot.variables[implied[0]] = (implied[1], ASSUMED + node.node.describe())
 
     def _set(self, robot: Robot, values: dict[str, Any], setter: str) -> None:
         for name, value in values.items():
@@ -748,7 +750,7 @@ class Step:
     def forget_assumptions(self, robot: Robot) -> None:
         """A skill's outputs or a message's data may have written any variable."""
         for name, (_, setter) in list(robot.variables.items()):
-            if setter.startswith("assumed"):
+            if setter.startswith(ASSUMED):
                 del robot.variables[name]
 
     def _consume(self, token: Tok) -> None:
