@@ -10,7 +10,8 @@ Each model is verified ``--repeat`` times, interleaved with the baseline: one ru
 mission in the engine itself, 600 simulated seconds on the in-process bus (what a modeller
 would otherwise do to find out). Best of N wall and CPU seconds for both; the findings of
 every repeat are checked equal to the first. The load average is printed: on this shared
-machine wall times stretch with it, CPU seconds less so.
+machine wall times stretch with it, CPU seconds less so, and the target is judged on CPU
+seconds (the verifier runs on one core: on a quiet machine that is its wall time).
 
     .venv/bin/python benchmarks/verify.py [--repeat 3] [--models DIR]
 """
@@ -18,6 +19,8 @@ machine wall times stretch with it, CPU seconds less so.
 from __future__ import annotations
 
 import argparse
+import contextlib
+import io
 import os
 import sys
 import time
@@ -62,7 +65,8 @@ def engine_once(path: Path, options: dict) -> float:
     mission = Mission(
         parse(path), clock=SimClock(start=0.0), skills=skills, library=Library(path.parent)
     )
-    return mission.run(until=600.0)
+    with contextlib.redirect_stdout(io.StringIO()):  # the scripts' console.log lines
+        return mission.run(until=600.0)
 
 
 def main() -> int:
@@ -81,7 +85,8 @@ def main() -> int:
         try:
             verify_once(path, options)  # deploys: a model the engine refuses is left out
         except ModelError as error:
-            print(f"{name:42} not deployable: {str(error).splitlines()[0][:90]}")
+            reason = str(error).splitlines()[0].replace(f"{path}: ", "").replace(f"{path}:", "")
+            print(f"{name:42} not deployable: {reason[:90]}")
             continue
         walls, cpus, engine_cpus, first = [], [], [], None
         for _ in range(args.repeat):  # verifier and engine in turns (A B A B)
@@ -100,15 +105,18 @@ def main() -> int:
                 engine_cpus.append(float("nan"))
         verdict = first[0]
         best_wall, best_cpu = min(walls), min(cpus)
-        slowest = max(slowest, best_wall)
+        slowest = max(slowest, best_cpu)
         rate = verdict.states / best_cpu if best_cpu > 0 else float("inf")
         bound = f" ({verdict.bound})" if verdict.bound else ""
         print(
             f"{name:42} {verdict.states:7d} {verdict.steps:7d} {best_wall:7.2f} {best_cpu:7.2f} "
             f"{rate:9.0f} {min(engine_cpus):12.3f} {len(verdict.findings):8d}  "
-            f"{'under' if best_wall < TARGET else 'OVER'} {TARGET:g} s{bound}"
+            f"{'under' if best_cpu < TARGET else 'OVER'} {TARGET:g} s{bound}"
         )
-    print(f"slowest model: {slowest:.2f} s wall (target: each under {TARGET:g} s)")
+    print(
+        f"slowest model: {slowest:.2f} CPU s (target: each under {TARGET:g} s; the verifier "
+        "uses one core, so on a quiet machine its wall time is its CPU time)"
+    )
     print(f"load average after: {' '.join(f'{x:.2f}' for x in os.getloadavg())}")
     return 0 if slowest < TARGET else 1
 

@@ -197,7 +197,8 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
     verify.add_argument(
         "--outside",
         metavar="A,B",
-        help="signals the world throws at any time (a camera, a skill), e.g. weed_found",
+        help="signals and errors the world raises at any time (a camera, a skill, a battery "
+        "monitor), e.g. weed_found,low_battery",
     )
     verify.add_argument(
         "--max-states", type=int, metavar="N", help="stop after this many states (200000)"

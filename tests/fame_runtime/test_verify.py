@@ -8,6 +8,7 @@ import json
 import pytest
 
 from robotale.cli import main
+from robotale.errors import ModelError
 from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.labels import element_label
 from robotale.fame_runtime.library import Library
@@ -419,3 +420,29 @@ def _labels(definitions):
         for node in process.walk()
         if not node.kind.endswith("Gateway") and node.kind not in ("startEvent", "endEvent")
     }
+
+
+BUSY = model(
+    (
+        "A",
+        START
+        + script("a_count", "Count", "n = 1")
+        + gateway("g")
+        + END
+        + flow("s", "a_count")
+        + flow("a_count", "g")
+        + flow("g", "a_count", "n == 1")
+        + flow("g", "e", "n == 2"),
+    ),
+)
+
+
+def test_a_loop_that_never_waits_stops_the_robot_as_the_engine_does():
+    verdict = check(BUSY)
+    stuck = next(f for f in verdict.findings if f.kind == "stuck")
+    assert stuck.robot == "a" and "is in a loop that never waits" in stuck.sentence
+    assert lines(stuck.trace)[:2] == [("a", "count", "start"), ("a", "count", "complete")]
+    assert len(stuck.trace) == 40  # the first rounds of the loop
+    mission = Mission(parse_bytes(BUSY, "m.bpmn"), clock=SimClock(start=0.0))
+    with pytest.raises(ModelError, match="without waiting for anything"):
+        mission.run(until=10.0)

@@ -44,6 +44,9 @@ INSTANCE_CAP = 2
 #: steps one macro step may take: more is a loop that never waits
 STEP_CAP = 10_000
 
+#: tags a step that never waits keeps for its trace
+BUSY_TAGS = 40
+
 #: how the setter of a value a test implied begins (see Step._assume)
 ASSUMED = "assumed at "
 #: the arming time of the timers a step arms: after all those of the state before it
@@ -502,6 +505,7 @@ class Step:
         self.failures: list[tuple[str, str, NodePlan, str]] = []
         self.messages = 0
         self.capped = False  # a catcher was left out by TOKEN_CAP
+        self.current: Tok | None = None  # the token that moved last
         self.set_now: set[tuple[str, str]] = set()  # (robot, variable) set in this step
 
     def run(self, event: Callable[[Step], None]) -> Outcome:
@@ -510,7 +514,8 @@ class Step:
         while self.work:
             steps += 1
             if steps > STEP_CAP:
-                raise RuntimeError("a loop that never waits")
+                self._busy()
+                continue
             self.work.popleft()()
             if not self.work and self.space.inclusive:
                 self._inclusive_joins()
@@ -625,9 +630,27 @@ class Step:
         self.data_out(robot, catcher)
         self._leave(token, catcher)
 
+    def _busy(self) -> None:
+        """The step never waits: the engine stops the robot whose token keeps going with a
+        model error; so does the step here."""
+        token = self.current
+        self.work.clear()
+        del self.tags[BUSY_TAGS:]  # the trace shows the loop's first rounds, not all of them
+        self.failures.append(
+            (
+                "stuck",
+                token.scope.robot.name,
+                token.node,
+                f"{token.node.node.kind} {token.node.node.describe()} is in a loop that never "
+                "waits: the engine stops the robot with a model error",
+            )
+        )
+        self._kill_instance(token)
+
     def _enter(self, token: Tok, node: NodePlan) -> None:
         if not token.alive:
             return
+        self.current = token
         token.node = node
         self.reached.add(element_key(node))
         _BEHAVIOURS.get(node.behaviour, Step._run_pass)(self, token, node)
