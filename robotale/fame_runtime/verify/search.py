@@ -13,20 +13,18 @@ from dataclasses import dataclass, field
 
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tags import Tag
-from robotale.fame_runtime.verify.space import (
-    ASSUMED,
+from robotale.fame_runtime.verify.registry import ElementKey, element_key
+from robotale.fame_runtime.verify.space import ASSUMED, Space
+from robotale.fame_runtime.verify.state import (
     Choices,
     Decision,
-    ElementKey,
     NeedChoice,
     Outcome,
     Robot,
-    Space,
     State,
-    Step,
-    element_key,
     scopes,
 )
+from robotale.fame_runtime.verify.step import Step
 from robotale.fame_runtime.verify.values import UNKNOWN
 
 #: the kinds of finding, in the order a report lists them
