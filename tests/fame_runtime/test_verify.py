@@ -282,6 +282,12 @@ CORRECT = model(
 )
 
 
+def test_parallel_and_inclusive_splits_joined_again_give_no_finding():
+    verdict = check(GATEWAYS)
+    assert verdict.findings == [] and verdict.complete
+    assert {"t_1", "t_2", "t_x", "t_y", "t_z", "join", "merge", "a_e"} <= set(verdict.reached)
+
+
 def test_a_correct_handshake_gives_no_finding():
     verdict = check(CORRECT)
     assert verdict.findings == [] and verdict.complete
@@ -378,10 +384,39 @@ BRANCHES = model(
 )
 
 
+GATEWAYS = model(
+    (
+        "A",
+        START
+        + '<bpmn:parallelGateway id="fork"/><bpmn:parallelGateway id="join"/>'
+        + '<bpmn:inclusiveGateway id="or"/><bpmn:inclusiveGateway id="merge"/>'
+        + task("t_1", "One")
+        + task("t_2", "Two")
+        + task("t_x", "X")
+        + task("t_y", "Y")
+        + task("t_z", "Z")
+        + END
+        + flow("s", "fork")
+        + flow("fork", "t_1")
+        + flow("fork", "t_2")
+        + flow("t_1", "join")
+        + flow("t_2", "join")
+        + flow("join", "or")
+        + flow("or", "t_x", "a")
+        + flow("or", "t_y", "b")
+        + flow("or", "t_z", "not a and not b")
+        + flow("t_x", "merge")
+        + flow("t_y", "merge")
+        + flow("t_z", "merge")
+        + flow("merge", "e"),
+    ),
+)
+
+
 @pytest.mark.parametrize(
     "data",
-    [BRANCHES, UNREACHABLE, NO_EXIT, CORRECT, DEADLOCK, LOST],
-    ids=["branches", "unreachable", "no_exit", "correct", "deadlock", "lost"],
+    [BRANCHES, UNREACHABLE, NO_EXIT, CORRECT, DEADLOCK, LOST, GATEWAYS],
+    ids=["branches", "unreachable", "no_exit", "correct", "deadlock", "lost", "gateways"],
 )
 def test_the_verifier_agrees_with_the_engine_run_over_every_combination_of_unknowns(data):
     definitions = parse_bytes(data, "m.bpmn")

@@ -518,17 +518,17 @@ class Step:
             self.armed.add(element_key(flow.target))
 
     def _run_exclusive(self, token: Tok, node: NodePlan) -> None:
-        flows = self._taken(token, node, first=True)
-        if not flows:
-            self._stuck(token, node)
-            return
-        self._follow(token, flows)
+        self._split(token, node, first=True)
 
     def _run_inclusive(self, token: Tok, node: NodePlan) -> None:
         if len(node.incoming) > 1:
             token.waiting = "join"
             return
-        flows = self._taken(token, node, first=False)
+        self._split(token, node, first=False)
+
+    def _split(self, token: Tok, node: NodePlan, *, first: bool) -> None:
+        """An exclusive (``first``) or inclusive split; no flow to take stops the robot."""
+        flows = self._taken(token, node, first=first)
         if not flows:
             self._stuck(token, node)
             return
@@ -566,11 +566,7 @@ class Step:
             other.alive = False
             scope.tokens.remove(other)
         survivor.waiting = ""
-        flows = self._taken(survivor, node, first=False)
-        if not flows:
-            self._stuck(survivor, node)
-            return
-        self._follow(survivor, flows)
+        self._split(survivor, node, first=False)
 
     def _stuck(self, token: Tok, node: NodePlan) -> None:
         robot = token.scope.robot
