@@ -189,6 +189,33 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
     )
     _handled_by(run, "fame.run_command")
 
+    verify = sub.add_parser(
+        "verify",
+        help="model analysis before anything runs; exit status 1 on a finding, 2 on bad input",
+        description="Explore the mission's states (one engine per robot, signals broadcast, "
+        "timers and unknown conditions as choices) and report deadlocks, lost signals, "
+        "catches that never fire, elements never reached and loops without exit, each with "
+        "a shortest trace.",
+    )
+    verify.add_argument("model", type=Path, help="the .bpmn collaboration")
+    verify.add_argument("--robots", **robots)
+    verify.add_argument("--skills", **skills)
+    verify.add_argument("--library", **library)
+    verify.add_argument(
+        "--outside",
+        metavar="A,B",
+        help="signals and errors the world raises at any time (a camera, a skill, a battery "
+        "monitor), e.g. weed_found,low_battery",
+    )
+    verify.add_argument(
+        "--max-states", type=int, metavar="N", help="stop after this many states (200000)"
+    )
+    verify.add_argument(
+        "--timeout", type=float, metavar="SECONDS", help="stop after this long (60)"
+    )
+    verify.add_argument("--json", dest="as_json", action="store_true", default=None)
+    _handled_by(verify, "fame_verify.verify_command")
+
     node = sub.add_parser(
         "node",
         help="run one robot's engine in this process over DDS (on that robot's machine)",
