@@ -699,14 +699,19 @@ def _add_perspectives(commands: argparse._SubParsersAction) -> None:
         metavar="PERCENT",
         help="battery level counted as low (default: 20)",
     )
-    perspectives.add_argument(
+    _add_delay(perspectives)
+    _handled_by(perspectives, "perspectives.perspectives_command")
+
+
+def _add_delay(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument(
         "--delay",
         type=float,
         metavar="SECONDS",
-        help="a message is delayed when its latency is above this (default: above its "
-        "channel's own 95th percentile)",
+        help="a message is delayed when its latency is above this (default: when it is in "
+        "the slow mode of its channel's two-mode latency distribution; none when its "
+        "latencies are all alike)",
     )
-    _handled_by(perspectives, "perspectives.perspectives_command")
 
 
 def _add_report(commands: argparse._SubParsersAction) -> None:
@@ -729,6 +734,7 @@ def _add_report(commands: argparse._SubParsersAction) -> None:
         metavar="PERCENT",
         help="battery level counted as low (default: 20)",
     )
+    _add_delay(report)
     _handled_by(report, "report.report_command")
 
 

@@ -54,13 +54,18 @@ def _headline(name: str, summary: dict) -> str:
     if name == "communication":
         return (
             f"{summary['messages']} messages, {summary['received']} received, "
-            f"{summary['lost']} lost, {summary['resends']} resends "
+            f"{summary['lost']} lost, {summary.get('unobserved', 0)} not observed as received, "
+            f"{summary['resends']} resends "
             f"({summary.get('resends_new_id', 0)} under a new id), "
             f"{summary.get('delayed', 0)} delayed, {summary.get('channels', 0)} channels"
         )
     if name == "battery":
-        energy = summary.get("energy_per_case_mean")
-        used = summary.get("battery_levels") if energy is None else f"{energy:.1f}% used per case"
+        per_run = summary.get("used_per_run")
+        used = (
+            summary.get("battery_levels")
+            if not per_run
+            else "used per run: " + ", ".join(f"{r} {u:.1f}%" for r, u in per_run.items())
+        )
         return f"{summary['low_battery_events']} low-battery events; {used}"
     if name == "performance":
         share = summary.get("waiting_share")

@@ -15,7 +15,13 @@ import pandas as pd
 
 from robotale.discovery.filters import LogFilter, filter_log
 from robotale.discovery.graph import END_NODE, START_NODE, Edge, Node, ProcessGraph, duration_stats
-from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
+from robotale.discovery.instances import (
+    DURATION,
+    FINISHED,
+    START_TIMESTAMP,
+    activity_instances,
+    interrupted,
+)
 from robotale.errors import InputError
 from robotale.eventlog.schema import ACTIVITY, CASE, REQUIRED, ROBOT, TIMESTAMP
 
@@ -24,7 +30,8 @@ def discover_dfg(log: pd.DataFrame, selection: LogFilter | None = None) -> Proce
     """The directly-follows graph of the events ``selection`` keeps (all events by default).
 
     Nodes carry the number of finished instances, the robots performing them, their mean and
-    median duration and how many instances never finished; edges the number of times one
+    median duration, how many instances never finished and how many were interrupted (ended
+    aborted or cancelled: in the graph like any other end); edges the number of times one
     activity directly followed the other and the mean and median time between them.
     """
     import pm4py  # 2 s to import, and a banner: only discovery itself loads it
@@ -81,7 +88,10 @@ def _activity_nodes(instances: pd.DataFrame) -> list[Node]:
                 robot=robots[0] if len(robots) == 1 else None,
                 robots=robots,
                 durations=duration_stats(done[DURATION]),
-                properties={"unfinished": int((~group[FINISHED]).sum())},
+                properties={
+                    "unfinished": int((~group[FINISHED]).sum()),
+                    "interrupted": int(interrupted(done).sum()),
+                },
             )
         )
     return [node for node in nodes if node.count or node.properties["unfinished"]]

@@ -6,7 +6,9 @@ activity), but per robot and per instance key (``execution_id`` or ``concept:ins
 the log has one, otherwise ``msg_id``), because robots run at the same time within one case
 and a message activity's start and complete always share the message id. ``inprogress`` rows
 carry continuous data and are never instances; an instant event (lifecycle ``none``, such as a
-timer firing) is an instance that starts and completes at once.
+timer firing) is an instance that starts and completes at once. An activity interrupted or
+cancelled (lifecycle ``aborted``/``cancelled``, XES' ``ate_abort``/``pi_abort``/``withdraw``)
+ends there: it is a finished instance whose end keeps that lifecycle (:func:`interrupted`).
 """
 
 from __future__ import annotations
@@ -16,6 +18,7 @@ from collections.abc import Sequence
 import numpy as np
 import pandas as pd
 
+from robotale.eventlog.reading import LIFECYCLE_VALUES
 from robotale.eventlog.schema import (
     ABORTED,
     ACTIVITY,
@@ -53,8 +56,8 @@ def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
 
 
 def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
-    """One row per activity instance, ordered by case and start (ties: the order in which
-    the start events appear in the log).
+    """One row per activity instance, ordered by case and start (ties: robot, then activity,
+    as :func:`in_tie_order` orders the events of one moment; not the file's order).
 
     Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
     completion), ``duration`` in seconds, ``finished`` and ``start_known``; for every column
@@ -65,9 +68,8 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     events = control_flow_events(log)
     if events.empty:
         return _empty_instances(log)
+    events = in_tie_order(events)
     events = events.assign(_order=np.arange(len(events)))
-    if not events[TIMESTAMP].is_monotonic_increasing:  # logs usually come in time order
-        events = events.sort_values([TIMESTAMP, "_order"], kind="stable")
     lifecycle = _lifecycle(events)
     group = events.groupby(_pairing_keys(events), dropna=False, sort=False).ngroup()
     starts = (lifecycle == START).to_numpy()
@@ -100,17 +102,69 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     return instances.drop(columns=["_order", "_start_order"]).reset_index(drop=True)
 
 
+def in_tie_order(events: pd.DataFrame) -> pd.DataFrame:
+    """The events in time order, those at the same moment in an order the file's does not
+    decide: a start before any other event, then by robot, then by activity (then as in the
+    file, which only rows alike in all of these keep). A start first pairs each completion
+    with the instance it ends however the rows of one moment were written."""
+    if not events[TIMESTAMP].is_monotonic_increasing:  # logs usually come in time order
+        events = events.sort_values(TIMESTAMP, kind="stable")
+    times = _ticks(events[TIMESTAMP])
+    same = times[1:] == times[:-1]
+    if not same.any():
+        return events
+    tied = np.zeros(len(events), dtype=bool)
+    tied[1:] |= same
+    tied[:-1] |= same
+    rows = np.flatnonzero(tied)
+    part = events.iloc[rows]
+    keys = [np.arange(len(rows))]  # the file's order: the last tie-break
+    for column in (ACTIVITY, ROBOT):
+        if column in part.columns:
+            values = part[column].astype("string").fillna("")
+            keys.append(pd.factorize(values, sort=True)[0])
+    keys.append((_lifecycle(part) != START).to_numpy(np.int8))
+    keys.append(times[rows])
+    order = np.arange(len(events))
+    order[rows] = rows[np.lexsort(keys)]
+    return events.iloc[order]
+
+
+def _ticks(times: pd.Series) -> np.ndarray:
+    """The times as integers (of their own unit) that compare as the times do."""
+    values = times.array
+    if not hasattr(values, "asi8"):  # times of several offsets, kept as objects
+        values = pd.to_datetime(times, utc=True).array
+    return np.asarray(values.asi8)
+
+
 def _lifecycle(log: pd.DataFrame) -> pd.Series:
     if LIFECYCLE not in log.columns:
         return pd.Series(COMPLETE, index=log.index)
-    # lowered once per distinct value: a log repeats a handful of them
-    codes, uniques = pd.factorize(log[LIFECYCLE].astype(object))
-    lowered = pd.Series(uniques, dtype="string").str.lower()
-    # an aborted or cancelled activity ended all the same: it pairs with its start (the row
-    # keeps its own lifecycle, so the outcome stays visible)
-    lowered = lowered.replace({ABORTED: COMPLETE, CANCELLED: COMPLETE})
+    codes, meaning = _meanings(log[LIFECYCLE])
+    # an aborted or cancelled activity (XES' ``ate_abort`` ...) ended all the same: it pairs
+    # with its start (the row keeps its own lifecycle, so the outcome stays visible)
+    lowered = meaning.replace({ABORTED: COMPLETE, CANCELLED: COMPLETE})
     lowered = pd.concat([lowered, pd.Series([COMPLETE], dtype="string")], ignore_index=True)
     return pd.Series(lowered.array[codes], index=log.index)
+
+
+def interrupted(instances: pd.DataFrame) -> pd.Series:
+    """Which instances ended aborted or cancelled (interrupted) rather than completed."""
+    if LIFECYCLE not in instances.columns:
+        return pd.Series(False, index=instances.index)
+    codes, meaning = _meanings(instances[LIFECYCLE])
+    stopped = meaning.isin([ABORTED, CANCELLED]).to_numpy(bool)
+    return pd.Series(np.append(stopped, False)[codes], index=instances.index)
+
+
+def _meanings(lifecycle: pd.Series) -> tuple[np.ndarray, pd.Series]:
+    """Codes of the lifecycle values (-1: missing) and what each distinct value means, worked
+    out once per value (a log repeats a handful of them)."""
+    codes, uniques = pd.factorize(lifecycle.astype(object))
+    lowered = pd.Series(uniques, dtype="string").str.lower()
+    meaning = lowered.map(lambda value: LIFECYCLE_VALUES.get(value, value), na_action="ignore")
+    return codes, meaning.astype("string")
 
 
 def _pairing_keys(events: pd.DataFrame) -> list[str]:

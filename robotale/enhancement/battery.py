@@ -10,6 +10,11 @@ that tags it, such as the thesis' ``low_battery``; for each the perspective list
 robot did next. Energy per case: per robot, the percentage points it used (every fall of its
 level added up) and charged (every rise). A log without battery levels says so; its figures
 are missing, never 0.
+
+A battery belongs to one robot: every figure is per robot (and run), never a sum over robots,
+whose batteries differ. Use is never negative: where a level rose (a robot charging during an
+activity or while it waits) that is ``charged``, apart from ``used``. The levels chart breaks
+each robot's line between runs, so the time between two runs draws no ramp.
 """
 
 from __future__ import annotations
@@ -117,11 +122,13 @@ def activity_consumption(
     chosen = focus_events(instances, activity, robot).dropna(subset=[BATTERY, f"start_{BATTERY}"])
     if chosen.empty:
         return pd.DataFrame()
-    chosen = chosen.assign(used=chosen[f"start_{BATTERY}"] - chosen[BATTERY])
+    change = chosen[f"start_{BATTERY}"] - chosen[BATTERY]
+    chosen = chosen.assign(used=change.clip(lower=0), charged=(-change).clip(lower=0))
     keys = [ACTIVITY] + ([ROBOT] if ROBOT in chosen.columns else [])
     table = chosen.groupby(keys, sort=True).agg(
         instances=("used", "size"),
         used=("used", "sum"),
+        charged=("charged", "sum"),
         seconds=(DURATION, "sum"),
         start_level_mean=(f"start_{BATTERY}", "mean"),
         start_level_min=(f"start_{BATTERY}", "min"),
@@ -220,26 +227,38 @@ def _idle_use(analysis: LogAnalysis, levels: pd.DataFrame) -> pd.DataFrame:
         }
     )
     probe = _fill_levels(probe, levels).dropna(subset=[BATTERY, f"start_{BATTERY}"])
-    probe = probe.assign(used=probe[f"start_{BATTERY}"] - probe[BATTERY], seconds=steps[WAIT])
+    change = probe[f"start_{BATTERY}"] - probe[BATTERY]
+    probe = probe.assign(
+        used=change.clip(lower=0), charged=(-change).clip(lower=0), seconds=steps[WAIT]
+    )
     table = probe.groupby(ROBOT, sort=True).agg(
-        instances=("used", "size"), used=("used", "sum"), seconds=("seconds", "sum")
+        instances=("used", "size"),
+        used=("used", "sum"),
+        charged=("charged", "sum"),
+        seconds=("seconds", "sum"),
     )
     return table.reset_index().assign(**{ACTIVITY: IDLE})
 
 
 def _energy_summary(consumption: pd.DataFrame, energy: pd.DataFrame) -> dict:
+    """Per robot: the mean percentage points it used per run, and what it used while waiting;
+    never a sum over robots."""
     if energy.empty:
         return {"battery_levels": f"the log has {NO_LEVELS}"}
-    per_case = energy.groupby(CASE)["used"].sum() if CASE in energy.columns else energy["used"]
+    robots = energy[ROBOT] if ROBOT in energy.columns else pd.Series("all", index=energy.index)
+    per_run = energy.groupby(robots.astype(str), sort=True)["used"].mean()
     summary = {
-        "energy_used": float(energy["used"].sum()),
-        "energy_per_case_mean": float(per_case.mean()),
+        "used_per_run": {robot: float(used) for robot, used in per_run.items()},
+        "most_used_robot": str(per_run.idxmax()),
     }
     if not consumption.empty:
         idle = consumption["activity"] == IDLE
         work = consumption[~idle].sort_values("used", ascending=False)
         summary["most_used_by"] = None if work.empty else str(work["activity"].iloc[0])
-        summary["used_while_waiting"] = float(consumption.loc[idle, "used"].sum())
+        waiting = consumption[idle]
+        if ROBOT in waiting.columns and not waiting.empty:
+            used = waiting.set_index(waiting[ROBOT].astype(str))["used"]
+            summary["used_while_waiting"] = {robot: float(u) for robot, u in used.items()}
     return summary
 
 
@@ -323,7 +342,8 @@ def _levels_figure(levels: pd.DataFrame, lows: pd.DataFrame):
     figure = go.Figure()
     robots = levels.groupby(ROBOT, sort=True) if ROBOT in levels.columns else [("all", levels)]
     for name, mine in robots if BATTERY in levels.columns else []:  # tagged lows, no levels
-        figure.add_scatter(x=mine[TIMESTAMP], y=mine[BATTERY], mode="lines", name=str(name))
+        times, values = broken_between_runs(mine)
+        figure.add_scatter(x=times, y=values, mode="lines", name=str(name), connectgaps=False)
     if not lows.empty:
         figure.add_scatter(
             x=lows[TIMESTAMP],
@@ -335,3 +355,17 @@ def _levels_figure(levels: pd.DataFrame, lows: pd.DataFrame):
         )
     figure.update_layout(title="Battery level (%)", yaxis_title="%", xaxis_title="time")
     return figure
+
+
+def broken_between_runs(levels: pd.DataFrame) -> tuple[np.ndarray, np.ndarray]:
+    """One robot's levels in time order as x and y of a line, with a gap (``None``) where a
+    run ends and the next begins: a line drawn across the time between runs would look like
+    charging or draining that never happened."""
+    ordered = levels.sort_values(TIMESTAMP, kind="stable")
+    times = ordered[TIMESTAMP].to_numpy(object)
+    values = ordered[BATTERY].to_numpy(float).astype(object)
+    if CASE not in ordered.columns:
+        return times, values
+    cases = ordered[CASE].astype(str).to_numpy(object)
+    ends = np.flatnonzero(cases[1:] != cases[:-1]) + 1
+    return np.insert(times, ends, None), np.insert(values, ends, None)

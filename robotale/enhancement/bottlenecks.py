@@ -31,9 +31,18 @@ row ``longer_by`` / ``extra_median`` say how much longer (mean / median) the cas
 a steady cost: the cases it hits hardest, above its median case) take than the others, and
 ``p_value`` how sure that is (Mann-Whitney U, see :mod:`robotale.enhancement.effects`).
 
-Rows whose p-value is :data:`ALPHA` or more come after all others: the cases with them may be
-longer by chance. A step found in all cases but one is "present" in every slow case, and
-without this its chance difference to that one case would outrank a real cause.
+A row is *ranked* (``ranked`` True) only with both a magnitude and a test: it adds at least
+:data:`MIN_SHARE` of the runs' time (``share``) and its p-value is below :data:`ALPHA`. Every
+ranked row comes before every other one (an effect that may be chance, one without a test
+result, or one that adds under 1 % of a run), each part by delay per case. A step found in all
+cases but one is "present" in every slow case, and without this its chance difference to that
+one case would outrank a real cause; and 0 ms must never rank first.
+
+The outcome is held fixed: when some runs did not complete (a robot's last activity in the run
+never completed, or ended aborted or cancelled) and at least two did, only the completed runs
+are compared, against each other; the aborted runs are left out and the summary says how many
+(``aborted_runs_left_out``), so an escort found in every completed run is not "slower than the
+others" because the others are the aborted ones.
 """
 
 from __future__ import annotations
@@ -42,7 +51,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.graph import format_seconds
-from robotale.discovery.instances import DURATION, START_TIMESTAMP
+from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, interrupted
 from robotale.enhancement.communication import TYPE, event_roles, shared_latencies
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.effects import compare_cases
@@ -68,6 +77,8 @@ KINDS = EFFECTS + STEADY
 KEY = ["kind", "activity", "robot"]
 #: an effect with a p-value at least this large may be chance: it is ranked after the others
 ALPHA = 0.05
+#: an effect that adds less than this share of the runs' time is ranked after the others
+MIN_SHARE = 0.01
 
 
 def find_bottlenecks(
@@ -93,10 +104,14 @@ def find_bottlenecks(
         steps = robot_steps(instances)
         robots = robot_times(instances, steps)
     cases = shared_cases(analysis).set_index(CASE)["duration"]
+    cases, left_out = _same_outcome(cases, run_outcomes(analysis))
     paths = _paths(robots, shared_case_variants(analysis))
     presence = _keep(_presence(instances, steps, paths, min_variant_cases), activity, robot)
     excess = _steady_excess(analysis, instances, steps, baseline_quantile)
     excess = _keep(excess, activity, robot)
+    if left_out:
+        presence = presence[presence[CASE].isin(cases.index)]
+        excess = excess[excess[CASE].isin(cases.index)]
     parts = [_effect_rows(presence, cases), _steady_rows(excess, cases)]
     parts = [part for part in parts if not part.empty]
     ranking = pd.concat(parts) if parts else pd.DataFrame({"delay_per_case": []})
@@ -117,9 +132,41 @@ def find_bottlenecks(
             "first_kind": first["kind"],
             "first_delay_per_case": float(first["delay_per_case"]),
             "candidates": len(ranking),
+            "ranked": int(ranking["ranked"].sum()),
             "cases": len(cases),
+            "aborted_runs_left_out": left_out,
+            "compared": "completed runs against completed runs"
+            if left_out
+            else "all runs (every run completed)",
         },
     )
+
+
+def run_outcomes(analysis: LogAnalysis) -> pd.Series:
+    """Per run, whether it completed: no robot's last activity instance in it is unfinished
+    or ended aborted or cancelled."""
+
+    def build() -> pd.Series:
+        instances = analysis.instances()
+        if instances.empty:
+            return pd.Series(dtype=bool)
+        keys = [CASE, ROBOT] if ROBOT in instances.columns else [CASE]
+        # instances come in start order: a robot's last is its last row in the run
+        last = instances.drop_duplicates(keys, keep="last")
+        failed = ~last[FINISHED].to_numpy(bool) | interrupted(last).to_numpy(bool)
+        completed = pd.Series(~failed, index=last.index).groupby(last[CASE].to_numpy()).all()
+        return completed
+
+    return analysis.shared("run_outcomes", build)
+
+
+def _same_outcome(cases: pd.Series, completed: pd.Series) -> tuple[pd.Series, int]:
+    """The runs to compare: the completed ones when some did not complete and at least two
+    did (else all), and how many were left out."""
+    done = completed.reindex(cases.index).fillna(True).astype(bool)
+    if done.all() or done.sum() < 2:
+        return cases, 0
+    return cases[done.to_numpy()], int((~done).sum())
 
 
 def _keep(rows: pd.DataFrame, activity: str | None, robot: str | None) -> pd.DataFrame:
@@ -450,15 +497,17 @@ def _medians_with_zeros(ids: np.ndarray, values: np.ndarray, width: int) -> pd.S
 
 
 def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
+    share = ranking["total"] / (total_time or float("nan"))
+    tested = pd.to_numeric(ranking["p_value"], errors="coerce").lt(ALPHA)
     ranking = ranking.assign(
-        share=ranking["total"] / (total_time or float("nan")),
+        share=share,
         longer_by=ranking["extra_mean"],
         _kind=ranking["kind"].map(KINDS.index),
-        _chance=pd.to_numeric(ranking["p_value"], errors="coerce").ge(ALPHA),
+        ranked=(tested & share.ge(MIN_SHARE)).to_numpy(bool),
     )
     ranking = ranking.sort_values(
-        ["_chance", "delay_per_case", "_kind", "occurrences"],
-        ascending=[True, False, True, False],
+        ["ranked", "delay_per_case", "_kind", "occurrences"],
+        ascending=[False, False, True, False],
         kind="stable",
     ).reset_index(drop=True)
     ranking.insert(0, "rank", range(1, len(ranking) + 1))
@@ -478,6 +527,7 @@ def _order(ranking: pd.DataFrame, total_time: float) -> pd.DataFrame:
         "longer_by",
         "extra_median",
         "p_value",
+        "ranked",
         "also",
         "explanation",
     ]
@@ -500,7 +550,7 @@ def _explain(row: dict) -> str:
         }[row["kind"]]
         sentence = (
             f"{subject} take {each} longer than the others "
-            f"({row['cases']} of {int(row['cases'] + row['cases_without'])} cases{_sure(row)})"
+            f"({row['cases']} of {int(row['cases'] + row['cases_without'])} cases)"
         )
     else:
         sentence = {
@@ -510,11 +560,17 @@ def _explain(row: dict) -> str:
             "delay": f"{name} by {who} runs {each} longer than its fastest runs ({times})",
             "queueing": f"{name} messages wait {each} from send to receipt ({times})",
         }[row["kind"]]
-    return f"{sentence}: {per_case} per case"
+    return f"{sentence}: {per_case} per case ({_how_sure(row)})"
 
 
-def _sure(row: dict) -> str:
-    return "" if pd.isna(row["p_value"]) else f", p = {row['p_value']:.2g}"
+def _how_sure(row: dict) -> str:
+    """The magnitude as a share of the runs' time, and the test: why a row ranks or not."""
+    share = row["share"]
+    size = "under 1% of a run" if not share >= MIN_SHARE else f"{share:.0%} of the runs' time"
+    if pd.isna(row["p_value"]):
+        return f"{size}; no test possible: may be chance"
+    verdict = "may be chance" if row["p_value"] >= ALPHA else "unlikely to be chance"
+    return f"{size}; p = {row['p_value']:.2g}, {verdict}"
 
 
 def _short(text: str, limit: int = 80) -> str:

@@ -8,16 +8,29 @@ where the log has it, else the robot of its sends; its receivers the robots of i
 else ``msg_receiver``, else the one robot that received every other message of its sender and
 type, else ``unknown``. A channel is a sender -> receiver pair. Per message:
 
-- sent: it has at least one send; received: at least one receive; lost: sent, never received;
+- sent: it has at least one send; received: at least one receive;
+- lost or not observed as received: sent, never received. Only a log that tags receives of
+  its type can say it was lost: a message type is *receive-tagged* when some receive of that
+  type appears in the log (and, for a message whose receiver is named, some receive of that
+  type by that receiver). A message of a type without receive tags may well have arrived (a
+  skill that consumes a message leaves no receive tag): it is ``unobserved``, never ``lost``,
+  and the summary names those types (``untagged_types``);
 - attempts: how many times it was sent under its id (the send activity's starts, or its events
   when the log has no lifecycle);
 - resends: attempts - 1 (``resends_same_id``), plus one when the sender sent it again under a
-  new id (``resends_new_id``): the next message of the same sender, type and channel in the
-  case, sent before this one was received (or when it never was), and with the same payload
-  when the log has ``msg_payload`` (a different payload is news, not a resend);
+  new id (``resends_new_id``): a later message of the same case and sender, sent while this
+  one had no answer, to the same receiver (of any type: a resend may change its type), or of
+  the same type where either receiver is unknown. An answer is a receive of it, or any message
+  from its receiver (from anyone, when its receiver is unknown) to its sender, so the next
+  task sent after a reply is news. Each resend names the message it repeats (``repeats``; the
+  repeated one names it in ``resent_as``); a message is repeated at most once (a chain of
+  resends repeats one after the other). The payload is a hint, never a requirement: when several
+  unanswered messages could be the repeated one, the one with the same payload wins, else the
+  latest (payloads are often constant or carry a stamp, so they neither make nor break one);
 - latency: from its first send to its first receive (per receiver on the channels);
-- delayed: a latency above ``delay_threshold`` seconds if given, else above the channel's own
-  95th percentile (for channels with at least ``MIN_FOR_P95`` received messages).
+- delayed: see :mod:`robotale.enhancement.delays` (an explicit threshold, or the slow mode of
+  a two-mode latency distribution per channel: sender, receiver and type; the channels table
+  says from which latency, ``delayed_from``); ``delay_rule`` states the rule used.
 
 For every lost message the ``lost`` table says what its sender did next, whether it was resent
 and got through, and how much later its case ended than the median case without a lost message.
@@ -29,6 +42,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.delays import delay_rule, delayed, slow_mode_starts
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.followed import what_followed
 from robotale.enhancement.performance import finished_instances, shared_cases
@@ -56,8 +70,6 @@ TYPE = "message_type"
 #: so each per-message step groups and looks up integers rather than pairs of texts
 MESSAGE = "_message"
 UNKNOWN = "unknown"
-#: the fewest received messages on a channel for its own 95th percentile to mean anything
-MIN_FOR_P95 = 20
 CHANNEL = ["sender", "receiver", TYPE]
 
 
@@ -92,11 +104,18 @@ def communication_perspective(
     deliveries = deliveries.merge(messages[_keys(messages)], on=_keys(messages))
     lost = lost.merge(messages[_keys(messages)], on=_keys(messages))
     types, channels = _by_type(messages, deliveries), _by_channel(deliveries)
+    if delay_threshold is None:
+        starts = slow_mode_starts(deliveries["latency"], _channel_of(deliveries))
+        channels["delayed_from"] = _channel_of(channels).map(starts).astype(float)
+    else:
+        channels["delayed_from"] = float(delay_threshold)
+    summary = _summary(messages, channels, lost_effect)
+    summary["delay_rule"] = delay_rule(delay_threshold)
     return Perspective(
         name="communication",
         tables={"message_types": types, "channels": channels, "messages": messages, "lost": lost},
         figures=Figures({"messages": lambda: _figure(types)}),
-        summary=_summary(messages, channels, lost_effect),
+        summary=summary,
     )
 
 
@@ -139,9 +158,10 @@ def message_tables(
     numbered = table.assign(**{MESSAGE: np.arange(len(table))})
     deliveries = _deliveries(numbered, events, receives, ids)
     table["receiver"] = _lookup(numbered, ids, _joined(deliveries, ids, "receiver"))
-    deliveries["delayed"] = _delayed(deliveries, delay_threshold)
-    delayed = deliveries.groupby(MESSAGE)["delayed"].any()
-    table["delayed"] = _lookup(numbered, ids, delayed).fillna(False).astype(bool)
+    deliveries["delayed"] = delayed(deliveries["latency"], _channel_of(deliveries), delay_threshold)
+    late = deliveries.groupby(MESSAGE)["delayed"].any()
+    table["delayed"] = _lookup(numbered, ids, late).fillna(False).astype(bool)
+    _split_lost(table, deliveries, numbered, ids)
     keys = _keys(table)
     return _with_resends(table), _with_keys(deliveries, table, keys)
 
@@ -155,8 +175,10 @@ def _with_keys(rows: pd.DataFrame, table: pd.DataFrame, keys: list[str]) -> pd.D
 def shared_latencies(analysis: LogAnalysis) -> pd.DataFrame:
     """Per message (rows as in :func:`message_table`): its type, sender and ``latency``, from
     the analysis' message table when it has one, else from the little that needs."""
-    if ("messages", None) in analysis:
-        return shared_message_tables(analysis)[0]
+    # the message table of any delay threshold: latencies do not depend on it
+    built = [k for k in analysis.built() if isinstance(k, tuple) and k[:1] == ("messages",)]
+    if built:
+        return shared_message_tables(analysis, built[0][1])[0]
 
     def build() -> pd.DataFrame:
         core = _message_core(analysis.log)
@@ -352,36 +374,134 @@ def _meant_for(missing, events, reached, keys) -> np.ndarray:
     return stated.combine_first(guessed).fillna(UNKNOWN).to_numpy(object)
 
 
-def _delayed(deliveries: pd.DataFrame, threshold: float | None) -> pd.Series:
-    latency = deliveries["latency"]
-    if threshold is not None:
-        return latency.gt(threshold)
-    channel = deliveries.groupby(CHANNEL, dropna=False)["latency"]
-    p95 = channel.transform("quantile", 0.95)
-    enough = channel.transform("count") >= MIN_FOR_P95
-    return latency.gt(p95) & enough
+def _split_lost(table, deliveries, numbered, ids) -> None:
+    """An unreceived delivery is lost only where the log tags receives of its type (by its
+    receiver, when named); else it is ``unobserved``: it may have arrived untagged."""
+    reached = deliveries[deliveries["received"]]
+    tagged_types = set(table.loc[table["received"], TYPE].dropna())
+    tagged_pairs = set(zip(reached[TYPE], reached["receiver"], strict=True))
+    receiver = deliveries["receiver"].astype(object)
+    pairs = pd.Series(list(zip(deliveries[TYPE], receiver, strict=True)), index=deliveries.index)
+    tagged = deliveries[TYPE].isin(tagged_types) & (receiver.eq(UNKNOWN) | pairs.isin(tagged_pairs))
+    # a message received by a robot the log does not name has a delivery without a receiver
+    arrived = table["received"].to_numpy(bool)[deliveries[MESSAGE].to_numpy()]
+    missing = deliveries["sent_at"].notna() & ~deliveries["received"] & ~arrived
+    deliveries["lost"] = missing & tagged
+    deliveries["unobserved"] = missing & ~tagged
+    lost = deliveries.groupby(MESSAGE)["lost"].any()
+    lost = _lookup(numbered, ids, lost).fillna(False).astype(bool)
+    table["lost"] = table["lost"] & lost
+    table["unobserved"] = table["sent"] & ~table["received"] & ~table["lost"]
+
+
+def _channel_of(rows: pd.DataFrame) -> pd.Series:
+    """Each row's channel (sender, receiver and type) as one value, to group by."""
+    parts = [rows[c].astype(object).where(rows[c].notna(), "") for c in CHANNEL]
+    return pd.Series(list(zip(*parts, strict=True)), index=rows.index, dtype=object)
+
+
+def untagged_types(messages: pd.DataFrame) -> list[str]:
+    """The message types sent in the log none of whose receives it tags: whether their
+    messages arrived is unknown."""
+    sent = messages[messages["sent"]]
+    received = set(messages.loc[messages["received"], TYPE])
+    return sorted({str(t) for t in sent[TYPE].dropna() if t not in received})
 
 
 def _with_resends(table: pd.DataFrame) -> pd.DataFrame:
-    """Adds which messages were sent again under a new id (``resent_as``), the resends by id
-    reuse and by new id, and ``recovered``: lost, but a resend got through."""
-    group = [k for k in (CASE, "sender", TYPE, "payload") if k in table.columns]
-    ordered = table.sort_values([*group, "sent_at"], kind="stable")
-    following = ordered.groupby(group, dropna=False, sort=False)[
-        [MSG_ID, "sent_at", "receiver", "received"]
-    ].shift(-1)
-    unanswered = ordered["received_at"].isna() | (following["sent_at"] < ordered["received_at"])
-    same_channel = ordered["receiver"].isin([UNKNOWN]) | (
-        ordered["receiver"] == following["receiver"]
-    )
-    again = following[MSG_ID].notna() & ordered["sent"] & unanswered & same_channel
-    table["resent_as"] = following[MSG_ID].where(again).reindex(table.index)
+    """Adds which message each message was sent again as (``resent_as``) and repeats
+    (``repeats``), the resends by id reuse and by new id, and ``recovered``: lost, but a
+    resend got through."""
+    resent_as, repeats = _repeated(table)
+    table["resent_as"] = resent_as
+    table["repeats"] = repeats
     table["resends_same_id"] = (table["attempts"] - 1).clip(lower=0)
-    table["resends_new_id"] = table["resent_as"].notna().astype(int)
+    table["resends_new_id"] = table["repeats"].notna().astype(int)
     table["resends"] = table["resends_same_id"] + table["resends_new_id"]
-    got_through = following["received"].where(again).reindex(table.index)
-    table["recovered"] = table["lost"] & got_through.fillna(False).astype(bool)
+    ids = pd.Series(np.arange(len(table)), index=table.index)
+    resend_row = _resend_rows(table, ids)
+    got_through = table["received"].to_numpy(bool)[np.maximum(resend_row, 0)] & (resend_row >= 0)
+    table["recovered"] = table["lost"].to_numpy(bool) & got_through
     return table
+
+
+def _resend_rows(table: pd.DataFrame, ids: pd.Series) -> np.ndarray:
+    """Per message, the row of the message it was resent as (-1: none)."""
+    keys = [k for k in (CASE,) if k in table.columns]
+    by_id = pd.Series(ids.to_numpy(), index=pd.MultiIndex.from_frame(table[[*keys, MSG_ID]]))
+    wanted = table[keys].assign(**{MSG_ID: table["resent_as"]})
+    found = by_id.reindex(pd.MultiIndex.from_frame(wanted[[*keys, MSG_ID]]))
+    return found.fillna(-1).to_numpy(np.int64)
+
+
+def _repeated(table: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
+    """Per message, the id of the message that repeated it and of the one it repeats (see
+    the module: same case and sender, same receiver or type, sent while it had no answer)."""
+    n = len(table)
+    resent_as = np.full(n, None, dtype=object)
+    repeats = np.full(n, None, dtype=object)
+    sent = table["sent"].to_numpy(bool) & table["sent_at"].notna().to_numpy(bool)
+    if not sent.any():
+        return pd.Series(resent_as, index=table.index), pd.Series(repeats, index=table.index)
+    cases = table[CASE].astype(object).to_numpy() if CASE in table.columns else np.zeros(n)
+    times = table["sent_at"]
+    order = np.flatnonzero(sent)[np.argsort(times.to_numpy()[sent], kind="stable")]
+    sent_at = times.to_numpy()
+    received_at = table["received_at"].to_numpy()
+    received = table["received"].to_numpy(bool)
+    senders = table["sender"].astype(object).to_numpy()
+    types = table[TYPE].astype(object).to_numpy()
+    ids = table[MSG_ID].astype(object).to_numpy()
+    receivers = [_receiver_set(r) for r in table["receiver"].astype(object).to_numpy()]
+    payloads = table["payload"].astype(object).to_numpy() if "payload" in table else None
+    # case -> sender -> the sender's unanswered messages (rows), oldest first
+    waiting: dict[object, dict[object, list[int]]] = {}
+    for row in order:
+        case, sender, at = cases[row], senders[row], sent_at[row]
+        in_case = waiting.setdefault(case, {})
+        _answer(in_case, sender, receivers[row], receivers)
+        mine = in_case.setdefault(sender, [])
+        mine[:] = [a for a in mine if not (received[a] and received_at[a] <= at)]
+        same = [
+            a for a in mine if payloads is not None and _same_payload(payloads[a], payloads[row])
+        ]
+        candidates = [a for a in mine if _may_repeat(a, row, types, receivers)]
+        if candidates:
+            chosen = ([a for a in candidates if a in same] or candidates)[-1]
+            mine.remove(chosen)
+            resent_as[chosen], repeats[row] = ids[row], ids[chosen]
+        mine.append(row)
+    return pd.Series(resent_as, index=table.index), pd.Series(repeats, index=table.index)
+
+
+def _may_repeat(earlier: int, later: int, types, receivers: list[frozenset]) -> bool:
+    """Whether ``later`` may repeat ``earlier`` by their ends and types alone: the same
+    receiver, whatever the type; or the same type where a receiver is unknown (a message to
+    another known robot is not a resend of it)."""
+    mine, theirs = receivers[earlier], receivers[later]
+    if mine and theirs:
+        return bool(mine & theirs)
+    return types[earlier] == types[later]
+
+
+def _same_payload(earlier, later) -> bool:
+    return isinstance(earlier, str) and isinstance(later, str) and earlier == later
+
+
+def _answer(waiting: dict, sender, to: frozenset, receivers: list[frozenset]) -> None:
+    """A message from ``sender`` to ``to`` (empty: unknown) answers the unanswered messages
+    of its case sent to ``sender`` (or to nobody known) by the robots it may be for."""
+    for other, theirs in waiting.items():
+        if other == sender or (to and other not in to):
+            continue
+        theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+
+
+def _receiver_set(receiver) -> frozenset:
+    """The robots a message went to (a joined list splits; ``unknown`` is none)."""
+    if not isinstance(receiver, str) or receiver == UNKNOWN:
+        return frozenset()
+    return frozenset(receiver.split(", "))
 
 
 def _what_followed(lost: pd.DataFrame, instances: pd.DataFrame, following: int) -> list[str]:
@@ -495,6 +615,7 @@ def _by_type(messages: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:
         sent=("sent", "sum"),
         received=("received", "sum"),
         lost=("lost", "sum"),
+        unobserved=("unobserved", "sum"),
         delayed=("delayed", "sum"),
         resends=("resends", "sum"),
         resends_same_id=("resends_same_id", "sum"),
@@ -503,7 +624,11 @@ def _by_type(messages: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:
         receivers_mean=("receivers", "mean"),
     )
     table = table.join(_latency_figures(grouped))
-    table["loss_rate"] = table["lost"] / table["sent"].where(table["sent"] > 0)
+    table["receive_tagged"] = table["received"] > 0
+    # a loss rate only where losses can be seen: a type without receive tags has none
+    table["loss_rate"] = table["lost"] / table["sent"].where(
+        (table["sent"] > 0) & table["receive_tagged"]
+    )
     # the distinct sender -> receiver pairs of each type, counted at once (no call per type)
     pairs = deliveries[[TYPE, "sender", "receiver"]].drop_duplicates()
     table["channels"] = pairs.groupby(TYPE).size()
@@ -516,6 +641,7 @@ def _by_channel(deliveries: pd.DataFrame) -> pd.DataFrame:
         sent=("sent_at", "count"),
         received=("received", "sum"),
         lost=("lost", "sum"),
+        unobserved=("unobserved", "sum"),
         delayed=("delayed", "sum"),
     )
     return table.join(_latency_figures(grouped)).reset_index()
@@ -528,6 +654,7 @@ def _summary(messages: pd.DataFrame, channels: pd.DataFrame, lost_effect: dict) 
             "sent",
             "received",
             "lost",
+            "unobserved",
             "delayed",
             "resends",
             "resends_same_id",
@@ -536,7 +663,13 @@ def _summary(messages: pd.DataFrame, channels: pd.DataFrame, lost_effect: dict) 
         )
     }
     pairs = channels[["sender", "receiver"]].drop_duplicates()
-    return {"messages": len(messages), **totals, "channels": len(pairs), **lost_effect}
+    return {
+        "messages": len(messages),
+        **totals,
+        "untagged_types": untagged_types(messages),
+        "channels": len(pairs),
+        **lost_effect,
+    }
 
 
 def _figure(types: pd.DataFrame):
@@ -548,6 +681,7 @@ def _figure(types: pd.DataFrame):
     for column, colour in (
         ("received", "#2ca02c"),
         ("lost", "#d62728"),
+        ("unobserved", "#bbbbbb"),
         ("resends", "#ff7f0e"),
         ("delayed", "#8c564b"),
     ):

@@ -60,6 +60,10 @@ class LogAnalysis:
         """Whether the table named ``key`` has been built."""
         return key in self._tables
 
+    def built(self) -> list[Hashable]:
+        """The names of the tables built so far."""
+        return list(self._tables)
+
     def instances(self, carry: Sequence[str] = ()) -> pd.DataFrame:
         """:func:`~robotale.discovery.instances.activity_instances` of the log, with the
         columns of :data:`INSTANCE_COLUMNS` and ``carry``."""

@@ -2,7 +2,7 @@
 
 1. What is the typical sequence, and its main variants?
 2. What delayed the runs (the bottlenecks, ranked by how much longer they make a run)?
-3. Where did each robot work, and where do robots overlap?
+3. Where did each robot work, and were robots at the same place at the same moment?
 4. Did battery affect the mission?
 5. Which messages were delayed, lost or resent (one example each)?
 
@@ -26,9 +26,17 @@ from robotale.enhancement.battery import battery_perspective
 from robotale.enhancement.bottlenecks import ALPHA, find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
 from robotale.enhancement.context import LogAnalysis
+from robotale.enhancement.encounters import (
+    METRES,
+    SECONDS,
+    encounters,
+    positions,
+    region_overlaps,
+    run_regions,
+)
 from robotale.enhancement.performance import ARROW, performance_perspective
 from robotale.enhancement.result import Perspective
-from robotale.eventlog.schema import ROBOT, X, Y
+from robotale.eventlog.schema import CASE, ROBOT, X, Y, Z
 
 #: how many variants and bottlenecks an answer names
 MAIN = 3
@@ -77,14 +85,18 @@ class Findings:
         return {"answers": [a.to_dict() for a in self.answers]}
 
 
-def find(log: pd.DataFrame, *, threshold: float = 20.0) -> Findings:
+def find(
+    log: pd.DataFrame, *, threshold: float = 20.0, delay_threshold: float | None = None
+) -> Findings:
     """The answers to the five questions for ``log`` (``threshold``: the battery level, in
-    percent, below which a robot's battery counts as low)."""
+    percent, below which a robot's battery counts as low; ``delay_threshold``: the latency in
+    seconds above which a message is delayed, else the rule of
+    :mod:`robotale.enhancement.delays`)."""
     # one analysis for all: the activity instances, steps, case durations and the message
     # table are built once; the messages come first so the bottlenecks' queueing reuses them.
     # The spatial perspective is not needed: the areas are two numbers per robot.
     analysis = LogAnalysis(log)
-    communication = communication_perspective(analysis)
+    communication = communication_perspective(analysis, delay_threshold=delay_threshold)
     perspectives = {
         "performance": performance_perspective(analysis),
         "bottlenecks": find_bottlenecks(analysis),
@@ -163,6 +175,13 @@ def delay_answer(bottlenecks: Perspective, performance: Perspective, runs: pd.Da
         answer.sentences.append(_sentence(bottlenecks.message))
         return answer
     _one_run_of_days(runs, answer)
+    left_out = int(bottlenecks.summary.get("aborted_runs_left_out", 0))
+    if left_out:
+        answer.facts["aborted_runs_left_out"] = left_out
+        answer.sentences.append(
+            f"Runs are compared with runs of the same outcome: the completed runs against each "
+            f"other, leaving out {_count(left_out, 'run')} that did not complete."
+        )
     ranking = trusted_first(bottlenecks.table).head(MAIN)
     answer.facts["bottlenecks"] = [
         {
@@ -215,12 +234,18 @@ def _one_run_of_days(runs: pd.DataFrame, answer: Answer) -> None:
 
 
 def trusted_first(ranking: pd.DataFrame, alpha: float = ALPHA) -> pd.DataFrame:
-    """The bottleneck ranking with the effects the runs do not show for certain (a p-value of
-    ``alpha`` or more: the runs with it may be longer by chance) after the others, each part
-    still by delay per case; ``rank`` numbers the new order."""
-    if ranking.empty or "p_value" not in ranking.columns:
+    """The bottleneck ranking with the rows that are not ``ranked`` (an effect that may be
+    chance, has no test result or adds under 1 % of a run; or, in a table without that column,
+    a p-value of ``alpha`` or more) after the others, each part still by delay per case;
+    ``rank`` numbers the new order."""
+    if ranking.empty:
         return ranking
-    uncertain = pd.to_numeric(ranking["p_value"], errors="coerce").ge(alpha).to_numpy(bool)
+    if "ranked" in ranking.columns:
+        uncertain = ~ranking["ranked"].astype(bool).to_numpy()
+    elif "p_value" in ranking.columns:
+        uncertain = pd.to_numeric(ranking["p_value"], errors="coerce").ge(alpha).to_numpy(bool)
+    else:
+        return ranking
     ordered = pd.concat([ranking[~uncertain], ranking[uncertain]]).reset_index(drop=True)
     return ordered.assign(rank=range(1, len(ordered) + 1))
 
@@ -245,6 +270,7 @@ def robot_answer(log: pd.DataFrame, performance: Perspective) -> Answer:
     for robot in work:
         area = areas.get(robot["robot"])
         where = f" in x {_span(area['x'])}, y {_span(area['y'])}" if area else ""
+        where += f", z {_span(area['z'])}" if area and "z" in area else ""
         robot["area"] = area
         answer.sentences.append(
             f"{robot['robot']} worked {seconds_text(robot['working'])} in "
@@ -253,16 +279,41 @@ def robot_answer(log: pd.DataFrame, performance: Perspective) -> Answer:
     if X not in log.columns or Y not in log.columns:
         answer.sentences.append("The log has no positions, so where robots overlap is unknown.")
         return answer
-    overlaps = area_overlaps(areas)
+    placed = positions(log)
+    met = encounters(placed)
+    overlaps = region_overlaps(run_regions(placed))
+    answer.facts["encounters"] = met.to_dict("records")
     answer.facts["overlaps"] = overlaps
-    if not overlaps:
-        answer.sentences.append("No two robots' working areas overlap.")
-    for overlap in overlaps:
-        answer.sentences.append(
-            f"{overlap['robots'][0]} and {overlap['robots'][1]} share the area x "
-            f"{_span(overlap['x'])}, y {_span(overlap['y'])}."
-        )
+    answer.facts["same_place"] = {"metres": METRES, "seconds": SECONDS}
+    answer.sentences += _encounter_sentences(met)
+    answer.sentences.append(_overlap_sentence(overlaps, placed))
     return answer
+
+
+def _encounter_sentences(met: pd.DataFrame) -> list[str]:
+    """Which robots were at the same place at the same moment, in 3D and time."""
+    within = f"within {METRES:g} m and {SECONDS:g} s, in 3D"
+    if met.empty:
+        return [f"No two robots were at the same place at the same moment ({within})."]
+    sentences = []
+    for (robot, other), rows in met.groupby(["robot", "other"], sort=True):
+        first = rows.sort_values("start", kind="stable").iloc[0]
+        sentences.append(
+            f"{robot} and {other} were at the same place at the same moment ({within}) "
+            f"{_count(len(rows), 'time')} in {_count(rows[CASE].nunique(), 'run')}; the first "
+            f"in run {first[CASE]} at {_clock(first['start'])}, at x {first[X]:.1f}, "
+            f"y {first[Y]:.1f}, z {first[Z]:.1f} ({first['closest']:.1f} m apart)."
+        )
+    return sentences
+
+
+def _overlap_sentence(overlaps: list[dict[str, Any]], placed: pd.DataFrame) -> str:
+    runs = placed[CASE].nunique() if not placed.empty else 0
+    if not overlaps:
+        return "No two robots' regions (x, y and z, per run) overlap."
+    pairs = Counter(tuple(o["robots"]) for o in overlaps)
+    listed = "; ".join(f"{a} and {b} in {n} of {runs} runs" for (a, b), n in sorted(pairs.items()))
+    return f"Regions (x, y and z, per run) overlap: {listed}, not necessarily at the same time."
 
 
 def _robot_work(performance: Perspective) -> list[dict[str, Any]]:
@@ -288,38 +339,22 @@ def _robot_work(performance: Perspective) -> list[dict[str, Any]]:
 
 
 def robot_areas(log: pd.DataFrame) -> dict[str, dict[str, list[float]]]:
-    """Per robot, the box (x and y ranges) its positions span."""
+    """Per robot, the box (x, y and, where the log has it, z ranges) its positions span."""
     if X not in log.columns or Y not in log.columns or ROBOT not in log.columns:
         return {}
-    placed = log[[ROBOT, X, Y]].dropna()
+    axes = [a for a in (X, Y, Z) if a in log.columns]
+    placed = log[[ROBOT, *axes]].dropna(subset=[ROBOT, X, Y])
     if placed.empty:
         return {}
-    box = placed.groupby(placed[ROBOT].astype(str))[[X, Y]].agg(["min", "max"])
+    box = placed.groupby(placed[ROBOT].astype(str))[axes].agg(["min", "max"])
     return {
         str(robot): {
-            "x": [float(row[(X, "min")]), float(row[(X, "max")])],
-            "y": [float(row[(Y, "min")]), float(row[(Y, "max")])],
+            axis: [float(row[(axis, "min")]), float(row[(axis, "max")])]
+            for axis in axes
+            if pd.notna(row[(axis, "min")])
         }
         for robot, row in box.iterrows()
     }
-
-
-def area_overlaps(areas: dict[str, dict[str, list[float]]]) -> list[dict[str, Any]]:
-    """Every pair of robots whose boxes intersect, with the intersection."""
-    names = sorted(areas)
-    overlaps = []
-    for i, first in enumerate(names):
-        for second in names[i + 1 :]:
-            shared = {
-                axis: [
-                    max(areas[first][axis][0], areas[second][axis][0]),
-                    min(areas[first][axis][1], areas[second][axis][1]),
-                ]
-                for axis in ("x", "y")
-            }
-            if all(low <= high for low, high in shared.values()):
-                overlaps.append({"robots": [first, second], **shared})
-    return overlaps
 
 
 # -- 4. battery --------------------------------------------------------------------------------
@@ -332,16 +367,18 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         return answer
     summary = battery.summary
     lows = battery.tables.get("low_battery", pd.DataFrame())
-    energy = summary.get("energy_per_case_mean")
+    per_run = summary.get("used_per_run") or {}
     answer.facts = {
         "low_battery_events": int(summary.get("low_battery_events", 0)),
-        "energy_per_run": None if energy is None else float(energy),
+        "used_per_run": dict(per_run),
         "most_used_by": summary.get("most_used_by"),
     }
-    if energy is not None:
+    if per_run:
+        each = ", ".join(f"{robot} {used:.1f}%" for robot, used in per_run.items())
+        most = summary.get("most_used_by")
         answer.sentences.append(
-            f"The robots used {energy:.1f}% of battery per run on average, most of it on "
-            f"{summary.get('most_used_by')}."
+            f"Battery used per run, each robot its own (mean): {each}"
+            + (f"; the activity that used most: {most}." if most else ".")
         )
     if lows.empty:
         answer.sentences.append(
@@ -398,14 +435,35 @@ def message_answer(communication: Perspective) -> Answer:
         return answer
     summary = communication.summary
     messages = communication.tables["messages"]
-    keys = ("messages", "received", "lost", "delayed", "resends", "resends_new_id", "recovered")
+    keys = (
+        "messages",
+        "received",
+        "lost",
+        "unobserved",
+        "delayed",
+        "resends",
+        "resends_new_id",
+        "recovered",
+    )
     answer.facts = {key: int(summary.get(key, 0)) for key in keys}
+    answer.facts["untagged_types"] = list(summary.get("untagged_types", []))
+    answer.facts["delay_rule"] = summary.get("delay_rule")
+    unobserved = int(summary.get("unobserved", 0))
+    not_seen = f", {unobserved} not observed as received" if unobserved else ""
     answer.sentences.append(
         f"{_count(summary['messages'], 'message')} sent: {summary['received']} received, "
-        f"{summary['lost']} lost, {summary.get('delayed', 0)} delayed, "
+        f"{summary['lost']} lost{not_seen}, {summary.get('delayed', 0)} delayed, "
         f"{_count(summary['resends'], 'resend')} "
         f"({summary.get('resends_new_id', 0)} under a new id)."
     )
+    untagged = answer.facts["untagged_types"]
+    if untagged:
+        answer.sentences.append(
+            f"The log tags no receive of {', '.join(untagged)}: whether those messages "
+            "arrived is unknown, so none of them is called lost."
+        )
+    if summary.get("delay_rule"):
+        answer.sentences.append(f"Delayed means {summary['delay_rule']}.")
     for kind, rows in (
         ("delayed", messages[messages["delayed"]]),
         ("lost", messages[messages["lost"]]),
@@ -423,9 +481,9 @@ def _message_example(kind: str, row: pd.Series, communication: Perspective) -> s
         late = seconds_text(row["latency"])
         return f"Delayed, for example: {where} reached {row['receiver']} after {late}."
     if kind == "resent":
-        new = _value(row.get("resent_as"))
-        how = f"under the new id {new}" if new else "under the same id"
-        return f"Resent, for example: {where}, {how}."
+        repeated = _value(row.get("repeats"))
+        how = f"repeats {repeated}, which had no answer" if repeated else "sent again under its id"
+        return f"Resent, for example: {where} {how}."
     lost = communication.tables.get("lost", pd.DataFrame())
     # the lost table's row of this message (by the keys it has: a log may lack the case)
     keys = [key for key in ("case", "msg_id") if key in lost.columns and key in row.index]

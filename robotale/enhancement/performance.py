@@ -1,6 +1,8 @@
 """Performance: working and waiting time, slowest transitions, variants and case durations.
 
-Working time is an activity instance's own duration (a start paired with its completion).
+Working time is an activity instance's own duration (a start paired with its completion). An
+instance that ends aborted or cancelled (interrupted, such as an exploration cut short by low
+battery) is an instance all the same: its time counts, and ``interrupted`` says how many.
 Waiting is measured per robot: the time before one of its activities starts during which the
 robot had no activity running (its previous activities had all completed). A robot running a
 long activity while others come and go, such as a drone exploring while it reports weeds, is
@@ -17,7 +19,13 @@ from __future__ import annotations
 import pandas as pd
 import plotly.graph_objects as go
 
-from robotale.discovery.instances import DURATION, FINISHED, START_KNOWN, START_TIMESTAMP
+from robotale.discovery.instances import (
+    DURATION,
+    FINISHED,
+    START_KNOWN,
+    START_TIMESTAMP,
+    interrupted,
+)
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.result import Figures, Perspective, focus_label, no_data
 from robotale.eventlog.schema import ACTIVITY, CASE, MSG_ID, ROBOT, TIMESTAMP
@@ -236,9 +244,10 @@ def activity_durations(instances: pd.DataFrame) -> pd.DataFrame:
     """Per activity and robot: how many instances and their mean, median, max, total duration
     (working time only)."""
     keys = [ACTIVITY] + ([ROBOT] if ROBOT in instances.columns else [])
-    table = instances.groupby(keys, sort=True, dropna=False)[DURATION].agg(
-        ["count", "mean", "median", "max", "sum"]
-    )
+    grouped = instances.groupby(keys, sort=True, dropna=False)
+    table = grouped[DURATION].agg(["count", "mean", "median", "max", "sum"])
+    # an instance that ended aborted or cancelled is counted, and said to be interrupted
+    table["interrupted"] = interrupted(instances).groupby([instances[k] for k in keys]).sum()
     table = table.rename(columns={"sum": "total"}).reset_index()
     return table.rename(columns={ACTIVITY: "activity"})
 
@@ -266,6 +275,7 @@ def _summary(cases: pd.DataFrame, waiting: pd.DataFrame, tables: dict) -> dict:
         "waiting_time": waited,
         "waiting_share": waited / (working + waited) if working + waited > 0 else None,
         "variants": len(variants),
+        "interrupted": int(tables["activities"]["interrupted"].sum()),
         "top_variant_cases": int(variants["cases"].iloc[0]) if len(variants) else 0,
         "robot_variants": len(tables["robot_variants"]),
     }

@@ -29,7 +29,7 @@ def all_perspectives(
 ) -> dict[str, Perspective]:
     """Spatial, communication, battery, performance and bottlenecks, for the whole log or for
     one activity and/or robot; a message is delayed above ``delay_threshold`` seconds (else
-    above its channel's own 95th percentile)."""
+    by the rule of :mod:`robotale.enhancement.delays`)."""
     focus = {"activity": activity, "robot": robot}
     analysis = analysis_of(log)  # instances, steps, cases and messages built once for all
     return {

@@ -2,10 +2,11 @@
 
 The main table gives, per activity and robot, how many positions were recorded and their
 bounds; the figure is the 3D scatter of all positions, coloured by activity, one symbol per
-robot. Given a field (x and y bounds), the covered fraction says how much of it the robots
-passed over: the field is cut into square cells and a cell counts as covered when a robot's
-path crosses it. Between two recorded positions a robot is taken to move in a straight line,
-since positions are sampled while it moves continuously.
+robot; the ``encounters`` table says when two robots were at the same place at the same moment
+(:mod:`robotale.enhancement.encounters`). Given a field (x and y bounds), the covered
+fraction says how much of it the robots passed over: the field is cut into square cells and a
+cell counts as covered when a robot's path crosses it. Between two recorded positions a robot
+is taken to move in a straight line, since positions are sampled while it moves continuously.
 """
 
 from __future__ import annotations
@@ -16,7 +17,9 @@ import numpy as np
 import pandas as pd
 import plotly.graph_objects as go
 
+from robotale.enhancement.colours import log_colours
 from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.encounters import encounters, positions
 from robotale.enhancement.result import (
     Figures,
     Perspective,
@@ -89,8 +92,12 @@ def spatial_perspective(
     )
     result = Perspective(
         name="spatial",
-        tables={"occupancy": _occupancy(placed)},
-        figures=Figures({"scatter": lambda: _scatter(shown.sort_index())}),
+        tables={
+            "occupancy": _occupancy(placed),
+            # the same place at the same moment (in 3D and time), of the focused events
+            "encounters": encounters(positions(placed)),
+        },
+        figures=Figures({"scatter": lambda: _scatter(shown.sort_index(), log_colours(log))}),
         summary={"positions": len(placed), "plotted": len(shown), "bounds": bounds(placed)},
     )
     if field is not None:
@@ -199,8 +206,9 @@ SYMBOLS = (
 )
 
 
-def _scatter(placed: pd.DataFrame):
-    """One trace per activity (its colour), one marker symbol per robot."""
+def _scatter(placed: pd.DataFrame, colours: dict[str, str]):
+    """One trace per activity (its colour, the log's: the same on every page), one marker
+    symbol per robot."""
     robots = placed[ROBOT].astype("string").fillna("") if ROBOT in placed.columns else None
     names = sorted(set(robots)) if robots is not None else []
     symbol_of = {r: SYMBOLS[i % len(SYMBOLS)] for i, r in enumerate(names)}
@@ -214,7 +222,11 @@ def _scatter(placed: pd.DataFrame):
             mode="markers",
             name=str(activity),
             # fixed-width text arrays: plotly copies them whole, not string by string
-            marker={"size": 3, "symbol": None if who is None else who.map(symbol_of).to_numpy(str)},
+            marker={
+                "size": 3,
+                "color": colours.get(str(activity)),
+                "symbol": None if who is None else who.map(symbol_of).to_numpy(str),
+            },
             text=None if who is None else who.to_numpy(str),
             hovertemplate="%{text}<br>x %{x:.2f}, y %{y:.2f}, z %{z:.2f}",
         )

@@ -1,6 +1,8 @@
 """One run at a glance: a lane per robot with its activity instances as bars, the messages
-between robots as arrows from sender to receiver (a lost message marked where it was sent) and
-each robot's battery as a line.
+between robots as arrows from sender to receiver (a lost message marked where it was sent, a
+message whose type the log tags no receive of marked apart: it may have arrived) and, on its
+own axis below the lanes, each robot's battery as a line. Each activity has one colour, the
+same on every page (:mod:`robotale.enhancement.colours`).
 
 The figure is plain plotly JSON, so the HTML report embeds it and the dashboard draws the same
 thing from a JSON endpoint.
@@ -9,13 +11,14 @@ thing from a JSON endpoint.
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import pandas as pd
 import plotly.graph_objects as go
 
 from robotale.discovery.instances import FINISHED, START_TIMESTAMP
+from robotale.enhancement.colours import activity_colours, log_colours
 from robotale.enhancement.communication import message_table
 from robotale.enhancement.context import LogAnalysis
 from robotale.enhancement.performance import case_durations, finished_instances
@@ -31,6 +34,10 @@ from robotale.eventlog.schema import (
     TIMESTAMP,
 )
 
+#: the battery axis' share of the figure's height, below the lanes, and the gap between them
+BATTERY_SHARE, GAP = 0.22, 0.06
+#: pixels the battery axis adds to the figure's height
+BATTERY_HEIGHT = 160
 #: the lane of events whose robot the log does not name
 NO_ROBOT = "(no robot)"
 LOST_COLOUR = "#d62728"
@@ -40,15 +47,16 @@ MESSAGE_COLOUR = "#555555"
 @dataclass(slots=True)
 class Timeline:
     """The data of one run's timeline: ``bars`` (robot, activity, start, end, source: where
-    its events were recorded, seconds),
-    ``messages`` (msg_id, sender, receiver, sent, received, lost, delayed) and ``battery``
-    (robot, time, level)."""
+    its events were recorded, seconds), ``messages`` (msg_id, sender, receiver, sent,
+    received, lost, unobserved, delayed) and ``battery`` (robot, time, level)."""
 
     case: str
     robots: list[str]
     bars: pd.DataFrame
     messages: pd.DataFrame
     battery: pd.DataFrame
+    #: activity -> colour, of the whole log (:mod:`robotale.enhancement.colours`)
+    colours: dict[str, str] = field(default_factory=dict)
 
     @property
     def lost(self) -> int:
@@ -91,7 +99,7 @@ def case_timeline(log: pd.DataFrame, case: str) -> Timeline:
     messages = _messages(events)
     battery = _battery(events)
     robots = sorted(set(bars["robot"]) | set(battery["robot"]) | _message_robots(messages))
-    return Timeline(str(case), robots, bars, messages, battery)
+    return Timeline(str(case), robots, bars, messages, battery, log_colours(log))
 
 
 def _robots(events: pd.DataFrame) -> pd.Series:
@@ -148,7 +156,7 @@ def _known(topic: Any, index: Any) -> bool:
 
 
 def _messages(events: pd.DataFrame) -> pd.DataFrame:
-    columns = ["msg_id", "sender", "receiver", "sent", "received", "lost", "delayed"]
+    columns = ["msg_id", "sender", "receiver", "sent", "received", "lost", "unobserved", "delayed"]
     table = message_table(events)
     if table.empty:
         return pd.DataFrame(columns=columns)
@@ -179,10 +187,12 @@ def _battery(events: pd.DataFrame) -> pd.DataFrame:
 
 
 def timeline_figure(timeline: Timeline) -> go.Figure:
-    """Lanes (robots) on the left axis, battery (%) on the right one, time along."""
+    """Lanes (robots) above, battery (%) on its own axis below them, time along: a level never
+    reads as a lane. Each activity has the log's colour for it."""
     figure = go.Figure()
+    colours = timeline.colours or activity_colours(timeline.bars["activity"])
     for activity, bars in timeline.bars.groupby("activity", sort=True):
-        figure.add_trace(_bar_trace(str(activity), bars))
+        figure.add_trace(_bar_trace(str(activity), bars, colours.get(str(activity))))
     if not timeline.messages.empty:
         figure.add_traces(_message_traces(timeline.messages, set(timeline.robots)))
     for robot, levels in timeline.battery.groupby("robot", sort=True):
@@ -193,24 +203,35 @@ def timeline_figure(timeline: Timeline) -> go.Figure:
                 yaxis="y2",
                 mode="lines",
                 name=f"battery {robot}",
-                line={"width": 1, "dash": "dot"},
+                line={"width": 1.5},
             )
         )
+    has_battery = not timeline.battery.empty
+    lanes = 90 * len(timeline.robots) + 120
     figure.update_layout(
         title=f"run {timeline.case}",
         barmode="overlay",
-        height=max(260, 90 * len(timeline.robots) + 120),
-        yaxis={"categoryorder": "array", "categoryarray": timeline.robots, "title": "robot"},
-        yaxis2={"overlaying": "y", "side": "right", "range": [0, 105], "title": "battery %"},
-        xaxis={"type": "date", "title": "time"},
+        height=max(260, lanes + (BATTERY_HEIGHT if has_battery else 0)),
+        yaxis={
+            "categoryorder": "array",
+            "categoryarray": timeline.robots,
+            "title": "robot",
+            "domain": [BATTERY_SHARE + GAP, 1.0] if has_battery else [0.0, 1.0],
+        },
+        yaxis2={
+            "domain": [0.0, BATTERY_SHARE],
+            "anchor": "x",
+            "range": [0, 105],
+            "title": "battery %",
+            "visible": has_battery,
+        },
+        xaxis={"type": "date", "title": "time", "anchor": "y2" if has_battery else "y"},
         legend={"orientation": "h", "y": -0.2},
     )
-    if timeline.battery.empty:
-        figure.update_layout(yaxis2={"visible": False})
     return figure
 
 
-def _bar_trace(activity: str, bars: pd.DataFrame) -> go.Bar:
+def _bar_trace(activity: str, bars: pd.DataFrame, colour: str | None) -> go.Bar:
     milliseconds = (bars["seconds"] * 1000).clip(lower=200)  # an instant stays visible
     return go.Bar(
         base=bars["start"],
@@ -225,6 +246,7 @@ def _bar_trace(activity: str, bars: pd.DataFrame) -> go.Bar:
         hovertemplate=(
             f"{activity}<br>%{{base}}<br>%{{customdata[0]:.1f}} s%{{customdata[1]}}<extra></extra>"
         ),
+        marker={"color": colour},
         opacity=0.75,
     )
 
@@ -238,7 +260,7 @@ def _from(bars: pd.DataFrame) -> list[str]:
 def _message_traces(messages: pd.DataFrame, lanes: set[str]) -> list[go.Scatter]:
     """One line per delivered message (ending in an arrow head at the receiver) and a cross on
     the sender's lane for each lost one."""
-    delivered = messages[~messages["lost"] & messages["receiver"].isin(lanes)]
+    delivered = messages[messages["received"].notna() & messages["receiver"].isin(lanes)]
     xs: list = []
     ys: list = []
     for row in delivered.itertuples(index=False):
@@ -256,15 +278,25 @@ def _message_traces(messages: pd.DataFrame, lanes: set[str]) -> list[go.Scatter]
         )
     ]
     lost = messages[messages["lost"]]
-    traces.append(
-        go.Scatter(
-            x=lost["sent"],
-            y=lost["sender"],
-            mode="markers",
-            name="lost message",
-            marker={"symbol": "x", "size": 12, "color": LOST_COLOUR},
-            text=lost["msg_id"],
-            hovertemplate="lost message %{text}<extra></extra>",
-        )
-    )
+    marker = {"symbol": "x", "size": 12, "color": LOST_COLOUR}
+    traces.append(_marker_trace(lost, "lost message", marker, "lost message %{text}"))
+    if "unobserved" in messages:
+        # sent, but the log tags no receive of its type: it may have arrived
+        unseen = messages[messages["unobserved"]]
+        marker = {"symbol": "circle-open", "size": 10, "color": MESSAGE_COLOUR}
+        hover = "%{text}: no receive tag of its type in the log"
+        traces.append(_marker_trace(unseen, "not observed as received", marker, hover))
     return traces
+
+
+def _marker_trace(messages: pd.DataFrame, name: str, marker: dict, hover: str) -> go.Scatter:
+    """A marker on the sender's lane where each of ``messages`` was sent."""
+    return go.Scatter(
+        x=messages["sent"],
+        y=messages["sender"],
+        mode="markers",
+        name=name,
+        marker=marker,
+        text=messages["msg_id"],
+        hovertemplate=f"{hover}<extra></extra>",
+    )

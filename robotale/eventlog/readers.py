@@ -347,6 +347,9 @@ def canonical_log(
     kinds = reading.event_kinds(log)
     dropped = reading.dropped_rows(kinds, lines)
     keep = reading.understood(kinds).to_numpy(bool)
+    copies, copied = reading.exact_copies(table, lines, keep)
+    dropped |= copied
+    keep = keep & ~copies
     if not keep.any():
         raise InputError(f"{path}: no row is an event ({next(iter(dropped))}).")
     log, kinds = log[keep].copy(), kinds[keep]

@@ -17,6 +17,8 @@ decides how a log is read, and :class:`Reading` reports the decisions so a user 
   ``suspend`` ...) is dropped, counted and named.
 - **Cases**: the case column, else the XES trace, else one case, or with a case gap a new case
   after every pause of at least that long.
+- **Copies**: a row equal to an earlier row in every cell is dropped, counted and named (an
+  event logged twice would otherwise be a second activity, a resend or a loop).
 """
 
 from __future__ import annotations
@@ -126,6 +128,8 @@ ROLE_NAMES: dict[str, str] = {
 KINDS = ("start", "complete", "instant", "sample")
 #: ends of an activity that failed or was called off: completions that keep their outcome
 OUTCOMES = (schema.ABORTED, schema.CANCELLED)
+#: why a row that repeats an earlier one cell for cell is dropped
+COPY_REASON = "an exact copy of an earlier row (the event counts once)"
 #: a dropped row's lines are listed up to this many.
 SHOWN_LINES = 5
 #: the pause offered as the end of a session when a log without cases spans several days
@@ -345,6 +349,18 @@ def dropped_rows(kinds: pd.Series, lines: pd.Series) -> dict[str, list[int]]:
         f"lifecycle {value[1:]!r} is not a start, an end or none": lines[group.index].tolist()
         for value, group in unknown.groupby(unknown, sort=True)
     }
+
+
+def exact_copies(
+    table: pd.DataFrame, lines: pd.Series, events: np.ndarray
+) -> tuple[np.ndarray, dict[str, list[int]]]:
+    """Which of the rows that are ``events`` repeat an earlier row cell for cell (a logger that
+    wrote an event twice), and their file lines under the reason they are dropped: an event
+    counts once, never as a second activity, message or loop."""
+    copies = table.duplicated(keep="first").to_numpy(bool) & events
+    if not copies.any():
+        return copies, {}
+    return copies, {COPY_REASON: lines[copies].tolist()}
 
 
 def pairing_description(log: pd.DataFrame, renames: Mapping[str, str]) -> str:

@@ -4,6 +4,7 @@ background, so the first visit after that computes nothing."""
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 from neo4j import Driver
@@ -13,7 +14,7 @@ from robotale import enhancement
 from robotale.enhancement.findings import find, trusted_first
 from robotale.enhancement.result import Perspective
 from robotale.enhancement.timeline import case_timeline, run_list
-from robotale.errors import RobotaleError
+from robotale.errors import InputError, RobotaleError
 from robotale.webapp.logdata import LogData, first_key, log_info
 
 #: the Perspectives page's sections, in the order it shows them
@@ -26,15 +27,34 @@ PERSPECTIVES: dict[str, Callable[..., Perspective]] = {
 }
 
 
-def stored_findings(driver: Driver, logs: LogData, name: str) -> bytes:
-    """The answers for the stored log ``name`` and its runs (case, start, duration)."""
+def parse_delay(text: str | None) -> float | None:
+    """The ``delay`` argument of a request: seconds above which a message is delayed (missing
+    or empty: the default rule)."""
+    if text is None or not text.strip():
+        return None
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not math.isfinite(seconds) or seconds < 0:
+        raise InputError(f"the delay {text!r} is not a number of seconds of 0 or more.")
+    return seconds
+
+
+def _delay_key(delay: float | None) -> tuple:
+    return () if delay is None else ("delay", repr(delay))
+
+
+def stored_findings(driver: Driver, logs: LogData, name: str, delay: float | None = None) -> bytes:
+    """The answers for the stored log ``name`` and its runs (case, start, duration); a message
+    is delayed above ``delay`` seconds (else by the default rule)."""
 
     def compute() -> dict:
-        result = find(logs.frame(driver, name))
+        result = find(logs.frame(driver, name), delay_threshold=delay)
         runs = result.runs.reindex(columns=["case", "start", "duration"])
         return {**result.to_dict(), "runs": runs.to_dict(orient="records")}
 
-    return logs.result(driver, name, ("findings",), compute)
+    return logs.result(driver, name, ("findings", *_delay_key(delay)), compute)
 
 
 def stored_perspective(
@@ -44,17 +64,23 @@ def stored_perspective(
     which: str,
     activity: str | None = None,
     robot: str | None = None,
+    delay: float | None = None,
 ) -> bytes:
-    """The perspective ``which`` of the whole log, or of one activity (and robot)."""
+    """The perspective ``which`` of the whole log, or of one activity (and robot); for the
+    communication perspective, a message is delayed above ``delay`` seconds if given."""
+    options = {"delay_threshold": delay} if which == "communication" else {}
 
     def compute() -> dict:
-        result = PERSPECTIVES[which](logs.frame(driver, name), activity=activity, robot=robot)
+        frame = logs.frame(driver, name)
+        result = PERSPECTIVES[which](frame, activity=activity, robot=robot, **options)
         if which == "bottlenecks" and result.has_data:
             # the same order as the Findings page: effects that may be chance come last
             result.tables["bottlenecks"] = trusted_first(result.tables["bottlenecks"])
         return result.to_dict()
 
     focus = ("activity", activity or "", "robot", robot or "") if activity or robot else ()
+    if options:
+        focus += _delay_key(delay)
     return logs.result(driver, name, ("perspective", which, *focus), compute)
 
 

@@ -118,7 +118,8 @@ def test_energy_per_case_by_hand(idle_drain, drained):
     energy = battery_perspective(idle_drain).tables["energy"].set_index("case")
     levels = idle_drain.dropna(subset=["battery"]).groupby("case:concept:name")["battery"]
     assert energy["used"].to_dict() == (levels.first() - levels.last()).to_dict()
-    assert battery_perspective(idle_drain).summary["energy_per_case_mean"] == 35.0
+    # per robot: the rover used 35 points in each of its two runs
+    assert battery_perspective(idle_drain).summary["used_per_run"] == {"rover": 35.0}
     # the drone's battery only falls: used = first - last level, charged nothing
     drone = battery_perspective(drained).tables["energy"].iloc[0]
     assert drone["used"] == drained["battery"].iloc[0] - drained["battery"].iloc[-1]

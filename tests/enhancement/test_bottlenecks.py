@@ -1,6 +1,7 @@
 import pytest
 
 from robotale.enhancement import find_bottlenecks
+from robotale.enhancement.findings import find
 
 
 @pytest.fixture
@@ -176,3 +177,91 @@ def test_queueing_for_an_activity_another_robot_is_doing(events):
     assert ranking.loc[("resource", "r2"), "total"] == 30 - 5  # r1 charged all the while
     assert ("waiting", "r2") not in ranking.index
     assert "queues" in ranking.loc[("resource", "r2"), "explanation"]
+
+
+@pytest.fixture
+def detour_and_quick_messages(events):
+    """8 runs: r1 does a (0-10 s) and b (10 s); in runs 0-3 it makes a 20 s detour between
+    them. Every run r1 tells r2 'done!' after b, received 10 ms later.
+
+    By hand: runs 0-3 take 40.01 s, runs 4-7 20.01 s (the last receipt ends them); the detour
+    adds 20 s to 4 of 8 runs (10 s per run, 80 of 240.08 s: 33 %), its runs all longer
+    (Mann-Whitney, 4 against 4, U = 16, ties of 4 and 4: sigma = sqrt(16/12 * (9 - 120/56)) =
+    3.024, z = (16 - 8 - 0.5) / 3.024 = 2.48, p = 0.013); the messages wait 10 ms per run
+    (0.03 % of the runs' time)."""
+    rows = []
+    for run in range(8):
+        t = 0.0
+        steps = [("a", 10)] + ([("detour", 20)] if run < 4 else []) + [("b", 10)]
+        for activity, seconds in steps:
+            rows += [
+                (run, "r1", activity, "start", t, None),
+                (run, "r1", activity, "complete", t + seconds, None),
+            ]
+            t += seconds
+        rows += [
+            (run, "r1", "done!", "complete", t, "m"),
+            (run, "r2", "done?", "complete", t + 0.01, "m"),
+        ]
+    return events(
+        *[
+            {"case": str(c), "robot": r, "activity": a, "lifecycle": lc, "t": t, "msg_id": m}
+            for c, r, a, lc, t, m in rows
+        ]
+    )  # fmt: skip
+
+
+def test_a_tiny_or_untested_effect_never_ranks_above_a_real_one(detour_and_quick_messages):
+    ranking = find_bottlenecks(detour_and_quick_messages).table
+    first = ranking.iloc[0]
+    assert (first["kind"], first["activity"], bool(first["ranked"])) == ("activity", "detour", True)
+    assert first["delay_per_case"] == pytest.approx(10.0)
+    assert first["share"] == pytest.approx(80 / (4 * 40.01 + 4 * 20.01))
+    assert "33% of the runs' time; p = 0.013, unlikely to be chance" in first["explanation"]
+    queueing = ranking[ranking["kind"] == "queueing"].iloc[0]
+    assert queueing["delay_per_case"] == pytest.approx(0.01)
+    assert not queueing["ranked"] and "under 1% of a run" in queueing["explanation"]
+    # every ranked row before every other
+    flags = ranking["ranked"].tolist()
+    assert flags == sorted(flags, reverse=True)
+
+
+@pytest.fixture
+def escort_and_aborted_runs(events):
+    """6 runs. Runs 0-3 complete: search (0-60 s), then escort (60 s to 100, 110, 120, 130 s).
+    Runs 4-5 abort: the search ends aborted at 20 s, nothing follows.
+
+    By hand: every completed run has the escort, so among completed runs it explains nothing
+    (no completed run without it); the 2 aborted runs are left out, not 'the others'."""
+    rows = []
+    for run in range(6):
+        if run < 4:
+            end = 100 + 10 * run
+            rows += [(run, "search", "start", 0), (run, "search", "complete", 60)]
+            rows += [(run, "escort", "start", 60), (run, "escort", "complete", end)]
+        else:
+            rows += [(run, "search", "start", 0), (run, "search", "aborted", 20)]
+    return events(
+        *[
+            {"case": str(c), "robot": "ugv_1", "activity": a, "lifecycle": lc, "t": t}
+            for c, a, lc, t in rows
+        ]
+    )
+
+
+def test_the_outcome_is_held_fixed(escort_and_aborted_runs):
+    result = find_bottlenecks(escort_and_aborted_runs)
+    assert result.summary["aborted_runs_left_out"] == 2
+    assert result.summary["compared"] == "completed runs against completed runs"
+    assert result.summary["cases"] == 4
+    table = result.table
+    escort = table[(table["activity"] == "escort") & (table["kind"] == "activity")]
+    assert escort.empty
+    # every comparison is among the 4 completed runs
+    assert (table["cases"] <= 4).all() and (table["cases_without"].fillna(0) <= 4).all()
+    assert not table["ranked"].any()  # 4 runs with steady costs only: nothing shown for sure
+    delays = find(escort_and_aborted_runs).answer("delays")
+    assert delays.sentences[0] == (
+        "Runs are compared with runs of the same outcome: the completed runs against each "
+        "other, leaving out 2 runs that did not complete."
+    )

@@ -1,5 +1,3 @@
-import itertools
-
 import pandas as pd
 import pytest
 
@@ -33,21 +31,30 @@ def by_hand(log: pd.DataFrame) -> pd.DataFrame:
 
 
 def new_id_resends(log: pd.DataFrame) -> pd.Series:
-    """Per message type: messages the sender sent again under another id (same type and
-    payload) before they were received, counted with a plain loop."""
+    """Per message type: messages the sender sent again under another id of the same type
+    while they had no answer (no receive, and no message of another robot since), counted
+    with a plain loop over the thesis' sends (every sender there is one robot)."""
     found: dict[str, int] = {}
     with_id = log.dropna(subset=["msg_id"])
     sends = with_id[with_id[ACTIVITY].str.endswith("!")]
     firsts = sends.groupby("msg_id").agg(
-        type=(ACTIVITY, "first"), payload=("msg_payload", "first"), sent=(TIMESTAMP, "min")
+        type=(ACTIVITY, "first"), sender=(ROBOT, "first"), sent=(TIMESTAMP, "min")
     )
     receives = with_id[with_id[ACTIVITY].str.endswith("?")].groupby("msg_id")[TIMESTAMP].min()
     firsts["received"] = receives.reindex(firsts.index)
-    for (kind, _), same in firsts.sort_values("sent").groupby(["type", "payload"]):
-        rows = list(same.itertuples())
-        for this, after in itertools.pairwise(rows):
-            if pd.isna(this.received) or after.sent < this.received:
-                found[kind] = found.get(kind, 0) + 1
+    ordered = list(firsts.sort_values("sent").itertuples())
+    for i, after in enumerate(ordered):
+        for this in reversed(ordered[:i]):
+            if (this.sender, this.type) != (after.sender, after.type):
+                continue
+            answered = not pd.isna(this.received) and this.received <= after.sent
+            replied = any(
+                other.sender != this.sender and this.sent < other.sent < after.sent
+                for other in ordered
+            )
+            if not answered and not replied:
+                found[after.type] = found.get(after.type, 0) + 1
+            break
     return pd.Series(found, dtype=int)
 
 
@@ -198,9 +205,15 @@ def test_resends_by_id_reuse_and_by_a_new_id(recoveries):
     result = communication_perspective(recoveries)
     messages = result.tables["messages"].set_index(["case", "msg_id"])
     assert messages.loc[("1", "m1"), "resends_same_id"] == 1  # go! sent at 0 and 5
-    assert messages.loc[("1", "m2"), "resent_as"] == "m3"  # unanswered, same payload, new id
+    assert messages.loc[("1", "m2"), "resent_as"] == "m3"  # unanswered, new id
+    # the resend is counted once, on the message that repeats, which names what it repeats
+    assert messages.loc[("1", "m3"), "repeats"] == "m2"
+    assert messages.loc[("1", "m3"), "resends"] == 1 and messages.loc[("1", "m2"), "resends"] == 0
     assert bool(messages.loc[("1", "m2"), "lost"]) and bool(messages.loc[("1", "m2"), "recovered"])
-    assert messages.loc[("1", "m3"), "resends"] == 0  # m4 carries other news
+    # m3 was received (70 s) before m4 was sent (80 s): m4 is news, not a resend
+    assert messages.loc[("1", "m4"), "resends"] == 0 and pd.isna(
+        messages.loc[("1", "m4"), "repeats"]
+    )
     sends = recoveries[recoveries["concept:name"].str.endswith("!")]
     attempts = sends.groupby(["case:concept:name", "msg_id"]).size()
     assert result.summary["resends_same_id"] == (attempts - 1).sum() == 1

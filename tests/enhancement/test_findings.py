@@ -11,7 +11,7 @@ import pandas as pd
 import pytest
 from conventions import busy_seconds
 
-from robotale.enhancement.findings import area_overlaps, find, robot_areas, seconds_text
+from robotale.enhancement.findings import find, robot_areas, seconds_text
 from robotale.enhancement.findings_report import (
     findings_dict,
     findings_html,
@@ -134,6 +134,9 @@ def test_messages(logged):
     assert first.startswith(f"{len(messages)} messages sent: {messages['received'].notna().sum()}")
     assert f"{len(lost)} lost, {len(delayed)} delayed" in first
     examples = {s.split(",")[0]: s for s in answer.sentences[1:]}
+    # every message type is receive-tagged in this mission; the delay rule is stated
+    assert answer.facts["untagged_types"] == [] and answer.facts["unobserved"] == 0
+    assert any(s.startswith("Delayed means a latency in the slow mode") for s in answer.sentences)
     delayed_row = delayed.iloc[0]
     assert delayed_row["msg_id"] in examples["Delayed"]
     assert f"after {seconds_text(mission.DELAYED_LATENCY)}" in examples["Delayed"]
@@ -146,7 +149,9 @@ def test_messages(logged):
     assert examples["Lost"].endswith(
         f"; its run took {seconds_text(shorter)} shorter than the median run without one."
     )
-    assert f"under the new id {resent.sort_values('case').iloc[0]['msg_id']}" in examples["Resent"]
+    first_resent = resent.sort_values("case").iloc[0]
+    assert examples["Resent"].startswith(f"Resent, for example: {first_resent['msg_id']} ")
+    assert f"repeats {first_resent['resend_of']}, which had no answer" in examples["Resent"]
     cases = [e["case"] for e in answer.evidence]
     assert cases == [delayed_row["case"], first_lost["case"], first_lost["case"]]
 
@@ -168,7 +173,7 @@ def test_report_outputs_carry_the_same_sentences(logged):
     assert "lost message" in page
 
 
-def test_areas_and_overlaps_against_pandas():
+def test_areas_against_pandas():
     log = pd.DataFrame(
         {
             "robot": ["a", "a", "b", "b", "c", "c"],
@@ -180,8 +185,7 @@ def test_areas_and_overlaps_against_pandas():
     areas = robot_areas(log)
     for robot in "abc":
         assert areas[robot]["x"] == [boxes.loc[robot, ("x", "min")], boxes.loc[robot, ("x", "max")]]
-    # a spans x 0-4, y 0-2 and b x 3-6, y 1-5: they share x 3-4, y 1-2; c is apart
-    assert area_overlaps(areas) == [{"robots": ["a", "b"], "x": [3.0, 4.0], "y": [1.0, 2.0]}]
+        assert "z" not in areas[robot]
 
 
 def test_thesis_log_split_into_days(thesis_csv):

@@ -133,6 +133,37 @@ def test_timeline_shows_the_lost_message(page, mission_log, screenshot):
 
 
 @browser
+def test_timeline_draws_battery_on_its_own_axis_one_colour_per_activity(page, mission_log):
+    """In the drawn page: the battery axis lies below the lanes (pixels apart), and each
+    activity has its own colour, the one its name's place among the log's activities (in
+    text order) picks from the palette."""
+    from robotale.enhancement.colours import PALETTE
+
+    run = sorted(mission.LOW_BATTERY_RUNS)[0]
+    page.goto(f"{page.base_url}/timeline?log={mission_log}&case={run}")
+    expect(page.locator("#timeline")).to_have_attribute("data-state", "shown")
+    drawn = page.evaluate(
+        """() => {
+          const el = document.getElementById('timeline');
+          const lanes = el._fullLayout.yaxis, battery = el._fullLayout.yaxis2;
+          return {
+            lanes: [lanes._offset, lanes._offset + lanes._length],
+            battery: [battery._offset, battery._offset + battery._length],
+            levels: el.data.filter(t => t.name.startsWith('battery ')).map(t => t.yaxis),
+            colours: Object.fromEntries(
+              el.data.filter(t => t.type === 'bar').map(t => [t.name, t.marker.color])),
+          };
+        }"""
+    )
+    assert drawn["battery"][0] > drawn["lanes"][1]  # pixels from the top: below the lanes
+    assert drawn["levels"] and set(drawn["levels"]) == {"y2"}
+    names = sorted({i.activity for i in TRUTH.instances})
+    expected = {name: PALETTE[n % len(PALETTE)] for n, name in enumerate(names)}
+    assert drawn["colours"] == {name: expected[name] for name in drawn["colours"]}
+    assert len(set(drawn["colours"].values())) == len(drawn["colours"]) >= 5
+
+
+@browser
 def test_perspectives_page_ranks_bottlenecks_and_shows_variants(page, mission_log):
     page.goto(f"{page.base_url}/perspectives?log={mission_log}")
     bottlenecks = page.locator("article.perspective[data-name=bottlenecks]")

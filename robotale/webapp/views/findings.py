@@ -7,7 +7,7 @@ from __future__ import annotations
 from flask import Blueprint, Response, render_template, request
 
 from robotale.webapp import pages
-from robotale.webapp.findings_data import stored_findings
+from robotale.webapp.findings_data import parse_delay, stored_findings
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("findings", __name__)
@@ -15,10 +15,13 @@ blueprint = Blueprint("findings", __name__)
 
 @blueprint.get("/findings")
 def page():
-    return render_template("findings.html", **pages.context("findings.page"))
+    delay = request.args.get("delay", "")
+    return render_template("findings.html", delay=delay, **pages.context("findings.page"))
 
 
 @blueprint.get("/api/findings")
 def findings():
     name = request.args.get("log", "")
-    return Response(stored_findings(driver(), state().logs, name), mimetype="application/json")
+    delay = parse_delay(request.args.get("delay"))
+    data = stored_findings(driver(), state().logs, name, delay)
+    return Response(data, mimetype="application/json")

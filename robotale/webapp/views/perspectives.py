@@ -8,7 +8,7 @@ from __future__ import annotations
 from flask import Blueprint, Response, abort, render_template, request
 
 from robotale.webapp import pages
-from robotale.webapp.findings_data import PERSPECTIVES, stored_perspective
+from robotale.webapp.findings_data import PERSPECTIVES, parse_delay, stored_perspective
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("perspectives", __name__)
@@ -23,6 +23,7 @@ def page():
         names=NAMES,
         activity=request.args.get("activity", ""),
         robot=request.args.get("robot", ""),
+        delay=request.args.get("delay", ""),
         **pages.context("perspectives.page"),
     )
 
@@ -38,5 +39,6 @@ def perspective(name: str):
         name,
         activity=request.args.get("activity") or None,
         robot=request.args.get("robot") or None,
+        delay=parse_delay(request.args.get("delay")),
     )
     return Response(data, mimetype="application/json")

@@ -56,7 +56,10 @@
       return;
     }
     try {
-      const data = await robotale.api(`/api/findings?log=${encodeURIComponent(log)}`);
+      const asked = new URLSearchParams({ log });
+      const delay = new URLSearchParams(window.location.search).get("delay");
+      if (delay) asked.set("delay", delay);
+      const data = await robotale.api(`/api/findings?${asked}`);
       box.replaceChildren(...data.answers.map((answer) => answerSection(log, answer)));
       document.getElementById("runs-table").replaceChildren(runsTable(log, data.runs));
       runsBox.hidden = !data.runs.length;

@@ -24,6 +24,9 @@ const robotalePerspective = (() => {
     const params = new URLSearchParams({ log });
     if (focus && focus.activity) params.set("activity", focus.activity);
     if (focus && focus.robot) params.set("robot", focus.robot);
+    // the page's own delay threshold (seconds), if the user gave one
+    const delay = new URLSearchParams(window.location.search).get("delay");
+    if (delay) params.set("delay", delay);
     return params.toString();
   }
 
