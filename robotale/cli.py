@@ -38,6 +38,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_record(commands)
     _add_simulate(commands)
     _add_prepare(commands)
+    _add_annotate(commands)
     _add_neo4j(commands)
     _add_inspect(commands)
     _add_ingest(commands)
@@ -294,6 +295,31 @@ def _add_prepare(commands: argparse._SubParsersAction) -> None:
     _handled_by(prepare, "prepare.prepare_command")
 
 
+def _add_annotate(commands: argparse._SubParsersAction) -> None:
+    annotate = commands.add_parser(
+        "annotate",
+        help="copy recordings as MCAP with their activities, messages and findings added",
+        description="Copy a rosbag2 directory, or each run of a folder of them, as an MCAP "
+        "rosbag2 directory under --out with added topics: each robot's current activity "
+        "(/robotale/<robot>/activity, std_msgs/String, and activity_index, std_msgs/Int32) "
+        "and, on /robotale/log (rcl_interfaces/Log), every message exchange, lost message, "
+        "bottleneck instance and, with --model, deviation from the model. The original "
+        "messages are copied byte for byte. Open it in Foxglove, Lichtblick or PlotJuggler "
+        "(docs/annotate.md).",
+    )
+    annotate.add_argument(
+        "source", type=Path, help="a rosbag2 directory or a folder of run directories"
+    )
+    annotate.add_argument(
+        "--out", type=Path, required=True, metavar="DIR", help="the folder the copies go to"
+    )
+    annotate.add_argument(
+        "--model", type=Path, metavar="BPMN", help="a BPMN collaboration to check the runs against"
+    )
+    _add_preparation_options(annotate)
+    _handled_by(annotate, "annotate.annotate_command")
+
+
 def _add_executor(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--executor",
@@ -332,8 +358,8 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         dest="msg_files",
         action="append",
         metavar="PATH",
-        help="a .msg/.idl/.action file or a folder of them, for types the bags do not define. "
-        "Repeatable",
+        help="a .msg/.srv/.action/.idl file or a folder of them, for types the bags do not "
+        "define. Repeatable",
     )
     parser.add_argument(
         "--bag-time",
@@ -367,6 +393,13 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         metavar="GLOB",
         default=None,
         help="behaviour-tree transition logs whose nodes are activities, e.g. /behavior_tree_log",
+    )
+    parser.add_argument(
+        "--robot",
+        metavar="NAME",
+        default=None,
+        help="the robot of tags and activities on topics without a namespace "
+        "(default: the bag's only namespace, else robot)",
     )
     parser.add_argument(
         "--auto",

@@ -141,6 +141,7 @@ def prepare_recordings(
     bt_log: str | None = None,
     auto: bool = False,
     distro: str | None = None,
+    robot: str | None = None,
     executor: str | None = None,
 ) -> pd.DataFrame:
     """The event log of the recordings at ``source``; an option left ``None`` takes
@@ -158,6 +159,7 @@ def prepare_recordings(
         "bt_log": bt_log,
         "auto": auto,
         "distro": distro,
+        "robot": robot,
     }
     return prepare_reporting(source, executor=executor, **_given(options))
 
@@ -183,6 +185,7 @@ def _given(options: dict[str, Any]) -> dict[str, Any]:
         "bt_logs": options.get("bt_log"),
         "auto": bool(options.get("auto")),
         "distro": options.get("distro"),
+        "robot": options.get("robot"),
         **{key: value for key, value in given.items() if value is not None},
     }
 

@@ -450,7 +450,8 @@ def parse_timestamps(path: Path, values: pd.Series, lines: pd.Series) -> pd.Seri
             )
     if parsed.dt.tz is None:
         parsed = parsed.dt.tz_localize("UTC")
-    return parsed
+    # one unit whatever the file gave (six decimals or nine): a log's times compare as read
+    return parsed.dt.as_unit("ns")
 
 
 def _to_datetime(text: pd.Series) -> pd.Series:

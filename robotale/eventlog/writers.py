@@ -1,7 +1,8 @@
 """Writing a canonical event log as CSV, XES (IEEE 1849) or OCEL 2.0 JSON.
 
 Each writer writes to a temporary file next to the target and renames it into place, so a
-failure never leaves a partial file behind. Timestamps are written in UTC with microseconds.
+failure never leaves a partial file behind. Timestamps are written in UTC with microseconds,
+or nanoseconds when the log's times have them (a recording's own resolution).
 
 - CSV: the short column names of :mod:`robotale.eventlog.schema`, one row per event.
 - XES: one trace per case; every event carries ``concept:name``, ``time:timestamp``,
@@ -63,7 +64,15 @@ def _target(path: str | Path) -> Path:
 
 
 def _utc_text(times: pd.Series) -> pd.Series:
-    return times.dt.tz_convert("UTC").dt.strftime(_TIME_FORMAT)
+    """ISO 8601 in UTC: six decimals of the second, or nine in a log whose times have
+    nanoseconds (a recording's own resolution), so that every time of a file has one form."""
+    utc = times.dt.tz_convert("UTC").dt.as_unit("ns")
+    text = utc.dt.strftime(_TIME_FORMAT)
+    nanos = utc.dt.nanosecond.to_numpy()
+    if not nanos.any():
+        return text
+    digits = pd.Series(np.char.zfill(nanos.astype(str), 3), index=text.index)
+    return text.str.slice(0, 26) + digits.where(utc.notna()) + "+00:00"
 
 
 def write_csv(log: pd.DataFrame, path: str | Path) -> None:
