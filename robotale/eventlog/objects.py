@@ -22,6 +22,11 @@ from robotale.eventlog import schema
 SEPARATOR = ","
 #: properties an Entity node keeps for itself: no object attribute may have these names
 ENTITY_KEYS = ("log", "type", "id")
+#: properties the graph sets on every Event node itself (robotale.ekg.tables.RESERVED, which
+#: comes later in the data flow; a test keeps the two equal)
+EVENT_OWN = ("log", "order")
+#: what an object type's entity column is called when the events already use its name
+COLUMN_PREFIX = "object:"
 #: the columns of each table of :class:`Objects`
 OBJECT_COLUMNS = ("type", "id")
 E2O_COLUMNS = ("event", "object", "qualifier")
@@ -45,11 +50,21 @@ class Objects:
     o2o: pd.DataFrame = field(default_factory=lambda: _empty(O2O_COLUMNS))
     #: ``object``, ``time``, ``field``, ``value``: an attribute's later values
     changes: pd.DataFrame = field(default_factory=lambda: _empty(CHANGE_COLUMNS))
+    #: object type -> the log's column (entity type) of its objects, where the two differ
+    columns: dict[str, str] = field(default_factory=dict)
 
     @property
     def types(self) -> list[str]:
         """The object types, in the order the log first names them."""
         return list(pd.unique(self.objects["type"].astype(str)))
+
+    def column(self, kind: str) -> str:
+        """The entity column (and entity type) of the object type ``kind``."""
+        return self.columns.get(kind, kind)
+
+    @property
+    def entity_types(self) -> list[str]:
+        return [self.column(kind) for kind in self.types]
 
     @property
     def attributes(self) -> list[str]:
@@ -65,20 +80,22 @@ class ObjectLog:
     objects: Objects
 
 
-def check_object_types(source: Path, types: list[str], event_columns: list[str]) -> None:
-    """Each object type becomes an entity column of the log: refuse a name that cannot be a
-    property or that an event attribute or a column of the log already has."""
+def entity_columns(source: Path, types: list[str], event_columns: list[str]) -> dict[str, str]:
+    """Each object type becomes an entity column of the log, named as the type unless the
+    events already use that name (an event attribute, a column robotale's logs have, a
+    property the graph sets on events: ``order``), then ``object:<type>``; a type whose name
+    cannot be a property is refused."""
+    taken = {*event_columns, *schema.CSV_NAMES, *schema.CSV_NAMES.values(), *EVENT_OWN, "id"}
+    columns = {}
     for name in types:
-        if not schema.is_property_name(name):
+        if not schema.is_property_name(name) or len(name) > 90:
             raise InputError(
                 f"{source}: the object type {name!r} cannot become a Neo4j name (use letters, "
                 "digits, _ : . - and blanks, starting with a letter)."
             )
-        if name in event_columns or name in schema.CSV_NAMES or name in schema.CSV_NAMES.values():
-            raise InputError(
-                f"{source}: the object type {name!r} has the name of a column of the events; "
-                "rename the object type or the event attribute."
-            )
+        if name in taken:
+            columns[name] = f"{COLUMN_PREFIX}{name}"
+    return columns
 
 
 def check_attribute_names(source: Path, names: list[str], where: str) -> None:
@@ -121,7 +138,7 @@ def _where(where: str, mask: pd.Series) -> str:
 
 
 def entity_cells(event_ids: pd.Series, objects: Objects) -> dict[str, pd.Series]:
-    """Per object type, each event's objects of that type as one comma-separated cell (None
+    """Per entity column, each event's objects of that type as one comma-separated cell (None
     where it has none), in the order of its relations."""
     kinds = objects.objects.set_index("id")["type"]
     links = objects.e2o.drop_duplicates(["event", "object"])
@@ -131,7 +148,7 @@ def entity_cells(event_ids: pd.Series, objects: Objects) -> dict[str, pd.Series]
         mine = links[links["type"] == kind]
         joined = mine.groupby("event", sort=False)["object"].agg(SEPARATOR.join)
         cell = event_ids.map(joined).astype(object)
-        cells[kind] = cell.where(cell.notna(), None)
+        cells[objects.column(kind)] = cell.where(cell.notna(), None)
     return cells
 
 

@@ -19,6 +19,7 @@ one, the line.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import warnings
 from collections.abc import Mapping, Sequence
@@ -35,7 +36,7 @@ from lxml import etree
 from robotale.errors import InputError
 from robotale.eventlog import dataset, ocel, reading, schema
 from robotale.eventlog.dataset import MANIFEST, WRITING
-from robotale.eventlog.objects import Objects, check_object_types, entity_cells
+from robotale.eventlog.objects import Objects, entity_cells, entity_columns
 from robotale.eventlog.oced import read_object_tables
 from robotale.eventlog.reading import SYNONYMS, TEXT_COLUMNS, Reading, column_mapping, listing
 from robotale.storage import place
@@ -265,9 +266,10 @@ def _read_ocel(
     no cases: unless ``case`` or ``case_gap`` says otherwise it is one, and each object's
     events follow one another over the whole log."""
     found = ocel.read_ocel(path)
-    events, objects = found.events, found.objects
+    events = found.events
     attributes = [c for c in events.columns if c not in _OCEL_COLUMNS]
-    check_object_types(path, objects.types, attributes)
+    columns = entity_columns(path, found.objects.types, attributes)
+    objects = dataclasses.replace(found.objects, columns=columns)
     cells = entity_cells(events[ocel.EVENT_ID], objects)
     table = events.assign(**cells)
     renames = {
@@ -277,7 +279,7 @@ def _read_ocel(
     } | _OCEL_COLUMNS
     lines = pd.Series(range(1, len(table) + 1), index=table.index)
     log, how = canonical_log(path, table, renames, lines, case, case_gap)
-    how.columns.update(dict.fromkeys(objects.types, "objects (entity type)"))
+    how.columns.update(dict.fromkeys(objects.entity_types, "objects (entity type)"))
     # OCEL's events are instants by the standard: no pairs is no finding
     how.warnings = [w for w in how.warnings if w not in reading.no_pairs_warning(log)]
     if case is None and case_gap is None:

@@ -438,7 +438,7 @@ def _object_centric_document(log: pd.DataFrame, objects: Objects) -> dict:
 def _event_attributes(log: pd.DataFrame, objects: Objects) -> list[str]:
     """The log's columns that are event attributes: not the event's own fields, not object
     columns, and not the case and lifecycle robotale fills in where a log has none."""
-    structure = {schema.EVENT_ID, ACTIVITY, TIME, *objects.types}
+    structure = {schema.EVENT_ID, ACTIVITY, TIME, *objects.entity_types}
     filled = {CASE: "1", schema.LIFECYCLE: schema.COMPLETE}
     for column, value in filled.items():
         if column in log and (log[column].astype("string") == value).all():

@@ -13,9 +13,10 @@ import pm4py
 import pytest
 from object_logs import missing, order_log, plain, pm4py_view
 
+from robotale.ekg.tables import RESERVED
 from robotale.errors import InputError
 from robotale.eventlog import schema
-from robotale.eventlog.objects import SEPARATOR, Objects
+from robotale.eventlog.objects import EVENT_OWN, SEPARATOR, Objects
 from robotale.eventlog.readers import read_log, read_with_objects
 from robotale.eventlog.writers import write_ocel
 
@@ -31,7 +32,7 @@ ENCODINGS = {
 def robotale_view(log: pd.DataFrame, objects: Objects) -> dict[str, object]:
     """robotale's reading in the shape of :func:`object_logs.pm4py_view`."""
     own = {schema.EVENT_ID, schema.ACTIVITY, schema.TIMESTAMP, schema.CASE, schema.LIFECYCLE}
-    attributes = [c for c in log.columns if c not in own | set(objects.types)]
+    attributes = [c for c in log.columns if c not in own | set(objects.entity_types)]
     events = {
         row[schema.EVENT_ID]: (
             row[schema.ACTIVITY],
@@ -81,11 +82,12 @@ def test_reading_equals_pm4py(tmp_path, ocel, encoding):
     assert len(found["changes"]) == len(ocel.object_changes) > 0
     # each event's objects of a type, as the entity column lists them
     for kind in ("order", "item", "package"):
+        column = objects.column(kind)
         listed = {
             (row[schema.EVENT_ID], oid)
             for row in log.to_dict("records")
-            if isinstance(row[kind], str)
-            for oid in row[kind].split(SEPARATOR)
+            if isinstance(row[column], str)
+            for oid in row[column].split(SEPARATOR)
         }
         related = ocel.relations[ocel.relations["ocel:type"] == kind]
         assert listed == set(zip(related["ocel:eid"], related["ocel:oid"], strict=True))
@@ -112,7 +114,12 @@ def test_read_log_gives_the_events_with_object_columns(tmp_path, ocel):
     pm4py.write_ocel2_json(ocel, str(path))
     log = read_log(path)
     assert len(log) == len(ocel.events)
-    assert {"order", "item", "package"} <= set(log.columns)
+    # "order" is a property every Event has (its position in the log)
+    assert {"object:order", "item", "package"} <= set(log.columns)
+
+
+def test_event_properties_the_graph_sets_are_no_entity_columns():
+    assert set(RESERVED) == set(EVENT_OWN)
 
 
 def _json_log(tmp_path, document) -> object:
