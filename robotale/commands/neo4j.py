@@ -43,7 +43,10 @@ def neo4j_start(
         print("The local Neo4j had crashed; starting it again.")
     state = server.start(options, timeout=timeout, progress=_progress)
     verb = "was already running" if already else "is running"
-    print(f"Neo4j {release(options.version).version} {verb} at {state.bolt_uri} (pid {state.pid}).")
+    # a server that was already running runs the release its data was written by
+    version = server.data_version() if already else None
+    version = version or release(options.version).version
+    print(f"Neo4j {version} {verb} at {state.bolt_uri} (pid {state.pid}).")
     print(f"Neo4j Browser: {state.browser_url}  user neo4j, password in {server.password_file}")
     if not already:
         _report_plugins(server, options)

@@ -291,7 +291,7 @@ def write_graph(
     """Entities and classes, then events with their CORR, OBSERVED, DF and COMM edges, then
     the DF and COMM edges between batches, and BEGINS edges. ``new_log``: nothing of the
     log is stored yet (an append finds the entities and BEGINS edges the log has). Returns
-    the node ids of each key's classes, by class row."""
+    the element ids of each key's classes, by class row."""
     entity_nodes = _write_entities(loader, tables.entities, new_log)
     class_nodes = [_write_classes(loader, c) for c in classes]
     per_event = _per_event(tables.corr, entity_nodes, len(tables.events))
@@ -327,7 +327,7 @@ def write_graph(
 
 
 def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:
-    """The DF_C edges computed in ``classes`` (``nodes``: the classes' node ids)."""
+    """The DF_C edges computed in ``classes`` (``nodes``: the classes' element ids)."""
     df_c = classes.df_c
     if df_c.empty:
         return
@@ -347,7 +347,7 @@ def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:
 def _write_entities(loader: Loader, entities: pd.DataFrame, new_log: bool) -> np.ndarray:
     # CREATE rather than MERGE where the log has no entity yet: no index lookup per entity
     query = "ekg_create_entities" if new_log else "ekg_merge_entities"
-    nodes = np.zeros(len(entities), dtype=np.int64)
+    nodes = np.empty(len(entities), dtype=object)
     for entity_type, part in entities.groupby("type", sort=False):
         created = loader.run(query, {"ids": part["id"].tolist()}, type=entity_type)
         nodes[part.index.to_numpy()] = created
@@ -364,7 +364,7 @@ def _write_classes(loader: Loader, classes: ClassTables) -> np.ndarray:
         type=classes.type,
         key=classes.key,
     )
-    return np.asarray(created, dtype=np.int64)
+    return np.asarray(created, dtype=object)
 
 
 def _write_begins(
@@ -386,8 +386,8 @@ def _write_begins(
     )
 
 
-def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> list[list[int]]:
-    """The entity node ids of each event, as one list per event."""
+def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> list[list[str]]:
+    """The entity element ids of each event, as one list per event."""
     ordered = corr.sort_values("event", kind="stable")
     nodes = entity_nodes[ordered["entity"].to_numpy()].tolist()
     bounds = np.searchsorted(ordered["event"].to_numpy(), np.arange(events + 1)).tolist()
@@ -396,8 +396,8 @@ def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> lis
 
 def _observed(
     classes: Sequence[ClassTables], class_nodes: Sequence[np.ndarray], events: int
-) -> list[list[int]]:
-    """The class node ids of each event (one per key), as one list per event."""
+) -> list[list[str]]:
+    """The class element ids of each event (one per key), as one list per event."""
     if not classes:
         return [[] for _ in range(events)]
     columns = [nodes[c.observed] for c, nodes in zip(classes, class_nodes, strict=True)]

@@ -357,12 +357,16 @@ class LocalServer:
         else:  # one removed from the home must not linger
             target.unlink(missing_ok=True)
 
+    def data_version(self) -> str | None:
+        """The Neo4j version that wrote this home's data (None: not recorded)."""
+        return self.version_file.read_text().strip() if self.version_file.is_file() else None
+
     def _require_data_of(self, chosen: Release) -> None:
         """Refuse to start ``chosen`` on data another Neo4j version wrote (an older release
         cannot read a newer store, and a newer one would upgrade it for good); record the
         version of a home without data."""
         data = self.home / "data"
-        written_by = self.version_file.read_text().strip() if self.version_file.is_file() else None
+        written_by = self.data_version()
         if not data.is_dir() or not any(data.iterdir()):
             self.home.mkdir(parents=True, exist_ok=True)
             write_file(self.version_file, chosen.version)
