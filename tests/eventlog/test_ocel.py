@@ -11,7 +11,7 @@ import sqlite3
 import pandas as pd
 import pm4py
 import pytest
-from object_logs import missing, order_log, plain, pm4py_view
+from object_logs import logistics_csv, missing, order_log, plain, pm4py_view
 
 from robotale.ekg.tables import RESERVED
 from robotale.errors import InputError
@@ -194,3 +194,35 @@ def test_objects_folder_with_ocel_is_refused(tmp_path, ocel):
     pm4py.write_ocel2_json(ocel, str(path))
     with pytest.raises(InputError, match="lists its objects itself"):
         read_with_objects(path, objects=tmp_path)
+
+
+def test_oced_csv_reads_objects_from_the_type_tables(tmp_path):
+    events_file, folder = logistics_csv(tmp_path)
+    log, _, objects = read_with_objects(events_file, objects=folder)
+    events = pd.read_csv(events_file)
+    assert sorted(objects.types) == ["Container", "Forklift", "Truck", "Vehicle"]
+    trucks = objects.objects[objects.objects["type"] == "Truck"].set_index("id")
+    table = pd.read_csv(folder / "Truck.csv").set_index("id")
+    assert trucks["plate"].to_dict() == table["plate"].to_dict()
+    assert trucks["axles"].astype(int).to_dict() == table["axles"].to_dict()
+    named = events["Container"].str.split(",").explode()
+    containers = objects.e2o[objects.e2o["object"].str.startswith("cr")]
+    assert len(containers) == len(named) and containers["qualifier"].isna().all()
+    assert log["Container"].tolist() == events["Container"].tolist()
+
+
+@pytest.mark.parametrize(
+    ("damage", "says"),
+    [
+        (lambda folder: (folder / "Truck.csv").write_text("plate\nK-1\n"), "has no 'id' column"),
+        (lambda folder: (folder / "Crane.csv").write_text("id\nc1\n"), "no column 'Crane'"),
+        (lambda folder: (folder / "Vehicle.csv").write_text("id,type\nve1,tug\n"), "'type'"),
+        (lambda folder: (folder / "Vehicle.csv").write_text("id\nve1\nve1\n"), "'ve1' appears"),
+    ],
+)
+def test_bad_object_tables_are_refused_naming_the_file(tmp_path, damage, says):
+    events_file, folder = logistics_csv(tmp_path)
+    damage(folder)
+    with pytest.raises(InputError, match=says) as refused:
+        read_with_objects(events_file, objects=folder)
+    assert str(folder) in str(refused.value)
