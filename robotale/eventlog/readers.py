@@ -171,8 +171,8 @@ def _csv_header(path: Path, text: str) -> list[str]:
     the second ``activity`` as ``activity.1``) or if the file is JSON (an OCEL log, say)."""
     if text.lstrip().startswith(("{", "[")):
         raise InputError(
-            f"{path} is JSON (an OCEL 2.0 log?), not a CSV or XES event log: give ingest a "
-            "CSV or XES file, or a folder of recordings."
+            f"{path} is JSON, not CSV: an OCEL 2.0 log is read as one when its name ends in "
+            ".jsonocel or .json."
         )
     try:
         names = next(csv.reader(io.StringIO(text), strict=True), [])
