@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 # Graphviz to draw discovered process models as SVG.
 SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
-.PHONY: install system-deps test demo bench lint format constraints clean fuzz bpmn-engine
+.PHONY: install system-deps test test-neo4j-next demo bench lint format constraints clean fuzz bpmn-engine
 
 install: $(STAMP)
 
@@ -50,6 +50,17 @@ $(HARNESS)/node_modules/.package-lock.json: $(HARNESS)/package.json $(HARNESS)/p
 	else \
 	  echo "node and npm are not installed: the differential suite will leave bpmn-engine out"; \
 	fi
+
+# The Neo4j tests again on the newest Neo4j release robotale runs (`make test` runs them on
+# 5.26 LTS, and starts the newest release with the real `robotale neo4j start --version`):
+# every file of cypher/ planned without a deprecation, logs built, appended, listed, locked
+# and deleted, object-centric logs. Its jars are downloaded once, like 5.26's.
+NEO4J_NEXT ?= 2026.08
+NEO4J_NEXT_TESTS ?= tests/ekg/test_cypher_files.py tests/ekg/test_build.py \
+  tests/ekg/test_append.py tests/ekg/test_batches.py tests/ekg/test_logs.py \
+  tests/ekg/test_writelock.py tests/ekg/test_objects.py tests/ekg/test_releases.py
+test-neo4j-next: install
+	ROBOTALE_TEST_NEO4J_VERSION=$(NEO4J_NEXT) $(BIN)/pytest -m "not slow" $(NEO4J_NEXT_TESTS)
 
 # The fuzz suite with many more examples than `make test` runs (FUZZ_EXAMPLES per test):
 # nothing but robotale's own errors may come out of the log readers, the bag reader and the

@@ -71,9 +71,9 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
     neo4j = commands.add_parser(
         "neo4j",
         help="run a local Neo4j server (not needed when NEO4J_URI names one)",
-        description="A local Neo4j 5.26 Community server on 127.0.0.1, kept under the robotale "
-        "home ($ROBOTALE_HOME, default ~/.robotale). With NEO4J_URI set, robotale uses that "
-        "server instead.",
+        description="A local Neo4j Community server (5.26 LTS, or a newer release with "
+        "--version) on 127.0.0.1, kept under the robotale home ($ROBOTALE_HOME, default "
+        "~/.robotale). With NEO4J_URI set, robotale uses that server instead.",
     )
     actions = neo4j.add_subparsers(dest="_action", metavar="ACTION", required=True)
     start = actions.add_parser("start", help="start the server in the background and wait for it")
@@ -86,6 +86,12 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
         metavar="DIR",
         help="folder of plugin jars such as APOC (ROBOTALE_NEO4J_PLUGINS; default: the "
         "plugins folder of the robotale home, when there is one)",
+    )
+    start.add_argument(
+        "--version",
+        help="the Neo4j release line or version, e.g. 2026.08 (ROBOTALE_NEO4J_VERSION; default "
+        "the LTS line; an unknown one is refused naming those offered); a home's data stays "
+        "with the release that wrote it",
     )
     start.add_argument("--timeout", type=float, help="seconds to wait (180)")
     _handled_by(start, "neo4j.neo4j_start")
@@ -420,15 +426,25 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
 def _add_ingest(commands: argparse._SubParsersAction) -> None:
     ingest = commands.add_parser(
         "ingest",
-        help="load an event log (CSV, XES or rosbag2 recordings) into Neo4j as an event "
-        "knowledge graph",
+        help="load an event log (CSV, XES, OCEL 2.0 or rosbag2 recordings) into Neo4j as an "
+        "event knowledge graph",
         description="Read an event log, or prepare one from rosbag2 recordings as `robotale "
         "prepare` does, and store it in Neo4j: Event, Entity and Class nodes, CORR, DF, COMM, "
         "OBSERVED and DF_C edges. Nothing is written if the log is refused, and a failed ingest "
         "leaves the database as it was.",
     )
     ingest.add_argument(
-        "path", type=Path, help="a .csv or .xes event log, a rosbag2 directory or a folder of runs"
+        "path",
+        type=Path,
+        help="a .csv or .xes event log, an OCEL 2.0 log (.jsonocel/.json, .xmlocel/.xml, "
+        ".sqlite/.db), a rosbag2 directory or a folder of runs",
+    )
+    ingest.add_argument(
+        "--objects",
+        type=Path,
+        metavar="DIR",
+        help="a CSV log's object tables: DIR/<Type>.csv with an id column and one column per "
+        "attribute, for the events' column <Type> (object ids, several comma-separated)",
     )
     ingest.add_argument(
         "--log", help="name of the log in Neo4j (default: the file's or folder's name)"

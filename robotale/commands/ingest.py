@@ -18,7 +18,7 @@ from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
-from robotale.eventlog.readers import is_parquet, parse_mapping, read_log_with_reading
+from robotale.eventlog.readers import is_parquet, parse_mapping, read_with_objects
 from robotale.eventlog.reading import format_reading
 from robotale.webapp.findings_data import prepare
 from robotale.webapp.logdata import LogData
@@ -41,15 +41,24 @@ def ingest_command(
     rate: float | None = None,
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
+    objects: Path | None = None,
     **recording: Any,
 ) -> int:
-    """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
-    Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the other
-    options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto ...).
-    With ``append`` its runs are added to the stored log of that name."""
+    """Store the log at ``path`` (CSV, XES, OCEL 2.0, or recordings prepared as ``prepare``
+    does) in Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the
+    other options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto
+    ...). With ``append`` its runs are added to the stored log of that name. ``objects``: the
+    folder of a CSV log's object tables (``<Type>.csv``). An object-centric log's object types
+    are its entity types unless ``entities`` names others."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
+    found_objects = None
     if path.is_dir() and not is_parquet(path):
+        if objects is not None:
+            raise InputError(
+                f"{path} holds recordings: --objects applies to a CSV event log with one "
+                "column per object type."
+            )
         if mapping or case:
             raise InputError(
                 f"{path} holds recordings: --map and --case apply to CSV and XES files "
@@ -71,11 +80,21 @@ def ingest_command(
             **recording,
         )
     else:
-        events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
+        events, reading, found_objects = read_with_objects(
+            path, parse_mapping(mapping), case, case_gap, objects
+        )
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
         print(format_reading(reading, short=True))
+    if append and found_objects is not None:
+        raise InputError(
+            f"{path} is object-centric: --append adds runs of a log with cases; rebuild the "
+            "log with --replace instead."
+        )
     name = log or log_name(path)
-    names = {"entities": split_names(entities) if entities else None}
+    chosen = split_names(entities) if entities else None
+    if chosen is None and found_objects is not None:
+        chosen = found_objects.entity_types
+    names = {"entities": chosen}
     with session_driver() as driver:
         if append:
             # the log's columnar copy no longer matches its build: the next analysis reads
@@ -89,6 +108,7 @@ def ingest_command(
                 aggregate=aggregate or DEFAULT_AGGREGATE,
                 replace=replace,
                 source=str(path),
+                objects=found_objects,
                 **names,
             )
         print(describe(summary, appended=append))
