@@ -45,6 +45,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_logs(commands)
     _add_serve(commands)
     _add_demo(commands)
+    _add_aggregate(commands)
     _add_discover(commands)
     _add_perspectives(commands)
     _add_report(commands)
@@ -660,6 +661,39 @@ def _add_inspect(commands: argparse._SubParsersAction) -> None:
     _add_mapping(inspect)
     _add_case_options(inspect)
     _handled_by(inspect, "inspect.inspect_command")
+
+
+def _add_aggregate(commands: argparse._SubParsersAction) -> None:
+    aggregate = commands.add_parser(
+        "aggregate",
+        help="collapse a stored log's events or entities into aggregates, step by step",
+        description="Run an aggregation specification (YAML: steps with aggr_type, ent_type, "
+        "group_by, where, attr_aggrs, as OCEAN's) on a log stored in Neo4j. Each step "
+        "collapses the matching events or entities into Aggregate nodes that keep their CORR, "
+        "DF and COMM edges, counted; steps stack and are undone as units. See docs/aggregate.md.",
+    )
+    aggregate.add_argument("log_name", metavar="LOG", help="the stored log")
+    aggregate.add_argument("--spec", type=Path, metavar="FILE", help="the specification to run")
+    aggregate.add_argument(
+        "--undo",
+        dest="undo_step",
+        nargs="?",
+        const="last",
+        metavar="STEP",
+        help="undo step STEP and the steps stacked on it (default: the last step)",
+    )
+    aggregate.add_argument(
+        "--steps", action="store_true", default=None, help="list the log's aggregation steps"
+    )
+    aggregate.add_argument(
+        "--json",
+        dest="as_json",
+        action="store_true",
+        default=None,
+        help="print each step's initial_events, final_events, initial_entities and "
+        "final_entities as JSON",
+    )
+    _handled_by(aggregate, "aggregate.aggregate_command")
 
 
 def _add_discover(commands: argparse._SubParsersAction) -> None:

@@ -16,6 +16,7 @@ import time
 import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import NoReturn
 
 import numpy as np
 import pandas as pd
@@ -184,20 +185,30 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
                 "runs again, `robotale logs list` shows the log as failed and "
                 f"`robotale logs delete {shlex.quote(target)}` removes it."
             ) from error
-        try:
-            _undo(driver, target, job.run)
-        except (Neo4jError, DriverError, OSError):
-            raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({why(error)}) and what was "
-                "written could not be removed; remove it with "
-                f"`robotale logs delete {shlex.quote(target)}`."
-            ) from error
-        if isinstance(error, Neo4jError | DriverError | OSError):
-            raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({why(error)}); nothing of it "
-                "was kept."
-            ) from error
-        raise
+        undo_after_failure(
+            error,
+            lambda: _undo(driver, target, job.run),
+            f"Writing the log {target!r} to Neo4j failed",
+            f"`robotale logs delete {shlex.quote(target)}`",
+        )
+
+
+def undo_after_failure(
+    error: BaseException, undo: Callable[[], None], failed: str, remover: str
+) -> NoReturn:
+    """Remove what a failed write wrote (``undo``) and raise: a :class:`ServerError` saying
+    so (``failed``: what failed; ``remover``: the command that removes what is left if
+    ``undo`` fails too) for a server's error, else ``error`` itself (e.g. Ctrl-C)."""
+    try:
+        undo()
+    except (Neo4jError, DriverError, OSError):
+        raise ServerError(
+            f"{failed} ({why(error)}) and what was written could not be removed; remove it "
+            f"with {remover}."
+        ) from error
+    if isinstance(error, Neo4jError | DriverError | OSError):
+        raise ServerError(f"{failed} ({why(error)}); nothing of it was kept.") from error
+    raise error
 
 
 def _answers(driver: Driver) -> bool:
