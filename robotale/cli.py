@@ -340,6 +340,14 @@ def _add_executor(parser: argparse.ArgumentParser) -> None:
 
 def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
     """How recordings become an event log; shared by ``prepare`` and ``ingest``."""
+    parser.add_argument(
+        "--skip-bad",
+        dest="skip_bad",
+        action="store_true",
+        default=None,
+        help="leave out a run that cannot be read (named, with why) and keep the others; "
+        "without it such a run stops everything before anything is written",
+    )
     parser.add_argument("--tags", metavar="GLOB", help="the tag topics (default: /*/tag)")
     parser.add_argument(
         "--tag-field",

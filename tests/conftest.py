@@ -144,6 +144,34 @@ def graph_counts(neo4j_driver: Driver) -> Callable[[], dict[str, int]]:
     return lambda: graph_counts(neo4j_driver)
 
 
+@pytest.fixture
+def small_disk(tmp_path: Path) -> Iterator[Callable[[str], Path]]:
+    """Mounts a filesystem of the given size (``small_disk("1m")``) and returns its folder:
+    a real full disk for the tests of what a command does when it runs out of space. Needs
+    root (``mount -t tmpfs``); the test is skipped where it cannot mount."""
+    import subprocess
+
+    mounted: list[Path] = []
+
+    def mount(size: str) -> Path:
+        folder = tmp_path / f"disk{len(mounted)}"
+        folder.mkdir()
+        done = subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(folder)],
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        if done.returncode != 0:
+            pytest.skip(f"cannot mount a small filesystem here ({done.stderr.strip()})")
+        mounted.append(folder)
+        return folder
+
+    yield mount
+    for folder in mounted:
+        subprocess.run(["umount", "-l", str(folder)], check=False)
+
+
 _exit_status = 0
 
 

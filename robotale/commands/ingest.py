@@ -10,7 +10,7 @@ from typing import Any
 import pandas as pd
 from neo4j import Driver
 
-from robotale.commands.prepare import prepare_recordings
+from robotale.commands.prepare import kept_runs, prepare_recordings
 from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg, why
 from robotale.ekg.columnar import delete_copies
@@ -42,6 +42,7 @@ def ingest_command(
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
     objects: Path | None = None,
+    skip_bad: bool = False,
     **recording: Any,
 ) -> int:
     """Store the log at ``path`` (CSV, XES, OCEL 2.0, or recordings prepared as ``prepare``
@@ -53,6 +54,12 @@ def ingest_command(
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
     found_objects = None
+    if log is not None and not log.strip():
+        raise InputError(
+            f"--log {log!r} names no log: give it a name, or leave --log out to use "
+            f"{log_name(path)!r}."
+        )
+    skipped: list[Path] | None = None
     if path.is_dir() and not is_parquet(path):
         if objects is not None:
             raise InputError(
@@ -69,6 +76,7 @@ def ingest_command(
                 f"{path} holds recordings: --case-gap applies to CSV and XES files "
                 "(each run of a recording is its own case)."
             )
+        skipped = [] if skip_bad else None
         events = prepare_recordings(
             path,
             tags=tags,
@@ -77,6 +85,7 @@ def ingest_command(
             rate=rate,
             msg_files=msg_files,
             bag_time=bag_time,
+            skipped=skipped,
             **recording,
         )
     else:
@@ -113,6 +122,8 @@ def ingest_command(
             )
         print(describe(summary, appended=append))
         prepare_pages(driver, name)
+    if skipped is not None:
+        print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
 
 

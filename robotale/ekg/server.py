@@ -42,6 +42,7 @@ from robotale.ekg.jars import (
     release,
 )
 from robotale.ekg.java import find_java
+from robotale.ekg.plan_check import ALLOWED_FUNCTIONS
 from robotale.ekg.port_holder import port_holder
 from robotale.ekg.queries import statements
 from robotale.ekg.server_config import (
@@ -632,6 +633,9 @@ def security_settings(heap: str) -> dict[str, str]:
         # LOAD CSV may not read files (the console also refuses the clause before sending it).
         "dbms.security.allow_csv_import_from_file_urls": "false",
         "server.directories.import": "import",
+        # No plugin's procedures or functions load unless the overlay names them: the
+        # console's queries then cannot reach them whatever their spelling.
+        "dbms.security.procedures.allowlist": ",".join(sorted(ALLOWED_FUNCTIONS)),
     }
     limit = _share_of(heap, _TRANSACTION_SHARE)
     if limit is not None:

@@ -139,6 +139,7 @@ def prepare(
     progress: bool = False,
     report: Callable[[str], None] | None = None,
     executor: str | None = None,
+    skip_bad: Callable[[Path, str], None] | None = None,
     **options: Any,
 ) -> pd.DataFrame:
     """The multi-perspective event log of a rosbag2 directory or of a folder of them.
@@ -162,18 +163,27 @@ def prepare(
     ``executor`` (``local[:N]``, ``dask://HOST:PORT``; see :mod:`robotale.executors`) reads
     the runs in parallel, each run on its own (no reading crosses runs), with the same log as
     reading them here one after the other.
+
+    ``skip_bad`` hears of each run that cannot be read (the run, why), which is then left
+    out; without it such a run stops the preparation.
     """
     job = preparation(**options)
     reading, msg_files, distro, rate = job.reading, job.msg_files, job.distro, job.rate
     chosen = list(reading.perspectives)
     runs = find_runs(Path(source))
+    if executor is not None and skip_bad is not None:
+        raise InputError("Skipping bad runs reads them in this process: leave out --executor.")
     if executor is not None:
         told: set[tuple[str, ...]] = set()
         parts = _read_in_parallel(
             runs, reading, msg_files, distro, executor, progress, _once(report, told)
         )
     else:
-        parts = _read_here(runs, reading, msg_files, distro, progress, report)
+        parts = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
+        runs = [run for run, part in zip(runs, parts, strict=True) if part is not None]
+        parts = [part for part in parts if part is not None]
+        if not parts:
+            raise InputError(f"None of the runs of {source} could be read.")
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
     if tag_rows.empty:
         raise InputError(_nothing_found(source, reading))
@@ -227,8 +237,10 @@ def _read_here(
     distro: str,
     progress: bool,
     report: Callable[[str], None] | None,
-) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
-    """Every run read in this process, with a progress bar over their messages."""
+    skip_bad: Callable[[Path, str], None] | None = None,
+) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None]:
+    """Every run read in this process, with a progress bar over their messages; None for a
+    run that could not be read when ``skip_bad`` was told of it."""
     extra_types = message_types([Path(p) for p in msg_files])
     globs = [reading.tags, *(glob for p in reading.perspectives for glob in p.topic.split("|"))]
     with tqdm(
@@ -239,10 +251,18 @@ def _read_here(
         leave=False,
     ) as bar:
         told: set[tuple[str, ...]] = set()
-        return [
-            _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
-            for run in runs
-        ]
+        read = []
+        for run in runs:
+            try:
+                read.append(
+                    _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
+                )
+            except InputError as error:
+                if skip_bad is None:
+                    raise
+                skip_bad(run, str(error))
+                read.append(None)
+        return read
 
 
 def _read_in_parallel(

@@ -517,7 +517,9 @@ def parse_timestamps(path: Path, values: pd.Series, lines: pd.Series) -> pd.Seri
     else:
         text = values.astype("string").str.strip()
         parsed = _to_datetime(text)
-        bad = parsed.isna()
+        # pandas reads some text that is no time as year 0 ("/1"), which Python's dates and
+        # everything built on them cannot hold
+        bad = parsed.isna() | (parsed.dt.year < 1)
         if bad.any():
             row = bad.idxmax()
             shown = "" if pd.isna(text[row]) else text[row]
