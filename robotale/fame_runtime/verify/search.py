@@ -27,6 +27,8 @@ from robotale.fame_runtime.verify.state import (
 from robotale.fame_runtime.verify.step import Step
 from robotale.fame_runtime.verify.values import UNKNOWN
 
+#: what a loop without exit that never waits adds to its sentence
+BUSY = " without ever waiting (the engine stops it with a model error after 1,000,000 steps)"
 #: the kinds of finding, in the order a report lists them
 KINDS = ("deadlock", "no_exit", "lost_signal", "never_fires", "unreachable", "uncaught", "stuck")
 
@@ -290,9 +292,11 @@ def _no_exit(graph: Exploration, robot: str, state: int) -> Finding:
     tags = _restamp([t for o in loop for t in o.tags], after)
     labels = list(dict.fromkeys(t.activity for t in tags if t.robot == robot))
     why = _why(decisions)
+    busy = bool(loop) and all(o.urgent for o in loop)
     sentence = (
         f"robot {robot} can never finish: it goes round "
         f"{' -> '.join(labels) if labels else 'the same states'} for ever"
+        + (BUSY if busy else "")
         + (f"; {why}" if why else "")
     )
     elements = sorted({d.node.node.id for d in decisions if d.node in closed})
@@ -399,7 +403,7 @@ def _read(read: tuple) -> str:
     name, value, setter, same_step = read
     if value is UNKNOWN:
         return f"{name} (unknown)"
-    shown = {True: "true", False: "false", None: "null"}.get(value, repr(value))
+    shown = _shown(value)
     if not setter:
         return f"{name} = {shown}"
     if setter.startswith(ASSUMED):
@@ -411,6 +415,13 @@ def _read(read: tuple) -> str:
         else ""
     )
     return f"{name} = {shown}, set by {setter}{when}"
+
+
+def _shown(value: object) -> str:
+    """A value as a model writes it (``1`` is not ``true``, though Python finds them equal)."""
+    if value is True or value is False or value is None:
+        return {True: "true", False: "false", None: "null"}[value]
+    return repr(value)
 
 
 def _lost(graph: Exploration) -> list[Finding]:

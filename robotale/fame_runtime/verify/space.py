@@ -153,6 +153,17 @@ class Space:
             for t in s.tokens
             for catcher, duration in self.timers(t)
         ]
+        ready = [
+            (r, t)
+            for r in robots
+            for s in scopes(r)
+            for t in s.tokens
+            if t.waiting in ("ready", "again")
+        ]
+        if ready:  # a loop's next round comes before anything else can happen
+            for robot, token in ready:
+                yield (f"{robot.name}: {token.node.label}", lambda step, t=token: step.resume(t))
+            return
         if not all(robot.begun for robot in robots):
             # the engines start together: every first instance runs before any timer fires
             yield ("the mission begins", lambda step: [step.begin(r) for r in step.robots])

@@ -105,6 +105,7 @@ class Outcome:
     lost: list[tuple[str, NodePlan, str]]  # robot, thrower, topic: thrown, nobody caught it
     capped: bool  # a catcher was left out by TOKEN_CAP or INSTANCE_CAP
     failures: list[tuple[str, str, NodePlan, str]]  # kind, robot, element, sentence
+    urgent: bool = False  # it only ran the next round of a loop that does not wait
 
 
 def scopes(robot: Robot) -> Iterator[Scope]:

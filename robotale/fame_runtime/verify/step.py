@@ -68,6 +68,9 @@ class Step:
         self.messages = 0
         self.capped = False  # a catcher was left out by TOKEN_CAP
         self.current: Tok | None = None  # the token that moved last
+        #: (token, node) entered in this step, (token, "round") for a loop's rounds
+        self.entered: set[tuple[int, object]] = set()
+        self.urgent = False  # the step only went on with a loop's next round
         self.set_now: set[tuple[str, str]] = set()  # (robot, variable) set in this step
 
     def run(self, event: Callable[[Step], None]) -> Outcome:
@@ -94,6 +97,7 @@ class Step:
             self.lost,
             self.capped,
             self.failures,
+            self.urgent,
         )
 
     def tag(self, robot: Robot, label: str, lifecycle: str, msg_id: str = "", role: str = ""):
@@ -160,6 +164,17 @@ class Step:
         child.tokens.append(token)
         self._caught(token, start, msg_id)
 
+    def resume(self, token: Tok) -> None:
+        """A token paused at the next round of a loop goes on."""
+        self.urgent = True
+        if token.waiting == "again":  # a loop activity's next round
+            token.waiting = "wait"
+            self.entered.add((id(token), "round"))
+            self._loop_body(token, token.node)
+            return
+        token.waiting = ""
+        self.work.append(lambda: self._enter(token, token.node))
+
     def finished(self, token: Tok) -> None:
         """A skill, or a script completing from a callback, ends."""
         if not token.alive:
@@ -212,6 +227,12 @@ class Step:
     def _enter(self, token: Tok, node: NodePlan) -> None:
         if not token.alive:
             return
+        if (id(token), id(node)) in self.entered:
+            # round a loop without waiting: the next round is a step of its own (urgent:
+            # nothing else happens before it), so the state graph has the loop, not the step
+            token.node, token.waiting = node, "ready"
+            return
+        self.entered.add((id(token), id(node)))
         self.current = token
         token.node = node
         self.reached.add(element_key(node))
@@ -477,6 +498,11 @@ class Step:
     def _run_loop(self, token: Tok, node: NodePlan) -> None:
         token.waiting = "wait"
         self._armed(token)
+        marker = node.loop.loop
+        # tested before: maybe no round at all
+        if marker.kind == "standard" and marker.test_before and not self._again(token, node):
+            self._loop_done(token, node)
+            return
         self._loop_body(token, node)
 
     def _loop_body(self, token: Tok, node: NodePlan) -> None:
@@ -488,17 +514,29 @@ class Step:
     def _loop_round(self, token: Tok, node: NodePlan) -> None:
         """A round of a loop ended: a standard loop goes round again while its condition may
         hold (a multi-instance activity's instances are alike: one round stands for all)."""
-        marker = node.loop
-        again = False
-        if marker.loop.kind == "standard":
-            holds = condition_holds(marker.loop.condition, token.scope.robot)
-            if marker.condition is None:
-                holds = UNKNOWN  # only loopMaximum ends it: some number of rounds
-            again = holds if holds is not UNKNOWN else self.choices.pick(2) == 1
+        again = node.loop.loop.kind == "standard" and self._again(token, node)
+        if again and (id(token), "round") in self.entered:
+            token.waiting = "again"  # the next round is a step of its own, as in _enter
+            return
         if again:
+            self.entered.add((id(token), "round"))
             token.waiting = "wait"
             self._loop_body(token, node)
             return
+        self._loop_done(token, node)
+
+    def _again(self, token: Tok, node: NodePlan) -> bool:
+        """Whether a standard loop goes round (again): its condition, a choice when unknown
+        or when a loopMaximum may end it (rounds are not counted)."""
+        marker = node.loop.loop
+        holds = condition_holds(marker.condition, token.scope.robot)
+        if marker.condition is None or (holds is True and marker.maximum is not None):
+            holds = UNKNOWN
+        return bool(holds) if holds is not UNKNOWN else self.choices.pick(2) == 1
+
+    def _loop_done(self, token: Tok, node: NodePlan) -> None:
+        token.waiting = ""
+        token.child = None
         self.tag(token.scope.robot, node.label, "complete")
         self._leave(token, node)
 
