@@ -4,7 +4,9 @@ A stored log's events are aggregated into classes by a key (``activity``, ``acti
 ``activity,robot,msg_id`` ...; robotale.ekg builds the Class nodes and DF_C edges, here they
 are built on demand for a key the log was not ingested with). The model shows:
 
-- one node per class, labelled with its key values and the number of events it aggregates;
+- one node per class, labelled with its key values and the number of activity instances it
+  aggregates (each instance counted once, by the event that ends it); its ``events`` and its
+  in-progress ``samples`` (continuous data, never instances) are counted apart;
 - the DF_C edges of the chosen entity types (``robot``: each robot's own flow; ``msg_id``:
   the flow of each message across robots), each edge naming its entity type;
 - ``COMM`` edges between the classes of a message's send and receive events, with the number
@@ -105,14 +107,17 @@ def _class_nodes(rows: list[dict[str, Any]], key: list[str]) -> list[Node]:
         values = {name: row["properties"].get(name) for name in key}
         robots = sorted(str(r) for r in row["robots"] if r is not None)
         robot = values.get("robot") if "robot" in values else None
+        # a class counts its activity instances; its events and in-progress samples are
+        # told apart, never added to them
+        counts = {"events": int(row["events"]), "samples": int(row["samples"])}
         nodes.append(
             Node(
                 id=row["id"],
                 label=_class_label(values),
-                count=int(row["events"]),
+                count=int(row["instances"]),
                 robot=robot if robot is not None else (robots[0] if len(robots) == 1 else None),
                 robots=robots,
-                properties=values,
+                properties=values | counts,
             )
         )
     return nodes

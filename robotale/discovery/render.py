@@ -61,8 +61,10 @@ def _node_style(node: Node, robot_colours: dict[str, str]) -> dict[str, str]:
     if node.kind == "entity":
         return {"label": label, "shape": "note", "style": "filled", "fillcolor": "#eeeeee"}
     colour = robot_colours.get(node.robot or "", "#dddddd")
+    samples = node.properties.get("samples")  # an EKG class's samples: apart, never added
+    extra = f" (+{samples} samples)" if samples else ""
     return {
-        "label": f"{label}\n{node.count}",
+        "label": f"{label}\n{node.count}{extra}",
         "shape": "box",
         "style": "rounded,filled",
         "fillcolor": colour + "40",

@@ -47,12 +47,17 @@ def test_per_robot_df_counts_equal_pm4py(by_robot, thesis_log):
         assert edges == dict(expected), robot
 
 
-def test_classes_count_their_events(by_robot, thesis_log):
-    expected = thesis_log.groupby([ACTIVITY, ROBOT]).size()
+def test_classes_count_their_instances_and_events_apart(by_robot, thesis_log):
+    events = thesis_log.groupby([ACTIVITY, ROBOT]).size()
+    # an instance is counted once, by the event that ends it (the thesis has no samples)
+    ends = thesis_log[thesis_log["lifecycle:transition"] != "start"]
+    instances = ends.groupby([ACTIVITY, ROBOT]).size().reindex(events.index, fill_value=0)
     classes = [n for n in by_robot.nodes if n.kind == "activity"]
-    assert len(classes) == len(expected)
+    assert len(classes) == len(events)
     for node in classes:
-        assert node.count == expected[(node.properties["activity"], node.robot)]
+        key = (node.properties["activity"], node.robot)
+        assert node.count == instances[key]
+        assert node.properties["events"] == events[key] and node.properties["samples"] == 0
     assert by_robot.node("explore|drone").label == "explore (drone)"
     assert by_robot.info["class_type"] == "activity+robot"
 
@@ -151,3 +156,32 @@ def test_command_line_writes_json_and_svg(stored, neo4j_server, tmp_path, capsys
     }
     assert "explore (drone)" in re.findall(r"<text[^>]*>(.*?)</text>", svg.read_text())
     assert "EKG:" in capsys.readouterr().out
+
+
+def test_samples_are_no_instances(neo4j_driver, tmp_path):
+    """A drone explores twice (each a start and a completion) with 5 in-progress samples in
+    between, and once ends an explore aborted. By hand: 3 explore instances, 5 samples, 11
+    events; land 1 instance."""
+    rows = ["case,robot,activity,lifecycle,state,time,battery"]
+    at = "2024-01-01T10:00:{:02d}Z".format
+    rows += [f"1,drone,explore,start,,{at(0)},90", f"1,drone,explore,complete,,{at(5)},88"]
+    rows += [f"1,drone,explore,start,,{at(6)},88"]
+    rows += [f"1,drone,explore,none,inprogress,{at(t)},{88 - t / 10}" for t in (7, 8, 9, 10, 11)]
+    rows += [f"1,drone,explore,complete,,{at(12)},86", f"1,drone,explore,start,,{at(13)},86"]
+    rows += [f"1,drone,explore,ate_abort,,{at(14)},85"]
+    rows += [f"1,drone,land,start,,{at(15)},85", f"1,drone,land,complete,,{at(16)},85"]
+    path = tmp_path / "samples.csv"
+    path.write_text("\n".join(rows) + "\n")
+    from robotale.eventlog.readers import read_log
+
+    name = f"test_samples_{uuid.uuid4().hex[:8]}"
+    build_ekg(neo4j_driver, read_log(path), name, entities=["robot"], aggregate=["activity"],
+              progress=False)  # fmt: skip
+    try:
+        graph = discover_ekg(name, "activity", driver=neo4j_driver)
+        explore = graph.node("explore")
+        assert explore.count == 3
+        assert (explore.properties["samples"], explore.properties["events"]) == (5, 11)
+        assert graph.node("land").count == 1
+    finally:
+        delete_log(neo4j_driver, name)

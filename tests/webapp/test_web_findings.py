@@ -74,6 +74,25 @@ def test_findings_api_names_the_injected_findings(client, mission_log):
     assert answers["messages"]["facts"]["lost"] == lost.sum()
 
 
+def test_findings_and_communication_take_a_delay_threshold(client, mission_log):
+    """The truth's latencies: 1.5 s to tractor_1, 2.5 s to tractor_2, one of 30 s. Above 2 s:
+    every delivery to tractor_2 and the 30 s one; the default rule finds the 30 s one only."""
+    messages = pd.DataFrame([m.__dict__ for m in TRUTH.messages])
+    latency = (messages["received"] - messages["sent"]).dt.total_seconds()
+    data = client.get(f"/api/findings?log={mission_log}&delay=2").json
+    facts = {a["key"]: a for a in data["answers"]}["messages"]["facts"]
+    assert facts["delayed"] == int((latency > 2).sum())
+    assert facts["delay_rule"] == "a latency above 2 s (the threshold given)"
+    default = client.get(f"/api/findings?log={mission_log}").json
+    facts = {a["key"]: a for a in default["answers"]}["messages"]["facts"]
+    assert facts["delayed"] == int((latency == mission.DELAYED_LATENCY).sum()) == 1
+    part = client.get(f"/api/perspectives/communication?log={mission_log}&delay=2").json
+    assert part["summary"]["delayed"] == int((latency > 2).sum())
+    bad = client.get(f"/api/findings?log={mission_log}&delay=soon")
+    assert bad.status_code == 400
+    assert bad.json["error"] == "the delay 'soon' is not a number of seconds of 0 or more."
+
+
 def test_timeline_api_has_the_lost_message(client, mission_log):
     run = sorted(mission.LOST_RUNS)[0]
     data = client.get(f"/api/timeline?log={mission_log}&case={run}").json

@@ -96,7 +96,7 @@
     }
     document.getElementById("details-title").textContent = robotalePerspective.describe(focus);
     const durations = node.durations || {};
-    const rows = [[state.graph.kind === "ekg" ? "events" : "instances", node.count],
+    const rows = [["instances", node.count],
       ["robots", (node.robots || []).join(", ")]];
     if (durations.mean !== undefined && durations.mean !== null) {
       rows.push(["mean duration", robotaleGraph.seconds(durations.mean)],

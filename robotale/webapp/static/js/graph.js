@@ -34,7 +34,10 @@ const robotaleGraph = (() => {
   function nodeLabel(node, labels) {
     if (node.kind === "start" || node.kind === "end") return node.label;
     const figure = labels === "performance" ? seconds((node.durations || {}).mean) : node.count;
-    return `${node.label}\n${figure}`;
+    // an EKG class: its instances, and its in-progress samples apart (never added to them)
+    const samples = (node.properties || {}).samples;
+    const extra = labels !== "performance" && samples ? ` (+${samples} samples)` : "";
+    return `${node.label}\n${figure}${extra}`;
   }
 
   function edgeLabel(edge, labels) {
