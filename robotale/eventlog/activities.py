@@ -201,22 +201,27 @@ def in_order(parts: Sequence[pd.DataFrame], recorded: Mapping[str, np.ndarray]) 
     before its own completion. :func:`implicit` places the
     completions it adds by the same rule.
     """
-    frames = []
-    for rank, part in enumerate(parts):
+    if not parts:
+        return pd.DataFrame(columns=[*COLUMNS, SEQUENCE])
+    when, rank = [], []
+    for k, part in enumerate(parts):
         at = part[SOURCE_INDEX].to_numpy(np.int64)
-        when = np.zeros(len(part), dtype=np.int64)
+        mine = np.zeros(len(part), dtype=np.int64)
         topics = part[SOURCE_TOPIC].to_numpy(object)
         for topic in pd.unique(topics):
-            mine = topics == topic
-            when[mine] = np.asarray(recorded[topic], dtype=np.int64)[at[mine]]
+            chosen = topics == topic
+            mine[chosen] = np.asarray(recorded[topic], dtype=np.int64)[at[chosen]]
         if AT_END in part:
-            when[part[AT_END].to_numpy(bool)] = np.iinfo(np.int64).max
-            part = part.drop(columns=AT_END)
-        frames.append(part.assign(_recorded=when, _part=rank, _position=np.arange(len(part))))
-    rows = pd.concat(frames, ignore_index=True) if frames else pd.DataFrame(columns=COLUMNS)
-    helpers = ["_recorded", "_part", "_position"]
-    rows = rows.sort_values([schema.TIMESTAMP, *helpers], kind="stable", ignore_index=True)
-    return rows.drop(columns=helpers).assign(**{SEQUENCE: np.arange(len(rows), dtype=float)})
+            mine[part[AT_END].to_numpy(bool)] = np.iinfo(np.int64).max
+        when.append(mine)
+        rank.append(np.full(len(part), k))
+    rows = pd.concat(parts, ignore_index=True)
+    rows = rows.drop(columns=[AT_END]) if AT_END in rows else rows
+    times = rows[schema.TIMESTAMP].to_numpy("datetime64[ns]").view(np.int64)
+    order = np.lexsort((np.concatenate(rank), np.concatenate(when), times), axis=0)
+    if (order != np.arange(len(order))).any():
+        rows = rows.take(order).reset_index(drop=True)
+    return rows.assign(**{SEQUENCE: np.arange(len(rows), dtype=float)})
 
 
 def implicit(
