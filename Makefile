@@ -53,12 +53,12 @@ $(HARNESS)/node_modules/.package-lock.json: $(HARNESS)/package.json $(HARNESS)/p
 
 # The Neo4j tests again on the newest Neo4j release robotale runs (`make test` runs them on
 # 5.26 LTS, and starts the newest release with the real `robotale neo4j start --version`):
-# every file of cypher/ planned without a deprecation, logs built, appended, listed, locked
-# and deleted, object-centric logs. Its jars are downloaded once, like 5.26's.
+# every file of cypher/ planned without a deprecation, logs built, appended, listed and
+# deleted, object-centric logs. Its jars are downloaded once, like 5.26's.
 NEO4J_NEXT ?= 2026.08
 NEO4J_NEXT_TESTS ?= tests/ekg/test_cypher_files.py tests/ekg/test_build.py \
   tests/ekg/test_append.py tests/ekg/test_batches.py tests/ekg/test_logs.py \
-  tests/ekg/test_writelock.py tests/ekg/test_objects.py tests/ekg/test_releases.py
+  tests/ekg/test_objects.py tests/ekg/test_releases.py
 test-neo4j-next: install
 	ROBOTALE_TEST_NEO4J_VERSION=$(NEO4J_NEXT) $(BIN)/pytest -m "not slow" $(NEO4J_NEXT_TESTS)
 
