@@ -67,16 +67,17 @@ class StepResult:
 
 def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepResult]:
     """Run ``steps`` on the stored log ``log``, each stacked on the ones before (also those
-    of earlier runs). Every step is checked against the log before it runs."""
+    of earlier runs). Every step is checked against the log before the first one runs, so a
+    specification that names something the log lacks writes nothing."""
     info = log_info(driver, log)
     ensure_schema(driver)
     with log_write_lock(driver, log, "aggregating"):
+        first = _last_step(driver, log) + 1
+        plans = [_plan(driver, log, info, step, n) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
-        number = _last_step(driver, log)
         events, entities = _unaggregated(driver, log)
-        for step in steps:
-            number += 1
-            result = _run_or_undo(driver, log, info, step, number, (events, entities))
+        for plan in plans:
+            result = _run_or_undo(driver, log, plan, (events, entities))
             events, entities = result.final_events, result.final_entities
             results.append(result)
         return results
@@ -122,16 +123,11 @@ def level_graph(driver: Driver, log: str, level: int) -> dict[str, list[dict[str
     }
 
 
-def _run_or_undo(
-    driver: Driver,
-    log: str,
-    info: dict[str, Any],
-    step: AggrStep,
-    number: int,
-    before: tuple[int, int],
-) -> StepResult:
+def _run_or_undo(driver: Driver, log: str, plan: _Plan, before: tuple[int, int]) -> StepResult:
+    step, number = plan.step, plan.number
     started = time.perf_counter()
-    table = _aggregates(driver, log, info, step, number)  # checks; nothing written yet
+    nodes = _read_nodes(driver, log, plan)
+    table = aggregate_table(step, number, nodes, set(plan.times) & set(plan.reads))
     try:
         with DeferredInterrupt() as interrupt:
             _write(driver, log, step, number, table, interrupt.check)
@@ -158,11 +154,20 @@ def _run_or_undo(
     )
 
 
-def _aggregates(
-    driver: Driver, log: str, info: dict[str, Any], step: AggrStep, number: int
-) -> pd.DataFrame:
-    """The aggregates of ``step`` as a table (:func:`aggregate_table`), read from Neo4j after
-    checking every name the step uses against the log."""
+@dataclass(frozen=True)
+class _Plan:
+    """A step checked against the log, with what it reads."""
+
+    step: AggrStep
+    number: int
+    reads: list[str]  # node properties
+    resolved: list[str]  # entity types an event step groups by (through CORR)
+    condition: Condition
+    times: list[str]  # the properties that hold zoned times
+
+
+def _plan(driver: Driver, log: str, info: dict[str, Any], step: AggrStep, number: int) -> _Plan:
+    """Check every name ``step`` uses against the log; what it will read."""
     what = f"step {number}"
     entity_types = list(info.get("entityTypes") or [])
     if step.origin == "Entity" and step.ent_type not in entity_types:
@@ -171,16 +176,14 @@ def _aggregates(
             f"{', '.join(entity_types) or 'none'}."
         )
     keys, times = _node_keys(driver, log, step.ent_type)
+    resolved: list[str] = []
     if step.origin == "Event":  # a property the sampled events lack may be on later ones
         keys |= set(info.get("properties") or []) | {"id", "order", "timestamp"}
-    if step.origin == "Event":
         resolved = [
             k.inputs[0]
             for k in step.group_by
             if k.kind == "property" and k.inputs[0] in entity_types
         ]
-    else:
-        resolved = []
     reads = [name for name in step.reads() if name not in resolved]
     missing = [name for name in reads if name not in keys]
     if missing:
@@ -194,8 +197,7 @@ def _aggregates(
         if step.where
         else Condition("true", {}, frozenset())
     )
-    nodes = _read_nodes(driver, log, step, reads, resolved, condition, times)
-    return aggregate_table(step, number, nodes, set(times) & set(reads))
+    return _Plan(step, number, reads, resolved, condition, times)
 
 
 def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[str], list[str]]:
@@ -210,23 +212,16 @@ def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[s
     return set(row["keys"]) - {"log"}, list(row["times"])
 
 
-def _read_nodes(
-    driver: Driver,
-    log: str,
-    step: AggrStep,
-    reads: list[str],
-    resolved: list[str],
-    condition: Condition,
-    times: list[str],
-) -> pd.DataFrame:
+def _read_nodes(driver: Driver, log: str, plan: _Plan) -> pd.DataFrame:
     """One row per node the step collapses: ``node`` and a column per property read (for
     an entity type a group-by names: what the event is correlated to, joined by ``,``)."""
+    step, reads, resolved, condition = plan.step, plan.reads, plan.resolved, plan.condition
     query = "aggr_read_events" if step.origin == "Event" else "aggr_read_entities"
     text = cypher(query).replace(_WHERE_MARKER, condition.cypher)
     parameters: dict[str, Any] = {
         "log": log,
         "properties": reads,
-        "times": [t for t in times if t in reads],
+        "times": [t for t in plan.times if t in reads],
         "entityTypes": resolved,
         "type": step.ent_type,
     }

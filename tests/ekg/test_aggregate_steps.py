@@ -219,6 +219,10 @@ def test_bad_steps_are_refused_before_anything_is_written(neo4j_driver, small, g
     for step, message in cases:
         with pytest.raises(InputError, match=message):
             run_spec(neo4j_driver, small, steps(step))
+    # a good first step is not run when a later one is refused
+    good = {"aggr_type": "EVENTS", "group_by": ["activity"]}
+    with pytest.raises(InputError, match="step 2"):
+        run_spec(neo4j_driver, small, steps(good, cases[0][0]))
     assert graph_counts() == before
 
 
@@ -281,3 +285,23 @@ def test_a_step_that_fails_while_writing_leaves_nothing(neo4j_driver, small, gra
     # the undo takes the node in the way along: it stood where step 1's aggregates go
     assert graph_counts() == before
     assert list_steps(neo4j_driver, small) == []
+
+
+def test_band_grid_and_region_keys(neo4j_driver, small):
+    spec = steps(
+        {"aggr_type": "EVENTS", "where": "robot = 'r1'",
+         "group_by": [{"band": {"property": "battery", "width": 25}},
+                      {"grid": {"size": 5}, "as": "tile"}]},
+        {"aggr_type": "EVENTS",
+         "group_by": [{"regions": {"areas": {"left": {"box": [0, 0, 5, 10]},
+                                             "right": [[5, 0], [10, 0], [10, 10], [5, 10]]}}}]},
+    )  # fmt: skip
+    run_spec(neo4j_driver, small, spec)
+    # r1: e1 (90, at 1,1), e2 (80, at 6,1), e5 (90, at 2,2): bands 75 75 75, tiles 0,0 1,0 0,0
+    found = aggregates(neo4j_driver, small, 1)
+    assert {n: a["count"] for n, a in found.items()} == {"75.0|0,0": 2, "75.0|1,0": 1}
+    assert found["75.0|1,0"]["battery_band"] == 75.0 and found["75.0|1,0"]["tile"] == "1,0"
+    # r2: e3 at 1,6 (left), e4 at 6,6 (right)
+    assert members(neo4j_driver, small) == {
+        "75.0|0,0": {"e1", "e5"}, "75.0|1,0": {"e2"}, "left": {"e3"}, "right": {"e4"},
+    }  # fmt: skip
