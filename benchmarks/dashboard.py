@@ -83,11 +83,14 @@ def main() -> int:
         "load Discover, over HTTP (console median and p99 beside Discover's)",
     )
     parser.add_argument("--rounds", type=int, default=5, help="requests of each kind per client")
+    parser.add_argument(
+        "--questions", nargs="+", metavar="NAME", help="with --clients: only these examples"
+    )
     args = parser.parse_args()
     if args.clients:
         with private_home(), private_neo4j(args.heap) as driver:
             name, _ = store(driver, "bench_thesis", thesis_log())
-            return measure_clients(driver, name, args.clients, args.rounds)
+            return measure_clients(driver, name, args.clients, args.rounds, args.questions)
     with private_home(), private_neo4j(args.heap) as driver:
         logs = {"thesis": store(driver, "bench_thesis", thesis_log())}
         for size in args.sizes:
@@ -155,7 +158,9 @@ def store(driver, name: str, log) -> tuple[str, int]:
     return name, len(log)
 
 
-def measure_clients(driver, log: str, clients: int, rounds: int) -> int:
+def measure_clients(
+    driver, log: str, clients: int, rounds: int, only: list[str] | None = None
+) -> int:
     """``clients`` threads, each asking the console every example in turn and loading the
     Discover page in between (A B A B), ``rounds`` times each; every console answer is checked
     equal to the same query run directly. Returns 1 when any request failed or differed."""
@@ -166,7 +171,7 @@ def measure_clients(driver, log: str, clients: int, rounds: int) -> int:
     from robotale.webapp import create_app
     from robotale.webapp.serve import Dashboard
 
-    questions = _questions(log)
+    questions = {k: v for k, v in _questions(log).items() if not only or k in only}
     expected = {
         name: [r.rows for r in run_read_only(driver, text, parameters, timeout=600)]
         for name, (text, parameters) in questions.items()

@@ -30,7 +30,7 @@ from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
 from robotale.ekg.load import Loader, neo4j_values, within_batches
-from robotale.ekg.logs import delete_log, log_exists, log_run
+from robotale.ekg.logs import FAILED, delete_log, log_exists, log_info, log_run
 from robotale.ekg.objects import write_objects
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import (
@@ -43,7 +43,7 @@ from robotale.ekg.tables import (
     property_name,
 )
 from robotale.ekg.writelock import log_write_lock
-from robotale.errors import InputError, ServerError
+from robotale.errors import InputError, LogNotFound, ServerError
 from robotale.eventlog.objects import Objects
 
 
@@ -59,6 +59,26 @@ class BuildSummary:
     comm: int
     df_c: dict[str, int] = field(default_factory=dict)
     seconds: float = 0.0
+
+
+def _exists_message(driver: Driver, name: str) -> str:
+    """Why a log of that name is in the way, and the commands that clear it: a failed
+    ingest's partial log is named as such."""
+    delete = f"`robotale logs delete {shlex.quote(name)}`"
+    try:
+        info = log_info(driver, name)
+    except LogNotFound:  # events without their Log node: what a very early failure leaves
+        info = {"status": FAILED, "events": None}
+    if info["status"] == FAILED:
+        events = f" ({info['events']:,} events)" if info.get("events") is not None else ""
+        return (
+            f"The log {name!r} in Neo4j is what a failed ingest left{events}: remove it with "
+            f"{delete}, or ingest again with --replace to rebuild it."
+        )
+    return (
+        f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
+        f"or {delete} first."
+    )
 
 
 def build_ekg(
@@ -94,10 +114,7 @@ def build_ekg(
     with log_write_lock(driver, name, "ingesting") as run:
         existing = log_exists(driver, name)
         if existing and not replace:
-            raise InputError(
-                f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
-                f"or `robotale logs delete {name}` first."
-            )
+            raise InputError(_exists_message(driver, name))
         target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
         job = _Job(tables, classes, target, source, progress, run, objects, chosen)
         summary = _write_or_undo(driver, job)

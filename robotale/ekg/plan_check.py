@@ -39,8 +39,6 @@ ALLOWED_PROCEDURES = frozenset(
 #: functions of plugins the console may call besides Neo4j's built-in ones (none so far: add
 #: a name here only for a function that reads and returns a bounded value)
 ALLOWED_FUNCTIONS: frozenset[str] = frozenset()
-#: the query that lists Neo4j's built-in functions (run once per process and server)
-BUILT_IN_FUNCTIONS_QUERY = "SHOW FUNCTIONS YIELD name, isBuiltIn WHERE isBuiltIn RETURN name"
 
 ONLY_READS = "The console only reads the graph"
 

@@ -43,12 +43,11 @@ from robotale.ekg.connection import Settings, connect, unreachable_message
 from robotale.ekg.connection import database as default_database
 from robotale.ekg.plan_check import (
     ALLOWED_PROCEDURES,
-    BUILT_IN_FUNCTIONS_QUERY,
     QueryRefused,
     WriteRefused,
     check_plan,
 )
-from robotale.ekg.queries import code_only, dotted_calls, split_statements
+from robotale.ekg.queries import code_only, cypher, dotted_calls, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
 
 __all__ = ["ALLOWED_PROCEDURES", "QueryRefused", "WriteRefused", "run_read_only"]
@@ -188,7 +187,7 @@ def built_in_functions(session: neo4j.Session, server: object) -> frozenset[str]
     process and server: the list changes only with the server's version)."""
     address = str(server)
     if address not in _BUILT_IN:
-        records = session.run(BUILT_IN_FUNCTIONS_QUERY).values()
+        records = session.run(cypher("console_built_in_functions")).values()
         _BUILT_IN[address] = frozenset(str(name) for (name,) in records)
     return _BUILT_IN[address]
 
