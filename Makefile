@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 # Graphviz to draw discovered process models as SVG.
 SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
-.PHONY: install system-deps test test-neo4j-next demo bench lint format constraints clean fuzz bpmn-engine
+.PHONY: install system-deps test test-neo4j-next demo bench lint format constraints clean fuzz bpmn-engine verify-findings
 
 install: $(STAMP)
 
@@ -70,6 +70,12 @@ FUZZ_EXAMPLES ?= 20000
 fuzz: install
 	ROBOTALE_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/pytest -p no:timeout tests/test_fuzz*.py tests/eventlog/test_fuzz*.py \
 	  tests/webapp/test_web_console_fuzz.py
+
+# robotale's answers against the simulation's truth on SEEDS generated missions (one run
+# each): a table of every disagreement, then the count per subject and the time per mission.
+SEEDS ?= 50
+verify-findings: install
+	$(BIN)/python scripts/verify_findings.py --seeds $(SEEDS)
 
 # DEMO_ARGS passes options on (`make demo DEMO_ARGS="--port 5001"`); ROBOTALE_DEMO_RUNS
 # shortens the simulation (20 runs by default).

@@ -236,7 +236,7 @@ def implicit(
     the end of its run (``ends``: case -> time) or at its start if that is later. The added
     completes keep their start's source.
     """
-    closing = {schema.COMPLETE, schema.ABORTED, schema.CANCELLED}
+    closing = schema.ENDINGS
     if SEQUENCE not in rows:
         rows = rows.assign(**{SEQUENCE: np.arange(len(rows), dtype=float)})
     chosen = set(topics) if topics is not None else None

@@ -102,7 +102,7 @@ _TAG_COLUMNS = {
     "msg_role": schema.MSG_ROLE,
     "payload": schema.MSG_PAYLOAD,
 }
-_LIFECYCLES = {schema.START, schema.COMPLETE, schema.NONE, schema.ABORTED, schema.CANCELLED}
+_LIFECYCLES = {schema.START, schema.NONE, *schema.ENDINGS}
 #: how tags say when an activity ends: their lifecycle field (``explicit``), the robot's next
 #: tag (``implicit``), or not at all: each tag one event (``events``)
 LIFECYCLE_MODES = ("explicit", "implicit", "events")
@@ -714,7 +714,7 @@ def _lifecycles(rows: pd.DataFrame, topic: str, run: Path, mode: str | None) -> 
         at = rows.loc[bad, schema.TIMESTAMP].iloc[0].isoformat()
         raise InputError(
             f"{run}: a tag on {topic} at {at} has lifecycle {given[bad].iloc[0]!r}; "
-            "expected start, complete or none (or an outcome: aborted, cancelled)."
+            "expected start, complete or none (or an outcome: aborted, cancelled, ate_abort)."
         )
     return lifecycles
 

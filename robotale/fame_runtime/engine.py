@@ -5,7 +5,8 @@ that takes time, a catching event, a sub-process, a join. Everything that wakes 
 a message on the bus, a timer, a skill's ``done``, a variable change satisfying a condition --
 is queued and run by the engine's own loop, never inside another engine's step or inside the
 bus. Every activity start and completion, every signal thrown or caught, every timer, error
-and conditional event becomes a :class:`~robotale.fame_runtime.tags.Tag`.
+and conditional event becomes a :class:`~robotale.fame_runtime.tags.Tag`; an activity that is
+interrupted or cancelled ends with an ``ate_abort`` tag instead of ``complete``.
 
 See ``docs/fame_runtime.md`` for the API and the exact semantics.
 """
@@ -38,7 +39,7 @@ from robotale.fame_runtime.plan import (
 )
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
-from robotale.fame_runtime.tags import Tagger, TagSink, payload_text
+from robotale.fame_runtime.tags import ABORT, COMPLETE, START, Tagger, TagSink, payload_text
 from robotale.fame_runtime.triggers import Triggers
 
 #: steps one engine may take without its clock moving on: more means a loop with no wait
@@ -53,6 +54,11 @@ _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 
 #: what charging work costs when the engine's clock charges nothing
 _FREE = contextlib.nullcontext()
+
+#: told of every activity instance as it starts and ends (robot, instance number, activity,
+#: ``start`` / ``completed`` / ``interrupted`` / ``cancelled``), apart from the tags: a
+#: simulation's ground truth numbers instances, which tags do not
+ActivityObserver = Callable[[str, int, str, str], None]
 
 
 _ABSENT = object()  # a variable a frame shadows that had no value outside it
@@ -233,6 +239,14 @@ class Engine:
         self._time = EngineTime.of(clock)  # None: computing takes no simulated time
         self._frame: _Frame | None = None  # the instance frame installed in the variables
         self._compensating: set[_Scope] = set()  # compensations running (see _compensate_one)
+        #: the activities started and not yet ended, by the token running each: the token's
+        #: activity label and instance number
+        self._running: dict[_Token, tuple[str, int]] = {}
+        self._instances = 0
+        #: how a cancel ends the activities it reaches: ``interrupted`` while an interrupting
+        #: boundary event or event sub-process takes over, else ``cancelled``
+        self._ending = "cancelled"
+        self.activity_observer: ActivityObserver | None = None
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -497,6 +511,7 @@ class Engine:
         self._disarm(token)
         if token.child is not None:
             self._cancel_scope(token.child)
+        self._end(token, ABORT)  # after its inner activities: they ended first
 
     def _disarm(self, token: _Token) -> None:
         token.generation += 1  # whatever fires for the old wait from now on is stale
@@ -669,15 +684,15 @@ class Engine:
         return None
 
     def _run_task(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         self.data.inputs(node)
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
         self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
     def _run_script(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         self.data.inputs(node)
         if node.script is not None and node.script.language == JAVASCRIPT:
             return self._run_javascript(token, node)
@@ -690,7 +705,7 @@ class Engine:
             except MemoryError:
                 self._script_limit(token, node, "ran out of the memory of the Python process")
                 return None
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
         self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
@@ -740,7 +755,7 @@ class Engine:
         if now[0] is not None:
             self._throw_error(token, now[0])
             return None
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
         self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
@@ -756,7 +771,7 @@ class Engine:
         return done
 
     def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         inputs = self.data.inputs(node)
         self._arm_boundaries(token, node)
         generation = token.generation
@@ -791,7 +806,7 @@ class Engine:
         self._activity_done(token, values)
 
     def _run_call(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         self.data.inputs(node)
         self._arm_boundaries(token, node)
         child = self._open(node.child, token.scope, token)
@@ -807,7 +822,7 @@ class Engine:
         node = token.node
         child, token.child = token.child, None
         self._disarm(token)
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
         if node.behaviour == "event_subprocess":
             self._consume(token)
             return
@@ -1116,7 +1131,8 @@ class Engine:
     def _boundary(self, token: _Token, boundary: NodePlan, envelope: Envelope | None) -> None:
         if boundary.node.cancel_activity:
             scope = token.scope
-            self._cancel(token)
+            with self._interrupting():
+                self._cancel(token)
             token = self._new_token(scope, boundary)
         else:
             token = self._new_token(token.scope, boundary)
@@ -1154,10 +1170,11 @@ class Engine:
             scope.safe = True
         holder = self._new_token(scope, esp)
         if interrupting:
-            for token in list(scope.tokens):
-                if token is not holder:
-                    self._cancel(token)
-        self._tag(esp.label, "start")
+            with self._interrupting():
+                for token in list(scope.tokens):
+                    if token is not holder:
+                        self._cancel(token)
+        self._begin(holder, esp.label)
         child = self._open(esp.child, scope, holder)
         start = esp.child.triggered_starts[0]
         token = self._new_token(child, start)
@@ -1224,7 +1241,7 @@ class Engine:
         place = self._compensation_scope(child, child.frame, then)
         place.done = child.done  # what a compensation throw inside the handler compensates
         holder = self._new_token(place, esp)
-        self._tag(esp.label, "start")
+        self._begin(holder, esp.label)
         inner = self._open(esp.child, place, holder)
         start = esp.child.triggered_starts[0]
         self._caught(self._new_token(inner, start), start, None)
@@ -1243,6 +1260,38 @@ class Engine:
 
         place.frame, place.on_close = frame, closed
         return place
+
+    # -- activity tags -----------------------------------------------------------------------------
+
+    def _begin(self, token: _Token, label: str) -> None:
+        """``token``'s activity starts: tagged, and remembered until it ends."""
+        self._tag(label, START)
+        self._instances += 1
+        self._running[token] = (label, self._instances)
+        if self.activity_observer is not None:
+            self.activity_observer(self.robot.name, self._instances, label, "start")
+
+    def _end(self, token: _Token, lifecycle: str) -> None:
+        """``token``'s activity, if one runs, ends: ``complete``, or ``ate_abort`` when it was
+        interrupted or cancelled."""
+        running = self._running.pop(token, None)
+        if running is None:
+            return
+        label, number = running
+        self._tag(label, lifecycle)
+        if self.activity_observer is not None:
+            how = "completed" if lifecycle == COMPLETE else self._ending
+            self.activity_observer(self.robot.name, number, label, how)
+
+    @contextlib.contextmanager
+    def _interrupting(self):
+        """The activities cancelled meanwhile were interrupted (an interrupting boundary event
+        or event sub-process), not merely cancelled."""
+        before, self._ending = self._ending, "interrupted"
+        try:
+            yield
+        finally:
+            self._ending = before
 
     # -- errors ------------------------------------------------------------------------------------
 
