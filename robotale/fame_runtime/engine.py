@@ -19,9 +19,11 @@ import types
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
+from threading import get_ident
 from typing import Any, ClassVar
 
 from robotale.errors import ModelError
+from robotale.fame_runtime import watchdog
 from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock, EngineTime
 from robotale.fame_runtime.data import Data
@@ -41,6 +43,7 @@ from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.tags import ABORT, COMPLETE, START, Tagger, TagSink, payload_text
 from robotale.fame_runtime.triggers import Triggers
+from robotale.fame_runtime.watchdog import MEASURE, ScriptTimeout
 
 #: steps one engine may take without its clock moving on: more means a loop with no wait
 MAX_STEPS = 1_000_000
@@ -236,6 +239,7 @@ class Engine:
         self.failures: list[str] = []  # why each failed instance ended, one sentence each
         self.output = output or (lambda line: print(f"[{robot}] {line}", flush=True))
         self._javascript: JavaScript | None = None  # made when a first script needs it
+        self._watch: watchdog.Watch | None = None  # made when a first Python script runs
         self._time = EngineTime.of(clock)  # None: computing takes no simulated time
         self._frame: _Frame | None = None  # the instance frame installed in the variables
         self._compensating: set[_Scope] = set()  # compensations running (see _compensate_one)
@@ -705,6 +709,12 @@ class Engine:
             except MemoryError:
                 self._script_limit(token, node, "ran out of the memory of the Python process")
                 return None
+            except ScriptTimeout:
+                limit = self._watch.limit if self._watch is not None else watchdog.TIME_LIMIT
+                self._script_limit(
+                    token, node, f"ran longer than its time limit of {limit:g} s of {MEASURE}"
+                )
+                return None
         self._end(token, COMPLETE)
         self._compensable(token, node)
         self.data.outputs(node, {})
@@ -712,10 +722,18 @@ class Engine:
 
     def _exec(self, node: NodePlan) -> None:
         script = node.script
+        watch = self._watch or self._watching()
         try:
             with self._charged("script"):
-                exec(script.code, self.env, self.variables)
-        except (BpmnError, MemoryError):
+                # the watchdog's stamp: a fresh tuple per run, told apart by identity
+                watch.running = (node, get_ident())
+                try:
+                    exec(script.code, self.env, self.variables)
+                finally:
+                    watch.running = None
+                    if watch.fired:  # the watchdog stopped it, or is about to
+                        watch.settle()
+        except (BpmnError, MemoryError, ScriptTimeout):
             raise
         except Exception as error:
             raise ModelError(
@@ -726,6 +744,11 @@ class Engine:
             if isinstance(self.variables.get(name), _NOT_VARIABLES):
                 del self.variables[name]
         self._changed(script.writes)
+
+    def _watching(self) -> watchdog.Watch:
+        """This engine's stamp for the Python scripts' time limit, made at its first script."""
+        self._watch = watchdog.watch()
+        return self._watch
 
     def _run_javascript(self, token: _Token, node: NodePlan) -> NodePlan | None:
         """A JavaScript script task completes when it calls ``next``: at once, like a Python

@@ -7,7 +7,7 @@ from pathlib import Path
 from fame_suite import pair, run, trace
 
 from robotale.cli import main
-from robotale.fame_runtime import javascript
+from robotale.fame_runtime import javascript, watchdog
 
 CASES = Path(__file__).resolve().parent / "semantics"
 ITEMS = {"rover": {"items": [10, 20, 30]}}
@@ -114,16 +114,27 @@ def test_a_script_exhausting_its_memory_ends_the_instance_as_a_model_error(
         "__kwdefaults__",
         {"time_limit": javascript.TIME_LIMIT, "memory_limit": 16 * 1024 * 1024},
     )
+    ends_as_model_error(
+        tmp_path,
+        capsys,
+        HOG,
+        "robot rover: script task t_hog (Hog) ran out of its 16 MiB of memory; the process "
+        "instance ended (a model error: no boundary event catches it)",
+    )
+
+
+def ends_as_model_error(tmp_path, capsys, model: str, sentence: str) -> None:
+    """``fame run`` of ``model`` ends its one instance with ``sentence``, counted as failed,
+    and the error boundary event around the script does not catch it."""
     path = tmp_path / "hog.bpmn"
-    path.write_text(HOG)
+    path.write_text(model)
     code = main(["fame", "run", str(path), "--until", "10"])
     out, err = capsys.readouterr()
     assert code == 1
     assert "caught" not in out  # no boundary event catches a model error
     assert err.splitlines()[-2:] == [
         next(line for line in err.splitlines() if line.startswith("# done")),
-        "# robot rover: script task t_hog (Hog) ran out of its 16 MiB of memory; the process "
-        "instance ended (a model error: no boundary event catches it)",
+        f"# {sentence}",
     ]
     assert "instances completed: rover 0; failed: rover 1" in err
 
@@ -169,3 +180,25 @@ def test_each_instance_is_compensated_with_its_own_data_the_last_completed_first
     names = [t.activity for t in tags if t.lifecycle == "complete"]
     assert names == ["load"] * 3 + ["undo"] + ["unload"] * 3
     assert mission.done
+
+
+def test_a_python_script_running_past_its_time_limit_ends_the_instance_as_a_model_error(
+    tmp_path, monkeypatch, capsys
+):
+    # a short limit keeps the test quick; the sentence names it
+    monkeypatch.setattr(watchdog, "TIME_LIMIT", 0.3)
+    looping = HOG.replace('scriptFormat="javascript"', 'scriptFormat="python"').replace(
+        """var a = [];
+        while (true) { a.push("xxxxxxxxxxxxxxxx" + a.length); }
+        next();""",
+        "n = 0\nwhile True:\n    try:\n        n += 1\n    except Exception:\n        pass",
+    )
+    assert "while True:" in looping and "var a" not in looping
+    ends_as_model_error(
+        tmp_path,
+        capsys,
+        looping,
+        "robot rover: script task t_hog (Hog) ran longer than its time limit of 0.3 s of "
+        f"{watchdog.MEASURE}; the process instance ended (a model error: no boundary event "
+        "catches it)",
+    )
