@@ -75,6 +75,8 @@ def print_verdict(verdict: Verdict, model: Path, out: TextIO) -> None:
             "a loop without exit is reported only inside the explored states",
             file=out,
         )
+    for abstraction in verdict.abstractions:
+        print(f"note: {abstraction}", file=out)
     print(f"findings: {len(verdict.findings)}", file=out)
     for finding in verdict.findings:
         print(f"{finding.kind}: {finding.sentence}", file=out)

@@ -4,6 +4,7 @@ every combination of the values the verifier does not know."""
 
 import itertools
 import json
+from pathlib import Path
 
 import pytest
 
@@ -500,3 +501,46 @@ def test_every_model_of_the_engine_tests_is_verified_completely(models):
         assert verdict.complete, path.name
         verified += 1
     assert verified >= 20
+
+
+def test_compensation_is_stated_as_not_explored_and_its_handlers_are_not_called_unreachable(
+    tmp_path, capsys
+):
+    semantics = Path(__file__).resolve().parent / "semantics"
+    source = (semantics / "compensation_boundary.bpmn").read_text()
+    # an element no flow reaches, outside compensation: still reported
+    lost = source.replace(
+        '<bpmn:task id="notice" name="notice" />',
+        '<bpmn:task id="notice" name="notice" /><bpmn:task id="orphan" name="orphan" />'
+        '<bpmn:endEvent id="orphan_end" />'
+        '<bpmn:sequenceFlow id="f_orphan" sourceRef="orphan" targetRef="orphan_end" />',
+    )
+    path = tmp_path / "compensation.bpmn"
+    path.write_text(lost)
+    assert main(["fame", "verify", str(path), "--json"]) == 1
+    verdict = json.loads(capsys.readouterr().out)
+    # the handlers (joined by associations, never by flows) are read from the file itself
+    assert verdict["abstractions"] == [
+        "compensation is not explored: compensation throw events (undo) pass on at once and "
+        "compensation handlers (release, refund) never run, so nothing inside them is "
+        "checked or reported"
+    ]
+    assert sorted(e for f in verdict["findings"] for e in f["elements"]) == [
+        "orphan",
+        "orphan_end",
+    ]
+    assert main(["fame", "verify", str(path)]) == 1
+    assert "note: compensation is not explored:" in capsys.readouterr().out
+    # a model without compensation states no abstraction
+    path.write_text(source.split("<bpmn:process")[0] + PLAIN)
+    assert main(["fame", "verify", str(path), "--json"]) == 0
+    assert json.loads(capsys.readouterr().out)["abstractions"] == []
+
+
+PLAIN = """<bpmn:process id="rover" isExecutable="true">
+    <bpmn:startEvent id="start" /><bpmn:task id="work" /><bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="work" />
+    <bpmn:sequenceFlow id="f2" sourceRef="work" targetRef="end" />
+  </bpmn:process>
+</bpmn:definitions>
+"""

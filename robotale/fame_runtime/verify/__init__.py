@@ -16,6 +16,7 @@ from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Process
 from robotale.fame_runtime.plan import deploy
 from robotale.fame_runtime.splitter import split
+from robotale.fame_runtime.verify.compensation import compensation
 from robotale.fame_runtime.verify.search import KINDS, Finding, explore, findings
 from robotale.fame_runtime.verify.space import Space
 
@@ -37,6 +38,8 @@ class Verdict:
     bound: str  # "" when every reachable state was explored
     findings: list[Finding] = field(default_factory=list)
     reached: list[str] = field(default_factory=list)  # ids of the elements some token reached
+    #: what the exploration leaves out of this model, one sentence each
+    abstractions: list[str] = field(default_factory=list)
 
     @property
     def complete(self) -> bool:
@@ -51,6 +54,7 @@ class Verdict:
             "seconds": round(self.seconds, 3),
             "complete": self.complete,
             "bound": self.bound or None,
+            "abstractions": self.abstractions,
             "findings": [f.as_dict() for f in self.findings],
         }
 
@@ -78,6 +82,12 @@ def verify(
     topics = frozenset(t if t.startswith("/") else f"/{t}" for t in outside)
     space = Space(plans, topics)
     graph = explore(space, max_states=max_states, timeout=timeout)
+    found = findings(graph)
+    abstractions = []
+    left_out = compensation(plan for _, plan in plans)
+    if left_out is not None:
+        abstractions.append(left_out.sentence())
+        found = [f for f in found if not _inside(f, left_out.hidden)]
     return Verdict(
         definitions.file.name,
         [name for name, _ in plans],
@@ -85,9 +95,15 @@ def verify(
         graph.steps,
         graph.seconds,
         graph.bound,
-        findings(graph),
+        found,
         sorted({element for _, element in graph.reached}),
+        abstractions,
     )
+
+
+def _inside(finding: Finding, hidden: frozenset[str]) -> bool:
+    """Whether ``finding`` is only about elements the exploration does not run."""
+    return finding.kind in ("unreachable", "never_fires") and set(finding.elements) <= hidden
 
 
 def unresolved_calls(
