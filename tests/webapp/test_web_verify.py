@@ -28,16 +28,22 @@ def test_the_api_gives_the_findings_the_command_gives(client, fame_models):
     goto = fame_models / "fame-ros" / "GoTo.bpmn"
     model_id = upload(client, goto)
     data = client.get(f"/api/models/{model_id}/verify").get_json()
-    # the store keeps the model without script bodies (web content): verified as stored
-    expected = verify(parse_bytes(sanitised(goto.read_bytes()), f"{model_id}.bpmn"))
+    # the page draws the model without script bodies (web content), but verifies it as
+    # uploaded: the findings are the command's on the authors' file, scripts read
+    expected = verify(parse_bytes(goto.read_bytes(), f"{model_id}.bpmn"))
     assert [(f["kind"], f["sentence"]) for f in data["findings"]] == [
         (f.kind, f.sentence) for f in expected.findings
     ]
     loop = data["findings"][0]
     assert loop["kind"] == "no_exit" and loop["elements"][0] == "Gateway_0mn0474"
     assert (
-        "reached = false, as Gateway_0mn0474 (destination reached?) found it" in (loop["sentence"])
+        "it reads reached = false, set by Activity_1gbttx6 (Check Position) in the same step"
+        in loop["sentence"]
     )
+    # what the page draws still has no script
+    drawn = client.get(f"/api/models/{model_id}.bpmn").data
+    assert drawn == sanitised(goto.read_bytes()) and b"reached = false" not in drawn
+    assert b"reached = false" in goto.read_bytes()
     assert [t["activity"] for t in loop["trace"]][-2:] == ["check_position", "check_position"]
     assert data["file"] == f"{model_id}.bpmn"  # no path of the server
     assert client.get("/api/models/0000000000000000/verify").status_code == 400
@@ -51,8 +57,7 @@ def test_choosing_a_finding_outlines_its_counterexample(page, fame_models):
     finding = page.locator("#verify-list li[data-kind=no_exit]")
     expect(finding).to_contain_text("Gateway_0mn0474 (destination reached?) never takes")
     finding.click()
-    stored = parse_bytes(sanitised(goto.read_bytes()), "GoTo.bpmn")
-    elements = verify(stored).findings[0].elements
+    elements = verify(parse_bytes(goto.read_bytes(), "GoTo.bpmn")).findings[0].elements
     expect(page.locator("#canvas")).to_have_attribute("data-counterexample", " ".join(elements))
     outlined = page.eval_on_selector_all(
         ".djs-element.counterexample", "els => els.map(e => e.dataset.elementId)"

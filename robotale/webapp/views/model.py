@@ -92,15 +92,16 @@ def xml(model_id: str):
 def verification(model_id: str):
     """What ``robotale fame verify`` finds in the model, each finding with its trace and the
     elements to highlight. Call activities are resolved among the stored models; one calling
-    nothing stored runs like a skill."""
+    nothing stored runs like a skill. The model is verified as uploaded, scripts included
+    (the page draws it without them)."""
     current = state()
     model = current.models.get(model_id)
     return jsonify(
         current.overlays.get(
             ("", "", "verify", model_id),
             lambda: verify(
-                parse(model.path),
-                library=Library(model.path.parent),
+                parse(model.original),
+                library=Library(model.original.parent),
                 opaque_calls=True,
                 timeout=VERIFY_SECONDS,
             ).as_dict(),
