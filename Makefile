@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 # Graphviz to draw discovered process models as SVG.
 SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
-.PHONY: install system-deps test demo bench lint format constraints clean fuzz
+.PHONY: install system-deps test test-neo4j-next demo bench lint format constraints clean fuzz bpmn-engine verify-findings
 
 install: $(STAMP)
 
@@ -34,9 +34,33 @@ system-deps:
 	  $$sudo apt-get update -qq && DEBIAN_FRONTEND=noninteractive $$sudo apt-get install -y -qq $$missing >/dev/null; \
 	fi
 
-test: install system-deps
+test: install system-deps bpmn-engine
 	$(BIN)/ruff check .
 	$(BIN)/pytest
+
+# bpmn-engine (FAME's own engine), pinned in the harness's package-lock.json, for the
+# differential semantics suite (tests/fame_runtime/test_differential.py). Without node and npm
+# the suite says so and leaves that engine out.
+HARNESS := tests/fame_runtime/bpmn_engine
+bpmn-engine: $(HARNESS)/node_modules/.package-lock.json
+
+$(HARNESS)/node_modules/.package-lock.json: $(HARNESS)/package.json $(HARNESS)/package-lock.json
+	@if command -v npm >/dev/null 2>&1; then \
+	  npm ci --prefix $(HARNESS) --no-audit --no-fund --silent; \
+	else \
+	  echo "node and npm are not installed: the differential suite will leave bpmn-engine out"; \
+	fi
+
+# The Neo4j tests again on the newest Neo4j release robotale runs (`make test` runs them on
+# 5.26 LTS, and starts the newest release with the real `robotale neo4j start --version`):
+# every file of cypher/ planned without a deprecation, logs built, appended, listed and
+# deleted, object-centric logs. Its jars are downloaded once, like 5.26's.
+NEO4J_NEXT ?= 2026.08
+NEO4J_NEXT_TESTS ?= tests/ekg/test_cypher_files.py tests/ekg/test_build.py \
+  tests/ekg/test_append.py tests/ekg/test_batches.py tests/ekg/test_logs.py \
+  tests/ekg/test_objects.py tests/ekg/test_releases.py
+test-neo4j-next: install
+	ROBOTALE_TEST_NEO4J_VERSION=$(NEO4J_NEXT) $(BIN)/pytest -m "not slow" $(NEO4J_NEXT_TESTS)
 
 # The fuzz suite with many more examples than `make test` runs (FUZZ_EXAMPLES per test):
 # nothing but robotale's own errors may come out of the log readers, the bag reader and the
@@ -46,6 +70,12 @@ FUZZ_EXAMPLES ?= 20000
 fuzz: install
 	ROBOTALE_FUZZ_EXAMPLES=$(FUZZ_EXAMPLES) $(BIN)/pytest -p no:timeout tests/test_fuzz*.py tests/eventlog/test_fuzz*.py \
 	  tests/webapp/test_web_console_fuzz.py
+
+# robotale's answers against the simulation's truth on SEEDS generated missions (one run
+# each): a table of every disagreement, then the count per subject and the time per mission.
+SEEDS ?= 50
+verify-findings: install
+	$(BIN)/python scripts/verify_findings.py --seeds $(SEEDS)
 
 # DEMO_ARGS passes options on (`make demo DEMO_ARGS="--port 5001"`); ROBOTALE_DEMO_RUNS
 # shortens the simulation (20 runs by default).

@@ -2,6 +2,7 @@
 
     python benchmarks/dashboard.py [--sizes 10000 100000] [--repeat 3]
                                    [--pages discover perspectives findings]
+    python benchmarks/dashboard.py --clients 20 [--rounds 5]
 
 Starts a private Neo4j (see ``ekg_build.py``), stores logs of the given sizes as the dashboard
 stores an upload (entities robot and msg_id, classes by activity and by activity and robot),
@@ -32,6 +33,12 @@ columnar copy is there, nothing is computed yet); warm: after the computation th
 log runs, in the dashboard and in ``robotale ingest`` alike, so the first visit after an
 ingest is warm. Targets: under 1 s at 10,000 events and under 3 s at 100,000, warm. The
 baseline of these is the warm Findings page of the thesis' own log.
+
+``--clients N`` measures the Cypher console under load instead: N clients at once, each
+asking the console's examples (``cypher/ask_*``, on the thesis' log) and loading the Discover
+page in turn (A B A B), over HTTP; every console answer is checked equal to the same query run
+directly. Printed: the median and 99th percentile of each, their ratio, errors and the load
+average. Target: console median under 1 s at 20 clients, no error; the baseline is Discover.
 """
 
 from __future__ import annotations
@@ -68,7 +75,22 @@ def main() -> int:
     parser.add_argument(
         "--pages", nargs="+", default=["discover", *PAGES], choices=["discover", *PAGES]
     )
+    parser.add_argument(
+        "--clients",
+        type=int,
+        default=0,
+        help="instead of the pages: this many clients at once ask the console's examples and "
+        "load Discover, over HTTP (console median and p99 beside Discover's)",
+    )
+    parser.add_argument("--rounds", type=int, default=5, help="requests of each kind per client")
+    parser.add_argument(
+        "--questions", nargs="+", metavar="NAME", help="with --clients: only these examples"
+    )
     args = parser.parse_args()
+    if args.clients:
+        with private_home(), private_neo4j(args.heap) as driver:
+            name, _ = store(driver, "bench_thesis", thesis_log())
+            return measure_clients(driver, name, args.clients, args.rounds, args.questions)
     with private_home(), private_neo4j(args.heap) as driver:
         logs = {"thesis": store(driver, "bench_thesis", thesis_log())}
         for size in args.sizes:
@@ -134,6 +156,130 @@ def store(driver, name: str, log) -> tuple[str, int]:
     build_ekg(driver, log, name, entities=entities, aggregate=built_keys(entities),
               replace=True, progress=False)  # fmt: skip
     return name, len(log)
+
+
+def measure_clients(
+    driver, log: str, clients: int, rounds: int, only: list[str] | None = None
+) -> int:
+    """``clients`` threads, each asking the console every example in turn and loading the
+    Discover page in between (A B A B), ``rounds`` times each; every console answer is checked
+    equal to the same query run directly. Returns 1 when any request failed or differed."""
+    import threading
+    import time
+
+    from robotale.ekg.readonly import run_read_only
+    from robotale.webapp import create_app
+    from robotale.webapp.serve import Dashboard
+
+    questions = {k: v for k, v in _questions(log).items() if not only or k in only}
+    expected = {
+        name: [r.rows for r in run_read_only(driver, text, parameters, timeout=600)]
+        for name, (text, parameters) in questions.items()
+    }
+    times: dict[str, list[float]] = {"console": [], "discover": []}
+    errors: list[str] = []
+    print(f"{clients} clients, {rounds} rounds; load average before: {os.getloadavg()[0]:.1f}")
+    with tempfile.TemporaryDirectory(prefix="robotale-bench-web-") as scratch:
+        folder = Path(scratch)
+        app = create_app(upload_dir=folder / "uploads", model_dir=folder / "models")
+        logging.getLogger("werkzeug").setLevel(logging.WARNING)
+        with Dashboard(app, port=0) as dashboard:
+
+            def client(number: int) -> None:
+                http = _Client(dashboard.url)
+                names = list(questions)
+                for turn in range(rounds):
+                    name = names[(number + turn) % len(names)]
+                    text, parameters = questions[name]
+                    started = time.monotonic()
+                    asked = {"query": text, "parameters": parameters}
+                    status, body = http.post_json("/api/cypher", asked)
+                    times["console"].append(time.monotonic() - started)
+                    rows = [r["rows"] for r in body.get("results", [])]
+                    if status != 200 or rows != expected[name]:
+                        errors.append(f"console {name}: {status} {str(body)[:200]}")
+                    started = time.monotonic()
+                    status = http.get(f"/discover?log={log}")
+                    times["discover"].append(time.monotonic() - started)
+                    if status != 200:
+                        errors.append(f"discover: {status}")
+
+            threads = [threading.Thread(target=client, args=(n,)) for n in range(clients)]
+            for thread in threads:
+                thread.start()
+            for thread in threads:
+                thread.join()
+    for kind, measured in times.items():
+        ordered = sorted(measured)
+        p99 = ordered[min(len(ordered) - 1, int(0.99 * len(ordered)))]
+        print(f"{kind:>9}: {len(ordered)} requests, median {statistics.median(ordered):.3f} s, "
+              f"p99 {p99:.3f} s")  # fmt: skip
+    ratio = statistics.median(times["console"]) / statistics.median(times["discover"])
+    met = "met" if statistics.median(times["console"]) < 1.0 else "MISSED"
+    print(f"console median / Discover median: {ratio:.2f}x; target console median < 1 s: {met}")
+    print(f"errors or differing answers: {len(errors)}")
+    for error in errors[:5]:
+        print(f"  {error}")
+    print(f"load average after: {os.getloadavg()[0]:.1f}")
+    return 1 if errors else 0
+
+
+def _questions(log: str) -> dict[str, tuple[str, dict]]:
+    """The console's examples with parameters for the thesis log (two of its robots, its
+    first run; the others at their defaults)."""
+    from robotale.eventlog import schema
+    from robotale.webapp.console import examples
+
+    thesis = thesis_log()
+    robots = [str(robot) for robot in thesis[schema.ROBOT].dropna().unique()[:2]]
+    values = {"log": log, "robot": robots[0], "other": robots[1],
+              "case": str(thesis[schema.CASE].iloc[0])}  # fmt: skip
+    return {
+        example.name: (example.text, {name: values.get(name) for name in example.parameters})
+        for example in examples()
+    }
+
+
+class _Client:
+    """One browser-like HTTP client: its own cookies and CSRF token."""
+
+    def __init__(self, url: str) -> None:
+        import http.cookiejar
+        import re
+        import urllib.request
+
+        self.url = url
+        self.opener = urllib.request.build_opener(
+            urllib.request.HTTPCookieProcessor(http.cookiejar.CookieJar())
+        )
+        page = self.opener.open(f"{url}/cypher", timeout=600).read().decode()
+        self.token = re.search(r'name="csrf-token" content="([^"]+)"', page).group(1)
+
+    def get(self, path: str) -> int:
+        import urllib.error
+
+        try:
+            with self.opener.open(f"{self.url}{path}", timeout=600) as response:
+                response.read()
+                return response.status
+        except urllib.error.HTTPError as error:
+            return error.code
+
+    def post_json(self, path: str, body: dict) -> tuple[int, dict]:
+        import json
+        import urllib.error
+        import urllib.request
+
+        request = urllib.request.Request(
+            f"{self.url}{path}",
+            data=json.dumps(body).encode(),
+            headers={"Content-Type": "application/json", "X-CSRFToken": self.token},
+        )
+        try:
+            with self.opener.open(request, timeout=600) as response:
+                return response.status, json.loads(response.read())
+        except urllib.error.HTTPError as error:
+            return error.code, json.loads(error.read() or b"{}")
 
 
 def measure_all(logs: dict, repeat: int, pages: list[str]) -> None:

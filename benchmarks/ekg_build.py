@@ -207,7 +207,7 @@ def plain_writes(driver, nodes: int, properties: int, edges: int) -> float:
     loader = Loader(driver, "bound")
     started = time.perf_counter()
     created = np.asarray(
-        loader.run("ekg_bound_nodes", {"rows": [0] * nodes}, properties=values), dtype=np.int64
+        loader.run("ekg_bound_nodes", {"rows": [0] * nodes}, properties=values), dtype=object
     )
     at = np.arange(edges)
     loader.run(

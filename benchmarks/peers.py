@@ -43,6 +43,7 @@ ENTITIES = ["robot", "msg_id"]
 # apoc.load.csv from the server's import folder, which robotale's defaults keep closed.
 OVERLAY = (
     "dbms.security.procedures.unrestricted=apoc.*\n"
+    "dbms.security.procedures.allowlist=apoc.*\n"
     "dbms.security.allow_csv_import_from_file_urls=true\n"
 )
 APOC_CONF = "apoc.import.file.enabled=true\n"

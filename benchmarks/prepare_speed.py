@@ -14,18 +14,29 @@ Four workloads:
    messages of the topics the preparation reads; target: within 1.5x. The bag is written to a
    temporary directory and removed afterwards.
 
+With ``--before DIR`` (a source tree of an earlier robotale, e.g. ``git archive COMMIT | tar
+-x -C DIR``), the synthetic bag's preparation is timed with that tree and with this one in
+turn (A B A B, each in a fresh process, best of ``--repeat``), the two logs checked equal to
+the microsecond (the earlier one's resolution), and the ratio printed: the cost of keeping the
+recording's nanoseconds (target: within 1.1x). With ``--annotate``, ``robotale annotate`` of the
+large MCAP bag (its preparation and the copy with the added topics) against a plain copy of the
+same bag written with rosbags (every message, raw), in turn, best of ``--repeat``; target: at
+most 1.5x. Only what is asked for runs when either is given.
+
 Figures are printed as ratios against baselines measured in the same process: the time to only
 read and decode every message of the bag with rosbags (the floor any preparation has to pay),
 and a search per event over the samples (what the sorted joins replace). The agri batch's target
 is under 30 s.
 
     python benchmarks/prepare_speed.py [--samples 1000000] [--tags 50000] [--batch runs/agri]
-        [--size-gb 1]
+        [--size-gb 1] [--before DIR] [--annotate] [--repeat 3]
 """
 
 from __future__ import annotations
 
 import argparse
+import contextlib
+import os
 import shutil
 import struct
 import subprocess
@@ -60,8 +71,20 @@ def main() -> int:
         "--size-gb", type=float, default=0.2, help="size of the large MCAP bag (0.2; target: 1)"
     )
     parser.add_argument("--only-large", action="store_true", help="only the large MCAP bag")
+    parser.add_argument("--before", type=Path, help="an earlier robotale source tree to compare")
+    parser.add_argument("--annotate", action="store_true", help="annotate against a plain copy")
+    parser.add_argument("--repeat", type=int, default=3, help="runs of each side (best kept)")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
+    print(f"load average: {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+    if args.before or args.annotate:
+        with tempfile.TemporaryDirectory(prefix="robotale-bench-") as scratch:
+            if args.before:
+                against_before(Path(scratch), args.before, args.samples, args.tags, args.repeat)
+            if args.annotate:
+                against_copy(Path(scratch) / "large", args.size_gb, args.repeat)
+        print(f"load average: {', '.join(f'{x:.1f}' for x in os.getloadavg())}")
+        return 0
     with tempfile.TemporaryDirectory(prefix="robotale-bench-") as scratch:
         large_mcap(Path(scratch) / "large", args.size_gb)
         if args.only_large:
@@ -112,6 +135,124 @@ def large_mcap(path: Path, size_gb: float) -> None:
         f"iteration; target within 1.5x: {verdict}"
     )
     shutil.rmtree(path)
+
+
+#: prepares a bag in a fresh process: prints the seconds, pickles the log
+_PREPARE = """
+import sys, time, warnings
+warnings.simplefilter("ignore")
+from robotale.eventlog.prepare import prepare
+began = time.perf_counter()
+log = prepare(sys.argv[1])
+print(time.perf_counter() - began)
+log.to_pickle(sys.argv[2])
+"""
+
+
+def against_before(scratch: Path, before: Path, samples: int, tags: int, repeat: int) -> None:
+    """The synthetic bag prepared by an earlier tree and by this one, in turn."""
+    path = scratch / "synthetic"
+    write_synthetic_bag(path, samples, tags)
+    print(f"synthetic bag: {samples:,} odometry samples, {tags:,} tags, {len(ROBOTS)} robots")
+    here = Path(__file__).resolve().parent.parent
+    best = {"before": float("inf"), "now": float("inf")}
+    logs = {}
+    for _ in range(repeat):
+        for side, tree in (("before", before.resolve()), ("now", here)):
+            out = scratch / f"{side}.pickle"
+            env = {**os.environ, "PYTHONPATH": str(tree)}
+            done = subprocess.run(
+                [sys.executable, "-c", _PREPARE, str(path), str(out)],
+                check=True, capture_output=True, text=True, env=env, cwd=tree,
+            )  # fmt: skip
+            best[side] = min(best[side], float(done.stdout.split()[-1]))
+            logs[side] = pd.read_pickle(out)
+    same = _same_to_the_microsecond(logs["before"], logs["now"])
+    ratio = best["now"] / best["before"]
+    verdict = "met" if ratio <= 1.1 else "NOT met"
+    print(
+        f"  prepare before: {best['before']:.2f} s, now (nanoseconds): {best['now']:.2f} s "
+        f"(best of {repeat}, in turn): {ratio:.2f}x; target within 1.1x: {verdict}; "
+        f"logs equal to the microsecond: {same}"
+    )
+
+
+def _same_to_the_microsecond(before: pd.DataFrame, now: pd.DataFrame) -> bool:
+    """The same events (every column), times cut to microseconds; the order of events at one
+    microsecond may differ, as the ordering rule decides it now."""
+    now = now.assign(**{schema.TIMESTAMP: now[schema.TIMESTAMP].dt.floor("us")})
+    columns = [c for c in before.columns if c != schema.EVENT_ID]
+    if sorted(columns) != sorted(c for c in now.columns if c != schema.EVENT_ID):
+        return False
+    key = [schema.CASE, schema.TIMESTAMP, schema.ACTIVITY, schema.LIFECYCLE, schema.ROBOT]
+
+    def ordered(log):
+        table = log[columns].astype({schema.TIMESTAMP: "datetime64[ns, UTC]"})
+        return table.sort_values(key, kind="stable").reset_index(drop=True)
+
+    try:
+        pd.testing.assert_frame_equal(ordered(before), ordered(now), check_dtype=False)
+    except AssertionError:
+        return False
+    return True
+
+
+def against_copy(path: Path, size_gb: float, repeat: int) -> None:
+    """``robotale annotate`` of the large bag against a plain copy of it, in turn."""
+    from robotale.commands.annotate import annotate_command  # why: only this figure needs it
+
+    images = max(len(ROBOTS), round(size_gb * 1e9 / np.prod(IMAGE)))
+    write_synthetic_bag(path, 200_000, 10_000, storage="mcap", images=images)
+    size = sum(f.stat().st_size for f in path.iterdir()) / 1e9
+    print(f"large MCAP bag: {size:.2f} GB, {images:,} images")
+    best = {"copy": float("inf"), "annotate": float("inf")}
+    counts = {}
+    for k in range(repeat):
+        copy, annotated = path.parent / f"copy_{k}", path.parent / f"annotated_{k}"
+        seconds, counts["copy"] = timed(plain_copy, path, copy)
+        best["copy"] = min(best["copy"], seconds)
+        seconds, _ = timed(_quietly, annotate_command, path, annotated)
+        best["annotate"] = min(best["annotate"], seconds)
+        with Reader(annotated / path.name) as reader:
+            counts["annotate"] = sum(
+                c.msgcount for c in reader.connections if not c.topic.startswith("/robotale/")
+            )
+        shutil.rmtree(copy)
+        shutil.rmtree(annotated)
+    ratio = best["annotate"] / best["copy"]
+    verdict = "met" if ratio <= 1.5 else "NOT met"
+    print(
+        f"  plain copy: {best['copy']:.2f} s, annotate: {best['annotate']:.2f} s (best of "
+        f"{repeat}, in turn): {ratio:.2f}x; target at most 1.5x: {verdict}; the same "
+        f"{counts['copy']:,} original messages in both: {counts['copy'] == counts['annotate']}"
+    )
+    shutil.rmtree(path)
+
+
+def _quietly(function, *args):
+    with open(os.devnull, "w") as sink, contextlib.redirect_stdout(sink):
+        return function(*args)
+
+
+def plain_copy(source: Path, target: Path) -> int:
+    """Every message of ``source`` written raw to a new MCAP bag with rosbags: the baseline."""
+    count = 0
+    with (
+        Reader(source) as reader,
+        Writer(target, version=9, storage_plugin=StoragePlugin.MCAP) as w,
+    ):
+        copies = {
+            c.id: w.add_connection(
+                c.topic, c.msgtype, msgdef=c.msgdef.data, rihs01=c.digest or "RIHS01_" + "0" * 64,
+                serialization_format=c.ext.serialization_format,
+                offered_qos_profiles=c.ext.offered_qos_profiles,
+            )
+            for c in reader.connections
+        }  # fmt: skip
+        for connection, when, raw in reader.messages():
+            w.write(copies[connection.id], when, raw)
+            count += 1
+    return count
 
 
 def iterate_topics(path: Path, topics: list[str]) -> int:

@@ -28,6 +28,14 @@ they have the given number of events. For each size, in the same run:
 - *report from a stored log*: the same with ``--log NAME`` (the log read back from Neo4j),
   for the ``--stored`` sizes, in a private Neo4j (see ``ekg_build.py``).
 
+With ``--truth N`` (5), N generated missions (``robotale.sim.generate``, seeds 1..N, one
+run each, simulated and prepared first, untimed) are checked against their ground truth as
+``make verify-findings`` does (``tests/truth``: the oracle's answers from the truth file and
+their comparison with robotale's messages, activities, durations, DFG and battery), and
+the findings of the same log are timed beside it, interleaved, best of ``--runs``: the time
+per mission of the truth check, and its ratio to the findings'. The check's message count is
+checked equal to the findings'.
+
 With ``--page`` sizes, the dashboard serves those stored logs and headless Chromium (Debian's,
 driven by Playwright) opens ``/findings?log=...``: the first paint of the findings runs from
 the start of the navigation to the page's ``robotale-findings-shown`` mark, cold (the
@@ -71,12 +79,13 @@ MARK = "performance.getEntriesByName('robotale-findings-shown')[0].startTime"
 
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
-    parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000, 1_000_000])
+    parser.add_argument("--sizes", type=int, nargs="*", default=[10_000, 100_000, 1_000_000])
     parser.add_argument("--stored", type=int, nargs="*", default=[10_000, 100_000, 1_000_000])
     parser.add_argument("--page", type=int, nargs="*", default=[10_000, 100_000])
     parser.add_argument("--repeat", type=int, default=3, help="page loads per log (median)")
     parser.add_argument("--heap", default="2g", help="heap of the private Neo4j (2g)")
     parser.add_argument("--runs", type=int, default=3, help="runs of pm4py and findings (best)")
+    parser.add_argument("--truth", type=int, default=5, help="generated missions checked (5)")
     args = parser.parse_args()
     warnings.simplefilter("ignore")
     warm_up()
@@ -84,6 +93,8 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="robotale-bench-report-") as scratch:
         for size in args.sizes:
             measure_file(size, Path(scratch), args.runs)
+        if args.truth:
+            measure_truth(args.truth, Path(scratch), args.runs)
         if args.stored or args.page:
             with private_neo4j(args.heap) as driver:
                 stored = {}
@@ -142,6 +153,47 @@ def measure_file(size: int, folder: Path, runs: int) -> None:
     )
     print_ratios("findings", ours, same, four)
     print(f"  {'robotale report FILE.csv --out --json':52} {command:7.2f} s")
+
+
+def measure_truth(missions: int, folder: Path, runs: int) -> None:
+    """The truth check of generated missions, per mission, against the findings of their log."""
+    # the oracle lives with the tests, apart from robotale, so that it cannot share its mistakes
+    sys.path.insert(0, str(BENCHMARKS.parent / "tests" / "truth"))
+    import compare  # here: the path above first, and only this measurement simulates
+    import oracle
+
+    from robotale.enhancement.findings import find
+    from robotale.sim.batch import simulate_batch
+    from robotale.sim.generate import DELAY_THRESHOLD, generate
+    from robotale.sim.plans import plans
+    from robotale.sim.worldspec import load_world
+
+    checking, finding, disagreeing = [], [], 0
+    for seed in range(1, missions + 1):
+        mission = generate(seed, folder / f"mission_{seed}")
+        batch = folder / f"mission_{seed}" / "runs"
+        quietly(simulate_batch, plans(load_world(mission.world), "generated", runs=1, seed=seed),
+                batch, workers=0)  # fmt: skip
+        log = compare.prepared(batch)
+        check, found = [], []
+        for _ in range(runs):  # interleaved: check, findings, check, findings ...
+            compare._TABLES.clear()  # the check analyses the log afresh each time
+            check.append(timed(compare.disagreements, batch, log, DELAY_THRESHOLD))
+            found.append(timed(find, log))
+        sent = oracle.message_counts(oracle.load_batch(batch), DELAY_THRESHOLD)["sent"]
+        said = len(compare._message_table(log, DELAY_THRESHOLD))
+        assert sent == said, (
+            f"mission {seed}: the truth sent {sent} messages, robotale lists {said}"
+        )
+        disagreeing += len(compare.disagreements(batch, log, DELAY_THRESHOLD))
+        checking.append(min(check))
+        finding.append(min(found))
+    per_check, per_find = statistics.mean(checking), statistics.mean(finding)
+    print(f"== truth check, {missions} generated missions (best of {runs}, messages checked equal)")
+    print(f"  {'truth check per mission':52} {per_check:7.2f} s")
+    print(f"  {'findings per mission (same log)':52} {per_find:7.2f} s")
+    print(f"  {'truth check / findings':52} {per_check / per_find:7.2f} x")
+    print(f"  {'disagreements found':52} {disagreeing:7d}")
 
 
 def same_work(log) -> None:

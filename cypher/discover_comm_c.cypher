@@ -6,7 +6,8 @@ MATCH (a:Class {log: $log, type: $type})<-[:OBSERVED]-(s:Event)-[m:COMM]->(t:Eve
       -[:OBSERVED]->(b:Class {log: $log, type: $type})
 WITH a, b, m.msgId AS message, min(s.timestamp) AS sent, min(t.timestamp) AS received
 WITH a, b, message,
-     (received.epochMillis - sent.epochMillis) / 1000.0 AS seconds
+     (received.epochSeconds - sent.epochSeconds)
+     + (received.nanosecond - sent.nanosecond) / 1e9 AS seconds
 RETURN a.id AS source, b.id AS target, count(message) AS count,
        avg(seconds) AS meanSeconds, percentileCont(seconds, 0.5) AS medianSeconds
 ORDER BY source, target

@@ -1,7 +1,7 @@
-// Where entities begin in a new log: BEGINS edges from entities (node ids $entities[i]) to
+// Where entities begin in a new log: BEGINS edges from entities (element ids $entities[i]) to
 // the classes of the first event of their chain in a case ($classes[i]), with the number of
 // $cases in which they began there (appends use ekg_merge_begins).
 UNWIND range(0, size($entities) - 1) AS i
-MATCH (n) WHERE id(n) = $entities[i]
-MATCH (c) WHERE id(c) = $classes[i]
+MATCH (n) WHERE elementId(n) = $entities[i]
+MATCH (c) WHERE elementId(c) = $classes[i]
 CREATE (n)-[:BEGINS {cases: $cases[i]}]->(c)

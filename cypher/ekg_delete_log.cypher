@@ -1,4 +1,4 @@
-// Delete one event log: its events, entities and classes with all their relationships, then
+// Delete one event log: its events, entities, classes and aggregates with all their relationships, then
 // its Log node. Batched: run it as an auto-commit query (in Neo4j Browser: prefix :auto).
 // The `IS NOT NULL` tests let the (log, ...) key indexes find the nodes.
 MATCH (e:Event) WHERE e.log = $log AND e.id IS NOT NULL
@@ -7,5 +7,9 @@ MATCH (n:Entity) WHERE n.log = $log AND n.type IS NOT NULL AND n.id IS NOT NULL
 CALL (n) { DETACH DELETE n } IN TRANSACTIONS OF 10000 ROWS;
 MATCH (c:Class) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL
 CALL (c) { DETACH DELETE c } IN TRANSACTIONS OF 10000 ROWS;
+MATCH (a:Aggregate) WHERE a.log = $log AND a.step IS NOT NULL AND a.id IS NOT NULL
+CALL (a) { DETACH DELETE a } IN TRANSACTIONS OF 1000 ROWS;
+MATCH (s:AggregationStep) WHERE s.log = $log AND s.step IS NOT NULL
+DELETE s;
 MATCH (l:Log {name: $log})
 DETACH DELETE l;

@@ -10,3 +10,7 @@ CREATE CONSTRAINT ekg_log_name IF NOT EXISTS
 FOR (l:Log) REQUIRE l.name IS UNIQUE;
 CREATE CONSTRAINT ekg_log_lock IF NOT EXISTS
 FOR (k:LogLock) REQUIRE k.name IS UNIQUE;
+CREATE CONSTRAINT ekg_aggregate_key IF NOT EXISTS
+FOR (a:Aggregate) REQUIRE (a.log, a.step, a.id) IS UNIQUE;
+CREATE CONSTRAINT ekg_aggregation_step_key IF NOT EXISTS
+FOR (s:AggregationStep) REQUIRE (s.log, s.step) IS UNIQUE;

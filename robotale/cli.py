@@ -38,12 +38,14 @@ def build_parser() -> argparse.ArgumentParser:
     _add_record(commands)
     _add_simulate(commands)
     _add_prepare(commands)
+    _add_annotate(commands)
     _add_neo4j(commands)
     _add_inspect(commands)
     _add_ingest(commands)
     _add_logs(commands)
     _add_serve(commands)
     _add_demo(commands)
+    _add_aggregate(commands)
     _add_discover(commands)
     _add_perspectives(commands)
     _add_report(commands)
@@ -70,9 +72,9 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
     neo4j = commands.add_parser(
         "neo4j",
         help="run a local Neo4j server (not needed when NEO4J_URI names one)",
-        description="A local Neo4j 5.26 Community server on 127.0.0.1, kept under the robotale "
-        "home ($ROBOTALE_HOME, default ~/.robotale). With NEO4J_URI set, robotale uses that "
-        "server instead.",
+        description="A local Neo4j Community server (5.26 LTS, or a newer release with "
+        "--version) on 127.0.0.1, kept under the robotale home ($ROBOTALE_HOME, default "
+        "~/.robotale). With NEO4J_URI set, robotale uses that server instead.",
     )
     actions = neo4j.add_subparsers(dest="_action", metavar="ACTION", required=True)
     start = actions.add_parser("start", help="start the server in the background and wait for it")
@@ -85,6 +87,12 @@ def _add_neo4j(commands: argparse._SubParsersAction) -> None:
         metavar="DIR",
         help="folder of plugin jars such as APOC (ROBOTALE_NEO4J_PLUGINS; default: the "
         "plugins folder of the robotale home, when there is one)",
+    )
+    start.add_argument(
+        "--version",
+        help="the Neo4j release line or version, e.g. 2026.08 (ROBOTALE_NEO4J_VERSION; default "
+        "the LTS line; an unknown one is refused naming those offered); a home's data stays "
+        "with the release that wrote it",
     )
     start.add_argument("--timeout", type=float, help="seconds to wait (180)")
     _handled_by(start, "neo4j.neo4j_start")
@@ -128,6 +136,13 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         type=Path,
         metavar="YAML",
         help="a simulation's world file: also list what its robots do not provide",
+    )
+    check.add_argument(
+        "--json",
+        dest="as_json",
+        action="store_true",
+        default=None,
+        help="the report as JSON (each problem with element, file, line, column, sentence)",
     )
     _handled_by(check, "fame.check_command")
 
@@ -181,6 +196,33 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         help="an initial variable, e.g. drone.delay=10 (repeatable)",
     )
     _handled_by(run, "fame.run_command")
+
+    verify = sub.add_parser(
+        "verify",
+        help="model analysis before anything runs; exit status 1 on a finding, 2 on bad input",
+        description="Explore the mission's states (one engine per robot, signals broadcast, "
+        "timers and unknown conditions as choices) and report deadlocks, lost signals, "
+        "catches that never fire, elements never reached and loops without exit, each with "
+        "a shortest trace.",
+    )
+    verify.add_argument("model", type=Path, help="the .bpmn collaboration")
+    verify.add_argument("--robots", **robots)
+    verify.add_argument("--skills", **skills)
+    verify.add_argument("--library", **library)
+    verify.add_argument(
+        "--outside",
+        metavar="A,B",
+        help="signals and errors the world raises at any time (a camera, a skill, a battery "
+        "monitor), e.g. weed_found,low_battery",
+    )
+    verify.add_argument(
+        "--max-states", type=int, metavar="N", help="stop after this many states (200000)"
+    )
+    verify.add_argument(
+        "--timeout", type=float, metavar="SECONDS", help="stop after this long (60)"
+    )
+    verify.add_argument("--json", dest="as_json", action="store_true", default=None)
+    _handled_by(verify, "fame_verify.verify_command")
 
     node = sub.add_parser(
         "node",
@@ -260,6 +302,31 @@ def _add_prepare(commands: argparse._SubParsersAction) -> None:
     _handled_by(prepare, "prepare.prepare_command")
 
 
+def _add_annotate(commands: argparse._SubParsersAction) -> None:
+    annotate = commands.add_parser(
+        "annotate",
+        help="copy recordings as MCAP with their activities, messages and findings added",
+        description="Copy a rosbag2 directory, or each run of a folder of them, as an MCAP "
+        "rosbag2 directory under --out with added topics: each robot's current activity "
+        "(/robotale/<robot>/activity, std_msgs/String, and activity_index, std_msgs/Int32) "
+        "and, on /robotale/log (rcl_interfaces/Log), every message exchange, lost message, "
+        "bottleneck instance and, with --model, deviation from the model. The original "
+        "messages are copied byte for byte. Open it in Foxglove, Lichtblick or PlotJuggler "
+        "(docs/annotate.md).",
+    )
+    annotate.add_argument(
+        "source", type=Path, help="a rosbag2 directory or a folder of run directories"
+    )
+    annotate.add_argument(
+        "--out", type=Path, required=True, metavar="DIR", help="the folder the copies go to"
+    )
+    annotate.add_argument(
+        "--model", type=Path, metavar="BPMN", help="a BPMN collaboration to check the runs against"
+    )
+    _add_preparation_options(annotate)
+    _handled_by(annotate, "annotate.annotate_command")
+
+
 def _add_executor(parser: argparse.ArgumentParser) -> None:
     parser.add_argument(
         "--executor",
@@ -273,6 +340,14 @@ def _add_executor(parser: argparse.ArgumentParser) -> None:
 
 def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
     """How recordings become an event log; shared by ``prepare`` and ``ingest``."""
+    parser.add_argument(
+        "--skip-bad",
+        dest="skip_bad",
+        action="store_true",
+        default=None,
+        help="leave out a run that cannot be read (named, with why) and keep the others; "
+        "without it such a run stops everything before anything is written",
+    )
     parser.add_argument("--tags", metavar="GLOB", help="the tag topics (default: /*/tag)")
     parser.add_argument(
         "--tag-field",
@@ -298,8 +373,8 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         dest="msg_files",
         action="append",
         metavar="PATH",
-        help="a .msg/.idl/.action file or a folder of them, for types the bags do not define. "
-        "Repeatable",
+        help="a .msg/.srv/.action/.idl file or a folder of them, for types the bags do not "
+        "define. Repeatable",
     )
     parser.add_argument(
         "--bag-time",
@@ -335,6 +410,13 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
         help="behaviour-tree transition logs whose nodes are activities, e.g. /behavior_tree_log",
     )
     parser.add_argument(
+        "--robot",
+        metavar="NAME",
+        default=None,
+        help="the robot of tags and activities on topics without a namespace "
+        "(default: the bag's only namespace, else robot)",
+    )
+    parser.add_argument(
         "--auto",
         action="store_true",
         default=None,
@@ -353,15 +435,25 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
 def _add_ingest(commands: argparse._SubParsersAction) -> None:
     ingest = commands.add_parser(
         "ingest",
-        help="load an event log (CSV, XES or rosbag2 recordings) into Neo4j as an event "
-        "knowledge graph",
+        help="load an event log (CSV, XES, OCEL 2.0 or rosbag2 recordings) into Neo4j as an "
+        "event knowledge graph",
         description="Read an event log, or prepare one from rosbag2 recordings as `robotale "
         "prepare` does, and store it in Neo4j: Event, Entity and Class nodes, CORR, DF, COMM, "
         "OBSERVED and DF_C edges. Nothing is written if the log is refused, and a failed ingest "
         "leaves the database as it was.",
     )
     ingest.add_argument(
-        "path", type=Path, help="a .csv or .xes event log, a rosbag2 directory or a folder of runs"
+        "path",
+        type=Path,
+        help="a .csv or .xes event log, an OCEL 2.0 log (.jsonocel/.json, .xmlocel/.xml, "
+        ".sqlite/.db), a rosbag2 directory or a folder of runs",
+    )
+    ingest.add_argument(
+        "--objects",
+        type=Path,
+        metavar="DIR",
+        help="a CSV log's object tables: DIR/<Type>.csv with an id column and one column per "
+        "attribute, for the events' column <Type> (object ids, several comma-separated)",
     )
     ingest.add_argument(
         "--log", help="name of the log in Neo4j (default: the file's or folder's name)"
@@ -577,6 +669,39 @@ def _add_inspect(commands: argparse._SubParsersAction) -> None:
     _add_mapping(inspect)
     _add_case_options(inspect)
     _handled_by(inspect, "inspect.inspect_command")
+
+
+def _add_aggregate(commands: argparse._SubParsersAction) -> None:
+    aggregate = commands.add_parser(
+        "aggregate",
+        help="collapse a stored log's events or entities into aggregates, step by step",
+        description="Run an aggregation specification (YAML: steps with aggr_type, ent_type, "
+        "group_by, where, attr_aggrs, as OCEAN's) on a log stored in Neo4j. Each step "
+        "collapses the matching events or entities into Aggregate nodes that keep their CORR, "
+        "DF and COMM edges, counted; steps stack and are undone as units. See docs/aggregate.md.",
+    )
+    aggregate.add_argument("log_name", metavar="LOG", help="the stored log")
+    aggregate.add_argument("--spec", type=Path, metavar="FILE", help="the specification to run")
+    aggregate.add_argument(
+        "--undo",
+        dest="undo_step",
+        nargs="?",
+        const="last",
+        metavar="STEP",
+        help="undo step STEP and the steps stacked on it (default: the last step)",
+    )
+    aggregate.add_argument(
+        "--steps", action="store_true", default=None, help="list the log's aggregation steps"
+    )
+    aggregate.add_argument(
+        "--json",
+        dest="as_json",
+        action="store_true",
+        default=None,
+        help="print each step's initial_events, final_events, initial_entities and "
+        "final_entities as JSON",
+    )
+    _handled_by(aggregate, "aggregate.aggregate_command")
 
 
 def _add_discover(commands: argparse._SubParsersAction) -> None:

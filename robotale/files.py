@@ -9,6 +9,7 @@ gets the permissions of a normally created one, 0666 less the umask (``mkstemp``
 from __future__ import annotations
 
 import contextlib
+import errno
 import os
 import tempfile
 from collections.abc import Iterator, Sequence
@@ -63,9 +64,30 @@ def _staged(path: Path, mode: str) -> Iterator[tuple[IO, str]]:
             file.flush()
             os.fsync(file.fileno())
         os.chmod(name, 0o666 & ~umask())
+    except OSError as error:
+        written = _size(name)
+        _remove(name)
+        if error.errno in (errno.ENOSPC, errno.EDQUOT):
+            raise InputError(_disk_full(path, written)) from None
+        raise
     except BaseException:
         _remove(name)
         raise
+
+
+def _size(name: str) -> int:
+    try:
+        return os.stat(name).st_size
+    except OSError:
+        return 0
+
+
+def _disk_full(path: Path, written: int) -> str:
+    fitted = f"{written / 2**20:.1f} MB" if written >= 2**20 else f"{written / 1024:.0f} KB"
+    return (
+        f"The disk of {path.parent} is full: {path} needs more than the {fitted} that "
+        "fitted there; nothing was written (free some space or write elsewhere)."
+    )
 
 
 def _replace(staged: Sequence[tuple[str, Path]]) -> None:

@@ -12,7 +12,9 @@ Neo4j (always a real server, never a mock):
   tests use. With ``NEO4J_URI`` set (plus ``NEO4J_USER``/``NEO4J_PASSWORD``) that server;
   otherwise a local Neo4j started for this session in a temporary robotale home on free ports
   (the jars come from the user's cache, so only the very first run downloads them) and
-  stopped at the end. While it runs, ``NEO4J_URI``, ``NEO4J_USER`` and ``NEO4J_PASSWORD`` point
+  stopped at the end: the release ``ROBOTALE_TEST_NEO4J_VERSION`` names (``2026.08``; default
+  the LTS release ``robotale neo4j start`` runs), so the suite runs on each release robotale
+  offers. While it runs, ``NEO4J_URI``, ``NEO4J_USER`` and ``NEO4J_PASSWORD`` point
   at it, so code under test and ``robotale`` subprocesses use it without further setup.
 - ``neo4j_driver`` (session): a connected ``neo4j.Driver`` for that server.
 - ``log_name``: a log name no other test uses; whatever was stored under it is deleted after
@@ -91,8 +93,11 @@ def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Settings]
     from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port
 
     server = LocalServer(tmp_path_factory.mktemp("robotale-home"))
+    version = os.environ.get("ROBOTALE_TEST_NEO4J_VERSION") or ServerOptions.version
     for attempt in range(3):  # a free port can be taken by someone else before Neo4j binds it
-        options = ServerOptions(free_port(), free_port(), heap="1g", pagecache="256m")
+        options = ServerOptions(
+            free_port(), free_port(), heap="1g", pagecache="256m", version=version
+        )
         try:
             running = server.start(options)
             break
@@ -137,6 +142,34 @@ def graph_counts(neo4j_driver: Driver) -> Callable[[], dict[str, int]]:
     from robotale.ekg.logs import graph_counts
 
     return lambda: graph_counts(neo4j_driver)
+
+
+@pytest.fixture
+def small_disk(tmp_path: Path) -> Iterator[Callable[[str], Path]]:
+    """Mounts a filesystem of the given size (``small_disk("1m")``) and returns its folder:
+    a real full disk for the tests of what a command does when it runs out of space. Needs
+    root (``mount -t tmpfs``); the test is skipped where it cannot mount."""
+    import subprocess
+
+    mounted: list[Path] = []
+
+    def mount(size: str) -> Path:
+        folder = tmp_path / f"disk{len(mounted)}"
+        folder.mkdir()
+        done = subprocess.run(
+            ["mount", "-t", "tmpfs", "-o", f"size={size}", "tmpfs", str(folder)],
+            capture_output=True,
+            text=True,
+            check=False,
+        )
+        if done.returncode != 0:
+            pytest.skip(f"cannot mount a small filesystem here ({done.stderr.strip()})")
+        mounted.append(folder)
+        return folder
+
+    yield mount
+    for folder in mounted:
+        subprocess.run(["umount", "-l", str(folder)], check=False)
 
 
 _exit_status = 0

@@ -13,6 +13,7 @@ from pathlib import Path
 
 import pandas as pd
 import pytest
+from patience import patience
 
 from robotale.ekg.logs import delete_log, log_summary
 
@@ -73,7 +74,7 @@ def test_make_demo_serves_the_dashboard_with_the_ingested_logs(tmp_path, neo4j_d
     )
     try:
         printed = "".join(wait_for_line(process, "robotale dashboard at ", 600))
-        page = urllib.request.urlopen(f"http://127.0.0.1:{port}/logs", timeout=30).read()
+        page = urllib.request.urlopen(f"http://127.0.0.1:{port}/logs", timeout=patience(30)).read()
         for name in DEMO_LOGS:
             assert f">{name}<".encode() in page, name
 
@@ -87,7 +88,7 @@ def test_make_demo_serves_the_dashboard_with_the_ingested_logs(tmp_path, neo4j_d
 
         # Ctrl-C in a terminal signals the whole foreground group: make and the demo
         os.killpg(process.pid, signal.SIGINT)
-        rest, _ = process.communicate(timeout=60)
+        rest, _ = process.communicate(timeout=patience(60))
         assert "Dashboard stopped" in rest
     finally:
         if process.poll() is None:

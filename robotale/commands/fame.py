@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import sys
 import time
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -14,9 +14,11 @@ from robotale.extras import require
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.check import Report, check, duplicate_ids
 from robotale.fame_runtime.clock import SimClock
+from robotale.fame_runtime.engine import Engine
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
-from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.model import Definitions, Problem
+from robotale.fame_runtime.parser import ReadError, parse, parse_all
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split, unbound_pools, write_split
 from robotale.fame_runtime.tags import Tag
@@ -34,19 +36,71 @@ def check_command(
     library: Path | None = None,
     skills: str | None = None,
     world: Path | None = None,
+    as_json: bool = False,
     out: TextIO | None = None,
 ) -> int:
-    """Print the structure and QoS report; with ``world`` (a simulation's world file) also
-    what the model needs that the world's robots do not provide. 1 when something is wrong."""
+    """Print the structure and QoS report -- every problem of reading and of deploying the
+    file at once; with ``world`` (a simulation's world file) also what the model needs that
+    the world's robots do not provide; with ``as_json`` as one JSON object. 1 when something
+    is wrong."""
     out = out or sys.stdout
     names = load_skills(skills) if skills else {}
-    definitions = parse(model)
+    try:
+        definitions = parse_all(model)
+    except ReadError as error:
+        if not as_json:
+            raise
+        print(json.dumps(unreadable_json(model, error.problems), indent=2), file=out)
+        return 1
     blocks = Library(library) if library else None
     report = check(definitions, skills=names, library=blocks)
-    missing = _simulation_lacks(definitions, model, world, blocks) if world is not None else []
-    print_report(report, out)
-    print_lacks(missing, out)
+    missing = []
+    if world is not None and not definitions.problems:
+        missing = _simulation_lacks(definitions, model, world, blocks)
+    if as_json:
+        print(json.dumps(report_json(report, missing), indent=2), file=out)
+    else:
+        print_report(report, out)
+        print_lacks(missing, out)
     return 0 if report.ok and not missing else 1
+
+
+def unreadable_json(model: Path, problems: Sequence[Problem]) -> dict[str, Any]:
+    """The JSON report of a file that is no BPMN at all."""
+    return {
+        "file": str(model),
+        "ok": False,
+        "pools": [],
+        "problems": [{**p.as_dict(), "pool": ""} for p in problems],
+        "qos": [],
+        "notes": [],
+        "warnings": [],
+        "lacks": [],
+    }
+
+
+def report_json(report: Report, missing: Sequence[str]) -> dict[str, Any]:
+    """The report as data: what ``print_report`` prints, each problem with its element id,
+    file, line, column (0: unknown) and sentence."""
+    return {
+        "file": report.file,
+        "ok": report.ok and not missing,
+        "pools": report.pools,
+        "problems": [{**p.as_dict(), "pool": pool} for pool, p in report.found],
+        "qos": [
+            {
+                "topic": pair.publisher.topic,
+                "publisher": pair.publisher.describe(),
+                "subscriber": pair.subscriber.describe(),
+                "compatible": pair.compatible,
+                "reasons": list(pair.reasons),
+            }
+            for pair in report.pairs
+        ],
+        "notes": report.notes,
+        "warnings": report.warnings,
+        "lacks": list(missing),
+    }
 
 
 def _simulation_lacks(definitions, model: Path, world: Path, library: Library | None):
@@ -67,9 +121,10 @@ def print_lacks(missing: Sequence[str], out: TextIO) -> None:
 
 def print_report(report: Report, out: TextIO) -> None:
     print(f"{report.file}: pools {', '.join(report.pools)}", file=out)
-    print(f"structure: {'ok' if not report.problems else 'the engine cannot run'}", file=out)
-    for problem in report.problems:
-        print(f"  {problem}", file=out)
+    print(f"structure: {'ok' if not report.found else 'the engine cannot run'}", file=out)
+    for pool, problem in report.found:
+        where = f"{problem.file}:{problem.line}:" + (f"{problem.column}:" if problem.column else "")
+        print(f"  {where} {pool + ': ' if pool else ''}{problem.sentence}", file=out)
     incompatible = sum(not p.compatible for p in report.pairs)
     print(
         f"QoS: {len(report.pairs)} publisher/subscriber pairs, {incompatible} incompatible",
@@ -151,7 +206,8 @@ def run_command(
         )
     if bus != "inprocess" or record is not None:
         raise InputError(_bus_problem(bus))
-    definitions = parse(model)
+    names = load_skills(skills) if skills else None
+    definitions = readable(model, names, library)
     begin = start_time(start)
     clock = SimClock(start=begin)
     mission = Mission(
@@ -161,7 +217,7 @@ def run_command(
         bus=InProcessBus(
             clock, latency=latency, on_warning=lambda text: print(f"# warning: {text}", file=err)
         ),
-        skills=load_skills(skills) if skills else None,
+        skills=names,
         library=library,
         tag_sink=lambda tag: print(tag_line(tag, begin), file=out),
         variables=parse_assignments(assignments),
@@ -170,6 +226,19 @@ def run_command(
         print(f"# warning: {warning}", file=err)
     mission.run(until=begin + until)
     return run_verdict(mission, begin, err)
+
+
+def readable(model: Path, skills: Mapping[str, Any] | None, library: Path | None) -> Definitions:
+    """The model, or one ModelError naming every problem of reading it together with what
+    deploying its pools would refuse (as ``fame check`` lists them)."""
+    definitions = parse_all(model)
+    if not definitions.problems:
+        return definitions
+    report = check(definitions, skills=skills or {}, library=Library(library) if library else None)
+    lines = "\n".join(
+        f"{p.file}:{p.line}: {pool + ': ' if pool else ''}{p.sentence}" for pool, p in report.found
+    )
+    raise ModelError(f"{model}: {len(report.found)} problems:\n{lines}")
 
 
 def refuse_duplicate_ids(model: Path) -> None:
@@ -206,13 +275,20 @@ def run_verdict(mission: Mission, begin: float, err: TextIO) -> int:
         state = "waiting for a timer"
     else:
         state = "still running"
-    counts = ", ".join(f"{r} {e.completed}" for r, e in mission.engines.items())
-    print(f"# {state} at {reached:.3f} s; instances completed: {counts}", file=err)
+    print(f"# {state} at {reached:.3f} s; {instance_counts(mission.engines)}", file=err)
     for place in mission.whereabouts():
         print(f"# {place}", file=err)
     for failure in mission.failures:
         print(f"# {failure}", file=err)
     return 1 if mission.failures or not mission.idle else 0
+
+
+def instance_counts(engines: Mapping[str, Engine]) -> str:
+    """``instances completed: drone 1, tractor 0; failed: tractor 1`` (failed only when some
+    instance failed)."""
+    completed = ", ".join(f"{r} {e.completed}" for r, e in engines.items())
+    failed = ", ".join(f"{r} {e.failed}" for r, e in engines.items() if e.failed)
+    return f"instances completed: {completed}" + (f"; failed: {failed}" if failed else "")
 
 
 def tag_line(tag: Tag, begin: float = 0.0) -> str:

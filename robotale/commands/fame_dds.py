@@ -17,7 +17,13 @@ from typing import TextIO
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
 from cyclonedds.core import Policy
 
-from robotale.commands.fame import parse_assignments, robot_list, start_time, tag_line
+from robotale.commands.fame import (
+    instance_counts,
+    parse_assignments,
+    robot_list,
+    start_time,
+    tag_line,
+)
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope
 from robotale.fame_runtime.clock import WallClock
@@ -106,7 +112,7 @@ def _node_verdict(node: Node, begin: float, err: TextIO) -> int:
         state = "still running"
     reached = node.clock.now() - begin
     print(
-        f"# {node.robot}: {state} at {reached:.3f} s; instances completed: {engine.completed}",
+        f"# {node.robot}: {state} at {reached:.3f} s; {instance_counts({node.robot: engine})}",
         file=err,
     )
     if not engine.idle:

@@ -10,7 +10,7 @@ from typing import Any
 import pandas as pd
 from neo4j import Driver
 
-from robotale.commands.prepare import prepare_recordings
+from robotale.commands.prepare import kept_runs, prepare_recordings
 from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg, why
 from robotale.ekg.columnar import delete_copies
@@ -18,7 +18,7 @@ from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
-from robotale.eventlog.readers import is_parquet, parse_mapping, read_log_with_reading
+from robotale.eventlog.readers import is_parquet, parse_mapping, read_with_objects
 from robotale.eventlog.reading import format_reading
 from robotale.webapp.findings_data import prepare
 from robotale.webapp.logdata import LogData
@@ -41,15 +41,31 @@ def ingest_command(
     rate: float | None = None,
     msg_files: Sequence[str] = (),
     bag_time: bool = False,
+    objects: Path | None = None,
+    skip_bad: bool = False,
     **recording: Any,
 ) -> int:
-    """Store the log at ``path`` (CSV, XES, or recordings prepared as ``prepare`` does) in
-    Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the other
-    options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto ...).
-    With ``append`` its runs are added to the stored log of that name."""
+    """Store the log at ``path`` (CSV, XES, OCEL 2.0, or recordings prepared as ``prepare``
+    does) in Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the
+    other options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto
+    ...). With ``append`` its runs are added to the stored log of that name. ``objects``: the
+    folder of a CSV log's object tables (``<Type>.csv``). An object-centric log's object types
+    are its entity types unless ``entities`` names others."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
+    found_objects = None
+    if log is not None and not log.strip():
+        raise InputError(
+            f"--log {log!r} names no log: give it a name, or leave --log out to use "
+            f"{log_name(path)!r}."
+        )
+    skipped: list[Path] | None = None
     if path.is_dir() and not is_parquet(path):
+        if objects is not None:
+            raise InputError(
+                f"{path} holds recordings: --objects applies to a CSV event log with one "
+                "column per object type."
+            )
         if mapping or case:
             raise InputError(
                 f"{path} holds recordings: --map and --case apply to CSV and XES files "
@@ -60,6 +76,7 @@ def ingest_command(
                 f"{path} holds recordings: --case-gap applies to CSV and XES files "
                 "(each run of a recording is its own case)."
             )
+        skipped = [] if skip_bad else None
         events = prepare_recordings(
             path,
             tags=tags,
@@ -68,14 +85,25 @@ def ingest_command(
             rate=rate,
             msg_files=msg_files,
             bag_time=bag_time,
+            skipped=skipped,
             **recording,
         )
     else:
-        events, reading = read_log_with_reading(path, parse_mapping(mapping), case, case_gap)
+        events, reading, found_objects = read_with_objects(
+            path, parse_mapping(mapping), case, case_gap, objects
+        )
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
         print(format_reading(reading, short=True))
+    if append and found_objects is not None:
+        raise InputError(
+            f"{path} is object-centric: --append adds runs of a log with cases; rebuild the "
+            "log with --replace instead."
+        )
     name = log or log_name(path)
-    names = {"entities": split_names(entities) if entities else None}
+    chosen = split_names(entities) if entities else None
+    if chosen is None and found_objects is not None:
+        chosen = found_objects.entity_types
+    names = {"entities": chosen}
     with session_driver() as driver:
         if append:
             # the log's columnar copy no longer matches its build: the next analysis reads
@@ -89,10 +117,13 @@ def ingest_command(
                 aggregate=aggregate or DEFAULT_AGGREGATE,
                 replace=replace,
                 source=str(path),
+                objects=found_objects,
                 **names,
             )
         print(describe(summary, appended=append))
         prepare_pages(driver, name)
+    if skipped is not None:
+        print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
 
 

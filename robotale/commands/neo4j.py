@@ -8,7 +8,7 @@ import sys
 from pathlib import Path
 
 from robotale.ekg.connection import bolt_answers, settings
-from robotale.ekg.jars import NEO4J_VERSION
+from robotale.ekg.jars import release
 from robotale.ekg.server import CRASHED, OTHER, RUNNING, LocalServer, ServerOptions
 from robotale.ekg.server_config import check_plugins
 
@@ -20,6 +20,7 @@ def neo4j_start(
     heap: str | None = None,
     pagecache: str | None = None,
     plugins: str | None = None,
+    version: str | None = None,
     timeout: float = 180.0,
 ) -> int:
     """Start the local server (options not given come from the environment's defaults)."""
@@ -32,6 +33,7 @@ def neo4j_start(
         "heap": heap,
         "pagecache": pagecache,
         "plugins": Path(plugins).expanduser() if plugins else None,
+        "version": version,
     }
     overrides = {field: value for field, value in given.items() if value is not None}
     server = LocalServer()
@@ -41,7 +43,10 @@ def neo4j_start(
         print("The local Neo4j had crashed; starting it again.")
     state = server.start(options, timeout=timeout, progress=_progress)
     verb = "was already running" if already else "is running"
-    print(f"Neo4j {NEO4J_VERSION} {verb} at {state.bolt_uri} (pid {state.pid}).")
+    # a server that was already running runs the release its data was written by
+    version = server.data_version() if already else None
+    version = version or release(options.version).version
+    print(f"Neo4j {version} {verb} at {state.bolt_uri} (pid {state.pid}).")
     print(f"Neo4j Browser: {state.browser_url}  user neo4j, password in {server.password_file}")
     if not already:
         _report_plugins(server, options)

@@ -6,7 +6,7 @@ from __future__ import annotations
 import sys
 import tempfile
 import warnings
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
@@ -29,21 +29,29 @@ def prepare_command(
     xes: Path | None = None,
     ocel: Path | None = None,
     executor: str | None = None,
+    skip_bad: bool = False,
     **options: Any,
 ) -> int:
     """Write the event log of the recordings at ``source`` as CSV (``out``, by default
     ``<source name>.csv`` when no other output is asked for) or, when ``out`` ends in
     ``.parquet``, as a Parquet dataset partitioned by run; also XES and/or OCEL 2.0.
     ``out`` may be an fsspec URL. ``executor`` (``local[:N]``, ``dask://HOST:PORT``) reads the
-    runs in parallel; ``options`` are those of :func:`prepare_recordings`."""
+    runs in parallel; ``options`` are those of :func:`prepare_recordings`. With ``skip_bad``
+    a run that cannot be read is left out, named with why on stderr."""
     if out is not None and is_dataset_name(out):
+        if skip_bad:
+            raise InputError(
+                "--skip-bad writes one CSV of the runs that could be read: give --out a .csv "
+                "name, or leave out --skip-bad."
+            )
         return _prepare_dataset(source, str(out), xes, ocel, executor, options)
     csv = out or (None if xes or ocel else f"{source.resolve().name}.csv")
     for target in (xes, ocel):  # all refused before hours of preparation, not after
         if target is not None:
             writers.check_target(target)
     csv_place = _csv_place(csv) if csv is not None else None
-    log = prepare_recordings(source, executor=executor, **options)
+    skipped: list[Path] | None = [] if skip_bad else None
+    log = prepare_recordings(source, executor=executor, skipped=skipped, **options)
     written = []
     if csv_place is not None:
         _write_csv(log, csv_place)
@@ -51,7 +59,15 @@ def prepare_command(
     written += _also_written(log, source, xes, ocel)
     cases = log["case:concept:name"].nunique()
     print(f"{len(log)} events from {cases} run(s) written to {', '.join(written)}")
+    if skipped is not None:
+        print(kept_runs(cases, skipped))
     return 0
+
+
+def kept_runs(kept: int, skipped: Sequence[Path]) -> str:
+    """How many runs a ``--skip-bad`` preparation kept, and which it left out."""
+    left_out = f"; skipped {len(skipped)}: {', '.join(run.name for run in skipped)}"
+    return f"kept {kept} of {kept + len(skipped)} run(s){left_out if skipped else ''}"
 
 
 def _also_written(
@@ -141,10 +157,14 @@ def prepare_recordings(
     bt_log: str | None = None,
     auto: bool = False,
     distro: str | None = None,
+    robot: str | None = None,
     executor: str | None = None,
+    skipped: list[Path] | None = None,
 ) -> pd.DataFrame:
     """The event log of the recordings at ``source``; an option left ``None`` takes
-    :func:`~robotale.eventlog.prepare.prepare`'s default (``executor``: read in this process)."""
+    :func:`~robotale.eventlog.prepare.prepare`'s default (``executor``: read in this process).
+    Given a list ``skipped``, a run that cannot be read is left out, added to it and named
+    with why on stderr; without, it stops the preparation before anything is written."""
     options = {
         "tags": tags,
         "tag_fields": tag_fields,
@@ -158,8 +178,18 @@ def prepare_recordings(
         "bt_log": bt_log,
         "auto": auto,
         "distro": distro,
+        "robot": robot,
     }
-    return prepare_reporting(source, executor=executor, **_given(options))
+    skip = None if skipped is None else _skipping(skipped)
+    return prepare_reporting(source, executor=executor, skip_bad=skip, **_given(options))
+
+
+def _skipping(skipped: list[Path]) -> Callable[[Path, str], None]:
+    def skip(run: Path, why: str) -> None:
+        skipped.append(run)
+        print(f"robotale: skipped {run.name}: {why}", file=sys.stderr)
+
+    return skip
 
 
 def _given(options: dict[str, Any]) -> dict[str, Any]:
@@ -183,6 +213,7 @@ def _given(options: dict[str, Any]) -> dict[str, Any]:
         "bt_logs": options.get("bt_log"),
         "auto": bool(options.get("auto")),
         "distro": options.get("distro"),
+        "robot": options.get("robot"),
         **{key: value for key, value in given.items() if value is not None},
     }
 

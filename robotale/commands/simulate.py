@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
+import errno
 import os
+import shutil
+import sqlite3
 import sys
 from collections.abc import Sequence
 from dataclasses import replace
@@ -14,7 +17,7 @@ from robotale.fame_runtime.clock import EngineCost
 from robotale.sim import stopping
 from robotale.sim.batch import SUMMARY, simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world
-from robotale.sim.run import RunPlan
+from robotale.sim.run import CRASHED, RunPlan
 from robotale.sim.worldspec import World
 from robotale.storage import local_path
 
@@ -55,6 +58,8 @@ def simulate_command(
     scenario's world calibrated to the thesis. The ``stop`` scenario runs the stop-distance
     experiment (``runs`` per variant and speed, 10) and prints its table."""
     out = out or sys.stdout
+    if runs is not None and runs < 1:
+        raise InputError(f"--runs {runs}: give the number of runs to simulate, 1 or more.")
     preset = "thesis" if thesis else None
     loaded, scenario = resolve_world(scenario, model, world, library, preset=preset)
     group_counts = dict(_count(text) for text in counts)
@@ -70,7 +75,7 @@ def simulate_command(
     if engine_cost is not None:
         loaded = replace(loaded, engine_cost=_engine_cost(engine_cost))
     experiment = scenario == "stop" and world is None
-    runs = runs or (10 if experiment else 1)
+    runs = runs if runs is not None else (10 if experiment else 1)
     missing = check(loaded)
     if missing:  # before anything runs, like fame check --world
         print(f"simulation lacks: {len(missing)}", file=out)
@@ -122,8 +127,55 @@ def simulate_command(
                 "give it a folder on this machine"
             )
         return stop_experiment(loaded, plans_for, simulate, folder, out)
-    print_summary(simulate(plans_for(loaded), target), target, out)
-    return 0
+    batch = plans_for(loaded)
+    try:
+        summary = simulate(batch, target)
+    except (OSError, sqlite3.OperationalError) as error:
+        if (folder := local_path(target)) is None or not _disk_full(error):
+            raise
+        raise InputError(_no_space(folder, batch)) from None
+    print_summary(summary, target, out)
+    return _crash_status(summary)
+
+
+def _disk_full(error: Exception) -> bool:
+    if isinstance(error, OSError):
+        return error.errno in (errno.ENOSPC, errno.EDQUOT)
+    return "disk is full" in str(error)  # sqlite3, writing a bag
+
+
+def _no_space(folder: Path, batch: list[RunPlan]) -> str:
+    """The sentence for a batch the disk of ``folder`` could not hold (the runs recorded
+    before stay whole; the one that stopped was removed with its hidden folder)."""
+    done = [run for plan in batch if (run := folder / plan.case).is_dir()]
+    size = sum(f.stat().st_size for run in done for f in run.rglob("*") if f.is_file())
+    free = shutil.disk_usage(folder).free
+    if not done:
+        return (
+            f"The disk of {folder} is full: not one run of {len(batch)} fitted in its "
+            f"{free / 2**20:.1f} MB free; nothing was kept."
+        )
+    each = size / len(done)
+    return (
+        f"The disk of {folder} is full: {len(batch)} runs need about "
+        f"{each * len(batch) / 2**20:.1f} MB there ({each / 2**20:.1f} MB each), and only "
+        f"{len(done)} fitted; they are kept whole, the run that did not fit was removed."
+    )
+
+
+def _crash_status(summary: dict[str, Any]) -> int:
+    """1 when any run crashed, said on stderr with each one's reason; 0 otherwise."""
+    crashed = [case for case in summary["cases"] if case["status"] == CRASHED]
+    if not crashed:
+        return 0
+    which = "; ".join(
+        f"{case['case']}: {case['reason'] or 'no reason recorded'}" for case in crashed
+    )
+    print(
+        f"robotale: {len(crashed)} of {summary['runs']} run(s) crashed ({which}).",
+        file=sys.stderr,
+    )
+    return 1
 
 
 def stop_experiment(world: World, plans_for, simulate, target: Path, out: TextIO) -> int:

@@ -2,7 +2,9 @@
 and aggregation into Class graphs. Every query is a file in ``cypher/``.
 
 ``build_ekg(driver, log, name, ...)`` stores a canonical event log; ``connect()`` returns a
-driver for the configured server; ``aggregate(driver, name, key)`` (re)builds a Class graph.
+driver for the configured server; ``aggregate(driver, name, key)`` (re)builds a Class graph;
+``run_spec(driver, name, read_spec(path))`` runs an aggregation specification, ``undo`` takes
+steps back and ``level_graph`` reads a level (docs/aggregate.md).
 """
 
 import importlib
@@ -13,6 +15,11 @@ _EXPORTS = {
     "BuildSummary": "robotale.ekg.build",
     "connect": "robotale.ekg.connection",
     "aggregate": "robotale.ekg.aggregate",
+    "read_spec": "robotale.ekg.spec",
+    "parse_spec": "robotale.ekg.spec",
+    "run_spec": "robotale.ekg.steps",
+    "undo": "robotale.ekg.steps",
+    "level_graph": "robotale.ekg.steps",
     "delete_log": "robotale.ekg.logs",
     "list_logs": "robotale.ekg.logs",
     "log_summary": "robotale.ekg.logs",

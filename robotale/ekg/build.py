@@ -16,6 +16,7 @@ import time
 import uuid
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import NoReturn
 
 import numpy as np
 import pandas as pd
@@ -29,7 +30,8 @@ from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
 from robotale.ekg.load import Loader, neo4j_values, within_batches
-from robotale.ekg.logs import delete_log, log_exists, log_run
+from robotale.ekg.logs import FAILED, delete_log, log_exists, log_info, log_run
+from robotale.ekg.objects import write_objects
 from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import (
     ClassTables,
@@ -38,9 +40,11 @@ from robotale.ekg.tables import (
     entity_types,
     graph_tables,
     log_values,
+    property_name,
 )
 from robotale.ekg.writelock import log_write_lock
-from robotale.errors import InputError, ServerError
+from robotale.errors import InputError, LogNotFound, ServerError
+from robotale.eventlog.objects import Objects
 
 
 @dataclass(frozen=True)
@@ -57,6 +61,26 @@ class BuildSummary:
     seconds: float = 0.0
 
 
+def _exists_message(driver: Driver, name: str) -> str:
+    """Why a log of that name is in the way, and the commands that clear it: a failed
+    ingest's partial log is named as such."""
+    delete = f"`robotale logs delete {shlex.quote(name)}`"
+    try:
+        info = log_info(driver, name)
+    except LogNotFound:  # events without their Log node: what a very early failure leaves
+        info = {"status": FAILED, "events": None}
+    if info["status"] == FAILED:
+        events = f" ({info['events']:,} events)" if info.get("events") is not None else ""
+        return (
+            f"The log {name!r} in Neo4j is what a failed ingest left{events}: remove it with "
+            f"{delete}, or ingest again with --replace to rebuild it."
+        )
+    return (
+        f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
+        f"or {delete} first."
+    )
+
+
 def build_ekg(
     driver: Driver,
     log: pd.DataFrame,
@@ -66,6 +90,7 @@ def build_ekg(
     replace: bool = False,
     source: str = "",
     progress: bool = True,
+    objects: Objects | None = None,
 ) -> BuildSummary:
     """Store ``log`` (a canonical event log) in Neo4j as the EKG named ``name``.
 
@@ -73,10 +98,13 @@ def build_ekg(
     entity type; default: ``robot`` and ``msg_id`` where present, else ``case``). Each item
     of ``aggregate`` is one aggregation key (``"activity"``, ``"activity,robot"``) that gets
     Class nodes and DF_C edges. An existing log of that name is refused unless ``replace``.
+    ``objects``: the objects of an object-centric log (their attributes, qualifiers and
+    relations, :mod:`robotale.ekg.objects`), written with the log and undone with it.
     """
     started = time.perf_counter()
     check_log_name(name)
-    tables = graph_tables(log, default_entities(log.columns) if entities is None else entities)
+    chosen = default_entities(log.columns) if entities is None else list(entities)
+    tables = graph_tables(log, chosen)
     keys = unique_keys(aggregate)
     check_keys(tables.events, keys)
     check_key_sizes(tables, keys)
@@ -86,12 +114,10 @@ def build_ekg(
     with log_write_lock(driver, name, "ingesting") as run:
         existing = log_exists(driver, name)
         if existing and not replace:
-            raise InputError(
-                f"A log named {name!r} already exists in Neo4j; use --replace to rebuild it "
-                f"or `robotale logs delete {name}` first."
-            )
+            raise InputError(_exists_message(driver, name))
         target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
-        summary = _write_or_undo(driver, _Job(tables, classes, target, source, progress, run))
+        job = _Job(tables, classes, target, source, progress, run, objects, chosen)
+        summary = _write_or_undo(driver, job)
         if existing:
             _swap(driver, target, name)
         # under the lock: no other build of this name can come between the graph and its copy
@@ -159,6 +185,8 @@ class _Job:
     source: str
     progress: bool
     run: str  # the id of this run's write lock, recorded on the Log node
+    objects: Objects | None = None
+    entity_types: Sequence[str] = ()
 
 
 def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
@@ -174,20 +202,30 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
                 "runs again, `robotale logs list` shows the log as failed and "
                 f"`robotale logs delete {shlex.quote(target)}` removes it."
             ) from error
-        try:
-            _undo(driver, target, job.run)
-        except (Neo4jError, DriverError, OSError):
-            raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({why(error)}) and what was "
-                "written could not be removed; remove it with "
-                f"`robotale logs delete {shlex.quote(target)}`."
-            ) from error
-        if isinstance(error, Neo4jError | DriverError | OSError):
-            raise ServerError(
-                f"Writing the log {target!r} to Neo4j failed ({why(error)}); nothing of it "
-                "was kept."
-            ) from error
-        raise
+        undo_after_failure(
+            error,
+            lambda: _undo(driver, target, job.run),
+            f"Writing the log {target!r} to Neo4j failed",
+            f"`robotale logs delete {shlex.quote(target)}`",
+        )
+
+
+def undo_after_failure(
+    error: BaseException, undo: Callable[[], None], failed: str, remover: str
+) -> NoReturn:
+    """Remove what a failed write wrote (``undo``) and raise: a :class:`ServerError` saying
+    so (``failed``: what failed; ``remover``: the command that removes what is left if
+    ``undo`` fails too) for a server's error, else ``error`` itself (e.g. Ctrl-C)."""
+    try:
+        undo()
+    except (Neo4jError, DriverError, OSError):
+        raise ServerError(
+            f"{failed} ({why(error)}) and what was written could not be removed; remove it "
+            f"with {remover}."
+        ) from error
+    if isinstance(error, Neo4jError | DriverError | OSError):
+        raise ServerError(f"{failed} ({why(error)}); nothing of it was kept.") from error
+    raise error
 
 
 def _answers(driver: Driver) -> bool:
@@ -236,6 +274,8 @@ def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> Bu
         class_nodes = write_graph(loader, tables, job.classes, new_log=True)
         for classes, nodes in zip(job.classes, class_nodes, strict=True):
             write_df_c(loader, classes, nodes)
+        if job.objects is not None:
+            write_objects(loader, job.objects, [property_name(t) for t in job.entity_types])
     for classes in job.classes:
         driver.execute_query(
             cypher("ekg_log_add_class_type"), log=target, type=classes.type, database_=database()
@@ -279,7 +319,7 @@ def write_graph(
     """Entities and classes, then events with their CORR, OBSERVED, DF and COMM edges, then
     the DF and COMM edges between batches, and BEGINS edges. ``new_log``: nothing of the
     log is stored yet (an append finds the entities and BEGINS edges the log has). Returns
-    the node ids of each key's classes, by class row."""
+    the element ids of each key's classes, by class row."""
     entity_nodes = _write_entities(loader, tables.entities, new_log)
     class_nodes = [_write_classes(loader, c) for c in classes]
     per_event = _per_event(tables.corr, entity_nodes, len(tables.events))
@@ -315,7 +355,7 @@ def write_graph(
 
 
 def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:
-    """The DF_C edges computed in ``classes`` (``nodes``: the classes' node ids)."""
+    """The DF_C edges computed in ``classes`` (``nodes``: the classes' element ids)."""
     df_c = classes.df_c
     if df_c.empty:
         return
@@ -335,7 +375,7 @@ def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:
 def _write_entities(loader: Loader, entities: pd.DataFrame, new_log: bool) -> np.ndarray:
     # CREATE rather than MERGE where the log has no entity yet: no index lookup per entity
     query = "ekg_create_entities" if new_log else "ekg_merge_entities"
-    nodes = np.zeros(len(entities), dtype=np.int64)
+    nodes = np.empty(len(entities), dtype=object)
     for entity_type, part in entities.groupby("type", sort=False):
         created = loader.run(query, {"ids": part["id"].tolist()}, type=entity_type)
         nodes[part.index.to_numpy()] = created
@@ -352,7 +392,7 @@ def _write_classes(loader: Loader, classes: ClassTables) -> np.ndarray:
         type=classes.type,
         key=classes.key,
     )
-    return np.asarray(created, dtype=np.int64)
+    return np.asarray(created, dtype=object)
 
 
 def _write_begins(
@@ -374,8 +414,8 @@ def _write_begins(
     )
 
 
-def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> list[list[int]]:
-    """The entity node ids of each event, as one list per event."""
+def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> list[list[str]]:
+    """The entity element ids of each event, as one list per event."""
     ordered = corr.sort_values("event", kind="stable")
     nodes = entity_nodes[ordered["entity"].to_numpy()].tolist()
     bounds = np.searchsorted(ordered["event"].to_numpy(), np.arange(events + 1)).tolist()
@@ -384,8 +424,8 @@ def _per_event(corr: pd.DataFrame, entity_nodes: np.ndarray, events: int) -> lis
 
 def _observed(
     classes: Sequence[ClassTables], class_nodes: Sequence[np.ndarray], events: int
-) -> list[list[int]]:
-    """The class node ids of each event (one per key), as one list per event."""
+) -> list[list[str]]:
+    """The class element ids of each event (one per key), as one list per event."""
     if not classes:
         return [[] for _ in range(events)]
     columns = [nodes[c.observed] for c, nodes in zip(classes, class_nodes, strict=True)]

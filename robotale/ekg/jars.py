@@ -1,5 +1,7 @@
-"""The Neo4j server's jars: pinned in ``neo4j_jars.lock``, fetched from Maven Central.
+"""The Neo4j server's jars: pinned per release in a lock file, fetched from Maven Central.
 
+:data:`RELEASES` are the Neo4j releases robotale runs: 5.26 LTS (the default, pinned in
+``neo4j_jars.lock``) and the newest release Maven Central serves (its own lock file).
 :func:`ensure_jars` makes ``cache_dir()/neo4j-<version>/lib`` hold exactly the locked jars.
 Each jar is downloaded with urllib, checked against its sha1 and moved into place atomically;
 a file lock lets several processes (parallel test runs, two terminals) provision at once. Once
@@ -28,8 +30,6 @@ from robotale.config import cache_dir
 from robotale.errors import ServerError
 from robotale.files import atomic_file
 
-NEO4J_VERSION = "5.26.30"
-BROWSER_VERSION = "5.24.0"
 LOCK_FILE = Path(__file__).with_name("neo4j_jars.lock")
 #: plugins (APOC) pinned for tests and benchmarks; a user's own plugins need no pin
 PLUGIN_LOCK_FILE = Path(__file__).with_name("plugin_jars.lock")
@@ -37,6 +37,56 @@ PLUGIN_LOCK_FILE = Path(__file__).with_name("plugin_jars.lock")
 DEFAULT_REPOSITORY = "https://repo1.maven.org/maven2"
 _MARKER = ".complete"
 _ATTEMPTS = 3
+
+
+@dataclass(frozen=True)
+class Release:
+    """One Neo4j release robotale can run: its jars' lock file and the Java it needs."""
+
+    version: str
+    browser: str
+    #: the Java feature versions it runs on, lowest and highest
+    java: tuple[int, int]
+    lock: Path
+    #: the class whose main method runs the server
+    entry_point: str = "org.neo4j.server.CommunityEntryPoint"
+
+    @property
+    def line(self) -> str:
+        """The release line ``--version`` names it by: ``5.26``, ``2026.08``."""
+        return ".".join(self.version.split(".")[:2])
+
+
+#: the releases ``robotale neo4j start --version`` offers, by line; the first is the default
+RELEASES = {
+    release.line: release
+    for release in (
+        Release("5.26.30", "5.24.0", (17, 21), LOCK_FILE),
+        Release(
+            "2026.08.1",
+            "5.24.0",
+            (21, 25),
+            Path(__file__).with_name("neo4j_2026_jars.lock"),
+            "org.neo4j.server.Neo4jCommunity",
+        ),
+    )
+}
+DEFAULT_RELEASE = next(iter(RELEASES.values()))
+NEO4J_VERSION = DEFAULT_RELEASE.version
+BROWSER_VERSION = DEFAULT_RELEASE.browser
+#: the environment variable that chooses the release where no ``--version`` is given
+VERSION_ENV = "ROBOTALE_NEO4J_VERSION"
+
+
+def release(name: str | None = None) -> Release:
+    """The release ``name`` names (a line such as ``2026.08`` or a full version); None: the
+    one :data:`VERSION_ENV` names, else the default."""
+    name = (name or os.environ.get(VERSION_ENV) or DEFAULT_RELEASE.line).strip()
+    for candidate in RELEASES.values():
+        if name in (candidate.line, candidate.version):
+            return candidate
+    offered = ", ".join(f"{r.line} ({r.version})" for r in RELEASES.values())
+    raise ServerError(f"robotale runs no Neo4j {name!r}; it runs {offered}.")
 
 
 @dataclass(frozen=True)
@@ -76,19 +126,24 @@ def read_lock(lock: Path = LOCK_FILE) -> list[Jar]:
     return jars
 
 
-def server_dir() -> Path:
-    """Where this Neo4j version's jars live, shared by every robotale home."""
-    return cache_dir() / f"neo4j-{NEO4J_VERSION}"
+def server_dir(version: str = NEO4J_VERSION) -> Path:
+    """Where a Neo4j version's jars live, shared by every robotale home."""
+    return cache_dir() / f"neo4j-{version}"
 
 
 def ensure_jars(
-    lib: Path | None = None, repository: str | None = None, lock: Path = LOCK_FILE
+    lib: Path | None = None,
+    repository: str | None = None,
+    lock: Path | None = None,
+    release: Release = DEFAULT_RELEASE,
 ) -> Path:
-    """Download whatever jar of ``lock`` is missing from ``lib``; returns ``lib``.
+    """Download whatever jar of ``lock`` (default: ``release``'s) is missing from ``lib``
+    (default: ``release``'s folder of :func:`server_dir`); returns ``lib``.
 
     Raises :class:`ServerError` naming the jar when a download fails or its sha1 differs.
     """
-    lib = lib or server_dir() / "lib"
+    lock = lock or release.lock
+    lib = lib or server_dir(release.version) / "lib"
     jars = read_lock(lock)
     marker = lib / _MARKER
     fingerprint = hashlib.sha1(lock.read_bytes()).hexdigest()
@@ -100,7 +155,8 @@ def ensure_jars(
             return lib
         missing = [jar for jar in jars if not _is_in_place(lib / jar.filename, jar)]
         if missing:
-            _download_all(missing, lib, repository or _repository())
+            what = f"Neo4j {release.version} jars"
+            _download_all(missing, lib, repository or _repository(), what)
         _remove_strays(lib, {jar.filename for jar in jars})
         marker.write_text(fingerprint)
     return lib
@@ -166,9 +222,7 @@ def _file_lock(path: Path) -> Iterator[None]:
             fcntl.flock(handle, fcntl.LOCK_UN)
 
 
-def _download_all(
-    jars: list[Jar], lib: Path, repository: str, what: str = f"Neo4j {NEO4J_VERSION} jars"
-) -> None:
+def _download_all(jars: list[Jar], lib: Path, repository: str, what: str) -> None:
     total = sum(jar.size for jar in jars)
     with (
         tqdm(

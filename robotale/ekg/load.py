@@ -3,8 +3,9 @@
 Each batch is one ``UNWIND`` query from ``cypher/`` run in a managed transaction (retried on
 transient errors), or, for an append, all of them in the one transaction the caller gives.
 Values travel as columns (one list per property) rather than one map per row: that is much
-less to encode. Nodes are created first and their internal ids returned, so each edge finds
-its two ends directly instead of through an index.
+less to encode. Nodes are created first and their element ids returned, so each edge finds
+its two ends directly instead of through an index (``elementId``, which every Neo4j release
+keeps, rather than the deprecated ``id``).
 """
 
 from __future__ import annotations
@@ -55,18 +56,18 @@ class Loader:
         maps: Mapping[str, Mapping[str, Sequence[Any]]] | None = None,
         batches: Mapping[str, Sequence[Any]] | None = None,
         **constants: Any,
-    ) -> list[int]:
+    ) -> list[str]:
         """Run ``cypher/<query>.cypher`` once per batch of ``columns``.
 
         ``maps`` are parameters that are maps of columns ({key: [values]}); they are cut into
         the same batches. ``batches`` are parameters given whole for each batch: item k of
-        each goes with batch k. Returns the node ids of the queries' ``nodes`` results in
+        each goes with batch k. Returns the element ids of the queries' ``nodes`` results in
         row order.
         """
         text = cypher(query)
         size = len(next(iter(columns.values())))
 
-        def write(start: int) -> list[int]:
+        def write(start: int) -> list[str]:
             self.between_batches()
             params = {name: _slice(values, start) for name, values in columns.items()}
             for name, columns_of_map in (maps or {}).items():
@@ -93,18 +94,18 @@ class Loader:
     def events(
         self,
         events: pd.DataFrame,
-        entities: list[list[int]],
-        classes: list[list[int]],
+        entities: list[list[str]],
+        classes: list[list[str]],
         df: pd.DataFrame,
         comm: pd.DataFrame,
         first: int = 0,
     ) -> np.ndarray:
         """Create the events with their CORR and OBSERVED edges (``entities``, ``classes``:
-        node ids per event) and the rows of ``df`` and ``comm`` (event positions) that lie
+        element ids per event) and the rows of ``df`` and ``comm`` (event positions) that lie
         within one batch (:func:`within_batches`); ``first`` is the first event's position
         in the stored log.
 
-        Returns the events' node ids by row.
+        Returns the events' element ids by row.
         """
         times = events["timestamp"]
         nanos = times.dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
@@ -130,7 +131,7 @@ class Loader:
             batches,
             timezone=timezone_name(times),
         )
-        return np.asarray(nodes, dtype=np.int64)
+        return np.asarray(nodes, dtype=object)
 
 
 def within_batches(edges: pd.DataFrame) -> np.ndarray:
@@ -158,16 +159,16 @@ def _per_batch(edges: pd.DataFrame, count: int, **properties: str) -> list[dict[
     return parts
 
 
-def _in_flight(write: Callable[[int], list[int]], starts: range) -> list[int]:
+def _in_flight(write: Callable[[int], list[str]], starts: range) -> list[str]:
     """``write`` for each start, :data:`WORKERS` at a time, results in order.
 
     Neo4j runs each transaction on one core; with two in flight it uses two. Batches that
     collide on a node are retried by the driver's managed transactions. Nothing new starts
     once one batch has failed.
     """
-    nodes: list[int] = []
+    nodes: list[str] = []
     with ThreadPoolExecutor(max_workers=WORKERS) as pool:
-        running: deque[Future[list[int]]] = deque()
+        running: deque[Future[list[str]]] = deque()
         for start in starts:
             running.append(pool.submit(write, start))
             if len(running) == WORKERS:

@@ -1,6 +1,7 @@
-"""Regenerate ``neo4j_jars.lock``, the pinned jar set of the local Neo4j server.
+"""Regenerate the lock file of a Neo4j release, the pinned jar set of the local Neo4j server.
 
-A maintainer's tool (it needs Maven): ``python -m robotale.ekg.neo4j_lock``. Maven resolves the
+A maintainer's tool (it needs Maven): ``python -m robotale.ekg.neo4j_lock [LINE]`` (a release
+line of :data:`~robotale.ekg.jars.RELEASES`, e.g. ``2026.08``; default 5.26). Maven resolves the
 runtime closure of the Neo4j Community server, its HTTP module and Neo4j Browser; the lock
 records each jar's Maven coordinates, sha1 and size, so users download exactly these files from
 Maven Central without Maven (see :mod:`robotale.ekg.jars`).
@@ -14,7 +15,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from robotale.ekg.jars import BROWSER_VERSION, LOCK_FILE, NEO4J_VERSION, Jar
+from robotale.ekg.jars import Jar, Release, release
 
 _SCOPES = {"compile", "runtime", "provided", "system", "test"}
 _POM = """<project xmlns="http://maven.apache.org/POM/4.0.0">
@@ -33,11 +34,11 @@ _POM = """<project xmlns="http://maven.apache.org/POM/4.0.0">
 """
 
 
-def resolve_with_maven() -> list[tuple[Jar, Path]]:
+def resolve_with_maven(chosen: Release) -> list[tuple[Jar, Path]]:
     """Every runtime jar Maven resolves for the server, with its file in the local repository."""
     with tempfile.TemporaryDirectory() as work:
         pom = Path(work) / "pom.xml"
-        pom.write_text(_POM.format(neo4j=NEO4J_VERSION, browser=BROWSER_VERSION))
+        pom.write_text(_POM.format(neo4j=chosen.version, browser=chosen.browser))
         listing = Path(work) / "deps.txt"
         subprocess.run(
             [
@@ -71,20 +72,22 @@ def _parse_listing_line(line: str) -> tuple[Jar, Path]:
     return Jar(group, artifact, version, classifier, digest, file.stat().st_size), file
 
 
-def write_lock(jars: list[Jar], lock: Path = LOCK_FILE) -> None:
+def write_lock(jars: list[Jar], chosen: Release) -> None:
     lines = [
-        f"# Neo4j {NEO4J_VERSION} Community server with Neo4j Browser {BROWSER_VERSION}:",
+        f"# Neo4j {chosen.version} Community server with Neo4j Browser {chosen.browser}:",
         "# the runtime jars, fetched from Maven Central and checked against these sha1 sums.",
-        "# Regenerate with `python -m robotale.ekg.neo4j_lock` (needs Maven).",
+        f"# Regenerate with `python -m robotale.ekg.neo4j_lock {chosen.line}` (needs Maven).",
         *sorted(jar.lock_line() for jar in jars),
     ]
-    lock.write_text("\n".join(lines) + "\n")
+    chosen.lock.write_text("\n".join(lines) + "\n")
 
 
-def main() -> int:
-    jars = [jar for jar, _ in resolve_with_maven()]
-    write_lock(jars)
-    print(f"{LOCK_FILE}: {len(jars)} jars, {sum(j.size for j in jars) / 1e6:.0f} MB")
+def main(argv: list[str] | None = None) -> int:
+    args = sys.argv[1:] if argv is None else argv
+    chosen = release(args[0] if args else None)
+    jars = [jar for jar, _ in resolve_with_maven(chosen)]
+    write_lock(jars, chosen)
+    print(f"{chosen.lock}: {len(jars)} jars, {sum(j.size for j in jars) / 1e6:.0f} MB")
     return 0
 
 

@@ -11,7 +11,7 @@ from importlib.resources import files
 #: one piece of Cypher text: a quoted string or name, a comment, a ``;``, or other code
 _PIECE = re.compile(
     r"""(?P<quoted>'(?:\\.?|[^'\\])*(?:'|$)|"(?:\\.?|[^"\\])*(?:"|$)|`[^`]*(?:`|$))
-      | (?P<comment>//[^\n]*|/\*.*?(?:\*/|$))
+      | (?P<comment>//[^\n\r]*|/\*.*?(?:\*/|$))
       | (?P<end>;)
       | (?P<code>[^'"`/;]+|/)""",
     re.VERBOSE | re.DOTALL,

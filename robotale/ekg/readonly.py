@@ -8,17 +8,19 @@ covers, checked in this order:
    functions that are not Neo4j's own (a plugin's: APOC's ``apoc.cypher.runFirstColumn``
    would run a ``LOAD CSV`` given to it as a string) are refused, as are integers Neo4j
    cannot hold.
-2. The plan (``EXPLAIN``, which runs nothing): every operator must work on robotale's database,
-   read no file, administer nothing, and call only the procedures of
-   :data:`ALLOWED_PROCEDURES`.
+2. The plan (``EXPLAIN``, which runs nothing): Neo4j's own reading of the query decides
+   (:mod:`robotale.ekg.plan_check`): every operator must read robotale's database and call
+   only allowed procedures and functions, however the text spelled them. The text check
+   before it is a fast first filter, never the only one.
 3. The transaction: opened in READ access mode with a timeout and without retries, so Neo4j
    refuses every write and a runaway query ends once.
 4. The answer: at most ``rows`` rows and ``bytes`` bytes of JSON are kept; the rest is counted
    up to :data:`COUNTED` rows. Every value becomes valid JSON (:func:`cell`).
 
-``python -m robotale.ekg.readonly <megabytes>`` runs one request read from stdin as JSON in a
-process whose memory is capped, so that a single enormous value (``RETURN range(1, 1e8)``)
-costs that process, not the dashboard.
+``python -m robotale.ekg.readonly <megabytes>`` answers requests (a JSON line each on stdin)
+in a process whose memory is capped, so that a single enormous value (``RETURN range(1, 1e8)``)
+costs that process, not the dashboard; the dashboard keeps a few such workers
+(:mod:`robotale.webapp.console_pool`).
 """
 
 from __future__ import annotations
@@ -39,22 +41,18 @@ from neo4j.graph import Node, Path, Relationship
 
 from robotale.ekg.connection import Settings, connect, unreachable_message
 from robotale.ekg.connection import database as default_database
-from robotale.ekg.queries import code_only, dotted_calls, split_statements
+from robotale.ekg.plan_check import (
+    ALLOWED_PROCEDURES,
+    QueryRefused,
+    WriteRefused,
+    check_plan,
+)
+from robotale.ekg.plan_check import ONLY_READS as _ONLY_READS
+from robotale.ekg.queries import code_only, cypher, dotted_calls, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
 
-#: procedures the console may call: they describe the graph and the server, and change nothing
-ALLOWED_PROCEDURES = frozenset(
-    {
-        "db.labels",
-        "db.relationshipTypes",
-        "db.propertyKeys",
-        "db.schema.visualization",
-        "db.schema.nodeTypeProperties",
-        "db.schema.relTypeProperties",
-        "dbms.components",
-        "dbms.showCurrentUser",
-    }
-)
+__all__ = ["ALLOWED_PROCEDURES", "QueryRefused", "WriteRefused", "run_read_only"]
+
 #: the namespaces of Neo4j's own functions (``duration.between``, ``point.distance``); a dotted
 #: function of any other namespace is a plugin's, and the console calls none
 BUILT_IN_FUNCTION_NAMESPACES = frozenset(
@@ -68,7 +66,6 @@ _EXACT_IN_JSON = 2**53 - 1
 _INT64 = (-(2**63), 2**63 - 1)
 _ACCESS_MODE = "Neo.ClientError.Statement.AccessMode"
 _TIMED_OUT = ("TransactionTimedOut", "TransactionTimedOutClientConfiguration")
-_ONLY_READS = "The console only reads the graph"
 
 _LOAD_CSV = re.compile(r"\bLOAD\s+CSV\b", re.IGNORECASE)
 _IN_TRANSACTIONS = re.compile(r"\bIN\s+(?:\d+\s+)?(?:CONCURRENT\s+)?TRANSACTIONS\b", re.I)
@@ -87,15 +84,6 @@ _ADMIN_OBJECT = re.compile(
 )
 _USE = re.compile(r"(?:^|\{)\s*USE\b", re.IGNORECASE)
 _LEADING_MODE = re.compile(r"^\s*(?:EXPLAIN|PROFILE)\b", re.IGNORECASE)
-_PROCEDURE_NAME = re.compile(r"\s*([\w.]+)\s*\(")
-
-
-class QueryRefused(InputError):
-    """The console does not run this query (it would do more than read the graph)."""
-
-
-class WriteRefused(QueryRefused):
-    """The query would change the graph."""
 
 
 @dataclass(frozen=True)
@@ -184,40 +172,26 @@ def _check_integers(name: str, value: Any) -> None:
 
 def refuse_plan(session: neo4j.Session, statement: str, parameters: dict, database: str) -> None:
     """Ask Neo4j for the plan of ``statement`` (nothing runs) and refuse what it would do
-    beyond reading ``database``."""
+    beyond reading ``database`` (:func:`robotale.ekg.plan_check.check_plan`)."""
     code = code_only(statement)
     leading = _LEADING_MODE.match(code)
     body = statement[leading.end() :] if leading else statement
     summary = session.run("EXPLAIN " + body, parameters).consume()
-    for operator, details in _operators(summary.plan or {}):
-        _check_operator(operator, details, database)
+    server = summary.server
+    check_plan(summary.plan or {}, database, built_in_functions(session, server.address))
 
 
-def _operators(plan: Mapping[str, Any]) -> list[tuple[str, str]]:
-    found = [(str(plan.get("operatorType", "")), str(plan.get("args", {}).get("Details", "")))]
-    for child in plan.get("children", []):
-        found += _operators(child)
-    return found
+def built_in_functions(session: neo4j.Session, server: object) -> frozenset[str]:
+    """The names of Neo4j's built-in functions, as ``server`` lists them (asked once per
+    process and server: the list changes only with the server's version)."""
+    address = str(server)
+    if address not in _BUILT_IN:
+        records = session.run(cypher("console_built_in_functions")).values()
+        _BUILT_IN[address] = frozenset(str(name) for (name,) in records)
+    return _BUILT_IN[address]
 
 
-def _check_operator(operator: str, details: str, database: str) -> None:
-    name, _, where = operator.partition("@")
-    if where and where != database:
-        raise QueryRefused(f"{_ONLY_READS} of robotale's database ({database}).")
-    if name == "LoadCSV":
-        raise QueryRefused(f"{_ONLY_READS}: LOAD CSV (reading files and URLs) is refused.")
-    if name.startswith(("Show", "Terminate", "Administration", "System")):
-        raise QueryRefused(f"{_ONLY_READS}: administration commands are refused.")
-    if name.startswith("Transaction"):
-        raise WriteRefused(f"{_ONLY_READS}: CALL {{ ... }} IN TRANSACTIONS is refused.")
-    if "Procedure" in name:
-        match = _PROCEDURE_NAME.match(details)
-        procedure = match.group(1) if match else details
-        if procedure not in ALLOWED_PROCEDURES:
-            allowed = ", ".join(sorted(ALLOWED_PROCEDURES))
-            raise QueryRefused(
-                f"{_ONLY_READS}: the procedure {procedure} is not one it calls ({allowed})."
-            )
+_BUILT_IN: dict[str, frozenset[str]] = {}
 
 
 # -- running --------------------------------------------------------------------------------
@@ -231,8 +205,10 @@ def run_read_only(
     timeout: float = Limits.timeout,
     byte_limit: int = Limits.bytes,
     database: str | None = None,
+    metadata: Mapping[str, Any] | None = None,
 ) -> list[StatementResult]:
-    """Run each statement of ``text`` (separated by ``;``) in its own read transaction.
+    """Run each statement of ``text`` (separated by ``;``) in its own read transaction,
+    which carries ``metadata`` (``SHOW TRANSACTIONS`` finds it by that).
 
     Every statement is checked (text, then plan) before the first one runs. Raises
     :class:`QueryRefused` (:class:`WriteRefused` for writes) for what the console does not
@@ -250,7 +226,7 @@ def run_read_only(
         try:
             for statement in statements:
                 refuse_plan(session, statement, values, database)
-            return [_run(session, statement, values, limits) for statement in statements]
+            return [_run(session, statement, values, limits, metadata) for statement in statements]
         except (ServiceUnavailable, SessionExpired):
             raise
         except (Neo4jError, DriverError) as error:
@@ -258,11 +234,15 @@ def run_read_only(
 
 
 def _run(
-    session: neo4j.Session, statement: str, parameters: dict, limits: Limits
+    session: neo4j.Session,
+    statement: str,
+    parameters: dict,
+    limits: Limits,
+    metadata: Mapping[str, Any] | None = None,
 ) -> StatementResult:
     # An explicit transaction: the driver retries none of it (a query that exhausted the
-    # server's memory once fails once).
-    with session.begin_transaction(timeout=limits.timeout) as tx:
+    # server's memory once fails once). The timeout is the transaction's, kept by Neo4j.
+    with session.begin_transaction(timeout=limits.timeout, metadata=dict(metadata or {})) as tx:
         result = tx.run(statement, parameters)
         columns = list(result.keys())
         rows: list[list[Any]] = []
@@ -359,39 +339,57 @@ def _path_elements(path: Path) -> list[Node | Relationship]:
 # -- the capped process ---------------------------------------------------------------------
 
 
-def answer(request: Mapping[str, Any]) -> dict[str, Any]:
+#: the transaction metadata key that names a console request (the watchdog looks for it)
+REQUEST_KEY = "robotale_console"
+
+
+def answer(request: Mapping[str, Any], drivers: dict[tuple[str, str, str], Driver]) -> dict:
     """Run one console request (connection, text, parameters, limits) and say how it went:
-    ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``."""
+    ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``. ``drivers`` keeps
+    one connected driver per server and user across requests."""
     where = Settings(request["uri"], request["user"], request["password"], True)
+    key = (where.uri, where.user, where.password)
     try:
-        with connect(where) as driver:
-            results = run_read_only(
-                driver,
-                request["text"],
-                request.get("parameters"),
-                row_limit=request["rows"],
-                timeout=request["timeout"],
-                byte_limit=request["bytes"],
-                database=request["database"],
-            )
+        if key not in drivers:
+            drivers[key] = connect(where)
+        results = run_read_only(
+            drivers[key],
+            request["text"],
+            request.get("parameters"),
+            row_limit=request["rows"],
+            timeout=request["timeout"],
+            byte_limit=request["bytes"],
+            database=request["database"],
+            metadata={REQUEST_KEY: request.get("id", "")},
+        )
     except RobotaleError as error:
         return {"error": str(error), "kind": type(error).__name__}
     except (ServiceUnavailable, SessionExpired):
+        drivers.pop(key).close()
         return {"error": unreachable_message(where), "kind": ServerError.__name__}
     return {"results": [result.to_dict() for result in results]}
 
 
-def _main(megabytes: int) -> None:
-    request = json.loads(sys.stdin.read())
+def serve(megabytes: int) -> None:
+    """Answer requests, one JSON line each on stdin, with one JSON line each on stdout, in a
+    process whose memory may grow by ``megabytes``; end at the end of stdin, or after a
+    request that ran out of memory (what it left behind is not worth keeping)."""
     # The cap is on top of what Python and the driver already map (their size varies).
     limit = _mapped_bytes() + megabytes * 1024 * 1024
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-    try:
-        reply = answer(request)
-    except MemoryError:
-        reply = {"error": "memory", "kind": "MemoryError"}
-    # allow_nan=False: a value cell() let through as NaN would be invalid JSON; fail loudly.
-    sys.stdout.write(json.dumps(reply, allow_nan=False))
+    drivers: dict[tuple[str, str, str], Driver] = {}
+    sys.stdout.write("ready\n")  # the pool counts a request's time from here on
+    sys.stdout.flush()
+    for line in sys.stdin:
+        try:
+            reply = answer(json.loads(line), drivers)
+        except MemoryError:
+            reply = {"error": "memory", "kind": "MemoryError"}
+        # allow_nan=False: a value cell() let through as NaN would be invalid JSON; fail loudly.
+        sys.stdout.write(json.dumps(reply, allow_nan=False) + "\n")
+        sys.stdout.flush()
+        if reply.get("kind") == "MemoryError":
+            return
 
 
 def _mapped_bytes() -> int:
@@ -403,4 +401,4 @@ def _mapped_bytes() -> int:
 
 
 if __name__ == "__main__":
-    _main(int(sys.argv[1]))
+    serve(int(sys.argv[1]))

@@ -33,7 +33,16 @@ from neo4j import Driver, GraphDatabase
 from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.config import robotale_home
-from robotale.ekg.jars import ensure_jars
+from robotale.ekg.jars import (
+    DEFAULT_RELEASE,
+    RELEASES,
+    VERSION_ENV,
+    Release,
+    ensure_jars,
+    release,
+)
+from robotale.ekg.java import find_java
+from robotale.ekg.plan_check import ALLOWED_FUNCTIONS
 from robotale.ekg.port_holder import port_holder
 from robotale.ekg.queries import statements
 from robotale.ekg.server_config import (
@@ -55,7 +64,8 @@ DEFAULT_BOLT_PORT = 7687
 DEFAULT_HTTP_PORT = 7474
 # How long `start` waits for the ports of a server that crashed or was just stopped.
 PORT_WAIT = 60.0
-ENTRY_POINT = "org.neo4j.server.CommunityEntryPoint"
+#: the classes that run a server, one per release (a running server is known by its own)
+ENTRY_POINTS = frozenset(release.entry_point for release in RELEASES.values())
 _ADMIN_TOOL = "org.neo4j.cli.AdminTool"
 # The JVM options of Neo4j's own launcher (we start java directly, so we pass them ourselves).
 _JVM_OPTIONS = (
@@ -86,6 +96,8 @@ class ServerOptions:
     pagecache: str = "512m"
     #: the folder of plugin jars; None: the robotale home's ``plugins/`` when it exists
     plugins: Path | None = None
+    #: the Neo4j release: a line of :data:`robotale.ekg.jars.RELEASES` or a full version
+    version: str = DEFAULT_RELEASE.line
 
     @classmethod
     def from_env(cls) -> ServerOptions:
@@ -97,6 +109,7 @@ class ServerOptions:
             heap=env.get("ROBOTALE_NEO4J_HEAP", cls.heap),
             pagecache=env.get("ROBOTALE_NEO4J_PAGECACHE", cls.pagecache),
             plugins=Path(plugins).expanduser() if plugins else None,
+            version=env.get(VERSION_ENV) or cls.version,
         )
 
 
@@ -143,6 +156,8 @@ class LocalServer:
         self.state_file = self.home / "server.json"
         self.ports_file = self.home / "ports.json"
         self.password_file = self.home / "password"
+        #: the Neo4j version that created ``data/``: another one is not started on it
+        self.version_file = self.home / "version"
         self.log_file = self.home / "logs" / "neo4j.log"
         self.console_file = self.home / "logs" / "console.log"
 
@@ -249,15 +264,17 @@ class LocalServer:
         if plugins is not None:
             check_plugins(plugins)
         overlay = read_overlay(self.overlay_file, progress)
-        java = java_executable()
-        lib = ensure_jars()
+        chosen = release(options.version)
+        self._require_data_of(chosen)
+        java = java_executable(chosen)
+        lib = ensure_jars(release=chosen)
         self._write_config(options, overlay)
         self._ensure_password(java, lib)
         # Plugins' extensions (APOC's configuration, for one) are found through the class
         # path, not the plugins folder. The server's jars come first: plugins bundle older
         # copies of libraries the server needs (APOC's commons-lang3 breaks its settings).
         classpath = f"{lib}/*:{plugins}/*" if plugins else f"{lib}/*"
-        process = self._launch(java, classpath, options, overlay.jvm_options)
+        process = self._launch(java, classpath, options, chosen, overlay.jvm_options)
         state = RunningServer(process.pid, options.bolt_port, options.http_port)
         write_file(self.state_file, json.dumps(asdict(state)))
         self._record(state, stopped=False)
@@ -341,6 +358,28 @@ class LocalServer:
         else:  # one removed from the home must not linger
             target.unlink(missing_ok=True)
 
+    def data_version(self) -> str | None:
+        """The Neo4j version that wrote this home's data (None: not recorded)."""
+        return self.version_file.read_text().strip() if self.version_file.is_file() else None
+
+    def _require_data_of(self, chosen: Release) -> None:
+        """Refuse to start ``chosen`` on data another Neo4j version wrote (an older release
+        cannot read a newer store, and a newer one would upgrade it for good); record the
+        version of a home without data."""
+        data = self.home / "data"
+        written_by = self.data_version()
+        if not data.is_dir() or not any(data.iterdir()):
+            self.home.mkdir(parents=True, exist_ok=True)
+            write_file(self.version_file, chosen.version)
+            return
+        written_by = written_by or DEFAULT_RELEASE.version  # homes from before the choice
+        if written_by != chosen.version:
+            raise ServerError(
+                f"The Neo4j data in {data} was written by Neo4j {written_by}, not "
+                f"{chosen.version}: start it with --version {written_by}, or move that folder "
+                f"away to start Neo4j {chosen.version} with an empty database."
+            )
+
     def _ensure_password(self, java: str, lib: Path) -> None:
         auth_store = self.home / "data" / "dbms" / "auth.ini"
         password = self.password()
@@ -369,7 +408,12 @@ class LocalServer:
             raise ServerError(f"Could not set the Neo4j password: {result.stderr.strip()}")
 
     def _launch(
-        self, java: str, classpath: str, options: ServerOptions, jvm_options: tuple[str, ...] = ()
+        self,
+        java: str,
+        classpath: str,
+        options: ServerOptions,
+        chosen: Release,
+        jvm_options: tuple[str, ...] = (),
     ) -> subprocess.Popen:
         command = [
             java,
@@ -379,7 +423,7 @@ class LocalServer:
             *jvm_options,
             "-cp",
             classpath,
-            ENTRY_POINT,
+            chosen.entry_point,
             f"--home-dir={self.home}",
             f"--config-dir={self.home / 'conf'}",
         ]
@@ -445,15 +489,10 @@ def _http_answers(state: RunningServer) -> bool:
         return False
 
 
-def java_executable() -> str:
-    java_home = os.environ.get("JAVA_HOME")
-    java = str(Path(java_home) / "bin" / "java") if java_home else shutil.which("java")
-    if not java or not Path(java).is_file():
-        raise ServerError(
-            "Neo4j 5.26 needs Java 17 and no `java` was found: install it (Debian: "
-            "openjdk-17-jre-headless) or set JAVA_HOME, or set NEO4J_URI to use another server."
-        )
-    return java
+def java_executable(chosen: Release = DEFAULT_RELEASE) -> str:
+    """The Java that runs the release ``chosen`` (see :mod:`robotale.ekg.java`)."""
+    lowest, highest = chosen.java
+    return str(find_java(lowest, highest, f"Neo4j {chosen.version}").executable)
 
 
 def _is_free(port: int) -> bool:
@@ -533,7 +572,8 @@ def _is_our_process(pid: int, home: Path) -> bool:
         cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().split(b"\0")
     except OSError:
         return False
-    return f"--home-dir={home}".encode() in cmdline and ENTRY_POINT.encode() in cmdline
+    ours = any(entry.encode() in cmdline for entry in ENTRY_POINTS)
+    return f"--home-dir={home}".encode() in cmdline and ours
 
 
 def _reap(pid: int) -> bool:
@@ -593,6 +633,9 @@ def security_settings(heap: str) -> dict[str, str]:
         # LOAD CSV may not read files (the console also refuses the clause before sending it).
         "dbms.security.allow_csv_import_from_file_urls": "false",
         "server.directories.import": "import",
+        # No plugin's procedures or functions load unless the overlay names them: the
+        # console's queries then cannot reach them whatever their spelling.
+        "dbms.security.procedures.allowlist": ",".join(sorted(ALLOWED_FUNCTIONS)),
     }
     limit = _share_of(heap, _TRANSACTION_SHARE)
     if limit is not None:

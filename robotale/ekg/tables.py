@@ -94,6 +94,12 @@ def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> 
     events = event_table(log, first)
     types = entity_types([property_name(c) for c in log.columns], entities)
     corr_ids = _correlations(events, types)
+    if len(events) and corr_ids.empty:
+        raise InputError(
+            f"None of the log's {len(events)} events has a value in its entity column(s) "
+            f"{', '.join(types)}, so no entity and no DF edge would be built; name the columns "
+            "that identify what the events belong to with --entities (e.g. --entities case)."
+        )
     entity_table = corr_ids[["type", "id"]].drop_duplicates().reset_index(drop=True)
     position = pd.MultiIndex.from_frame(entity_table).get_indexer(
         pd.MultiIndex.from_frame(corr_ids[["type", "id"]])
@@ -296,9 +302,9 @@ def class_tables(tables: GraphTables, key: Sequence[str]) -> ClassTables:
 
     A class's id joins its key values with ``|`` (``move|tractor_1``, a missing value as
     nothing), as the Cypher aggregation of a stored log names them. The seconds of a DF edge
-    are those between the two events' times in whole milliseconds, as Neo4j's
-    ``epochMillis`` gives them; DF_C's median interpolates between the middle two, as
-    ``percentileCont(x, 0.5)`` does.
+    are those between the two events' times to the nanosecond, whole seconds and the
+    nanoseconds apart added as the Cypher of a stored log adds them; DF_C's median
+    interpolates between the middle two, as ``percentileCont(x, 0.5)`` does.
     """
     events = tables.events
     codes, ids = pd.factorize(_class_ids(events, key))
@@ -333,21 +339,21 @@ def _neo4j_text(values: pd.Series) -> pd.Series:
     return text.astype("string").fillna("")
 
 
-def _milliseconds(events: pd.DataFrame) -> np.ndarray:
+def _seconds_between(events: pd.DataFrame, source: np.ndarray, target: np.ndarray) -> np.ndarray:
     nanos = events["timestamp"].dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
-    return nanos // 1_000_000
+    seconds, part = np.divmod(nanos, 1_000_000_000)
+    return (seconds[target] - seconds[source]) + (part[target] - part[source]) / 1e9
 
 
 def _df_c(tables: GraphTables, codes: np.ndarray) -> pd.DataFrame:
     df = tables.df
-    millis = _milliseconds(tables.events)
     source, target = df["source"].to_numpy(), df["target"].to_numpy()
     edges = pd.DataFrame(
         {
             "source": codes[source],
             "target": codes[target],
             "entityType": df["entityType"].to_numpy(),
-            "seconds": (millis[target] - millis[source]) / 1000.0,
+            "seconds": _seconds_between(tables.events, source, target),
         }
     )
     grouped = edges.groupby(["source", "target", "entityType"], sort=True)["seconds"]

@@ -21,7 +21,7 @@ TALE enrichment then treats as it treats tags:
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -60,6 +60,8 @@ class Event:
     lifecycle: str
     index: int
     execution: str | None = None
+    #: made by the end of the recording rather than by a message (the last state's end)
+    at_end: bool = False
 
 
 def action_of(topic: str) -> tuple[str, str]:
@@ -114,7 +116,8 @@ def state_events(
             events.append(Event(time, value, schema.START, index))
         current = value
     if current:
-        events.append(Event(max(end, events[-1].time), current, schema.COMPLETE, events[-1].index))
+        last = events[-1]
+        events.append(Event(max(end, last.time), current, schema.COMPLETE, last.index, None, True))
     return events
 
 
@@ -175,24 +178,79 @@ def rows(events: Sequence[Event], case: str, robot: str, topic: str) -> pd.DataF
             schema.EXECUTION_ID: [e.execution for e in events],
             SOURCE_TOPIC: topic,
             SOURCE_INDEX: np.array([e.index for e in events], dtype=np.int64),
+            AT_END: np.array([e.at_end for e in events], dtype=bool),
         },
-        columns=COLUMNS,
+        columns=[*COLUMNS, AT_END],
     )
 
 
-def implicit(tags: pd.DataFrame, ends: dict[str, pd.Timestamp]) -> pd.DataFrame:
+#: a helper column of :func:`rows`: the event was made by the end of the recording
+AT_END = "_at_end"
+#: the position of a row in the order of :func:`in_order` (a helper column, dropped at the end)
+SEQUENCE = "_sequence"
+
+
+def in_order(parts: Sequence[pd.DataFrame], recorded: Mapping[str, np.ndarray]) -> pd.DataFrame:
+    """The rows of ``parts`` as one table in the order of events of a run, numbered by
+    :data:`SEQUENCE`.
+
+    Events are ordered by time. At equal times the recording decides: the event of the
+    message the bag recorded first comes first (``recorded``: topic -> each message's
+    recording time), an event the end of the recording makes after every message's; the
+    events one message gives keep the order they were made in, so an activity's start comes
+    before its own completion. :func:`implicit` places the
+    completions it adds by the same rule.
+    """
+    if not parts:
+        return pd.DataFrame(columns=[*COLUMNS, SEQUENCE])
+    when, rank = [], []
+    for k, part in enumerate(parts):
+        at = part[SOURCE_INDEX].to_numpy(np.int64)
+        mine = np.zeros(len(part), dtype=np.int64)
+        topics = part[SOURCE_TOPIC].to_numpy(object)
+        for topic in pd.unique(topics):
+            chosen = topics == topic
+            mine[chosen] = np.asarray(recorded[topic], dtype=np.int64)[at[chosen]]
+        if AT_END in part:
+            mine[part[AT_END].to_numpy(bool)] = np.iinfo(np.int64).max
+        when.append(mine)
+        rank.append(np.full(len(part), k))
+    rows = pd.concat(parts, ignore_index=True)
+    rows = rows.drop(columns=[AT_END]) if AT_END in rows else rows
+    times = rows[schema.TIMESTAMP].to_numpy("datetime64[ns]").view(np.int64)
+    order = np.lexsort((np.concatenate(rank), np.concatenate(when), times), axis=0)
+    if (order != np.arange(len(order))).any():
+        rows = rows.take(order).reset_index(drop=True)
+    return rows.assign(**{SEQUENCE: np.arange(len(rows), dtype=float)})
+
+
+def implicit(
+    rows: pd.DataFrame, ends: Mapping[str, pd.Timestamp], topics: Iterable[str] | None = None
+) -> pd.DataFrame:
     """Tags whose activities end when the robot's next one starts.
 
-    Every tag that is not a ``complete`` (or another outcome) starts an activity; one that its
-    robot does not complete before its next tag is completed at that tag's time, the robot's last
-    at the end of its run (``ends``: case -> time). The added completes keep their start's
-    source.
+    ``rows`` are in the order of :func:`in_order`; only those of ``topics`` (default: all)
+    are tags. Every tag that is not a ``complete`` (or another outcome) starts an activity;
+    one that its robot does not complete with its next tag is completed at that tag's time,
+    just before it (so after its own start even at the same instant), the robot's last at
+    the end of its run (``ends``: case -> time) or at its start if that is later. The added
+    completes keep their start's source.
     """
-    closing = {schema.COMPLETE, schema.ABORTED, schema.CANCELLED}
-    tags = tags.sort_values([schema.CASE, schema.ROBOT, schema.TIMESTAMP], kind="stable")
-    tags = tags.assign(**{schema.LIFECYCLE: tags[schema.LIFECYCLE].where(
-        tags[schema.LIFECYCLE].isin(closing), schema.START
-    )})  # fmt: skip
+    closing = schema.ENDINGS
+    if SEQUENCE not in rows:
+        rows = rows.assign(**{SEQUENCE: np.arange(len(rows), dtype=float)})
+    chosen = set(topics) if topics is not None else None
+    is_tag = (
+        rows[SOURCE_TOPIC].isin(chosen).to_numpy(bool)
+        if chosen is not None
+        else np.ones(len(rows), bool)
+    )
+    lifecycle = rows[schema.LIFECYCLE].where(
+        ~is_tag | rows[schema.LIFECYCLE].isin(closing), schema.START
+    )
+    rows = rows.assign(**{schema.LIFECYCLE: lifecycle})
+    tags = rows[is_tag].sort_values([schema.CASE, schema.ROBOT, SEQUENCE], kind="stable")
+    last = float(len(rows))
     added = []
     for (case, _), group in tags.groupby([schema.CASE, schema.ROBOT], sort=False):
         records = group.to_dict("records")
@@ -206,16 +264,17 @@ def implicit(tags: pd.DataFrame, ends: dict[str, pd.Timestamp]) -> pd.DataFrame:
             ):
                 continue
             close = dict(tag, **{schema.LIFECYCLE: schema.COMPLETE})
-            close[schema.TIMESTAMP] = after[schema.TIMESTAMP] if after else ends[case]
+            if after is not None:
+                close[schema.TIMESTAMP] = after[schema.TIMESTAMP]
+                close[SEQUENCE] = after[SEQUENCE] - 0.5
+            else:
+                close[schema.TIMESTAMP] = max(ends[case], tag[schema.TIMESTAMP])
+                close[SEQUENCE] = last + len(added)
             for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
                 close.pop(column, None)
-            added.append((tag, close))
-    return _with_closes(tags, added)
-
-
-def _with_closes(tags: pd.DataFrame, added: list[tuple[dict, dict]]) -> pd.DataFrame:
-    """``tags`` in time order, each added complete before any tag at its time (it ends the
-    previous activity that a tag at the same time follows)."""
-    closes = pd.DataFrame([close for _, close in added], columns=tags.columns)
-    merged = pd.concat([closes, tags], ignore_index=True) if len(closes) else tags
-    return merged.sort_values([schema.CASE, schema.TIMESTAMP], kind="stable", ignore_index=True)
+            added.append(close)
+    closes = pd.DataFrame(added, columns=rows.columns)
+    merged = pd.concat([rows, closes], ignore_index=True) if len(closes) else rows
+    return merged.sort_values(
+        [schema.CASE, schema.TIMESTAMP, SEQUENCE], kind="stable", ignore_index=True
+    )

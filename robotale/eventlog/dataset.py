@@ -9,8 +9,9 @@ The layout is Hive's, which pyarrow, pandas, DuckDB, Spark and Polars read as on
 
 The files hold the log's columns under their short CSV names (``time``, ``activity`` ...)
 except ``case``, which the folder names. Every part has the same column types (those of the
-canonical log: text as strings, ``time`` as UTC microseconds, numbers as doubles), so a
-reader never has to reconcile them.
+canonical log: text as strings, ``time`` as UTC nanoseconds, numbers as doubles), so a
+reader never has to reconcile them. Datasets written before times kept nanoseconds hold UTC
+microseconds; they are read as they are.
 
 Each part is written whole by whoever prepared its run (a Dask worker writes its own); the
 process that asked writes the manifest last. Until then the folder holds
@@ -40,7 +41,9 @@ FORMAT = "robotale event log, partitioned by case"
 PART = "part-0.parquet"
 CASE_KEY = "case"
 
-_TIME = pa.timestamp("us", tz="UTC")
+_TIME = pa.timestamp("ns", tz="UTC")
+#: the time of datasets written when the log held microseconds (still read)
+_TIME_US = pa.timestamp("us", tz="UTC")
 #: the types of the canonical columns; other columns are numbers or text, as their values are
 _KNOWN_TYPES: dict[str, pa.DataType] = {
     **{schema.CSV_NAMES[c]: pa.string() for c in schema.CSV_NAMES},
@@ -90,7 +93,7 @@ def part_table(log: pd.DataFrame) -> pa.Table:
 
 def _array(values: pd.Series, kind: pa.DataType) -> pa.Array:
     if kind == _TIME:
-        return pa.array(values.dt.tz_convert("UTC").dt.floor("us"), type=_TIME)
+        return pa.array(values.dt.tz_convert("UTC").dt.as_unit("ns"), type=_TIME)
     if kind == pa.string():
         present = values.notna().to_numpy()
         text = np.where(present, values.astype(str).to_numpy(object), None)
@@ -214,7 +217,7 @@ def read_manifest(dataset: Place) -> Mapping | None:
 
 
 #: the types a manifest names, by the name pyarrow gives them
-_TYPES = {str(kind): kind for kind in (pa.string(), pa.float64(), pa.bool_(), _TIME)}
+_TYPES = {str(kind): kind for kind in (pa.string(), pa.float64(), pa.bool_(), _TIME, _TIME_US)}
 
 
 def arrow_schema(manifest: Mapping, text: str) -> pa.Schema:

@@ -30,7 +30,7 @@ KEYS = [CASE, ROBOT]
 #: the order of events that share a timestamp: tags as recorded, then inprogress rows.
 _ORDER = "_order"
 #: lifecycles that end an activity: its completion, or an outcome such as an aborted goal
-_CLOSING = frozenset({schema.COMPLETE, schema.ABORTED, schema.CANCELLED})
+_CLOSING = schema.ENDINGS
 
 
 class PreparationWarning(UserWarning):

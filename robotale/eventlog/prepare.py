@@ -42,12 +42,15 @@ from robotale.eventlog.enrich import (
     robots_without_samples,
 )
 from robotale.eventlog.rosbag import (
+    RECORDED,
     TIME,
     Bag,
     check_distro,
     is_bag,
     message_types,
     namespace,
+    storage_files,
+    without_metadata,
 )
 from robotale.eventlog.sources import Sources
 from robotale.executors import open_executor, parse_executor, worker_lost
@@ -99,7 +102,7 @@ _TAG_COLUMNS = {
     "msg_role": schema.MSG_ROLE,
     "payload": schema.MSG_PAYLOAD,
 }
-_LIFECYCLES = {schema.START, schema.COMPLETE, schema.NONE, schema.ABORTED, schema.CANCELLED}
+_LIFECYCLES = {schema.START, schema.NONE, *schema.ENDINGS}
 #: how tags say when an activity ends: their lifecycle field (``explicit``), the robot's next
 #: tag (``implicit``), or not at all: each tag one event (``events``)
 LIFECYCLE_MODES = ("explicit", "implicit", "events")
@@ -116,6 +119,8 @@ class _Reading:
     auto: bool
     perspectives: Sequence[Perspective]
     bag_time: bool
+    #: the robot of activities on topics without a namespace (None: the bag says)
+    robot: str | None = None
 
 
 @dataclass(frozen=True)
@@ -134,6 +139,7 @@ def prepare(
     progress: bool = False,
     report: Callable[[str], None] | None = None,
     executor: str | None = None,
+    skip_bad: Callable[[Path, str], None] | None = None,
     **options: Any,
 ) -> pd.DataFrame:
     """The multi-perspective event log of a rosbag2 directory or of a folder of them.
@@ -150,23 +156,34 @@ def prepare(
     ``<action>/_action/status`` topics), ``states`` (``GLOB[:FIELD]`` state topics) and
     ``bt_logs`` (a glob of behaviour-tree logs); ``auto`` adds whatever of those each bag
     holds and tells ``report`` what it chose. ``distro`` names the ROS 2 distribution whose
-    standard types fill in those a bag does not define.
+    standard types fill in those a bag does not define. ``robot`` names the robot of tags and
+    activities on topics without a namespace (else the bag's only namespace, else ``robot``,
+    with a warning).
 
     ``executor`` (``local[:N]``, ``dask://HOST:PORT``; see :mod:`robotale.executors`) reads
     the runs in parallel, each run on its own (no reading crosses runs), with the same log as
     reading them here one after the other.
+
+    ``skip_bad`` hears of each run that cannot be read (the run, why), which is then left
+    out; without it such a run stops the preparation.
     """
     job = preparation(**options)
     reading, msg_files, distro, rate = job.reading, job.msg_files, job.distro, job.rate
     chosen = list(reading.perspectives)
     runs = find_runs(Path(source))
+    if executor is not None and skip_bad is not None:
+        raise InputError("Skipping bad runs reads them in this process: leave out --executor.")
     if executor is not None:
         told: set[tuple[str, ...]] = set()
         parts = _read_in_parallel(
             runs, reading, msg_files, distro, executor, progress, _once(report, told)
         )
     else:
-        parts = _read_here(runs, reading, msg_files, distro, progress, report)
+        parts = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
+        runs = [run for run, part in zip(runs, parts, strict=True) if part is not None]
+        parts = [part for part in parts if part is not None]
+        if not parts:
+            raise InputError(f"None of the runs of {source} could be read.")
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
     if tag_rows.empty:
         raise InputError(_nothing_found(source, reading))
@@ -194,6 +211,7 @@ def preparation(
     bt_logs: str | None = None,
     auto: bool = False,
     distro: str | None = None,
+    robot: str | None = None,
 ) -> Job:
     """The options of :func:`prepare` and :func:`prepare_dataset`, checked: what every bag is
     read for and how its events are enriched."""
@@ -203,7 +221,12 @@ def preparation(
     if rate < 0:
         raise InputError(f"The inprogress rate must be 0 or more per second, not {rate}.")
     sources = Sources(actions, tuple(states), bt_logs)
-    reading = _Reading(tags, tag_fields or TagFields(), lifecycle, sources, auto, chosen, bag_time)
+    if robot is not None and not robot.strip():
+        raise InputError("--robot names the robot of topics without a namespace: give a name.")
+    reading = _Reading(
+        tags, tag_fields or TagFields(), lifecycle, sources, auto, chosen, bag_time,
+        robot and robot.strip(),
+    )  # fmt: skip
     return Job(reading, tuple(Path(p).resolve() for p in msg_files), check_distro(distro), rate)
 
 
@@ -214,8 +237,10 @@ def _read_here(
     distro: str,
     progress: bool,
     report: Callable[[str], None] | None,
-) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
-    """Every run read in this process, with a progress bar over their messages."""
+    skip_bad: Callable[[Path, str], None] | None = None,
+) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None]:
+    """Every run read in this process, with a progress bar over their messages; None for a
+    run that could not be read when ``skip_bad`` was told of it."""
     extra_types = message_types([Path(p) for p in msg_files])
     globs = [reading.tags, *(glob for p in reading.perspectives for glob in p.topic.split("|"))]
     with tqdm(
@@ -226,10 +251,18 @@ def _read_here(
         leave=False,
     ) as bar:
         told: set[tuple[str, ...]] = set()
-        return [
-            _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
-            for run in runs
-        ]
+        read = []
+        for run in runs:
+            try:
+                read.append(
+                    _read_run(Bag(run, extra_types, distro), reading, bar, _once(report, told))
+                )
+            except InputError as error:
+                if skip_bad is None:
+                    raise
+                skip_bad(run, str(error))
+                read.append(None)
+        return read
 
 
 def _read_in_parallel(
@@ -426,13 +459,9 @@ def find_runs(source: Path) -> list[Path]:
     if not source.is_dir():
         raise InputError(f"{source} is not a rosbag2 directory (a folder with metadata.yaml).")
     children = sorted(child for child in source.iterdir() if child.is_dir())
-    for child in children:
-        storage = [*child.glob("*.db3"), *child.glob("*.mcap")]
-        if storage and not is_bag(child):
-            raise InputError(
-                f"{child} has {storage[0].name} but no metadata.yaml, so it is not a complete "
-                "rosbag2 directory (was the recording interrupted?)."
-            )
+    for child in [source, *children]:
+        if storage_files(child) and not is_bag(child):
+            raise InputError(without_metadata(child))
     runs = [child for child in children if is_bag(child)]
     if not runs:
         raise InputError(
@@ -469,15 +498,18 @@ def _read_run(
         for p in reading.perspectives:
             for topic in sample_topics[p.name]:
                 columns[topic] = {**columns.get(topic, {}), **p.columns}
-        tables = bag.tables(columns, bag_time=reading.bag_time, progress=bar)
+        tables = bag.tables(columns, bag_time=reading.bag_time, recorded=True, progress=bar)
+        recorded = {topic: table.pop(RECORDED).to_numpy() for topic, table in tables.items()}
         tables = {topic: sources.numbered(table) for topic, table in tables.items()}
         end = pd.Timestamp(max(bag.reader.end_time - 1, 0), unit="ns", tz="UTC")
         _warn_foreign(bag, columns)
-        parts = [_tag_rows(tables[t], t, run, reading, bag.topics[t]) for t in tag_topics]
-        if reading.lifecycle == "implicit" and parts:
-            parts = [activities.implicit(pd.concat(parts, ignore_index=True), {run.name: end})]
-        parts += sources.activity_rows(bag, tables, chosen, run.name, end)
-    tag_rows = pd.concat(parts, ignore_index=True)
+        robot_of = _robots(bag, reading)
+        parts = [_tag_rows(tables[t], t, run, reading, robot_of) for t in tag_topics]
+        parts += sources.activity_rows(bag, tables, chosen, run.name, end, robot_of)
+    tag_rows = activities.in_order(parts, recorded)
+    if reading.lifecycle == "implicit" and tag_topics:
+        tag_rows = activities.implicit(tag_rows, {run.name: end}, tag_topics)
+    tag_rows = tag_rows.drop(columns=activities.SEQUENCE)
     robots = sorted(set(tag_rows[schema.ROBOT]))
     samples = {
         p.name: _samples(run, [(t, tables[t]) for t in sample_topics[p.name]], p, robots)
@@ -498,9 +530,20 @@ def _sources(bag: Bag, reading: _Reading, report: Callable[[str], None]) -> Sour
     )
     tags = [t for t, n in bag.reader.topics.items() if fnmatchcase(t, reading.tags) and n.msgcount]
     said = [f"--tags {reading.tags}"] if tags else []
+    unread = [
+        f"{t} ({kind})" for t, kind in bag.topics.items() if kind not in bag.typestore.fielddefs
+    ]
+    more = ", ..." if len(unread) > 3 else ""
+    skipped = (
+        f" ({len(unread)} topic(s) not looked into, their types having no definition: "
+        f"{', '.join(unread[:3])}{more}; give them with --msg)"
+        if unread
+        else ""
+    )
     report(
         f"{bag.name}: activities from "
         + (", ".join(said + chosen.describe()) or "nothing (no tags, actions, states or BT logs)")
+        + skipped
     )
     return chosen
 
@@ -519,12 +562,28 @@ def _once(report: Callable[[str], None] | None, told: set) -> Callable[[str], No
 
 
 def _nothing_found(source: Path | str, reading: _Reading) -> str:
+    """Why no activity came out, from what the bags hold (their metadata's counts)."""
+    counts: dict[str, int] = {}
+    for run in find_runs(Path(source)):
+        for topic, count in _message_counts(run, [reading.tags]).items():
+            counts[topic] = counts.get(topic, 0) + count
+    tags = sum(counts.values())
+    if tags:
+        held = (
+            f"its topics matching {reading.tags!r} hold {tags} message(s) whose activity field "
+            f"({reading.tag_fields.activity!r}) is empty; name the field that holds the activity "
+            "with --tag-field activity=FIELD"
+        )
+    elif counts:
+        held = f"its topics matching {reading.tags!r} ({', '.join(sorted(counts))}) hold no message"
+    else:
+        held = f"no topic matches {reading.tags!r} (name the tag topics with --tags)"
     if reading.sources or reading.auto:
         return (
-            f"{source} has no activities: neither its tags ({reading.tags!r}) nor its action, "
-            "state or behaviour-tree topics hold any."
+            f"{source} has no activities: {held}, and its action, state and behaviour-tree "
+            "topics asked for hold none (with --auto, what it looked into is said above)."
         )
-    return f"{source} has no tags: its topics matching {reading.tags!r} hold no messages."
+    return f"{source} has no tags: {held}."
 
 
 def _warn_foreign(bag: Bag, columns: Mapping[str, Mapping[str, str]]) -> None:
@@ -565,26 +624,53 @@ def _tag_columns(bag: Bag, topic: str, tag_fields: TagFields) -> dict[str, str]:
     return columns
 
 
+def _robots(bag: Bag, reading: _Reading) -> Callable[[str], str]:
+    """The robot of a topic's tags and activities: its namespace; for a topic without one,
+    ``--robot``, else the bag's only namespace, else :data:`DEFAULT_ROBOT`, said once per
+    topic as a warning (a wrong robot would silently split or merge robots)."""
+    spaces = sorted({namespace(t).split("/")[0] for t in bag.topics} - {""})
+    told: set[str] = set()
+
+    def robot_of(topic: str) -> str:
+        found = namespace(topic)
+        if found:
+            return found
+        if reading.robot:
+            return reading.robot
+        robot, why = (
+            (spaces[0], "the only namespace of its topics")
+            if len(spaces) == 1
+            else (DEFAULT_ROBOT, "the bag's topics have no namespace" if not spaces else
+                  f"the bag's topics have {len(spaces)} namespaces")
+        )  # fmt: skip
+        if topic not in told:
+            told.add(topic)
+            warnings.warn(
+                f"{bag.path}: {topic} ({bag.topics[topic]}) has no namespace, so its "
+                f"activities are of robot {robot!r} ({why}); name the robot with --robot NAME.",
+                PreparationWarning,
+                stacklevel=2,
+            )
+        return robot
+
+    return robot_of
+
+
 def _tag_rows(
-    table: pd.DataFrame, topic: str, run: Path, reading: _Reading, msgtype: str
+    table: pd.DataFrame,
+    topic: str,
+    run: Path,
+    reading: _Reading,
+    robot_of: Callable[[str], str],
 ) -> pd.DataFrame:
     rows = table.rename(columns={TIME: schema.TIMESTAMP, sources.INDEX: schema.SOURCE_INDEX})
     rows.insert(0, schema.CASE, run.name)
     rows[schema.SOURCE_TOPIC] = topic
     rows = _without_empty_activities(rows, topic, run, reading.tag_fields)
     rows[schema.LIFECYCLE] = _lifecycles(rows, topic, run, reading.lifecycle)
-    fallback = namespace(topic)
     robot = rows[schema.ROBOT].astype(str).str.strip() if schema.ROBOT in rows else None
     defaulted = robot is None or (robot == "").any()
-    if not fallback and defaulted and len(rows):
-        fallback = DEFAULT_ROBOT
-        warnings.warn(
-            f"{run}: tags on {topic} ({msgtype}) name no robot and the topic has no namespace, "
-            f"so their robot is {DEFAULT_ROBOT!r}; name the field holding it with --tag-field "
-            "robot=FIELD, or record the tags as /<robot>/tag.",
-            PreparationWarning,
-            stacklevel=4,
-        )
+    fallback = robot_of(topic) if defaulted and len(rows) else namespace(topic)
     rows[schema.ROBOT] = fallback if robot is None else robot.replace("", fallback)
     for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
         if column in rows:
@@ -628,7 +714,7 @@ def _lifecycles(rows: pd.DataFrame, topic: str, run: Path, mode: str | None) -> 
         at = rows.loc[bad, schema.TIMESTAMP].iloc[0].isoformat()
         raise InputError(
             f"{run}: a tag on {topic} at {at} has lifecycle {given[bad].iloc[0]!r}; "
-            "expected start, complete or none (or an outcome: aborted, cancelled)."
+            "expected start, complete or none (or an outcome: aborted, cancelled, ate_abort)."
         )
     return lifecycles
 
@@ -723,8 +809,8 @@ def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.Dat
     for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
         if column not in log:
             log[column] = None
-    # the written formats hold microseconds; the log should equal what is written
-    log[schema.TIMESTAMP] = log[schema.TIMESTAMP].dt.floor("us")
+    # nanoseconds, as the bag records them (every written format but XES keeps them)
+    log[schema.TIMESTAMP] = log[schema.TIMESTAMP].dt.as_unit("ns")
     position = log.groupby(schema.CASE, sort=False).cumcount().astype(str)
     log[schema.EVENT_ID] = log[schema.CASE].astype(str) + ":" + position
     known = [c for c in schema.CSV_NAMES if c in log]
@@ -733,17 +819,22 @@ def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.Dat
 
 def _message_count(run: Path, globs: Sequence[str]) -> int:
     """How many messages of a bag the preparation reads, from its metadata alone."""
+    return sum(_message_counts(run, globs).values())
+
+
+def _message_counts(run: Path, globs: Sequence[str]) -> dict[str, int]:
+    """The message count of each topic of a bag matching ``globs``, from its metadata."""
     try:
         text = (run / "metadata.yaml").read_text(encoding="utf-8")
         meta = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
         topics = meta["rosbag2_bagfile_information"]["topics_with_message_count"]
-        return sum(
-            int(t["message_count"])
+        return {
+            str(t["topic_metadata"]["name"]): int(t["message_count"])
             for t in topics
             if any(fnmatchcase(t["topic_metadata"]["name"], g) for g in globs)
-        )
+        }
     except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError):
-        return 0  # the bag's own reader explains what is wrong with it
+        return {}  # the bag's own reader explains what is wrong with it
 
 
 __all__ = [

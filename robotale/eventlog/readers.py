@@ -19,6 +19,7 @@ one, the line.
 from __future__ import annotations
 
 import csv
+import dataclasses
 import io
 import warnings
 from collections.abc import Mapping, Sequence
@@ -33,8 +34,10 @@ import pyarrow.parquet as pq
 from lxml import etree
 
 from robotale.errors import InputError
-from robotale.eventlog import dataset, reading, schema
+from robotale.eventlog import dataset, ocel, reading, schema
 from robotale.eventlog.dataset import MANIFEST, WRITING
+from robotale.eventlog.objects import Objects, entity_cells, entity_columns
+from robotale.eventlog.oced import read_object_tables
 from robotale.eventlog.reading import SYNONYMS, TEXT_COLUMNS, Reading, column_mapping, listing
 from robotale.storage import place
 
@@ -77,12 +80,40 @@ def read_log_with_reading(
     ``attrs`` into some derived frames and not others, so a reading there would silently
     follow a filtered or merged log it no longer describes.
     """
+    return read_with_objects(path, mapping, case, case_gap)[:2]
+
+
+def read_with_objects(
+    path: str | Path,
+    mapping: Mapping[str, str] | None = None,
+    case: str | None = None,
+    case_gap: Gap = None,
+    objects: str | Path | None = None,
+) -> tuple[pd.DataFrame, Reading, Objects | None]:
+    """The log, how it was read, and its objects where it is object-centric: an OCEL 2.0
+    file (``.jsonocel``/``.json``, ``.xmlocel``/``.xml``, ``.sqlite``/``.db``), or a CSV log
+    whose ``objects`` folder holds one ``<Type>.csv`` per object type (:mod:`.oced`).
+
+    This is the one place that decides what kind of log a path is.
+    """
     path = Path(path)
+    if ocel.encoding(path):
+        if objects is not None:
+            raise InputError(
+                f"{path} is an OCEL 2.0 log, which lists its objects itself: --objects "
+                "belongs to a CSV log."
+            )
+        return _read_ocel(path, mapping, case, case_gap)
     if path.suffix.lower() == ".xes":
-        return _read_xes(path, mapping, case, case_gap)
-    if is_parquet(path):
-        return _read_parquet(path, mapping, case, case_gap)
-    return _read_csv(path, mapping, case, case_gap)
+        log, found = _read_xes(path, mapping, case, case_gap)
+    elif is_parquet(path):
+        log, found = _read_parquet(path, mapping, case, case_gap)
+    else:
+        types = [p.stem for p in Path(objects).glob("*.csv")] if objects is not None else []
+        log, found = _read_csv(path, mapping, case, case_gap, types)
+    if objects is None:
+        return log, found, None
+    return log, found, read_object_tables(Path(objects), log, path)
 
 
 def is_parquet(path: str | Path) -> bool:
@@ -115,14 +146,21 @@ def read_xes(
 
 
 def _read_csv(
-    path: Path, mapping: Mapping[str, str] | None, case: str | None, case_gap: Gap
+    path: Path,
+    mapping: Mapping[str, str] | None,
+    case: str | None,
+    case_gap: Gap,
+    objects: Sequence[str] = (),
 ) -> tuple[pd.DataFrame, Reading]:
+    """``objects``: object types whose columns hold ids, which stay text ("12", not 12.0)."""
     text = _read_text(path)
     header = _csv_header(path, text)
     renames = column_mapping(path, list(header), mapping)
     text_columns = [src for src, canonical in renames.items() if canonical in TEXT_COLUMNS]
     if case is not None:
         text_columns.append(case)
+    kinds = {reading.normalised(kind) for kind in objects}
+    text_columns += [name for name in header if reading.normalised(name) in kinds]
     table, missing = _csv_table(path, text, text_columns)
     lines = pd.Series(range(2, len(table) + 2), index=table.index)  # line 1 is the header
     return canonical_log(path, table, renames, lines, case, case_gap, missing)
@@ -133,8 +171,8 @@ def _csv_header(path: Path, text: str) -> list[str]:
     the second ``activity`` as ``activity.1``) or if the file is JSON (an OCEL log, say)."""
     if text.lstrip().startswith(("{", "[")):
         raise InputError(
-            f"{path} is JSON (an OCEL 2.0 log?), not a CSV or XES event log: give ingest a "
-            "CSV or XES file, or a folder of recordings."
+            f"{path} is JSON, not CSV: an OCEL 2.0 log is read as one when its name ends in "
+            ".jsonocel or .json."
         )
     try:
         names = next(csv.reader(io.StringIO(text), strict=True), [])
@@ -210,6 +248,45 @@ def _read_xes(
     table = table.infer_objects()  # an int column whose markers were text is numbers again
     renames = column_mapping(path, list(table.columns), mapping)
     return canonical_log(path, table, renames, lines, case, case_gap, missing, traces=True)
+
+
+# -- OCEL 2.0 --------------------------------------------------------------------------------
+
+_OCEL_COLUMNS = {
+    ocel.EVENT_ID: schema.EVENT_ID,
+    ocel.ACTIVITY: schema.ACTIVITY,
+    ocel.TIME: schema.TIMESTAMP,
+}
+
+
+def _read_ocel(
+    path: Path, mapping: Mapping[str, str] | None, case: str | None, case_gap: Gap
+) -> tuple[pd.DataFrame, Reading, Objects]:
+    """The events with one column per object type; the objects beside them. An OCEL log has
+    no cases: unless ``case`` or ``case_gap`` says otherwise it is one, and each object's
+    events follow one another over the whole log."""
+    found = ocel.read_ocel(path)
+    events = found.events
+    attributes = [c for c in events.columns if c not in _OCEL_COLUMNS]
+    columns = entity_columns(path, found.objects.types, attributes)
+    objects = dataclasses.replace(found.objects, columns=columns)
+    cells = entity_cells(events[ocel.EVENT_ID], objects)
+    table = events.assign(**cells)
+    renames = {
+        source: target
+        for source, target in column_mapping(path, attributes, mapping).items()
+        if target not in _OCEL_COLUMNS.values()
+    } | _OCEL_COLUMNS
+    lines = pd.Series(range(1, len(table) + 1), index=table.index)
+    log, how = canonical_log(path, table, renames, lines, case, case_gap)
+    how.columns.update(dict.fromkeys(objects.entity_types, "objects (entity type)"))
+    # OCEL's events are instants by the standard: no pairs is no finding
+    how.warnings = [w for w in how.warnings if w not in reading.no_pairs_warning(log)]
+    if case is None and case_gap is None:
+        how.case = "no case: an object-centric log, each object's events in one sequence"
+        how.warnings = [w for w in how.warnings if w not in reading.days_warning(path, log)]
+        how.session_gap = None
+    return log, how, objects
 
 
 # -- Parquet ---------------------------------------------------------------------------------
@@ -440,7 +517,9 @@ def parse_timestamps(path: Path, values: pd.Series, lines: pd.Series) -> pd.Seri
     else:
         text = values.astype("string").str.strip()
         parsed = _to_datetime(text)
-        bad = parsed.isna()
+        # pandas reads some text that is no time as year 0 ("/1"), which Python's dates and
+        # everything built on them cannot hold
+        bad = parsed.isna() | (parsed.dt.year < 1)
         if bad.any():
             row = bad.idxmax()
             shown = "" if pd.isna(text[row]) else text[row]
@@ -450,7 +529,8 @@ def parse_timestamps(path: Path, values: pd.Series, lines: pd.Series) -> pd.Seri
             )
     if parsed.dt.tz is None:
         parsed = parsed.dt.tz_localize("UTC")
-    return parsed
+    # one unit whatever the file gave (six decimals or nine): a log's times compare as read
+    return parsed.dt.as_unit("ns")
 
 
 def _to_datetime(text: pd.Series) -> pd.Series:

@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import contextlib
 import functools
-import re
 import struct
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -45,10 +44,21 @@ from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
 from robotale.eventlog.cdrlayout import Layout, columns
+from robotale.eventlog.interfaces import (
+    RELEASES,
+    definition_file,
+    message_types,
+    normalized,
+    shipped,
+    stored_types,
+)
 from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches, zstd
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
 
 TIME = "time"
+#: the column of a table holding when the bag recorded each message (ns since the epoch), when
+#: asked for: the recording's order of messages from different topics
+RECORDED = "_recorded"
 HEADER_TYPE = "std_msgs/msg/Header"
 TIME_TYPE = "builtin_interfaces/msg/Time"
 
@@ -61,82 +71,22 @@ def is_bag(path: Path) -> bool:
     return path.is_dir() and (path / "metadata.yaml").is_file()
 
 
-def message_types(paths: Sequence[Path]) -> dict:
-    """Type definitions from ``.msg`` / ``.idl`` / ``.action`` files, or folders holding them.
-
-    A ``.msg`` file's type is named by where it lives, as in a ROS package:
-    ``my_pkg/msg/Event.msg`` defines ``my_pkg/msg/Event``; ``my_pkg/action/Dock.action``
-    defines the types of the action's topics (:func:`action_types`).
-    """
-    typs: dict = {}
-    for path in paths:
-        files = (
-            [f for ext in ("msg", "idl", "action") for f in sorted(path.rglob(f"*.{ext}"))]
-            if path.is_dir()
-            else [path]
-        )
-        if not files:
-            raise InputError(f"{path} holds no .msg, .idl or .action files.")
-        for file in files:
-            typs.update(_types_from_file(file))
-    return typs
+def storage_files(path: Path) -> list[Path]:
+    """The rosbag2 storage files (``.db3``, ``.mcap``) directly in ``path``."""
+    return sorted([*path.glob("*.db3"), *path.glob("*.mcap")]) if path.is_dir() else []
 
 
-def _types_from_file(file: Path) -> dict:
-    if not file.is_file():
-        raise InputError(f"Message definition {file} does not exist.")
-    try:
-        text = file.read_text(encoding="utf-8")
-        if file.suffix == ".idl":
-            return get_types_from_idl(text)
-        if file.suffix == ".action" and file.parent.name == "action":
-            return action_types(text, file.parent.parent.name, file.stem)
-        if file.suffix != ".msg" or file.parent.name != "msg":
-            raise InputError(
-                f"Cannot tell the type name of {file}: put it at <package>/msg/<Type>.msg "
-                "(or <package>/action/<Action>.action)."
-            )
-        return get_types_from_msg(text, f"{file.parent.parent.name}/msg/{file.stem}")
-    except (TypesysError, UnicodeDecodeError) as error:
-        reason = " ".join(str(error).split())
-        raise InputError(f"Message definition {file} cannot be parsed: {reason}") from None
-
-
-def action_types(text: str, package: str, action: str) -> dict:
-    """The types of an action's ``.action`` file (goal, result and feedback, split by ``---``)
-    and of the feedback topic's message, which wraps the feedback with the goal's id, as
-    rosidl generates them: ``<package>/action/<action>_Goal`` ... ``_FeedbackMessage``.
-
-    rosbag2 stores no definition for these (its search for them knows ``msg`` and ``srv``
-    only), so a bag's action feedback is read with the action's own file.
-    """
-    parts = re.split(r"^---[ \t]*$", text, flags=re.MULTILINE)
-    if len(parts) != 3:
-        raise TypesysError(f"an action has a goal, a result and a feedback, not {len(parts)} parts")
-    prefix = f"{package}/action/{action}"
-    typs: dict = {}
-    for suffix, part in zip(("_Goal", "_Result", "_Feedback"), parts, strict=True):
-        typs.update(get_types_from_msg(part, prefix + suffix))
-    wrapper = f"unique_identifier_msgs/UUID goal_id\n{prefix}_Feedback feedback\n"
-    typs.update(get_types_from_msg(wrapper, f"{prefix}_FeedbackMessage"))
-    return {name: _in_msg_folder(spec, package, set(typs)) for name, spec in typs.items()}
-
-
-def _in_msg_folder(spec: tuple, package: str, own: set[str]) -> tuple:
-    """``spec`` with its references to types of the package that are not the action's own
-    (written without a package in the file, read as ``<package>/action/X``) made
-    ``<package>/msg/X``, where ROS looks for them."""
-
-    def moved(desc: tuple) -> tuple:
-        nodetype, detail = desc
-        if nodetype == _NAME and detail.startswith(f"{package}/action/") and detail not in own:
-            return nodetype, detail.replace("/action/", "/msg/", 1)
-        if nodetype in (_ARRAY, _SEQUENCE):
-            return nodetype, (moved(detail[0]), *detail[1:])
-        return desc
-
-    consts, fields = spec
-    return consts, [(name, moved(desc)) for name, desc in fields]
+def without_metadata(path: Path) -> str:
+    """Why a folder without ``metadata.yaml`` is not read, and what would make it a bag."""
+    storage = storage_files(path)
+    if not storage:
+        return f"{path} is not a rosbag2 directory (it has no metadata.yaml and no storage file)."
+    return (
+        f"{path} holds {storage[0].name}"
+        + (f" and {len(storage) - 1} more storage file(s)" if len(storage) > 1 else "")
+        + " but no metadata.yaml (was the recording interrupted?); `ros2 bag reindex "
+        f"{path}` writes it from the storage files, then prepare the folder again."
+    )
 
 
 @dataclass
@@ -162,12 +112,14 @@ class Bag:
     unparsed: dict[str, str] = field(default_factory=dict, init=False, repr=False)
     #: topics whose QoS in metadata.yaml differs from their storage's (read from the storage)
     qos_mismatch: list[str] = field(default_factory=list, init=False, repr=False)
+    #: the distribution whose standard and shipped types fill in what the bag does not define
+    release: str = field(default="", init=False, repr=False)
 
     def __enter__(self) -> Bag:
         if not self.path.exists():
             raise InputError(f"{self.path} does not exist.")
         if not is_bag(self.path):
-            raise InputError(f"{self.path} is not a rosbag2 directory (it has no metadata.yaml).")
+            raise InputError(without_metadata(self.path))
         try:
             reader = Reader(self.path)
             reader.open()
@@ -185,11 +137,13 @@ class Bag:
             reason = " ".join(str(error).split()) or "a damaged index names an impossible size"
             raise InputError(f"{self.path} is not a readable rosbag2 directory: {reason}") from None
         self._reader = reader
-        self._topics = {n: i.msgtype or "" for n, i in sorted(reader.topics.items())}
+        self._topics = {n: normalized(i.msgtype or "") for n, i in sorted(reader.topics.items())}
         try:
-            distro = _distribution(self.distro or reader.ros_distro)
-            self._definitions = _definitions(reader, self.extra_types, distro, self.unparsed)
-            roots = {c.msgtype for c in reader.connections if c.topic not in self.unparsed}
+            self.release = _release(self.distro or reader.ros_distro)
+            self._definitions = _definitions(reader, self.extra_types, self.release, self.unparsed)
+            roots = {
+                normalized(c.msgtype) for c in reader.connections if c.topic not in self.unparsed
+            }
             self.typestore = _typestore(self._definitions, roots, self.path)
             self.qos_mismatch = _qos_mismatches(reader)
         except BaseException:
@@ -227,12 +181,14 @@ class Bag:
         columns: Mapping[str, Mapping[str, str]],
         *,
         bag_time: bool = False,
+        recorded: bool = False,
         progress=None,
     ) -> dict[str, pd.DataFrame]:
         """One table per topic: ``time`` plus ``columns[topic]`` (column name -> field path).
 
-        ``bag_time`` uses the recording time instead of the message stamps. ``progress`` is a
-        tqdm bar to advance by one per message read.
+        ``bag_time`` uses the recording time instead of the message stamps; ``recorded`` adds
+        the :data:`RECORDED` column. ``progress`` is a tqdm bar to advance by one per message
+        read.
         """
         unknown = [topic for topic in columns if topic not in self.topics]
         if unknown:
@@ -243,7 +199,7 @@ class Bag:
             rows[topic].add(batch)
         tables = {}
         for topic, topic_rows in rows.items():
-            table = topic_rows.table(list(columns[topic]), bag_time)
+            table = topic_rows.table(list(columns[topic]), bag_time, recorded)
             msgtype = self.topics[topic]
             for column, path in columns[topic].items():
                 if field_type(msgtype, path, self.typestore) == "float32":
@@ -276,15 +232,18 @@ class Bag:
         if topic in self.unparsed:
             raise InputError(
                 f"{self.path}: the definition of {msgtype} stored in the bag for {topic} cannot "
-                f"be parsed ({self.unparsed[topic]}); give it with --msg (a .msg or .idl file)."
+                f"be parsed ({self.unparsed[topic]}); give it with --msg "
+                f"{definition_file(msgtype)}."
             )
         if msgtype not in self.typestore.fielddefs:
             missing = _missing(self._definitions, msgtype) or msgtype
             part = "" if missing == msgtype else f", which {msgtype} contains,"
+            file = definition_file(missing)
             raise InputError(
-                f"{self.path}: cannot decode {topic}: the message type {missing}{part} is not "
-                f"defined in the bag; register it with --msg {_definition_file(missing)} (or a "
-                "folder of .msg files)."
+                f"{self.path}: cannot decode {topic}: the message type {missing}{part} is "
+                f"defined neither in the bag nor among the {self.release.title()} types robotale "
+                f"knows; give its definition with --msg {file} (a file at that path, or a "
+                f"folder holding {file})."
             )
         return msgtype
 
@@ -298,8 +257,9 @@ class Bag:
                 reason = str(error).strip().rstrip(".") or type(error).__name__
                 raise InputError(
                     f"{self.path}: a message on {topic} cannot be decoded as {msgtype} "
-                    f"({reason}); the definition registered for it does "
-                    "not match the recording (give the right one with --msg or --distro)."
+                    f"({reason}); the definition registered for it does not match the "
+                    f"recording (give the right one with --msg {definition_file(msgtype)}, or "
+                    "the bag's distribution with --distro)."
                 ) from None
 
         return decode
@@ -320,7 +280,8 @@ class Bag:
                 raise InputError(
                     f"{self.path}: the messages on {topic} do not match the definition of "
                     f"{msgtype} they are read with ({len(raw)} bytes, the definition accounts "
-                    f"for {again}); give the right one with --msg or --distro."
+                    f"for {again}); give the right one with --msg {definition_file(msgtype)}, "
+                    "or the bag's distribution with --distro."
                 )
 
         return check
@@ -409,7 +370,7 @@ class _TopicRows:
         same = all(a == b or (a != a and b != b) for a, b in zip(bulk, decoded, strict=True))
         return layout if same else None
 
-    def table(self, names: list[str], bag_time: bool) -> pd.DataFrame:
+    def table(self, names: list[str], bag_time: bool, with_recorded: bool = False) -> pd.DataFrame:
         count = self.count
         recorded = np.concatenate(self.recorded) if self.recorded else np.zeros(0, np.int64)
         bulk = columns(self.layout, np.concatenate(self.bulk)) if self.bulk_at else None
@@ -429,7 +390,10 @@ class _TopicRows:
         if (order != np.arange(count)).any():
             recorded = recorded[order]
             values = {name: column[order] for name, column in values.items()}
-        return _table(recorded, values, names, bag_time)
+        table = _table(recorded, values, names, bag_time)
+        if with_recorded:
+            table[RECORDED] = recorded.astype(np.int64, copy=False)
+        return table
 
 
 def read_bag(
@@ -445,17 +409,6 @@ def read_bag(
         chosen = list(bag.topics) if topics is None else list(topics)
         columns = {topic: {f: f for f in bag.fields(topic)} for topic in chosen}
         return bag.tables(columns, bag_time=bag_time)
-
-
-def _definition_file(msgtype: str) -> str:
-    """Where a ROS package keeps the definition of ``msgtype``: an action's types come from its
-    ``.action`` file."""
-    package, _, rest = msgtype.partition("/") if "/" in msgtype else ("my_pkg", "", msgtype)
-    kind, _, name = rest.rpartition("/")
-    if kind == "action":
-        stem = re.sub(r"_(Goal|Result|Feedback|FeedbackMessage)$", "", name)
-        return f"{package}/action/{stem}.action"
-    return f"{package}/msg/{name}.msg"
 
 
 def _extractor(paths: list[str]):
@@ -495,8 +448,9 @@ def _storage_files(reader: Reader) -> list[str]:
     return []
 
 
-def _definitions(reader: Reader, extra: Mapping, distro: Mapping, unparsed: dict) -> dict:
-    """The user's types, then the bag's, then the distribution's, then robotale's.
+def _definitions(reader: Reader, extra: Mapping, release: str, unparsed: dict) -> dict:
+    """The user's types, then the bag's, then the distribution's (rosbags' store), then those
+    robotale ships for it, then robotale's Tag.
 
     The user's come first: they are given to correct or complete what the bag says. A stored
     definition that cannot be parsed is noted in ``unparsed`` (topic -> reason) and left out.
@@ -510,7 +464,9 @@ def _definitions(reader: Reader, extra: Mapping, distro: Mapping, unparsed: dict
             unparsed[connection.topic] = reason if len(reason) < 160 else f"{reason[:157]}..."
             continue
         typs.update({name: spec for name, spec in embedded.items() if name not in extra})
-    for source in (distro, get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
+    # a release rosbags has no store of yet (rolling) takes the latest it has
+    standard = get_typestore(DISTROS.get(release, [*DISTROS.values()][-1])).fielddefs
+    for source in (standard, shipped(release), get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
         typs.update({name: spec for name, spec in source.items() if name not in typs})
     return typs
 
@@ -589,7 +545,7 @@ def _embedded_types(connection: Connection) -> dict:
 def _parsed(kind: MessageDefinitionFormat, data: str, msgtype: str) -> tuple:
     """A stored definition parsed once: the runs of a batch all store the same ones."""
     if kind == MessageDefinitionFormat.MSG:
-        return tuple(get_types_from_msg(data, msgtype).items())
+        return tuple(stored_types(data, normalized(msgtype)).items())
     if kind == MessageDefinitionFormat.IDL:
         separator = "=" * 80 + "\n"
         typs: dict = {}
@@ -610,10 +566,11 @@ DISTROS = {
 DEFAULT_DISTRO = "humble"
 
 
-def _distribution(name: str | None) -> Mapping:
-    """The standard types of a ROS 2 distribution (Humble's for a bag that names none)."""
-    store = DISTROS.get((name or DEFAULT_DISTRO).lower(), DISTROS[DEFAULT_DISTRO])
-    return get_typestore(store).fielddefs
+def _release(name: str | None) -> str:
+    """The distribution a bag's types are completed from: ``name`` if robotale knows it, else
+    Humble (what a bag that names none was most likely recorded with)."""
+    name = (name or DEFAULT_DISTRO).lower()
+    return name if name in DISTROS or name in RELEASES else DEFAULT_DISTRO
 
 
 def check_distro(name: str | None) -> str | None:
@@ -752,8 +709,10 @@ def namespace(topic: str) -> str:
     """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``.
 
     An action's topics are in the namespace of the action, not in the action's own:
-    ``/r1/navigate_to_pose/_action/feedback`` -> ``r1``.
+    ``/r1/navigate_to_pose/_action/feedback`` -> ``r1``; a service's events in the service's:
+    ``/r1/get_plan/_service_event`` -> ``r1``.
     """
     if "/_action/" in topic:
         topic = topic.rsplit("/_action/", 1)[0]
+    topic = topic.removesuffix("/_service_event")
     return topic.strip("/").rpartition("/")[0]

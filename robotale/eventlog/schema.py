@@ -78,6 +78,11 @@ REQUIRED = (CASE, ACTIVITY, TIMESTAMP)
 START, COMPLETE, NONE = "start", "complete", "none"
 #: outcomes other than success that end an activity (a ROS 2 action's aborted or cancelled goal)
 ABORTED, CANCELLED = "aborted", "cancelled"
+#: XES' standard transition for an aborted activity: robotale's engine ends an activity that
+#: an interrupting boundary event or event sub-process cut short, or that was cancelled, with it
+ATE_ABORT = "ate_abort"
+#: the lifecycles that end an activity: its completion or an outcome
+ENDINGS = frozenset({COMPLETE, ABORTED, CANCELLED, ATE_ABORT})
 INPROGRESS = "inprogress"
 SEND, RECEIVE = "send", "receive"
 

@@ -7,7 +7,7 @@ makes one from what a bag holds (``--auto``); :func:`columns` says which fields 
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fnmatch import fnmatchcase
 
@@ -76,6 +76,7 @@ def columns(bag: Bag, sources: Sources) -> dict[str, dict[str, str]]:
             state = _state_field(bag, topic, name or None, strict=True)
             wanted[topic] = {**wanted.get(topic, {}), state: state}
     for topic in _matching(bag, sources.bt_logs):
+        bag.fields(topic)  # a type without a definition is named as such, with the file to give
         column = _bt_column(bag, topic)
         if column is False:
             raise InputError(
@@ -88,26 +89,31 @@ def columns(bag: Bag, sources: Sources) -> dict[str, dict[str, str]]:
 
 
 def activity_rows(
-    bag: Bag, tables: Mapping[str, pd.DataFrame], sources: Sources, case: str, end: pd.Timestamp
+    bag: Bag,
+    tables: Mapping[str, pd.DataFrame],
+    sources: Sources,
+    case: str,
+    end: pd.Timestamp,
+    robot_of: Callable[[str], str] = namespace,
 ) -> list[pd.DataFrame]:
-    """Tag rows of every source topic in ``tables`` (each table numbered by :data:`INDEX`)."""
+    """Tag rows of every source topic in ``tables`` (each table numbered by :data:`INDEX`);
+    ``robot_of`` names the robot of a topic (default: its namespace)."""
     parts = []
     for topic in _matching(bag, sources.actions):
         if bag.topics[topic] == STATUS_TYPE:
-            robot, _ = activities.action_of(topic)
             events = activities.goal_events(tables[topic], topic)
-            parts.append(activities.rows(events, case, robot, topic))
+            parts.append(activities.rows(events, case, robot_of(topic), topic))
     for spec in sources.states:
         glob, _, name = spec.partition(":")
         for topic in _matching(bag, glob):
             state = _state_field(bag, topic, name or None, strict=True)
             names = _constant_names(bag, topic)
             events = activities.state_events(tables[topic], state, end, names)
-            parts.append(activities.rows(events, case, namespace(topic), topic))
+            parts.append(activities.rows(events, case, robot_of(topic), topic))
     for topic in _matching(bag, sources.bt_logs):
         changes = activities.bt_changes(tables[topic], _bt_column(bag, topic) or None)
         events = activities.bt_events(changes)
-        parts.append(activities.rows(events, case, namespace(topic), topic))
+        parts.append(activities.rows(events, case, robot_of(topic), topic))
     return parts
 
 

@@ -1,7 +1,8 @@
 """Writing a canonical event log as CSV, XES (IEEE 1849) or OCEL 2.0 JSON.
 
 Each writer writes to a temporary file next to the target and renames it into place, so a
-failure never leaves a partial file behind. Timestamps are written in UTC with microseconds.
+failure never leaves a partial file behind. Timestamps are written in UTC with microseconds,
+or nanoseconds when the log's times have them (a recording's own resolution).
 
 - CSV: the short column names of :mod:`robotale.eventlog.schema`, one row per event.
 - XES: one trace per case; every event carries ``concept:name``, ``time:timestamp``,
@@ -9,7 +10,8 @@ failure never leaves a partial file behind. Timestamps are written in UTC with m
   (``float`` for x, y, z and battery ...), as in the thesis' listing 6.1. Empty values are left
   out, as XES has no null.
 - OCEL 2.0 JSON: events linked to objects of three types, ``robot``, ``message`` and ``run``,
-  for object-centric tools (pm4py's ``read_ocel2_json``, OCPM tools).
+  for object-centric tools (pm4py's ``read_ocel2_json``, OCPM tools); an object-centric log
+  read with its objects (:mod:`.objects`) is written with those objects instead.
 """
 
 from __future__ import annotations
@@ -26,6 +28,7 @@ from lxml import etree
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
+from robotale.eventlog.objects import Objects
 from robotale.fame_runtime.manifest import RunManifest
 from robotale.files import atomic_file
 
@@ -63,7 +66,15 @@ def _target(path: str | Path) -> Path:
 
 
 def _utc_text(times: pd.Series) -> pd.Series:
-    return times.dt.tz_convert("UTC").dt.strftime(_TIME_FORMAT)
+    """ISO 8601 in UTC: six decimals of the second, or nine in a log whose times have
+    nanoseconds (a recording's own resolution), so that every time of a file has one form."""
+    utc = times.dt.tz_convert("UTC").dt.as_unit("ns")
+    text = utc.dt.strftime(_TIME_FORMAT)
+    nanos = utc.dt.nanosecond.to_numpy()
+    if not nanos.any():
+        return text
+    digits = pd.Series(np.char.zfill(nanos.astype(str), 3), index=text.index)
+    return text.str.slice(0, 26) + digits.where(utc.notna()) + "+00:00"
 
 
 def write_csv(log: pd.DataFrame, path: str | Path) -> None:
@@ -210,15 +221,24 @@ _OCEL_OBJECTS = (schema.ROBOT, schema.MSG_ID)
 
 
 def write_ocel(
-    log: pd.DataFrame, path: str | Path, runs: Mapping[str, RunManifest] | None = None
+    log: pd.DataFrame,
+    path: str | Path,
+    runs: Mapping[str, RunManifest] | None = None,
+    objects: Objects | None = None,
 ) -> None:
-    """The log as OCEL 2.0 JSON with objects ``robot``, ``message`` and ``run``.
+    """The log as OCEL 2.0 JSON with objects ``robot``, ``message`` and ``run``, or, for an
+    object-centric log, with its own ``objects``.
 
     A robot object is one robot in one run (``drone@run_0001``), a message one message of a
     run (``m52@run_0001``); ``runs`` (case -> manifest) gives run objects their attributes.
     Each event is related to its robot (``performed by``), its run (``in run``) and, for a
     message event, its message (qualified ``send`` or ``receive``).
     """
+    if objects is not None:
+        document = _object_centric_document(log, objects)
+        with atomic_file(_target(path)) as file:
+            json.dump(document, file, ensure_ascii=False, allow_nan=False)
+        return
     # A log may name no robots or messages at all (any CSV read as a log): none are objects.
     log = log.assign(
         **{
@@ -375,3 +395,119 @@ def _flat(manifest: Mapping, prefix: str = "") -> dict[str, str]:
         elif value is not None:
             flat[f"{prefix}{key}"] = value if isinstance(value, str) else json.dumps(value)
     return flat
+
+
+# -- OCEL 2.0 of an object-centric log ------------------------------------------------------
+
+
+def _object_centric_document(log: pd.DataFrame, objects: Objects) -> dict:
+    """The OCEL 2.0 document of a log read with its objects: its events with their own
+    attributes, its objects with theirs and their changes, and the relations between them."""
+    attributes = _event_attributes(log, objects)
+    kinds = {c: xes_type(log[c]) for c in attributes}
+    values = {c: _json_values(log[c], kinds[c]) for c in attributes}
+    event_ids = log[schema.EVENT_ID].astype(str).tolist()
+    activities = log[ACTIVITY].astype(str).tolist()
+    times = _utc_text(log[TIME]).tolist()
+    links = objects.e2o.groupby("event", sort=False)
+    relationships = {
+        str(event): [
+            {"objectId": str(o), "qualifier": "" if pd.isna(q) else str(q)}
+            for o, q in zip(group["object"], group["qualifier"], strict=True)
+        ]
+        for event, group in links
+    }
+    events = []
+    declared: dict[str, dict[str, str]] = {}
+    for row, event_id in enumerate(event_ids):
+        present = [c for c in attributes if values[c][row] is not None]
+        kind = declared.setdefault(activities[row], {})
+        kind.update({c: _OCEL_TYPES.get(kinds[c], "string") for c in present})
+        events.append(
+            {
+                "id": event_id,
+                "type": activities[row],
+                "time": times[row],
+                "attributes": [{"name": c, "value": values[c][row]} for c in present],
+                "relationships": relationships.get(event_id, []),
+            }
+        )
+    object_types, listed = _listed_objects(objects)
+    return {
+        "objectTypes": object_types,
+        "eventTypes": [
+            {"name": name, "attributes": [{"name": a, "type": t} for a, t in sorted(kind.items())]}
+            for name, kind in sorted(declared.items())
+        ],
+        "objects": listed,
+        "events": events,
+    }
+
+
+def _event_attributes(log: pd.DataFrame, objects: Objects) -> list[str]:
+    """The log's columns that are event attributes: not the event's own fields, not object
+    columns, and not the case and lifecycle robotale fills in where a log has none."""
+    structure = {schema.EVENT_ID, ACTIVITY, TIME, *objects.entity_types}
+    filled = {CASE: "1", schema.LIFECYCLE: schema.COMPLETE}
+    for column, value in filled.items():
+        if column in log and (log[column].astype("string") == value).all():
+            structure.add(column)
+    return [c for c in log.columns if c not in structure]
+
+
+def _listed_objects(objects: Objects) -> tuple[list[dict], list[dict]]:
+    table = objects.objects
+    changes = objects.changes.groupby("object", sort=False)
+    changed = {str(o): group for o, group in changes}
+    related = {str(o): group for o, group in objects.o2o.groupby("source", sort=False)}
+    types: dict[str, dict[str, str]] = {}
+    listed = []
+    for _, row in table.iterrows():
+        object_id, kind = str(row["id"]), str(row["type"])
+        declared = types.setdefault(kind, {})
+        attributes = []
+        for name in objects.attributes:
+            value = _json_value(row[name])
+            if value is not None:
+                declared[name] = _json_type(value)
+                attributes.append({"name": name, "time": _EPOCH, "value": value})
+        if object_id in changed:
+            for change in changed[object_id].itertuples(index=False):
+                value = _json_value(change.value)
+                declared.setdefault(change.field, _json_type(value))
+                time = pd.Timestamp(change.time).tz_convert("UTC").strftime(_TIME_FORMAT)
+                attributes.append({"name": change.field, "time": time, "value": value})
+        entry = {"id": object_id, "type": kind, "attributes": attributes}
+        if object_id in related:
+            group = related[object_id]
+            entry["relationships"] = [
+                {"objectId": str(t), "qualifier": "" if pd.isna(q) else str(q)}
+                for t, q in zip(group["target"], group["qualifier"], strict=True)
+            ]
+        listed.append(entry)
+    object_types = [
+        {"name": kind, "attributes": [{"name": a, "type": t} for a, t in sorted(names.items())]}
+        for kind, names in types.items()
+    ]
+    return object_types, listed
+
+
+def _json_value(value: object) -> object:
+    """A cell as a JSON value (None where it is missing)."""
+    if value is None or (not isinstance(value, str | list) and pd.isna(value)):
+        return None
+    if isinstance(value, np.generic):
+        return value.item()
+    if isinstance(value, pd.Timestamp):
+        return value.tz_convert("UTC").strftime(_TIME_FORMAT) if value.tzinfo else value.isoformat()
+    return value
+
+
+def _json_type(value: object) -> str:
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, int):
+        return "integer"
+    if isinstance(value, float):
+        return "float"
+    return "string"

@@ -96,6 +96,15 @@ class Bus(Protocol):
 #: decides whether one delivery is lost (fault injection: a dropped message).
 DropRule = Callable[[Envelope, Subscription], bool]
 
+#: told what became of each delivery, apart from the subscribers (a simulation's ground truth):
+#: the outcome (one of :data:`OUTCOMES`), the envelope and the subscription it was meant for
+DeliveryObserver = Callable[[str, Envelope, Subscription], None]
+#: what becomes of one delivery: handed to its subscriber; publisher and subscriber cannot talk
+#: (QoS or message types); dropped by a fault; lost on the way (``loss``, the network); the
+#: subscriber had left when it arrived
+DELIVERED, QOS, FAULT, LOSS, LEFT = "delivered", "qos", "fault", "loss", "left"
+OUTCOMES = (DELIVERED, QOS, FAULT, LOSS, LEFT)
+
 #: a publisher as DDS sees it: one data writer per topic, sender, QoS and message type
 WriterKey = tuple[str, str, QoS, str]
 
@@ -201,6 +210,8 @@ class InProcessBus:
         #: deliveries scheduled on the clock but not made yet (a mission is not over while
         #: a message is in flight)
         self.pending = 0
+        #: told what became of every delivery (None: nobody asks)
+        self.observer: DeliveryObserver | None = None
 
     def new_msg_id(self) -> str:
         """A message id unique on this bus (``m_1``, ``m_2`` ... as in the thesis' log)."""
@@ -215,16 +226,20 @@ class InProcessBus:
         self._keep(envelope)
         for subscription in list(self._subscribers.get(topic, ())):
             if not self._talk(envelope, subscription):
-                continue
-            if self.drop and self.drop(envelope, subscription):
-                continue
-            if self._lost(envelope, subscription):
-                continue
-            if self.network is not None:
+                self._observe(QOS, envelope, subscription)
+            elif self.drop and self.drop(envelope, subscription):
+                self._observe(FAULT, envelope, subscription)
+            elif self._lost(envelope, subscription):
+                self._observe(LOSS, envelope, subscription)
+            elif self.network is not None:
                 self._transmit(subscription, envelope)
             else:
                 self._send(subscription, envelope)
         return envelope
+
+    def _observe(self, outcome: str, envelope: Envelope, subscription: Subscription) -> None:
+        if self.observer is not None:
+            self.observer(outcome, envelope, subscription)
 
     def subscribe(self, topic, callback, *, msgtype=None, qos=None, owner="") -> Subscription:
         subscription = Subscription(topic, callback, msgtype, qos or DEFAULT_QOS, owner, _bus=self)
@@ -252,6 +267,7 @@ class InProcessBus:
                 self.pending += 1
                 self.clock.call_later(delay, self._delivery(subscription, envelope))
                 return
+        self._observe(LOSS, envelope, subscription)
 
     def _latency(self, link: Link) -> float:
         if not link.jitter:
@@ -325,7 +341,10 @@ class InProcessBus:
             self.pending -= 1
             # A subscriber that left between publish and delivery does not receive it.
             if subscription.active:
+                self._observe(DELIVERED, envelope, subscription)
                 subscription.callback(envelope)
+            else:
+                self._observe(LEFT, envelope, subscription)
 
         return deliver
 

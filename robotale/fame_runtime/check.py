@@ -18,8 +18,8 @@ from lxml import etree
 
 from robotale.fame_runtime.labels import THROWING, catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
-from robotale.fame_runtime.model import Definitions, Node, Process, Scope
-from robotale.fame_runtime.plan import problems
+from robotale.fame_runtime.model import Definitions, Node, Problem, Process, Scope
+from robotale.fame_runtime.plan import findings
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS, pair_problems
 
 
@@ -56,14 +56,20 @@ class Pairing:
 class Report:
     file: str
     pools: list[str] = field(default_factory=list)
-    problems: list[str] = field(default_factory=list)  # "<pool>: <element> <why>"
+    #: what cannot be read or run, reading and deploying together, with the pool it is in
+    found: list[tuple[str, Problem]] = field(default_factory=list)
     pairs: list[Pairing] = field(default_factory=list)
     notes: list[str] = field(default_factory=list)
     warnings: list[str] = field(default_factory=list)  # silent choices of the parser
 
     @property
+    def problems(self) -> list[str]:
+        """Each problem as "<pool>: <sentence>" (the file's own: the sentence alone)."""
+        return [f"{pool}: {p.sentence}" if pool else p.sentence for pool, p in self.found]
+
+    @property
     def ok(self) -> bool:
-        return not self.problems and all(p.compatible for p in self.pairs)
+        return not self.found and all(p.compatible for p in self.pairs)
 
 
 def check(
@@ -71,13 +77,16 @@ def check(
 ) -> Report:
     """Structure (what the engine would refuse) and QoS compatibility of a collaboration."""
     report = Report(str(definitions.file), warnings=list(definitions.warnings))
-    report.problems += duplicate_ids(definitions.file)
+    report.found += [("", p) for p in definitions.problems]
+    report.found += [("", p) for p in shared_ids(definitions.file)]
     for pool, process in definitions.pools():
         report.pools.append(pool.name + (" (multi-instance)" if pool.multi_instance else ""))
-        report.problems += [
-            f"{pool.name}: {p}" for p in problems(process, skills=skills, library=library)
+        found = findings(process, skills=skills, library=library)
+        found += [
+            Problem(str(definitions.file), process.line, process.id, sentence)
+            for sentence in progress_problems(process)
         ]
-        report.problems += [f"{pool.name}: {p}" for p in progress_problems(process)]
+        report.found += [(pool.name, _placed(p, definitions)) for p in found]
     publishers, subscribers = endpoints(definitions, skills=skills, library=library)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [
@@ -124,6 +133,14 @@ def _signal_events(process: Process, skills: Collection[str], library: Library |
                 )
                 if called is not None:
                     stack.append(called)
+
+
+def _placed(problem: Problem, definitions: Definitions) -> Problem:
+    """``problem`` with the column of its element's start tag, when it is in this file."""
+    line, column = definitions.positions.get(problem.element, (0, 0))
+    if problem.column or line != problem.line or problem.file != str(definitions.file):
+        return problem
+    return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
 
 def _endpoint(pool: str, process: Process, node: Node) -> Endpoint:
@@ -279,9 +296,21 @@ def _names(scope: Scope, ids: list[str]) -> str:
     return ", ".join(scope.nodes[n].describe() for n in ids)
 
 
+#: the namespaces of the standard's own elements (model, diagram interchange): vendors'
+#: elements elsewhere may carry ids of their own meaning (``<adonis:target id=...>``)
+_OMG = "http://www.omg.org/spec/"
+
+
 def duplicate_ids(file: Path | None) -> list[str]:
     """Element ids given to more than one element of the file: the parser keeps only one of
     them, so a model with two ``start`` ids would look as if it had none."""
+    return [p.sentence for p in shared_ids(file)]
+
+
+def shared_ids(file: Path | None) -> list[Problem]:
+    """:func:`duplicate_ids` with where each id is first given. Only the standard's elements
+    count: ids on vendor extensions (in ``extensionElements`` or a foreign namespace) are the
+    vendor's business."""
     if file is None or not Path(file).is_file():
         return []
     lines: dict[str, list[int]] = defaultdict(list)
@@ -289,12 +318,28 @@ def duplicate_ids(file: Path | None) -> list[str]:
         tree = etree.parse(str(file), etree.XMLParser(resolve_entities=False, no_network=True))
     except etree.XMLSyntaxError:
         return []  # the parser has refused it already
-    for element in tree.iter():
-        if isinstance(element.tag, str) and (ident := element.get("id")):
-            lines[ident].append(element.sourceline or 0)
+    _standard_ids(tree.getroot(), lines)
     return [
-        f"the id {ident!r} is given to {len(at)} elements (lines "
-        f"{', '.join(map(str, at))}); each element needs its own id"
+        Problem(
+            str(file),
+            at[0],
+            ident,
+            f"the id {ident!r} is given to {len(at)} elements (lines "
+            f"{', '.join(map(str, at))}); each element needs its own id",
+        )
         for ident, at in sorted(lines.items())
         if len(at) > 1
     ]
+
+
+def _standard_ids(element: etree._Element, lines: dict[str, list[int]]) -> None:
+    stack = [element]
+    while stack:
+        current = stack.pop()
+        if not isinstance(current.tag, str) or not current.tag.startswith("{" + _OMG):
+            continue  # a vendor's element: neither it nor its content counts
+        if current.tag.endswith("}extensionElements"):
+            continue
+        if ident := current.get("id"):
+            lines[ident].append(current.sourceline or 0)
+        stack.extend(reversed(current))

@@ -5,7 +5,8 @@ that takes time, a catching event, a sub-process, a join. Everything that wakes 
 a message on the bus, a timer, a skill's ``done``, a variable change satisfying a condition --
 is queued and run by the engine's own loop, never inside another engine's step or inside the
 bus. Every activity start and completion, every signal thrown or caught, every timer, error
-and conditional event becomes a :class:`~robotale.fame_runtime.tags.Tag`.
+and conditional event becomes a :class:`~robotale.fame_runtime.tags.Tag`; an activity that is
+interrupted or cancelled ends with an ``ate_abort`` tag instead of ``complete``.
 
 See ``docs/fame_runtime.md`` for the API and the exact semantics.
 """
@@ -18,14 +19,16 @@ import types
 from collections import deque
 from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
+from threading import get_ident
 from typing import Any, ClassVar
 
 from robotale.errors import ModelError
+from robotale.fame_runtime import watchdog
 from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock, EngineTime
 from robotale.fame_runtime.data import Data
 from robotale.fame_runtime.expressions import BpmnError, Compiled
-from robotale.fame_runtime.javascript import Completion, JavaScript, ScriptFailure
+from robotale.fame_runtime.javascript import Completion, JavaScript, ScriptFailure, ScriptLimit
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import JAVASCRIPT, Process
 from robotale.fame_runtime.plan import (
@@ -38,8 +41,9 @@ from robotale.fame_runtime.plan import (
 )
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
-from robotale.fame_runtime.tags import Tagger, TagSink, payload_text
+from robotale.fame_runtime.tags import ABORT, COMPLETE, START, Tagger, TagSink, payload_text
 from robotale.fame_runtime.triggers import Triggers
+from robotale.fame_runtime.watchdog import MEASURE, ScriptTimeout
 
 #: steps one engine may take without its clock moving on: more means a loop with no wait
 MAX_STEPS = 1_000_000
@@ -54,6 +58,37 @@ _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 #: what charging work costs when the engine's clock charges nothing
 _FREE = contextlib.nullcontext()
 
+#: told of every activity instance as it starts and ends (robot, instance number, activity,
+#: ``start`` / ``completed`` / ``interrupted`` / ``cancelled``), apart from the tags: a
+#: simulation's ground truth numbers instances, which tags do not
+ActivityObserver = Callable[[str, int, str, str], None]
+
+
+_ABSENT = object()  # a variable a frame shadows that had no value outside it
+
+
+class _Frame:
+    """The variables of one multi-instance instance that are its own (BPMN 2.0 section
+    10.3.8: every instance has its own ``loopCounter``, input item and output item). The
+    engine keeps one variables dict for a robot; before it runs a token of an instance it
+    installs that instance's frame (its values in, the outer ones kept aside) and takes it
+    out again afterwards, so instances running side by side never see each other's item."""
+
+    __slots__ = ("outer", "parent", "values")
+
+    def __init__(self, parent: _Frame | None, values: dict[str, Any]) -> None:
+        self.parent = parent
+        self.values = values  # the instance's own values while it is not installed
+        self.outer: dict[str, Any] = {}  # what the variables held before it was installed
+
+    def chain(self) -> list[_Frame]:
+        """This frame and the frames around it, outermost first."""
+        frames, frame = [], self
+        while frame is not None:
+            frames.append(frame)
+            frame = frame.parent
+        return frames[::-1]
+
 
 class _Token:
     __slots__ = (
@@ -61,6 +96,7 @@ class _Token:
         "boundaries",
         "child",
         "flow",
+        "frame",
         "generation",
         "instance",
         "node",
@@ -69,6 +105,7 @@ class _Token:
     )
 
     def __init__(self, scope: _Scope, node: NodePlan) -> None:
+        self.frame: _Frame | None = scope.frame  # the instance variables it runs with
         self.scope = scope
         self.node = node
         self.flow = ""  # the sequence flow it arrived by (joins count them)
@@ -96,21 +133,50 @@ class _Loop:
         self.outputs: dict[int, Any] = {}  # instance index -> its output item
 
 
+class _Done:
+    """An activity that completed and may be compensated (BPMN 2.0 section 10.6.5): the
+    scope it completed in, its instance frame, and for a sub-process its finished content."""
+
+    __slots__ = ("child", "frame", "node", "scope")
+
+    def __init__(self, node: NodePlan, scope: _Scope, frame: _Frame | None, child) -> None:
+        self.node, self.scope, self.frame = node, scope, frame
+        self.child: _Scope | None = child
+
+
 class _Scope:
     """A running process, called process, sub-process or event sub-process."""
 
-    __slots__ = ("armed", "depth", "ended", "holder", "joins", "parent", "plan", "safe", "tokens")
+    __slots__ = (
+        "armed",
+        "depth",
+        "done",
+        "ended",
+        "failed",
+        "frame",
+        "holder",
+        "joins",
+        "on_close",
+        "parent",
+        "plan",
+        "safe",
+        "tokens",
+    )
 
     def __init__(self, plan: ScopePlan, parent: _Scope | None, holder: _Token | None) -> None:
         self.plan = plan
         self.parent = parent
         self.holder = holder  # the token of the activity this scope runs inside
+        self.frame = holder.frame if holder is not None else None
         self.depth = parent.depth + 1 if parent else 0
         self.tokens: set[_Token] = set()
         self.joins: dict[str, list[_Token]] = {}
         self.armed: dict[str, Callable[[], Any]] = {}  # event sub-process id -> disarm
         self.ended = False
+        self.failed = False  # a top-level scope ended by an uncaught error or a model error
         self.safe = False  # its safe-state handler runs before it ends
+        self.done: list[_Done] = []  # its completed activities to compensate, oldest first
+        self.on_close: Callable[[], Any] | None = None  # a compensation's: what comes next
 
 
 class Engine:
@@ -168,11 +234,23 @@ class Engine:
         self._starting = 0  # none-start instances scheduled but not begun
         self.started = False
         self.stopped = False
-        self.completed = 0  # process instances that ended
-        self.failures: list[str] = []  # BPMN errors nobody caught
+        self.completed = 0  # process instances that ended normally
+        self.failed = 0  # process instances an uncaught error or a script's limit ended
+        self.failures: list[str] = []  # why each failed instance ended, one sentence each
         self.output = output or (lambda line: print(f"[{robot}] {line}", flush=True))
         self._javascript: JavaScript | None = None  # made when a first script needs it
+        self._watch: watchdog.Watch | None = None  # made when a first Python script runs
         self._time = EngineTime.of(clock)  # None: computing takes no simulated time
+        self._frame: _Frame | None = None  # the instance frame installed in the variables
+        self._compensating: set[_Scope] = set()  # compensations running (see _compensate_one)
+        #: the activities started and not yet ended, by the token running each: the token's
+        #: activity label and instance number
+        self._running: dict[_Token, tuple[str, int]] = {}
+        self._instances = 0
+        #: how a cancel ends the activities it reaches: ``interrupted`` while an interrupting
+        #: boundary event or event sub-process takes over, else ``cancelled``
+        self._ending = "cancelled"
+        self.activity_observer: ActivityObserver | None = None
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -307,6 +385,8 @@ class Engine:
                 if self._time is not None and self._time.wait(self._drain):
                     computing = True  # what is queued waits until the clock catches up
                     break
+                if self._frame is not None:
+                    self._enter(None)  # work runs on the process's variables unless it says
                 self._work.popleft()()
                 if not self._work and self._inclusive:
                     self._recheck_joins()
@@ -315,6 +395,8 @@ class Engine:
             raise
         finally:
             self._busy = computing
+            if self._frame is not None:
+                self._enter(None)  # what reads the variables from outside sees the robot's
         if not computing:
             self._idle_check()
 
@@ -328,6 +410,8 @@ class Engine:
     def _advance(self, token: _Token, node: NodePlan | None) -> None:
         """Move ``token`` from ``node`` on until it has to wait."""
         behaviours = self._BEHAVIOURS  # a local: this loop is the engine's hot path
+        if token.frame is not self._frame:
+            self._enter(token.frame)
         while node is not None and token.alive:
             token.node = node
             self._steps += 1
@@ -357,6 +441,40 @@ class Engine:
     def _charged(self, kind: str) -> contextlib.AbstractContextManager[None]:
         """A ``with`` block of work of ``kind`` (script, condition) charged to the clock."""
         return _FREE if self._time is None else self._time.work(kind)
+
+    # -- instance frames ---------------------------------------------------------------------
+
+    def _enter(self, frame: _Frame | None) -> None:
+        """Install ``frame`` (and the frames around it) in the variables; None: only the
+        process's own variables."""
+        if frame is self._frame:
+            return
+        current = self._frame.chain() if self._frame is not None else []
+        wanted = frame.chain() if frame is not None else []
+        common = 0
+        while common < min(len(current), len(wanted)) and current[common] is wanted[common]:
+            common += 1
+        variables = self.variables
+        for leaving in reversed(current[common:]):
+            for name in leaving.values:
+                leaving.values[name] = variables.get(name, _ABSENT)
+                outer = leaving.outer.pop(name)
+                if outer is _ABSENT:
+                    variables.pop(name, None)
+                else:
+                    variables[name] = outer
+        for entering in wanted[common:]:
+            for name, value in entering.values.items():
+                entering.outer[name] = variables.get(name, _ABSENT)
+                if value is _ABSENT:
+                    variables.pop(name, None)
+                else:
+                    variables[name] = value
+        self._frame = frame
+
+    def _enter_token(self, token: _Token) -> None:
+        if token.frame is not self._frame:
+            self._enter(token.frame)
 
     # -- tokens and scopes ---------------------------------------------------------------------
 
@@ -397,6 +515,7 @@ class Engine:
         self._disarm(token)
         if token.child is not None:
             self._cancel_scope(token.child)
+        self._end(token, ABORT)  # after its inner activities: they ended first
 
     def _disarm(self, token: _Token) -> None:
         token.generation += 1  # whatever fires for the old wait from now on is stale
@@ -406,6 +525,8 @@ class Engine:
         token.boundaries.clear()
 
     def _cancel_scope(self, scope: _Scope) -> None:
+        if self._compensating:
+            self._cancel_compensations(scope)
         scope.ended = True
         for disarm in scope.armed.values():
             disarm()
@@ -414,12 +535,29 @@ class Engine:
             self._cancel(token)
         self._inclusive.discard(scope)
 
+    def _cancel_compensations(self, scope: _Scope) -> None:
+        """A scope that ends takes the compensations running inside it along."""
+        for place in list(self._compensating):
+            outer = place.parent
+            while outer is not None and outer is not scope:
+                outer = outer.parent
+            if outer is scope:
+                self._compensating.discard(place)
+                place.on_close = None  # cancelled: nothing waits for it any more
+                self._cancel_scope(place)
+
     def _close(self, scope: _Scope) -> None:
         """``scope`` has no token left: it completes."""
         self._cancel_scope(scope)
+        if scope.on_close is not None:  # a compensation ran in it
+            scope.on_close()
+            return
         if scope.holder is None:
             self._roots.remove(scope)
-            self.completed += 1
+            if scope.failed:
+                self.failed += 1
+            else:
+                self.completed += 1
         elif scope.holder.alive:
             self._activity_done(scope.holder)
 
@@ -519,7 +657,10 @@ class Engine:
         return self._follow(token, self._taken(node, first=False))
 
     def _run_pass(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        if node.throw is not None and node.throw.kind == "escalation":
+        if node.throw is not None and node.throw.kind == "compensate":
+            if not self._throw_compensation(token, node, lambda: self._go_on(token, node)):
+                return None  # it goes on once the compensation is done
+        elif node.throw is not None and node.throw.kind == "escalation":
             if not self._escalate(token, node):
                 return None  # an interrupting catcher cancelled the thrower
         elif node.throw is not None:
@@ -535,6 +676,10 @@ class Engine:
             return None
         if kind == "escalation" and not self._escalate(token, node):
             return None
+        if kind == "compensate" and not self._throw_compensation(
+            token, node, lambda: self._consume(token)
+        ):
+            return None  # it ends once the compensation is done
         self._consume(token)
         return None
 
@@ -543,14 +688,15 @@ class Engine:
         return None
 
     def _run_task(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         self.data.inputs(node)
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
+        self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
     def _run_script(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         self.data.inputs(node)
         if node.script is not None and node.script.language == JAVASCRIPT:
             return self._run_javascript(token, node)
@@ -560,16 +706,34 @@ class Engine:
             except BpmnError as error:
                 self._throw_error(token, error.name)
                 return None
-        self._tag(node.label, "complete")
+            except MemoryError:
+                self._script_limit(token, node, "ran out of the memory of the Python process")
+                return None
+            except ScriptTimeout:
+                limit = self._watch.limit if self._watch is not None else watchdog.TIME_LIMIT
+                self._script_limit(
+                    token, node, f"ran longer than its time limit of {limit:g} s of {MEASURE}"
+                )
+                return None
+        self._end(token, COMPLETE)
+        self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
     def _exec(self, node: NodePlan) -> None:
         script = node.script
+        watch = self._watch or self._watching()
         try:
             with self._charged("script"):
-                exec(script.code, self.env, self.variables)
-        except BpmnError:
+                # the watchdog's stamp: a fresh tuple per run, told apart by identity
+                watch.running = (node, get_ident())
+                try:
+                    exec(script.code, self.env, self.variables)
+                finally:
+                    watch.running = None
+                    if watch.fired:  # the watchdog stopped it, or is about to
+                        watch.settle()
+        except (BpmnError, MemoryError, ScriptTimeout):
             raise
         except Exception as error:
             raise ModelError(
@@ -580,6 +744,11 @@ class Engine:
             if isinstance(self.variables.get(name), _NOT_VARIABLES):
                 del self.variables[name]
         self._changed(script.writes)
+
+    def _watching(self) -> watchdog.Watch:
+        """This engine's stamp for the Python scripts' time limit, made at its first script."""
+        self._watch = watchdog.watch()
+        return self._watch
 
     def _run_javascript(self, token: _Token, node: NodePlan) -> NodePlan | None:
         """A JavaScript script task completes when it calls ``next``: at once, like a Python
@@ -600,13 +769,17 @@ class Engine:
         except ScriptFailure as failure:
             self._throw_error(token, f"script task {node.node.describe()}: {failure.text}")
             return None
+        except ScriptLimit as limit:
+            self._script_limit(token, node, limit.what)
+            return None
         if now is None:
             self._arm_boundaries(token, node)
             return None
         if now[0] is not None:
             self._throw_error(token, now[0])
             return None
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
+        self._compensable(token, node)
         self.data.outputs(node, {})
         return self._follow(token, self._taken(node, first=False))
 
@@ -621,7 +794,7 @@ class Engine:
         return done
 
     def _run_skill(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         inputs = self.data.inputs(node)
         self._arm_boundaries(token, node)
         generation = token.generation
@@ -646,6 +819,7 @@ class Engine:
     def _skill_done(self, token: _Token, generation: int, outputs: Any) -> None:
         if not token.alive or token.generation != generation:
             return  # cancelled meanwhile, or called twice
+        self._enter_token(token)
         token.waits.clear()  # the skill ended: nothing to cancel any more
         if isinstance(outputs, BpmnError):
             self._throw_error(token, outputs.name)
@@ -655,7 +829,7 @@ class Engine:
         self._activity_done(token, values)
 
     def _run_call(self, token: _Token, node: NodePlan) -> NodePlan | None:
-        self._tag(node.label, "start")
+        self._begin(token, node.label)
         self.data.inputs(node)
         self._arm_boundaries(token, node)
         child = self._open(node.child, token.scope, token)
@@ -667,13 +841,15 @@ class Engine:
 
     def _activity_done(self, token: _Token, outputs: Mapping[str, Any] | None = None) -> None:
         """A waiting activity (skill, call, sub-process, event sub-process) completed."""
+        self._enter_token(token)
         node = token.node
-        token.child = None
+        child, token.child = token.child, None
         self._disarm(token)
-        self._tag(node.label, "complete")
+        self._end(token, COMPLETE)
         if node.behaviour == "event_subprocess":
             self._consume(token)
             return
+        self._compensable(token, node, child)
         self.data.outputs(node, outputs or {})
         self._go_on(token, node)
 
@@ -700,6 +876,7 @@ class Engine:
 
     def _caught(self, token: _Token, node: NodePlan, envelope: Envelope | None) -> None:
         """A catching event fired for ``token``: tag it, store the message, move on."""
+        self._enter_token(token)
         values = self._received(node, envelope)
         self.data.outputs(node, values)
         token.node = node
@@ -844,13 +1021,26 @@ class Engine:
         token = self._new_token(run.holder.scope, body)
         token.instance = run
         run.active[token] = index
+        if run.items is not None:  # a multi-instance activity: each instance its own frame
+            token.frame = _Frame(run.holder.frame, self._own_variables(run, index))
 
         def begin() -> None:
             if token.alive:
+                self._enter_token(token)
                 self.data.set(self._instance_variables(run, index))
                 self._advance(token, body)
 
         self._call(begin)
+
+    def _own_variables(self, run: _Loop, index: int) -> dict[str, Any]:
+        """The variables an instance of a multi-instance activity has for itself."""
+        marker = run.node.loop.loop
+        own: dict[str, Any] = {"loopCounter": index}
+        if marker.element:
+            own[marker.element] = run.items[index]
+        if marker.output_element:
+            own[marker.output_element] = _ABSENT
+        return own
 
     def _instance_variables(self, run: _Loop, index: int) -> dict[str, Any]:
         """What an instance finds in the variables as it starts (Camunda's names)."""
@@ -871,15 +1061,19 @@ class Engine:
         index = run.active.pop(token)
         run.completed += 1
         marker = run.node.loop.loop
+        self._enter_token(token)  # its output item is in its own frame
         if marker.output_collection and run.items is not None:
-            # the outputs of the instances that completed, in instance order (as SpiffWorkflow)
             run.outputs[index] = self.variables.get(marker.output_element)
-            self.data.set({marker.output_collection: [run.outputs[i] for i in sorted(run.outputs)]})
         if run.items is not None:
             self.data.set(
                 {"nrOfCompletedInstances": run.completed, "nrOfActiveInstances": len(run.active)}
             )
-        if self._loop_finished(run, before=False):
+        completion = self._loop_finished(run, before=False)  # may read the instance's item
+        self._enter(run.holder.frame)
+        if marker.output_collection and run.items is not None:
+            # the outputs of the instances that completed, in instance order (as SpiffWorkflow)
+            self.data.set({marker.output_collection: [run.outputs[i] for i in sorted(run.outputs)]})
+        if completion:
             holder = run.holder
             self._disarm(holder)  # cancels the instances a completion condition cut short
             self._go_on(holder, run.node)
@@ -960,7 +1154,8 @@ class Engine:
     def _boundary(self, token: _Token, boundary: NodePlan, envelope: Envelope | None) -> None:
         if boundary.node.cancel_activity:
             scope = token.scope
-            self._cancel(token)
+            with self._interrupting():
+                self._cancel(token)
             token = self._new_token(scope, boundary)
         else:
             token = self._new_token(token.scope, boundary)
@@ -969,6 +1164,8 @@ class Engine:
     def _arm_event_subprocess(self, scope: _Scope, esp: NodePlan) -> None:
         start = esp.child.triggered_starts[0]
         interrupting = start.node.interrupting
+        if start.trigger.kind == "compensate":
+            return  # it runs when its scope is compensated (see _compensate_one)
         if start.trigger.kind == "escalation":  # nothing to wait for outside the engine
             scope.armed[esp.id] = _nothing
             return
@@ -996,10 +1193,11 @@ class Engine:
             scope.safe = True
         holder = self._new_token(scope, esp)
         if interrupting:
-            for token in list(scope.tokens):
-                if token is not holder:
-                    self._cancel(token)
-        self._tag(esp.label, "start")
+            with self._interrupting():
+                for token in list(scope.tokens):
+                    if token is not holder:
+                        self._cancel(token)
+        self._begin(holder, esp.label)
         child = self._open(esp.child, scope, holder)
         start = esp.child.triggered_starts[0]
         token = self._new_token(child, start)
@@ -1007,6 +1205,116 @@ class Engine:
             self._caught(token, start, envelope)
         else:
             self._go_on(token, start)
+
+    # -- compensation (BPMN 2.0 sections 10.6.5 and 13.5.5) ----------------------------------------
+
+    def _compensable(self, token: _Token, node: NodePlan, child: _Scope | None = None) -> None:
+        """Remember a completed activity that has something to compensate: a compensation
+        handler, or (a sub-process) a compensation event sub-process or completed content."""
+        scope = token.scope
+        if child is not None and not child.done and child.plan.compensation_handler is None:
+            child = None
+        if child is None and node.id not in scope.plan.compensations:
+            return
+        scope.done.append(_Done(node, scope, token.frame, child))
+
+    def _throw_compensation(self, token: _Token, node: NodePlan, then: Callable[[], Any]) -> bool:
+        """Compensate the activity the event names, or every completed one of its scope (of
+        the scope around, thrown in an event sub-process), the last completed first. True
+        when the thrower goes on now; else ``then`` runs once the compensation is done."""
+        self._tag.pair(node.throw.label)
+        scope = token.scope
+        if scope.holder is not None and scope.holder.node.behaviour == "event_subprocess":
+            scope = scope.parent
+        records = _take_done(scope, node.throw.topic)
+        if not node.throw.wait or not records:
+            self._compensate_all(records, _nothing)
+            return True
+        generation = token.generation
+
+        def resume() -> None:
+            if token.alive and token.generation == generation:
+                self._enter_token(token)
+                then()
+
+        self._compensate_all(records, resume)
+        return False
+
+    def _compensate_all(self, records: list[_Done], then: Callable[[], Any]) -> None:
+        """Compensate ``records`` one after the other, then call ``then``."""
+        if not records:
+            then()
+            return
+        first, rest = records[0], records[1:]
+        self._compensate_one(first, lambda: self._compensate_all(rest, then))
+
+    def _compensate_one(self, record: _Done, then: Callable[[], Any]) -> None:
+        """Run one activity's compensation: its handler; for a sub-process without one, its
+        compensation event sub-process, else its own completed activities in reverse."""
+        handler = record.scope.plan.compensations.get(record.node.id)
+        if handler is not None:
+            place = self._compensation_scope(record.scope, record.frame, then)
+            self._push(self._new_token(place, handler), handler)
+            return
+        child = record.child
+        esp = child.plan.compensation_handler if child is not None else None
+        if esp is None:
+            self._compensate_all(_take_done(child, "") if child is not None else [], then)
+            return
+        place = self._compensation_scope(child, child.frame, then)
+        place.done = child.done  # what a compensation throw inside the handler compensates
+        holder = self._new_token(place, esp)
+        self._begin(holder, esp.label)
+        inner = self._open(esp.child, place, holder)
+        start = esp.child.triggered_starts[0]
+        self._caught(self._new_token(inner, start), start, None)
+
+    def _compensation_scope(
+        self, scope: _Scope, frame: _Frame | None, then: Callable[[], Any]
+    ) -> _Scope:
+        """A scope beside ``scope`` (its plan, its frame) for a compensation to run in;
+        ``then`` runs when its last token is gone."""
+        place = _Scope(scope.plan, scope, None)
+        self._compensating.add(place)
+
+        def closed() -> None:
+            self._compensating.discard(place)
+            then()
+
+        place.frame, place.on_close = frame, closed
+        return place
+
+    # -- activity tags -----------------------------------------------------------------------------
+
+    def _begin(self, token: _Token, label: str) -> None:
+        """``token``'s activity starts: tagged, and remembered until it ends."""
+        self._tag(label, START)
+        self._instances += 1
+        self._running[token] = (label, self._instances)
+        if self.activity_observer is not None:
+            self.activity_observer(self.robot.name, self._instances, label, "start")
+
+    def _end(self, token: _Token, lifecycle: str) -> None:
+        """``token``'s activity, if one runs, ends: ``complete``, or ``ate_abort`` when it was
+        interrupted or cancelled."""
+        running = self._running.pop(token, None)
+        if running is None:
+            return
+        label, number = running
+        self._tag(label, lifecycle)
+        if self.activity_observer is not None:
+            how = "completed" if lifecycle == COMPLETE else self._ending
+            self.activity_observer(self.robot.name, number, label, how)
+
+    @contextlib.contextmanager
+    def _interrupting(self):
+        """The activities cancelled meanwhile were interrupted (an interrupting boundary event
+        or event sub-process), not merely cancelled."""
+        before, self._ending = self._ending, "interrupted"
+        try:
+            yield
+        finally:
+            self._ending = before
 
     # -- errors ------------------------------------------------------------------------------------
 
@@ -1063,14 +1371,29 @@ class Engine:
         return None
 
     def _uncaught(self, token: _Token, name: str) -> None:
+        self._fail(
+            token,
+            f"robot {self.robot.name}: error {name!r} thrown at {token.node.node.describe()} "
+            "was not caught; the process instance ended",
+        )
+
+    def _fail(self, token: _Token, sentence: str) -> None:
+        """End ``token``'s process instance as failed, saying why."""
         root = token.scope
         while root.parent is not None:
             root = root.parent
-        self.failures.append(
-            f"robot {self.robot.name}: error {name!r} thrown at {token.node.node.describe()} "
-            "was not caught; the process instance ended"
-        )
+        self.failures.append(sentence)
+        root.failed = True
         self._kill(root, safe=False)
+
+    def _script_limit(self, token: _Token, node: NodePlan, what: str) -> None:
+        """A script ran out of time or memory: a model error, not a BPMN error (no boundary
+        event may catch it), that ends the robot's instance."""
+        self._fail(
+            token,
+            f"robot {self.robot.name}: script task {node.node.describe()} {what}; the process "
+            "instance ended (a model error: no boundary event catches it)",
+        )
 
     # -- messages ------------------------------------------------------------------------------
 
@@ -1106,6 +1429,14 @@ class Engine:
 
 def _nothing() -> None:
     return None
+
+
+def _take_done(scope: _Scope, activity: str) -> list[_Done]:
+    """The completed activities of ``scope`` to compensate (``activity``'s instances only,
+    when named), the last completed first; they are compensated once, so they leave it."""
+    taken = [d for d in scope.done if not activity or d.node.id == activity]
+    scope.done = [d for d in scope.done if d not in taken]
+    return taken[::-1]
 
 
 def _outer(token: _Token) -> _Token:

@@ -21,7 +21,7 @@ from types import CodeType
 from typing import Any
 
 from robotale.fame_runtime.javascript import function_source, member_names, syntax_error
-from robotale.fame_runtime.model import JAVASCRIPT, PYTHON, Expression
+from robotale.fame_runtime.model import JAVASCRIPT, PYTHON, XPATH, Expression
 
 
 class BpmnError(Exception):
@@ -66,7 +66,18 @@ def compile_condition(expression: Expression) -> Compiled:
             f"evaluate (it evaluates {EVALUATED})"
         )
     text = _unwrap_placeholder(expression.text.strip())
-    return _compile(text, "eval", expression.element_id)
+    try:
+        return _compile(text, "eval", expression.element_id)
+    except ValueError:
+        if expression.stated:
+            raise
+        # no language named anywhere: the standard's default is XPath, not a Python typo
+        raise ValueError(
+            f"it is no Python or JavaScript, so it is read in {XPATH!r}, the standard's default "
+            "expression language when neither the element nor the file names one, which "
+            f"robotale does not evaluate (it evaluates {EVALUATED}: give "
+            'language="python" or language="javascript")'
+        ) from None
 
 
 def compile_script(expression: Expression) -> Compiled:

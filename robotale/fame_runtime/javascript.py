@@ -510,6 +510,15 @@ class ScriptFailure(Exception):
         self.text = text
 
 
+class ScriptLimit(ModelError):
+    """A script ran out of its CPU time or memory: a model error (no BPMN error a boundary
+    event could catch); ``what`` says which limit, as "ran out of its 64 MiB of memory"."""
+
+    def __init__(self, robot: str, what: str) -> None:
+        super().__init__(f"robot {robot}: JavaScript {what}")
+        self.what = what
+
+
 #: called when a script calls ``next(err, value)``: err is None or the error's text
 Completion = Callable[[str | None, Any], None]
 #: what a script passed to ``next``: (err, value)
@@ -553,7 +562,7 @@ class JavaScript:
     ) -> None:
         self.robot, self.bus, self.variables = robot, bus, variables
         self.schedule, self.changed, self.output = schedule, changed, output
-        self.time_limit = time_limit
+        self.time_limit, self.memory_limit = time_limit, memory_limit
         self.context = quickjs.Context()
         self.context.set_memory_limit(memory_limit)
         self.context.eval(_PRELUDE)
@@ -569,6 +578,7 @@ class JavaScript:
             hide(name, node)
         self.context.set_time_limit(time_limit)
         self._scripts: dict[str, _Script] = {}
+        self._source = ""  # the script running (what a failure is read against)
         self._opaque: set[str] = set()  # variables JavaScript holds that JSON cannot carry
         self._promises = False  # a script that may queue promise jobs was compiled
         self._mirror: dict[str, Any] = {}  # what the JavaScript side holds, by identity
@@ -592,6 +602,7 @@ class JavaScript:
         ScriptFailure when it throws."""
         self._run_ids += 1
         run = self._run_ids
+        self._source = source
         script = self._scripts.get(source) or self._compile(source)
         if script.names is not None:
             values = self._quick_values(script.names)
@@ -726,15 +737,24 @@ class JavaScript:
         """What a call that JavaScript stopped raises."""
         text = str(error)
         if "interrupted" in text:
-            return ScriptFailure(
-                f"the script ran longer than its time limit of {self.time_limit:g} s of "
-                "CPU time and was stopped"
+            return ScriptLimit(
+                self.robot,
+                f"ran longer than its time limit of {self.time_limit:g} s of CPU time",
             )
-        if "out of memory" in text:
-            return ModelError(
-                f"robot {self.robot}: JavaScript ran out of its {MEMORY_LIMIT >> 20} MiB of memory"
-            )
+        if _out_of_memory(text):
+            return self._memory_limit()
         return ScriptFailure(f"{_first_line(text)} (line {_script_line(text)})")
+
+    def _memory_limit(self) -> ScriptLimit:
+        return ScriptLimit(self.robot, f"ran out of its {self.memory_limit >> 20} MiB of memory")
+
+    def _exhausted(self, text: str | None) -> bool:
+        """Whether a script's caught failure is running out of memory: QuickJS throws null
+        when it cannot even make the error object, so a null that the script itself does not
+        throw is that."""
+        if text is not None and text != "null":
+            return _out_of_memory(text)
+        return "throw null" not in self._source
 
     def _push(self) -> str:
         """The variables that changed in Python since JavaScript last saw them, as JSON."""
@@ -868,6 +888,8 @@ class JavaScript:
                 done(effect[2], effect[3])
         elif kind == "throw":
             self._runs.pop(effect[1], None)
+            if self._exhausted(effect[2]):
+                raise self._memory_limit()
             raise ScriptFailure(f"{_first_line(effect[2])} (line {_script_line(effect[3])})")
         elif kind == "pub":
             self.bus.publish(
@@ -920,6 +942,10 @@ class JavaScript:
                 f"robot {self.robot}: a JavaScript callback on {envelope.topic} failed: "
                 f"{failure.text}"
             ) from None
+
+
+def _out_of_memory(text: str) -> bool:
+    return "out of memory" in text or "string too long" in text
 
 
 _FLAT_CONSTANTS = {"t": True, "f": False, "z": None}

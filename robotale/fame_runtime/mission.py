@@ -13,12 +13,14 @@ from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import Any
 
+from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Bus, InProcessBus
 from robotale.fame_runtime.clock import Clock, SimClock
 from robotale.fame_runtime.engine import Engine
 from robotale.fame_runtime.library import Library
-from robotale.fame_runtime.model import Definitions, Process
+from robotale.fame_runtime.model import Definitions, Problem, Process
 from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.plan import ScopePlan, deploy, findings
 from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.splitter import Assignment, split
 from robotale.fame_runtime.tags import TagSink
@@ -46,9 +48,10 @@ class Mission:
         if library is not None and not isinstance(library, Library):
             library = Library(library)
         self.assignments: list[Assignment] = split(self.definitions, robots)
+        plans = _deploy_all(self.assignments, skills or {}, library)
         self.engines: dict[str, Engine] = {
             a.robot: Engine(
-                a.process,
+                plans[id(a.process)],
                 robot=a.robot,
                 robot_type=a.robot_type,
                 bus=self.bus,
@@ -103,3 +106,25 @@ class Mission:
     @property
     def failures(self) -> list[str]:
         return [f for engine in self.engines.values() for f in engine.failures]
+
+
+def _deploy_all(
+    assignments: list[Assignment], skills: Mapping[str, Skill], library: Library | None
+) -> dict[int, ScopePlan]:
+    """Each pool's process deployed once (robots of one pool share its plan); what no pool
+    can run is refused in one ModelError naming every element of every pool, with its line."""
+    plans: dict[int, ScopePlan] = {}
+    found: list[Problem] = []
+    for assignment in assignments:
+        process = assignment.process
+        if id(process) in plans:
+            continue
+        problems = findings(process, skills=skills, library=library)
+        if problems:
+            found += problems
+            continue
+        plans[id(process)] = deploy(process, skills=skills, library=library)
+    if found:
+        lines = "\n".join(str(p) for p in found)
+        raise ModelError(f"the engine cannot run {len(found)} elements of the mission:\n{lines}")
+    return plans

@@ -16,6 +16,32 @@ from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.timers import TimerSpec
 
 PYTHON, JAVASCRIPT = "python", "javascript"
+#: the expression language BPMN 2.0 assumes when a file names none (section 8.3.1)
+XPATH = "http://www.w3.org/1999/XPath"
+
+
+@dataclass(frozen=True, slots=True)
+class Problem:
+    """One thing robotale cannot read or run in a file: where, which element, and a sentence
+    saying what is wrong and what would be accepted."""
+
+    file: str
+    line: int
+    element: str  # the element's id ("" for the file as a whole)
+    sentence: str
+    column: int = 0  # 0 when unknown
+
+    def __str__(self) -> str:
+        return f"{self.file}:{self.line}: {self.sentence}"
+
+    def as_dict(self) -> dict[str, object]:
+        return {
+            "element": self.element,
+            "file": self.file,
+            "line": self.line,
+            "column": self.column,
+            "sentence": self.sentence,
+        }
 
 
 @dataclass(frozen=True, slots=True)
@@ -23,9 +49,12 @@ class Expression:
     """A condition or script as written in the model, with where it was written."""
 
     text: str
-    language: str  # python | javascript | the raw scriptFormat of anything else
+    language: str  # python | javascript | the language URI or scriptFormat as written
     element_id: str
     line: int = 0
+    #: False when neither the element nor the file names a language: robotale reads Python
+    #: or JavaScript then, and anything else as the standard's default, XPath
+    stated: bool = True
 
 
 @dataclass(frozen=True, slots=True)
@@ -48,10 +77,11 @@ class EventDefinition:
     """What triggers or is thrown by an event."""
 
     kind: str  # signal timer conditional error terminate message escalation compensate cancel link
-    ref: str = ""  # signalRef / errorRef / messageRef as written
+    ref: str = ""  # signalRef / errorRef / messageRef / compensation's activityRef as written
     ref_name: str = ""  # the name of the referenced signal / error, "" when not declared
     timer: TimerSpec | None = None
     condition: Expression | None = None
+    wait: bool = True  # a compensation throw's waitForCompletion
 
 
 @dataclass(frozen=True, slots=True)
@@ -120,6 +150,8 @@ class Node:
     triggered_by_event: bool = False
     loop: Loop | None = None  # a loop or multi-instance marker
     quirks: list[str] = field(default_factory=list)  # what the engine would have to refuse
+    for_compensation: bool = False  # isForCompensation: run only to compensate another
+    compensation_handler: str = ""  # a compensation boundary event: its handler's id
 
     @property
     def event(self) -> EventDefinition | None:
@@ -141,6 +173,8 @@ class Scope:
 
     nodes: dict[str, Node] = field(default_factory=dict)
     flows: dict[str, Flow] = field(default_factory=dict)
+    #: bpmn:association source -> targets (a compensation boundary event -> its handler)
+    associations: dict[str, list[str]] = field(default_factory=dict)
 
 
 @dataclass(slots=True)
@@ -194,9 +228,14 @@ class Definitions:
     errors: dict[str, str] = field(default_factory=dict)  # id -> name (or errorCode)
     messages: dict[str, str] = field(default_factory=dict)  # id -> name
     escalations: dict[str, str] = field(default_factory=dict)  # id -> name (or code)
+    global_tasks: dict[str, str] = field(default_factory=dict)  # id -> globalUserTask ...
     message_flows: list[tuple[str, str, str]] = field(default_factory=list)
     #: silent choices made visible: "<file>:<line>: <element> <what happens>"
     warnings: list[str] = field(default_factory=list)
+    #: what could not be read (only when read with ``parse_all``; ``parse`` raises instead)
+    problems: list[Problem] = field(default_factory=list)
+    #: element id -> (line, column) of its start tag, for reports that name columns
+    positions: dict[str, tuple[int, int]] = field(default_factory=dict, repr=False)
 
     def pools(self) -> list[tuple[Participant, Process]]:
         """Every pool with the process it holds; a file without a collaboration has one pool

@@ -5,12 +5,16 @@ Reads what FAME's two modelers write: the thesis' ``ros:message``/``ros:payload`
 ``camunda:inputOutput``, matched by local name so any namespace URI or prefix works. It keeps
 the authors' quirks readable: signals referenced before (or without) being declared, pools
 without names, message flows, elements outside the FAME subset. A file that cannot be read
-raises :class:`~robotale.errors.ModelError` naming the file, the line and the element id.
+raises :class:`~robotale.errors.ModelError` naming the file, the line and the element id of
+every problem at once; :func:`parse_all` gives the model with its problems listed instead, so
+that ``robotale fame check`` can add what the deployer would refuse.
 """
 
 from __future__ import annotations
 
+import contextlib
 from pathlib import Path
+from xml.parsers import expat
 
 from lxml import etree
 
@@ -27,6 +31,7 @@ from robotale.fame_runtime.model import (
     Loop,
     Node,
     Participant,
+    Problem,
     Process,
     RosMessage,
     Scope,
@@ -49,7 +54,7 @@ FLOW_NODES = frozenset(EVENTS + ACTIVITIES + GATEWAYS)
 
 #: what a data association may also point at in valid BPMN; the engine moves no data there
 _NOT_DATA_OBJECTS = frozenset(
-    ("dataStoreReference", "dataStore", "dataInput", "dataOutput", "property")
+    ("dataObject", "dataStoreReference", "dataStore", "dataInput", "dataOutput", "property")
 )
 
 #: the children of extensionElements the engine reads (anything else is reported, not run)
@@ -79,20 +84,79 @@ SCOPES = frozenset(("subProcess", "transaction", "adHocSubProcess"))
 
 
 def parse(path: str | Path) -> Definitions:
-    """The model of one .bpmn file."""
+    """The model of one .bpmn file; a ModelError naming every problem of the file."""
+    definitions = parse_all(path)
+    raise_problems(definitions)
+    return definitions
+
+
+def parse_bytes(data: bytes, file: str | Path = "<string>") -> Definitions:
+    """The model of BPMN XML given as bytes; ``file`` names it in error messages."""
+    definitions = parse_all_bytes(data, file)
+    raise_problems(definitions)
+    return definitions
+
+
+def parse_all(path: str | Path) -> Definitions:
+    """The model of one .bpmn file with what could not be read in ``problems`` (the rest of
+    the file is still read). A file that is no readable XML is a ModelError."""
     path = Path(path)
     try:
         data = path.read_bytes()
     except OSError as error:
         raise ModelError(f"cannot read the BPMN file {path}: {error.strerror}") from error
-    return parse_bytes(data, path)
+    return parse_all_bytes(data, path)
 
 
-def parse_bytes(data: bytes, file: str | Path = "<string>") -> Definitions:
-    """The model of BPMN XML given as bytes; ``file`` names it in error messages."""
+def parse_all_bytes(data: bytes, file: str | Path = "<string>") -> Definitions:
+    """:func:`parse_all` of BPMN XML given as bytes."""
     file = Path(file)
     root = _xml_root(data, file)
-    return _Reader(file).definitions(root)
+    definitions = _Reader(file).definitions(root)
+    definitions.positions = _positions(data)
+    definitions.problems = [_placed(p, definitions.positions) for p in definitions.problems]
+    return definitions
+
+
+def raise_problems(definitions: Definitions) -> None:
+    """One ModelError listing every reading problem of ``definitions`` (none: nothing)."""
+    found = definitions.problems
+    if len(found) == 1:
+        raise ModelError(str(found[0]))
+    if found:
+        lines = "\n".join(str(p) for p in found)
+        raise ModelError(f"{definitions.file}: {len(found)} problems:\n{lines}")
+
+
+def _positions(data: bytes) -> dict[str, tuple[int, int]]:
+    """id -> (line, column) of each element's start tag (lxml keeps lines, not columns);
+    the first element wins when an id is shared."""
+    positions: dict[str, tuple[int, int]] = {}
+    reader = expat.ParserCreate()
+
+    def start(_name: str, attributes: dict[str, str]) -> None:
+        ident = attributes.get("id")
+        if ident and ident not in positions:
+            positions[ident] = (reader.CurrentLineNumber, reader.CurrentColumnNumber + 1)
+
+    reader.StartElementHandler = start
+    # lxml read the file: what expat reads of it before any complaint is enough for columns
+    with contextlib.suppress(expat.ExpatError):
+        reader.Parse(data, True)
+    return positions
+
+
+def _placed(problem: Problem, positions: dict[str, tuple[int, int]]) -> Problem:
+    """``problem`` with its element's column, when the element starts on its line."""
+    line, column = positions.get(problem.element, (0, 0))
+    if problem.column or line != problem.line:
+        return problem
+    return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
+
+
+def one_line(text: str | None) -> str:
+    """A name as one line: line breaks and runs of spaces are one space."""
+    return " ".join((text or "").split())
 
 
 def _xml_root(data: bytes, file: Path) -> etree._Element:
@@ -100,14 +164,28 @@ def _xml_root(data: bytes, file: Path) -> etree._Element:
     try:
         root = etree.fromstring(data, parser)
     except etree.XMLSyntaxError as error:
-        line = error.lineno or 0
-        raise ModelError(f"{file}:{line}: malformed XML: {error.msg}") from None
+        line, column = error.position if error.position else (error.lineno or 0, 0)
+        problem = Problem(str(file), line or 0, "", f"malformed XML: {error.msg}", column or 0)
+        raise ReadError(problem) from None
     if root.tag != f"{_B}definitions":
-        raise ModelError(
-            f"{file}:{root.sourceline}: not a BPMN 2.0 file: the root element is "
-            f"{etree.QName(root).localname}, not bpmn:definitions"
+        raise ReadError(
+            Problem(
+                str(file),
+                root.sourceline or 0,
+                root.get("id", ""),
+                f"not a BPMN 2.0 file: the root element is {etree.QName(root).localname}, not "
+                f"bpmn:definitions of {BPMN_NS}",
+            )
         )
     return root
+
+
+class ReadError(ModelError):
+    """A file that is no BPMN at all (not XML, another root): its one problem as data."""
+
+    def __init__(self, problem: Problem) -> None:
+        super().__init__(str(problem))
+        self.problems = [problem]
 
 
 def _local(element: etree._Element) -> str:
@@ -130,15 +208,12 @@ class _Reader:
         self.file = file
         self.signals: dict[str, str] = {}
         self.errors: dict[str, str] = {}
-        self.problems: list[str] = []  # every problem of the file, reported together
+        self.problems: list[Problem] = []  # every problem of the file, reported together
         self.warnings: list[str] = []
-        self.language = ""  # the file's expressionLanguage, when it declares one
+        self.language = ""  # the file's expressionLanguage as written, when it declares one
 
-    def fail(self, element: etree._Element, message: str) -> ModelError:
-        return ModelError(f"{self.file}:{element.sourceline}: {message}")
-
-    def problem(self, line: int | None, message: str) -> None:
-        self.problems.append(f"{self.file}:{line or 0}: {message}")
+    def problem(self, line: int | None, message: str, element: str = "") -> None:
+        self.problems.append(Problem(str(self.file), line or 0, element, message))
 
     def warn(self, line: int | None, message: str) -> None:
         self.warnings.append(f"{self.file}:{line or 0}: {message}")
@@ -151,11 +226,23 @@ class _Reader:
             for e in root.iter(f"{_B}error")
         }
         self.messages = _names(root, "message", "name")
+        self.data_stores = {
+            e.get("id", "")
+            for e in root.iter(f"{_B}dataStoreReference", f"{_B}dataStore")
+            if e.get("id")
+        }
+        #: global tasks (10.2.4) a call activity may call: id -> their kind, as written
+        global_tasks = {
+            e.get("id", ""): _local(e)
+            for e in root
+            if isinstance(e.tag, str) and _local(e).startswith("global")
+        }
         self.escalations = _names(root, "escalation", "escalationCode")
-        self.language = (root.get("expressionLanguage") or "").strip().lower()
+        self.language = (root.get("expressionLanguage") or "").strip()
         definitions = Definitions(self.file, root.get("id", ""), signals=dict(self.signals))
         definitions.errors = dict(self.errors)
         definitions.messages, definitions.escalations = self.messages, self.escalations
+        definitions.global_tasks = global_tasks
         for element in _bpmn_children(root, "process"):
             process = self.process(element)
             process.definitions = definitions
@@ -163,13 +250,8 @@ class _Reader:
         for collaboration in _bpmn_children(root, "collaboration"):
             self.collaboration(collaboration, definitions)
         self.outside_pools(definitions)
-        if len(self.problems) == 1:
-            raise ModelError(self.problems[0])
-        if self.problems:
-            raise ModelError(
-                f"{self.file}: {len(self.problems)} problems:\n" + "\n".join(self.problems)
-            )
         definitions.warnings = self.warnings
+        definitions.problems = self.problems
         return definitions
 
     def outside_pools(self, definitions: Definitions) -> None:
@@ -187,7 +269,7 @@ class _Reader:
 
     def collaboration(self, element: etree._Element, definitions: Definitions) -> None:
         for pool in _bpmn_children(element, "participant"):
-            ref = pool.get("processRef", "")
+            ref = _ref(pool, "processRef")
             if not ref:
                 continue  # a black-box pool: nobody runs it
             if ref not in definitions.processes:
@@ -195,12 +277,13 @@ class _Reader:
                     pool.sourceline,
                     f"pool {pool.get('id')} refers to process {ref}, which is not in the file "
                     f"(processes: {', '.join(definitions.processes) or 'none'})",
+                    pool.get("id", ""),
                 )
                 continue
             definitions.participants.append(self.participant(pool, definitions.processes[ref]))
         for flow in _bpmn_children(element, "messageFlow"):
             definitions.message_flows.append(
-                (flow.get("id", ""), flow.get("sourceRef", ""), flow.get("targetRef", ""))
+                (flow.get("id", ""), _ref(flow, "sourceRef"), _ref(flow, "targetRef"))
             )
 
     def participant(self, pool: etree._Element, process: Process) -> Participant:
@@ -210,10 +293,10 @@ class _Reader:
             if multiplicity is not None
             else (None, None)
         )
-        name = pool.get("name") or process.name or process.id
+        name = one_line(pool.get("name")) or process.name or process.id
         return Participant(
             pool.get("id", ""),
-            name.strip(),
+            name,
             process.id,
             multi_instance=multiplicity is not None,
             minimum=bound[0],
@@ -224,7 +307,7 @@ class _Reader:
     def process(self, element: etree._Element) -> Process:
         process = Process(
             id=self.required_id(element),
-            name=(element.get("name") or "").strip(),
+            name=one_line(element.get("name")),
             executable=element.get("isExecutable", "true") != "false",
             line=element.sourceline or 0,
             file=self.file,
@@ -234,6 +317,12 @@ class _Reader:
             for e in element.iter()
             if isinstance(e.tag, str) and _local(e) in _NOT_DATA_OBJECTS
         }
+        self.not_data_objects |= self.data_stores  # a store is the file's, whichever process
+        # an association is an artifact of the process, wherever the elements it joins are
+        self.associations: dict[str, list[str]] = {}
+        for association in element.iter(f"{_B}association"):
+            source, target = _ref(association, "sourceRef"), _ref(association, "targetRef")
+            self.associations.setdefault(source, []).append(target)
         self.scope(element, process, process)
         self.check_data_associations(process)
         return process
@@ -242,7 +331,9 @@ class _Reader:
         identifier = element.get("id")
         if not identifier:
             identifier = f"<{_local(element)} on line {element.sourceline}>"
-            self.problem(element.sourceline, f"a bpmn:{_local(element)} has no id (add one)")
+            self.problem(
+                element.sourceline, f'a bpmn:{_local(element)} has no id (add one: id="...")'
+            )
         return identifier
 
     def scope(self, element: etree._Element, scope: Scope, process: Process) -> None:
@@ -257,7 +348,11 @@ class _Reader:
             elif kind == "dataObjectReference":
                 data_object = self.data_object(child, element)
                 process.data_objects[data_object.id] = data_object
+            elif kind == "association":
+                source, target = _ref(child, "sourceRef"), _ref(child, "targetRef")
+                scope.associations.setdefault(source, []).append(target)
         self.check_flows(scope)
+        self.compensation_handlers(scope)
 
     def check_flows(self, scope: Scope) -> None:
         for flow in scope.flows.values():
@@ -268,6 +363,7 @@ class _Reader:
                         flow.line,
                         f"sequence flow {flow.id} is dangling: its {end}{where} is not an "
                         "element of the same process or sub-process",
+                        flow.id,
                     )
         for flow_id in [f.id for f in scope.flows.values() if not _joined(f, scope)]:
             del scope.flows[flow_id]  # reported above; the rest of the file is still read
@@ -276,7 +372,8 @@ class _Reader:
                 self.problem(
                     node.line,
                     f"boundary event {node.id} is attached to {node.attached_to or 'nothing'}, "
-                    "which is not in the same process",
+                    "which is not in the same process (attach it to an activity beside it)",
+                    node.id,
                 )
         self.unconditioned_choices(scope)
 
@@ -297,6 +394,25 @@ class _Reader:
                     f"a condition ({', '.join(bare)}): the engine takes the first, {bare[0]}",
                 )
 
+    def compensation_handlers(self, scope: Scope) -> None:
+        """A compensation boundary event names its handler by an association (10.6.5)."""
+        for node in scope.nodes.values():
+            if node.kind != "boundaryEvent" or node.event_kind != "compensate":
+                continue
+            targets = [t for t in self.associations.get(node.id, ()) if t in scope.nodes]
+            handlers = [t for t in targets if scope.nodes[t].for_compensation]
+            if len(handlers) == 1:
+                node.compensation_handler = handlers[0]
+                continue
+            found = ", ".join(targets) or "nothing"
+            self.problem(
+                node.line,
+                f"compensation boundary event {node.describe()} is associated with {found}: "
+                "it needs an association to exactly one activity marked "
+                'isForCompensation="true" beside it (its compensation handler)',
+                node.id,
+            )
+
     def check_data_associations(self, process: Process) -> None:
         for node in process.walk():
             for refs in (node.data_inputs, node.data_outputs):
@@ -309,26 +425,27 @@ class _Reader:
                     self.problem(
                         node.line,
                         f"{node.kind} {node.id} has a data association with {ref or 'nothing'}, "
-                        "which is no data object, data store, input, output or property of "
-                        f"process {process.id}",
+                        "which is no data object, data object reference, data store reference, "
+                        f"input, output or property of process {process.id}",
+                        node.id,
                     )
 
     def node(self, element: etree._Element, kind: str, process: Process) -> Node:
         node = Node(
             id=self.required_id(element),
             kind=kind,
-            name=(element.get("name") or "").strip(),
+            name=one_line(element.get("name")),
             line=element.sourceline or 0,
-            attached_to=element.get("attachedToRef", ""),
+            attached_to=_ref(element, "attachedToRef"),
             cancel_activity=element.get("cancelActivity", "true") != "false",
             interrupting=element.get("isInterrupting", "true") != "false",
             default_flow=element.get("default", ""),
-            called_element=(element.get("calledElement") or "").strip(),
+            called_element=_ref(element, "calledElement"),
             triggered_by_event=element.get("triggeredByEvent") == "true",
         )
         node.events = [self.event_definition(d, node) for d in element if _is_definition(d)]
         if kind in ("sendTask", "receiveTask"):  # its message, like a message event's
-            ref = element.get("messageRef", "")
+            ref = _ref(element, "messageRef")
             node.events = [EventDefinition("message", ref, self.messages.get(ref, ""))]
         self.data_associations(element, node)
         self.markers(element, node)
@@ -353,16 +470,16 @@ class _Reader:
                 node.loop = self.standard_loop(child, node)
             elif _local(child) == "multiInstanceLoopCharacteristics":
                 node.loop = self.multi_instance(child, node)
-        if element.get("isForCompensation") == "true":
-            node.quirks.append("is a compensation activity")
+        node.for_compensation = element.get("isForCompensation") == "true"
 
     def standard_loop(self, element: etree._Element, node: Node) -> Loop:
-        maximum = element.get("loopMaximum")
+        maximum = (element.get("loopMaximum") or "").strip() or None  # "" is as good as none
         if maximum is not None and _int_or_none(maximum) is None:
             self.problem(
                 element.sourceline,
                 f"the loop of {node.kind} {node.id} has loopMaximum {maximum!r}, which is no "
                 'whole number (write e.g. loopMaximum="5")',
+                node.id,
             )
         return Loop(
             "standard",
@@ -387,14 +504,7 @@ class _Reader:
             output_element=_item_name(output_item),
             condition=self.loop_expression(element, "completionCondition", node),
         )
-        if loop.cardinality is None and not loop.collection:
-            self.problem(
-                element.sourceline,
-                f"the multi-instance marker of {node.kind} {node.id} has neither a "
-                "loopCardinality nor a collection (loopDataInputRef or camunda:collection): "
-                "give one, e.g. <bpmn:loopCardinality>3</bpmn:loopCardinality>",
-            )
-        return loop
+        return loop  # without cardinality or collection it is valid BPMN the deployer refuses
 
     def loop_expression(self, element: etree._Element, name: str, node: Node):
         """``loopCardinality``, ``loopCondition`` or ``completionCondition``; Camunda's
@@ -412,25 +522,28 @@ class _Reader:
     def event_definition(self, element: etree._Element, node: Node) -> EventDefinition:
         kind = _local(element).removesuffix("EventDefinition")
         if kind == "signal":
-            ref = element.get("signalRef", "")
+            ref = _ref(element, "signalRef")
             return EventDefinition("signal", ref, self.signals.get(ref, ""))
         if kind == "error":
-            ref = element.get("errorRef", "")
+            ref = _ref(element, "errorRef")
             return EventDefinition("error", ref, self.errors.get(ref, ""))
         if kind == "timer":
             return EventDefinition("timer", timer=self.timer(element, node))
         if kind == "message":
-            ref = element.get("messageRef", "")
+            ref = _ref(element, "messageRef")
             return EventDefinition("message", ref, self.messages.get(ref, ""))
+        if kind == "compensate":
+            wait = element.get("waitForCompletion", "true") != "false"
+            return EventDefinition("compensate", _ref(element, "activityRef"), wait=wait)
         if kind == "escalation":
-            ref = element.get("escalationRef", "")
+            ref = _ref(element, "escalationRef")
             return EventDefinition("escalation", ref, self.escalations.get(ref, ""))
         if kind == "conditional":
             condition = element.find(f"{_B}condition")
             text = _text(condition)
             expression = self.expression(condition, text, node.id) if text else None
             return EventDefinition("conditional", condition=expression)
-        return EventDefinition(kind, element.get("messageRef", ""))
+        return EventDefinition(kind, _ref(element, "messageRef"))
 
     def timer(self, element: etree._Element, node: Node):
         for child in element:
@@ -441,22 +554,30 @@ class _Reader:
                     return parse_timer(_local(child), _text(child))
                 except ValueError as error:
                     self.problem(
-                        child.sourceline, f"timer event {node.describe()} is malformed: {error}"
+                        child.sourceline,
+                        f"timer event {node.describe()} is malformed: {error}",
+                        node.id,
                     )
         return None
 
     def expression(self, element: etree._Element, text: str, element_id: str) -> Expression:
-        language = (element.get("language") or self.language).lower()
-        if _is_javascript(language) or (not language and looks_like_javascript(text)):
-            language = JAVASCRIPT
-        return Expression(text, language or PYTHON, element_id, element.sourceline or 0)
+        """A condition in the language its element or the file names (as written, for
+        messages); without one, JavaScript or Python by its look, else the standard's XPath
+        (see :func:`~robotale.fame_runtime.expressions.compile_condition`)."""
+        language = (element.get("language") or self.language).strip()
+        line = element.sourceline or 0
+        if _is_javascript(language.lower()) or (not language and looks_like_javascript(text)):
+            return Expression(text, JAVASCRIPT, element_id, line)
+        if language.lower() in ("python", "py", "python3"):
+            language = PYTHON
+        return Expression(text, language or PYTHON, element_id, line, stated=bool(language))
 
     def flow(self, element: etree._Element) -> Flow:
         flow = Flow(
             id=self.required_id(element),
             source=element.get("sourceRef", ""),
             target=element.get("targetRef", ""),
-            name=(element.get("name") or "").strip(),
+            name=one_line(element.get("name")),
             line=element.sourceline or 0,
         )
         condition = element.find(f"{_B}conditionExpression")
@@ -467,17 +588,18 @@ class _Reader:
     def script(self, element: etree._Element, node: Node) -> Expression:
         body = element.find(f"{_B}script")
         text = body.text if body is not None and body.text else ""
-        script_format = (element.get("scriptFormat") or "").strip().lower()
-        if _is_javascript(script_format) or (not script_format and looks_like_javascript(text)):
+        script_format = (element.get("scriptFormat") or "").strip()
+        lowered = script_format.lower()
+        if _is_javascript(lowered) or (not script_format and looks_like_javascript(text)):
             language = JAVASCRIPT
-        elif not script_format or script_format in ("python", "py", "python3"):
+        elif not script_format or lowered in ("python", "py", "python3"):
             language = PYTHON
         else:
             language = script_format
         return Expression(text, language, node.id, body.sourceline if body is not None else 0)
 
     def data_object(self, element: etree._Element, container: etree._Element) -> DataObject:
-        ref = element.get("dataObjectRef", "")
+        ref = _ref(element, "dataObjectRef")
         target = next(
             (d for d in _bpmn_children(container, "dataObject") if d.get("id") == ref), None
         )
@@ -485,7 +607,7 @@ class _Reader:
         extensions = _Extensions(element.find(f"{_B}extensionElements"))
         parameters = {**extensions.properties, **extensions.parameters}
         return DataObject(
-            self.required_id(element), name.strip(), parameters, element.sourceline or 0
+            self.required_id(element), one_line(name), parameters, element.sourceline or 0
         )
 
     def ros_message(
@@ -504,25 +626,35 @@ class _Reader:
         try:
             qos = qos_from_policies(policies)
         except ValueError as error:
-            raise self.fail(element, f"signal event {node.describe()}: {error}") from None
+            self.problem(element.sourceline, f"signal event {node.describe()}: {error}", node.id)
+            return RosMessage(msgtype.strip(), payload)
         return RosMessage(msgtype.strip(), payload, qos, bool(policies))
 
-    def embedded_process(self, text: str, element: etree._Element) -> Process:
+    def embedded_process(self, text: str, element: etree._Element) -> Process | None:
         wrapped = (
             f'<bpmn:definitions xmlns:bpmn="{BPMN_NS}" '
             'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance" '
             'xmlns:camunda="http://camunda.org/schema/1.0/bpmn">'
             f"{text}</bpmn:definitions>"
         ).encode()
+        ident = element.get("id", "")
         try:
             definitions = parse_bytes(wrapped, self.file)
         except ModelError as error:
-            raise self.fail(
-                element,
-                f"the process embedded in call activity {element.get('id')} is unreadable: {error}",
-            ) from None
+            self.problem(
+                element.sourceline,
+                f"the process embedded in call activity {ident} is unreadable: {error}",
+                ident,
+            )
+            return None
         if not definitions.processes:
-            raise self.fail(element, f"call activity {element.get('id')} embeds no bpmn:process")
+            self.problem(
+                element.sourceline,
+                f"call activity {ident} embeds no bpmn:process (embed one, or name a "
+                "calledElement)",
+                ident,
+            )
+            return None
         return next(iter(definitions.processes.values()))
 
 
@@ -532,9 +664,16 @@ _CAMUNDA = "{http://camunda.org/schema/1.0/bpmn}"
 def _names(root: etree._Element, tag: str, fallback: str) -> dict[str, str]:
     """id -> name of every ``bpmn:<tag>`` (its ``fallback`` attribute when it has no name)."""
     return {
-        e.get("id", ""): (e.get("name") or e.get(fallback) or "").strip()
-        for e in root.iter(f"{_B}{tag}")
+        e.get("id", ""): one_line(e.get("name") or e.get(fallback)) for e in root.iter(f"{_B}{tag}")
     }
+
+
+def _ref(element: etree._Element, attribute: str) -> str:
+    """A reference as written, without the namespace prefix a QName reference may carry
+    (``processRef="bpmn2:Process_1"``, the prefix declared in the file)."""
+    value = (element.get(attribute) or "").strip()
+    prefix, colon, local = value.partition(":")
+    return local if colon and prefix in (element.nsmap or {}) else value
 
 
 def _unwrap(text: str) -> str:
@@ -579,11 +718,12 @@ class _Extensions:
         if element is not None:
             for child in element.iter():
                 self.read(child)
-            self.ignored = [
+            ignored = [
                 f"{child.prefix or 'extension'}:{_local(child)}"
                 for child in element
                 if isinstance(child.tag, str) and _local(child) not in _READ_EXTENSIONS
             ]
+            self.ignored = list(dict.fromkeys(ignored))  # each kind once
 
     def read(self, child: etree._Element) -> None:
         kind, parent = _local(child), _local(child.getparent())

@@ -3,7 +3,8 @@
 :func:`deploy` checks every element once -- scripts and conditions compiled, signal topics and
 timers resolved, call activities bound to a skill or a process -- and refuses the process with
 one :class:`~robotale.errors.ModelError` naming every element the engine cannot run.
-:func:`problems` lists the same without raising, for ``robotale fame check``.
+:func:`problems` lists the same without raising, for ``robotale fame check``, and
+:func:`findings` as :class:`~robotale.fame_runtime.model.Problem` (file, line, element).
 """
 
 from __future__ import annotations
@@ -31,6 +32,7 @@ from robotale.fame_runtime.model import (
     Definitions,
     Loop,
     Node,
+    Problem,
     Process,
     RosMessage,
     Scope,
@@ -41,22 +43,29 @@ from robotale.fame_runtime.timers import TimerSpec
 
 EMPTY_MSGTYPE = "std_msgs/msg/Empty"
 
-#: elements of BPMN the engine does not run, and why
+#: what a robot runs instead of a task kind it does not run
+_TASKS = "a task, script task, send or receive task, or a call activity bound to a skill"
+
+#: elements of BPMN the engine does not run, why, and what it would run instead
 OUTSIDE = {
-    "userTask": "needs a person",
-    "manualTask": "needs a person",
+    "userTask": f"needs a person (robotale runs {_TASKS})",
+    "manualTask": f"needs a person (robotale runs {_TASKS})",
     "serviceTask": "is a service call (use a call activity bound to a skill)",
-    "businessRuleTask": "needs a rule engine",
-    "transaction": "is a transaction",
-    "adHocSubProcess": "is an ad-hoc sub-process",
-    "complexGateway": "is a complex gateway",
-    "implicitThrowEvent": "is an implicit throw event",
+    "businessRuleTask": f"needs a rule engine (robotale runs {_TASKS})",
+    "transaction": "is a transaction (robotale runs a plain sub-process)",
+    "adHocSubProcess": "is an ad-hoc sub-process (robotale runs a plain sub-process)",
+    "complexGateway": (
+        "is a complex gateway (robotale runs exclusive, parallel, inclusive and event-based "
+        "gateways)"
+    ),
+    "implicitThrowEvent": "is an implicit throw event (robotale runs intermediate throw events)",
 }
 
 _ROLES = {
     "start": "process start event",
     "event_start": "event sub-process start event",
     "sub_start": "sub-process start event",
+    "called_start": "called process start event",
     "intermediateCatchEvent": "catching intermediate event",
     "intermediateThrowEvent": "throwing intermediate event",
     "endEvent": "end event",
@@ -66,12 +75,29 @@ _ROLES = {
 #: the event kinds each kind of event may have ("none" = no event definition)
 ALLOWED = {
     "start": {"none", "signal", "timer", "conditional", "message"},
-    "event_start": {"signal", "timer", "conditional", "error", "message", "escalation"},
+    "event_start": {
+        "signal",
+        "timer",
+        "conditional",
+        "error",
+        "message",
+        "escalation",
+        "compensate",
+    },
     "sub_start": {"none"},
+    "called_start": {"none"},
     "intermediateCatchEvent": {"signal", "timer", "conditional", "message"},
-    "intermediateThrowEvent": {"none", "signal", "message", "escalation"},
-    "endEvent": {"none", "terminate", "signal", "error", "message", "escalation"},
-    "boundaryEvent": {"signal", "timer", "conditional", "error", "message", "escalation"},
+    "intermediateThrowEvent": {"none", "signal", "message", "escalation", "compensate"},
+    "endEvent": {"none", "terminate", "signal", "error", "message", "escalation", "compensate"},
+    "boundaryEvent": {
+        "signal",
+        "timer",
+        "conditional",
+        "error",
+        "message",
+        "escalation",
+        "compensate",
+    },
 }
 _SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
 
@@ -93,12 +119,13 @@ class Trigger:
 class Throw:
     """What a throwing event publishes or raises."""
 
-    kind: str  # signal | message | error | escalation
+    kind: str  # signal | message | error | escalation | compensate
     label: str
-    topic: str
+    topic: str  # compensate: the activity to compensate ("" every completed one)
     msgtype: str = EMPTY_MSGTYPE
     payload: dict[str, str] | str | None = None
     qos: QoS = DEFAULT_QOS
+    wait: bool = True  # compensate: the thrower waits until the compensation is done
 
 
 @dataclass(slots=True, eq=False)
@@ -155,6 +182,10 @@ class ScopePlan:
     event_subprocesses: list[NodePlan] = field(default_factory=list)
     data_objects: list[DataObject] = field(default_factory=list)  # initialised on entry
     safe_state: NodePlan | None = None
+    #: activity id -> the compensation handler its compensation boundary event names
+    compensations: dict[str, NodePlan] = field(default_factory=dict)
+    #: the event sub-process whose start is a compensation event (compensates this scope)
+    compensation_handler: NodePlan | None = None
 
 
 def deploy(
@@ -166,11 +197,11 @@ def deploy(
     """The process ready to run, or a ModelError naming every element the engine cannot run."""
     planner = _Planner(skills, library)
     plan = planner.process(process, top=True)
-    if planner.problems:
+    if planner.found:
         file = f"{process.file}: " if process.file else ""
         raise ModelError(
             f"{file}the engine cannot run process {process.describe()}: "
-            + "; ".join(planner.problems)
+            + "; ".join(f"{p.sentence} (line {p.line})" for p in planner.found)
         )
     return plan
 
@@ -179,9 +210,16 @@ def problems(
     process: Process, *, skills: Collection[str] = (), library: Library | None = None
 ) -> list[str]:
     """What :func:`deploy` would refuse in ``process``, one phrase per element."""
+    return [p.sentence for p in findings(process, skills=skills, library=library)]
+
+
+def findings(
+    process: Process, *, skills: Collection[str] = (), library: Library | None = None
+) -> list[Problem]:
+    """What :func:`deploy` would refuse in ``process``, with file, line and element id."""
     planner = _Planner(skills, library)
     planner.process(process, top=True)
-    return planner.problems
+    return planner.found
 
 
 def speaks_javascript(plan: ScopePlan) -> bool:
@@ -231,14 +269,22 @@ class _Planner:
     def __init__(self, skills: Collection[str], library: Library | None) -> None:
         self.skills = skills
         self.library = library
-        self.problems: list[str] = []
+        self.found: list[Problem] = []
+        self.file = ""  # the file of the process being planned (a called one has its own)
         self.called: dict[int, ScopePlan] = {}
         self.where = ""  # which called process the planner is in, for messages
         self.definitions: Definitions | None = None  # the top process's file (messages)
         self.pool = ""  # the namespace of the top process's pool (its messages' topics)
 
     def refuse(self, node: Node, reason: str) -> None:
-        self.problems.append(f"{node.kind} {node.describe()}{self.where} {reason}")
+        self.found.append(
+            Problem(
+                self.file, node.line, node.id, f"{node.kind} {node.describe()}{self.where} {reason}"
+            )
+        )
+
+    def problem(self, line: int, element: str, sentence: str) -> None:
+        self.found.append(Problem(self.file, line, element, sentence))
 
     def process(self, process: Process, *, top: bool = False) -> ScopePlan:
         if id(process) in self.called:  # recursive calls share one plan
@@ -248,14 +294,23 @@ class _Planner:
         if top:
             self.definitions = process.definitions
             self.pool = _pool_namespace(process.definitions, process.id)
-        outer = self.where
+        outer, outer_file = self.where, self.file
+        self.file = str(process.file or "")
         if not top:
             file = f" ({process.file.name})" if process.file else ""
             self.where = f" of called process {process.describe()}{file}"
         self.scope(process, plan, top=top)
         self.where = outer
+        if not plan.starts and not plan.triggered_starts:
+            plan.starts = _implicit_starts(plan)
         if top and not plan.starts and not plan.triggered_starts:
-            self.problems.append(f"process {process.describe()} has no start event")
+            self.problem(
+                process.line,
+                process.id,
+                f"process {process.describe()} has no start event and nothing else to start "
+                "(add a bpmn:startEvent)",
+            )
+        self.file = outer_file
         return plan
 
     def scope(self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False):
@@ -266,6 +321,7 @@ class _Planner:
         self.flows(scope, plan)
         for node_plan in plan.nodes.values():
             self.gateway(node_plan)
+            self.compensation(node_plan, plan)
         plan.safe_state = next(
             (n for n in plan.event_subprocesses if _SAFE_STATE.search(n.node.name)), None
         )
@@ -278,9 +334,11 @@ class _Planner:
                 try:
                     condition = compile_condition(flow.condition)
                 except ValueError as error:
-                    self.problems.append(
+                    self.problem(
+                        flow.line,
+                        flow.id,
                         f"sequence flow {flow.id}{self.where} has a condition the engine "
-                        f"cannot run: {error}"
+                        f"cannot run: {error}",
                     )
             flow_plan = FlowPlan(flow.id, target, condition)
             source.outgoing.append(flow_plan)
@@ -291,16 +349,42 @@ class _Planner:
     def gateway(self, plan: NodePlan) -> None:
         node = plan.node
         if node.kind.endswith("Gateway") and not plan.outgoing:
-            self.refuse(node, "has no outgoing sequence flow")
+            self.refuse(node, "has no outgoing sequence flow (give it at least one)")
         if node.kind == "eventBasedGateway":
             for flow in plan.outgoing:
                 target = flow.target.node
                 if target.kind != "intermediateCatchEvent":
-                    self.refuse(node, f"leads to {target.describe()}, which is no catching event")
+                    self.refuse(
+                        node,
+                        f"leads to {target.describe()}, which is no catching event (an "
+                        "event-based gateway leads to intermediate catch events)",
+                    )
         if node.kind.startswith("start") and plan.incoming:
-            self.refuse(node, "has incoming sequence flows")
+            self.refuse(node, "has incoming sequence flows (a start event has none)")
         if node.kind == "endEvent" and plan.outgoing:
-            self.refuse(node, "has outgoing sequence flows")
+            self.refuse(node, "has outgoing sequence flows (an end event has none)")
+
+    def compensation(self, plan: NodePlan, scope: ScopePlan) -> None:
+        """A compensation boundary event binds its handler to its activity; the handler runs
+        only to compensate, never by a sequence flow (BPMN 2.0 section 10.6.5)."""
+        node = plan.node
+        if node.for_compensation and (plan.incoming or plan.outgoing):
+            self.refuse(
+                node,
+                "is a compensation handler (isForCompensation) with sequence flows: it runs "
+                "only when its activity is compensated (remove its incoming and outgoing flows)",
+            )
+        if node.kind != "boundaryEvent" or node.event_kind != "compensate":
+            return
+        handler = scope.nodes.get(node.compensation_handler)
+        if handler is not None and node.attached_to in scope.nodes:
+            scope.compensations[node.attached_to] = handler
+        if plan.outgoing:
+            self.refuse(
+                node,
+                "is a compensation boundary event with outgoing sequence flows (its handler is "
+                "joined by an association, not a flow)",
+            )
 
     def node(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
@@ -313,7 +397,7 @@ class _Planner:
             self.refuse(node, OUTSIDE[node.kind])
             return
         if len(node.events) > 1:
-            self.refuse(node, "has several event definitions")
+            self.refuse(node, "has several event definitions (robotale runs events with one)")
             return
         if node.kind.endswith("Event"):
             self.event(plan, scope, top=top, event=event)
@@ -349,7 +433,18 @@ class _Planner:
             except ValueError as error:
                 self.refuse(plan.node, f"has a loop {name} the engine cannot run: {error}")
         if loop.kind == "standard" and loop.condition is None and loop.maximum is None:
-            self.refuse(plan.node, "has a standard loop without loopCondition or loopMaximum")
+            self.refuse(
+                plan.node,
+                "has a standard loop without loopCondition or loopMaximum (give one, e.g. "
+                'loopMaximum="5")',
+            )
+        if loop.kind != "standard" and loop.cardinality is None and not loop.collection:
+            self.refuse(
+                plan.node,
+                "has a multi-instance marker with neither a loopCardinality nor a collection "
+                "(loopDataInputRef or camunda:collection), so robotale cannot tell how many "
+                "instances to run: give one, e.g. <bpmn:loopCardinality>3</bpmn:loopCardinality>",
+            )
         plan.behaviour, plan.loop = "loop", looped
 
     def activity(self, plan: NodePlan, scope: ScopePlan) -> None:
@@ -395,10 +490,24 @@ class _Planner:
             return None
         topic = message_topic(targets[0], node)
         if not topic:
-            self.refuse(node, "names no message (give the element or its message a name)")
+            self.refuse(node, self.no_message(node))
         message = node.message or RosMessage()
         msgtype = message.msgtype or EMPTY_MSGTYPE
         return Throw("message", plan.label, topic, msgtype, message.payload, message.qos)
+
+    def no_message(self, node: Node) -> str:
+        """Why a message event or task has no topic: a messageRef to nothing, or no name."""
+        ref = node.event.ref if node.event else ""
+        declared = self.definitions.messages if self.definitions else {}
+        if ref and ref not in declared:
+            known = ", ".join(sorted(declared)) or "none"
+            return (
+                f"refers to message {ref}, which the file does not declare (messages: {known}; "
+                f'declare <bpmn:message id="{ref}" name="..."/> or name the element)'
+            )
+        if ref:
+            return f"refers to message {ref}, which has no name (give it or the element one)"
+        return "names no message (give the element a name or a messageRef to a named message)"
 
     def call(self, plan: NodePlan) -> None:
         node = plan.node
@@ -407,12 +516,23 @@ class _Planner:
             plan.behaviour, plan.skill = "skill", name
             return
         process = node.embedded_process or resolve_call(name, plan.scope.process, self.library)
+        definitions = plan.scope.process.definitions
+        global_kind = definitions.global_tasks.get(name) if definitions else None
+        if process is None and global_kind:
+            self.refuse(
+                node,
+                f"calls the global task {name} (a bpmn:{global_kind}), which robotale does not "
+                "run (call a process of the file, a building block or a skill)",
+            )
+            return
         if process is None:
             where = "no skill, no process of the file" + (
                 f" and no building block in {self.library.folder}" if self.library else ""
             )
             what = (
-                f"calls {name!r}, which is {where}" if name else "calls nothing (no calledElement)"
+                f"calls {name!r}, which is {where} (name one of those)"
+                if name
+                else "calls nothing (give it a calledElement naming a skill or a process)"
             )
             self.refuse(node, what)
             return
@@ -430,19 +550,37 @@ class _Planner:
             plan.behaviour = "subprocess"
         self.scope(node.scope or Scope(), child, event=node.triggered_by_event)
         if node.triggered_by_event and len(child.triggered_starts) != 1:
-            self.refuse(node, "needs exactly one start event with a trigger")
-        if not node.triggered_by_event and len(child.starts) != 1:
-            self.refuse(node, "needs exactly one none start event")
+            found = len(child.triggered_starts) or "no"
+            self.refuse(
+                node,
+                f"is an event sub-process with {found} start events with a trigger: it needs "
+                "exactly one (a signal, timer, conditional, error, message, escalation or "
+                "compensation start event)",
+            )
+        elif node.triggered_by_event and child.triggered_starts[0].node.event_kind == "compensate":
+            scope.compensation_handler = plan
+        if not node.triggered_by_event and len(child.starts) > 1:
+            self.refuse(
+                node,
+                f"is a sub-process with {len(child.starts)} none start events: it needs one "
+                "(or none: then every element without an incoming flow starts)",
+            )
+        if not node.triggered_by_event and not child.starts:
+            child.starts = _implicit_starts(child)  # none (an empty sub-process): it completes
 
     def event(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
         role = node.kind
         if node.kind == "startEvent":
             role = "start" if top else ("event_start" if event else "sub_start")
+            if role == "sub_start" and self.called.get(id(scope.process)) is scope:
+                role = "called_start"  # the called process itself, not a sub-process of it
         if node.event_kind not in ALLOWED[role]:
-            hint = " (use a signal event, guideline G3)" if node.event_kind == "message" else ""
+            runs = ", ".join(sorted(ALLOWED[role]))
             self.refuse(
-                node, f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run{hint}"
+                node,
+                f"is a {node.event_kind} {_ROLES[role]}, which the engine does not run (it runs "
+                f"a {_ROLES[role]} of these kinds: {runs})",
             )
             return
         if catches(node):
@@ -452,11 +590,14 @@ class _Planner:
 
     def catching(self, plan: NodePlan, scope: ScopePlan) -> None:
         node = plan.node
+        if node.kind == "boundaryEvent" and node.event_kind == "compensate":
+            plan.behaviour = "boundary"  # never armed: compensation runs its handler instead
+            return
         if node.kind == "boundaryEvent":
             plan.behaviour = "boundary"
             host = scope.nodes.get(node.attached_to)
             if host is None or host.node.kind.endswith(("Event", "Gateway")):
-                self.refuse(node, "is attached to something that is no activity")
+                self.refuse(node, "is attached to something that is no activity (attach it to one)")
             else:
                 host.boundaries.append(plan)
             if node.event_kind == "error" and not node.cancel_activity:
@@ -485,22 +626,32 @@ class _Planner:
         if kind == "message":
             topic = message_topic(self.pool, node)
             if not topic:
-                self.refuse(node, "names no message (give the element or its message a name)")
+                self.refuse(node, self.no_message(node))
             return Trigger("signal", plan.label, topic, message.msgtype, message.qos)
         if kind == "escalation":
             return Trigger("escalation", plan.label, escalation_name(node))
         if kind == "timer":
             timer = node.event.timer if node.event else None
             if timer is None:
-                self.refuse(node, "is a timer without a date, duration or cycle")
+                self.refuse(
+                    node,
+                    "is a timer without a date, duration or cycle (give a timeDate, "
+                    "timeDuration or timeCycle with a value, e.g. PT10S)",
+                )
             return Trigger("timer", plan.label, timer=timer)
+        if kind == "compensate":  # an event sub-process's start: run by compensation only
+            return Trigger("compensate", plan.label)
         return self.conditional(plan)
 
     def conditional(self, plan: NodePlan) -> Trigger | None:
         node = plan.node
         expression = node.event.condition if node.event else None
         if expression is None:
-            self.refuse(node, "is a conditional event without a condition")
+            self.refuse(
+                node,
+                "is a conditional event without a condition (give its "
+                "conditionalEventDefinition a bpmn:condition)",
+            )
             return None
         try:
             return Trigger("conditional", plan.label, condition=compile_condition(expression))
@@ -528,6 +679,38 @@ class _Planner:
             plan.throw = Throw("escalation", plan.label, escalation_name(node))
         elif kind == "message":
             plan.throw = self.message_throw(plan)
+        elif kind == "compensate":
+            plan.throw = self.compensation_throw(plan)
+
+    def compensation_throw(self, plan: NodePlan) -> Throw:
+        """A compensation throw names one activity (``activityRef``) or every completed one
+        of its scope; the activity must be in the process."""
+        node = plan.node
+        event = node.event
+        ref = event.ref if event else ""
+        activities = {n.id for n in plan.scope.process.walk() if not n.kind.endswith("Event")}
+        if ref and ref not in activities:
+            self.refuse(
+                node,
+                f"compensates activity {ref}, which is no activity of process "
+                f"{plan.scope.process.describe()} (name an activity beside the event, or none "
+                "to compensate every completed one)",
+            )
+        return Throw("compensate", plan.label, ref, wait=event.wait if event else True)
+
+
+def _implicit_starts(plan: ScopePlan) -> list[NodePlan]:
+    """Where a process or sub-process without start events begins (BPMN 2.0 10.5.2): at
+    every activity, gateway and intermediate event without an incoming sequence flow (not a
+    boundary event, an event sub-process or a compensation handler)."""
+    return [
+        node
+        for node in plan.nodes.values()
+        if not node.incoming
+        and node.node.kind not in ("boundaryEvent", "startEvent")
+        and node.behaviour != "event_subprocess"
+        and not node.node.for_compensation
+    ]
 
 
 def _pool_namespace(definitions: Definitions | None, process_id: str) -> str:

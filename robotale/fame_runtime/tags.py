@@ -14,6 +14,12 @@ from dataclasses import dataclass
 
 TAG_TYPE = "robotale_msgs/msg/Tag"
 
+#: the lifecycles of activity tags: started, completed, and ended without completing
+#: (interrupted by a boundary event or an event sub-process, or cancelled)
+START, COMPLETE, ABORT = "start", "complete", "ate_abort"
+#: the roles of message tags
+SEND, RECEIVE = "send", "receive"
+
 TAG_MSGDEF = """\
 # One tagged event of a robot's mission (TALE).
 builtin_interfaces/Time stamp
@@ -31,9 +37,12 @@ class Tag:
     """One tagged event.
 
     ``stamp`` is seconds since the Unix epoch on the engine's clock (simulated time in a
-    simulation). ``lifecycle`` is ``start``, ``complete`` or ``none`` (instant events such as a
-    timer firing). Message events name the message: ``msg_role`` is ``send`` or ``receive`` and
-    every receive carries the ``msg_id`` of the send it caught; ``payload`` is JSON text.
+    simulation). ``lifecycle`` is ``start``, ``complete``, ``ate_abort`` (an activity that was
+    interrupted or cancelled ends with it instead of ``complete``: XES' standard transition for
+    an aborted activity) or ``none`` (instant events such as a timer firing). Message events
+    name the message: ``msg_role`` is ``send`` or ``receive`` and every receive carries the
+    ``msg_id`` of the send it caught, whether a catching event or a skill consumed it;
+    ``payload`` is JSON text.
     """
 
     stamp: float
@@ -65,8 +74,8 @@ class Tagger:
 
     def pair(self, activity: str, msg_id: str = "", role: str = "", payload: str = "") -> None:
         """A start and a complete tag at the same instant (events, messages)."""
-        self(activity, "start", msg_id, role, payload)
-        self(activity, "complete", msg_id, role, payload)
+        self(activity, START, msg_id, role, payload)
+        self(activity, COMPLETE, msg_id, role, payload)
 
     def new_msg_id(self) -> str:
         """The bus's next message id, or ``m_<robot>_<n>``: robot namespaces are unique in a

@@ -32,6 +32,8 @@ class BusyDeaf:
         self._bus = bus
         self._ignores = ignores  # robot -> topics
         self.engines: Mapping[str, Engine] = {}
+        #: told of each message a busy robot did not hear (the robot, the envelope)
+        self.observer: Callable[[str, Envelope], None] | None = None
 
     def __getattr__(self, name: str) -> Any:
         return getattr(self._bus, name)
@@ -47,6 +49,8 @@ class BusyDeaf:
         def deliver(envelope: Envelope) -> None:
             if self.engines[robot].idle:
                 callback(envelope)
+            elif self.observer is not None:
+                self.observer(robot, envelope)
 
         return deliver
 

@@ -3,8 +3,9 @@
 :func:`simulate_run` draws the run's setup from its seed, builds the pybullet world, one
 engine per robot (the mission split by :mod:`robotale.fame_runtime`) and a recorder tapping
 the bus, runs the clock until every engine has ended or the time limit, and writes the bag and
-its manifest (``robotale-run.json``) into a folder. A run that raises is recorded as crashed,
-with the reason; whatever was recorded until then stays in the bag.
+its manifest (``robotale-run.json``) into a folder, with the run's ground truth beside them
+(``robotale-truth.jsonl``, :mod:`robotale.sim.truth`). A run that raises is recorded as
+crashed, with the reason; whatever was recorded until then stays in the bag and the truth.
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from robotale.sim.faults import Fault, Planned
 from robotale.sim.recorder import Recorder
 from robotale.sim.setup import Setup, draw, run_seed
 from robotale.sim.skills import SKILLS
+from robotale.sim.truth import Truth
 from robotale.sim.world import SimWorld, WindowClosed
 from robotale.sim.worldspec import World
 
@@ -97,11 +99,13 @@ def simulate_run(
         seed=plan.seed,
         network=network,
     )
+    truth = Truth(clock, plan.case, [r.name for r in setup.robots])
+    truth.watch_bus(bus)
     recorder = sim = mission = None
     status, reason, detail = CRASHED, "", ""
     try:
         definitions = parse(world.model)
-        mission = _mission(world, definitions, setup, clock, bus)
+        mission = _mission(world, definitions, setup, clock, bus, truth)
         signals, errors = model_topics(definitions)
         recorder = Recorder(
             folder,
@@ -121,7 +125,8 @@ def simulate_run(
             network.locate = sim.position
         mission.start()
         sim.start()
-        _schedule(planned, clock, start, sim, mission)
+        _sample(truth, sim, clock, world.record_rate)
+        _schedule(planned, clock, start, sim, mission, truth)
         clock.run(until=start + world.time_limit, stop_when=lambda: mission.done, pace=pace)
         status = ENDED if mission.done else TIME_LIMIT
     except WindowClosed:
@@ -130,6 +135,7 @@ def simulate_run(
         reason = f"{type(error).__name__}: {error}"
         detail = traceback.format_exc(limit=8)
     finally:
+        truth.ended(status)
         if recorder is not None:
             recorder.close()
         if sim is not None:
@@ -138,6 +144,7 @@ def simulate_run(
     manifest.update(_what_happened(mission, sim, recorder, start))
     manifest["wall_time"] = round(time.perf_counter() - began, 3)
     folder.mkdir(parents=True, exist_ok=True)
+    truth.write(folder)
     write_manifest(folder, manifest)
     return manifest
 
@@ -167,7 +174,9 @@ def _what_happened(
     return facts
 
 
-def _mission(world: World, definitions: Definitions, setup: Setup, clock, bus) -> Mission:
+def _mission(
+    world: World, definitions: Definitions, setup: Setup, clock, bus, truth: Truth
+) -> Mission:
     variables = {}
     for start in setup.robots:
         spec = next(r for r in world.robots if r.name == start.group)
@@ -179,6 +188,13 @@ def _mission(world: World, definitions: Definitions, setup: Setup, clock, bus) -
         }
     groups = {spec.name: spec.busy_ignores for spec in world.robots}
     engines_bus = BusyDeaf(bus, ignores_of(groups, {s.name: s.group for s in setup.robots}))
+    engines_bus.observer = truth.busy
+    tags = bus_sink(bus)
+
+    def living(tag) -> None:
+        if tag.robot not in truth.dead:  # a dead robot's engine ends without a further tag
+            tags(tag)
+
     mission = Mission(
         definitions,
         robots=[r.name for r in setup.robots],
@@ -186,10 +202,11 @@ def _mission(world: World, definitions: Definitions, setup: Setup, clock, bus) -
         bus=engines_bus,
         skills=skills_of(world),
         library=world.library,
-        tag_sink=bus_sink(bus),
+        tag_sink=living,
         variables=variables,
     )
     engines_bus.engines = mission.engines
+    truth.watch_engines(mission.engines)
     return mission
 
 
@@ -223,7 +240,23 @@ def skill_signals(definitions: Definitions) -> frozenset[str]:
     )
 
 
-def _schedule(planned: list[Planned], clock: SimClock, start, sim: SimWorld, mission: Mission):
+def _sample(truth: Truth, sim: SimWorld, clock: SimClock, rate: float) -> None:
+    """The robots' true poses and batteries into the truth, ``rate`` times a second."""
+    period = 1.0 / rate if rate and rate > 0 else 0.5
+
+    def tick() -> None:
+        for name, robot in sim.robots.items():
+            if robot.alive:
+                pose = robot.pose
+                truth.sample(name, pose.x, pose.y, pose.z, robot.battery.level)
+        clock.call_later(period, tick)
+
+    tick()
+
+
+def _schedule(
+    planned: list[Planned], clock: SimClock, start, sim: SimWorld, mission: Mission, truth: Truth
+):
     for item in planned:
         fault = item.fault
         if not item.applied or item.at is None:
@@ -231,6 +264,7 @@ def _schedule(planned: list[Planned], clock: SimClock, start, sim: SimWorld, mis
         if fault.kind == "die":
 
             def die(name: str = fault.target) -> None:
+                truth.died(name)
                 sim.kill(name)
                 if name in mission.engines:
                     mission.engines[name].stop(safe=False)

@@ -25,8 +25,9 @@ Fire                    duration (1.0)                                          
 Explore drives a coverage path (lanes ``swath`` apart) and listens to the robot's
 ``detection`` topic. For each object it sees it throws the signal named by ``signal`` (if
 any) with the object's position, tagged ``<signal>!`` like a throw event; with ``resume_on``
-it then holds still until a message on that topic (or ``resume_after`` seconds), and with
-``stop_after`` it ends after that many finds.
+it then holds still until a message on that topic (or ``resume_after`` seconds), tagging the
+message it consumed ``<resume_on>?`` with the sender's message id as a catch event would, and
+with ``stop_after`` it ends after that many finds.
 """
 
 from __future__ import annotations
@@ -40,7 +41,16 @@ from typing import Any
 from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Envelope
 from robotale.fame_runtime.skills import Cancel, Done, Robot, Skill
-from robotale.fame_runtime.tags import TAG_TYPE, Tag, tag_topic
+from robotale.fame_runtime.tags import (
+    COMPLETE,
+    RECEIVE,
+    SEND,
+    START,
+    TAG_TYPE,
+    Tag,
+    payload_text,
+    tag_topic,
+)
 
 TWIST = "geometry_msgs/msg/Twist"
 EMPTY = "std_msgs/msg/Empty"
@@ -346,9 +356,15 @@ class _Explorer:
         self.drive.pause()
         topic = self.resume_on if self.resume_on.startswith("/") else f"/{self.resume_on}"
         self.waiting = [
-            self.robot.subscribe(topic, lambda _: self._resume()),
+            self.robot.subscribe(topic, self._heard),
             self.robot.clock.call_later(self.resume_after, self._resume),
         ]
+
+    def _heard(self, envelope: Envelope) -> None:
+        """The message it held for: consumed (a receive tag, as a catch event leaves), and on."""
+        if self.waiting:
+            receive(self.robot, envelope)
+            self._resume()
 
     def _resume(self) -> None:
         self._release()
@@ -420,13 +436,24 @@ def throw(robot: Robot, signal: str, data: Mapping[str, Any], msgtype: str) -> N
     new_id = getattr(robot.bus, "new_msg_id", None)
     msg_id = new_id() if new_id else f"m_{robot.name}_{name}_{robot.now()}"
     payload = json.dumps(data, separators=(",", ":"))
-    _tag(robot, f"{name}!", "start", msg_id, payload)
+    _tag(robot, f"{name}!", START, msg_id, payload)
     robot.bus.publish(f"/{name}", dict(data), msgtype=msgtype, sender=robot.name, msg_id=msg_id)
-    _tag(robot, f"{name}!", "complete", msg_id, payload)
+    _tag(robot, f"{name}!", COMPLETE, msg_id, payload)
 
 
-def _tag(robot: Robot, activity: str, lifecycle: str, msg_id: str, payload: str) -> None:
-    tag = Tag(robot.clock.now(), robot.name, activity, lifecycle, msg_id, "send", payload)
+def receive(robot: Robot, envelope: Envelope) -> None:
+    """Tag a signal a skill consumed, ``<signal>?`` with the sender's message id, as a catch
+    event is tagged: every message a robot consumes is a receive in the log."""
+    name = envelope.topic.strip("/")
+    payload = payload_text(envelope.data)
+    for lifecycle in (START, COMPLETE):
+        _tag(robot, f"{name}?", lifecycle, envelope.msg_id, payload, RECEIVE)
+
+
+def _tag(
+    robot: Robot, activity: str, lifecycle: str, msg_id: str, payload: str, role: str = SEND
+) -> None:
+    tag = Tag(robot.clock.now(), robot.name, activity, lifecycle, msg_id, role, payload)
     robot.bus.publish(tag_topic(robot.name), tag, msgtype=TAG_TYPE, sender=robot.name)
 
 

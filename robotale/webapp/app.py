@@ -12,6 +12,7 @@ from robotale import __version__
 from robotale.webapp import defences, errors, pages, state, uploads
 from robotale.webapp.settings import WebSettings
 from robotale.webapp.views import (
+    aggregation,
     assets,
     console,
     discover,
@@ -54,5 +55,15 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
 
 
 def _register_blueprints(app: Flask) -> None:
-    for module in (assets, logs, findings, discover, perspectives, timeline, model, console):
+    for module in (
+        assets,
+        logs,
+        findings,
+        discover,
+        aggregation,
+        perspectives,
+        timeline,
+        model,
+        console,
+    ):
         app.register_blueprint(module.blueprint)

@@ -1,10 +1,12 @@
 """The Cypher console's work: run a user's query so that it can only read, and show the rows.
 
 The checks and the running are :mod:`robotale.ekg.readonly`'s (text, plan, READ transaction,
-bounded answer). Here the console picks its Neo4j user and runs each request in a child
-process whose memory is capped (``console_memory_mb``), so that no answer can grow the
-dashboard itself. Values come in as parameters, never pasted into the text. The examples are
-the analyst's questions among the files of ``cypher/`` (``ask_*``).
+bounded answer). Here the console picks its Neo4j user and runs each request on one of a few
+long-lived worker processes whose memory is capped (``console_memory_mb``,
+:mod:`robotale.webapp.console_pool`), so that no answer can grow the dashboard itself; a
+query that outlives its time is the watchdog's (:mod:`robotale.webapp.console_watchdog`).
+Values come in as parameters, never pasted into the text. The examples are the analyst's
+questions among the files of ``cypher/`` (``ask_*``).
 
 Its user: ``ROBOTALE_CONSOLE_USER`` and ``ROBOTALE_CONSOLE_PASSWORD`` when set; otherwise, on
 robotale's local server, a user of its own that the server creates (``robotale_console``);
@@ -13,16 +15,17 @@ otherwise (``NEO4J_URI``) robotale's own user, and the page says how to give it 
 
 from __future__ import annotations
 
-import json
 import os
+import queue
 import re
-import subprocess
-import sys
+import uuid
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib.resources import files
 from typing import Any
 
-from robotale.ekg import readonly
+from neo4j import Driver
+
 from robotale.ekg.connection import Settings, database, settings
 from robotale.ekg.queries import split_statements
 from robotale.ekg.readonly import (
@@ -34,6 +37,8 @@ from robotale.ekg.readonly import (
 )
 from robotale.ekg.server import LocalServer
 from robotale.errors import InputError, RobotaleError, ServerError
+from robotale.webapp import console_watchdog
+from robotale.webapp.console_pool import Died, NoAnswer, Pool
 from robotale.webapp.settings import WebSettings
 
 __all__ = [
@@ -48,8 +53,6 @@ __all__ = [
 ]
 
 _PARAMETER = re.compile(r"\$([A-Za-z_][A-Za-z0-9_]*)")
-#: seconds the child may take beyond the query's own timeout (start, connect, send)
-_GRACE = 30
 _ERRORS: dict[str, type[RobotaleError]] = {
     error.__name__: error for error in (InputError, QueryRefused, WriteRefused, ServerError)
 }
@@ -96,10 +99,19 @@ def own_user_notice(main: Settings | None = None) -> str:
     )
 
 
-def run(text: str, parameters: dict[str, Any], web: WebSettings) -> list[dict[str, Any]]:
-    """Run a console request in a capped child process; the results as JSON-ready dicts."""
+def run(
+    text: str,
+    parameters: dict[str, Any],
+    web: WebSettings,
+    pool: Pool,
+    watchdog_driver: Callable[[], Driver],
+) -> list[dict[str, Any]]:
+    """Run a console request on one of ``pool``'s capped workers; the results as JSON-ready
+    dicts. A request that does not answer in time is the watchdog's (with robotale's own
+    connection, ``watchdog_driver``), and the user reads what became of it."""
     where = login().settings
     request = {
+        "id": uuid.uuid4().hex,
         "uri": where.uri,
         "user": where.user,
         "password": where.password,
@@ -110,39 +122,24 @@ def run(text: str, parameters: dict[str, Any], web: WebSettings) -> list[dict[st
         "bytes": web.console_byte_limit,
         "timeout": web.console_timeout,
     }
-    reply = _child(request, web)
+    try:
+        reply = pool.ask(request, web.console_timeout + web.console_grace, web.console_timeout)
+    except queue.Empty:
+        raise InputError(
+            f"The console is busy ({pool.size} queries are running): try again in a moment."
+        ) from None
+    except NoAnswer:
+        outcome = console_watchdog.stop(watchdog_driver(), request["id"])
+        raise InputError(console_watchdog.sentence(outcome, web.console_timeout)) from None
+    except Died as died:
+        if died.memory:
+            raise InputError(_too_large(web)) from None
+        raise InputError(f"The console could not run the query ({died.last_line}).") from None
     if "error" in reply:
         if reply["kind"] == "MemoryError":
             raise InputError(_too_large(web))
         raise _ERRORS.get(reply["kind"], InputError)(reply["error"])
     return reply["results"]
-
-
-def _child(request: dict[str, Any], web: WebSettings) -> dict[str, Any]:
-    command = [sys.executable, "-m", readonly.__name__, str(web.console_memory_mb)]
-    try:
-        done = subprocess.run(
-            command,
-            input=json.dumps(request),
-            capture_output=True,
-            text=True,
-            timeout=web.console_timeout + _GRACE,
-            check=False,
-        )
-    except subprocess.TimeoutExpired:
-        raise InputError(
-            f"The query did not finish within {web.console_timeout:.0f} s: narrow it (a LIMIT, "
-            "a WHERE on the log)."
-        ) from None
-    try:
-        return json.loads(done.stdout)
-    except json.JSONDecodeError:
-        pass
-    # The child died without answering: its memory cap is what ends such a query.
-    if "MemoryError" in done.stderr or done.returncode < 0:
-        return {"error": "memory", "kind": "MemoryError"}
-    last = (done.stderr.strip().splitlines() or [f"exit status {done.returncode}"])[-1]
-    raise InputError(f"The console could not run the query ({last[:300]}).")
 
 
 def _too_large(web: WebSettings) -> str:

@@ -5,7 +5,10 @@ same file twice keeps one copy), with ``<id>.json`` holding the name it was uplo
 Only files the FAME parser reads are stored, so every stored model can be drawn and checked,
 and only as :func:`sanitised` writes them again: without web content (XHTML, SVG, scripts,
 event-handler attributes, processing instructions, a DOCTYPE), which a browser could run if it
-opened the file on the dashboard's origin.
+opened the file on the dashboard's origin. The file as uploaded is kept too, in
+``originals/<id>.bpmn``, for the verification alone (it reads the scripts the sanitised copy
+lacks); nothing serves it. Two uploads that differ only in what sanitising removes share an
+id, and the later one's original is kept.
 ``links.json`` remembers which model drove which log.
 """
 
@@ -28,6 +31,7 @@ from robotale.webapp.settings import WebSettings
 
 _ID = re.compile(r"[0-9a-f]{16}")
 _LINKS = "links.json"
+_ORIGINALS = "originals"
 #: namespaces whose elements a browser renders or runs; BPMN never needs them
 _WEB_NAMESPACES = frozenset(
     {
@@ -51,6 +55,9 @@ class StoredModel:
     name: str
     path: Path
     pools: list[str]
+    #: the file as uploaded (with its scripts), never served; ``path`` for a model stored
+    #: before originals were kept
+    original: Path
 
 
 class ModelStore:
@@ -69,20 +76,23 @@ class ModelStore:
         pools = [pool.name for pool, _ in definitions.pools()]
         if not pools:
             raise InputError(f"{name!r} holds no process to show.")
-        data = sanitised(data)
-        model_id = hashlib.sha256(data).hexdigest()[:16]
-        self.folder.mkdir(parents=True, exist_ok=True)
-        write_file(self.folder / f"{model_id}.bpmn", data)
+        shown = sanitised(data)
+        model_id = hashlib.sha256(shown).hexdigest()[:16]
+        (self.folder / _ORIGINALS).mkdir(parents=True, exist_ok=True)
+        write_file(self.folder / _ORIGINALS / f"{model_id}.bpmn", data)
+        write_file(self.folder / f"{model_id}.bpmn", shown)
         meta = {"name": name, "pools": pools}
         write_file(self.folder / f"{model_id}.json", json.dumps(meta).encode())
-        return StoredModel(model_id, name, self.folder / f"{model_id}.bpmn", pools)
+        return self.get(model_id)
 
     def get(self, model_id: str) -> StoredModel:
         path = self.folder / f"{model_id}.bpmn"
         if not _ID.fullmatch(model_id or "") or not path.is_file():
             raise InputError(f"There is no stored model {model_id!r}: upload the .bpmn file.")
         meta = json.loads((self.folder / f"{model_id}.json").read_text())
-        return StoredModel(model_id, meta["name"], path, meta["pools"])
+        original = self.folder / _ORIGINALS / f"{model_id}.bpmn"
+        original = original if original.is_file() else path
+        return StoredModel(model_id, meta["name"], path, meta["pools"], original)
 
     def all(self) -> list[StoredModel]:
         if not self.folder.is_dir():

@@ -47,6 +47,7 @@ class Dashboard:
         if self._thread is not None:
             self._thread.join(timeout=10)
         state(self.app).neo4j.close()
+        state(self.app).console.close()
 
     def __enter__(self) -> Dashboard:
         return self.start()

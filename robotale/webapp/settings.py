@@ -42,8 +42,12 @@ class WebSettings:
     console_timeout: float = 30.0
     #: bytes of JSON the console sends at most (rows past them are counted, not sent)
     console_byte_limit: int = 5_000_000
-    #: megabytes the process that runs a console query may grow by
+    #: megabytes a process that runs console queries may grow by
     console_memory_mb: int = 256
+    #: processes that run console queries at once (ROBOTALE_CONSOLE_WORKERS)
+    console_workers: int = 4
+    #: seconds past the timeout before the watchdog ends a query Neo4j did not stop
+    console_grace: float = 10.0
     #: host names the dashboard answers to ("*": any)
     allowed_hosts: tuple[str, ...] = LOCAL_HOSTS
 
@@ -56,6 +60,7 @@ class WebSettings:
             upload_limit_mb=_megabytes(env.get("ROBOTALE_UPLOAD_LIMIT_MB"), cls.upload_limit_mb),
             secret_key=env.get("ROBOTALE_SECRET_KEY") or secrets.token_hex(32),
             allowed_hosts=_hosts(env.get("ROBOTALE_ALLOWED_HOSTS")),
+            console_workers=_count(env.get("ROBOTALE_CONSOLE_WORKERS"), cls.console_workers),
         )
 
 
@@ -63,6 +68,14 @@ def _hosts(value: str | None) -> tuple[str, ...]:
     # The names of this machine always stay: a remote name adds to them.
     named = (name.strip().strip("[]").lower() for name in (value or "").split(","))
     return LOCAL_HOSTS + tuple(name for name in named if name and name not in LOCAL_HOSTS)
+
+
+def _count(value: str | None, default: int) -> int:
+    if not value:
+        return default
+    if not value.strip().isdigit() or int(value) < 1:
+        raise InputError(f"ROBOTALE_CONSOLE_WORKERS is {value!r}: give a whole number, 1 or more.")
+    return int(value)
 
 
 def _megabytes(value: str | None, default: int) -> int:

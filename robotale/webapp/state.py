@@ -1,6 +1,6 @@
 """The dashboard's app-level objects, made once by ``create_app`` and kept in
 ``app.extensions``: the settings, the Neo4j driver, the background jobs, the uploads waiting for
-their column choice, the model store and the caches.
+their column choice, the model store, the console's workers and the caches.
 
 Nothing of the kind lives in a module: two apps in one process (the tests, a benchmark) each
 have their own. Views reach the current app's through :func:`state`; work that runs outside a
@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from flask import Flask, current_app
 from neo4j import Driver
 
+from robotale.webapp.console_pool import Pool
 from robotale.webapp.ingest import PendingLogs
 from robotale.webapp.jobs import Jobs
 from robotale.webapp.logdata import Cache, LogData
@@ -30,6 +31,8 @@ OVERLAYS_KEPT = 2
 class AppState:
     settings: WebSettings
     models: ModelStore
+    #: the Cypher console's capped worker processes
+    console: Pool
     neo4j: Neo4jAccess = field(default_factory=Neo4jAccess)
     jobs: Jobs = field(default_factory=Jobs)
     pending: PendingLogs = field(default_factory=PendingLogs)
@@ -41,7 +44,8 @@ class AppState:
 
 def init_app(app: Flask, settings: WebSettings) -> AppState:
     """Give ``app`` its objects."""
-    app.extensions[_KEY] = made = AppState(settings, ModelStore(settings.model_dir))
+    workers = Pool(settings.console_workers, settings.console_memory_mb)
+    app.extensions[_KEY] = made = AppState(settings, ModelStore(settings.model_dir), workers)
     return made
 
 

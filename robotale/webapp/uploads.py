@@ -3,11 +3,13 @@
 An upload is kept as ``<token>.<kind>`` in the upload folder, never under the name the browser
 sent, and only if its content is what its extension says (a CSV with a header line, an XES
 document, a zip archive). A zipped bag folder is unpacked member by member: absolute paths,
-``..``, links and archives that unpack to more than a limit are refused.
+``..``, links and archives that unpack to more than a limit (or than the free disk) are
+refused, and unpacking counts every byte it writes.
 """
 
 from __future__ import annotations
 
+import errno
 import re
 import secrets
 import shutil
@@ -26,6 +28,12 @@ _TOKEN = re.compile(r"[0-9a-f]{32}")
 _SNIFF = 64 * 1024
 #: uploads nobody ingested are removed after this many seconds
 STALE_AFTER = 24 * 3600
+#: an archive may unpack to this many times its own size (recordings and logs compress far
+#: less; a few megabytes of zeros compress a thousandfold) ...
+MAX_RATIO = 50
+#: ... or to this many bytes, whichever is more
+RATIO_FLOOR = 64 * 2**20
+_CHUNK = 1024 * 1024
 
 
 @dataclass(frozen=True)
@@ -126,23 +134,73 @@ def _check_content(path: Path, kind: str, filename: str) -> None:
         )
 
 
-def unpack(upload: Upload, limit_bytes: int) -> Path:
-    """Unpack a zip upload into a folder next to it; refuses unsafe or oversized archives."""
+def unpack(
+    upload: Upload, limit_bytes: int, ratio: int = MAX_RATIO, floor: int = RATIO_FLOOR
+) -> Path:
+    """Unpack a zip upload into a folder next to it; refuses unsafe or oversized archives.
+
+    An archive may unpack to ``limit_bytes``, and to no more than ``ratio`` times its own size
+    (at least ``floor``): a few megabytes of zeros make gigabytes. The sizes the archive
+    declares are checked first, against those limits and the free disk; then every byte
+    written is counted, and unpacking stops before the first byte past the limit."""
+    allowed = min(limit_bytes, max(floor, upload.path.stat().st_size * ratio))
     target = upload.path.with_suffix("")
     target.mkdir(exist_ok=False)
     try:
         with zipfile.ZipFile(upload.path) as archive:
             members = archive.infolist()
-            _check_members(members, upload.filename, limit_bytes)
+            _check_members(members, upload.filename, allowed)
+            budget = _Budget(upload.filename, allowed, target)
+            budget.check_disk(sum(member.file_size for member in members))
             for member in members:
-                _extract(archive, member, target)
+                _extract(archive, member, target, budget)
     except (zipfile.BadZipFile, EOFError) as error:
         shutil.rmtree(target, ignore_errors=True)
         raise InputError(f"{upload.filename!r} is a damaged zip archive ({error}).") from None
+    except OSError as error:
+        shutil.rmtree(target, ignore_errors=True)
+        if error.errno == errno.ENOSPC:
+            raise InputError(
+                f"The disk of {target.parent} is full: unpacking {upload.filename!r} needs "
+                f"{_megabytes(budget.written + budget.free_needed)} MB there."
+            ) from None
+        raise
     except BaseException:
         shutil.rmtree(target, ignore_errors=True)
         raise
     return target
+
+
+@dataclass
+class _Budget:
+    """The bytes an archive may still write, counted as they are written."""
+
+    filename: str
+    limit: int
+    target: Path
+    written: int = 0
+    free_needed: int = 0
+
+    def check_disk(self, declared: int) -> None:
+        free = shutil.disk_usage(self.target).free
+        self.free_needed = declared
+        if declared > free:
+            raise InputError(
+                f"Unpacking {self.filename!r} needs {_megabytes(declared)} MB, but the disk of "
+                f"{self.target.parent} has {_megabytes(free)} MB free."
+            )
+
+    def take(self, size: int) -> None:
+        if self.written + size > self.limit:
+            raise InputError(
+                f"{self.filename!r} unpacks to more than the limit of "
+                f"{_megabytes(self.limit)} MB; nothing past it was written."
+            )
+        self.written += size
+
+
+def _megabytes(size: int) -> str:
+    return f"{size / 2**20:.1f}".removesuffix(".0")
 
 
 def _check_members(members: list[zipfile.ZipInfo], filename: str, limit_bytes: int) -> None:
@@ -156,16 +214,20 @@ def _check_members(members: list[zipfile.ZipInfo], filename: str, limit_bytes: i
         total += member.file_size
     if total > limit_bytes:
         raise InputError(
-            f"{filename!r} unpacks to {total // 2**20} MB, more than the limit of "
-            f"{limit_bytes // 2**20} MB."
+            f"{filename!r} unpacks to {_megabytes(total)} MB, more than the limit of "
+            f"{_megabytes(limit_bytes)} MB."
         )
 
 
-def _extract(archive: zipfile.ZipFile, member: zipfile.ZipInfo, target: Path) -> None:
+def _extract(
+    archive: zipfile.ZipFile, member: zipfile.ZipInfo, target: Path, budget: _Budget
+) -> None:
     destination = target.joinpath(*PurePosixPath(member.filename).parts)
     if member.is_dir():
         destination.mkdir(parents=True, exist_ok=True)
         return
     destination.parent.mkdir(parents=True, exist_ok=True)
     with archive.open(member) as source, destination.open("wb") as out:
-        shutil.copyfileobj(source, out, 1024 * 1024)
+        while chunk := source.read(_CHUNK):
+            budget.take(len(chunk))
+            out.write(chunk)

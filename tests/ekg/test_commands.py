@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import shutil
+
 import pandas as pd
 import pytest
 
@@ -88,6 +90,54 @@ def test_ingest_maps_columns_and_picks_the_case(tmp_path, capsys, neo4j_driver, 
 def test_bad_map_option(capsys, tmp_path):
     code, _, err = run(capsys, "ingest", str(tmp_path / "x.csv"), "--map", "Zeit")
     assert code == 1 and "--map 'Zeit' is not COLUMN=FIELD" in err
+
+
+@pytest.mark.parametrize("name", ["", "   "])
+def test_an_empty_log_name_is_refused_not_replaced_by_the_files(capsys, thesis_csv, name):
+    code, _, err = run(capsys, "ingest", str(thesis_csv), "--log", name)
+    assert code == 1
+    assert err.strip() == (
+        f"robotale: --log {name!r} names no log: give it a name, or leave --log out to use "
+        "'robotic_data'."
+    )
+
+
+@pytest.mark.slow
+@pytest.mark.filterwarnings("ignore:Install the optional requirement:UserWarning")
+def test_ingest_skips_a_corrupted_run_when_asked(
+    capsys, neo4j_driver, log_name, agri_recordings, tmp_path
+):
+    from robotale.eventlog.prepare import prepare
+
+    runs = tmp_path / "runs"
+    for recorded in sorted(p for p in agri_recordings.iterdir() if p.is_dir()):
+        shutil.copytree(recorded, runs / recorded.name)
+    bad = runs / "run_0000"
+    bad.mkdir()
+    (bad / "metadata.yaml").write_text("rosbag2_bagfile_information: [\n")
+    capsys.readouterr()
+    code, _, err = run(capsys, "ingest", str(runs), "--log", log_name)
+    assert code == 1 and f"robotale: {bad} is not a readable rosbag2 directory" in err
+    assert log_name not in {log["name"] for log in list_logs(neo4j_driver)}
+    code, out, err = run(capsys, "ingest", str(runs), "--log", log_name, "--skip-bad")
+    assert code == 0, err
+    assert f"skipped run_0000: {bad} is not a readable rosbag2 directory" in err
+    assert out.strip().splitlines()[-1] == "kept 2 of 3 run(s); skipped 1: run_0000"
+    assert log_summary(neo4j_driver, log_name)["counts"]["events"] == len(prepare(agri_recordings))
+
+
+def test_a_full_disk_under_the_home_keeps_the_graph_and_says_what_was_not_kept(
+    capsys, caplog, neo4j_driver, log_name, thesis_csv, small_disk, monkeypatch
+):
+    home = small_disk("64k")  # the graph fits in Neo4j, the log's columnar copy not here
+    monkeypatch.setenv("ROBOTALE_HOME", str(home))
+    capsys.readouterr()
+    code, _, err = run(capsys, "ingest", str(thesis_csv), "--log", log_name)
+    assert code == 0, err
+    assert log_summary(neo4j_driver, log_name)["counts"]["events"] == len(pd.read_csv(thesis_csv))
+    [said] = [r.getMessage() for r in caplog.records if "was not kept" in r.getMessage()]
+    assert said.startswith(f"The columnar copy of {log_name!r} was not kept (The disk of {home}")
+    assert "is full" in said and not list(home.rglob("events.parquet*"))
 
 
 def test_xes_log_with_a_named_time_zone(tmp_path, capsys, neo4j_driver, log_name):

@@ -18,6 +18,7 @@ from pathlib import Path
 import pandas as pd
 import pytest
 from neo4j import GraphDatabase
+from patience import patience
 
 from robotale.ekg import server as server_module
 from robotale.ekg.server import CRASHED, LocalServer, PortInUse, free_port
@@ -101,6 +102,13 @@ def test_sigkill_mid_ingest_then_start_status_list_delete(tmp_path, env):
             assert listed.returncode == 0, listed.stderr
             assert f"big  [failed]  {stored:,} events" in listed.stdout
             assert "remove it with `robotale logs delete big`" in listed.stdout
+            retry = run([*ROBOTALE, "ingest", str(csv), "--log", "big"])
+            assert retry.returncode == 1
+            assert retry.stderr.strip() == (
+                f"robotale: The log 'big' in Neo4j is what a failed ingest left ({stored:,} "
+                "events): remove it with `robotale logs delete big`, or ingest again with "
+                "--replace to rebuild it."
+            )
             deleted = run([*ROBOTALE, "logs", "delete", "big"])
             assert deleted.returncode == 0, deleted.stderr
             # The database was empty before the ingest: nothing is left, not even its lock.
@@ -212,13 +220,17 @@ def test_start_after_a_crash_waits_with_a_progress_line_until_its_port_is_free(t
         assert "The local Neo4j had crashed; starting it again." in out
         assert f"is running at bolt://127.0.0.1:{bolt}" in out
         status = subprocess.run(
-            [*ROBOTALE, "neo4j", "status"], env=env, capture_output=True, text=True, timeout=60
+            [*ROBOTALE, "neo4j", "status"],
+            env=env,
+            capture_output=True,
+            text=True,
+            timeout=patience(60),
         )
         assert status.returncode == 0, status.stdout
     finally:
         if holder.stdin and not holder.stdin.closed:
             holder.stdin.close()
-        holder.wait(timeout=30)
+        holder.wait(timeout=patience(30))
         if start.poll() is None:
             start.kill()
             start.wait()

@@ -15,6 +15,8 @@ from pathlib import Path
 
 import yaml
 
+from robotale.ekg import jars
+
 REPO = Path(__file__).resolve().parents[2]
 
 
@@ -35,7 +37,9 @@ def compose_config(**env: str) -> dict:
 def test_compose_runs_neo4j_and_the_dashboard_against_it():
     config = compose_config(NEO4J_PASSWORD="a-secret-1")
     neo4j, dashboard = config["services"]["neo4j"], config["services"]["dashboard"]
-    assert neo4j["image"] == "neo4j:5.26-community"
+    assert neo4j["image"] == f"neo4j:{jars.RELEASES['2026.08'].version}-community"
+    lts = compose_config(NEO4J_PASSWORD="a-secret-1", NEO4J_VERSION="5.26")
+    assert lts["services"]["neo4j"]["image"] == "neo4j:5.26-community"
     assert neo4j["environment"]["NEO4J_AUTH"] == "neo4j/a-secret-1"
     assert "neo4j-data:/data:rw" in neo4j["volumes"]
     assert "cypher-shell" in " ".join(neo4j["healthcheck"]["test"])

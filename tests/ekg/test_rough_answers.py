@@ -61,9 +61,9 @@ def one_sentence(message: str) -> bool:
             "roles.xes line 6: the message role is the boolean true, not text",
         ),
         (
-            "log.jsonocel",
+            "log.csv",
             json.dumps(OCEL).encode(),
-            "log.jsonocel is JSON (an OCEL 2.0 log?), not a CSV or XES event log",
+            "log.csv is JSON, not CSV: an OCEL 2.0 log is read as one when its name ends in",
         ),
     ],
 )

@@ -182,6 +182,7 @@ def test_apoc_from_maven_central_through_plugins_and_overlay(env, tmp_path):
     overlay = home / "neo4j.conf"
     overlay.write_text(
         "dbms.security.procedures.unrestricted=apoc.*\n"
+        "dbms.security.procedures.allowlist=apoc.*\n"
         "server.bolt.listen_address=0.0.0.0:7687\n"
         "server.jvm.additional=-Drobotale.overlay=read\n"
     )
@@ -194,7 +195,7 @@ def test_apoc_from_maven_central_through_plugins_and_overlay(env, tmp_path):
         assert started.returncode == 0, started.stderr
         assert f"Plugins from {plugins.resolve()}: {apoc.name}" in started.stdout
         assert started.stderr.strip() == (
-            f"{overlay} line 2: server.bolt.listen_address is ignored (use --bolt-port)."
+            f"{overlay} line 3: server.bolt.listen_address is ignored (use --bolt-port)."
         )
         server = LocalServer(home)
         running = server.running()

@@ -158,3 +158,22 @@ def test_a_named_zone_is_kept_and_offsets_are_written_as_such():
     fixed = pd.Series(pd.to_datetime(["2024-03-31T01:30:00-03:30"]))
     assert timezone_name(fixed) == "-03:30"
     assert timezone_name(pd.Series(pd.to_datetime(["2024-03-31T01:30:00Z"]))) == "+00:00"
+
+
+def test_a_log_whose_events_name_no_entity_is_refused_saying_why():
+    """Building nothing from a non-empty log and saying nothing would look like success."""
+    frame = pd.DataFrame(
+        {
+            "case:concept:name": ["run"] * 3,
+            "concept:name": ["a", "b", "c"],
+            "time:timestamp": pd.to_datetime([1, 2, 3], unit="s", utc=True),
+            "robot": [None, None, None],
+        }
+    )
+    with pytest.raises(InputError) as error:
+        graph_tables(frame, ["robot"])
+    assert str(error.value) == (
+        "None of the log's 3 events has a value in its entity column(s) robot, so no entity "
+        "and no DF edge would be built; name the columns that identify what the events belong "
+        "to with --entities (e.g. --entities case)."
+    )

@@ -20,6 +20,7 @@ from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 from robotale.errors import InputError
 from robotale.eventlog.enrich import PreparationWarning
 from robotale.eventlog.prepare import TagFields, prepare
+from robotale.eventlog.rosbag import read_bag
 from robotale.sim import bagmeta
 
 STATUS = "/r1/navigate_to_pose/_action/status"
@@ -98,7 +99,10 @@ class Nav2Bag:
         message = t["action_msgs/msg/GoalStatusArray"](status_list=entries)
         self.add(seconds, STATUS, "action_msgs/msg/GoalStatusArray", message)
 
-    def write(self, path, storage="sqlite3", distro="jazzy", *, definitions=None, qos_of=None):
+    def write(
+        self, path, storage="sqlite3", distro="jazzy", *, definitions=None, qos_of=None,
+        service_def=SERVICE_DEF,
+    ):  # fmt: skip
         """The bag; ``definitions`` overrides what is stored for a type, ``qos_of`` maps topics
         to the QoS metadata.yaml gives them (the storage keeps the default)."""
         definitions = definitions or {}
@@ -117,14 +121,38 @@ class Nav2Bag:
                 w.write(connections[topic], nanos(seconds), data)
             service = w.add_connection(
                 "/r1/get_plan/_service_event", SERVICE_EVENT,
-                msgdef=SERVICE_DEF,
+                msgdef=service_def,
                 rihs01="RIHS01_" + "1" * 64,
             )  # fmt: skip
-            w.write(service, nanos(2), b"\x00\x01\x00\x00" + bytes(40))
+            for seconds, kind in ((2, 0), (2.5, 3)):  # a request sent, its response received
+                w.write(service, nanos(seconds), service_event(kind, seconds))
         bagmeta.for_distro(path, distro)
         if qos_of:
             _set_qos(path, qos_of)
         return path
+
+
+def service_event(kind: int, seconds: float) -> bytes:
+    """A BasicTypes service event's bytes, serialized by rosbags under stand-in names (CDR
+    holds no names, and rosbags' parser knows no ``srv`` folder)."""
+    store = get_typestore(Stores.ROS2_JAZZY)
+    store.register(get_types_from_msg("bool bool_value\nstring string_value\n", "sv/msg/Part"))
+    store.register(
+        get_types_from_msg(
+            "service_msgs/ServiceEventInfo info\nsv/Part[<=1] request\nsv/Part[<=1] response\n",
+            "sv/msg/Event",
+        )
+    )
+    t, n = store.types, nanos(seconds)
+    info = t["service_msgs/msg/ServiceEventInfo"](
+        event_type=kind, stamp=t["builtin_interfaces/msg/Time"](sec=n // 10**9, nanosec=n % 10**9),
+        client_gid=np.arange(16, dtype=np.uint8), sequence_number=7,
+    )  # fmt: skip
+    part = [t["sv/msg/Part"](bool_value=True, string_value="plan")]
+    event = t["sv/msg/Event"](
+        info=info, request=part if kind == 0 else [], response=part if kind == 3 else []
+    )
+    return bytes(store.serialize_cdr(event, "sv/msg/Event"))
 
 
 def _set_qos(path, qos_of: dict) -> None:
@@ -193,7 +221,7 @@ def test_action_goals_become_activities_with_their_outcome(tmp_path, storage, di
     # the status messages (numbered from 0) where each event was seen
     assert log["source_index"].tolist() == [0, 2, 3, 4, 5, 7]
     assert log["execution_id"].nunique() == 3
-    assert any("/r1/get_plan/_service_event" in w for w in warned)  # reported, skipped
+    assert not warned
 
 
 @pytest.mark.parametrize(("storage", "distro"), STORAGES_AND_DISTROS)
@@ -225,7 +253,12 @@ def test_auto_finds_actions_and_modes_and_says_so(tmp_path):
     said = []
     log, _ = quiet_prepare(bag, auto=True, report=said.append)
     assert rows(log) == by_time(GOALS + MODES)
-    assert said == ["nav: activities from --actions /*/_action/status, --state-topic /r1/mode:data"]
+    # Humble has no service events (service_msgs): the one topic that cannot be looked into
+    assert said == [
+        "nav: activities from --actions /*/_action/status, --state-topic /r1/mode:data (1 "
+        "topic(s) not looked into, their types having no definition: /r1/get_plan/_service_event "
+        "(test_msgs/srv/BasicTypes_Event); give them with --msg)"
+    ]
 
 
 @pytest.mark.parametrize(("storage", "distro"), STORAGES_AND_DISTROS)
@@ -262,18 +295,45 @@ def test_a_wrong_stored_definition_is_refused_naming_the_topic(tmp_path, storage
         "string function\nuint32 line\n"
     )
     log, _ = quiet_prepare(bag, tags="/none", states=["/rosout:name"], msg_files=[given])
-    assert rows(log) == [(at(3), "nav", "start", ""), (at(10), "nav", "complete", "")]
+    # /rosout has no namespace: its robot is the bag's only namespace
+    assert rows(log) == [(at(3), "nav", "start", "r1"), (at(10), "nav", "complete", "r1")]
 
 
 @pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
-def test_a_service_event_topic_asked_for_is_named(tmp_path, storage):
+def test_a_service_event_topic_is_read_with_the_service_definition_the_bag_stores(
+    tmp_path, storage
+):
+    """rosbag2 stores a service event's definition as the service's .srv text."""
     bag = Nav2Bag().write(tmp_path / "nav", storage)
-    with pytest.raises(InputError) as error:
-        prepare(bag, tags="/none", states=["/r1/get_plan/_service_event"], perspectives=[])
-    assert str(error.value).startswith(
-        f"{bag}: the definition of {SERVICE_EVENT} stored in the bag for "
-        "/r1/get_plan/_service_event cannot be parsed"
+    log, _ = quiet_prepare(
+        bag, tags="/none", states=["/r1/get_plan/_service_event:info.event_type"]
     )
+    # 0 (request sent) from 2 s, then 3 (response received) until the end of the recording
+    assert rows(log) == one_after_another(("0", 2, 2.5), ("3", 2.5, 10))
+    tables = read_bag(bag, ["/r1/get_plan/_service_event"])
+    assert tables["/r1/get_plan/_service_event"]["info.sequence_number"].tolist() == [7, 7]
+
+
+@pytest.mark.parametrize("storage", ["sqlite3", "mcap"])
+def test_a_service_event_without_a_definition_names_the_srv_file(tmp_path, storage):
+    bag = Nav2Bag().write(tmp_path / "nav", storage, service_def="")
+    with pytest.raises(InputError) as error:
+        prepare(
+            bag, tags="/none", states=["/r1/get_plan/_service_event:info.event_type"],
+            perspectives=[],
+        )  # fmt: skip
+    assert "the message type test_msgs/srv/BasicTypes_Event is defined neither" in str(error.value)
+    assert "--msg test_msgs/srv/BasicTypes.srv" in str(error.value)
+    srv = tmp_path / "test_msgs" / "srv" / "BasicTypes.srv"
+    srv.parent.mkdir(parents=True)
+    srv.write_text(
+        "bool bool_value\nstring string_value\n---\nbool bool_value\nstring string_value\n"
+    )
+    log, _ = quiet_prepare(
+        bag, tags="/none", states=["/r1/get_plan/_service_event:info.event_type"],
+        msg_files=[srv],
+    )  # fmt: skip
+    assert rows(log) == one_after_another(("0", 2, 2.5), ("3", 2.5, 10))
 
 
 def test_a_defaulted_robot_and_an_empty_activity_are_warnings(tmp_path):
@@ -283,8 +343,12 @@ def test_a_defaulted_robot_and_an_empty_activity_are_warnings(tmp_path):
     bag = b.write(tmp_path / "nav")
     fields = TagFields.parse(["activity=action", "lifecycle=", "robot="])
     log, warned = quiet_prepare(bag, tags="/events", tag_fields=fields, lifecycle="events")
-    assert rows(log) == [(at(6), "dock", "complete", "robot")]
-    assert any("--tag-field robot=FIELD" in w for w in warned)
+    assert rows(log) == [(at(6), "dock", "complete", "r1")]  # the bag's only namespace
+    assert any(
+        "/events (my_msgs/msg/Event) has no namespace, so its activities are of robot 'r1' "
+        "(the only namespace of its topics); name the robot with --robot NAME." in w
+        for w in warned
+    )
     assert any("1 tag(s) on /events have an empty activity" in w for w in warned)
 
 
@@ -331,8 +395,8 @@ def test_behaviour_tree_transitions_become_activities(tmp_path):
 
 
 FEEDBACK = "/r1/navigate_to_pose/_action/feedback"
-FEEDBACK_TYPE = "nav2_msgs/action/NavigateToPose_FeedbackMessage"
-#: the action's definition as nav2_msgs ships it (the parts that matter here)
+FEEDBACK_TYPE = "demo_nav_msgs/action/NavigateToPose_FeedbackMessage"
+#: the action's definition as demo_nav_msgs ships it (the parts that matter here)
 NAVIGATE_ACTION = (
     "geometry_msgs/PoseStamped pose\nstring behavior_tree\n---\nstd_msgs/Empty result\n---\n"
     "float32 distance_remaining\nint16 number_of_recoveries\n"
@@ -340,8 +404,8 @@ NAVIGATE_ACTION = (
 SEPARATOR = "=" * 80 + "\n"
 #: the feedback message's full text, as a recorder that resolves action types stores it
 FEEDBACK_DEF = (
-    "unique_identifier_msgs/UUID goal_id\nnav2_msgs/action/NavigateToPose_Feedback feedback\n"
-    f"{SEPARATOR}MSG: nav2_msgs/action/NavigateToPose_Feedback\n"
+    "unique_identifier_msgs/UUID goal_id\ndemo_nav_msgs/action/NavigateToPose_Feedback feedback\n"
+    f"{SEPARATOR}MSG: demo_nav_msgs/action/NavigateToPose_Feedback\n"
     "float32 distance_remaining\nint16 number_of_recoveries\n"
     f"{SEPARATOR}MSG: unique_identifier_msgs/UUID\nuint8[16] uuid\n"
 )
@@ -354,7 +418,7 @@ def with_feedback(stored: str) -> Nav2Bag:
     t = b.t
     for seconds, goal, left in ((2, 1, 8.0), (3, 1, 6.0), (4, 1, 2.5), (6, 2, 7.0), (7, 2, 3.0)):
         uuid = t["unique_identifier_msgs/msg/UUID"](uuid=np.full(16, goal, np.uint8))
-        feedback = t["nav2_msgs/action/NavigateToPose_Feedback"](
+        feedback = t["demo_nav_msgs/action/NavigateToPose_Feedback"](
             distance_remaining=left, number_of_recoveries=0
         )
         b.add(seconds, FEEDBACK, FEEDBACK_TYPE, t[FEEDBACK_TYPE](goal_id=uuid, feedback=feedback))
@@ -385,8 +449,8 @@ def test_an_action_file_defines_the_feedback_a_bag_leaves_undefined(tmp_path):
     bag = b.write(tmp_path / "nav", "mcap", "jazzy", definitions=b.stored)
     with pytest.raises(InputError) as error:
         prepare(bag, tags="/none", actions="/*/_action/status", rate=0, perspectives=[LEFT])
-    assert "--msg nav2_msgs/action/NavigateToPose.action" in str(error.value)
-    action = tmp_path / "nav2_msgs" / "action" / "NavigateToPose.action"
+    assert "--msg demo_nav_msgs/action/NavigateToPose.action" in str(error.value)
+    action = tmp_path / "demo_nav_msgs" / "action" / "NavigateToPose.action"
     action.parent.mkdir(parents=True)
     action.write_text(NAVIGATE_ACTION)
     log = prepare(

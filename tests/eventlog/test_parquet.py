@@ -69,7 +69,7 @@ def test_the_parts_keep_the_canonical_column_types(tmp_path, runs):
     log = prepare(runs)
     part = pads.dataset(parquet / "case=run_0001", format="parquet").to_table()
     types = {field.name: str(field.type) for field in part.schema}
-    assert types["time"] == "timestamp[us, tz=UTC]"
+    assert types["time"] == "timestamp[ns, tz=UTC]"
     for column in ("activity", "robot", "msg_id", "event_id"):
         assert types[column] == "string"
     for column in ("x", "y", "z", "battery", "source_index"):

@@ -71,3 +71,65 @@ def test_warnings_and_errors_are_one_line_each(tmp_path, bag_builder, capsys):
         )
     )
     assert not (tmp_path / "x.csv").exists()
+
+
+def _four_runs_one_corrupted(folder, bag_builder):
+    """Four runs of real bags; the third's database cut short (an interrupted copy)."""
+    for number in range(1, 5):
+        agri_like(bag_builder, x0=number).write(folder / f"run_{number:04d}")
+    [database] = (folder / "run_0003").glob("*.db3")
+    database.write_bytes(database.read_bytes()[:4096])
+    return folder / "run_0003"
+
+
+def test_a_corrupted_run_stops_prepare_before_anything_is_written(tmp_path, bag_builder, capsys):
+    bad = _four_runs_one_corrupted(tmp_path / "runs", bag_builder)
+    out = tmp_path / "log.csv"
+    assert main(["prepare", str(tmp_path / "runs"), "--out", str(out)]) == 1
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert error.startswith(f"robotale: {bad} is not a readable rosbag2 directory")
+    assert not out.exists()
+
+
+def test_skip_bad_keeps_the_good_runs_and_names_the_bad_one(tmp_path, bag_builder, capsys):
+    bad = _four_runs_one_corrupted(tmp_path / "runs", bag_builder)
+    out = tmp_path / "log.csv"
+    assert main(["prepare", str(tmp_path / "runs"), "--out", str(out), "--skip-bad"]) == 0
+    captured = capsys.readouterr()
+    skipped = [line for line in captured.err.splitlines() if "skipped" in line]
+    assert len(skipped) == 1
+    assert (
+        skipped[0]
+        .split("robotale: ")[-1]
+        .startswith(f"skipped run_0003: {bad} is not a readable rosbag2 directory")
+    )
+    assert captured.out.strip().splitlines()[-1] == "kept 3 of 4 run(s); skipped 1: run_0003"
+    written = pd.read_csv(out)
+    assert written["case"].unique().tolist() == ["run_0001", "run_0002", "run_0004"]
+    # the three good runs' events are exactly those prepared without the bad one
+    (tmp_path / "good").mkdir()
+    for run in ("run_0001", "run_0002", "run_0004"):
+        (tmp_path / "good" / run).symlink_to(tmp_path / "runs" / run)
+    alone = tmp_path / "alone.csv"
+    assert main(["prepare", str(tmp_path / "good"), "--out", str(alone)]) == 0
+    pd.testing.assert_frame_equal(written, pd.read_csv(alone))
+
+
+def test_a_full_disk_is_one_sentence_and_leaves_nothing(tmp_path, bag_builder, small_disk, capsys):
+    runs = tmp_path / "runs"
+    for number in (1, 2):
+        agri_like(bag_builder, x0=number).write(runs / f"run_{number:04d}")
+    rate = ["--rate", "20"]  # inprogress events: a log larger than the disk
+    assert main(["prepare", str(runs), "--out", str(tmp_path / "whole.csv"), *rate]) == 0
+    size = (tmp_path / "whole.csv").stat().st_size
+    disk = small_disk("8k")
+    assert size > 8 * 1024  # the log does not fit
+    out = disk / "log.csv"
+    capsys.readouterr()
+    assert main(["prepare", str(runs), "--out", str(out), *rate]) == 1
+    error = capsys.readouterr().err.strip().splitlines()[-1].split("\r")[-1]
+    assert error.startswith(f"robotale: The disk of {disk} is full: {out} needs more than the ")
+    assert error.endswith(
+        "that fitted there; nothing was written (free some space or write elsewhere)."
+    )
+    assert list(disk.iterdir()) == []

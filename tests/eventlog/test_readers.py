@@ -177,6 +177,11 @@ def test_read_log_chooses_by_extension(tmp_path, thesis_csv):
             "time,activity\n2023-05-16T10:00Z,a\nyesterday,b\n",
             r"badtime\.csv line 3: cannot read the timestamp 'yesterday'",
         ),
+        (  # the fuzz test's find: pandas reads "/1" as the year 0, which no date can hold
+            "yearzero.csv",
+            "activity,time\n2024-01-01T00:00:00Z,/1\n",
+            r"yearzero\.csv line 2: cannot read the timestamp '/1'",
+        ),
         (
             "notime2.csv",
             "time,activity\n2023-05-16T10:00Z,a\n,b\n",

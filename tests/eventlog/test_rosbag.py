@@ -69,8 +69,10 @@ def test_a_type_the_bag_does_not_define_is_named_with_how_to_register_it(tmp_pat
     with pytest.raises(InputError) as error:
         read_bag(bag)
     assert str(error.value) == (
-        f"{bag}: cannot decode /turtle/events: the message type {EVENT_TYPE} is not defined in "
-        f"the bag; register it with --msg turtle_msgs/msg/Event.msg (or a folder of .msg files)."
+        f"{bag}: cannot decode /turtle/events: the message type {EVENT_TYPE} is defined neither "
+        "in the bag nor among the Humble types robotale knows; give its definition with --msg "
+        "turtle_msgs/msg/Event.msg (a file at that path, or a folder holding "
+        "turtle_msgs/msg/Event.msg)."
     )
 
 
@@ -89,7 +91,8 @@ def test_a_missing_type_inside_a_registered_one_is_named(tmp_path, bag_builder):
         read_bag(bag, ["/arm/plan"], msg_files=[given])
     assert str(error.value).startswith(
         f"{bag}: cannot decode /arm/plan: the message type arm_msgs/msg/Target, which "
-        "arm_msgs/msg/Plan contains, is not defined in the bag; register it with --msg "
+        "arm_msgs/msg/Plan contains, is defined neither in the bag nor among the Humble types "
+        "robotale knows; give its definition with --msg "
         "arm_msgs/msg/Target.msg"
     )
     (given.parent / "Target.msg").write_text("float64 x\n")

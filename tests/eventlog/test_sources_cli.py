@@ -306,9 +306,10 @@ def test_distro_names_the_standard_types_of_a_bag_without_definitions(tmp_path, 
     )
     assert code == 1 and not out.exists()
     assert err.splitlines()[-1] == (
-        f"robotale: {bag}: cannot decode /r1/logger: the message type {LOGGER} is not defined in "
-        f"the bag; register it with --msg rcl_interfaces/msg/LoggerLevel.msg (or a folder of .msg "
-        "files)."
+        f"robotale: {bag}: cannot decode /r1/logger: the message type {LOGGER} is defined "
+        "neither in the bag nor among the Humble types robotale knows; give its definition with "
+        "--msg rcl_interfaces/msg/LoggerLevel.msg (a file at that path, or a folder holding "
+        "rcl_interfaces/msg/LoggerLevel.msg)."
     )
 
 
@@ -323,8 +324,8 @@ def test_a_topic_that_cannot_be_decoded_is_one_sentence(tmp_path, capsys):
     assert lines == [
         f"robotale: {bag}: a message on /r1/mode cannot be decoded as std_msgs/msg/String "
         f"(CDR message size mismatch for 'std_msgs/msg/String'); the definition "
-        "registered for it does not match the recording (give the right one with --msg or "
-        "--distro)."
+        "registered for it does not match the recording (give the right one with --msg "
+        "std_msgs/msg/String.msg, or the bag's distribution with --distro)."
     ]
 
 

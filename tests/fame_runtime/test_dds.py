@@ -20,6 +20,7 @@ from cyclonedds.pub import DataWriter  # noqa: E402
 from cyclonedds.sub import DataReader  # noqa: E402
 from cyclonedds.topic import Topic  # noqa: E402
 from fame_suite import MODELS  # noqa: E402
+from patience import patience  # noqa: E402
 
 from robotale.cli import main  # noqa: E402
 from robotale.fame_runtime.clock import WallClock  # noqa: E402
@@ -337,7 +338,7 @@ def test_ctrl_c_stops_every_robot_through_its_safe_state_and_closes_the_bag(tmp_
             if all(patrols(seen, robot) >= 3 for robot in ("rover", "drone")):
                 break
         os.killpg(run.pid, signal.SIGINT)
-        rest, errors = run.communicate(timeout=90)
+        rest, errors = run.communicate(timeout=patience(90))
     finally:
         if run.poll() is None:
             os.killpg(run.pid, signal.SIGKILL)
@@ -405,9 +406,9 @@ def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
         for robot in ("caller", "listener")
     }
     try:
-        said = {robot: run.communicate(timeout=120) for robot, run in nodes.items()}
+        said = {robot: run.communicate(timeout=patience(120)) for robot, run in nodes.items()}
         recorder.send_signal(signal.SIGINT)
-        recorded = recorder.communicate(timeout=60)[1]
+        recorded = recorder.communicate(timeout=patience(60))[1]
     finally:
         for run in [recorder, *nodes.values()]:
             if run.poll() is None:

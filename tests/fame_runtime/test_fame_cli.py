@@ -3,6 +3,7 @@
 import sys
 
 import pytest
+from fame_suite import PERSON
 
 from robotale.cli import main
 from robotale.fame_runtime.parser import parse
@@ -41,7 +42,11 @@ def test_check_lists_what_the_engine_cannot_run(fame_models, capsys):
     assert main(["fame", "check", str(fame_models / "fame-modeler" / "example.bpmn")]) == 1
     out = capsys.readouterr().out
     assert "structure: the engine cannot run" in out
-    assert "  Process_1: userTask Task_026c0id (Insert Card) needs a person" in out
+    model = fame_models / "fame-modeler" / "example.bpmn"
+    assert (
+        f"  {model}:100:5: Process_1: userTask Task_026c0id (Insert Card) needs a person" + PERSON
+        in out
+    )
 
 
 def test_split_prints_and_writes_one_process_per_robot(fame_models, tmp_path, capsys):

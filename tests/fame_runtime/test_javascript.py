@@ -207,7 +207,9 @@ def test_a_script_that_throws_ends_the_instance_naming_the_element_and_line(tmp_
     script = "var v = this.environment.variables;\nvar n = null;\nv.y = n.x;\nnext();"
     mission, tags = run(model(tmp_path, script, "next();"))
     engine = mission.engines["rover"]
-    assert trace(tags) == [(0.0, "rover", "s1", "start")]
+    # the uncaught error ends the instance, so the script task ends without completing
+    aborted = [(0.0, "rover", "s1", "start"), (0.0, "rover", "s1", "ate_abort")]
+    assert trace(tags, aborts=True) == aborted
     assert engine.failures == [
         "robot rover: error \"script task s1 (S1): TypeError: cannot read property 'x' of "
         'null (line 3)" thrown at s1 (S1) was not caught; the process instance ended'
@@ -232,11 +234,12 @@ def test_an_endless_loop_is_stopped_by_the_time_limit(tmp_path, monkeypatch):
         },
     )
     mission, _ = run(model(tmp_path, "while (true) {}\nnext();"))
-    assert mission.engines["rover"].failures == [
-        "robot rover: error 'script task s1 (S1): the script ran longer than its time limit of "
-        "0.2 s of CPU time and was stopped' thrown at s1 (S1) was not caught; the "
-        "process instance ended"
+    rover = mission.engines["rover"]
+    assert rover.failures == [
+        "robot rover: script task s1 (S1) ran longer than its time limit of 0.2 s of CPU time; "
+        "the process instance ended (a model error: no boundary event catches it)"
     ]
+    assert (rover.completed, rover.failed) == (0, 1)
 
 
 def test_a_syntax_error_is_refused_when_the_process_is_deployed(tmp_path):

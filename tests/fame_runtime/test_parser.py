@@ -180,7 +180,7 @@ def test_gateway_without_outgoing_flow_is_refused_naming_it(tmp_path):
     )
     assert refusal(deploy, parse(path).processes["p"]) == (
         f"{path}: the engine cannot run process p: exclusiveGateway Gateway_7 (which way?) "
-        "has no outgoing sequence flow"
+        "has no outgoing sequence flow (give it at least one) (line 3)"
     )
 
 
@@ -194,7 +194,7 @@ def test_unknown_called_element_is_refused_naming_it(tmp_path):
     message = refusal(deploy, parse(path).processes["p"], skills={"navigate"})
     assert message == (
         f"{path}: the engine cannot run process p: callActivity Call_1 (Fly) calls 'FlyAway', "
-        "which is no skill, no process of the file"
+        "which is no skill, no process of the file (name one of those) (line 3)"
     )
 
 

@@ -456,9 +456,13 @@ def test_conditional_boundary_event_cancels_nested_scopes(when):
         *pair(when, "rover", "abort_survey"),
         *pair(when, "rover", "abandon"),
     ]
+    # the cut-short activities end with ate_abort, the innermost first
+    cut = ["blink", "survey"] if when < 1 else ["survey"]
+    aborted = [t for t in trace(tags, aborts=True) if t[3] == "ate_abort"]
+    assert aborted == [(when, "rover", name, "ate_abort") for name in cut]
     assert mission.bus.topics() == []  # the 6 s photo request finds nobody listening
     mission.clock.run()
-    assert len(tags) == len(before) + 4
+    assert len(tags) == len(before) + 4 + len(cut)
 
 
 def test_conditional_event_reading_a_variable_not_set_yet_waits_for_it():

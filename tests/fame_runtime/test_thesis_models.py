@@ -2,7 +2,7 @@
 trace their structure implies; the rest is refused at deploy time, naming the elements."""
 
 import pytest
-from fame_suite import pair, run, trace
+from fame_suite import PERSON, pair, run, trace
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.library import Library
@@ -96,22 +96,26 @@ def test_process_2_each_robot_catches_its_own_signal(tests_folder):
     assert mission.engines["paperino_1"].variables["hello_world"] == {"data": "Hello World!"}
 
 
+NO_CONDITION = " (give its conditionalEventDefinition a bpmn:condition)"
+NO_TIMER = " (give a timeDate, timeDuration or timeCycle with a value, e.g. PT10S)"
+
+
 def test_general_bpmn_elements_are_refused_naming_each(fame_models):
     example = parse(fame_models / "fame-modeler" / "example.bpmn").processes["Process_1"]
     found = problems(example)
     assert sorted(found) == sorted(
         [
-            "userTask Task_026c0id (Insert Card) needs a person",
-            "userTask Task_0p47z7h (Select Amount) needs a person",
-            "userTask Task_0po6mda (Select Interaction) needs a person",
+            "userTask Task_026c0id (Insert Card) needs a person" + PERSON,
+            "userTask Task_0p47z7h (Select Amount) needs a person" + PERSON,
+            "userTask Task_0po6mda (Select Interaction) needs a person" + PERSON,
             "intermediateCatchEvent IntermediateThrowEvent_02yoqsl (Cash Withdrawn) is a "
-            "conditional event without a condition",
+            f"conditional event without a condition{NO_CONDITION}",
             "intermediateCatchEvent IntermediateCatchEvent_12qf66u (30 seconds elapsed) is a timer "
-            "without a date, duration or cycle",
+            f"without a date, duration or cycle{NO_TIMER}",
             "intermediateCatchEvent IntermediateThrowEvent_10vhtou (Balance checked) is a "
-            "conditional event without a condition",
+            f"conditional event without a condition{NO_CONDITION}",
             "boundaryEvent BoundaryEvent_Timer_non_interrupting is a timer without a date, "
-            "duration or cycle",
+            f"duration or cycle{NO_TIMER}",
         ]
     )
     # its three message events run now (each waits on its pool's topic): none is refused
@@ -126,7 +130,7 @@ def test_general_bpmn_elements_are_refused_naming_each(fame_models):
     assert str(error.value).startswith(
         f"{fame_models / 'fame-modeler' / 'example.bpmn'}: the engine cannot run process "
         "Process_1: intermediateCatchEvent IntermediateThrowEvent_02yoqsl (Cash Withdrawn) is a "
-        "conditional event without a condition; "
+        f"conditional event without a condition{NO_CONDITION} (line 49); "
     )
 
 

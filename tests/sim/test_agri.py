@@ -112,7 +112,10 @@ def test_a_tractor_running_low_goes_home_charges_until_full_and_leaves_its_weed(
     assert "move" in started[:handler] and "cut_grass" not in started
     after = [t for t in started[handler:] if not t.startswith("field_cleaned")]
     assert after[:4] == ["low_battery_handler", "low_battery", "return_to_base", "battery_full"]
-    assert [t.lifecycle for t in tractor if t.activity == "move"] == ["start"]  # interrupted
+    assert [t.lifecycle for t in tractor if t.activity == "move"] == [
+        "start",
+        "ate_abort",
+    ]  # interrupted
     full = next(t for t in tractor if t.activity == "battery_full")
     levels = [
         m.percentage

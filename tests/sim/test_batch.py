@@ -148,6 +148,8 @@ def test_the_command_simulates_a_batch_and_reports_it(tmp_path, capsys):
         (["agri", "--weeds", "many"], "--weeds 'many' must be a number or LOW-HIGH"),
         (["rexdingo", "--weeds", "2"], "this world has no weeds to count"),
         (["agri", "--gui"], "--gui needs a display"),
+        (["agri", "--runs", "0"], "--runs 0: give the number of runs to simulate, 1 or more."),
+        (["agri", "--runs", "-2"], "--runs -2: give the number of runs to simulate, 1 or more."),
     ],
 )
 def test_mistakes_are_one_sentence_and_write_nothing(
@@ -161,6 +163,35 @@ def test_mistakes_are_one_sentence_and_write_nothing(
     assert error.startswith("robotale: ") and message in error
     assert len(error.strip().splitlines()) == 1
     assert not out.exists()
+
+
+def test_a_batch_with_crashed_runs_exits_non_zero_naming_them(tmp_path, capsys):
+    folder = tmp_path / "mine"
+    rover_world(folder, "undefined_name")  # a NameError when the rover starts east
+    out = tmp_path / "runs"
+    arguments = ["simulate", "--world", str(folder / "rover.yaml"), "--runs", "6", "--seed", "5"]
+    assert main([*arguments, "--out", str(out), "--quiet", "--workers", "0"]) == 1
+    runs = [manifest(out / f"run_{i:04d}") for i in range(1, 7)]
+    crashed = [r for r in runs if r["outcome"]["status"] == "crashed"]
+    assert crashed and len(crashed) < 6  # the seed gives both kinds; the good runs are kept
+    error = capsys.readouterr().err.strip()
+    which = "; ".join(f"{r['case']}: {r['outcome']['reason']}" for r in crashed)
+    assert error == f"robotale: {len(crashed)} of 6 run(s) crashed ({which})."
+    assert "NameError" in crashed[0]["outcome"]["reason"]
+
+
+def test_a_full_disk_is_one_sentence_and_keeps_only_whole_runs(small_disk, capsys):
+    out = small_disk("200k") / "runs"  # one rexdingo run fits, two do not
+    arguments = ["simulate", "rexdingo", "--runs", "2", "--quiet", "--workers", "0"]
+    assert main([*arguments, "--out", str(out)]) == 1
+    error = capsys.readouterr().err.strip()
+    assert error.startswith(f"robotale: The disk of {out} is full: 2 runs need about ")
+    assert error.endswith(
+        "and only 1 fitted; they are kept whole, the run that did not fit was removed."
+    )
+    assert sorted(p.name for p in out.iterdir()) == ["run_0001"]  # no hidden partial run
+    assert manifest(out / "run_0001")["outcome"]["status"] == "ended"
+    assert (out / "run_0001" / "metadata.yaml").is_file()
 
 
 def test_pace_slows_a_run_down_to_the_wall_clock_for_a_person_watching(tmp_path, capsys):

@@ -12,6 +12,7 @@ from pathlib import Path
 import dask
 import pandas as pd
 import pytest
+from patience import patience
 from simbags import manifest
 from test_batch import east, rover_world
 
@@ -175,7 +176,7 @@ def test_runs_and_a_dataset_written_to_an_ftp_url_are_the_local_ones(
     url, home = ftp
     # a test before may have killed workers: their nannies bring them back
     with distributed.Client(cluster.replace("dask://", "tcp://")) as client:
-        client.wait_for_workers(2, timeout=120)
+        client.wait_for_workers(2, timeout=patience(120))
     world = adjust(short_agri, time_limit=30)
     batch = plans(world, "agri", runs=2, seed=3)
     local = tmp_path / "local"

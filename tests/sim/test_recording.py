@@ -108,6 +108,7 @@ def test_a_runs_storage_file_carries_the_runs_name(short_agri, tmp_path):
     assert sorted(p.name for p in bag.iterdir()) == [
         "metadata.yaml",
         "robotale-run.json",
+        "robotale-truth.jsonl",
         "run_0001.db3",
     ]
     assert not list((tmp_path / "runs").glob(".*")), "no hidden partial folder is left behind"

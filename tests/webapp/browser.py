@@ -62,3 +62,13 @@ def wait_for(page: Any, expression: str, timeout: float = 60.0) -> Any:
         if time.monotonic() > deadline:
             raise TimeoutError(f"{expression} was still false after {timeout:.0f} s")
         page.wait_for_timeout(100)
+
+
+def upload_model(page: Any, path: Path) -> None:
+    """Upload a .bpmn on the Model page and wait until bpmn-js has drawn it."""
+    from playwright.sync_api import expect  # the browser tests' extra, as in launch
+
+    page.goto(page.base_url + "/model")
+    page.set_input_files("input[name=model]", str(path))
+    page.click("form.inline-form button[type=submit]")
+    expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")

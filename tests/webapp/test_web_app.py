@@ -13,6 +13,7 @@ import urllib.request
 from pathlib import Path
 
 import pytest
+from patience import patience
 
 from robotale.ekg.server import free_port
 from robotale.webapp import create_app
@@ -141,13 +142,14 @@ def test_robotale_serve_answers(neo4j_server, tmp_path):
         assert "Cypher console" in body
     finally:
         process.terminate()
-        _, stderr = process.communicate(timeout=20)
+        _, stderr = process.communicate(timeout=patience(20))
     assert f"robotale dashboard at http://127.0.0.1:{port}/discover?log=agri+runs" in stderr
     # NEO4J_URI names the server: the console would log in as robotale's own user
     assert "ROBOTALE_CONSOLE_USER and ROBOTALE_CONSOLE_PASSWORD" in stderr
 
 
 def _wait_for(url: str, process: subprocess.Popen, timeout: float = 60) -> str:
+    timeout = patience(timeout)
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline:
         assert process.poll() is None, process.communicate()[1]

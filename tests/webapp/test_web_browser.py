@@ -8,7 +8,7 @@ import subprocess
 import sys
 
 import pytest
-from browser import wait_for
+from browser import upload_model, wait_for
 from playwright.sync_api import expect
 
 pytestmark = pytest.mark.browser
@@ -39,10 +39,7 @@ def test_model_page_draws_an_uploaded_collaboration(page, fame_models):
     from robotale.fame_runtime.parser import parse
 
     agri = fame_models / "fame-ros" / "agri.bpmn"
-    page.goto(page.base_url + "/model")
-    page.set_input_files("input[name=model]", str(agri))
-    page.click("form.inline-form button[type=submit]")
-    expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")
+    upload_model(page, agri)
     drawn = set(
         page.eval_on_selector_all("[data-element-id]", "els => els.map(e => e.dataset.elementId)")
     )

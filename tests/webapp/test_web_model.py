@@ -28,8 +28,11 @@ def test_models_are_stored_once_by_content_and_linked_to_logs(tmp_path, agri):
     store.link("agri", first.id)
     assert store.linked("agri").id == first.id
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted(
-        [f"{first.id}.bpmn", f"{first.id}.json", "links.json"]
+        [f"{first.id}.bpmn", f"{first.id}.json", "links.json", "originals"]
     )
+    # the upload itself, kept for the verification (it reads the scripts), never served
+    assert store.get(first.id).original == tmp_path / "originals" / f"{first.id}.bpmn"
+    assert store.get(first.id).original.read_bytes() == agri.read_bytes()
 
 
 @pytest.mark.parametrize(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import io
 import os
+import shutil
 import time
 import zipfile
 
@@ -103,3 +104,40 @@ def test_stale_uploads_are_removed(tmp_path, thesis_csv):
     os.utime(tmp_path / "notes.txt", (day_ago, day_ago))
     assert uploads.remove_stale(tmp_path) == 1
     assert sorted(p.name for p in tmp_path.iterdir()) == sorted([fresh.path.name, "notes.txt"])
+
+
+def _zip_of_zeros(path, megabytes: int) -> None:
+    # written in pieces: the archive's content is never in memory at once
+    with (
+        zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED, compresslevel=9) as archive,
+        archive.open("run/zeros.bin", "w", force_zip64=True) as member,
+    ):
+        for _ in range(megabytes):
+            member.write(bytes(2**20))
+
+
+def test_a_zip_bomb_writes_nothing_past_the_limit(tmp_path, small_disk):
+    bomb = tmp_path / "bomb.zip"
+    _zip_of_zeros(bomb, 1024)  # 1 GB of zeros in about 1 MB
+    assert bomb.stat().st_size < 2 * 2**20
+    disk = small_disk("16m")  # far less than the bomb, more than the archive
+    with bomb.open("rb") as stream:
+        upload = uploads.save(stream, "bomb.zip", disk)
+    with pytest.raises(InputError) as refused:
+        uploads.unpack(upload, limit_bytes=10 * 2**30)
+    assert str(refused.value) == "'bomb.zip' unpacks to 1024 MB, more than the limit of 64 MB."
+    assert [p.name for p in disk.iterdir()] == [upload.path.name]
+
+
+def test_an_archive_larger_than_the_free_disk_is_refused_before_unpacking(small_disk):
+    disk = small_disk("8m")
+    entries = {"run/noise.bin": os.urandom(5 * 2**20)}  # does not compress
+    upload = uploads.save(zipped(entries), "noise.zip", disk)
+    free = shutil.disk_usage(disk).free
+    with pytest.raises(InputError) as refused:
+        uploads.unpack(upload, limit_bytes=2**30)
+    assert str(refused.value) == (
+        f"Unpacking 'noise.zip' needs 5 MB, but the disk of {disk} has "
+        f"{free / 2**20:.1f} MB free.".replace(".0 MB", " MB")
+    )
+    assert [p.name for p in disk.iterdir()] == [upload.path.name]

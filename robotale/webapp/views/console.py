@@ -8,9 +8,12 @@ from flask import Blueprint, jsonify, render_template, request
 
 from robotale.errors import InputError, RobotaleError
 from robotale.webapp import console, pages
+from robotale.webapp.json_body import read_json
 from robotale.webapp.state import state
 
 blueprint = Blueprint("console", __name__)
+#: what the console's endpoint takes
+_SHAPE = '{"query": "...", "parameters": {...}}'
 
 
 @blueprint.get("/cypher")
@@ -35,11 +38,12 @@ def _notice() -> str:
 
 @blueprint.post("/api/cypher")
 def run():
-    body = request.get_json(silent=True)
+    body = read_json(request, _SHAPE)
     if not isinstance(body, dict) or not isinstance(body.get("query"), str):
-        raise InputError('Send {"query": "...", "parameters": {...}} as JSON.')
+        raise InputError(f"Send {_SHAPE} as JSON.")
     parameters = body.get("parameters") or {}
     if not isinstance(parameters, dict):
         raise InputError('The parameters must be a JSON object, e.g. {"log": "agri"}.')
-    results = console.run(body["query"], parameters, state().settings)
+    app = state()
+    results = console.run(body["query"], parameters, app.settings, app.console, app.neo4j.driver)
     return jsonify(results=results)

@@ -11,14 +11,19 @@ from flask import Blueprint, Response, jsonify, redirect, render_template, reque
 
 from robotale.ekg.logs import log_robots
 from robotale.errors import InputError, ModelError
+from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.splitter import split
+from robotale.fame_runtime.verify import verify
 from robotale.webapp import overlay, pages
 from robotale.webapp.logdata import log_info
 from robotale.webapp.model_store import ModelStore, StoredModel
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("model", __name__)
+
+#: how long the Model page's verification may explore before it reports what it found
+VERIFY_SECONDS = 20.0
 
 
 @blueprint.get("/model")
@@ -81,6 +86,27 @@ def xml(model_id: str):
     response.headers["Content-Disposition"] = f'attachment; filename="{model_id}.bpmn"'
     response.headers["Content-Security-Policy"] = "default-src 'none'; sandbox"
     return response
+
+
+@blueprint.get("/api/models/<model_id>/verify")
+def verification(model_id: str):
+    """What ``robotale fame verify`` finds in the model, each finding with its trace and the
+    elements to highlight. Call activities are resolved among the stored models; one calling
+    nothing stored runs like a skill. The model is verified as uploaded, scripts included
+    (the page draws it without them)."""
+    current = state()
+    model = current.models.get(model_id)
+    return jsonify(
+        current.overlays.get(
+            ("", "", "verify", model_id),
+            lambda: verify(
+                parse(model.original),
+                library=Library(model.original.parent),
+                opaque_calls=True,
+                timeout=VERIFY_SECONDS,
+            ).as_dict(),
+        )
+    )
 
 
 @blueprint.get("/api/models/<model_id>/frequencies")

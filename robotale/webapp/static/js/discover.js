@@ -12,6 +12,8 @@
   const DEFAULT_EDGES = 150;
   const ekgForm = document.getElementById("ekg-form");
   const dfgForm = document.getElementById("dfg-form");
+  const aggregationForm = document.getElementById("aggregation-form");
+  const levelBox = document.getElementById("aggregation-level");
   const state = { log: "", view: "ekg", graph: null, robotFilter: [], edges: DEFAULT_EDGES };
 
   function setView(view) {
@@ -26,6 +28,10 @@
 
   function graphUrl() {
     const params = new URLSearchParams({ log: state.log });
+    if (state.view === "aggregation") {
+      params.append("level", levelBox.value);
+      return `/api/aggregation/graph?${params}`;
+    }
     if (state.view === "ekg") {
       for (const box of ekgForm.querySelectorAll("input[name=by]:checked")) params.append("by", box.value);
       for (const box of ekgForm.querySelectorAll("input[name=edges]:checked")) params.append("edges", box.value);
@@ -39,6 +45,11 @@
 
   async function discover() {
     robotale.clearError();
+    if (state.view === "aggregation" && !levelBox.value) {
+      status.textContent = "No aggregation steps yet: run a specification.";
+      graphBox.replaceChildren();
+      return;
+    }
     status.textContent = "discovering…";
     state.robotFilter = state.view === "dfg" ? selected("robot") : [];
     try {
@@ -54,7 +65,9 @@
   function draw() {
     const graph = state.graph;
     const activities = graph.nodes.filter((n) => n.kind === "activity").length;
-    status.textContent = `${graph.kind.toUpperCase()}: ${activities} activities, ${graph.edges.length} edges`;
+    status.textContent = graph.kind === "aggregates"
+      ? `Level ${graph.level}: ${graph.nodes.length} aggregates, ${graph.edges.length} edges`
+      : `${graph.kind.toUpperCase()}: ${activities} activities, ${graph.edges.length} edges`;
     graphBox.dataset.kind = graph.kind;
     showNode(null);
     const total = graph.edges.length;
@@ -145,6 +158,31 @@
     }
   }
 
+  // The steps stored for the log: a table, and the levels one can draw (the last by default).
+  async function loadSteps() {
+    const { steps } = await robotale.api(`/api/aggregation/steps?log=${encodeURIComponent(state.log)}`);
+    document.getElementById("aggregation-steps").replaceChildren(...steps.map((step) =>
+      robotale.el("tr", {}, robotale.el("th", { text: `step ${step.step}` }),
+        robotale.el("td", { text: `${step.aggregates ?? 0} aggregates` }),
+        robotale.el("td", { text: step.spec }))));
+    levelBox.replaceChildren(...steps.map((step) =>
+      robotale.el("option", { value: String(step.step), text: `after step ${step.step}` })));
+    if (steps.length) levelBox.value = String(steps[steps.length - 1].step);
+  }
+
+  async function aggregation(path, body) {
+    robotale.clearError();
+    status.textContent = "aggregating…";
+    try {
+      await robotale.api(path, { method: "POST", body: { log: state.log, ...body } });
+    } catch (error) {
+      status.textContent = "";
+      robotale.showError(error);
+    }
+    await loadSteps().catch(robotale.showError);
+    discover();
+  }
+
   async function start() {
     state.log = await robotale.currentLog().catch((error) => { robotale.showError(error); return ""; });
     if (!state.log) {
@@ -153,6 +191,7 @@
     }
     const log = (await robotale.logs()).find((l) => l.name === state.log) || { entityTypes: [] };
     fillSelectors(log, null);
+    loadSteps().catch(robotale.showError);
     await discover();
     robotale.api(`/api/discover/values?log=${encodeURIComponent(state.log)}`)
       .then((values) => fillSelectors({}, values))
@@ -165,6 +204,13 @@
   for (const form of [ekgForm, dfgForm]) {
     form.addEventListener("submit", (event) => { event.preventDefault(); discover(); });
   }
+  aggregationForm.addEventListener("submit", (event) => {
+    event.preventDefault();
+    aggregation("/api/aggregation/run", { spec: document.getElementById("aggregation-spec").value });
+  });
+  document.getElementById("aggregation-undo").addEventListener("click",
+    () => aggregation("/api/aggregation/undo", {}));
+  levelBox.addEventListener("change", discover);
   dfgForm.addEventListener("reset", () => setTimeout(discover, 0));
   ekgForm.addEventListener("change", discover);
   labels.addEventListener("change", () => state.graph && draw());

@@ -75,6 +75,52 @@
           r.fitness === null ? null : Number(r.fitness.toFixed(3)), r.fitting_runs])));
   }
 
+  // Verify: the model's findings (robotale fame verify); choosing one outlines the elements of
+  // its counterexample and lists its trace as tags.
+  let marked = [];
+  function highlight(finding, item) {
+    const canvas = viewer.get("canvas");
+    const registry = viewer.get("elementRegistry");
+    for (const id of marked) canvas.removeMarker(id, "counterexample");
+    marked = finding.elements.filter((id) => registry.get(id));
+    for (const id of marked) canvas.addMarker(id, "counterexample");
+    for (const other of item.parentNode.children) other.classList.toggle("chosen", other === item);
+    canvasBox.dataset.counterexample = marked.join(" ");
+    const trace = document.getElementById("verify-trace");
+    trace.replaceChildren(finding.trace.length
+      ? robotale.table(["step", "robot", "activity", "lifecycle", "msg_id", "msg_role"],
+        finding.trace.map((t) => [t.step, t.robot, t.activity, t.lifecycle, t.msg_id, t.msg_role]))
+      : robotale.el("p", { text: "No trace: nothing leads there." }));
+  }
+
+  function listFindings(verdict) {
+    const box = document.getElementById("verify-findings");
+    const explored = `${verdict.states} states explored` +
+      (verdict.complete ? "" : ` (stopped early: ${verdict.bound})`);
+    const list = robotale.el("ul", { id: "verify-list" });
+    for (const finding of verdict.findings) {
+      const item = robotale.el("li", { text: `${finding.kind}: ${finding.sentence}` });
+      item.dataset.kind = finding.kind;
+      item.addEventListener("click", () => highlight(finding, item));
+      list.append(item);
+    }
+    box.replaceChildren(
+      robotale.el("h2", { text: `Verification: ${verdict.findings.length} findings` }),
+      robotale.el("p", { class: "count", text: explored }), list,
+      robotale.el("div", { id: "verify-trace" }));
+  }
+
+  document.getElementById("verify").addEventListener("click", async () => {
+    status.textContent = "verifying…";
+    try {
+      listFindings(await robotale.api(`/api/models/${modelId}/verify`));
+      status.textContent = "verified: choose a finding to outline its counterexample";
+    } catch (error) {
+      status.textContent = "";
+      robotale.showError(error);
+    }
+  });
+
   async function show() {
     if (!modelId) return;
     try {

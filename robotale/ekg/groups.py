@@ -1,0 +1,187 @@
+"""The aggregates of one step, computed in pandas from the nodes it collapses.
+
+:func:`aggregate_table` takes one row per node (its node id and the properties the step reads;
+times as Unix nanoseconds) and returns one row per aggregate: its id and name, how many
+nodes it replaces and which, the group-by values and the attribute aggregations. The
+derived keys of robot logs (grid cell, region, time window, value band) are computed here.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+from collections import Counter
+from collections.abc import Callable, Sequence
+
+import numpy as np
+import pandas as pd
+from neo4j.time import DateTime
+
+from robotale.ekg.spec import AggrStep, AttrAggr, GroupKey
+from robotale.errors import InputError
+
+#: where a region key puts a point that lies in none of the areas
+OUTSIDE = "outside"
+#: how a missing group-by value shows in an aggregate's name
+UNKNOWN = "unknown"
+
+
+def aggregate_table(
+    step: AggrStep, number: int, nodes: pd.DataFrame, times: set[str]
+) -> pd.DataFrame:
+    """One row per aggregate of ``nodes`` (columns ``node`` and the properties the step reads;
+    the properties in ``times`` hold Unix nanoseconds): ``id``, ``name``, ``count``,
+    ``members`` (node ids), a column per group key and per attribute output."""
+    keys = pd.DataFrame({key.name: group_values(key, nodes, times) for key in step.group_by})
+    names = keys.astype(object).where(keys.notna(), UNKNOWN).astype(str)
+    label = names.iloc[:, 0]
+    for column in names.columns[1:]:
+        label = label.str.cat(names[column], sep="|")
+    frame = pd.DataFrame({"name": label.to_numpy(), "node": nodes["node"].to_numpy()})
+    grouped = frame.groupby("name", sort=True)
+    table = pd.DataFrame({"count": grouped.size(), "members": grouped["node"].agg(list)})
+    first = keys.groupby(label.to_numpy(), sort=True).first()
+    for key in step.group_by:
+        table[key.name] = first[key.name]
+    labels = label.to_numpy()
+    for attr in step.attr_aggrs:
+        for output, values in attribute_values(attr, nodes[attr.name], labels, attr.name in times):
+            table[output] = values
+    table = table.reset_index(names="name")
+    table.insert(0, "id", [f"{number}:{name}" for name in table["name"]])
+    return table
+
+
+def group_values(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
+    """The value of ``key`` for each node (None where the node lacks what the key reads)."""
+    return _GROUPERS[key.kind](key, nodes, times)
+
+
+def _property(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
+    values = nodes[key.inputs[0]]
+    if key.inputs[0] in times:
+        return _iso(values)
+    return values.astype(object).where(values.notna(), None)
+
+
+def _grid(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
+    x, y = (np.floor(_numbers(nodes[c]) / key.size) for c in key.inputs)
+    cells = [
+        None if np.isnan(i) or np.isnan(j) else f"{int(i)},{int(j)}"
+        for i, j in zip(x, y, strict=True)
+    ]
+    return pd.Series(cells, index=nodes.index, dtype=object)
+
+
+def _band(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
+    lower = np.floor(_numbers(nodes[key.inputs[0]]) / key.size) * key.size
+    return pd.Series(lower, index=nodes.index).astype(object).where(~np.isnan(lower), None)
+
+
+def _window(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
+    if key.inputs[0] in times:  # nanoseconds, in integers: floats would blur the bounds
+        values = pd.to_numeric(nodes[key.inputs[0]]).astype("Int64")
+        width = round(key.size * 1_000_000_000)
+        return _iso((values // width) * width)
+    lower = np.floor(_numbers(nodes[key.inputs[0]]) / key.size) * key.size
+    return pd.Series(lower, index=nodes.index).astype(object).where(~np.isnan(lower), None)
+
+
+def _regions(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
+    x, y = (_numbers(nodes[c]) for c in key.inputs)
+    found = np.full(len(nodes), OUTSIDE, dtype=object)
+    free = np.ones(len(nodes), dtype=bool)
+    for name, corners in key.areas:  # the first area that holds a point names it
+        inside = free & _inside(x, y, np.asarray(corners))
+        found[inside] = name
+        free &= ~inside
+    found[np.isnan(x) | np.isnan(y)] = None
+    return pd.Series(found, index=nodes.index, dtype=object)
+
+
+def _inside(x: np.ndarray, y: np.ndarray, corners: np.ndarray) -> np.ndarray:
+    """Whether each point lies in the polygon (even-odd rule; a point on the lower or left
+    edge of a box is inside, one on the upper or right edge is not)."""
+    inside = np.zeros(len(x), dtype=bool)
+    for (x1, y1), (x2, y2) in zip(corners, np.roll(corners, -1, axis=0), strict=True):
+        if y1 == y2:
+            continue
+        crosses = (y1 <= y) != (y2 <= y)
+        at = x1 + (y - y1) * (x2 - x1) / (y2 - y1)
+        inside ^= crosses & (x < at)
+    return inside
+
+
+def _numbers(values: pd.Series) -> np.ndarray:
+    return pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
+
+
+def _iso(nanoseconds: pd.Series) -> pd.Series:
+    moments = pd.to_datetime(pd.to_numeric(nanoseconds).astype("Int64"), unit="ns", utc=True)
+    text = moments.dt.strftime("%Y-%m-%dT%H:%M:%S.%fZ")
+    return text.astype(object).where(moments.notna(), None)
+
+
+_GROUPERS: dict[str, Callable[[GroupKey, pd.DataFrame, set[str]], pd.Series]] = {
+    "property": _property,
+    "grid": _grid,
+    "band": _band,
+    "window": _window,
+    "regions": _regions,
+}
+
+
+def attribute_values(
+    attr: AttrAggr, values: pd.Series, labels: np.ndarray, is_time: bool
+) -> list[tuple[str, list[object]]]:
+    """(aggregate property, value per group, groups in the order of their labels) for one
+    attribute aggregation. Missing values are left out, as Cypher's aggregating functions
+    leave out nulls."""
+    outputs = attr.outputs()
+    if attr.function == "MULTISET":
+        return [(outputs[0], [multiset(part) for _, part in values.groupby(labels, sort=True)])]
+    if attr.function in ("SUM", "AVG"):
+        numbers = pd.to_numeric(values, errors="coerce")
+        if (numbers.isna() & values.notna()).any():
+            raise InputError(
+                f"{attr.function} of {attr.name!r} needs numbers, and some nodes hold "
+                f"{values[numbers.isna() & values.notna()].iloc[0]!r}."
+            )
+        found = numbers.groupby(labels, sort=True).agg("sum" if attr.function == "SUM" else "mean")
+        return [(outputs[0], [None if pd.isna(v) else _plain(v) for v in found])]
+    if is_time:  # nanoseconds as integers: grouped as numbers, not as Python objects
+        values = pd.to_numeric(values).astype("Int64")
+    hows = ["min", "max"] if attr.function == "MINMAX" else [attr.function.lower()]
+    grouped = values.groupby(labels, sort=True)
+    return [
+        (out, _extreme(grouped.agg(how), is_time)) for out, how in zip(outputs, hows, strict=True)
+    ]
+
+
+def _extreme(found: pd.Series, is_time: bool) -> list[object]:
+    values = [None if _missing(v) else _plain(v) for v in found]
+    if is_time:  # the earliest or latest time, as a time again
+        return [None if v is None else _moment(int(v)) for v in values]
+    return values
+
+
+def _moment(nanoseconds: int) -> DateTime:
+    """A Unix time in nanoseconds as a Neo4j time in UTC (Python's own stops at microseconds)."""
+    t = pd.Timestamp(nanoseconds, unit="ns", tz="UTC")
+    return DateTime(t.year, t.month, t.day, t.hour, t.minute, t.second,
+                    t.microsecond * 1000 + t.nanosecond, tzinfo=dt.UTC)  # fmt: skip
+
+
+def multiset(values: Sequence[object] | pd.Series) -> list[str]:
+    """OCEAN's MULTISET: each distinct value with how often it occurs, as ``value:count``,
+    in the order of the values' text."""
+    counts = Counter(str(_plain(v)) for v in values if not _missing(v))
+    return [f"{value}:{count}" for value, count in sorted(counts.items())]
+
+
+def _missing(value: object) -> bool:
+    return value is None or (isinstance(value, float) and np.isnan(value))
+
+
+def _plain(value: object) -> object:
+    """numpy scalars as Python ones, which the driver sends."""
+    return value.item() if isinstance(value, np.generic) else value
