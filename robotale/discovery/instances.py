@@ -56,8 +56,8 @@ def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
 
 
 def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
-    """One row per activity instance, ordered by case and start (ties: robot, then activity,
-    as :func:`in_tie_order` orders the events of one moment; not the file's order).
+    """One row per activity instance, ordered by case and start (ties: as :func:`in_tie_order`
+    orders the events of one moment).
 
     Columns: the completing event's columns, plus ``start_timestamp``, ``time:timestamp`` (the
     completion), ``duration`` in seconds, ``finished`` and ``start_known``; for every column
@@ -103,10 +103,13 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
 
 
 def in_tie_order(events: pd.DataFrame) -> pd.DataFrame:
-    """The events in time order, those at the same moment in an order the file's does not
-    decide: a start before any other event, then by robot, then by activity (then as in the
-    file, which only rows alike in all of these keep). A start first pairs each completion
-    with the instance it ends however the rows of one moment were written."""
+    """The events in time order, those at the same moment by a rule: a start before any other
+    event, then by robot, then as the file has them. A start first pairs each completion with
+    the instance it ends however the rows of one moment were written; robots in name order
+    make the interleaving of robots independent of the file. Within one robot the file's
+    order stays: a robot's engine tags its events one after the other, so a sequence of
+    activities that take no time (a simulated clock) keeps its order, which the activities'
+    names would not."""
     if not events[TIMESTAMP].is_monotonic_increasing:  # logs usually come in time order
         events = events.sort_values(TIMESTAMP, kind="stable")
     times = _ticks(events[TIMESTAMP])
@@ -119,10 +122,9 @@ def in_tie_order(events: pd.DataFrame) -> pd.DataFrame:
     rows = np.flatnonzero(tied)
     part = events.iloc[rows]
     keys = [np.arange(len(rows))]  # the file's order: the last tie-break
-    for column in (ACTIVITY, ROBOT):
-        if column in part.columns:
-            values = part[column].astype("string").fillna("")
-            keys.append(pd.factorize(values, sort=True)[0])
+    if ROBOT in part.columns:
+        values = part[ROBOT].astype("string").fillna("")
+        keys.append(pd.factorize(values, sort=True)[0])
     keys.append((_lifecycle(part) != START).to_numpy(np.int8))
     keys.append(times[rows])
     order = np.arange(len(events))
