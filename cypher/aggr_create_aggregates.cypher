@@ -1,10 +1,10 @@
 // One batch of the aggregates of step $step of log $log: $ids, $names, $counts (how many
 // nodes each replaces), $origin ('Event' or 'Entity'), $type (the entity type, or null),
 // $key (the group-by names) and $properties {key: [values]} (group-by values and attribute
-// aggregations; null values are not stored). Returns [row, node id] pairs.
+// aggregations; null values are not stored). Returns [row, element id] pairs.
 UNWIND range(0, size($ids) - 1) AS i
 CREATE (a:Aggregate {log: $log, step: $step, id: $ids[i], name: $names[i], count: $counts[i],
                      origin: $origin, key: $key})
 SET a.type = $type
 FOREACH (key IN keys($properties) | SET a[key] = $properties[key][i])
-RETURN collect([i, id(a)]) AS nodes
+RETURN collect([i, elementId(a)]) AS nodes

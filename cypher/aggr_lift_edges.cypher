@@ -1,4 +1,4 @@
-// The relationships of the nodes the aggregates $aggregates (node ids, all of step $step)
+// The relationships of the nodes the aggregates $aggregates (element ids, all of step $step)
 // replace, lifted to them: every CORR, DF and COMM edge of a member becomes an edge of the
 // same type between the aggregate and what now stands for its other end at this level (the
 // aggregate holding that node, else the node), one per pair (and entity type, for DF) with
@@ -6,7 +6,7 @@
 // this step is written once, from its source's side. Only edges between events and entities
 // are lifted: those the build wrote, never those of earlier steps.
 UNWIND $aggregates AS aggregate
-MATCH (a:Aggregate) WHERE id(a) = aggregate
+MATCH (a:Aggregate) WHERE elementId(a) = aggregate
 CALL (a) {
   MATCH (a)<-[:AGGREGATED_IN]-(:Event)-[:CORR]->(o:Entity)
   OPTIONAL MATCH (o)-[:AGGREGATED_IN]->(g:Aggregate)

@@ -10,4 +10,4 @@ WITH n,
      [k IN $properties |
        CASE WHEN k IN $times THEN n[k].epochSeconds * 1000000000 + n[k].nanosecond
             ELSE n[k] END] AS values
-RETURN collect(id(n)) AS nodes, collect(values) AS values
+RETURN collect(elementId(n)) AS nodes, collect(values) AS values

@@ -14,4 +14,4 @@ WITH n,
      [t IN $entityTypes |
        [(n)-[:CORR]->(x:Entity {type: t}) |
          coalesce(head([(x)-[:AGGREGATED_IN]->(a:Aggregate) | a.id]), x.id)]] AS entities
-RETURN collect(id(n)) AS nodes, collect(values) AS values, collect(entities) AS entities
+RETURN collect(elementId(n)) AS nodes, collect(values) AS values, collect(entities) AS entities

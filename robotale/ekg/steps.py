@@ -270,7 +270,7 @@ def _write(
         )
         sizes = table["count"].astype(int).tolist()
         owners = [node for node, size in zip(created, sizes, strict=True) for _ in range(size)]
-        members = [int(m) for group in table["members"] for m in group]
+        members = [str(m) for group in table["members"] for m in group]
         loader.run("aggr_create_members", {"members": members, "aggregates": owners})
         _lift(driver, created, number, between_batches)
     driver.execute_query(
@@ -290,7 +290,7 @@ def _storable(column: pd.Series) -> list[Any]:
 
 
 def _lift(
-    driver: Driver, aggregates: list[int], number: int, between_batches: Callable[[], None]
+    driver: Driver, aggregates: list[str], number: int, between_batches: Callable[[], None]
 ) -> None:
     # One batch after the other: batches running side by side would wait on each other's
     # locks of the nodes that both reach.
