@@ -34,14 +34,15 @@ def test_every_robot_conforms_to_the_collaboration_that_drove_it(agri_csv):
     assert report.summary["fitness"] == 1.0 and report.deviations.empty
     assert set(report.robots["pool"]) == {"Drone", "Tractor"}
     assert report.robots.set_index("robot").loc["drone", "runs"] == 2
-    # the explore skill publishes weed_found itself: the process does not model that send
-    assert report.outside.to_dict("records") == [
-        {
-            "robot": "drone",
-            "activity": "weed_found!",
-            "instances": int(report.outside["instances"].sum()),
-        }
-    ]
+    # the explore skill publishes weed_found itself and consumes closest_tractor itself (its
+    # resume_on): the process models neither, and each is tagged as the skill sent or received it
+    outside = report.outside.set_index("activity")["instances"].to_dict()
+    assert set(report.outside["robot"]) == {"drone"}
+    assert set(outside) == {"weed_found!", "closest_tractor?"}
+    log = read_log(agri_csv)
+    ends = log[(log["robot"] == "drone") & (log["lifecycle:transition"] != "start")]
+    for activity, instances in outside.items():  # an instance per send or receive: its end
+        assert instances == ends["concept:name"].eq(activity).sum() > 0
 
 
 def test_a_run_missing_an_activity_is_caught(agri_csv):
