@@ -37,10 +37,12 @@ def annotate_command(
     model: Path | None = None,
     msg_files: Sequence[str] = (),
     distro: str | None = None,
+    skip_bad: bool = False,
     **options: Any,
 ) -> int:
     """Write ``out/<run>/`` for every run of ``source``: an MCAP rosbag2 copy of the run with
-    the added topics; ``options`` are those of ``prepare``."""
+    the added topics; ``options`` are those of ``prepare``. With ``skip_bad`` a run that
+    cannot be read is named and left out, as ``prepare --skip-bad`` does."""
     runs = find_runs(source)
     taken = [out / run.name for run in runs if (out / run.name).exists()]
     if taken:
@@ -50,7 +52,10 @@ def annotate_command(
     # the added topics need activities and messages only: no perspective (the odometry a
     # bag is mostly made of) is read unless one is asked for
     options = {"perspectives": "", **options, "rate": 0.0}
-    log = prepare_recordings(source, msg_files=msg_files, distro=distro, **options)
+    skipped: list[Path] | None = [] if skip_bad else None
+    log = prepare_recordings(source, msg_files=msg_files, distro=distro, skipped=skipped, **options)
+    if skipped:
+        runs = [run for run in runs if run not in skipped]
     names = sorted(log[ACTIVITY].dropna().astype(str).unique())
     extra = message_types([Path(p) for p in msg_files])
     slow = bottleneck_instances(log)  # ranked over every run: one run has no baseline

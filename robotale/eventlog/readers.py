@@ -424,7 +424,7 @@ def canonical_log(
     kinds = reading.event_kinds(log)
     dropped = reading.dropped_rows(kinds, lines)
     keep = reading.understood(kinds).to_numpy(bool)
-    copies, copied = reading.exact_copies(table, lines, keep)
+    copies, copied = reading.exact_copies(table, lines, keep, schema.EVENT_ID in log.columns)
     dropped |= copied
     keep = keep & ~copies
     if not keep.any():

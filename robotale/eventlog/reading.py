@@ -129,7 +129,7 @@ KINDS = ("start", "complete", "instant", "sample")
 #: ends of an activity that failed or was called off: completions that keep their outcome
 OUTCOMES = (schema.ABORTED, schema.CANCELLED)
 #: why a row that repeats an earlier one cell for cell is dropped
-COPY_REASON = "an exact copy of the row before it (the event counts once)"
+COPY_REASON = "an exact copy of an earlier row (the event counts once)"
 #: a dropped row's lines are listed up to this many.
 SHOWN_LINES = 5
 #: the pause offered as the end of a session when a log without cases spans several days
@@ -352,15 +352,19 @@ def dropped_rows(kinds: pd.Series, lines: pd.Series) -> dict[str, list[int]]:
 
 
 def exact_copies(
-    table: pd.DataFrame, lines: pd.Series, events: np.ndarray
+    table: pd.DataFrame, lines: pd.Series, events: np.ndarray, identified: bool = False
 ) -> tuple[np.ndarray, dict[str, list[int]]]:
-    """Which of the rows that are ``events`` repeat the event row just before them cell for
-    cell (a logger that wrote an event twice), and their file lines under the reason they are
-    dropped: an event counts once, never as a second activity, message or loop.
+    """Which of the rows that are ``events`` are copies of an event row (a logger that wrote
+    an event twice), and their file lines under the reason they are dropped: an event counts
+    once, never as a second activity, message or loop.
 
-    Only the row just before counts: a log on a simulated clock repeats a whole row
-    legitimately (the same activity started again at the same instant after others), so a
-    copy further back is a second event, not a copy."""
+    In a log whose rows carry event ids (``identified``) a row equal to any earlier one is a
+    copy: the id says it is the same event. Otherwise only the row just before counts: a log
+    on a simulated clock repeats a whole row legitimately (the same activity started again at
+    the same instant after others), so a row equal to one further back is a second event."""
+    if identified:
+        copies = table.duplicated(keep="first").to_numpy(bool) & events
+        return copies, ({COPY_REASON: lines[copies].tolist()} if copies.any() else {})
     rows = table[events]
     before = rows.shift()
     same = (rows.eq(before) | (rows.isna() & before.isna())).all(axis=1).to_numpy(bool, copy=True)

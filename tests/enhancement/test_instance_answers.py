@@ -108,7 +108,7 @@ def test_an_exact_copy_is_flagged_and_counted_once(tmp_path, capsys):
     )
     inspect_command(path)
     printed = capsys.readouterr().out
-    copy = "1 dropped: an exact copy of the row before it (the event counts once) (line 4)"
+    copy = "1 dropped: an exact copy of an earlier row (the event counts once) (line 4)"
     assert copy in printed
     log = read_log(path)
     assert len(log) == 4

@@ -181,7 +181,7 @@ def test_a_batch_with_crashed_runs_exits_non_zero_naming_them(tmp_path, capsys):
 
 
 def test_a_full_disk_is_one_sentence_and_keeps_only_whole_runs(small_disk, capsys):
-    out = small_disk("200k") / "runs"  # one rexdingo run fits, two do not
+    out = small_disk("300k") / "runs"  # one rexdingo run (about 190 KB) fits, two do not
     arguments = ["simulate", "rexdingo", "--runs", "2", "--quiet", "--workers", "0"]
     assert main([*arguments, "--out", str(out)]) == 1
     error = capsys.readouterr().err.strip()

@@ -98,12 +98,15 @@ def test_ekg_aggregated_by_activity_and_robot(client, stored_thesis, thesis_rows
     classes = [n for n in graph["nodes"] if n["kind"] == "activity"]
     pairs = {(r["activity"], r["resource"]) for r in thesis_rows}
     assert {(n["properties"]["activity"], n["properties"]["robot"]) for n in classes} == pairs
-    events = {pair: 0 for pair in pairs}
+    # a class counts its activity instances, each once by the event that ends it, and its
+    # events apart (the thesis' rows are starts and completions)
+    events, instances = dict.fromkeys(pairs, 0), dict.fromkeys(pairs, 0)
     for row in thesis_rows:
         events[(row["activity"], row["resource"])] += 1
-    assert {
-        (n["properties"]["activity"], n["properties"]["robot"]): n["count"] for n in classes
-    } == events
+        instances[(row["activity"], row["resource"])] += row["lifecycle"] != "start"
+    shown = {(n["properties"]["activity"], n["properties"]["robot"]): n for n in classes}
+    assert {pair: node["count"] for pair, node in shown.items()} == instances
+    assert {pair: node["properties"]["events"] for pair, node in shown.items()} == events
     assert {e["entity_type"] for e in graph["edges"]} >= {"robot", "msg_id"}
 
     only_robots = client.get(f"/api/discover/ekg?log={stored_thesis}&by=robot&edges=robot").json
