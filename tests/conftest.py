@@ -90,14 +90,12 @@ def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Settings]
     if os.environ.get("NEO4J_URI"):
         yield settings()
         return
-    from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port
+    from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_ports
 
     server = LocalServer(tmp_path_factory.mktemp("robotale-home"))
     version = os.environ.get("ROBOTALE_TEST_NEO4J_VERSION") or ServerOptions.version
     for attempt in range(3):  # a free port can be taken by someone else before Neo4j binds it
-        options = ServerOptions(
-            free_port(), free_port(), heap="1g", pagecache="256m", version=version
-        )
+        options = ServerOptions(*free_ports(2), heap="1g", pagecache="256m", version=version)
         try:
             running = server.start(options)
             break

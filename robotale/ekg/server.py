@@ -14,6 +14,7 @@ Plugin jars (``--plugins`` or ``<robotale home>/plugins``) and the user's settin
 
 from __future__ import annotations
 
+import contextlib
 import dataclasses
 import json
 import os
@@ -553,9 +554,19 @@ def _held_by(port: int) -> str:
 
 def free_port() -> int:
     """A TCP port on 127.0.0.1 that nobody listens on right now."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind((HOST, 0))
-        return int(probe.getsockname()[1])
+    return free_ports(1)[0]
+
+
+def free_ports(count: int) -> list[int]:
+    """``count`` different TCP ports on 127.0.0.1 that nobody listens on right now: each probe
+    stays bound until all are chosen, since two probes one after the other can be given the
+    same port (Bolt and HTTP on one port: Neo4j then fails to start)."""
+    with contextlib.ExitStack() as stack:
+        probes = [stack.enter_context(socket.socket(socket.AF_INET, socket.SOCK_STREAM))
+                  for _ in range(count)]  # fmt: skip
+        for probe in probes:
+            probe.bind((HOST, 0))
+        return [int(probe.getsockname()[1]) for probe in probes]
 
 
 def _write_private(path: Path, text: str) -> None:

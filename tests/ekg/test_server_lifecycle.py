@@ -13,7 +13,7 @@ import pytest
 from neo4j import GraphDatabase
 
 from robotale.ekg import jars
-from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port
+from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port, free_ports
 from robotale.ekg.server_config import check_plugins, read_overlay
 from robotale.errors import ServerError
 
@@ -67,7 +67,7 @@ def test_the_cli_reports_the_held_port_in_one_line(env, held_port):
 @pytest.mark.slow
 def test_start_right_after_stop_with_clients_connected(tmp_path, neo4j_server):
     server = LocalServer(tmp_path)
-    options = ServerOptions(free_port(), free_port(), heap="512m", pagecache="64m")
+    options = ServerOptions(*free_ports(2), heap="512m", pagecache="64m")
     first = server.start(options)
     waits: list[str] = []
     try:
@@ -135,7 +135,7 @@ def test_the_overlay_changes_defaults_but_not_what_robotale_owns(tmp_path):
     )
     overlay.write_text(text)
     warnings: list[str] = []
-    options = ServerOptions(free_port(), free_port())
+    options = ServerOptions(*free_ports(2))
     server._write_config(options, read_overlay(overlay, warnings.append))
     written = _settings(server.home / "conf" / "neo4j.conf")
     assert written["dbms.security.procedures.unrestricted"] == "apoc.*"
