@@ -72,32 +72,22 @@ _ROLES = {
     "boundaryEvent": "boundary event",
 }
 
+#: what may interrupt or start handling from outside: an event sub-process's start and a
+#: boundary event take the same triggers
+_HANDLER_TRIGGERS = frozenset(
+    {"signal", "timer", "conditional", "error", "message", "escalation", "compensate"}
+)
+
 #: the event kinds each kind of event may have ("none" = no event definition)
 ALLOWED = {
     "start": {"none", "signal", "timer", "conditional", "message"},
-    "event_start": {
-        "signal",
-        "timer",
-        "conditional",
-        "error",
-        "message",
-        "escalation",
-        "compensate",
-    },
+    "event_start": _HANDLER_TRIGGERS,
     "sub_start": {"none"},
     "called_start": {"none"},
     "intermediateCatchEvent": {"signal", "timer", "conditional", "message"},
     "intermediateThrowEvent": {"none", "signal", "message", "escalation", "compensate"},
     "endEvent": {"none", "terminate", "signal", "error", "message", "escalation", "compensate"},
-    "boundaryEvent": {
-        "signal",
-        "timer",
-        "conditional",
-        "error",
-        "message",
-        "escalation",
-        "compensate",
-    },
+    "boundaryEvent": _HANDLER_TRIGGERS,
 }
 _SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
 
