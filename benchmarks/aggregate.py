@@ -44,10 +44,10 @@ from ocean_shaped import LOGISTICS_SPEC, logistics  # noqa: E402
 
 from robotale.ekg.build import build_ekg  # noqa: E402
 from robotale.ekg.connection import database  # noqa: E402
-from robotale.ekg.queries import split_statements, statements  # noqa: E402
 from robotale.ekg.spec import parse_spec  # noqa: E402
 from robotale.ekg.steps import run_spec, undo  # noqa: E402
 from robotale.eventlog.readers import read_csv  # noqa: E402
+from robotale.queries import split_statements, statements  # noqa: E402
 
 OCEAN = {35_413: 1.9, 1_200_000: 28.6}  # events -> seconds, OCEAN's paper
 CUTOFF = pd.Timestamp("2024-03-01T00:00:00Z").to_pydatetime()

@@ -353,7 +353,7 @@ def page_seconds(page, dashboard, which: str, log: str, repeat: int, cold: bool)
     from browser import wait_for  # tests/webapp, put on the path by measure_all
 
     from robotale.ekg.columnar import log_build, results_folder
-    from robotale.webapp.findings_data import prepare
+    from robotale.results.findings import prepare
     from robotale.webapp.state import state
 
     current = state(dashboard.app)

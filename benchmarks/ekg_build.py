@@ -132,7 +132,7 @@ class private_neo4j:
 
     def __enter__(self):
         from robotale.ekg.connection import Settings, connect
-        from robotale.ekg.server import LocalServer, ServerOptions, free_port
+        from robotale.neo4j_server.server import LocalServer, ServerOptions, free_port
 
         self.home = tempfile.TemporaryDirectory(prefix="robotale-bench-")
         self.server = LocalServer(Path(self.home.name))
@@ -201,7 +201,7 @@ def plain_writes(driver, nodes: int, properties: int, edges: int) -> float:
     relationships between them, in the build's batches, with nothing to compute or index:
     the plain write rate of that graph on this server."""
     from robotale.ekg.load import Loader
-    from robotale.ekg.queries import cypher
+    from robotale.queries import cypher
 
     values = {f"p{k}": k for k in range(properties)}
     loader = Loader(driver, "bound")
@@ -269,7 +269,7 @@ def thesis_build(driver, log: pd.DataFrame, entity_types: list[str], limit: floa
     from neo4j import Query
     from neo4j.exceptions import Neo4jError
 
-    from robotale.ekg.queries import cypher
+    from robotale.queries import cypher
 
     short = schema.to_csv_names(log)
     rows = short.astype(object).where(short.notna(), None)

@@ -4,7 +4,7 @@
 
 Creates a throwaway virtual environment under a temporary folder (``python -m venv``, then
 ``pip install promg``: the network is needed), starts robotale's local Neo4j in a temporary
-home with APOC core and APOC extended (pinned in ``robotale/ekg/plugin_jars.lock``, fetched
+home with APOC core and APOC extended (pinned in ``robotale/neo4j_server/plugin_jars.lock``, fetched
 once from Maven Central) through ``--plugins`` and an overlay that lets APOC read the import
 folder, and builds, one after the other on an emptied database:
 
@@ -294,8 +294,8 @@ class private_neo4j:
 
     def __enter__(self):
         from robotale.ekg.connection import Settings, connect
-        from robotale.ekg.jars import apoc_with_file_access
-        from robotale.ekg.server import LocalServer, ServerOptions, free_port
+        from robotale.neo4j_server.jars import apoc_with_file_access
+        from robotale.neo4j_server.server import LocalServer, ServerOptions, free_port
 
         plugins = self.work / "plugins"
         plugins.mkdir()
@@ -333,7 +333,7 @@ def synthetic(events: int) -> pd.DataFrame:
 
 
 def clear(driver) -> None:
-    from robotale.ekg.queries import cypher
+    from robotale.queries import cypher
 
     with driver.session() as session:
         session.run(cypher("peers_clear")).consume()

@@ -90,7 +90,7 @@ def neo4j_server(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Settings]
     if os.environ.get("NEO4J_URI"):
         yield settings()
         return
-    from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_ports
+    from robotale.neo4j_server.server import LocalServer, PortInUse, ServerOptions, free_ports
 
     server = LocalServer(tmp_path_factory.mktemp("robotale-home"))
     version = os.environ.get("ROBOTALE_TEST_NEO4J_VERSION") or ServerOptions.version

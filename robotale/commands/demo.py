@@ -21,10 +21,10 @@ from robotale.commands.simulate import print_summary
 from robotale.config import robotale_home
 from robotale.ekg.connection import connect
 from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
-from robotale.ekg.server import LocalServer, ServerOptions
 from robotale.errors import InputError
 from robotale.eventlog.readers import read_log
 from robotale.eventlog.writers import write_csv
+from robotale.neo4j_server.server import LocalServer, ServerOptions
 from robotale.sim import scenarios
 from robotale.sim.batch import simulate_batch
 from robotale.sim.plans import check, plans, resolve_world

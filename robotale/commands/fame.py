@@ -4,7 +4,6 @@ from __future__ import annotations
 
 import json
 import sys
-import time
 from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, TextIO
@@ -12,22 +11,22 @@ from typing import Any, TextIO
 from robotale.errors import InputError, ModelError, require_range
 from robotale.extras import require
 from robotale.fame_runtime.bus import InProcessBus
-from robotale.fame_runtime.check import Report, check, duplicate_ids
+from robotale.fame_runtime.check import Report, check
 from robotale.fame_runtime.clock import SimClock
-from robotale.fame_runtime.engine import Engine
+from robotale.fame_runtime.launch import (
+    instance_counts,
+    parse_assignments,
+    refuse_duplicate_ids,
+    robot_list,
+    start_time,
+)
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.model import Definitions, Problem
 from robotale.fame_runtime.parser import ReadError, parse, parse_all
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split, unbound_pools, write_split
-from robotale.fame_runtime.tags import Tag
-from robotale.fame_runtime.timers import parse_date
-
-
-def robot_list(text: str | None) -> list[str] | None:
-    """``drone,tractor_1`` -> ["drone", "tractor_1"]."""
-    return [r.strip() for r in text.split(",") if r.strip()] if text else None
+from robotale.fame_runtime.tags import tag_line
 
 
 def check_command(
@@ -241,29 +240,10 @@ def readable(model: Path, skills: Mapping[str, Any] | None, library: Path | None
     raise ModelError(f"{model}: {len(report.found)} problems:\n{lines}")
 
 
-def refuse_duplicate_ids(model: Path) -> None:
-    """The parser keeps one of the elements sharing an id, so a run would fail later with a
-    misleading sentence (no start event ...): name the shared id instead, before anything runs."""
-    shared = duplicate_ids(model)
-    if shared:
-        more = f" (and {len(shared) - 1} more)" if len(shared) > 1 else ""
-        raise ModelError(f"{model}: {shared[0]}{more}")
-
-
 def _bus_problem(bus: str) -> str:
     if bus != "inprocess":
         return f"--bus {bus!r} is not one of inprocess, dds"
     return "--record needs --bus dds (a simulation records with robotale simulate)"
-
-
-def start_time(text: str | None) -> float:
-    """The clock's start: now, or an ISO 8601 date-time (``timeDate`` timers fire on it)."""
-    if text is None:
-        return time.time()
-    try:
-        return parse_date(text)
-    except ValueError as error:
-        raise InputError(f"--start: {error}") from None
 
 
 def run_verdict(mission: Mission, begin: float, err: TextIO) -> int:
@@ -281,41 +261,3 @@ def run_verdict(mission: Mission, begin: float, err: TextIO) -> int:
     for failure in mission.failures:
         print(f"# {failure}", file=err)
     return 1 if mission.failures or not mission.idle else 0
-
-
-def instance_counts(engines: Mapping[str, Engine]) -> str:
-    """``instances completed: drone 1, tractor 0; failed: tractor 1`` (failed only when some
-    instance failed)."""
-    completed = ", ".join(f"{r} {e.completed}" for r, e in engines.items())
-    failed = ", ".join(f"{r} {e.failed}" for r, e in engines.items() if e.failed)
-    return f"instances completed: {completed}" + (f"; failed: {failed}" if failed else "")
-
-
-def tag_line(tag: Tag, begin: float = 0.0) -> str:
-    """A tag as one tab-separated line, its stamp in seconds since ``begin``."""
-    fields = (
-        f"{tag.stamp - begin:10.3f}",
-        tag.robot,
-        tag.activity,
-        tag.lifecycle,
-        tag.msg_id,
-        tag.msg_role,
-        tag.payload,
-    )
-    return "\t".join(fields).rstrip()
-
-
-def parse_assignments(assignments: Sequence[str]) -> dict[str, dict[str, Any]]:
-    """``drone.delay=10`` -> {"drone": {"delay": 10}} (values are JSON, else text)."""
-    variables: dict[str, dict[str, Any]] = {}
-    for text in assignments:
-        target, equals, value = text.partition("=")
-        robot, dot, name = target.partition(".")
-        if not equals or not dot or not name.isidentifier():
-            raise InputError(f"--set {text!r} is not ROBOT.NAME=VALUE (for example drone.delay=10)")
-        try:
-            parsed: Any = json.loads(value)
-        except ValueError:
-            parsed = value
-        variables.setdefault(robot, {})[name] = parsed
-    return variables

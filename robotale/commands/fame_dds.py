@@ -10,35 +10,29 @@ import threading
 import time
 from collections.abc import Sequence
 from contextlib import suppress
-from dataclasses import replace
 from pathlib import Path
-from typing import TextIO
+from typing import TYPE_CHECKING, TextIO
 
-from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsPublication
-from cyclonedds.core import Policy
-
-from robotale.commands.fame import (
+from robotale.errors import InputError
+from robotale.fame_runtime.clock import WallClock
+from robotale.fame_runtime.dds import DdsBus
+from robotale.fame_runtime.launch import (
     instance_counts,
     parse_assignments,
     robot_list,
     start_time,
-    tag_line,
 )
-from robotale.errors import InputError
-from robotale.fame_runtime.bus import Envelope
-from robotale.fame_runtime.clock import WallClock
-from robotale.fame_runtime.dds import DdsBus, type_of
-from robotale.fame_runtime.node import STATUS_TOPIC, Node
+from robotale.fame_runtime.node import Node
 from robotale.fame_runtime.parser import parse
-from robotale.fame_runtime.qos import DEFAULT_QOS
-from robotale.fame_runtime.rostypes import known, ros_topic
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split
+from robotale.fame_runtime.tags import tag_line
+
+if TYPE_CHECKING:
+    from robotale.sim.live_recording import LiveRecording
 
 #: seconds a run waits for its robots beyond ``until`` before ending them
 GRACE = 30.0
-#: seconds between two looks for new publications on the domain (a recorder)
-DISCOVERY_POLL = 0.1
 
 
 def node_command(
@@ -144,7 +138,7 @@ def run_processes(
     names = [a.robot for a in split(definitions, robot_list(robots))]
     begin = start_time(start)
     offset = begin - time.time()
-    recording = _Recording(record, names, offset) if record is not None else None
+    recording = _recording(record, names, offset) if record is not None else None
     command = [sys.executable, "-m", "robotale", "fame", "node", str(model)]
     command += ["--robots", ",".join(names), "--until", repr(until)]
     command += [f"--clock-offset={offset!r}", f"--origin={begin!r}"]
@@ -205,7 +199,7 @@ _SINK_LOCKS: dict[int, threading.Lock] = {}
 
 def _wait(
     children,
-    recording: _Recording | None,
+    recording: LiveRecording | None,
     deadline: float,
     interrupted: threading.Event | None = None,
 ) -> None:
@@ -220,76 +214,12 @@ def _wait(
             time.sleep(0.05)
 
 
-class _Recording:
-    """A rosbag2 of everything robotale can read on the domain, written as it arrives."""
+def _recording(path: Path, robots: list[str], offset: float) -> LiveRecording:
+    # A node process never records: the simulator's recorder (1.2 s to import) is loaded by a
+    # recording only.
+    from robotale.sim.live_recording import LiveRecording
 
-    def __init__(self, path: Path, robots: list[str], offset: float) -> None:
-        # A node process never records: the simulator's recorder (1.2 s to import) is loaded
-        # by a recording only.
-        from robotale.sim.recorder import Recorder
-
-        if path.exists():
-            raise InputError(f"{path} exists already: record into a new folder")
-        self.clock = WallClock(offset=offset)
-        self.bus = DdsBus(self.clock, node="recorder", recorder=True)
-        self.recorder = Recorder(path, robots=robots, announced={}, rate=None)
-        self.path = path
-        self._seen: set[str] = set()
-        self._publications = _publication_reader(self.bus)
-        self._discover()
-
-    def _discover(self) -> None:
-        """Subscribe to each new ROS-typed topic, asking what its publisher offers."""
-        for sample in self._publications.take(N=256):
-            # a publication that ended comes as a sample without data (no topic, no type)
-            if not sample.sample_info.valid_data or sample.type_name is None:
-                continue
-            msgtype = type_of(sample.type_name)
-            topic = ros_topic(sample.topic_name)
-            if not sample.topic_name.startswith("rt/") or topic == STATUS_TOPIC:
-                continue
-            if msgtype is None or not known(msgtype) or (topic, msgtype) in self._seen:
-                continue
-            self._seen.add((topic, msgtype))
-            self.bus.subscribe(topic, self._write, msgtype=msgtype, qos=_asking(sample.qos))
-        self.clock.call_later(DISCOVERY_POLL, self._discover)
-
-    def _write(self, envelope: Envelope) -> None:
-        self.recorder.tap(envelope)
-
-    def pump(self, seconds: float) -> None:
-        self.clock.run(until=self.clock.now() + seconds)
-
-    def close(self, err: TextIO) -> None:
-        """Write what is still on its way, then close the bag."""
-        quiet_until = time.monotonic() + 0.3
-        while time.monotonic() < quiet_until:
-            # what the readers hold already, even if Cyclone has not called their listeners
-            pending = self.bus.drain() + self.bus.pending
-            self.pump(0.05)
-            if pending:
-                quiet_until = time.monotonic() + 0.3
-        self.recorder.close()
-        self.bus.close()
-        counts = ", ".join(f"{t} {c}" for t, c in sorted(self.recorder.counts.items()) if c)
-        print(f"# recorded {self.path}: {counts or 'nothing'}", file=err)
-
-
-def _publication_reader(bus: DdsBus):
-    return BuiltinDataReader(bus.participant, BuiltinTopicDcpsPublication)
-
-
-def _asking(offered):
-    """A reader QoS every publisher offering ``offered`` serves: its reliability and
-    durability, everything kept, no deadline or liveliness demands."""
-    reliable = isinstance(offered[Policy.Reliability], Policy.Reliability.Reliable)
-    latched = offered[Policy.Durability] == Policy.Durability.TransientLocal
-    return replace(
-        DEFAULT_QOS,
-        reliability="reliable" if reliable else "best_effort",
-        durability="transient_local" if latched else "volatile",
-        history="keep_all",
-    )
+    return LiveRecording(path, robots, offset)
 
 
 def record_command(
@@ -305,7 +235,7 @@ def record_command(
     names = robot_list(robots)
     if not names:
         raise InputError("--robots names no robot (for example drone,tractor_1)")
-    recording = _Recording(out_dir, names, 0.0)
+    recording = _recording(out_dir, names, 0.0)
     deadline = time.monotonic() + duration if duration is not None else float("inf")
     stopped = threading.Event()
     # Ctrl-C or SIGTERM ends a recording: the bag is closed whole below

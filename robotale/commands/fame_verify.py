@@ -7,11 +7,12 @@ import sys
 from pathlib import Path
 from typing import TextIO
 
-from robotale.commands.fame import refuse_duplicate_ids, robot_list, tag_line
 from robotale.errors import RobotaleError, require_range
+from robotale.fame_runtime.launch import refuse_duplicate_ids, robot_list
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.skills import load_skills
+from robotale.fame_runtime.tags import tag_line
 from robotale.fame_runtime.verify import MAX_STATES, TIMEOUT, Verdict, verify
 
 #: exit statuses: no finding, a finding, input that cannot be verified

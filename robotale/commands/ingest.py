@@ -20,8 +20,8 @@ from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary,
 from robotale.errors import InputError
 from robotale.eventlog.readers import is_parquet, parse_mapping, read_with_objects
 from robotale.eventlog.reading import format_reading
-from robotale.webapp.findings_data import prepare
-from robotale.webapp.logdata import LogData
+from robotale.results.findings import prepare
+from robotale.results.logdata import LogData
 
 
 def ingest_command(

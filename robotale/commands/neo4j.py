@@ -8,9 +8,9 @@ import sys
 from pathlib import Path
 
 from robotale.ekg.connection import bolt_answers, settings
-from robotale.ekg.jars import release
-from robotale.ekg.server import CRASHED, OTHER, RUNNING, LocalServer, ServerOptions
-from robotale.ekg.server_config import check_plugins
+from robotale.neo4j_server.jars import release
+from robotale.neo4j_server.server import CRASHED, OTHER, RUNNING, LocalServer, ServerOptions
+from robotale.neo4j_server.server_config import check_plugins
 
 
 def neo4j_start(

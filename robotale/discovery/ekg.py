@@ -32,8 +32,8 @@ from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import read_rows, session_driver
 from robotale.ekg.keys import DISCOVERY_KEY
 from robotale.ekg.logs import log_info
-from robotale.ekg.queries import cypher
 from robotale.errors import InputError
+from robotale.queries import cypher
 
 COMM = "COMM"
 #: above this many entities of a type, one entry node stands for all of them

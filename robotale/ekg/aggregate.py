@@ -15,9 +15,9 @@ from neo4j import Driver
 
 from robotale.ekg.connection import database
 from robotale.ekg.logs import log_info
-from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import check_name, property_name
 from robotale.errors import InputError
+from robotale.queries import cypher, statements
 
 
 def aggregation_key(key: str | Sequence[str]) -> list[str]:

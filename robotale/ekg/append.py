@@ -34,7 +34,6 @@ from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.load import Loader
 from robotale.ekg.logs import log_info, log_values
-from robotale.ekg.queries import cypher
 from robotale.ekg.tables import (
     SUMMARY_PROPERTIES,
     ClassTables,
@@ -48,6 +47,7 @@ from robotale.ekg.tables import log_values as table_values
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, ServerError
 from robotale.eventlog import schema
+from robotale.queries import cypher
 
 
 class _Interrupted(Exception):

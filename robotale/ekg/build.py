@@ -32,7 +32,6 @@ from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
 from robotale.ekg.load import Loader, neo4j_values, within_batches
 from robotale.ekg.logs import FAILED, delete_log, log_exists, log_info, log_run
 from robotale.ekg.objects import write_objects
-from robotale.ekg.queries import cypher, statements
 from robotale.ekg.tables import (
     ClassTables,
     GraphTables,
@@ -45,6 +44,7 @@ from robotale.ekg.tables import (
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, LogNotFound, ServerError
 from robotale.eventlog.objects import Objects
+from robotale.queries import cypher, statements
 
 
 @dataclass(frozen=True)

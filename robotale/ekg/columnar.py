@@ -36,11 +36,11 @@ from neo4j import Driver
 from robotale.config import robotale_home
 from robotale.ekg.connection import database, read_rows
 from robotale.ekg.logs import log_build_row
-from robotale.ekg.queries import cypher
 from robotale.ekg.tables import EVENT_PROPERTIES, property_name
 from robotale.errors import InputError, RobotaleError
 from robotale.eventlog import schema
 from robotale.files import atomic_file
+from robotale.queries import cypher
 
 #: the folder of the copies under the robotale home
 FOLDER = "columnar"

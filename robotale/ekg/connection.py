@@ -21,10 +21,12 @@ from typing import Any
 from neo4j import Driver, GraphDatabase, RoutingControl
 from neo4j.exceptions import AuthError, ServiceUnavailable
 
-from robotale.ekg.queries import cypher
-from robotale.ekg.server import CRASHED, HOST, OTHER, RUNNING, USER, LocalServer
-from robotale.ekg.server import bolt_answers as bolt_answers  # re-exported: the server owns it
 from robotale.errors import ServerError
+from robotale.neo4j_server.server import CRASHED, HOST, OTHER, RUNNING, USER, LocalServer
+from robotale.neo4j_server.server import (
+    bolt_answers as bolt_answers,  # re-exported: the server owns it
+)
+from robotale.queries import cypher
 
 # The driver logs every refused connection attempt and every connection a server dropped
 # (as errors, on stderr); robotale turns the failure into one sentence instead.

@@ -24,7 +24,7 @@ from neo4j import Driver, ManagedTransaction
 from tqdm import tqdm
 
 from robotale.ekg.connection import database
-from robotale.ekg.queries import cypher
+from robotale.queries import cypher
 
 BATCH = 5_000
 WORKERS = 2

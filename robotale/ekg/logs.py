@@ -13,9 +13,9 @@ from typing import Any
 from neo4j import READ_ACCESS, Driver
 
 from robotale.ekg.connection import database, read_rows
-from robotale.ekg.queries import cypher, statements
 from robotale.ekg.writelock import Holder, holders, log_write_lock
 from robotale.errors import LogNotFound
+from robotale.queries import cypher, statements
 
 # The status of a log whose ingest ended before it was complete.
 FAILED = "failed"

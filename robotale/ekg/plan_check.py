@@ -22,6 +22,7 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 from robotale.errors import InputError
+from robotale.neo4j_server.server_config import ALLOWED_FUNCTIONS
 
 #: procedures the console may call: they describe the graph and the server, and change nothing
 ALLOWED_PROCEDURES = frozenset(
@@ -36,9 +37,6 @@ ALLOWED_PROCEDURES = frozenset(
         "dbms.showCurrentUser",
     }
 )
-#: functions of plugins the console may call besides Neo4j's built-in ones (none so far: add
-#: a name here only for a function that reads and returns a bounded value)
-ALLOWED_FUNCTIONS: frozenset[str] = frozenset()
 
 ONLY_READS = "The console only reads the graph"
 

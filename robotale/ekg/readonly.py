@@ -48,8 +48,8 @@ from robotale.ekg.plan_check import (
     check_plan,
 )
 from robotale.ekg.plan_check import ONLY_READS as _ONLY_READS
-from robotale.ekg.queries import code_only, cypher, dotted_calls, split_statements
 from robotale.errors import InputError, RobotaleError, ServerError
+from robotale.queries import code_only, cypher, dotted_calls, split_statements
 
 __all__ = ["ALLOWED_PROCEDURES", "QueryRefused", "WriteRefused", "run_read_only"]
 

@@ -31,11 +31,11 @@ from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.load import Loader, neo4j_values
 from robotale.ekg.logs import log_info
-from robotale.ekg.queries import cypher, statements
 from robotale.ekg.spec import AggrStep
 from robotale.ekg.where import Condition, parse_where
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError
+from robotale.queries import cypher, statements
 
 #: the properties every aggregate has; a group-by key of one of these names is only in ``name``
 OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")

@@ -23,8 +23,8 @@ from neo4j import Driver, RoutingControl
 from neo4j.exceptions import ConstraintError, DriverError, Neo4jError
 
 from robotale.ekg.connection import database
-from robotale.ekg.queries import cypher
 from robotale.errors import InputError
+from robotale.queries import cypher
 
 # The runs of this process that hold a lock right now.
 _ACTIVE: set[str] = set()

@@ -114,3 +114,17 @@ def register_tag_type(typestore) -> None:
 
     if TAG_TYPE not in typestore.fielddefs:
         typestore.register(get_types_from_msg(TAG_MSGDEF, TAG_TYPE))
+
+
+def tag_line(tag: Tag, begin: float = 0.0) -> str:
+    """A tag as one tab-separated line, its stamp in seconds since ``begin``."""
+    fields = (
+        f"{tag.stamp - begin:10.3f}",
+        tag.robot,
+        tag.activity,
+        tag.lifecycle,
+        tag.msg_id,
+        tag.msg_role,
+        tag.payload,
+    )
+    return "\t".join(fields).rstrip()

@@ -27,7 +27,6 @@ from typing import Any
 from neo4j import Driver
 
 from robotale.ekg.connection import Settings, database, settings
-from robotale.ekg.queries import split_statements
 from robotale.ekg.readonly import (
     QueryRefused,
     StatementResult,
@@ -35,8 +34,9 @@ from robotale.ekg.readonly import (
     cell,
     run_read_only,
 )
-from robotale.ekg.server import LocalServer
 from robotale.errors import InputError, RobotaleError, ServerError
+from robotale.neo4j_server.server import LocalServer
+from robotale.queries import split_statements
 from robotale.webapp import console_watchdog
 from robotale.webapp.console_pool import Died, NoAnswer, Pool
 from robotale.webapp.settings import WebSettings

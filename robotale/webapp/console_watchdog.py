@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
 
-from robotale.ekg.queries import cypher
+from robotale.queries import cypher
 
 log = logging.getLogger(__name__)
 #: seconds the watchdog waits for terminated transactions to be gone

@@ -28,10 +28,10 @@ from robotale.eventlog.prepare import find_runs, prepare
 from robotale.eventlog.readers import read_log_with_reading
 from robotale.eventlog.reading import format_reading
 from robotale.fame_runtime.manifest import read_manifests
+from robotale.results.logdata import LogData, first_key
 from robotale.sim import scenarios
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
-from robotale.webapp.logdata import LogData, first_key
 from robotale.webapp.model_store import ModelStore
 
 #: columns every stored log keeps, whatever the user unticks

@@ -14,10 +14,10 @@ from dataclasses import dataclass, field
 from flask import Flask, current_app
 from neo4j import Driver
 
+from robotale.results.logdata import Cache, LogData
 from robotale.webapp.console_pool import Pool
 from robotale.webapp.ingest import PendingLogs
 from robotale.webapp.jobs import Jobs
-from robotale.webapp.logdata import Cache, LogData
 from robotale.webapp.model_store import ModelStore
 from robotale.webapp.neo4j_access import Neo4jAccess
 from robotale.webapp.settings import WebSettings

@@ -14,7 +14,7 @@ from robotale.eventlog.readers import read_csv
 def env(tmp_path, neo4j_server) -> dict[str, str]:
     """The environment of a `robotale` with a Neo4j home of its own under ``tmp_path/home``
     (neo4j_server first: it provisions the jar cache this second server shares)."""
-    from robotale.ekg import jars
+    from robotale.neo4j_server import jars
 
     clean = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")}
     return clean | {

@@ -22,9 +22,9 @@ from robotale.ekg.append import append_ekg
 from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import database
 from robotale.ekg.logs import delete_log, log_info, log_summary, log_values
-from robotale.ekg.queries import cypher
 from robotale.eventlog.readers import read_csv
 from robotale.eventlog.schema import EVENT_ID
+from robotale.queries import cypher
 
 ENTITIES = "robot,msg_id"
 KEYS = ("activity", "activity,robot")

@@ -12,7 +12,7 @@ import pytest
 
 from robotale.cli import main
 from robotale.ekg.logs import list_logs, log_summary
-from robotale.ekg.server import free_port
+from robotale.neo4j_server.server import free_port
 
 GOOD = "time,activity,robot\n2023-05-16T10:00:00Z,takeoff,drone\n2023-05-16T10:00:05Z,land,drone\n"
 

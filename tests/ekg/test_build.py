@@ -12,9 +12,9 @@ from robotale.ekg import build_ekg
 from robotale.ekg.aggregate import aggregate
 from robotale.ekg.connection import database
 from robotale.ekg.logs import delete_log, list_logs, log_summary
-from robotale.ekg.queries import cypher
 from robotale.errors import InputError
 from robotale.eventlog import schema
+from robotale.queries import cypher
 
 
 @pytest.fixture(scope="module")

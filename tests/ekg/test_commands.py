@@ -141,7 +141,7 @@ def test_a_full_disk_under_the_home_keeps_the_graph_and_says_what_was_not_kept(
 
 
 def test_xes_log_with_a_named_time_zone(tmp_path, capsys, neo4j_driver, log_name):
-    from robotale.ekg.queries import cypher
+    from robotale.queries import cypher
 
     path = tmp_path / "zones.xes"
     path.write_text(

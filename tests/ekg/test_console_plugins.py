@@ -16,9 +16,10 @@ from pathlib import Path
 import pytest
 from neo4j import Driver, GraphDatabase
 
-from robotale.ekg import jars, plan_check, readonly
-from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port
+from robotale.ekg import plan_check, readonly
 from robotale.errors import InputError
+from robotale.neo4j_server import jars
+from robotale.neo4j_server.server import LocalServer, PortInUse, ServerOptions, free_port
 
 pytestmark = pytest.mark.slow
 

@@ -20,8 +20,8 @@ import pytest
 from neo4j import GraphDatabase
 from patience import patience
 
-from robotale.ekg import server as server_module
-from robotale.ekg.server import CRASHED, LocalServer, PortInUse, free_port
+from robotale.neo4j_server import server as server_module
+from robotale.neo4j_server.server import CRASHED, LocalServer, PortInUse, free_port
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
 EVENTS = 150_000

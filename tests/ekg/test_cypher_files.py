@@ -9,7 +9,7 @@ from importlib.resources import files
 
 import pytest
 
-from robotale.ekg.queries import statements
+from robotale.queries import statements
 
 NAMES = sorted(
     entry.name.removesuffix(".cypher")

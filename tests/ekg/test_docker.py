@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from robotale.ekg import jars
+from robotale.neo4j_server import jars
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -100,7 +100,7 @@ def _get(port: int, path: str, host: str) -> http.client.HTTPResponse:
 
 
 def test_the_images_command_serves_the_dashboard_with_waitress(tmp_path):
-    from robotale.ekg.server import free_port
+    from robotale.neo4j_server.server import free_port
 
     port = free_port()
     command = [

@@ -10,8 +10,8 @@ import stat
 import pytest
 from tqdm import tqdm
 
-from robotale.ekg.jars import Jar, _download
 from robotale.errors import ServerError
+from robotale.neo4j_server.jars import Jar, _download
 
 CONTENT = b"PK\x03\x04 not really a jar, but bytes with a checksum" * 100
 

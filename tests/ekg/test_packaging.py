@@ -11,7 +11,7 @@ from pathlib import Path
 
 import pytest
 
-from robotale.ekg.queries import cypher, statements
+from robotale.queries import cypher, statements
 
 REPO = Path(__file__).resolve().parents[2]
 
@@ -55,9 +55,7 @@ def test_an_installed_wheel_carries_the_cypher_files(tmp_path):
         check=True,
         capture_output=True,
     )
-    probe = (
-        "import robotale.ekg.queries as q; print(q.__file__); print(q.cypher('ekg_server_version'))"
-    )
+    probe = "import robotale.queries as q; print(q.__file__); print(q.cypher('ekg_server_version'))"
     result = subprocess.run(
         [sys.executable, "-c", probe],
         capture_output=True,

@@ -6,7 +6,7 @@ from importlib.resources import files
 
 import pytest
 
-from robotale.ekg.queries import split_statements, statements
+from robotale.queries import split_statements, statements
 
 
 @pytest.mark.parametrize(

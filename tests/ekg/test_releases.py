@@ -11,11 +11,11 @@ from pathlib import Path
 import pytest
 from neo4j import GraphDatabase
 
-from robotale.ekg import jars, java
 from robotale.ekg.build import build_ekg
 from robotale.ekg.logs import log_summary
-from robotale.ekg.server import LocalServer, free_port
 from robotale.errors import ServerError
+from robotale.neo4j_server import jars, java
+from robotale.neo4j_server.server import LocalServer, free_port
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
 NEWEST = list(jars.RELEASES.values())[-1]

@@ -19,9 +19,16 @@ from typing import ClassVar
 
 import pytest
 
-from robotale.ekg import connection, jars
-from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port, java_executable
+from robotale.ekg import connection
 from robotale.errors import ServerError
+from robotale.neo4j_server import jars
+from robotale.neo4j_server.server import (
+    LocalServer,
+    PortInUse,
+    ServerOptions,
+    free_port,
+    java_executable,
+)
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
 

@@ -12,10 +12,16 @@ from pathlib import Path
 import pytest
 from neo4j import GraphDatabase
 
-from robotale.ekg import jars
-from robotale.ekg.server import LocalServer, PortInUse, ServerOptions, free_port, free_ports
-from robotale.ekg.server_config import check_plugins, read_overlay
 from robotale.errors import ServerError
+from robotale.neo4j_server import jars
+from robotale.neo4j_server.server import (
+    LocalServer,
+    PortInUse,
+    ServerOptions,
+    free_port,
+    free_ports,
+)
+from robotale.neo4j_server.server_config import check_plugins, read_overlay
 
 ROBOTALE = [sys.executable, "-m", "robotale"]
 # A program other than robotale that holds a port until its stdin closes.

@@ -19,8 +19,8 @@ from rosbags.rosbag2 import StoragePlugin, Writer
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.cli import main
-from robotale.webapp.findings_data import stored_timeline
-from robotale.webapp.logdata import LogData
+from robotale.results.findings import stored_timeline
+from robotale.results.logdata import LogData
 
 ACTION = "navigate_to_pose"
 STATUS = f"/{{robot}}/{ACTION}/_action/status"

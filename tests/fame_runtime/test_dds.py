@@ -444,7 +444,7 @@ def test_a_live_run_ingests_with_its_comm_edges(tmp_path, capsys, neo4j_driver, 
     from robotale.commands.prepare import prepare_recordings
     from robotale.ekg.connection import database
     from robotale.ekg.logs import log_summary
-    from robotale.ekg.queries import cypher
+    from robotale.queries import cypher
 
     bag = tmp_path / "live"
     model = str(MODELS / "hello_at_once.bpmn")

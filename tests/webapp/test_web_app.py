@@ -15,7 +15,7 @@ from pathlib import Path
 import pytest
 from patience import patience
 
-from robotale.ekg.server import free_port
+from robotale.neo4j_server.server import free_port
 from robotale.webapp import create_app
 from robotale.webapp.serve import Dashboard
 

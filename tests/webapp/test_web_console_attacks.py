@@ -18,7 +18,7 @@ from pathlib import Path
 import pytest
 
 from robotale.ekg import readonly
-from robotale.ekg.server import (
+from robotale.neo4j_server.server import (
     CONSOLE_USER,
     LocalServer,
     create_console_user,
@@ -365,9 +365,9 @@ def test_with_apoc_installed_cypher_given_as_text_reads_no_url(
     even in a READ transaction. The console refuses the function."""
     from neo4j import READ_ACCESS, GraphDatabase
 
-    from robotale.ekg import jars
     from robotale.ekg.readonly import QueryRefused, run_read_only
-    from robotale.ekg.server import ServerOptions, free_port
+    from robotale.neo4j_server import jars
+    from robotale.neo4j_server.server import ServerOptions, free_port
 
     plugins = tmp_path / "plugins"
     plugins.mkdir()

@@ -111,7 +111,7 @@ def test_a_new_build_is_computed_again(app, neo4j_driver, thesis):
 
 
 def test_storing_prepares_everything_the_pages_show_first(app, neo4j_driver, thesis):
-    from robotale.webapp.findings_data import prepare
+    from robotale.results.findings import prepare
     from robotale.webapp.state import state
 
     name, _ = thesis

@@ -7,8 +7,8 @@ from flask import Blueprint, jsonify, render_template, request
 
 from robotale.discovery import LogFilter, discover_dfg
 from robotale.ekg.logs import log_values
+from robotale.results.logdata import log_info
 from robotale.webapp import pages
-from robotale.webapp.logdata import log_info
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("discover", __name__)

@@ -6,8 +6,8 @@ from __future__ import annotations
 
 from flask import Blueprint, Response, render_template, request
 
+from robotale.results.findings import parse_delay, stored_findings
 from robotale.webapp import pages
-from robotale.webapp.findings_data import parse_delay, stored_findings
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("findings", __name__)

@@ -19,8 +19,8 @@ from robotale.ekg.columnar import delete_copies
 from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
+from robotale.results.findings import prepare
 from robotale.webapp import ingest, pages, uploads
-from robotale.webapp.findings_data import prepare
 from robotale.webapp.jobs import Jobs
 from robotale.webapp.settings import WebSettings
 from robotale.webapp.state import driver, state

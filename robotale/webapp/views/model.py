@@ -15,8 +15,8 @@ from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.splitter import split
 from robotale.fame_runtime.verify import verify
+from robotale.results.logdata import log_info
 from robotale.webapp import overlay, pages
-from robotale.webapp.logdata import log_info
 from robotale.webapp.model_store import ModelStore, StoredModel
 from robotale.webapp.state import driver, state
 

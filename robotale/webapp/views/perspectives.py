@@ -7,8 +7,8 @@ from __future__ import annotations
 
 from flask import Blueprint, Response, abort, render_template, request
 
+from robotale.results.findings import PERSPECTIVES, parse_delay, stored_perspective
 from robotale.webapp import pages
-from robotale.webapp.findings_data import PERSPECTIVES, parse_delay, stored_perspective
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("perspectives", __name__)

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 from flask import Blueprint, Response, render_template, request
 
+from robotale.results.findings import stored_runs, stored_timeline
 from robotale.webapp import pages
-from robotale.webapp.findings_data import stored_runs, stored_timeline
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("timeline", __name__)

@@ -1,7 +1,7 @@
 """The local Neo4j server: start, stop and status.
 
-Neo4j Community runs from the jars of :mod:`robotale.ekg.jars` through its real server entry
-point (Bolt, HTTP and Neo4j Browser at ``/browser/``), bound to 127.0.0.1 only. Its home is
+Neo4j Community runs from the jars of :mod:`robotale.neo4j_server.jars` through its real server
+entry point (Bolt, HTTP and Neo4j Browser at ``/browser/``), bound to 127.0.0.1 only. Its home is
 ``$ROBOTALE_HOME/neo4j``: ``conf/neo4j.conf``, ``data/``, ``logs/``, ``server.json`` (pid and
 ports of the running server), ``ports.json`` (the last server's pid and ports and whether it was
 stopped: it outlives a crash, so robotale keeps talking about the right port) and ``password``
@@ -9,7 +9,7 @@ stopped: it outlives a crash, so robotale keeps talking about the right port) an
 ``NEO4J_PASSWORD`` when that is set at the first start, otherwise a generated one.
 
 Plugin jars (``--plugins`` or ``<robotale home>/plugins``) and the user's settings
-(``<robotale home>/neo4j.conf``) join in as :mod:`robotale.ekg.server_config` describes.
+(``<robotale home>/neo4j.conf``) join in as :mod:`robotale.neo4j_server.server_config` describes.
 """
 
 from __future__ import annotations
@@ -34,7 +34,9 @@ from neo4j import Driver, GraphDatabase
 from neo4j.exceptions import AuthError, ServiceUnavailable
 
 from robotale.config import robotale_home
-from robotale.ekg.jars import (
+from robotale.errors import ServerError
+from robotale.files import write_file
+from robotale.neo4j_server.jars import (
     DEFAULT_RELEASE,
     RELEASES,
     VERSION_ENV,
@@ -42,11 +44,10 @@ from robotale.ekg.jars import (
     ensure_jars,
     release,
 )
-from robotale.ekg.java import find_java
-from robotale.ekg.plan_check import ALLOWED_FUNCTIONS
-from robotale.ekg.port_holder import port_holder
-from robotale.ekg.queries import statements
-from robotale.ekg.server_config import (
+from robotale.neo4j_server.java import find_java
+from robotale.neo4j_server.port_holder import port_holder
+from robotale.neo4j_server.server_config import (
+    ALLOWED_FUNCTIONS,
     APOC_CONF_NAME,
     OVERLAY_NAME,
     PLUGINS_NAME,
@@ -56,8 +57,7 @@ from robotale.ekg.server_config import (
     read_overlay,
     render,
 )
-from robotale.errors import ServerError
-from robotale.files import write_file
+from robotale.queries import statements
 
 HOST = "127.0.0.1"
 USER = "neo4j"
@@ -97,7 +97,7 @@ class ServerOptions:
     pagecache: str = "512m"
     #: the folder of plugin jars; None: the robotale home's ``plugins/`` when it exists
     plugins: Path | None = None
-    #: the Neo4j release: a line of :data:`robotale.ekg.jars.RELEASES` or a full version
+    #: the Neo4j release: a line of :data:`robotale.neo4j_server.jars.RELEASES` or a full version
     version: str = DEFAULT_RELEASE.line
 
     @classmethod
@@ -491,7 +491,7 @@ def _http_answers(state: RunningServer) -> bool:
 
 
 def java_executable(chosen: Release = DEFAULT_RELEASE) -> str:
-    """The Java that runs the release ``chosen`` (see :mod:`robotale.ekg.java`)."""
+    """The Java that runs the release ``chosen`` (see :mod:`robotale.neo4j_server.java`)."""
     lowest, highest = chosen.java
     return str(find_java(lowest, highest, f"Neo4j {chosen.version}").executable)
 

@@ -1,10 +1,11 @@
 """Regenerate the lock file of a Neo4j release, the pinned jar set of the local Neo4j server.
 
-A maintainer's tool (it needs Maven): ``python -m robotale.ekg.neo4j_lock [LINE]`` (a release
-line of :data:`~robotale.ekg.jars.RELEASES`, e.g. ``2026.08``; default 5.26). Maven resolves the
+A maintainer's tool (it needs Maven): ``python -m robotale.neo4j_server.neo4j_lock [LINE]``
+(a release line of :data:`~robotale.neo4j_server.jars.RELEASES`, e.g. ``2026.08``; default
+5.26). Maven resolves the
 runtime closure of the Neo4j Community server, its HTTP module and Neo4j Browser; the lock
 records each jar's Maven coordinates, sha1 and size, so users download exactly these files from
-Maven Central without Maven (see :mod:`robotale.ekg.jars`).
+Maven Central without Maven (see :mod:`robotale.neo4j_server.jars`).
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ import sys
 import tempfile
 from pathlib import Path
 
-from robotale.ekg.jars import Jar, Release, release
+from robotale.neo4j_server.jars import Jar, Release, release
 
 _SCOPES = {"compile", "runtime", "provided", "system", "test"}
 _POM = """<project xmlns="http://maven.apache.org/POM/4.0.0">
@@ -76,7 +77,8 @@ def write_lock(jars: list[Jar], chosen: Release) -> None:
     lines = [
         f"# Neo4j {chosen.version} Community server with Neo4j Browser {chosen.browser}:",
         "# the runtime jars, fetched from Maven Central and checked against these sha1 sums.",
-        f"# Regenerate with `python -m robotale.ekg.neo4j_lock {chosen.line}` (needs Maven).",
+        f"# Regenerate with `python -m robotale.neo4j_server.neo4j_lock {chosen.line}`"
+        " (needs Maven).",
         *sorted(jar.lock_line() for jar in jars),
     ]
     chosen.lock.write_text("\n".join(lines) + "\n")

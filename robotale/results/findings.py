@@ -15,7 +15,7 @@ from robotale.enhancement.findings import find, trusted_first
 from robotale.enhancement.result import Perspective
 from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import InputError, RobotaleError
-from robotale.webapp.logdata import LogData, first_key, log_info
+from robotale.results.logdata import LogData, first_key, log_info
 
 #: the Perspectives page's sections, in the order it shows them
 PERSPECTIVES: dict[str, Callable[..., Perspective]] = {

@@ -19,6 +19,10 @@ from pathlib import Path
 
 from robotale.errors import ServerError
 
+#: functions of plugins a query may call besides Neo4j's built-in ones (none so far: add
+#: a name here only for a function that reads and returns a bounded value)
+ALLOWED_FUNCTIONS: frozenset[str] = frozenset()
+
 OVERLAY_NAME = "neo4j.conf"
 APOC_CONF_NAME = "apoc.conf"
 PLUGINS_NAME = "plugins"
