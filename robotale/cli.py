@@ -33,7 +33,7 @@ def build_parser() -> argparse.ArgumentParser:
     parser.add_argument("--version", action="version", version=f"robotale {__version__}")
     commands = parser.add_subparsers(dest="_command", metavar="COMMAND")
     commands.required = True
-    # One line per command group, in the order of the data flow (see DESIGN.md).
+    # One line per command group, in the order of the data flow (see docs/architecture.md).
     _add_fame(commands)
     _add_record(commands)
     _add_simulate(commands)

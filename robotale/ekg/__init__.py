@@ -1,5 +1,6 @@
-"""Event Knowledge Graph in Neo4j: the local server, the connection, the schema, loading,
-and aggregation into Class graphs. Every query is a file in ``cypher/``.
+"""Event Knowledge Graph in Neo4j: the connection, the schema, loading, and aggregation into
+Class graphs (the local server robotale starts is :mod:`robotale.neo4j_server`). Every query
+is a file in ``cypher/``.
 
 ``build_ekg(driver, log, name, ...)`` stores a canonical event log; ``connect()`` returns a
 driver for the configured server; ``aggregate(driver, name, key)`` (re)builds a Class graph;
