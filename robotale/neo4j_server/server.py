@@ -415,7 +415,7 @@ class LocalServer:
         options: ServerOptions,
         chosen: Release,
         jvm_options: tuple[str, ...] = (),
-    ) -> subprocess.Popen:
+    ) -> subprocess.Popen[bytes]:
         command = [
             java,
             f"-Xms{options.heap}",
@@ -441,7 +441,7 @@ class LocalServer:
             )
 
     def _wait_until_answering(
-        self, process: subprocess.Popen, state: RunningServer, timeout: float
+        self, process: subprocess.Popen[bytes], state: RunningServer, timeout: float
     ) -> None:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
@@ -485,7 +485,7 @@ def bolt_answers(uri: str, auth: tuple[str, str]) -> bool:
 def _http_answers(state: RunningServer) -> bool:
     try:
         with urllib.request.urlopen(f"http://{HOST}:{state.http_port}/", timeout=2) as response:
-            return response.status == 200
+            return bool(response.status == 200)
     except OSError:
         return False
 
