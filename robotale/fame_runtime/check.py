@@ -16,7 +16,8 @@ from pathlib import Path
 
 from lxml import etree
 
-from robotale.fame_runtime.labels import THROWING, catches, signal_topic
+from robotale.fame_runtime.kinds import GATEWAYS, THROWING, EventKind, Kind
+from robotale.fame_runtime.labels import catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Node, Problem, Process, Scope
 from robotale.fame_runtime.plan import findings
@@ -125,9 +126,9 @@ def _signal_events(process: Process, skills: Collection[str], library: Library |
             continue
         seen.add(id(current))
         for node in current.walk():
-            if node.event_kind == "signal" and signal_topic(node):
+            if node.event_kind == EventKind.SIGNAL and signal_topic(node):
                 yield node, current
-            if node.kind == "callActivity" and node.called_element not in skills:
+            if node.kind == Kind.CALL_ACTIVITY and node.called_element not in skills:
                 called = node.embedded_process or resolve_call(
                     node.called_element, current, library
                 )
@@ -165,16 +166,6 @@ def _lonely(topic: str, publishers: list[Endpoint], subscribers: list[Endpoint])
 
 
 # -- flows that can never complete -------------------------------------------------------------
-
-GATEWAYS = frozenset(
-    {
-        "exclusiveGateway",
-        "parallelGateway",
-        "inclusiveGateway",
-        "eventBasedGateway",
-        "complexGateway",
-    }
-)
 
 
 def progress_problems(process: Process) -> list[str]:
@@ -227,7 +218,7 @@ def _deadlocked_joins(scope: Scope, graph: dict[str, list[str]]) -> list[str]:
     starts = [n for n in graph if not incoming[n]]
     found = []
     for join, node in scope.nodes.items():
-        if node.kind != "parallelGateway" or len(incoming[join]) < 2:
+        if node.kind != Kind.PARALLEL_GATEWAY or len(incoming[join]) < 2:
             continue
         reached = _reachable(graph, starts, avoid=join)
         stuck = sorted(source for source in incoming[join] if source not in reached)

@@ -19,6 +19,7 @@ import builtins
 import contextlib
 from collections import deque
 from collections.abc import Callable, Iterable, Iterator, Mapping
+from enum import StrEnum
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -40,7 +41,7 @@ from robotale.fame_runtime.model import JAVASCRIPT, Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, speaks_javascript
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
-from robotale.fame_runtime.tags import ABORT, COMPLETE, START, Tagger, TagSink
+from robotale.fame_runtime.tags import Lifecycle, Tagger, TagSink
 from robotale.fame_runtime.tokens import Frame, RunScope, Token, install
 from robotale.fame_runtime.triggers import Triggers
 
@@ -51,9 +52,18 @@ MAX_STEPS = 1_000_000
 _FREE = contextlib.nullcontext()
 
 #: told of every activity instance as it starts and ends (robot, instance number, activity,
-#: ``start`` / ``completed`` / ``interrupted`` / ``cancelled``), apart from the tags: a
-#: simulation's ground truth numbers instances, which tags do not
+#: an :class:`Ending`'s text), apart from the tags: a simulation's ground truth numbers
+#: instances, which tags do not
 ActivityObserver = Callable[[str, int, str, str], None]
+
+
+class Ending(StrEnum):
+    """What the activity observer is told of an activity instance."""
+
+    START = "start"
+    COMPLETED = "completed"
+    INTERRUPTED = "interrupted"  # by an interrupting boundary event or event sub-process
+    CANCELLED = "cancelled"
 
 
 class Engine:
@@ -129,7 +139,7 @@ class Engine:
         self._instances = 0
         #: how a cancel ends the activities it reaches: ``interrupted`` while an interrupting
         #: boundary event or event sub-process takes over, else ``cancelled``
-        self._ending = "cancelled"
+        self._ending = Ending.CANCELLED
         self.activity_observer: ActivityObserver | None = None
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
@@ -376,7 +386,7 @@ class Engine:
         self.disarm(token)
         if token.child is not None:
             self.cancel_scope(token.child)
-        self.end_activity(token, ABORT)  # after its inner activities: they ended first
+        self.end_activity(token, Lifecycle.ABORT)  # after its inner activities: they ended first
 
     def disarm(self, token: Token) -> None:
         token.generation += 1  # whatever fires for the old wait from now on is stale
@@ -536,13 +546,13 @@ class Engine:
 
     def begin_activity(self, token: Token, label: str) -> None:
         """``token``'s activity starts: tagged, and remembered until it ends."""
-        self.tag(label, START)
+        self.tag(label, Lifecycle.START)
         self._instances += 1
         self._running[token] = (label, self._instances)
         if self.activity_observer is not None:
-            self.activity_observer(self.robot.name, self._instances, label, "start")
+            self.activity_observer(self.robot.name, self._instances, label, Ending.START.value)
 
-    def end_activity(self, token: Token, lifecycle: str) -> None:
+    def end_activity(self, token: Token, lifecycle: Lifecycle) -> None:
         """``token``'s activity, if one runs, ends: ``complete``, or ``ate_abort`` when it was
         interrupted or cancelled."""
         running = self._running.pop(token, None)
@@ -551,14 +561,14 @@ class Engine:
         label, number = running
         self.tag(label, lifecycle)
         if self.activity_observer is not None:
-            how = "completed" if lifecycle == COMPLETE else self._ending
-            self.activity_observer(self.robot.name, number, label, how)
+            how = Ending.COMPLETED if lifecycle == Lifecycle.COMPLETE else self._ending
+            self.activity_observer(self.robot.name, number, label, how.value)
 
     @contextlib.contextmanager
     def interrupting(self) -> Iterator[None]:
         """The activities cancelled meanwhile were interrupted (an interrupting boundary event
         or event sub-process), not merely cancelled."""
-        before, self._ending = self._ending, "interrupted"
+        before, self._ending = self._ending, Ending.INTERRUPTED
         try:
             yield
         finally:

@@ -12,6 +12,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robotale.fame_runtime.kinds import EventKind, Kind, LoopKind
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.timers import TimerSpec
 
@@ -76,7 +77,8 @@ class RosMessage:
 class EventDefinition:
     """What triggers or is thrown by an event."""
 
-    kind: str  # signal timer conditional error terminate message escalation compensate cancel link
+    #: what it is; a definition BPMN does not name (``fooEventDefinition``) stays as written
+    kind: EventKind | str
     ref: str = ""  # signalRef / errorRef / messageRef / compensation's activityRef as written
     ref_name: str = ""  # the name of the referenced signal / error, "" when not declared
     timer: TimerSpec | None = None
@@ -94,7 +96,7 @@ class Loop:
     ``camunda:elementVariable`` (the item's id, as SpiffWorkflow reads it).
     """
 
-    kind: str
+    kind: LoopKind
     cardinality: Expression | None = None
     collection: str = ""  # the variable holding the input collection
     element: str = ""  # the variable each instance finds its item in
@@ -130,7 +132,7 @@ class Node:
     """One flow node (event, activity, gateway) of a process or sub-process."""
 
     id: str
-    kind: str  # the BPMN tag: startEvent, scriptTask, exclusiveGateway, subProcess ...
+    kind: Kind  # the BPMN tag: startEvent, scriptTask, exclusiveGateway, subProcess ...
     name: str = ""
     line: int = 0
     events: list[EventDefinition] = field(default_factory=list)
@@ -158,9 +160,9 @@ class Node:
         return self.events[0] if self.events else None
 
     @property
-    def event_kind(self) -> str:
+    def event_kind(self) -> EventKind | str:
         """``none`` for an event without a definition, else the definition's kind."""
-        return self.events[0].kind if self.events else "none"
+        return self.events[0].kind if self.events else EventKind.NONE
 
     def describe(self) -> str:
         """``Activity_1 (Take Off)``: how messages name this element."""

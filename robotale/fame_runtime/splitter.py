@@ -15,6 +15,7 @@ from pathlib import Path
 from lxml import etree
 
 from robotale.errors import ModelError
+from robotale.fame_runtime.kinds import Kind
 from robotale.fame_runtime.library import find_process
 from robotale.fame_runtime.model import Definitions, Participant, Process
 
@@ -140,7 +141,7 @@ def _same_file_calls(process: Process) -> set[str]:
         keep.add(current.id)
         for node in current.walk():
             called = find_process(definitions, node.called_element) if definitions else None
-            if node.kind == "callActivity" and called is not None:
+            if node.kind == Kind.CALL_ACTIVITY and called is not None:
                 stack.append(called)
     return keep
 

@@ -11,12 +11,22 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from dataclasses import dataclass
+from enum import StrEnum
 
 TAG_TYPE = "robotale_msgs/msg/Tag"
 
-#: the lifecycles of activity tags: started, completed, and ended without completing
-#: (interrupted by a boundary event or an event sub-process, or cancelled)
-START, COMPLETE, ABORT = "start", "complete", "ate_abort"
+
+class Lifecycle(StrEnum):
+    """The lifecycles of activity tags: started, completed, and ended without completing
+    (interrupted by a boundary event or an event sub-process, or cancelled)."""
+
+    START = "start"
+    COMPLETE = "complete"
+    ABORT = "ate_abort"
+
+
+#: the lifecycles as the plain text a tag carries
+START, COMPLETE, ABORT = Lifecycle.START.value, Lifecycle.COMPLETE.value, Lifecycle.ABORT.value
 #: the roles of message tags
 SEND, RECEIVE = "send", "receive"
 
@@ -67,15 +77,22 @@ class Tagger:
         self._count = 0
 
     def __call__(
-        self, activity: str, lifecycle: str, msg_id: str = "", role: str = "", payload: str = ""
+        self,
+        activity: str,
+        lifecycle: Lifecycle,
+        msg_id: str = "",
+        role: str = "",
+        payload: str = "",
     ) -> None:
         if self.sink is not None:
-            self.sink(Tag(self.clock.now(), self.robot, activity, lifecycle, msg_id, role, payload))
+            stamp = self.clock.now()
+            # the plain text: a tag is written to bags and logs as it is
+            self.sink(Tag(stamp, self.robot, activity, lifecycle.value, msg_id, role, payload))
 
     def pair(self, activity: str, msg_id: str = "", role: str = "", payload: str = "") -> None:
         """A start and a complete tag at the same instant (events, messages)."""
-        self(activity, START, msg_id, role, payload)
-        self(activity, COMPLETE, msg_id, role, payload)
+        self(activity, Lifecycle.START, msg_id, role, payload)
+        self(activity, Lifecycle.COMPLETE, msg_id, role, payload)
 
     def new_msg_id(self) -> str:
         """The bus's next message id, or ``m_<robot>_<n>``: robot namespaces are unique in a

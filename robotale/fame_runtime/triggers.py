@@ -25,6 +25,7 @@ from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Bus, Envelope, Subscription
 from robotale.fame_runtime.clock import Clock
 from robotale.fame_runtime.expressions import substitute
+from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import EMPTY_MSGTYPE, Trigger
 from robotale.fame_runtime.timers import parse_timer
 
@@ -86,11 +87,11 @@ class Triggers:
     def arm(
         self, trigger: Trigger, fire: Fire, *, repeat: bool = False, depth: float = 0
     ) -> Disarm:
-        if trigger.kind == "signal":
+        if trigger.kind == EventKind.SIGNAL:
             return self._signal(trigger, fire)
-        if trigger.kind == "timer":
+        if trigger.kind == EventKind.TIMER:
             return self._timer(trigger, fire, repeat)
-        if trigger.kind == "conditional":
+        if trigger.kind == EventKind.CONDITIONAL:
             return self._conditional(trigger, fire, repeat)
         return self._error(trigger, fire, depth)
 

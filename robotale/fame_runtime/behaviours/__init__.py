@@ -17,6 +17,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from robotale.fame_runtime.behaviours import activities, events, gateways, loops
+from robotale.fame_runtime.kinds import Run
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tokens import Token
 
@@ -29,21 +30,21 @@ Behaviour = Callable[["Engine", Token, NodePlan], "NodePlan | None"]
 
 #: how a node runs, by the behaviour the deployer gave it (``NodePlan.behaviour``)
 BEHAVIOURS: dict[str, Behaviour] = {
-    "start": events.run_start,
-    "catch": events.run_catch,
-    "boundary": events.run_boundary,
-    "pass": events.run_pass,
-    "end": events.run_end,
-    "terminate": events.run_terminate,
-    "event_subprocess": events.run_event_subprocess,
-    "task": activities.run_task,
-    "script": activities.run_script,
-    "skill": activities.run_skill,
-    "call": activities.run_call,
-    "subprocess": activities.run_call,  # its content runs like a called process
-    "loop": loops.run_loop,
-    "exclusiveGateway": gateways.run_exclusive,
-    "parallelGateway": gateways.run_parallel,
-    "inclusiveGateway": gateways.run_inclusive,
-    "eventBasedGateway": gateways.run_event_based,
+    Run.START: events.run_start,
+    Run.CATCH: events.run_catch,
+    Run.BOUNDARY: events.run_boundary,
+    Run.PASS: events.run_pass,
+    Run.END: events.run_end,
+    Run.TERMINATE: events.run_terminate,
+    Run.EVENT_SUBPROCESS: events.run_event_subprocess,
+    Run.TASK: activities.run_task,
+    Run.SCRIPT: activities.run_script,
+    Run.SKILL: activities.run_skill,
+    Run.CALL: activities.run_call,
+    Run.SUBPROCESS: activities.run_call,  # its content runs like a called process
+    Run.LOOP: loops.run_loop,
+    Run.EXCLUSIVE_GATEWAY: gateways.run_exclusive,
+    Run.PARALLEL_GATEWAY: gateways.run_parallel,
+    Run.INCLUSIVE_GATEWAY: gateways.run_inclusive,
+    Run.EVENT_BASED_GATEWAY: gateways.run_event_based,
 }

@@ -17,9 +17,10 @@ from robotale.fame_runtime.behaviours.compensation import compensable
 from robotale.fame_runtime.behaviours.errors import script_limit, throw_error
 from robotale.fame_runtime.expressions import BpmnError, Compiled
 from robotale.fame_runtime.javascript import Completion, ScriptFailure, ScriptLimit
+from robotale.fame_runtime.kinds import Run
 from robotale.fame_runtime.model import JAVASCRIPT
 from robotale.fame_runtime.plan import NodePlan
-from robotale.fame_runtime.tags import COMPLETE
+from robotale.fame_runtime.tags import Lifecycle
 from robotale.fame_runtime.tokens import Token
 from robotale.fame_runtime.watchdog import MEASURE, ScriptTimeout
 
@@ -64,7 +65,7 @@ def run_script(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
 def _completed(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
     """An activity that ran at once completed: tagged, remembered for compensation, its
     outputs written, its token on its way."""
-    engine.end_activity(token, COMPLETE)
+    engine.end_activity(token, Lifecycle.COMPLETE)
     compensable(token, node)
     engine.data.outputs(node, {})
     return engine.follow(token, engine.taken(node, first=False))
@@ -202,8 +203,8 @@ def activity_done(engine: Engine, token: Token, outputs: Mapping[str, Any] | Non
     node = token.node
     child, token.child = token.child, None
     engine.disarm(token)
-    engine.end_activity(token, COMPLETE)
-    if node.behaviour == "event_subprocess":
+    engine.end_activity(token, Lifecycle.COMPLETE)
+    if node.behaviour == Run.EVENT_SUBPROCESS:
         engine.consume(token)
         return
     compensable(token, node, child)

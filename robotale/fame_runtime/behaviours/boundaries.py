@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING
 
 from robotale.fame_runtime.behaviours.catching import caught
 from robotale.fame_runtime.bus import Envelope
+from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tokens import RunScope, Token, nothing
 
@@ -22,7 +23,7 @@ def arm_boundaries(engine: Engine, token: Token, node: NodePlan) -> None:
     for boundary in node.boundaries:
         trigger = boundary.trigger
         assert trigger is not None  # the deployer gives every boundary event its trigger
-        if trigger.kind == "escalation":
+        if trigger.kind == EventKind.ESCALATION:
             continue  # found when an escalation is thrown inside (see errors.escalate)
         repeat = not boundary.node.cancel_activity
         fire = _boundary_fire(engine, token, boundary)
@@ -63,9 +64,9 @@ def arm_event_subprocess(engine: Engine, scope: RunScope, esp: NodePlan) -> None
     trigger = start.trigger
     assert trigger is not None
     interrupting = start.node.interrupting
-    if trigger.kind == "compensate":
+    if trigger.kind == EventKind.COMPENSATE:
         return  # it runs when its scope is compensated (see compensation.compensate_one)
-    if trigger.kind == "escalation":  # nothing to wait for outside the engine
+    if trigger.kind == EventKind.ESCALATION:  # nothing to wait for outside the engine
         scope.armed[esp.id] = nothing
         return
 

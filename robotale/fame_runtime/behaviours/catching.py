@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
 from robotale.fame_runtime.bus import Envelope
+from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tags import RECEIVE, payload_text
 from robotale.fame_runtime.tokens import Token
@@ -42,7 +43,7 @@ def received(engine: Engine, node: NodePlan, envelope: Envelope | None) -> dict[
     """Tag a fired catching event; a message's data goes to the variables."""
     trigger = node.trigger
     assert trigger is not None  # the deployer gives every catching node its trigger
-    if envelope is None or trigger.kind != "signal":
+    if envelope is None or trigger.kind != EventKind.SIGNAL:
         engine.tag.pair(trigger.label)
         return {}
     payload = payload_text(envelope.data)

@@ -8,6 +8,7 @@ from collections.abc import Callable
 from typing import TYPE_CHECKING
 
 from robotale.fame_runtime.behaviours.catching import caught
+from robotale.fame_runtime.kinds import Run
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tokens import Done, Frame, RunScope, Token, nothing
 
@@ -36,7 +37,7 @@ def throw_compensation(
     assert throw is not None  # the deployer gives every throwing node what it throws
     engine.tag.pair(throw.label)
     scope = token.scope
-    if scope.holder is not None and scope.holder.node.behaviour == "event_subprocess":
+    if scope.holder is not None and scope.holder.node.behaviour == Run.EVENT_SUBPROCESS:
         assert scope.parent is not None  # an event sub-process runs inside a scope
         scope = scope.parent
     records = _take_done(scope, throw.topic)

@@ -7,6 +7,7 @@ from __future__ import annotations
 from typing import TYPE_CHECKING
 
 from robotale.fame_runtime.behaviours.boundaries import boundary_fired, event_subprocess
+from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tokens import RunScope, Token, outer
 
@@ -59,7 +60,9 @@ def _catch_above(engine: Engine, token: Token, kind: str, name: str) -> bool:
         esp = _esp_catcher(scope, kind, name)
         if esp is not None:
             assert esp.child is not None
-            interrupting = kind == "error" or esp.child.triggered_starts[0].node.interrupting
+            interrupting = (
+                kind == EventKind.ERROR or esp.child.triggered_starts[0].node.interrupting
+            )
             event_subprocess(engine, scope, esp, None, interrupting=interrupting)
             return True
         if scope.holder is not None:

@@ -10,8 +10,9 @@ from robotale.fame_runtime.behaviours.boundaries import arm_boundaries
 from robotale.fame_runtime.behaviours.catching import waker
 from robotale.fame_runtime.behaviours.compensation import throw_compensation
 from robotale.fame_runtime.behaviours.errors import escalate, throw_error
+from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import NodePlan
-from robotale.fame_runtime.tags import COMPLETE, SEND, START, payload_text
+from robotale.fame_runtime.tags import SEND, Lifecycle, payload_text
 from robotale.fame_runtime.tokens import Token
 
 if TYPE_CHECKING:
@@ -39,30 +40,30 @@ def run_catch(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
 
 def run_pass(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
     """An intermediate throw event or a send task: throw, then go on."""
-    kind = node.throw.kind if node.throw is not None else ""
-    if kind == "compensate":
+    kind = node.throw.kind if node.throw is not None else EventKind.NONE
+    if kind == EventKind.COMPENSATE:
         if not throw_compensation(engine, token, node, lambda: engine.go_on(token, node)):
             return None  # it goes on once the compensation is done
-    elif kind == "escalation":
+    elif kind == EventKind.ESCALATION:
         if not escalate(engine, token, node):
             return None  # an interrupting catcher cancelled the thrower
-    elif kind:
+    elif kind != EventKind.NONE:
         publish(engine, node)
     return engine.follow(token, engine.taken(node, first=False))
 
 
 def run_end(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
     throw = node.throw
-    kind = throw.kind if throw is not None else "none"
-    if kind in ("signal", "message"):
+    kind = throw.kind if throw is not None else EventKind.NONE
+    if kind in (EventKind.SIGNAL, EventKind.MESSAGE):
         publish(engine, node)
-    if kind == "error":
+    if kind == EventKind.ERROR:
         assert throw is not None
         throw_error(engine, token, throw.topic)  # the catching event is tagged
         return None
-    if kind == "escalation" and not escalate(engine, token, node):
+    if kind == EventKind.ESCALATION and not escalate(engine, token, node):
         return None
-    if kind == "compensate" and not throw_compensation(
+    if kind == EventKind.COMPENSATE and not throw_compensation(
         engine, token, node, lambda: engine.consume(token)
     ):
         return None  # it ends once the compensation is done
@@ -82,7 +83,7 @@ def publish(engine: Engine, node: NodePlan) -> None:
     data = engine.data.payload(node)
     msg_id = engine.tag.new_msg_id()
     payload = payload_text(data)
-    engine.tag(throw.label, START, msg_id, SEND, payload)
+    engine.tag(throw.label, Lifecycle.START, msg_id, SEND, payload)
     engine.bus.publish(
         throw.topic,
         data,
@@ -91,4 +92,4 @@ def publish(engine: Engine, node: NodePlan) -> None:
         msg_id=msg_id,
         qos=throw.qos,
     )
-    engine.tag(throw.label, COMPLETE, msg_id, SEND, payload)
+    engine.tag(throw.label, Lifecycle.COMPLETE, msg_id, SEND, payload)

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.behaviours.catching import waker
+from robotale.fame_runtime.kinds import Run
 from robotale.fame_runtime.plan import NodePlan, reachable_flows
 from robotale.fame_runtime.tokens import RunScope, Token
 
@@ -46,7 +47,7 @@ def recheck_joins(engine: Engine) -> None:
     for scope in list(engine.inclusive):
         for node_id, waiting in list(scope.joins.items()):
             node = scope.plan.nodes[node_id]
-            if node.behaviour == "inclusiveGateway" and waiting and _may_go(scope, node):
+            if node.behaviour == Run.INCLUSIVE_GATEWAY and waiting and _may_go(scope, node):
                 _merge_inclusive(engine, scope, node, waiting)
         if not any(scope.joins.values()):
             engine.inclusive.discard(scope)

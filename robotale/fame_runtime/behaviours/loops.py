@@ -9,6 +9,7 @@ from typing import TYPE_CHECKING, Any
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.behaviours.boundaries import arm_boundaries
+from robotale.fame_runtime.kinds import LoopKind
 from robotale.fame_runtime.plan import LoopPlan, NodePlan
 from robotale.fame_runtime.tokens import ABSENT, Frame, LoopRun, Token
 
@@ -21,13 +22,13 @@ def run_loop(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
     by the activity's flows; the token waits at the activity meanwhile, with its boundary
     events armed, and cancelling it cancels the instances."""
     marker = _looped(node).loop
-    items = None if marker.kind == "standard" else _loop_items(engine, node)
+    items = None if marker.kind == LoopKind.STANDARD else _loop_items(engine, node)
     run = LoopRun(token, node, items)
     if _loop_finished(engine, run, before=True):
         return engine.follow(token, engine.taken(node, first=False))
     arm_boundaries(engine, token, node)
     token.waits.append(lambda: _stop_instances(engine, run))
-    count = len(items) if items is not None and marker.kind == "parallel" else 1
+    count = len(items) if items is not None and marker.kind == LoopKind.PARALLEL else 1
     for _ in range(count):
         _start_instance(engine, run)
     return None
@@ -56,7 +57,7 @@ def instance_done(engine: Engine, token: Token, run: LoopRun) -> None:
         holder = run.holder
         engine.disarm(holder)  # cancels the instances a completion condition cut short
         engine.go_on(holder, run.node)
-    elif marker.kind != "parallel":
+    elif marker.kind != LoopKind.PARALLEL:
         _start_instance(engine, run)
 
 
@@ -145,7 +146,7 @@ def _loop_finished(engine: Engine, run: LoopRun, *, before: bool) -> bool:
     looped = _looped(run.node)
     marker = looped.loop
     where = f"the loop of {run.node.node.describe()}"
-    if marker.kind == "standard" or run.items is None:
+    if marker.kind == LoopKind.STANDARD or run.items is None:
         if before and not marker.test_before:
             return False
         if marker.maximum is not None and run.completed >= marker.maximum:

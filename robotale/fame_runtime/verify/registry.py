@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 
+from robotale.fame_runtime.kinds import EventKind, Run
 from robotale.fame_runtime.model import Expression, Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan
 from robotale.fame_runtime.verify.values import (
@@ -144,12 +145,12 @@ def node_timers(node: NodePlan) -> tuple[list, list]:
     and while it waits there (a catch event's or an event-based gateway's too)."""
     catchers = list(node.boundaries)
     running = [(c, timer_seconds(c)) for c in catchers if _is_timer(c)]
-    if node.behaviour == "catch":
+    if node.behaviour == Run.CATCH:
         catchers.append(node)
-    if node.behaviour == "eventBasedGateway":
+    if node.behaviour == Run.EVENT_BASED_GATEWAY:
         catchers += [f.target for f in node.outgoing]
     return running, [(c, timer_seconds(c)) for c in catchers if _is_timer(c)]
 
 
 def _is_timer(node: NodePlan) -> bool:
-    return node.trigger is not None and node.trigger.kind == "timer"
+    return node.trigger is not None and node.trigger.kind == EventKind.TIMER

@@ -11,6 +11,7 @@ import time
 from collections import deque
 from dataclasses import dataclass, field
 
+from robotale.fame_runtime.kinds import EventKind, Kind, Run
 from robotale.fame_runtime.plan import NodePlan
 from robotale.fame_runtime.tags import Tag
 from robotale.fame_runtime.verify.registry import ElementKey, element_key
@@ -182,11 +183,11 @@ def _for(node: NodePlan, waiting: str) -> str:
     if waiting == "join":
         return " for tokens on all its incoming flows"
     trigger = node.trigger
-    if trigger is not None and trigger.kind == "signal":
+    if trigger is not None and trigger.kind == EventKind.SIGNAL:
         return f" for signal {trigger.topic}"
-    if trigger is not None and trigger.kind == "conditional":
+    if trigger is not None and trigger.kind == EventKind.CONDITIONAL:
         return " for its condition, which never holds"
-    if node.behaviour == "eventBasedGateway":
+    if node.behaviour == Run.EVENT_BASED_GATEWAY:
         wanted = [f.target.trigger.topic for f in node.outgoing if f.target.trigger is not None]
         return f" for {', '.join(w for w in wanted if w)}"
     return ""
@@ -457,9 +458,9 @@ def _unreached(graph: Exploration) -> list[Finding]:
     seen: set[ElementKey] = set()
     for node in graph.space.registry.nodes:
         key = element_key(node)
-        if key in seen or node.behaviour == "event_subprocess":
+        if key in seen or node.behaviour == Run.EVENT_SUBPROCESS:
             continue
-        catching = node.trigger is not None and node.behaviour != "skill"
+        catching = node.trigger is not None and node.behaviour != Run.SKILL
         if (key in graph.fired) or (key in graph.reached and not catching):
             continue
         seen.add(key)
@@ -487,15 +488,15 @@ def _unreached(graph: Exploration) -> list[Finding]:
 
 def _always_armed(node: NodePlan) -> bool:
     """Start events of a process or event sub-process wait as long as it runs."""
-    return node.node.kind == "startEvent"
+    return node.node.kind == Kind.START_EVENT
 
 
 def _never_because(node: NodePlan) -> str:
     trigger = node.trigger
-    if trigger.kind == "signal":
+    if trigger.kind == EventKind.SIGNAL:
         return f"no robot throws signal {trigger.topic} while it waits"
-    if trigger.kind == "conditional":
+    if trigger.kind == EventKind.CONDITIONAL:
         return "its condition never holds while it waits"
-    if trigger.kind == "error":
+    if trigger.kind == EventKind.ERROR:
         return f"no error {trigger.topic or ''} is thrown where it catches".replace("  ", " ")
     return f"nothing {trigger.kind} reaches it while it waits"

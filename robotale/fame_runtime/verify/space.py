@@ -19,6 +19,7 @@ import itertools
 from collections.abc import Callable, Iterator
 from typing import Any
 
+from robotale.fame_runtime.kinds import EventKind, Run
 from robotale.fame_runtime.model import Expression
 from robotale.fame_runtime.plan import NodePlan, ScopePlan
 from robotale.fame_runtime.verify.registry import (
@@ -66,7 +67,7 @@ class Space:
             self.registry.add_scope(plan)
             for start in plan.triggered_starts:
                 self.registry.add_node(start)
-        self.inclusive = any(n.behaviour == "inclusiveGateway" for n in self.registry.nodes)
+        self.inclusive = any(n.behaviour == Run.INCLUSIVE_GATEWAY for n in self.registry.nodes)
         self.relevant = relevant_names(self.registry)
 
     def timers(self, token: Tok) -> list[tuple[NodePlan, float | None]]:
@@ -202,14 +203,14 @@ class Space:
     def _token_events(self, robot: Robot, token: Tok) -> Iterator[tuple[str, Callable]]:
         node = token.node
         if token.waiting == "wait":
-            if node.behaviour == "catch" and self._may_fire(robot, node, token):
+            if node.behaviour == Run.CATCH and self._may_fire(robot, node, token):
                 yield (
                     f"{robot.name}: {node.label}",
                     lambda step, t=token: step.fire(t, t.node, ""),
                 )
-            elif node.behaviour in ("skill", "script"):
+            elif node.behaviour in (Run.SKILL, Run.SCRIPT):
                 yield (f"{robot.name}: {node.label} ends", lambda step, t=token: step.finished(t))
-            elif node.behaviour == "eventBasedGateway":
+            elif node.behaviour == Run.EVENT_BASED_GATEWAY:
                 for flow in node.outgoing:
                     if self._may_fire(robot, flow.target, token):
                         yield (
@@ -235,13 +236,13 @@ class Space:
         trigger = catcher.trigger
         if trigger is None:
             return False
-        if trigger.kind == "timer":
+        if trigger.kind == EventKind.TIMER:
             return token is None or self._first_due(token, catcher)
-        if trigger.kind == "conditional":
+        if trigger.kind == EventKind.CONDITIONAL:
             return condition_holds(event_condition(catcher), robot) is not False
-        if trigger.kind == "error":  # a battery monitor, a skill: errors the world raises
+        if trigger.kind == EventKind.ERROR:  # a battery monitor, a skill: errors the world raises
             return f"/{trigger.topic}" in self.outside
-        return trigger.kind == "signal" and trigger.topic in self.outside
+        return trigger.kind == EventKind.SIGNAL and trigger.topic in self.outside
 
     def _first_due(self, token: Tok, catcher: NodePlan) -> bool:
         """A timer armed at or before this one with a shorter duration is due first: the

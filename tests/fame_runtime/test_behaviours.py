@@ -1,0 +1,127 @@
+"""The engine's table of behaviours against the parser's vocabulary and the models' plans, and
+the JavaScript runtime the engine loads against the package's files."""
+
+from __future__ import annotations
+
+import dataclasses
+import fnmatch
+import tomllib
+from pathlib import Path
+
+from fame_suite import build
+
+import robotale.fame_runtime
+from robotale.errors import ModelError
+from robotale.fame_runtime import javascript
+from robotale.fame_runtime.behaviours import BEHAVIOURS
+from robotale.fame_runtime.kinds import FLOW_NODES, Kind
+from robotale.fame_runtime.library import Library
+from robotale.fame_runtime.parser import parse_all
+from robotale.fame_runtime.plan import OUTSIDE, NodePlan, deploy
+
+HERE = Path(__file__).resolve().parent
+PACKAGE = Path(robotale.fame_runtime.__file__).parent
+PYPROJECT = PACKAGE.parent.parent / "pyproject.toml"
+
+
+def _plans(obj: object, seen: set[int]):
+    """Every node plan reachable from ``obj`` (sub-processes, loop bodies, called processes
+    and boundary events included)."""
+    if id(obj) in seen:
+        return
+    seen.add(id(obj))
+    if isinstance(obj, NodePlan):
+        yield obj
+    if dataclasses.is_dataclass(obj) and type(obj).__module__ == NodePlan.__module__:
+        for field in dataclasses.fields(obj):
+            yield from _plans(getattr(obj, field.name), seen)
+    elif isinstance(obj, dict):
+        for value in obj.values():
+            yield from _plans(value, seen)
+    elif isinstance(obj, list | tuple):
+        for value in obj:
+            yield from _plans(value, seen)
+
+
+def _deployed_behaviours() -> dict[str, set[str]]:
+    """Element kind -> the behaviours the deployer gave its elements in every test model
+    that deploys (the semantics suite, the modelers' files, the differential models)."""
+    library = Library(HERE / "models" / "library")
+    found: dict[str, set[str]] = {}
+    for path in sorted(HERE.rglob("*.bpmn")):
+        if "node_modules" in path.parts:
+            continue
+        for _, process in parse_all(path).pools():
+            try:
+                plan = deploy(process, skills=["drive", "take_off", "land"], library=library)
+            except ModelError:  # skills these tests do not name, or elements refused
+                continue
+            for node in _plans(plan, set()):
+                found.setdefault(str(node.node.kind), set()).add(str(node.behaviour))
+    return found
+
+
+def test_every_kind_the_parser_reads_has_a_behaviour_or_is_refused_with_a_reason():
+    deployed = _deployed_behaviours()
+    # the parser reads exactly the flow nodes BPMN 2.0 defines (by their XML names)
+    assert {str(k) for k in FLOW_NODES} == {
+        *("startEvent", "endEvent", "intermediateCatchEvent", "intermediateThrowEvent"),
+        *("boundaryEvent", "implicitThrowEvent", "task", "scriptTask", "callActivity"),
+        *("subProcess", "transaction", "adHocSubProcess", "userTask", "serviceTask"),
+        *("sendTask", "receiveTask", "manualTask", "businessRuleTask", "exclusiveGateway"),
+        *("parallelGateway", "inclusiveGateway", "eventBasedGateway", "complexGateway"),
+    }
+    for kind in FLOW_NODES:
+        if kind in OUTSIDE:  # refused by the deployer, with what robotale runs instead
+            assert "robotale runs" in OUTSIDE[kind] or "use a" in OUTSIDE[kind], kind
+            assert kind not in deployed, f"{kind} is refused, yet a model deployed one"
+        else:
+            assert deployed.get(kind), f"no test model deploys a {kind}"
+            assert deployed[kind] <= set(BEHAVIOURS), (kind, deployed[kind] - set(BEHAVIOURS))
+    # and the table has no entry the deployer never gives
+    assert set().union(*deployed.values()) == {str(b) for b in BEHAVIOURS}
+    assert deployed[Kind.CALL_ACTIVITY] >= {"call", "skill", "loop"}
+
+
+def _function_text(source: str, name: str) -> str:
+    """The text of the top-level JavaScript function ``name`` in ``source``: from its
+    ``function`` keyword to the closing brace at the start of a line."""
+    start = source.index(f"function {name}(")
+    return source[start : source.index("\n}", start) + 2]
+
+
+def test_the_engine_runs_the_javascript_files_of_the_package(tmp_path):
+    files = {
+        name: (PACKAGE / name).read_text(encoding="utf-8")
+        for name in ("rclnodejs.js", "javascript.js")
+    }
+    assert files["rclnodejs.js"] + files["javascript.js"] == javascript._PRELUDE
+    assert "var __fame = " not in (PACKAGE / "javascript.py").read_text(encoding="utf-8")
+    # what a script of a running engine sees is the file's function, as written there
+    path = tmp_path / "shim.bpmn"
+    path.write_text(
+        '<?xml version="1.0" encoding="UTF-8"?>'
+        '<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="d">'
+        '<bpmn:process id="rover" isExecutable="true"><bpmn:startEvent id="start" />'
+        '<bpmn:scriptTask id="s" scriptFormat="javascript"><bpmn:script>'
+        "this.environment.variables.shim = String(fame_rclnodejs); next();"
+        '</bpmn:script></bpmn:scriptTask><bpmn:endEvent id="end" />'
+        '<bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="s" />'
+        '<bpmn:sequenceFlow id="f2" sourceRef="s" targetRef="end" />'
+        "</bpmn:process></bpmn:definitions>"
+    )
+    mission, _ = build(path)
+    mission.run(until=1.0)
+    (engine,) = mission.engines.values()
+    assert engine.completed == 1
+    assert engine.variables["shim"] == _function_text(files["rclnodejs.js"], "fame_rclnodejs")
+
+
+def test_an_installed_package_carries_the_javascript_files():
+    package_data = tomllib.loads(PYPROJECT.read_text(encoding="utf-8"))["tool"]["setuptools"][
+        "package-data"
+    ]
+    patterns = [*package_data.get("*", []), *package_data.get("robotale.fame_runtime", [])]
+    for name in javascript.PRELUDE_FILES:
+        assert (PACKAGE / name).is_file()
+        assert any(fnmatch.fnmatch(name, pattern) for pattern in patterns), name
