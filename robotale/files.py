@@ -14,13 +14,13 @@ import os
 import tempfile
 from collections.abc import Iterator, Sequence
 from pathlib import Path
-from typing import IO
+from typing import IO, Any
 
 from robotale.errors import InputError
 
 
 @contextlib.contextmanager
-def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO]:
+def atomic_file(path: str | Path, mode: str = "w") -> Iterator[IO[Any]]:
     """A file opened for writing (``"w"`` text in UTF-8, ``"wb"`` bytes) that appears at
     ``path`` only once the block ends without an exception. The folder must exist."""
     with _staged(Path(path), mode) as (file, temporary):
@@ -50,7 +50,7 @@ def write_files(outputs: Sequence[tuple[Path, str | bytes]]) -> None:
 
 
 @contextlib.contextmanager
-def _staged(path: Path, mode: str) -> Iterator[tuple[IO, str]]:
+def _staged(path: Path, mode: str) -> Iterator[tuple[IO[Any], str]]:
     """A temporary file next to ``path`` and its name; when the block ends it is synced to
     the disk and has a normal file's permissions (it is removed if the block raises)."""
     try:
@@ -58,7 +58,8 @@ def _staged(path: Path, mode: str) -> Iterator[tuple[IO, str]]:
     except OSError as error:
         raise InputError(f"Cannot write {path}: {error.strerror or error}.") from None
     try:
-        with os.fdopen(handle, mode, **({} if "b" in mode else {"encoding": "utf-8"})) as file:
+        encoding = None if "b" in mode else "utf-8"
+        with os.fdopen(handle, mode, encoding=encoding) as file:
             yield file, name
             # Without fsync a crash soon after the rename can leave an empty file behind.
             file.flush()

@@ -10,7 +10,7 @@ and a message type that differs on the two sides is reported too.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Collection
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -87,7 +87,7 @@ def check(
             Problem(str(definitions.file), process.line, process.id, sentence)
             for sentence in progress_problems(process)
         ]
-        report.found += [(pool.name, _placed(p, definitions)) for p in found]
+        report.found += [(pool.name, definitions.placed(p)) for p in found]
     publishers, subscribers = endpoints(definitions, skills=skills, library=library)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [
@@ -116,7 +116,9 @@ def endpoints(
     return publishers, subscribers
 
 
-def _signal_events(process: Process, skills: Collection[str], library: Library | None):
+def _signal_events(
+    process: Process, skills: Collection[str], library: Library | None
+) -> Iterator[tuple[Node, Process]]:
     """The signal events of a process and of every process it calls (once each)."""
     seen: set[int] = set()
     stack = [process]
@@ -134,14 +136,6 @@ def _signal_events(process: Process, skills: Collection[str], library: Library |
                 )
                 if called is not None:
                     stack.append(called)
-
-
-def _placed(problem: Problem, definitions: Definitions) -> Problem:
-    """``problem`` with the column of its element's start tag, when it is in this file."""
-    line, column = definitions.positions.get(problem.element, (0, 0))
-    if problem.column or line != problem.line or problem.file != str(definitions.file):
-        return problem
-    return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
 
 def _endpoint(pool: str, process: Process, node: Node) -> Endpoint:

@@ -37,7 +37,7 @@ from robotale.fame_runtime.data import Data
 from robotale.fame_runtime.expressions import BpmnError, Compiled
 from robotale.fame_runtime.javascript import JavaScript, ScriptFailure
 from robotale.fame_runtime.library import Library
-from robotale.fame_runtime.model import JAVASCRIPT, Process
+from robotale.fame_runtime.model import Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, speaks_javascript
 from robotale.fame_runtime.robot import RobotHandle
 from robotale.fame_runtime.skills import Skill
@@ -189,6 +189,7 @@ class Engine:
             return
         self.started, self.stopped = True, False
         for start in self.plan.triggered_starts:
+            assert start.trigger is not None  # the deployer gives every one its trigger
             self._start_disarms.append(
                 self.triggers.arm(start.trigger, self._starter(start), repeat=True)
             )
@@ -311,18 +312,18 @@ class Engine:
                     f"loop that ran {MAX_STEPS} steps without waiting for anything"
                 )
             if self.time is not None:
-                node = self._timed_step(token, node)
+                node = self._timed_step(token, node, self.time)
                 continue
             node = behaviours[node.behaviour](self, token, node)
 
-    def _timed_step(self, token: Token, node: NodePlan) -> NodePlan | None:
+    def _timed_step(self, token: Token, node: NodePlan, time: EngineTime) -> NodePlan | None:
         """Run one step, charged to the clock; while the engine computes, the token's next
         step waits at the head of the queue (None: it waits or has gone)."""
-        began = self.time.begin()
+        began = time.begin()
         try:
             next_node = self._BEHAVIOURS[node.behaviour](self, token, node)
         finally:
-            computing = self.time.spent("step", began)
+            computing = time.spent("step", began)
         if computing and next_node is not None and token.alive:
             self._work.appendleft(lambda: self.advance(token, next_node))
             return None
@@ -508,7 +509,7 @@ class Engine:
         """The value of a condition or expression (a loop's cardinality), errors explained."""
         try:
             with self.charged("condition"):
-                if condition.language == JAVASCRIPT:
+                if condition.code is None:  # JavaScript: its own engine compiled it
                     return self.javascript.condition(condition.source)
                 return eval(condition.code, self.env, self.variables)
         except BpmnError:
@@ -528,7 +529,7 @@ class Engine:
         """A conditional event's condition; one reading a variable nobody set yet is false
         (it cannot have become true), unlike a gateway's, where that is a model error."""
         try:
-            if condition.language == JAVASCRIPT:
+            if condition.code is None:  # JavaScript: its own engine compiled it
                 return self.condition(condition, "a conditional event")
             with self.charged("condition"):
                 return eval(condition.code, self.env, self.variables)

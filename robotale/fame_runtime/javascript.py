@@ -259,8 +259,8 @@ def _script_line(stack: str) -> int:
     for match in _FRAME.finditer(stack):
         if not match.group("name").startswith("fame_"):
             return max(int(match.group("line")) - 1, 1)
-    match = re.search(r"<input>:(\d+)", stack)
-    return max(int(match.group(1)) - 1, 1) if match else 0
+    line = re.search(r"<input>:(\d+)", stack)
+    return max(int(line.group(1)) - 1, 1) if line else 0
 
 
 class ScriptFailure(Exception):
@@ -398,6 +398,8 @@ class JavaScript:
         self, script: _Script, run: int, values: list[Any], later: Callable[[], Completion]
     ) -> Outcome | None:
         """Run a script on the values of the variables it names (see ``fame_quick``)."""
+        names = script.names
+        assert names is not None  # only a script whose variables are known runs quick
         try:
             outbox = script.quick(run, *values)
             jobs = self._jobs() if self._promises else None
@@ -405,7 +407,7 @@ class JavaScript:
             raise self._failure(error) from None
         kind = type(outbox)
         if kind is str and outbox[:1] == "Q":
-            now = self._apply_quick(outbox, script.names)
+            now = self._apply_quick(outbox, names)
             if now is None:  # it may call next later (from a callback a former script set up)
                 self._runs[run] = later()
         elif kind is str:  # what it did could not go flat: the usual outbox
@@ -413,8 +415,8 @@ class JavaScript:
         else:  # next() and one variable set to a number or a boolean (see _QUICK_DIRECT)
             if kind is float and outbox.is_integer() and -_JSON_INT < outbox < _JSON_INT:
                 outbox = int(outbox)  # what JSON would have made of it
-            self.variables[script.names[0]] = outbox
-            self.changed(script.names)
+            self.variables[names[0]] = outbox
+            self.changed(names)
             now = _NEXT
         if jobs:
             self._apply((jobs,))
@@ -467,7 +469,7 @@ class JavaScript:
         body = source[len(_WRAP_HEAD) : -len(_WRAP_TAIL)] if _is_wrapped(source) else None
         names = None if body is None else touches(body)
         script = _Script(source, names)
-        if names is not None:
+        if body is not None and names is not None:
             script.quick = self.context.eval(quick_source(body, names))
         self._scripts[source] = script
         return script
@@ -495,7 +497,8 @@ class JavaScript:
             return None
         while self.context.execute_pending_job():
             pass
-        return self._drain()
+        outbox: str = self._drain()
+        return outbox
 
     def _failure(self, error: quickjs.JSException) -> Exception:
         """What a call that JavaScript stopped raises."""

@@ -9,6 +9,7 @@ file says, including elements the engine cannot run: refusing those is the deplo
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -194,9 +195,9 @@ class Process(Scope):
     def describe(self) -> str:
         return f"{self.id} ({self.name})" if self.name and self.name != self.id else self.id
 
-    def walk(self):
+    def walk(self) -> Iterator[Node]:
         """Every node of the process, those of sub-processes included."""
-        stack = [self]
+        stack: list[Scope] = [self]
         while stack:
             scope = stack.pop()
             for node in scope.nodes.values():
@@ -238,6 +239,14 @@ class Definitions:
     problems: list[Problem] = field(default_factory=list)
     #: element id -> (line, column) of its start tag, for reports that name columns
     positions: dict[str, tuple[int, int]] = field(default_factory=dict, repr=False)
+
+    def placed(self, problem: Problem) -> Problem:
+        """``problem`` with the column of its element's start tag, when that element starts
+        on the problem's line of this file."""
+        line, column = self.positions.get(problem.element, (0, 0))
+        if problem.column or line != problem.line or problem.file != str(self.file):
+            return problem
+        return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
     def pools(self) -> list[tuple[Participant, Process]]:
         """Every pool with the process it holds; a file without a collaboration has one pool

@@ -39,7 +39,7 @@ from robotale.fame_runtime.model import (
 )
 from robotale.fame_runtime.qos import policy_name, qos_from_policies
 from robotale.fame_runtime.timers import KINDS as TIMER_KINDS
-from robotale.fame_runtime.timers import parse_timer
+from robotale.fame_runtime.timers import TimerSpec, parse_timer
 
 BPMN_NS = "http://www.omg.org/spec/BPMN/20100524/MODEL"
 _B = f"{{{BPMN_NS}}}"
@@ -106,7 +106,7 @@ def parse_all_bytes(data: bytes, file: str | Path = "<string>") -> Definitions:
     root = _xml_root(data, file)
     definitions = _Reader(file).definitions(root)
     definitions.positions = _positions(data)
-    definitions.problems = [_placed(p, definitions.positions) for p in definitions.problems]
+    definitions.problems = [definitions.placed(p) for p in definitions.problems]
     return definitions
 
 
@@ -114,10 +114,10 @@ def raise_problems(definitions: Definitions) -> None:
     """One ModelError listing every reading problem of ``definitions`` (none: nothing)."""
     found = definitions.problems
     if len(found) == 1:
-        raise ModelError(str(found[0]))
+        raise ModelError(str(found[0]), problems=found)
     if found:
         lines = "\n".join(str(p) for p in found)
-        raise ModelError(f"{definitions.file}: {len(found)} problems:\n{lines}")
+        raise ModelError(f"{definitions.file}: {len(found)} problems:\n{lines}", problems=found)
 
 
 def _positions(data: bytes) -> dict[str, tuple[int, int]]:
@@ -136,14 +136,6 @@ def _positions(data: bytes) -> dict[str, tuple[int, int]]:
     with contextlib.suppress(expat.ExpatError):
         reader.Parse(data, True)
     return positions
-
-
-def _placed(problem: Problem, positions: dict[str, tuple[int, int]]) -> Problem:
-    """``problem`` with its element's column, when the element starts on its line."""
-    line, column = positions.get(problem.element, (0, 0))
-    if problem.column or line != problem.line:
-        return problem
-    return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
 
 def one_line(text: str | None) -> str:
@@ -176,8 +168,7 @@ class ReadError(ModelError):
     """A file that is no BPMN at all (not XML, another root): its one problem as data."""
 
     def __init__(self, problem: Problem) -> None:
-        super().__init__(str(problem))
-        self.problems = [problem]
+        super().__init__(str(problem), problems=[problem])
 
 
 def _local(element: etree._Element) -> str:
@@ -186,7 +177,7 @@ def _local(element: etree._Element) -> str:
 
 
 def _bpmn_children(element: etree._Element, name: str) -> list[etree._Element]:
-    return element.findall(f"{_B}{name}")
+    return list(element.findall(f"{_B}{name}"))
 
 
 def _text(element: etree._Element | None) -> str:
@@ -320,7 +311,7 @@ class _Reader:
         return process
 
     def required_id(self, element: etree._Element) -> str:
-        identifier = element.get("id")
+        identifier: str = element.get("id") or ""
         if not identifier:
             identifier = f"<{_local(element)} on line {element.sourceline}>"
             self.problem(
@@ -502,7 +493,7 @@ class _Reader:
         )
         return loop  # without cardinality or collection it is valid BPMN the deployer refuses
 
-    def loop_expression(self, element: etree._Element, name: str, node: Node):
+    def loop_expression(self, element: etree._Element, name: str, node: Node) -> Expression | None:
         """``loopCardinality``, ``loopCondition`` or ``completionCondition``; Camunda's
         ``${...}`` wrapping is taken off (the expression inside is what runs)."""
         child = element.find(f"{_B}{name}")
@@ -541,7 +532,7 @@ class _Reader:
             return EventDefinition(EventKind.CONDITIONAL, condition=expression)
         return EventDefinition(event_kind(kind), _ref(element, "messageRef"))
 
-    def timer(self, element: etree._Element, node: Node):
+    def timer(self, element: etree._Element, node: Node) -> TimerSpec | None:
         for child in element:
             if _local(child) in TIMER_KINDS:
                 if not _text(child):

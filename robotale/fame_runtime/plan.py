@@ -12,7 +12,7 @@ from __future__ import annotations
 import re
 from collections.abc import Collection
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Literal, TypeVar
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
@@ -21,13 +21,13 @@ from robotale.fame_runtime.kinds import (
     EVENTS,
     GATEWAYS,
     HANDLER_TRIGGERS,
+    MESSAGE_TASKS,
     EventKind,
     Kind,
     LoopKind,
     Run,
 )
 from robotale.fame_runtime.labels import (
-    MESSAGE_TASKS,
     catches,
     element_label,
     error_name,
@@ -53,6 +53,7 @@ from robotale.fame_runtime.splitter import namespace
 from robotale.fame_runtime.timers import TimerSpec
 
 EMPTY_MSGTYPE = "std_msgs/msg/Empty"
+_T = TypeVar("_T")
 
 #: what a robot runs instead of a task kind it does not run
 _TASKS = "a task, script task, send or receive task, or a call activity bound to a skill"
@@ -181,6 +182,29 @@ class NodePlan:
     def id(self) -> str:
         return self.node.id
 
+    # What the deployer gives every node of a kind, for the readers that know the kind: a
+    # node plan of another kind has none (an AttributeError naming the field).
+
+    @property
+    def content(self) -> ScopePlan:
+        """A call activity's or sub-process's ``child``."""
+        return _given(self, "child", self.child)
+
+    @property
+    def looping(self) -> LoopPlan:
+        """A loop node's ``loop``."""
+        return _given(self, "loop", self.loop)
+
+    @property
+    def caught(self) -> Trigger:
+        """A catching event's (or receive task's) ``trigger``."""
+        return _given(self, "trigger", self.trigger)
+
+    @property
+    def thrown(self) -> Throw:
+        """A throwing event's (or send task's) ``throw``."""
+        return _given(self, "throw", self.throw)
+
 
 @dataclass(slots=True, eq=False)
 class LoopPlan:
@@ -223,7 +247,8 @@ def deploy(
         file = f"{process.file}: " if process.file else ""
         raise ModelError(
             f"{file}the engine cannot run process {process.describe()}: "
-            + "; ".join(f"{p.sentence} (line {p.line})" for p in planner.found)
+            + "; ".join(f"{p.sentence} (line {p.line})" for p in planner.found),
+            problems=_placed(process, planner.found),
         )
     return plan
 
@@ -241,7 +266,7 @@ def findings(
     """What :func:`deploy` would refuse in ``process``, with file, line and element id."""
     planner = _Planner(skills, library)
     planner.process(process, top=True)
-    return planner.found
+    return _placed(process, planner.found)
 
 
 def speaks_javascript(plan: ScopePlan) -> bool:
@@ -335,7 +360,9 @@ class _Planner:
         self.file = outer_file
         return plan
 
-    def scope(self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False):
+    def scope(
+        self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False
+    ) -> None:
         for node in scope.nodes.values():
             plan.nodes[node.id] = NodePlan(node, "", "", plan)
         for node_plan in plan.nodes.values():
@@ -426,12 +453,11 @@ class _Planner:
         else:
             self.activity(plan, scope)
         if node.loop is not None:
-            self.looped(plan)
+            self.looped(plan, node.loop)
 
-    def looped(self, plan: NodePlan) -> None:
+    def looped(self, plan: NodePlan, loop: Loop) -> None:
         """The activity becomes a loop around a copy of itself (its body): the loop owns the
         outgoing flows and the boundary events, the body runs once per instance."""
-        loop = plan.node.loop
         body = NodePlan(
             plan.node,
             plan.behaviour,
@@ -595,7 +621,7 @@ class _Planner:
 
     def event(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
-        role = node.kind
+        role: str = node.kind
         if node.kind == Kind.START_EVENT:
             role = "start" if top else ("event_start" if event else "sub_start")
             if role == "sub_start" and self.called.get(id(scope.process)) is scope:
@@ -726,6 +752,18 @@ class _Planner:
                 "to compensate every completed one)",
             )
         return Throw(EventKind.COMPENSATE, plan.label, ref, wait=event.wait if event else True)
+
+
+def _given(plan: NodePlan, name: str, value: _T | None) -> _T:
+    if value is None:
+        raise AttributeError(f"{plan.node.kind} {plan.node.describe()} has no {name}")
+    return value
+
+
+def _placed(process: Process, found: list[Problem]) -> list[Problem]:
+    """``found`` with their elements' columns, where the process's file has them."""
+    definitions = process.definitions
+    return [definitions.placed(p) for p in found] if definitions is not None else found
 
 
 def _implicit_starts(plan: ScopePlan) -> list[NodePlan]:

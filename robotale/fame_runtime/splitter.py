@@ -65,7 +65,9 @@ def _binds(pool: Participant, robot: str, pools: list[tuple[Participant, Process
     return pool.multi_instance and not exact and re.fullmatch(pattern, robot.lower()) is not None
 
 
-def _check_count(definitions: Definitions, pool: Participant, robots: list[str], given: bool):
+def _check_count(
+    definitions: Definitions, pool: Participant, robots: list[str], given: bool
+) -> None:
     if not pool.multi_instance:
         if len(robots) > 1:
             raise ModelError(
@@ -127,7 +129,8 @@ def process_file(assignment: Assignment) -> bytes:
             for part in list(child):
                 if part.get("processRef") != process.id:
                     child.remove(part)  # other pools, message flows between them
-    return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
+    xml: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8")
+    return xml
 
 
 def _same_file_calls(process: Process) -> set[str]:

@@ -12,6 +12,10 @@ import json
 from collections.abc import Callable
 from dataclasses import dataclass
 from enum import StrEnum
+from typing import Any
+
+from robotale.fame_runtime.bus import Bus
+from robotale.fame_runtime.clock import Clock
 
 TAG_TYPE = "robotale_msgs/msg/Tag"
 
@@ -71,9 +75,11 @@ TagSink = Callable[[Tag], None]
 class Tagger:
     """Tags one robot's events on its clock, and numbers its messages when the bus does not."""
 
-    def __init__(self, robot: str, clock, sink: TagSink | None, bus=None) -> None:
+    def __init__(
+        self, robot: str, clock: Clock, sink: TagSink | None, bus: Bus | None = None
+    ) -> None:
         self.robot, self.clock, self.sink = robot, clock, sink
-        self._bus_ids = getattr(bus, "new_msg_id", None)
+        self._bus_ids: Callable[[], str] | None = getattr(bus, "new_msg_id", None)
         self._count = 0
 
     def __call__(
@@ -103,7 +109,7 @@ class Tagger:
         return f"m_{self.robot}_{self._count}"
 
 
-def payload_text(data) -> str:
+def payload_text(data: Any) -> str:  # any message: JSON text, else its str
     """A message's data as the JSON text tags carry."""
     return json.dumps(data, default=str, separators=(",", ":"))
 
@@ -113,7 +119,7 @@ def tag_topic(robot: str) -> str:
     return f"/{robot}/tag"
 
 
-def bus_sink(bus) -> TagSink:
+def bus_sink(bus: Bus) -> TagSink:
     """A tag sink that publishes every tag on its robot's ``/<robot>/tag`` topic, where a
     recorder tapping the bus writes it to a bag like any other message."""
 
@@ -123,7 +129,7 @@ def bus_sink(bus) -> TagSink:
     return publish
 
 
-def register_tag_type(typestore) -> None:
+def register_tag_type(typestore: Any) -> None:  # rosbags has no type information
     """Add ``robotale_msgs/msg/Tag`` to a rosbags type store (idempotent)."""
     # rosbags is imported here, by those who read or write bags, not with the module: every
     # engine imports this module, and rosbags would add a fifth (about 30 ms) to its import

@@ -160,7 +160,7 @@ class RunScope:
         self.parent = parent
         self.holder = holder  # the token of the activity this scope runs inside
         self.frame = holder.frame if holder is not None else None
-        self.depth = parent.depth + 1 if parent else 0
+        self.depth: int = parent.depth + 1 if parent else 0
         self.tokens: set[Token] = set()
         self.joins: dict[str, list[Token]] = {}
         self.armed: dict[str, Undo] = {}  # event sub-process id -> disarm

@@ -8,6 +8,7 @@ import fnmatch
 import tomllib
 from pathlib import Path
 
+import pytest
 from fame_suite import build
 
 import robotale.fame_runtime
@@ -16,7 +17,7 @@ from robotale.fame_runtime import javascript
 from robotale.fame_runtime.behaviours import BEHAVIOURS
 from robotale.fame_runtime.kinds import FLOW_NODES, Kind
 from robotale.fame_runtime.library import Library
-from robotale.fame_runtime.parser import parse_all
+from robotale.fame_runtime.parser import parse, parse_all
 from robotale.fame_runtime.plan import OUTSIDE, NodePlan, deploy
 
 HERE = Path(__file__).resolve().parent
@@ -125,3 +126,50 @@ def test_an_installed_package_carries_the_javascript_files():
     for name in javascript.PRELUDE_FILES:
         assert (PACKAGE / name).is_file()
         assert any(fnmatch.fnmatch(name, pattern) for pattern in patterns), name
+    # and says it is typed (PEP 561)
+    assert (PACKAGE.parent / "py.typed").is_file()
+    assert "py.typed" in package_data["robotale"]
+
+
+MODEL_WITH_PROBLEMS = """<?xml version="1.0" encoding="UTF-8"?>
+<bpmn:definitions xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" id="d">
+  <bpmn:process id="rover" isExecutable="true">
+    <bpmn:startEvent id="start" />
+      <bpmn:userTask id="ask" name="Ask" />
+    <bpmn:endEvent id="end" />
+    <bpmn:sequenceFlow id="f1" sourceRef="start" targetRef="ask" />
+    <bpmn:sequenceFlow id="f2" sourceRef="ask" targetRef="end" />
+  </bpmn:process>
+</bpmn:definitions>
+"""
+
+
+def _where(text: str, element: str) -> tuple[int, int]:
+    """Line and column (both from 1) of the start tag of ``element``, counted by hand."""
+    for number, line in enumerate(text.splitlines(), 1):
+        if f'id="{element}"' in line:
+            return number, line.index("<") + 1
+    raise AssertionError(element)
+
+
+def test_errors_of_the_reader_and_the_deployer_carry_file_line_column_and_element(tmp_path):
+    path = tmp_path / "ask.bpmn"
+    path.write_text(MODEL_WITH_PROBLEMS, encoding="utf-8")
+    (_, process), *_ = parse(path).pools()
+    with pytest.raises(ModelError) as refused:
+        deploy(process)
+    (problem,) = refused.value.problems
+    assert (problem.file, problem.element) == (str(path), "ask")
+    assert (problem.line, problem.column) == _where(MODEL_WITH_PROBLEMS, "ask")
+    assert problem.sentence in str(refused.value) and "needs a person" in problem.sentence
+    # a file the reader refuses: the boundary event's problem, placed the same way
+    boundary = '<bpmn:boundaryEvent id="late" attachedToRef="nowhere" />'
+    end = '<bpmn:endEvent id="end" />'
+    broken = MODEL_WITH_PROBLEMS.replace(end, f"{end}\n      {boundary}")
+    path.write_text(broken, encoding="utf-8")
+    with pytest.raises(ModelError) as unread:
+        parse(path)
+    (problem,) = unread.value.problems
+    assert (problem.file, problem.element) == (str(path), "late")
+    assert (problem.line, problem.column) == _where(broken, "late")
+    assert str(unread.value) == f"{path}:{problem.line}: {problem.sentence}"

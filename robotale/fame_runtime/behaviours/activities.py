@@ -73,6 +73,7 @@ def _completed(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
 
 def _exec(engine: Engine, node: NodePlan, script: Compiled) -> None:
     watch = engine.watch or engine.watching()
+    assert script.code is not None  # a Python script: compiled by the deployer
     try:
         with engine.charged("script"):
             # the watchdog's stamp: a fresh tuple per run, told apart by identity

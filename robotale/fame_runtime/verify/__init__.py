@@ -46,7 +46,7 @@ class Verdict:
     def complete(self) -> bool:
         return not self.bound
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, object]:
         return {
             "file": self.file,
             "robots": self.robots,

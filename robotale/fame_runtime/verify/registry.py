@@ -112,8 +112,8 @@ def relevant_names(registry: Registry) -> frozenset[str]:
         for data_object in [*node.data_inputs, *node.data_outputs]:
             for name, text in data_object.parameters.items():
                 assigned(name, text)
-        for name, text in {**node.node.inputs, **node.node.outputs}.items():
-            assigned(name, text)
+        for name, value in {**node.node.inputs, **node.node.outputs}.items():
+            assigned(name, value)
         script = node.node.script
         if script is not None:
             for name, tree in script_effect(script.text, script.language).sets:
@@ -140,7 +140,11 @@ def timer_seconds(catcher: NodePlan) -> float | None:
     return spec.interval
 
 
-def node_timers(node: NodePlan) -> tuple[list, list]:
+#: the timers at a node while it runs and while it waits, with their seconds
+Timers = tuple[list[tuple[NodePlan, float | None]], list[tuple[NodePlan, float | None]]]
+
+
+def node_timers(node: NodePlan) -> Timers:
     """The timers a token at ``node`` waits on while the node runs (its boundary events)
     and while it waits there (a catch event's or an event-based gateway's too)."""
     catchers = list(node.boundaries)

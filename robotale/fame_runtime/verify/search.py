@@ -9,10 +9,12 @@ from __future__ import annotations
 
 import time
 from collections import deque
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
 from robotale.fame_runtime.kinds import EventKind, Kind, Run
-from robotale.fame_runtime.plan import NodePlan
+from robotale.fame_runtime.plan import FlowPlan, NodePlan
 from robotale.fame_runtime.tags import Tag
 from robotale.fame_runtime.verify.registry import ElementKey, element_key
 from robotale.fame_runtime.verify.space import ASSUMED, Space
@@ -42,7 +44,7 @@ class Finding:
     elements: list[str] = field(default_factory=list)  # element ids to highlight
     trace: list[Tag] = field(default_factory=list)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, object]:
         return {
             "kind": self.kind,
             "robot": self.robot,
@@ -75,7 +77,7 @@ class Exploration:
     reached: set[ElementKey] = field(default_factory=set)
     fired: set[ElementKey] = field(default_factory=set)
     first_armed: dict[ElementKey, int] = field(default_factory=dict)  # state it is armed in
-    firsts: dict[tuple, tuple[int, Outcome, object]] = field(default_factory=dict)
+    firsts: dict[tuple[Any, ...], tuple[int, Outcome, NodePlan]] = field(default_factory=dict)
     frontier: set[int] = field(default_factory=set)  # not expanded (a bound was hit)
     bound: str = ""
     capped: bool = False  # some step left a catcher out (TOKEN_CAP, INSTANCE_CAP)
@@ -131,7 +133,7 @@ def explore(space: Space, *, max_states: int, timeout: float) -> Exploration:
     return graph
 
 
-def _successors(space: Space, state: State, stamp: int, graph: Exploration):
+def _successors(space: Space, state: State, stamp: int, graph: Exploration) -> Iterator[Outcome]:
     robots = space.thaw(state)
     events = space.events(robots)
     if not events:
@@ -392,7 +394,7 @@ def _why(decisions: list[Decision]) -> str:
     return "; ".join(reasons)
 
 
-def _flow_name(flow) -> str:
+def _flow_name(flow: FlowPlan) -> str:
     name = next(
         (f.name for f in flow.target.scope.process.flows.values() if f.id == flow.id and f.name),
         "",
@@ -400,7 +402,7 @@ def _flow_name(flow) -> str:
     return f"{flow.id} ({name})" if name else flow.id
 
 
-def _read(read: tuple) -> str:
+def _read(read: tuple[str, Any, str, bool]) -> str:
     name, value, setter, same_step = read
     if value is UNKNOWN:
         return f"{name} (unknown)"
@@ -492,7 +494,7 @@ def _always_armed(node: NodePlan) -> bool:
 
 
 def _never_because(node: NodePlan) -> str:
-    trigger = node.trigger
+    trigger = node.caught
     if trigger.kind == EventKind.SIGNAL:
         return f"no robot throws signal {trigger.topic} while it waits"
     if trigger.kind == EventKind.CONDITIONAL:

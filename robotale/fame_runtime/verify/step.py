@@ -6,6 +6,7 @@ followed), with the choices it is given.
 from __future__ import annotations
 
 import ast
+import functools
 from collections import deque
 from collections.abc import Callable, Iterator
 from itertools import combinations
@@ -150,8 +151,8 @@ class Step:
     def fire_esp(self, scope: Scope, esp: NodePlan, msg_id: str) -> None:
         if scope.closed:
             return
-        start = esp.child.triggered_starts[0]
-        interrupting = start.node.interrupting or start.trigger.kind == EventKind.ERROR
+        start = esp.content.triggered_starts[0]
+        interrupting = start.node.interrupting or start.caught.kind == EventKind.ERROR
         if interrupting:
             scope.fired.add(self.space.registry.node_id(esp))
             for token in list(scope.tokens):
@@ -214,6 +215,7 @@ class Step:
         """The step never waits: the engine stops the robot whose token keeps going with a
         model error; so does the step here."""
         token = self.current
+        assert token is not None  # a step that runs has moved a token
         self.work.clear()
         del self.tags[BUSY_TAGS:]  # the trace shows the loop's first rounds, not all of them
         self.failures.append(
@@ -280,7 +282,16 @@ class Step:
         )
         return chosen
 
-    def _assume(self, robot, node, flows, values, chosen, *, first: bool) -> None:
+    def _assume(
+        self,
+        robot: Robot,
+        node: NodePlan,
+        flows: list[FlowPlan],
+        values: list[Any],
+        chosen: list[FlowPlan],
+        *,
+        first: bool,
+    ) -> None:
         """An unknown variable a condition tested keeps the value the choice implies until
         something writes it (``a`` taken: a is true), so a later test of it agrees."""
         taken = {id(f) for f in chosen}
@@ -294,6 +305,8 @@ class Step:
             else:
                 continue
             expression = self.space.registry.condition(flow)
+            if expression is None:  # no condition: it holds, never unknown
+                continue
             implied = _implied(condition_tree(expression.text, expression.language), outcome)
             if implied is not None and implied[0] not in robot.later:
                 robot.variables[implied[0]] = (implied[1], ASSUMED + node.node.describe())
@@ -492,16 +505,16 @@ class Step:
         child = Scope(robot, node.child, token)
         token.child = child
         self.declare(robot, node.child)
-        if not node.child.starts:
+        if not node.content.starts:
             self._close(child)
             return
-        for start in node.child.starts:
+        for start in node.content.starts:
             self._go(Tok(child, start), start)
 
     def _run_loop(self, token: Tok, node: NodePlan) -> None:
         token.waiting = "wait"
         self._armed(token)
-        marker = node.loop.loop
+        marker = node.looping.loop
         # tested before: maybe no round at all
         if marker.kind == LoopKind.STANDARD and marker.test_before and not self._again(token, node):
             self._loop_done(token, node)
@@ -511,13 +524,13 @@ class Step:
     def _loop_body(self, token: Tok, node: NodePlan) -> None:
         child = Scope(token.scope.robot, None, token)
         token.child = child
-        body = node.loop.body
+        body = node.looping.body
         self._go(Tok(child, body), body)
 
     def _loop_round(self, token: Tok, node: NodePlan) -> None:
         """A round of a loop ended: a standard loop goes round again while its condition may
         hold (a multi-instance activity's instances are alike: one round stands for all)."""
-        again = node.loop.loop.kind == LoopKind.STANDARD and self._again(token, node)
+        again = node.looping.loop.kind == LoopKind.STANDARD and self._again(token, node)
         if again and (id(token), "round") in self.entered:
             token.waiting = "again"  # the next round is a step of its own, as in _enter
             return
@@ -531,7 +544,7 @@ class Step:
     def _again(self, token: Tok, node: NodePlan) -> bool:
         """Whether a standard loop goes round (again): its condition, a choice when unknown
         or when a loopMaximum may end it (rounds are not counted)."""
-        marker = node.loop.loop
+        marker = node.looping.loop
         holds = condition_holds(marker.condition, token.scope.robot)
         if marker.condition is None or (holds is True and marker.maximum is not None):
             holds = UNKNOWN
@@ -625,7 +638,7 @@ class Step:
     # -- signals and errors ----------------------------------------------------------------------
 
     def _publish(self, robot: Robot, node: NodePlan) -> None:
-        throw = node.throw
+        throw = node.thrown
         self.messages += 1
         msg_id = f"m{int(self.stamp)}.{self.messages}"  # unique in a trace: one step a stamp
         self.tag(robot, throw.label, Lifecycle.START, msg_id, "send")
@@ -633,7 +646,7 @@ class Step:
         if not receivers and not self.capped:
             self.lost.append((robot.name, node, throw.topic))
         for receive in receivers:
-            self.work.append(lambda r=receive, m=msg_id: r(m))
+            self.work.append(functools.partial(receive, msg_id))
         self.tag(robot, throw.label, Lifecycle.COMPLETE, msg_id, "send")
 
     def _receivers(self, topic: str) -> Iterator[Callable[[str], None]]:
@@ -647,31 +660,31 @@ class Step:
                 if len(robot.instances) >= INSTANCE_CAP:
                     self.capped = True  # not lost: more instances than the bound keeps
                     continue
-                yield lambda m, r=robot, s=start: self.start_instance(r, s, m)
+                yield functools.partial(self.start_instance, robot, start)
 
     def _scope_receivers(self, scope: Scope, topic: str) -> Iterator[Callable[[str], None]]:
         if scope.plan is not None:
             for esp in scope.plan.event_subprocesses:
-                starts = esp.child.triggered_starts
+                starts = esp.content.triggered_starts
                 fired = self.space.registry.node_id(esp) in scope.fired
                 if not starts or not _listens(starts[0], topic) or fired:
                     continue
                 if len(scope.tokens) >= TOKEN_CAP:
                     self.capped = True
                     continue
-                yield lambda m, s=scope, e=esp: self.fire_esp(s, e, m)
+                yield functools.partial(self.fire_esp, scope, esp)
         for token in list(scope.tokens):
             node = token.node
             if token.waiting == "wait" and node.behaviour == Run.CATCH and _listens(node, topic):
-                yield lambda m, t=token: self.fire(t, t.node, m)
+                yield _fire_where_it_is(self, token)
             if token.waiting == "wait" and node.behaviour == Run.EVENT_BASED_GATEWAY:
                 for flow in node.outgoing:
                     if _listens(flow.target, topic):
-                        yield lambda m, t=token, c=flow.target: self.fire(t, c, m)
+                        yield functools.partial(self.fire, token, flow.target)
             if token.waiting == "wait" or token.child is not None:
                 for boundary in node.boundaries:
                     if _listens(boundary, topic):
-                        yield lambda m, t=token, b=boundary: self.fire_boundary(t, b, m)
+                        yield functools.partial(self.fire_boundary, token, boundary)
 
     def _throw_error(self, token: Tok, name: str) -> None:
         """To the nearest catcher: event sub-processes of each scope and boundary events of
@@ -681,7 +694,7 @@ class Step:
         while scope is not None:
             if scope.plan is not None:
                 for esp in scope.plan.event_subprocesses:
-                    starts = esp.child.triggered_starts
+                    starts = esp.content.triggered_starts
                     if starts and _catches_error(starts[0], name):
                         self.fire_esp(scope, esp, "")
                         return
@@ -810,6 +823,11 @@ def _reads(
             value, setter = robot.variables.get(name, (UNKNOWN, ""))
             reads.append((name, value, setter, (robot.name, name) in set_now))
     return tuple(dict.fromkeys(reads))
+
+
+def _fire_where_it_is(step: Step, token: Tok) -> Callable[[str], None]:
+    """Fire ``token``'s catching event where the token is when the message arrives."""
+    return lambda msg_id: step.fire(token, token.node, msg_id)
 
 
 _BEHAVIOURS: dict[str, Callable[[Step, Tok, NodePlan], None]] = {
