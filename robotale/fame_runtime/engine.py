@@ -18,8 +18,7 @@ from __future__ import annotations
 import builtins
 import contextlib
 from collections import deque
-from collections.abc import Callable, Iterable, Iterator, Mapping
-from enum import StrEnum
+from collections.abc import Callable, Iterable, Mapping
 from pathlib import Path
 from typing import Any, ClassVar
 
@@ -33,13 +32,15 @@ from robotale.fame_runtime.behaviours.gateways import recheck_joins
 from robotale.fame_runtime.behaviours.loops import instance_done
 from robotale.fame_runtime.bus import Bus, Envelope
 from robotale.fame_runtime.clock import Clock, EngineTime
+from robotale.fame_runtime.conditions import Conditions
 from robotale.fame_runtime.data import Data
-from robotale.fame_runtime.expressions import BpmnError, Compiled
-from robotale.fame_runtime.javascript import JavaScript, ScriptFailure
+from robotale.fame_runtime.expressions import BpmnError
+from robotale.fame_runtime.javascript import JavaScript
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.model import Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, deploy, speaks_javascript
 from robotale.fame_runtime.robot import RobotHandle
+from robotale.fame_runtime.running import ActivityObserver, RunningActivities
 from robotale.fame_runtime.skills import Skill
 from robotale.fame_runtime.tags import Lifecycle, Tagger, TagSink
 from robotale.fame_runtime.tokens import Frame, RunScope, Token, install
@@ -50,20 +51,6 @@ MAX_STEPS = 1_000_000
 
 #: what charging work costs when the engine's clock charges nothing
 _FREE = contextlib.nullcontext()
-
-#: told of every activity instance as it starts and ends (robot, instance number, activity,
-#: an :class:`Ending`'s text), apart from the tags: a simulation's ground truth numbers
-#: instances, which tags do not
-ActivityObserver = Callable[[str, int, str, str], None]
-
-
-class Ending(StrEnum):
-    """What the activity observer is told of an activity instance."""
-
-    START = "start"
-    COMPLETED = "completed"
-    INTERRUPTED = "interrupted"  # by an interrupting boundary event or event sub-process
-    CANCELLED = "cancelled"
 
 
 class Engine:
@@ -111,8 +98,15 @@ class Engine:
         self.data = Data(robot, self.variables, self.env, self.changed)
         self.data.keep_unset = speaks_javascript(self.plan)
         self.tag = Tagger(robot, clock, tag_sink, bus)
+        self.conditions = Conditions(
+            robot,
+            self.env,
+            self.variables,
+            javascript=lambda: self.javascript,
+            charged=self.charged,
+        )
         self.triggers = Triggers(
-            robot, bus, clock, self.call, self._value, self.env, self.variables
+            robot, bus, clock, self.call, self.conditions.event, self.env, self.variables
         )
         self._work: deque[Callable[[], object]] = deque()  # first queued, first run
         self._busy = False
@@ -133,14 +127,7 @@ class Engine:
         self.time = EngineTime.of(clock)  # None: computing takes no simulated time
         self._frame: Frame | None = None  # the instance frame installed in the variables
         self.compensating: set[RunScope] = set()  # compensations running (compensation.py)
-        #: the activities started and not yet ended, by the token running each: the token's
-        #: activity label and instance number
-        self._running: dict[Token, tuple[str, int]] = {}
-        self._instances = 0
-        #: how a cancel ends the activities it reaches: ``interrupted`` while an interrupting
-        #: boundary event or event sub-process takes over, else ``cancelled``
-        self._ending = Ending.CANCELLED
-        self.activity_observer: ActivityObserver | None = None
+        self.activities = RunningActivities(robot, self.tag)  # started, not yet ended
 
     def _deploy(self, process: Process | ScopePlan) -> ScopePlan:
         if isinstance(process, ScopePlan):
@@ -387,7 +374,7 @@ class Engine:
         self.disarm(token)
         if token.child is not None:
             self.cancel_scope(token.child)
-        self.end_activity(token, Lifecycle.ABORT)  # after its inner activities: they ended first
+        self.activities.end(token, Lifecycle.ABORT)  # after its inner activities: they ended first
 
     def disarm(self, token: Token) -> None:
         token.generation += 1  # whatever fires for the old wait from now on is stale
@@ -465,7 +452,7 @@ class Engine:
         for flow in node.outgoing:
             if flow is node.default:
                 continue
-            if flow.condition is None or self.condition(flow.condition, flow.id):
+            if flow.condition is None or self.conditions.holds(flow.condition, flow.id):
                 taken.append(flow)
                 if first:
                     break
@@ -502,78 +489,19 @@ class Engine:
             )
         return self._javascript
 
-    def condition(self, condition: Compiled, where: str) -> bool:
-        return bool(self.evaluate(condition, where))
-
-    def evaluate(self, condition: Compiled, where: str) -> Any:
-        """The value of a condition or expression (a loop's cardinality), errors explained."""
-        try:
-            with self.charged("condition"):
-                if condition.code is None:  # JavaScript: its own engine compiled it
-                    return self.javascript.condition(condition.source)
-                return eval(condition.code, self.env, self.variables)
-        except BpmnError:
-            raise
-        except ScriptFailure as failure:
-            raise ModelError(
-                f"robot {self.robot.name}: the JavaScript condition of {where} failed: "
-                f"{failure.text}"
-            ) from None
-        except Exception as error:
-            raise ModelError(
-                f"robot {self.robot.name}: the condition of {where} ({condition.source}) "
-                f"failed: {type(error).__name__}: {error}"
-            ) from error
-
-    def _value(self, condition: Compiled) -> Any:
-        """A conditional event's condition; one reading a variable nobody set yet is false
-        (it cannot have become true), unlike a gateway's, where that is a model error."""
-        try:
-            if condition.code is None:  # JavaScript: its own engine compiled it
-                return self.condition(condition, "a conditional event")
-            with self.charged("condition"):
-                return eval(condition.code, self.env, self.variables)
-        except NameError:
-            return False
-        except Exception:
-            return self.condition(condition, "a conditional event")
-
     def watching(self) -> watchdog.Watch:
         """This engine's stamp for the Python scripts' time limit, made at its first script."""
         self.watch = watchdog.watch()
         return self.watch
 
-    # -- activity tags -----------------------------------------------------------------------------
+    @property
+    def activity_observer(self) -> ActivityObserver | None:
+        """Told of every activity instance as it starts and ends, apart from the tags."""
+        return self.activities.observer
 
-    def begin_activity(self, token: Token, label: str) -> None:
-        """``token``'s activity starts: tagged, and remembered until it ends."""
-        self.tag(label, Lifecycle.START)
-        self._instances += 1
-        self._running[token] = (label, self._instances)
-        if self.activity_observer is not None:
-            self.activity_observer(self.robot.name, self._instances, label, Ending.START.value)
-
-    def end_activity(self, token: Token, lifecycle: Lifecycle) -> None:
-        """``token``'s activity, if one runs, ends: ``complete``, or ``ate_abort`` when it was
-        interrupted or cancelled."""
-        running = self._running.pop(token, None)
-        if running is None:
-            return
-        label, number = running
-        self.tag(label, lifecycle)
-        if self.activity_observer is not None:
-            how = Ending.COMPLETED if lifecycle == Lifecycle.COMPLETE else self._ending
-            self.activity_observer(self.robot.name, number, label, how.value)
-
-    @contextlib.contextmanager
-    def interrupting(self) -> Iterator[None]:
-        """The activities cancelled meanwhile were interrupted (an interrupting boundary event
-        or event sub-process), not merely cancelled."""
-        before, self._ending = self._ending, Ending.INTERRUPTED
-        try:
-            yield
-        finally:
-            self._ending = before
+    @activity_observer.setter
+    def activity_observer(self, observer: ActivityObserver | None) -> None:
+        self.activities.observer = observer
 
     def changed(self, names: Iterable[str]) -> None:
         self.triggers.changed(names)

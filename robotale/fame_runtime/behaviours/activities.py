@@ -32,13 +32,13 @@ _NOT_VARIABLES = (types.ModuleType, types.FunctionType, type)
 
 
 def run_task(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
-    engine.begin_activity(token, node.label)
+    engine.activities.begin(token, node.label)
     engine.data.inputs(node)
     return _completed(engine, token, node)
 
 
 def run_script(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
-    engine.begin_activity(token, node.label)
+    engine.activities.begin(token, node.label)
     engine.data.inputs(node)
     script = node.script
     if script is not None and script.language == JAVASCRIPT:
@@ -65,7 +65,7 @@ def run_script(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
 def _completed(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
     """An activity that ran at once completed: tagged, remembered for compensation, its
     outputs written, its token on its way."""
-    engine.end_activity(token, Lifecycle.COMPLETE)
+    engine.activities.end(token, Lifecycle.COMPLETE)
     compensable(token, node)
     engine.data.outputs(node, {})
     return engine.follow(token, engine.taken(node, first=False))
@@ -142,7 +142,7 @@ def _script_done(engine: Engine, token: Token, generation: int) -> Completion:
 
 
 def run_skill(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
-    engine.begin_activity(token, node.label)
+    engine.activities.begin(token, node.label)
     inputs = engine.data.inputs(node)
     arm_boundaries(engine, token, node)
     generation = token.generation
@@ -186,7 +186,7 @@ def _skill_done(
 def run_call(engine: Engine, token: Token, node: NodePlan) -> NodePlan | None:
     """A called process or a sub-process: its content runs in a scope of its own while the
     token waits at the activity."""
-    engine.begin_activity(token, node.label)
+    engine.activities.begin(token, node.label)
     engine.data.inputs(node)
     arm_boundaries(engine, token, node)
     assert node.child is not None  # the deployer gives every call and sub-process its content
@@ -204,7 +204,7 @@ def activity_done(engine: Engine, token: Token, outputs: Mapping[str, Any] | Non
     node = token.node
     child, token.child = token.child, None
     engine.disarm(token)
-    engine.end_activity(token, Lifecycle.COMPLETE)
+    engine.activities.end(token, Lifecycle.COMPLETE)
     if node.behaviour == Run.EVENT_SUBPROCESS:
         engine.consume(token)
         return

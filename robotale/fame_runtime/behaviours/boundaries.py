@@ -49,7 +49,7 @@ def boundary_fired(
     a new token leaves by the boundary event."""
     if boundary.node.cancel_activity:
         scope = token.scope
-        with engine.interrupting():
+        with engine.activities.interrupting():
             engine.cancel(token)
         token = engine.new_token(scope, boundary)
     else:
@@ -96,11 +96,11 @@ def event_subprocess(
         scope.safe = True
     holder = engine.new_token(scope, esp)
     if interrupting:
-        with engine.interrupting():
+        with engine.activities.interrupting():
             for token in list(scope.tokens):
                 if token is not holder:
                     engine.cancel(token)
-    engine.begin_activity(holder, esp.label)
+    engine.activities.begin(holder, esp.label)
     assert esp.child is not None
     child = engine.open_scope(esp.child, scope, holder)
     start = esp.child.triggered_starts[0]

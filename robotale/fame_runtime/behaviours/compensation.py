@@ -80,7 +80,7 @@ def _compensate_one(engine: Engine, record: Done, then: Callable[[], object]) ->
     place = _compensation_scope(engine, child, child.frame, then)
     place.done = child.done  # what a compensation throw inside the handler compensates
     holder = engine.new_token(place, esp)
-    engine.begin_activity(holder, esp.label)
+    engine.activities.begin(holder, esp.label)
     assert esp.child is not None
     inner = engine.open_scope(esp.child, place, holder)
     start = esp.child.triggered_starts[0]

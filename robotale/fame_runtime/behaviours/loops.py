@@ -72,7 +72,7 @@ def _loop_items(engine: Engine, node: NodePlan) -> list[Any]:
     looped = _looped(node)
     where = f"the multi-instance activity {node.node.describe()}"
     if looped.cardinality is not None:
-        count = engine.evaluate(looped.cardinality, where)
+        count = engine.conditions.value(looped.cardinality, where)
         if not isinstance(count, int | float) or count < 0 or count != int(count):
             raise ModelError(
                 f"robot {engine.robot.name}: the loopCardinality of {where} is {count!r}, "
@@ -152,12 +152,12 @@ def _loop_finished(engine: Engine, run: LoopRun, *, before: bool) -> bool:
         if marker.maximum is not None and run.completed >= marker.maximum:
             return True
         engine.data.set({"loopCounter": run.completed})
-        return looped.condition is not None and not engine.condition(looped.condition, where)
+        return looped.condition is not None and not engine.conditions.holds(looped.condition, where)
     if run.completed >= len(run.items):
         return True
     if before or looped.condition is None:
         return False
-    return engine.condition(looped.condition, where)
+    return engine.conditions.holds(looped.condition, where)
 
 
 def _stop_instances(engine: Engine, run: LoopRun) -> None:
