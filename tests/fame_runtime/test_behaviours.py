@@ -3,9 +3,9 @@ the JavaScript runtime the engine loads against the package's files."""
 
 from __future__ import annotations
 
-import dataclasses
 import fnmatch
 import tomllib
+from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
@@ -18,30 +18,25 @@ from robotale.fame_runtime.behaviours import BEHAVIOURS
 from robotale.fame_runtime.kinds import FLOW_NODES, Kind
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.parser import parse, parse_all
-from robotale.fame_runtime.plan import OUTSIDE, NodePlan, deploy
+from robotale.fame_runtime.plan import OUTSIDE, NodePlan, ScopePlan, deploy
 
 HERE = Path(__file__).resolve().parent
 PACKAGE = Path(robotale.fame_runtime.__file__).parent
 PYPROJECT = PACKAGE.parent.parent / "pyproject.toml"
 
 
-def _plans(obj: object, seen: set[int]):
-    """Every node plan reachable from ``obj`` (sub-processes, loop bodies, called processes
-    and boundary events included)."""
-    if id(obj) in seen:
+def _node_plans(scope: ScopePlan, seen: set[int]) -> Iterator[NodePlan]:
+    """Every node plan of ``scope``: its nodes and event sub-processes, with the content of
+    sub-processes and called processes and the bodies of loops (each scope once)."""
+    if id(scope) in seen:
         return
-    seen.add(id(obj))
-    if isinstance(obj, NodePlan):
-        yield obj
-    if dataclasses.is_dataclass(obj) and type(obj).__module__ == NodePlan.__module__:
-        for field in dataclasses.fields(obj):
-            yield from _plans(getattr(obj, field.name), seen)
-    elif isinstance(obj, dict):
-        for value in obj.values():
-            yield from _plans(value, seen)
-    elif isinstance(obj, list | tuple):
-        for value in obj:
-            yield from _plans(value, seen)
+    seen.add(id(scope))
+    for node in [*scope.nodes.values(), *scope.event_subprocesses]:
+        while node is not None:
+            yield node
+            if node.child is not None:
+                yield from _node_plans(node.child, seen)
+            node = node.loop.body if node.loop is not None else None
 
 
 def _deployed_behaviours() -> dict[str, set[str]]:
@@ -57,7 +52,7 @@ def _deployed_behaviours() -> dict[str, set[str]]:
                 plan = deploy(process, skills=["drive", "take_off", "land"], library=library)
             except ModelError:  # skills these tests do not name, or elements refused
                 continue
-            for node in _plans(plan, set()):
+            for node in _node_plans(plan, set()):
                 found.setdefault(str(node.node.kind), set()).add(str(node.behaviour))
     return found
 
