@@ -14,7 +14,7 @@ from __future__ import annotations
 import re
 
 from robotale.fame_runtime.kinds import CATCHING, MESSAGE_TASKS, EventKind
-from robotale.fame_runtime.kinds import THROWING as THROWING  # for those reading it here
+from robotale.fame_runtime.kinds import THROWING as THROWING  # read here too (one object)
 from robotale.fame_runtime.model import Node
 
 #: how a message event's label ends, as in the thesis' logs: ``!`` sends, ``?`` receives
