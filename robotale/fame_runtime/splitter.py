@@ -17,7 +17,7 @@ from lxml import etree
 from robotale.errors import ModelError
 from robotale.fame_runtime.kinds import Kind
 from robotale.fame_runtime.library import find_process
-from robotale.fame_runtime.model import Definitions, Participant, Process
+from robotale.fame_runtime.model import Definitions, Participant, Problem, Process
 
 
 @dataclass(frozen=True, slots=True)
@@ -70,21 +70,32 @@ def _check_count(
 ) -> None:
     if not pool.multi_instance:
         if len(robots) > 1:
-            raise ModelError(
-                f"{definitions.file}:{pool.line}: pool {pool.name} is single-instance but "
-                f"robots {', '.join(robots)} all match it"
+            raise _pool_error(
+                definitions,
+                pool,
+                f"pool {pool.name} is single-instance but robots {', '.join(robots)} all match it",
             )
         return
     if pool.maximum is not None and len(robots) > pool.maximum:
-        raise ModelError(
-            f"{definitions.file}:{pool.line}: pool {pool.name} allows at most {pool.maximum} "
-            f"robots, {len(robots)} given ({', '.join(robots)})"
+        raise _pool_error(
+            definitions,
+            pool,
+            f"pool {pool.name} allows at most {pool.maximum} robots, {len(robots)} given "
+            f"({', '.join(robots)})",
         )
     if given and pool.minimum and len(robots) < pool.minimum:
-        raise ModelError(
-            f"{definitions.file}:{pool.line}: pool {pool.name} needs at least {pool.minimum} "
-            f"robot{'s' if pool.minimum > 1 else ''}, {len(robots)} given"
+        raise _pool_error(
+            definitions,
+            pool,
+            f"pool {pool.name} needs at least {pool.minimum} "
+            f"robot{'s' if pool.minimum > 1 else ''}, {len(robots)} given",
         )
+
+
+def _pool_error(definitions: Definitions, pool: Participant, sentence: str) -> ModelError:
+    """``sentence`` about ``pool``, placed at the pool in its file."""
+    problem = definitions.placed(Problem(str(definitions.file), pool.line, pool.id, sentence))
+    return ModelError(str(problem), problems=[problem])
 
 
 def _default_robots(pools: list[tuple[Participant, Process]]) -> list[str]:

@@ -15,10 +15,14 @@ import robotale.fame_runtime
 from robotale.errors import ModelError
 from robotale.fame_runtime import javascript
 from robotale.fame_runtime.behaviours import BEHAVIOURS
+from robotale.fame_runtime.bus import InProcessBus
+from robotale.fame_runtime.clock import SimClock
 from robotale.fame_runtime.kinds import FLOW_NODES, Kind
 from robotale.fame_runtime.library import Library
+from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.parser import parse, parse_all
 from robotale.fame_runtime.plan import OUTSIDE, NodePlan, ScopePlan, deploy
+from robotale.fame_runtime.splitter import split
 
 HERE = Path(__file__).resolve().parent
 PACKAGE = Path(robotale.fame_runtime.__file__).parent
@@ -168,3 +172,26 @@ def test_errors_of_the_reader_and_the_deployer_carry_file_line_column_and_elemen
     assert (problem.file, problem.element) == (str(path), "late")
     assert (problem.line, problem.column) == _where(broken, "late")
     assert str(unread.value) == f"{path}:{problem.line}: {problem.sentence}"
+
+
+def test_a_pool_and_a_mission_refused_carry_their_places(tmp_path):
+    collaboration = MODEL_WITH_PROBLEMS.replace(
+        '  <bpmn:process id="rover"',
+        '  <bpmn:collaboration id="c">\n'
+        '    <bpmn:participant id="rovers" name="Rover" processRef="rover">\n'
+        '      <bpmn:participantMultiplicity minimum="2" />\n'
+        "    </bpmn:participant>\n"
+        "  </bpmn:collaboration>\n"
+        '  <bpmn:process id="rover"',
+    )
+    path = tmp_path / "pool.bpmn"
+    path.write_text(collaboration, encoding="utf-8")
+    with pytest.raises(ModelError, match="needs at least 2 robots, 1 given") as few:
+        split(parse(path), ["rover_1"])
+    (problem,) = few.value.problems
+    assert (problem.file, problem.element) == (str(path), "rovers")
+    assert (problem.line, problem.column) == _where(collaboration, "rovers")
+    with pytest.raises(ModelError, match="elements of the mission") as refused:
+        Mission(path, clock=SimClock(0.0), bus=InProcessBus(SimClock(0.0)))
+    places = {(p.file, p.element, p.line, p.column) for p in refused.value.problems}
+    assert places == {(str(path), "ask", *_where(collaboration, "ask"))}
