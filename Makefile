@@ -11,7 +11,7 @@ STAMP := $(VENV)/.installed
 # Graphviz to draw discovered process models as SVG.
 SYSTEM_PACKAGES ?= chromium chromium-driver docker-compose graphviz
 
-.PHONY: install system-deps test test-neo4j-next demo bench lint format constraints clean fuzz bpmn-engine verify-findings
+.PHONY: install system-deps test typecheck test-neo4j-next demo bench lint format constraints clean fuzz bpmn-engine verify-findings
 
 install: $(STAMP)
 
@@ -36,6 +36,7 @@ system-deps:
 
 test: install system-deps bpmn-engine
 	$(BIN)/ruff check .
+	$(BIN)/mypy --strict $(TYPED_PACKAGES)
 	$(BIN)/pytest
 
 # bpmn-engine (FAME's own engine), pinned in the harness's package-lock.json, for the
@@ -86,6 +87,12 @@ demo: install
 bench: install
 	@for b in benchmarks/*.py; do echo "== $$b"; $(BIN)/python $$b || exit 1; done
 
+# The packages whose types mypy checks strictly (settings in pyproject.toml's [tool.mypy]);
+# `make test` checks them too.
+TYPED_PACKAGES := robotale/fame_runtime
+typecheck: install
+	$(BIN)/mypy --strict $(TYPED_PACKAGES)
+
 lint: install
 	$(BIN)/ruff check .
 	$(BIN)/ruff format --check .
@@ -99,4 +106,4 @@ constraints: install
 	mv constraints.txt.new constraints.txt
 
 clean:
-	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache
+	rm -rf $(VENV) build *.egg-info .pytest_cache .ruff_cache .mypy_cache

@@ -5,6 +5,11 @@ Every error a user can provoke (a bad file, a bad model, a server that is down) 
 The command line prints that sentence and exits with status 1; nothing is half-written.
 """
 
+from __future__ import annotations
+
+from collections.abc import Sequence
+from typing import Protocol
+
 
 class RobotaleError(Exception):
     """A problem with the user's input or environment, explained in one sentence."""
@@ -14,8 +19,40 @@ class InputError(RobotaleError):
     """A file or value the user gave cannot be used (missing, malformed, wrong column ...)."""
 
 
+class Located(Protocol):
+    """Where one problem of a model is: its file, line, column (0: unknown) and element id,
+    and the sentence saying what is wrong there."""
+
+    @property
+    def file(self) -> str: ...
+
+    @property
+    def line(self) -> int: ...
+
+    @property
+    def column(self) -> int: ...
+
+    @property
+    def element(self) -> str: ...
+
+    @property
+    def sentence(self) -> str: ...
+
+    def as_dict(self) -> dict[str, object]:
+        """The fields by name, as JSON reports give them."""
+        ...
+
+
 class ModelError(RobotaleError):
-    """A BPMN model cannot be parsed, checked or run; the message names the element id."""
+    """A BPMN model cannot be parsed, checked or run; the message names the element id.
+
+    ``problems`` are the same problems with their fields, for those who point at them (the
+    dashboard, ``robotale fame check --json``); empty when the model was read and a running
+    engine found the problem."""
+
+    def __init__(self, sentence: str, *, problems: Sequence[Located] = ()) -> None:
+        super().__init__(sentence)
+        self.problems: tuple[Located, ...] = tuple(problems)
 
 
 class ServerError(RobotaleError):

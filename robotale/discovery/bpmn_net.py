@@ -35,26 +35,11 @@ from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
+from robotale.fame_runtime.kinds import ACTIVITIES, EventKind, Kind
 from robotale.fame_runtime.labels import element_label
 
-ACTIVITY_KINDS = frozenset(
-    {
-        "task",
-        "scriptTask",
-        "serviceTask",
-        "userTask",
-        "sendTask",
-        "receiveTask",
-        "manualTask",
-        "businessRuleTask",
-        "callActivity",
-        "subProcess",
-        "transaction",
-        "adHocSubProcess",
-    }
-)
-CHOICE_GATEWAYS = frozenset({"exclusiveGateway", "eventBasedGateway"})
-SUBSET_GATEWAYS = frozenset({"inclusiveGateway", "complexGateway"})
+CHOICE_GATEWAYS = frozenset({Kind.EXCLUSIVE_GATEWAY, Kind.EVENT_BASED_GATEWAY})
+SUBSET_GATEWAYS = frozenset({Kind.INCLUSIVE_GATEWAY, Kind.COMPLEX_GATEWAY})
 MAX_SUBSET_BRANCHES = 6  # 63 transitions: beyond that a gateway is modelled as a choice
 
 #: finds the process a call activity calls (``None`` when it is a skill or unknown).
@@ -152,19 +137,19 @@ class _Builder:
         incoming = _by(content.flows.values(), "target")
         outgoing = _by(content.flows.values(), "source")
         attached = _by(
-            (n for n in content.nodes.values() if n.kind == "boundaryEvent"), "attached_to"
+            (n for n in content.nodes.values() if n.kind == Kind.BOUNDARY_EVENT), "attached_to"
         )
         for node in content.nodes.values():
             ins = [flows[f.id] for f in incoming.get(node.id, [])]
             outs = [flows[f.id] for f in outgoing.get(node.id, [])]
             conditional = any(f.condition is not None for f in outgoing.get(node.id, []))
-            if node.kind == "startEvent":
+            if node.kind == Kind.START_EVENT:
                 self.start(node, scope, (entries or {}).get(node.id, entry), outs)
-            elif node.kind == "boundaryEvent":
+            elif node.kind == Kind.BOUNDARY_EVENT:
                 continue  # translated with the activity it is attached to
-            elif node.kind == "subProcess" and node.triggered_by_event:
+            elif node.kind == Kind.SUB_PROCESS and node.triggered_by_event:
                 self.event_subprocess(node, scope)
-            elif node.kind in ACTIVITY_KINDS or node.kind not in _EVENT_AND_GATEWAY_KINDS:
+            elif node.kind in ACTIVITIES or node.kind not in _EVENT_AND_GATEWAY_KINDS:
                 ready = self.merge(scope, node.id, ins, entry)
                 boundaries = [
                     (b, [flows[f.id] for f in outgoing.get(b.id, [])])
@@ -183,7 +168,7 @@ class _Builder:
         its start events' triggers fires; an interrupting one cancels its parent scope."""
         inner = _Scope(done=None)
         entries = {}
-        for start in (n for n in node.scope.nodes.values() if n.kind == "startEvent"):
+        for start in (n for n in node.scope.nodes.values() if n.kind == Kind.START_EVENT):
             entries[start.id] = self.place(inner, f"triggered_{start.id}")
             cancels = [self.cancel(parent)] if start.interrupting else []
             label = element_label(node)
@@ -193,9 +178,9 @@ class _Builder:
     def flow_node(self, node, scope: _Scope, entry, ins, outs, conditional: bool) -> None:
         """End events, gateways and intermediate events."""
         kind = node.kind
-        if kind == "endEvent":
+        if kind == Kind.END_EVENT:
             self.end(node, scope, ins)
-        elif kind == "parallelGateway":
+        elif kind == Kind.PARALLEL_GATEWAY:
             self.transition(f"and_{node.id}", None, ins, outs)
         elif kind in SUBSET_GATEWAYS:
             joined = self.place(scope, f"or_{node.id}")
@@ -217,7 +202,7 @@ class _Builder:
         label = self.event_label(node)
         if entry is not None:
             self.transition(f"start_{node.id}", label, [entry], outs)
-        elif node.event_kind == "none":
+        elif node.event_kind == EventKind.NONE:
             source = self.place(scope, f"source_{node.id}")
             self.initial[source] = 1
             self.transition(f"start_{node.id}", label, [source], outs)
@@ -229,7 +214,7 @@ class _Builder:
             self.transition(f"start_{node.id}", label, [], outs)
 
     def end(self, node, scope: _Scope, ins) -> None:
-        if node.event_kind == "terminate":
+        if node.event_kind == EventKind.TERMINATE:
             outputs = [self.cancel(scope)]
         else:
             outputs = [scope.done] if scope.done is not None else []
@@ -270,7 +255,7 @@ class _Builder:
         return done
 
     def content(self, node):
-        if node.kind != "callActivity":
+        if node.kind != Kind.CALL_ACTIVITY:
             return node.scope
         if node.embedded_process is not None:
             return node.embedded_process
@@ -318,19 +303,19 @@ class _Builder:
     def event_label(self, node) -> str | None:
         """Signal and error events are always visible; other events only when tagged."""
         label = element_label(node)
-        if node.event_kind in ("signal", "error") or label in self.observed:
+        if node.event_kind in (EventKind.SIGNAL, EventKind.ERROR) or label in self.observed:
             return label
         return None
 
 
 _EVENT_AND_GATEWAY_KINDS = frozenset(
     {
-        "startEvent",
-        "endEvent",
-        "intermediateThrowEvent",
-        "intermediateCatchEvent",
-        "boundaryEvent",
-        "parallelGateway",
+        Kind.START_EVENT,
+        Kind.END_EVENT,
+        Kind.INTERMEDIATE_THROW_EVENT,
+        Kind.INTERMEDIATE_CATCH_EVENT,
+        Kind.BOUNDARY_EVENT,
+        Kind.PARALLEL_GATEWAY,
         *CHOICE_GATEWAYS,
         *SUBSET_GATEWAYS,
     }

@@ -109,7 +109,7 @@ OUTCOMES = (DELIVERED, QOS, FAULT, LOSS, LEFT)
 WriterKey = tuple[str, str, QoS, str]
 
 
-def reader_key(subscription: Subscription) -> tuple:
+def reader_key(subscription: Subscription) -> tuple[str | None, str, QoS, str | None]:
     """A subscription as DDS sees it: a re-armed catch event is the same reader again."""
     return (subscription.topic, subscription.owner, subscription.qos, subscription.msgtype)
 
@@ -167,7 +167,7 @@ class Network:
         here, there = self.locate(sender), self.locate(receiver)
         if here is None or there is None:
             return link.loss
-        distance = ((here[0] - there[0]) ** 2 + (here[1] - there[1]) ** 2) ** 0.5
+        distance: float = ((here[0] - there[0]) ** 2 + (here[1] - there[1]) ** 2) ** 0.5
         return min(1.0, link.loss + link.loss_per_metre * distance)
 
 
@@ -201,7 +201,7 @@ class InProcessBus:
         self._random = random.Random(seed)
         self.on_warning = on_warning or _log.warning
         self.warnings: list[str] = []
-        self._warned: set[tuple] = set()
+        self._warned: set[tuple[Any, ...]] = set()
         self._subscribers: dict[str, list[Subscription]] = defaultdict(list)
         self._taps: list[Subscription] = []
         self._ids = itertools.count(1)
@@ -217,7 +217,16 @@ class InProcessBus:
         """A message id unique on this bus (``m_1``, ``m_2`` ... as in the thesis' log)."""
         return f"m_{next(self._ids)}"
 
-    def publish(self, topic, data, *, msgtype, sender="", msg_id="", qos=None) -> Envelope:
+    def publish(
+        self,
+        topic: str,
+        data: Any,
+        *,
+        msgtype: str,
+        sender: str = "",
+        msg_id: str = "",
+        qos: QoS | None = None,
+    ) -> Envelope:
         envelope = Envelope(
             topic, data, msgtype, self.clock.now(), sender, msg_id, qos or DEFAULT_QOS
         )
@@ -241,7 +250,15 @@ class InProcessBus:
         if self.observer is not None:
             self.observer(outcome, envelope, subscription)
 
-    def subscribe(self, topic, callback, *, msgtype=None, qos=None, owner="") -> Subscription:
+    def subscribe(
+        self,
+        topic: str,
+        callback: Callable[[Envelope], None],
+        *,
+        msgtype: str | None = None,
+        qos: QoS | None = None,
+        owner: str = "",
+    ) -> Subscription:
         subscription = Subscription(topic, callback, msgtype, qos or DEFAULT_QOS, owner, _bus=self)
         self._subscribers[topic].append(subscription)
         if subscription.qos.durability == "transient_local":
@@ -322,7 +339,7 @@ class InProcessBus:
             for envelope in samples:
                 self._send(subscription, envelope)
 
-    def tap(self, callback) -> Subscription:
+    def tap(self, callback: Callable[[Envelope], None]) -> Subscription:
         """See every envelope at publish time (a recorder); taps are never dropped."""
         subscription = Subscription(None, callback, _bus=self)
         self._taps.append(subscription)

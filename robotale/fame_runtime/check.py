@@ -10,13 +10,14 @@ and a message type that differs on the two sides is reported too.
 from __future__ import annotations
 
 from collections import defaultdict
-from collections.abc import Collection
+from collections.abc import Collection, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from lxml import etree
 
-from robotale.fame_runtime.labels import THROWING, catches, signal_topic
+from robotale.fame_runtime.kinds import GATEWAYS, THROWING, EventKind, Kind
+from robotale.fame_runtime.labels import catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Node, Problem, Process, Scope
 from robotale.fame_runtime.plan import findings
@@ -86,7 +87,7 @@ def check(
             Problem(str(definitions.file), process.line, process.id, sentence)
             for sentence in progress_problems(process)
         ]
-        report.found += [(pool.name, _placed(p, definitions)) for p in found]
+        report.found += [(pool.name, definitions.placed(p)) for p in found]
     publishers, subscribers = endpoints(definitions, skills=skills, library=library)
     for topic in sorted(set(publishers) | set(subscribers)):
         report.pairs += [
@@ -115,7 +116,9 @@ def endpoints(
     return publishers, subscribers
 
 
-def _signal_events(process: Process, skills: Collection[str], library: Library | None):
+def _signal_events(
+    process: Process, skills: Collection[str], library: Library | None
+) -> Iterator[tuple[Node, Process]]:
     """The signal events of a process and of every process it calls (once each)."""
     seen: set[int] = set()
     stack = [process]
@@ -125,22 +128,14 @@ def _signal_events(process: Process, skills: Collection[str], library: Library |
             continue
         seen.add(id(current))
         for node in current.walk():
-            if node.event_kind == "signal" and signal_topic(node):
+            if node.event_kind == EventKind.SIGNAL and signal_topic(node):
                 yield node, current
-            if node.kind == "callActivity" and node.called_element not in skills:
+            if node.kind == Kind.CALL_ACTIVITY and node.called_element not in skills:
                 called = node.embedded_process or resolve_call(
                     node.called_element, current, library
                 )
                 if called is not None:
                     stack.append(called)
-
-
-def _placed(problem: Problem, definitions: Definitions) -> Problem:
-    """``problem`` with the column of its element's start tag, when it is in this file."""
-    line, column = definitions.positions.get(problem.element, (0, 0))
-    if problem.column or line != problem.line or problem.file != str(definitions.file):
-        return problem
-    return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
 
 def _endpoint(pool: str, process: Process, node: Node) -> Endpoint:
@@ -165,16 +160,6 @@ def _lonely(topic: str, publishers: list[Endpoint], subscribers: list[Endpoint])
 
 
 # -- flows that can never complete -------------------------------------------------------------
-
-GATEWAYS = frozenset(
-    {
-        "exclusiveGateway",
-        "parallelGateway",
-        "inclusiveGateway",
-        "eventBasedGateway",
-        "complexGateway",
-    }
-)
 
 
 def progress_problems(process: Process) -> list[str]:
@@ -227,7 +212,7 @@ def _deadlocked_joins(scope: Scope, graph: dict[str, list[str]]) -> list[str]:
     starts = [n for n in graph if not incoming[n]]
     found = []
     for join, node in scope.nodes.items():
-        if node.kind != "parallelGateway" or len(incoming[join]) < 2:
+        if node.kind != Kind.PARALLEL_GATEWAY or len(incoming[join]) < 2:
             continue
         reached = _reachable(graph, starts, avoid=join)
         stuck = sorted(source for source in incoming[join] if source not in reached)

@@ -47,6 +47,14 @@ class Clock(Protocol):
     def call_soon(self, callback: Callable[[], None]) -> Timer: ...
 
 
+class RunningClock(Clock, Protocol):
+    """A clock that runs its callbacks itself (both of robotale's do)."""
+
+    def run(
+        self, until: float | None = None, stop_when: Callable[[], bool] | None = None
+    ) -> float: ...
+
+
 class SimClock:
     """Simulated time driven by a queue of callbacks.
 

@@ -87,6 +87,7 @@ class Data:
 
     def payload(self, node: NodePlan) -> dict[str, Any]:
         """The data a signal throw publishes, its template filled in."""
+        assert node.throw is not None  # only throwing nodes publish
         template = node.throw.payload
         try:
             if isinstance(template, dict):
@@ -111,7 +112,9 @@ class Data:
             self.variables.update(values)
             self.changed(values)
 
-    def _resolve(self, data_objects: Iterable[DataObject], extra: Mapping[str, Any]) -> dict:
+    def _resolve(
+        self, data_objects: Iterable[DataObject], extra: Mapping[str, Any]
+    ) -> dict[str, Any]:
         names = {**self.variables, **extra} if extra else self.variables
         values = {}
         for data_object in data_objects:

@@ -21,6 +21,7 @@ writers that are not robotale's get an id from their writer's handle and timesta
 from __future__ import annotations
 
 import contextlib
+import functools
 import os
 import threading
 import time
@@ -39,7 +40,7 @@ from cyclonedds.util import duration
 
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope, Subscription
-from robotale.fame_runtime.clock import Clock
+from robotale.fame_runtime.clock import RunningClock
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.rostypes import dds_topic, dds_type_name, idl_type, to_data, to_sample
 
@@ -125,7 +126,7 @@ class _Reader:
             self.reader.set_listener(None)
         del old
 
-    def _arrived(self, _reader=None) -> int:
+    def _arrived(self, _reader: Any = None) -> int:
         # a Cyclone thread (or a drain): take the samples, hand them to the clock's thread
         taken = 0
         for sample in self.reader.take(N=256):
@@ -133,7 +134,7 @@ class _Reader:
             if not info.valid_data:
                 continue
             envelope = self.bus.envelope(self.reader, self.topic, self.msgtype, sample, info)
-            self.bus.hand_over(lambda envelope=envelope: self.dispatch(envelope))
+            self.bus.hand_over(functools.partial(self.dispatch, envelope))
             taken += 1
         return taken
 
@@ -144,7 +145,7 @@ class _Reader:
             if subscription.active:
                 subscription.callback(envelope)
 
-    def _incompatible(self, reader, status) -> None:
+    def _incompatible(self, reader: Any, status: Any) -> None:  # Cyclone's status
         self.bus.warn(
             f"{self.topic}: a publisher and {self.bus.node}'s subscriber cannot talk "
             f"({_POLICIES.get(status.last_policy_id, status.last_policy_id)} does not match; "
@@ -161,7 +162,7 @@ class DdsBus:
 
     def __init__(
         self,
-        clock: Clock,
+        clock: RunningClock,
         *,
         node: str = "",
         domain: int | None = None,
@@ -176,8 +177,8 @@ class DdsBus:
         self.on_warning = on_warning or (lambda text: None)
         self.warnings: list[str] = []
         self._topics: dict[tuple[str, str], Any] = {}
-        self._writers: dict[tuple, Any] = {}
-        self._readers: dict[tuple, _Reader] = {}
+        self._writers: dict[tuple[str, str, QoS, str], Any] = {}
+        self._readers: dict[tuple[str, str | None, QoS], _Reader] = {}
         self._taps: list[Subscription] = []
         self._senders: dict[int, tuple[str, str]] = {}
         self._lock = threading.Lock()
@@ -251,7 +252,16 @@ class DdsBus:
             self._last_stamp = max(time.time_ns(), self._last_stamp + 1)
             return self._last_stamp
 
-    def publish(self, topic, data, *, msgtype, sender="", msg_id="", qos=None) -> Envelope:
+    def publish(
+        self,
+        topic: str,
+        data: Any,
+        *,
+        msgtype: str,
+        sender: str = "",
+        msg_id: str = "",
+        qos: QoS | None = None,
+    ) -> Envelope:
         qos = qos or DEFAULT_QOS
         prefix = f"m_{self.node}_"
         own = msg_id.startswith(prefix) and msg_id[len(prefix) :].isdigit()
@@ -263,17 +273,25 @@ class DdsBus:
         self.writer(topic, msgtype, qos, sender).write(sample, timestamp=stamp)
         return envelope
 
-    def subscribe(self, topic, callback, *, msgtype=None, qos=None, owner="") -> Subscription:
+    def subscribe(
+        self,
+        topic: str,
+        callback: Callable[[Envelope], None],
+        *,
+        msgtype: str | None = None,
+        qos: QoS | None = None,
+        owner: str = "",
+    ) -> Subscription:
         if not msgtype:
             raise ValueError(f"{topic}: a DDS subscription needs the message type")
         reader = self.reader(topic, msgtype, qos)
         subscription = Subscription(topic, callback, msgtype, reader.qos, owner, _bus=self)
         reader.subscriptions.append(subscription)
         for envelope in list(reader.kept):  # transient local: what the reader holds
-            self.hand_over(lambda envelope=envelope: subscription.active and callback(envelope))
+            self.hand_over(functools.partial(_kept, subscription, envelope))
         return subscription
 
-    def tap(self, callback) -> Subscription:
+    def tap(self, callback: Callable[[Envelope], None]) -> Subscription:
         """See every envelope this process publishes, when it publishes it."""
         subscription = Subscription(None, callback, _bus=self)
         self._taps.append(subscription)
@@ -368,6 +386,12 @@ class Recorders:
             else:  # a recording that was closed
                 self.keys.discard(sample.key)
         return self.keys
+
+
+def _kept(subscription: Subscription, envelope: Envelope) -> None:
+    """Hand a sample a transient-local reader kept to a subscription still listening."""
+    if subscription.active:
+        subscription.callback(envelope)
 
 
 def _parse_userdata(qos: Any) -> tuple[str, str]:

@@ -177,7 +177,7 @@ def substitute(
     if "${" not in text:
         return literal(text)
 
-    def fill(match: re.Match) -> str:
+    def fill(match: re.Match[str]) -> str:
         if keep_unset and unset(match.group(1), names, env):
             return match.group(0)
         return str(evaluate(match.group(1), names, env))

@@ -3,7 +3,8 @@
 The engine tags every element it runs with :func:`element_label`; conformance labels its
 Petri net transitions with it and the Model page finds elements in a log by it, so a log made
 by the engines and the model always agree. The facts the label is made of live here too:
-which element kinds catch (:data:`CATCHING`) and throw (:data:`THROWING`), the topic a signal
+which element kinds catch (:data:`~robotale.fame_runtime.kinds.CATCHING`) and throw
+(:data:`~robotale.fame_runtime.kinds.THROWING`), the topic a signal
 event uses (:func:`signal_name`, :func:`signal_topic`) and the error an error event names
 (:func:`error_name`).
 """
@@ -12,14 +13,9 @@ from __future__ import annotations
 
 import re
 
+from robotale.fame_runtime.kinds import CATCHING, MESSAGE_TASKS, EventKind
+from robotale.fame_runtime.kinds import THROWING as THROWING  # read here too (one object)
 from robotale.fame_runtime.model import Node
-
-#: element kinds whose event definition waits for something (a signal catch is a subscriber)
-CATCHING = frozenset({"startEvent", "intermediateCatchEvent", "boundaryEvent", "receiveTask"})
-#: element kinds whose event definition is thrown (a signal throw is a publisher)
-THROWING = frozenset({"intermediateThrowEvent", "endEvent", "sendTask"})
-#: tasks that send or receive a message: tagged by their own name, like any activity
-MESSAGE_TASKS = frozenset({"sendTask", "receiveTask"})
 
 #: how a message event's label ends, as in the thesis' logs: ``!`` sends, ``?`` receives
 SEND, RECEIVE = "!", "?"
@@ -99,12 +95,12 @@ def element_label(node: Node) -> str:
     if node.kind in MESSAGE_TASKS:
         suffix = RECEIVE if catches(node) else SEND
         return activity_label(node.name or message_name(node) + suffix, node.id)
-    if node.event_kind in ("signal", "message"):
+    if node.event_kind in (EventKind.SIGNAL, EventKind.MESSAGE):
         suffix = RECEIVE if catches(node) else SEND
-        name = signal_name(node) if node.event_kind == "signal" else message_name(node)
+        name = signal_name(node) if node.event_kind == EventKind.SIGNAL else message_name(node)
         return activity_label(name + suffix, node.id)
-    if node.event_kind == "error":
+    if node.event_kind == EventKind.ERROR:
         return activity_label(error_name(node), node.id)
-    if node.event_kind == "escalation":
+    if node.event_kind == EventKind.ESCALATION:
         return activity_label(escalation_name(node), node.id)
     return activity_label(node.name, node.id)

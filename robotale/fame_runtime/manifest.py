@@ -14,7 +14,7 @@ from __future__ import annotations
 import json
 from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, TypedDict
+from typing import Any, TypedDict, cast
 
 from robotale.errors import InputError
 from robotale.files import write_file
@@ -70,7 +70,7 @@ def parse_manifest(data: str | bytes, where: object) -> RunManifest:
         raise InputError(f"{where} is not valid JSON: {error}.") from None
     if not isinstance(manifest, dict):
         raise InputError(f"{where} holds no JSON object, so it is no run manifest.")
-    return manifest
+    return cast(RunManifest, manifest)  # a JSON object; its keys are read with defaults
 
 
 def write_manifest(folder: Path, manifest: RunManifest) -> Path:

@@ -126,5 +126,7 @@ def _deploy_all(
         plans[id(process)] = deploy(process, skills=skills, library=library)
     if found:
         lines = "\n".join(str(p) for p in found)
-        raise ModelError(f"the engine cannot run {len(found)} elements of the mission:\n{lines}")
+        raise ModelError(
+            f"the engine cannot run {len(found)} elements of the mission:\n{lines}", problems=found
+        )
     return plans

@@ -9,9 +9,11 @@ file says, including elements the engine cannot run: refusing those is the deplo
 
 from __future__ import annotations
 
+from collections.abc import Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
 
+from robotale.fame_runtime.kinds import EventKind, Kind, LoopKind
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.timers import TimerSpec
 
@@ -76,7 +78,8 @@ class RosMessage:
 class EventDefinition:
     """What triggers or is thrown by an event."""
 
-    kind: str  # signal timer conditional error terminate message escalation compensate cancel link
+    #: what it is; a definition BPMN does not name (``fooEventDefinition``) stays as written
+    kind: EventKind | str
     ref: str = ""  # signalRef / errorRef / messageRef / compensation's activityRef as written
     ref_name: str = ""  # the name of the referenced signal / error, "" when not declared
     timer: TimerSpec | None = None
@@ -94,7 +97,7 @@ class Loop:
     ``camunda:elementVariable`` (the item's id, as SpiffWorkflow reads it).
     """
 
-    kind: str
+    kind: LoopKind
     cardinality: Expression | None = None
     collection: str = ""  # the variable holding the input collection
     element: str = ""  # the variable each instance finds its item in
@@ -130,7 +133,7 @@ class Node:
     """One flow node (event, activity, gateway) of a process or sub-process."""
 
     id: str
-    kind: str  # the BPMN tag: startEvent, scriptTask, exclusiveGateway, subProcess ...
+    kind: Kind  # the BPMN tag: startEvent, scriptTask, exclusiveGateway, subProcess ...
     name: str = ""
     line: int = 0
     events: list[EventDefinition] = field(default_factory=list)
@@ -158,9 +161,9 @@ class Node:
         return self.events[0] if self.events else None
 
     @property
-    def event_kind(self) -> str:
+    def event_kind(self) -> EventKind | str:
         """``none`` for an event without a definition, else the definition's kind."""
-        return self.events[0].kind if self.events else "none"
+        return self.events[0].kind if self.events else EventKind.NONE
 
     def describe(self) -> str:
         """``Activity_1 (Take Off)``: how messages name this element."""
@@ -192,9 +195,9 @@ class Process(Scope):
     def describe(self) -> str:
         return f"{self.id} ({self.name})" if self.name and self.name != self.id else self.id
 
-    def walk(self):
+    def walk(self) -> Iterator[Node]:
         """Every node of the process, those of sub-processes included."""
-        stack = [self]
+        stack: list[Scope] = [self]
         while stack:
             scope = stack.pop()
             for node in scope.nodes.values():
@@ -236,6 +239,14 @@ class Definitions:
     problems: list[Problem] = field(default_factory=list)
     #: element id -> (line, column) of its start tag, for reports that name columns
     positions: dict[str, tuple[int, int]] = field(default_factory=dict, repr=False)
+
+    def placed(self, problem: Problem) -> Problem:
+        """``problem`` with the column of its element's start tag, when that element starts
+        on the problem's line of this file."""
+        line, column = self.positions.get(problem.element, (0, 0))
+        if problem.column or line != problem.line or problem.file != str(self.file):
+            return problem
+        return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
     def pools(self) -> list[tuple[Participant, Process]]:
         """Every pool with the process it holds; a file without a collaboration has one pool

@@ -17,7 +17,7 @@ seconds.
 from __future__ import annotations
 
 import time
-from collections.abc import Callable, Iterable, Mapping
+from collections.abc import Callable, Collection, Iterable, Mapping
 from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
@@ -109,7 +109,9 @@ class Node:
     def robot(self) -> str:
         return self.assignment.robot
 
-    def _declare(self, definitions: Definitions, skills, library) -> None:
+    def _declare(
+        self, definitions: Definitions, skills: Collection[str], library: Library | None
+    ) -> None:
         """Writers and readers for every signal of this robot's pool, and which of them
         must be matched before the robot starts (those another pool uses too)."""
         publishers, subscribers = endpoints(definitions, skills=skills, library=library)

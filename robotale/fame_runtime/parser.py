@@ -20,6 +20,7 @@ from lxml import etree
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.javascript import looks_like_javascript
+from robotale.fame_runtime.kinds import FLOW_NODES, SCOPES, EventKind, Kind, LoopKind, event_kind
 from robotale.fame_runtime.model import (
     JAVASCRIPT,
     PYTHON,
@@ -38,19 +39,11 @@ from robotale.fame_runtime.model import (
 )
 from robotale.fame_runtime.qos import policy_name, qos_from_policies
 from robotale.fame_runtime.timers import KINDS as TIMER_KINDS
-from robotale.fame_runtime.timers import parse_timer
+from robotale.fame_runtime.timers import TimerSpec, parse_timer
 
 BPMN_NS = "http://www.omg.org/spec/BPMN/20100524/MODEL"
 _B = f"{{{BPMN_NS}}}"
 
-EVENTS = ("startEvent", "endEvent", "intermediateCatchEvent", "intermediateThrowEvent")
-EVENTS += ("boundaryEvent", "implicitThrowEvent")
-ACTIVITIES = ("task", "scriptTask", "callActivity", "subProcess", "transaction")
-ACTIVITIES += ("adHocSubProcess", "userTask", "serviceTask", "sendTask", "receiveTask")
-ACTIVITIES += ("manualTask", "businessRuleTask")
-GATEWAYS = ("exclusiveGateway", "parallelGateway", "inclusiveGateway", "eventBasedGateway")
-GATEWAYS += ("complexGateway",)
-FLOW_NODES = frozenset(EVENTS + ACTIVITIES + GATEWAYS)
 
 #: what a data association may also point at in valid BPMN; the engine moves no data there
 _NOT_DATA_OBJECTS = frozenset(
@@ -80,7 +73,6 @@ _READ_EXTENSIONS = frozenset(
         "qos",
     )
 )
-SCOPES = frozenset(("subProcess", "transaction", "adHocSubProcess"))
 
 
 def parse(path: str | Path) -> Definitions:
@@ -114,7 +106,7 @@ def parse_all_bytes(data: bytes, file: str | Path = "<string>") -> Definitions:
     root = _xml_root(data, file)
     definitions = _Reader(file).definitions(root)
     definitions.positions = _positions(data)
-    definitions.problems = [_placed(p, definitions.positions) for p in definitions.problems]
+    definitions.problems = [definitions.placed(p) for p in definitions.problems]
     return definitions
 
 
@@ -122,10 +114,10 @@ def raise_problems(definitions: Definitions) -> None:
     """One ModelError listing every reading problem of ``definitions`` (none: nothing)."""
     found = definitions.problems
     if len(found) == 1:
-        raise ModelError(str(found[0]))
+        raise ModelError(str(found[0]), problems=found)
     if found:
         lines = "\n".join(str(p) for p in found)
-        raise ModelError(f"{definitions.file}: {len(found)} problems:\n{lines}")
+        raise ModelError(f"{definitions.file}: {len(found)} problems:\n{lines}", problems=found)
 
 
 def _positions(data: bytes) -> dict[str, tuple[int, int]]:
@@ -144,14 +136,6 @@ def _positions(data: bytes) -> dict[str, tuple[int, int]]:
     with contextlib.suppress(expat.ExpatError):
         reader.Parse(data, True)
     return positions
-
-
-def _placed(problem: Problem, positions: dict[str, tuple[int, int]]) -> Problem:
-    """``problem`` with its element's column, when the element starts on its line."""
-    line, column = positions.get(problem.element, (0, 0))
-    if problem.column or line != problem.line:
-        return problem
-    return Problem(problem.file, problem.line, problem.element, problem.sentence, column)
 
 
 def one_line(text: str | None) -> str:
@@ -184,8 +168,7 @@ class ReadError(ModelError):
     """A file that is no BPMN at all (not XML, another root): its one problem as data."""
 
     def __init__(self, problem: Problem) -> None:
-        super().__init__(str(problem))
-        self.problems = [problem]
+        super().__init__(str(problem), problems=[problem])
 
 
 def _local(element: etree._Element) -> str:
@@ -194,7 +177,7 @@ def _local(element: etree._Element) -> str:
 
 
 def _bpmn_children(element: etree._Element, name: str) -> list[etree._Element]:
-    return element.findall(f"{_B}{name}")
+    return list(element.findall(f"{_B}{name}"))
 
 
 def _text(element: etree._Element | None) -> str:
@@ -328,7 +311,7 @@ class _Reader:
         return process
 
     def required_id(self, element: etree._Element) -> str:
-        identifier = element.get("id")
+        identifier: str = element.get("id") or ""
         if not identifier:
             identifier = f"<{_local(element)} on line {element.sourceline}>"
             self.problem(
@@ -340,7 +323,7 @@ class _Reader:
         for child in element:
             kind = _local(child)
             if kind in FLOW_NODES:
-                node = self.node(child, kind, process)
+                node = self.node(child, Kind(kind), process)
                 scope.nodes[node.id] = node
             elif kind == "sequenceFlow":
                 flow = self.flow(child)
@@ -368,7 +351,7 @@ class _Reader:
         for flow_id in [f.id for f in scope.flows.values() if not _joined(f, scope)]:
             del scope.flows[flow_id]  # reported above; the rest of the file is still read
         for node in scope.nodes.values():
-            if node.kind == "boundaryEvent" and node.attached_to not in scope.nodes:
+            if node.kind == Kind.BOUNDARY_EVENT and node.attached_to not in scope.nodes:
                 self.problem(
                     node.line,
                     f"boundary event {node.id} is attached to {node.attached_to or 'nothing'}, "
@@ -380,7 +363,7 @@ class _Reader:
     def unconditioned_choices(self, scope: Scope) -> None:
         """An exclusive gateway with several unconditioned flows takes the first: say so."""
         for node in scope.nodes.values():
-            if node.kind != "exclusiveGateway":
+            if node.kind != Kind.EXCLUSIVE_GATEWAY:
                 continue
             bare = [
                 f.id
@@ -397,7 +380,7 @@ class _Reader:
     def compensation_handlers(self, scope: Scope) -> None:
         """A compensation boundary event names its handler by an association (10.6.5)."""
         for node in scope.nodes.values():
-            if node.kind != "boundaryEvent" or node.event_kind != "compensate":
+            if node.kind != Kind.BOUNDARY_EVENT or node.event_kind != EventKind.COMPENSATE:
                 continue
             targets = [t for t in self.associations.get(node.id, ()) if t in scope.nodes]
             handlers = [t for t in targets if scope.nodes[t].for_compensation]
@@ -430,7 +413,7 @@ class _Reader:
                         node.id,
                     )
 
-    def node(self, element: etree._Element, kind: str, process: Process) -> Node:
+    def node(self, element: etree._Element, kind: Kind, process: Process) -> Node:
         node = Node(
             id=self.required_id(element),
             kind=kind,
@@ -444,20 +427,24 @@ class _Reader:
             triggered_by_event=element.get("triggeredByEvent") == "true",
         )
         node.events = [self.event_definition(d, node) for d in element if _is_definition(d)]
-        if kind in ("sendTask", "receiveTask"):  # its message, like a message event's
+        if kind in (Kind.SEND_TASK, Kind.RECEIVE_TASK):  # its message, like a message event's
             ref = _ref(element, "messageRef")
-            node.events = [EventDefinition("message", ref, self.messages.get(ref, ""))]
+            node.events = [EventDefinition(EventKind.MESSAGE, ref, self.messages.get(ref, ""))]
         self.data_associations(element, node)
         self.markers(element, node)
         extensions = _Extensions(element.find(f"{_B}extensionElements"))
         for ignored in extensions.ignored:
             self.warn(node.line, f"{kind} {node.describe()}: {ignored} is ignored (not run)")
         node.inputs, node.outputs = extensions.inputs, extensions.outputs
-        if node.events and node.events[0].kind in ("signal", "error", "message"):
+        if node.events and node.events[0].kind in (
+            EventKind.SIGNAL,
+            EventKind.ERROR,
+            EventKind.MESSAGE,
+        ):
             node.message = self.ros_message(extensions, element, node)
-        if kind == "scriptTask":
+        if kind == Kind.SCRIPT_TASK:
             node.script = self.script(element, node)
-        if kind == "callActivity" and extensions.embedded_process:
+        if kind == Kind.CALL_ACTIVITY and extensions.embedded_process:
             node.embedded_process = self.embedded_process(extensions.embedded_process, element)
         if kind in SCOPES:
             node.scope = Scope()
@@ -482,7 +469,7 @@ class _Reader:
                 node.id,
             )
         return Loop(
-            "standard",
+            LoopKind.STANDARD,
             condition=self.loop_expression(element, "loopCondition", node),
             test_before=element.get("testBefore") == "true",
             maximum=_int_or_none(maximum),
@@ -496,7 +483,7 @@ class _Reader:
         collection = _text(element.find(f"{_B}loopDataInputRef"))
         collection = collection or _unwrap(element.get(_CAMUNDA + "collection") or "")
         loop = Loop(
-            "sequential" if element.get("isSequential") == "true" else "parallel",
+            LoopKind.SEQUENTIAL if element.get("isSequential") == "true" else LoopKind.PARALLEL,
             cardinality=self.loop_expression(element, "loopCardinality", node),
             collection=collection,
             element=_item_name(item) or (element.get(_CAMUNDA + "elementVariable") or ""),
@@ -506,7 +493,7 @@ class _Reader:
         )
         return loop  # without cardinality or collection it is valid BPMN the deployer refuses
 
-    def loop_expression(self, element: etree._Element, name: str, node: Node):
+    def loop_expression(self, element: etree._Element, name: str, node: Node) -> Expression | None:
         """``loopCardinality``, ``loopCondition`` or ``completionCondition``; Camunda's
         ``${...}`` wrapping is taken off (the expression inside is what runs)."""
         child = element.find(f"{_B}{name}")
@@ -521,31 +508,31 @@ class _Reader:
 
     def event_definition(self, element: etree._Element, node: Node) -> EventDefinition:
         kind = _local(element).removesuffix("EventDefinition")
-        if kind == "signal":
+        if kind == EventKind.SIGNAL:
             ref = _ref(element, "signalRef")
-            return EventDefinition("signal", ref, self.signals.get(ref, ""))
-        if kind == "error":
+            return EventDefinition(EventKind.SIGNAL, ref, self.signals.get(ref, ""))
+        if kind == EventKind.ERROR:
             ref = _ref(element, "errorRef")
-            return EventDefinition("error", ref, self.errors.get(ref, ""))
-        if kind == "timer":
-            return EventDefinition("timer", timer=self.timer(element, node))
-        if kind == "message":
+            return EventDefinition(EventKind.ERROR, ref, self.errors.get(ref, ""))
+        if kind == EventKind.TIMER:
+            return EventDefinition(EventKind.TIMER, timer=self.timer(element, node))
+        if kind == EventKind.MESSAGE:
             ref = _ref(element, "messageRef")
-            return EventDefinition("message", ref, self.messages.get(ref, ""))
-        if kind == "compensate":
+            return EventDefinition(EventKind.MESSAGE, ref, self.messages.get(ref, ""))
+        if kind == EventKind.COMPENSATE:
             wait = element.get("waitForCompletion", "true") != "false"
-            return EventDefinition("compensate", _ref(element, "activityRef"), wait=wait)
-        if kind == "escalation":
+            return EventDefinition(EventKind.COMPENSATE, _ref(element, "activityRef"), wait=wait)
+        if kind == EventKind.ESCALATION:
             ref = _ref(element, "escalationRef")
-            return EventDefinition("escalation", ref, self.escalations.get(ref, ""))
-        if kind == "conditional":
+            return EventDefinition(EventKind.ESCALATION, ref, self.escalations.get(ref, ""))
+        if kind == EventKind.CONDITIONAL:
             condition = element.find(f"{_B}condition")
             text = _text(condition)
             expression = self.expression(condition, text, node.id) if text else None
-            return EventDefinition("conditional", condition=expression)
-        return EventDefinition(kind, _ref(element, "messageRef"))
+            return EventDefinition(EventKind.CONDITIONAL, condition=expression)
+        return EventDefinition(event_kind(kind), _ref(element, "messageRef"))
 
-    def timer(self, element: etree._Element, node: Node):
+    def timer(self, element: etree._Element, node: Node) -> TimerSpec | None:
         for child in element:
             if _local(child) in TIMER_KINDS:
                 if not _text(child):

@@ -12,11 +12,22 @@ from __future__ import annotations
 import re
 from collections.abc import Collection
 from dataclasses import dataclass, field
+from typing import Literal, TypeVar
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.expressions import Compiled, compile_condition, compile_script
-from robotale.fame_runtime.labels import (
+from robotale.fame_runtime.kinds import (
+    ACTIVITIES,
+    EVENTS,
+    GATEWAYS,
+    HANDLER_TRIGGERS,
     MESSAGE_TASKS,
+    EventKind,
+    Kind,
+    LoopKind,
+    Run,
+)
+from robotale.fame_runtime.labels import (
     catches,
     element_label,
     error_name,
@@ -42,23 +53,26 @@ from robotale.fame_runtime.splitter import namespace
 from robotale.fame_runtime.timers import TimerSpec
 
 EMPTY_MSGTYPE = "std_msgs/msg/Empty"
+_T = TypeVar("_T")
 
 #: what a robot runs instead of a task kind it does not run
 _TASKS = "a task, script task, send or receive task, or a call activity bound to a skill"
 
 #: elements of BPMN the engine does not run, why, and what it would run instead
 OUTSIDE = {
-    "userTask": f"needs a person (robotale runs {_TASKS})",
-    "manualTask": f"needs a person (robotale runs {_TASKS})",
-    "serviceTask": "is a service call (use a call activity bound to a skill)",
-    "businessRuleTask": f"needs a rule engine (robotale runs {_TASKS})",
-    "transaction": "is a transaction (robotale runs a plain sub-process)",
-    "adHocSubProcess": "is an ad-hoc sub-process (robotale runs a plain sub-process)",
-    "complexGateway": (
+    Kind.USER_TASK: f"needs a person (robotale runs {_TASKS})",
+    Kind.MANUAL_TASK: f"needs a person (robotale runs {_TASKS})",
+    Kind.SERVICE_TASK: "is a service call (use a call activity bound to a skill)",
+    Kind.BUSINESS_RULE_TASK: f"needs a rule engine (robotale runs {_TASKS})",
+    Kind.TRANSACTION: "is a transaction (robotale runs a plain sub-process)",
+    Kind.AD_HOC_SUB_PROCESS: "is an ad-hoc sub-process (robotale runs a plain sub-process)",
+    Kind.COMPLEX_GATEWAY: (
         "is a complex gateway (robotale runs exclusive, parallel, inclusive and event-based "
         "gateways)"
     ),
-    "implicitThrowEvent": "is an implicit throw event (robotale runs intermediate throw events)",
+    Kind.IMPLICIT_THROW_EVENT: (
+        "is an implicit throw event (robotale runs intermediate throw events)"
+    ),
 }
 
 _ROLES = {
@@ -66,28 +80,47 @@ _ROLES = {
     "event_start": "event sub-process start event",
     "sub_start": "sub-process start event",
     "called_start": "called process start event",
-    "intermediateCatchEvent": "catching intermediate event",
-    "intermediateThrowEvent": "throwing intermediate event",
-    "endEvent": "end event",
-    "boundaryEvent": "boundary event",
+    Kind.INTERMEDIATE_CATCH_EVENT: "catching intermediate event",
+    Kind.INTERMEDIATE_THROW_EVENT: "throwing intermediate event",
+    Kind.END_EVENT: "end event",
+    Kind.BOUNDARY_EVENT: "boundary event",
 }
 
-#: what may interrupt or start handling from outside: an event sub-process's start and a
-#: boundary event take the same triggers
-_HANDLER_TRIGGERS = frozenset(
-    {"signal", "timer", "conditional", "error", "message", "escalation", "compensate"}
-)
-
 #: the event kinds each kind of event may have ("none" = no event definition)
-ALLOWED = {
-    "start": {"none", "signal", "timer", "conditional", "message"},
-    "event_start": _HANDLER_TRIGGERS,
-    "sub_start": {"none"},
-    "called_start": {"none"},
-    "intermediateCatchEvent": {"signal", "timer", "conditional", "message"},
-    "intermediateThrowEvent": {"none", "signal", "message", "escalation", "compensate"},
-    "endEvent": {"none", "terminate", "signal", "error", "message", "escalation", "compensate"},
-    "boundaryEvent": _HANDLER_TRIGGERS,
+ALLOWED: dict[str, frozenset[EventKind] | set[EventKind]] = {
+    "start": {
+        EventKind.NONE,
+        EventKind.SIGNAL,
+        EventKind.TIMER,
+        EventKind.CONDITIONAL,
+        EventKind.MESSAGE,
+    },
+    "event_start": HANDLER_TRIGGERS,
+    "sub_start": {EventKind.NONE},
+    "called_start": {EventKind.NONE},
+    Kind.INTERMEDIATE_CATCH_EVENT: {
+        EventKind.SIGNAL,
+        EventKind.TIMER,
+        EventKind.CONDITIONAL,
+        EventKind.MESSAGE,
+    },
+    Kind.INTERMEDIATE_THROW_EVENT: {
+        EventKind.NONE,
+        EventKind.SIGNAL,
+        EventKind.MESSAGE,
+        EventKind.ESCALATION,
+        EventKind.COMPENSATE,
+    },
+    Kind.END_EVENT: {
+        EventKind.NONE,
+        EventKind.TERMINATE,
+        EventKind.SIGNAL,
+        EventKind.ERROR,
+        EventKind.MESSAGE,
+        EventKind.ESCALATION,
+        EventKind.COMPENSATE,
+    },
+    Kind.BOUNDARY_EVENT: HANDLER_TRIGGERS,
 }
 _SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
 
@@ -96,7 +129,7 @@ _SAFE_STATE = re.compile(r"safe[\s_-]*state", re.IGNORECASE)
 class Trigger:
     """What a catching event waits for (a message is a signal on its receiver's topic)."""
 
-    kind: str  # signal | timer | conditional | error | escalation
+    kind: EventKind  # signal | timer | conditional | error | escalation | compensate
     label: str  # the activity its tags carry
     topic: str = ""  # signal: /name; error: the robot-relative name ("" catches any error)
     msgtype: str = ""
@@ -109,7 +142,7 @@ class Trigger:
 class Throw:
     """What a throwing event publishes or raises."""
 
-    kind: str  # signal | message | error | escalation | compensate
+    kind: EventKind  # signal | message | error | escalation | compensate
     label: str
     topic: str  # compensate: the activity to compensate ("" every completed one)
     msgtype: str = EMPTY_MSGTYPE
@@ -128,7 +161,7 @@ class FlowPlan:
 @dataclass(slots=True, eq=False)
 class NodePlan:
     node: Node
-    behaviour: str  # how the engine runs it; see Engine._BEHAVIOURS
+    behaviour: Run | Literal[""]  # how the engine runs it (behaviours.BEHAVIOURS); "": refused
     label: str
     scope: ScopePlan
     outgoing: list[FlowPlan] = field(default_factory=list)
@@ -148,6 +181,29 @@ class NodePlan:
     @property
     def id(self) -> str:
         return self.node.id
+
+    # What the deployer gives every node of a kind, for the readers that know the kind: a
+    # node plan of another kind has none (an AttributeError naming the field).
+
+    @property
+    def content(self) -> ScopePlan:
+        """A call activity's or sub-process's ``child``."""
+        return _given(self, "child", self.child)
+
+    @property
+    def looping(self) -> LoopPlan:
+        """A loop node's ``loop``."""
+        return _given(self, "loop", self.loop)
+
+    @property
+    def caught(self) -> Trigger:
+        """A catching event's (or receive task's) ``trigger``."""
+        return _given(self, "trigger", self.trigger)
+
+    @property
+    def thrown(self) -> Throw:
+        """A throwing event's (or send task's) ``throw``."""
+        return _given(self, "throw", self.throw)
 
 
 @dataclass(slots=True, eq=False)
@@ -191,7 +247,8 @@ def deploy(
         file = f"{process.file}: " if process.file else ""
         raise ModelError(
             f"{file}the engine cannot run process {process.describe()}: "
-            + "; ".join(f"{p.sentence} (line {p.line})" for p in planner.found)
+            + "; ".join(f"{p.sentence} (line {p.line})" for p in planner.found),
+            problems=_placed(process, planner.found),
         )
     return plan
 
@@ -209,7 +266,7 @@ def findings(
     """What :func:`deploy` would refuse in ``process``, with file, line and element id."""
     planner = _Planner(skills, library)
     planner.process(process, top=True)
-    return planner.found
+    return _placed(process, planner.found)
 
 
 def speaks_javascript(plan: ScopePlan) -> bool:
@@ -303,7 +360,9 @@ class _Planner:
         self.file = outer_file
         return plan
 
-    def scope(self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False):
+    def scope(
+        self, scope: Scope, plan: ScopePlan, *, top: bool = False, event: bool = False
+    ) -> None:
         for node in scope.nodes.values():
             plan.nodes[node.id] = NodePlan(node, "", "", plan)
         for node_plan in plan.nodes.values():
@@ -338,20 +397,20 @@ class _Planner:
 
     def gateway(self, plan: NodePlan) -> None:
         node = plan.node
-        if node.kind.endswith("Gateway") and not plan.outgoing:
+        if node.kind in GATEWAYS and not plan.outgoing:
             self.refuse(node, "has no outgoing sequence flow (give it at least one)")
-        if node.kind == "eventBasedGateway":
+        if node.kind == Kind.EVENT_BASED_GATEWAY:
             for flow in plan.outgoing:
                 target = flow.target.node
-                if target.kind != "intermediateCatchEvent":
+                if target.kind != Kind.INTERMEDIATE_CATCH_EVENT:
                     self.refuse(
                         node,
                         f"leads to {target.describe()}, which is no catching event (an "
                         "event-based gateway leads to intermediate catch events)",
                     )
-        if node.kind.startswith("start") and plan.incoming:
+        if node.kind == Kind.START_EVENT and plan.incoming:
             self.refuse(node, "has incoming sequence flows (a start event has none)")
-        if node.kind == "endEvent" and plan.outgoing:
+        if node.kind == Kind.END_EVENT and plan.outgoing:
             self.refuse(node, "has outgoing sequence flows (an end event has none)")
 
     def compensation(self, plan: NodePlan, scope: ScopePlan) -> None:
@@ -364,7 +423,7 @@ class _Planner:
                 "is a compensation handler (isForCompensation) with sequence flows: it runs "
                 "only when its activity is compensated (remove its incoming and outgoing flows)",
             )
-        if node.kind != "boundaryEvent" or node.event_kind != "compensate":
+        if node.kind != Kind.BOUNDARY_EVENT or node.event_kind != EventKind.COMPENSATE:
             return
         handler = scope.nodes.get(node.compensation_handler)
         if handler is not None and node.attached_to in scope.nodes:
@@ -389,17 +448,16 @@ class _Planner:
         if len(node.events) > 1:
             self.refuse(node, "has several event definitions (robotale runs events with one)")
             return
-        if node.kind.endswith("Event"):
+        if node.kind in EVENTS:
             self.event(plan, scope, top=top, event=event)
         else:
             self.activity(plan, scope)
         if node.loop is not None:
-            self.looped(plan)
+            self.looped(plan, node.loop)
 
-    def looped(self, plan: NodePlan) -> None:
+    def looped(self, plan: NodePlan, loop: Loop) -> None:
         """The activity becomes a loop around a copy of itself (its body): the loop owns the
         outgoing flows and the boundary events, the body runs once per instance."""
-        loop = plan.node.loop
         body = NodePlan(
             plan.node,
             plan.behaviour,
@@ -422,48 +480,48 @@ class _Planner:
                 setattr(looped, name, compile_condition(expression))
             except ValueError as error:
                 self.refuse(plan.node, f"has a loop {name} the engine cannot run: {error}")
-        if loop.kind == "standard" and loop.condition is None and loop.maximum is None:
+        if loop.kind == LoopKind.STANDARD and loop.condition is None and loop.maximum is None:
             self.refuse(
                 plan.node,
                 "has a standard loop without loopCondition or loopMaximum (give one, e.g. "
                 'loopMaximum="5")',
             )
-        if loop.kind != "standard" and loop.cardinality is None and not loop.collection:
+        if loop.kind != LoopKind.STANDARD and loop.cardinality is None and not loop.collection:
             self.refuse(
                 plan.node,
                 "has a multi-instance marker with neither a loopCardinality nor a collection "
                 "(loopDataInputRef or camunda:collection), so robotale cannot tell how many "
                 "instances to run: give one, e.g. <bpmn:loopCardinality>3</bpmn:loopCardinality>",
             )
-        plan.behaviour, plan.loop = "loop", looped
+        plan.behaviour, plan.loop = Run.LOOP, looped
 
     def activity(self, plan: NodePlan, scope: ScopePlan) -> None:
         node = plan.node
-        if node.kind.endswith("Gateway"):
-            plan.behaviour = node.kind
-        elif node.kind == "task":
-            plan.behaviour = "task"
-        elif node.kind == "scriptTask":
-            plan.behaviour = "script"
+        if node.kind in GATEWAYS:
+            plan.behaviour = Run(node.kind)
+        elif node.kind == Kind.TASK:
+            plan.behaviour = Run.TASK
+        elif node.kind == Kind.SCRIPT_TASK:
+            plan.behaviour = Run.SCRIPT
             try:
                 plan.script = compile_script(node.script) if node.script else None
             except ValueError as error:
                 self.refuse(node, f"has a script that cannot run: {error}")
         elif node.kind in MESSAGE_TASKS:
             self.message_task(plan)
-        elif node.kind == "callActivity":
+        elif node.kind == Kind.CALL_ACTIVITY:
             self.call(plan)
-        elif node.kind == "subProcess":
+        elif node.kind == Kind.SUB_PROCESS:
             self.subprocess(plan, scope)
 
     def message_task(self, plan: NodePlan) -> None:
         """A send task publishes like a message throw event, a receive task waits like a
         message catch event; both are tagged by their own name."""
-        if plan.node.kind == "sendTask":
-            plan.behaviour = "pass"
+        if plan.node.kind == Kind.SEND_TASK:
+            plan.behaviour = Run.PASS
             plan.throw = self.message_throw(plan)
         else:
-            plan.behaviour = "catch"
+            plan.behaviour = Run.CATCH
             plan.trigger = self.trigger(plan)
 
     def message_throw(self, plan: NodePlan) -> Throw | None:
@@ -483,7 +541,7 @@ class _Planner:
             self.refuse(node, self.no_message(node))
         message = node.message or RosMessage()
         msgtype = message.msgtype or EMPTY_MSGTYPE
-        return Throw("message", plan.label, topic, msgtype, message.payload, message.qos)
+        return Throw(EventKind.MESSAGE, plan.label, topic, msgtype, message.payload, message.qos)
 
     def no_message(self, node: Node) -> str:
         """Why a message event or task has no topic: a messageRef to nothing, or no name."""
@@ -503,7 +561,7 @@ class _Planner:
         node = plan.node
         name = node.called_element
         if name and name in self.skills:
-            plan.behaviour, plan.skill = "skill", name
+            plan.behaviour, plan.skill = Run.SKILL, name
             return
         process = node.embedded_process or resolve_call(name, plan.scope.process, self.library)
         definitions = plan.scope.process.definitions
@@ -526,7 +584,7 @@ class _Planner:
             )
             self.refuse(node, what)
             return
-        plan.behaviour = "call"
+        plan.behaviour = Run.CALL
         plan.child = self.process(process)
 
     def subprocess(self, plan: NodePlan, scope: ScopePlan) -> None:
@@ -534,10 +592,10 @@ class _Planner:
         child = ScopePlan(scope.process)
         plan.child = child
         if node.triggered_by_event:
-            plan.behaviour = "event_subprocess"
+            plan.behaviour = Run.EVENT_SUBPROCESS
             scope.event_subprocesses.append(plan)
         else:
-            plan.behaviour = "subprocess"
+            plan.behaviour = Run.SUBPROCESS
         self.scope(node.scope or Scope(), child, event=node.triggered_by_event)
         if node.triggered_by_event and len(child.triggered_starts) != 1:
             found = len(child.triggered_starts) or "no"
@@ -547,7 +605,10 @@ class _Planner:
                 "exactly one (a signal, timer, conditional, error, message, escalation or "
                 "compensation start event)",
             )
-        elif node.triggered_by_event and child.triggered_starts[0].node.event_kind == "compensate":
+        elif (
+            node.triggered_by_event
+            and child.triggered_starts[0].node.event_kind == EventKind.COMPENSATE
+        ):
             scope.compensation_handler = plan
         if not node.triggered_by_event and len(child.starts) > 1:
             self.refuse(
@@ -560,8 +621,8 @@ class _Planner:
 
     def event(self, plan: NodePlan, scope: ScopePlan, *, top: bool, event: bool) -> None:
         node = plan.node
-        role = node.kind
-        if node.kind == "startEvent":
+        role: str = node.kind
+        if node.kind == Kind.START_EVENT:
             role = "start" if top else ("event_start" if event else "sub_start")
             if role == "sub_start" and self.called.get(id(scope.process)) is scope:
                 role = "called_start"  # the called process itself, not a sub-process of it
@@ -580,24 +641,24 @@ class _Planner:
 
     def catching(self, plan: NodePlan, scope: ScopePlan) -> None:
         node = plan.node
-        if node.kind == "boundaryEvent" and node.event_kind == "compensate":
-            plan.behaviour = "boundary"  # never armed: compensation runs its handler instead
+        if node.kind == Kind.BOUNDARY_EVENT and node.event_kind == EventKind.COMPENSATE:
+            plan.behaviour = Run.BOUNDARY  # never armed: compensation runs its handler instead
             return
-        if node.kind == "boundaryEvent":
-            plan.behaviour = "boundary"
+        if node.kind == Kind.BOUNDARY_EVENT:
+            plan.behaviour = Run.BOUNDARY
             host = scope.nodes.get(node.attached_to)
-            if host is None or host.node.kind.endswith(("Event", "Gateway")):
+            if host is None or host.node.kind not in ACTIVITIES:
                 self.refuse(node, "is attached to something that is no activity (attach it to one)")
             else:
                 host.boundaries.append(plan)
-            if node.event_kind == "error" and not node.cancel_activity:
+            if node.event_kind == EventKind.ERROR and not node.cancel_activity:
                 self.refuse(node, "is a non-interrupting error event (errors always interrupt)")
         else:
-            plan.behaviour = "start" if node.kind == "startEvent" else "catch"
-        if node.kind == "startEvent" and node.event_kind == "none":
+            plan.behaviour = Run.START if node.kind == Kind.START_EVENT else Run.CATCH
+        if node.kind == Kind.START_EVENT and node.event_kind == EventKind.NONE:
             scope.starts.append(plan)
             return
-        if node.kind == "startEvent":
+        if node.kind == Kind.START_EVENT:
             scope.triggered_starts.append(plan)
         plan.trigger = self.trigger(plan)
 
@@ -605,22 +666,22 @@ class _Planner:
         node = plan.node
         kind = node.event_kind
         message = node.message or RosMessage()
-        if kind == "signal":
+        if kind == EventKind.SIGNAL:
             topic = signal_topic(node)
             if not topic:
                 self.refuse(node, "names no signal (give the event or its signal a name)")
-            return Trigger("signal", plan.label, topic, message.msgtype, message.qos)
-        if kind == "error":
+            return Trigger(EventKind.SIGNAL, plan.label, topic, message.msgtype, message.qos)
+        if kind == EventKind.ERROR:
             name = error_name(node)
-            return Trigger("error", plan.label, name, EMPTY_MSGTYPE, message.qos)
-        if kind == "message":
+            return Trigger(EventKind.ERROR, plan.label, name, EMPTY_MSGTYPE, message.qos)
+        if kind == EventKind.MESSAGE:
             topic = message_topic(self.pool, node)
             if not topic:
                 self.refuse(node, self.no_message(node))
-            return Trigger("signal", plan.label, topic, message.msgtype, message.qos)
-        if kind == "escalation":
-            return Trigger("escalation", plan.label, escalation_name(node))
-        if kind == "timer":
+            return Trigger(EventKind.SIGNAL, plan.label, topic, message.msgtype, message.qos)
+        if kind == EventKind.ESCALATION:
+            return Trigger(EventKind.ESCALATION, plan.label, escalation_name(node))
+        if kind == EventKind.TIMER:
             timer = node.event.timer if node.event else None
             if timer is None:
                 self.refuse(
@@ -628,9 +689,9 @@ class _Planner:
                     "is a timer without a date, duration or cycle (give a timeDate, "
                     "timeDuration or timeCycle with a value, e.g. PT10S)",
                 )
-            return Trigger("timer", plan.label, timer=timer)
-        if kind == "compensate":  # an event sub-process's start: run by compensation only
-            return Trigger("compensate", plan.label)
+            return Trigger(EventKind.TIMER, plan.label, timer=timer)
+        if kind == EventKind.COMPENSATE:  # an event sub-process's start: run by compensation only
+            return Trigger(EventKind.COMPENSATE, plan.label)
         return self.conditional(plan)
 
     def conditional(self, plan: NodePlan) -> Trigger | None:
@@ -644,7 +705,9 @@ class _Planner:
             )
             return None
         try:
-            return Trigger("conditional", plan.label, condition=compile_condition(expression))
+            return Trigger(
+                EventKind.CONDITIONAL, plan.label, condition=compile_condition(expression)
+            )
         except ValueError as error:
             self.refuse(node, f"has a condition the engine cannot run: {error}")
             return None
@@ -652,24 +715,26 @@ class _Planner:
     def throwing(self, plan: NodePlan) -> None:
         node = plan.node
         kind = node.event_kind
-        if node.kind == "endEvent":
-            plan.behaviour = {"none": "end", "terminate": "terminate"}.get(kind, "end")
+        if node.kind == Kind.END_EVENT:
+            plan.behaviour = Run.TERMINATE if kind == EventKind.TERMINATE else Run.END
         else:
-            plan.behaviour = "pass"
+            plan.behaviour = Run.PASS
         message = node.message or RosMessage()
-        if kind == "signal":
+        if kind == EventKind.SIGNAL:
             topic = signal_topic(node)
             if not topic:
                 self.refuse(node, "names no signal (give the event or its signal a name)")
             msgtype = message.msgtype or EMPTY_MSGTYPE
-            plan.throw = Throw("signal", plan.label, topic, msgtype, message.payload, message.qos)
-        elif kind == "error":
-            plan.throw = Throw("error", plan.label, error_name(node))
-        elif kind == "escalation":
-            plan.throw = Throw("escalation", plan.label, escalation_name(node))
-        elif kind == "message":
+            plan.throw = Throw(
+                EventKind.SIGNAL, plan.label, topic, msgtype, message.payload, message.qos
+            )
+        elif kind == EventKind.ERROR:
+            plan.throw = Throw(EventKind.ERROR, plan.label, error_name(node))
+        elif kind == EventKind.ESCALATION:
+            plan.throw = Throw(EventKind.ESCALATION, plan.label, escalation_name(node))
+        elif kind == EventKind.MESSAGE:
             plan.throw = self.message_throw(plan)
-        elif kind == "compensate":
+        elif kind == EventKind.COMPENSATE:
             plan.throw = self.compensation_throw(plan)
 
     def compensation_throw(self, plan: NodePlan) -> Throw:
@@ -678,7 +743,7 @@ class _Planner:
         node = plan.node
         event = node.event
         ref = event.ref if event else ""
-        activities = {n.id for n in plan.scope.process.walk() if not n.kind.endswith("Event")}
+        activities = {n.id for n in plan.scope.process.walk() if n.kind not in EVENTS}
         if ref and ref not in activities:
             self.refuse(
                 node,
@@ -686,7 +751,19 @@ class _Planner:
                 f"{plan.scope.process.describe()} (name an activity beside the event, or none "
                 "to compensate every completed one)",
             )
-        return Throw("compensate", plan.label, ref, wait=event.wait if event else True)
+        return Throw(EventKind.COMPENSATE, plan.label, ref, wait=event.wait if event else True)
+
+
+def _given(plan: NodePlan, name: str, value: _T | None) -> _T:
+    if value is None:
+        raise AttributeError(f"{plan.node.kind} {plan.node.describe()} has no {name}")
+    return value
+
+
+def _placed(process: Process, found: list[Problem]) -> list[Problem]:
+    """``found`` with their elements' columns, where the process's file has them."""
+    definitions = process.definitions
+    return [definitions.placed(p) for p in found] if definitions is not None else found
 
 
 def _implicit_starts(plan: ScopePlan) -> list[NodePlan]:
@@ -697,8 +774,8 @@ def _implicit_starts(plan: ScopePlan) -> list[NodePlan]:
         node
         for node in plan.nodes.values()
         if not node.incoming
-        and node.node.kind not in ("boundaryEvent", "startEvent")
-        and node.behaviour != "event_subprocess"
+        and node.node.kind not in (Kind.BOUNDARY_EVENT, Kind.START_EVENT)
+        and node.behaviour != Run.EVENT_SUBPROCESS
         and not node.node.for_compensation
     ]
 

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass, replace
+from typing import Any
 
 from robotale.fame_runtime.timers import parse_duration
 
@@ -61,7 +62,7 @@ def qos_from_policies(policies: Mapping[str, str]) -> QoS:
     Values are case and spacing tolerant (``Best Effort``); durations are seconds or ISO 8601
     (``PT2S``); ``infinite`` or an empty value keeps the ROS default.
     """
-    fields: dict[str, object] = {}
+    fields: dict[str, Any] = {}  # each policy's value, of its field's type
     for name, text in policies.items():
         key = policy_name(name)
         if key is None:

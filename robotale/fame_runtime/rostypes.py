@@ -17,11 +17,16 @@ from collections.abc import Mapping
 from functools import cache
 from typing import Any
 
-from cyclonedds.idl import make_idl_struct, types
+from cyclonedds.idl import make_idl_struct
+from cyclonedds.idl import types as idl_types
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type
+
+#: cyclonedds' IDL types, made by subscripting (``array[int8, 3]``), which its annotations
+#: do not express
+types: Any = idl_types
 
 _BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4  # rosbags' Nodetype values
 
@@ -62,7 +67,7 @@ def _parts(msgtype: str) -> tuple[str, str, str]:
 
 
 @cache
-def _store():
+def _store() -> Any:  # a rosbags type store: rosbags has no type information
     store = get_typestore(Stores.ROS2_HUMBLE)
     register_tag_type(store)
     if STATUS_TYPE not in store.fielddefs:
@@ -83,10 +88,11 @@ def idl_type(msgtype: str) -> type:
     _, fields = store.fielddefs[msgtype]
     annotations = {name: _field_type(desc) for name, desc in fields}
     class_name = _parts(msgtype)[2] + "_"
-    return make_idl_struct(class_name, dds_type_name(msgtype), annotations)
+    struct: type = make_idl_struct(class_name, dds_type_name(msgtype), annotations)
+    return struct
 
 
-def _field_type(desc) -> Any:
+def _field_type(desc: Any) -> Any:  # a rosbags field description
     kind, rest = desc
     if kind == _NAME:
         return idl_type(rest)
@@ -141,7 +147,7 @@ def _build(msgtype: str, data: Mapping[str, Any], where: str) -> Any:
     return idl_type(msgtype)(**values)
 
 
-def _value(desc, value: Any, where: str) -> Any:
+def _value(desc: Any, value: Any, where: str) -> Any:  # a rosbags field description
     kind, rest = desc
     if kind == _NAME:
         return _build(rest, value if isinstance(value, Mapping) else {}, where)

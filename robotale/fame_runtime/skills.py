@@ -36,7 +36,11 @@ class Robot(Protocol):
     robot_type: str  # its pool: Drone, Tractor
     bus: Bus
     clock: Clock
-    variables: Mapping[str, Any]  # the process variables, read-only for skills
+
+    @property
+    def variables(self) -> Mapping[str, Any]:
+        """The process variables, read-only for skills."""
+        ...
 
     def topic(self, name: str) -> str:
         """``name`` inside the robot's namespace (``odom`` -> ``/tractor_1/odom``)."""
@@ -78,6 +82,7 @@ def _import(module_name: str) -> ModuleType:
     try:
         if path.suffix == ".py" and path.is_file():
             spec = importlib.util.spec_from_file_location(path.stem, path)
+            assert spec is not None and spec.loader is not None  # a .py file has both
             module = importlib.util.module_from_spec(spec)
             spec.loader.exec_module(module)
             return module

@@ -15,8 +15,9 @@ from pathlib import Path
 from lxml import etree
 
 from robotale.errors import ModelError
+from robotale.fame_runtime.kinds import Kind
 from robotale.fame_runtime.library import find_process
-from robotale.fame_runtime.model import Definitions, Participant, Process
+from robotale.fame_runtime.model import Definitions, Participant, Problem, Process
 
 
 @dataclass(frozen=True, slots=True)
@@ -64,24 +65,37 @@ def _binds(pool: Participant, robot: str, pools: list[tuple[Participant, Process
     return pool.multi_instance and not exact and re.fullmatch(pattern, robot.lower()) is not None
 
 
-def _check_count(definitions: Definitions, pool: Participant, robots: list[str], given: bool):
+def _check_count(
+    definitions: Definitions, pool: Participant, robots: list[str], given: bool
+) -> None:
     if not pool.multi_instance:
         if len(robots) > 1:
-            raise ModelError(
-                f"{definitions.file}:{pool.line}: pool {pool.name} is single-instance but "
-                f"robots {', '.join(robots)} all match it"
+            raise _pool_error(
+                definitions,
+                pool,
+                f"pool {pool.name} is single-instance but robots {', '.join(robots)} all match it",
             )
         return
     if pool.maximum is not None and len(robots) > pool.maximum:
-        raise ModelError(
-            f"{definitions.file}:{pool.line}: pool {pool.name} allows at most {pool.maximum} "
-            f"robots, {len(robots)} given ({', '.join(robots)})"
+        raise _pool_error(
+            definitions,
+            pool,
+            f"pool {pool.name} allows at most {pool.maximum} robots, {len(robots)} given "
+            f"({', '.join(robots)})",
         )
     if given and pool.minimum and len(robots) < pool.minimum:
-        raise ModelError(
-            f"{definitions.file}:{pool.line}: pool {pool.name} needs at least {pool.minimum} "
-            f"robot{'s' if pool.minimum > 1 else ''}, {len(robots)} given"
+        raise _pool_error(
+            definitions,
+            pool,
+            f"pool {pool.name} needs at least {pool.minimum} "
+            f"robot{'s' if pool.minimum > 1 else ''}, {len(robots)} given",
         )
+
+
+def _pool_error(definitions: Definitions, pool: Participant, sentence: str) -> ModelError:
+    """``sentence`` about ``pool``, placed at the pool in its file."""
+    problem = definitions.placed(Problem(str(definitions.file), pool.line, pool.id, sentence))
+    return ModelError(str(problem), problems=[problem])
 
 
 def _default_robots(pools: list[tuple[Participant, Process]]) -> list[str]:
@@ -126,7 +140,8 @@ def process_file(assignment: Assignment) -> bytes:
             for part in list(child):
                 if part.get("processRef") != process.id:
                     child.remove(part)  # other pools, message flows between them
-    return etree.tostring(root, xml_declaration=True, encoding="UTF-8")
+    xml: bytes = etree.tostring(root, xml_declaration=True, encoding="UTF-8")
+    return xml
 
 
 def _same_file_calls(process: Process) -> set[str]:
@@ -140,7 +155,7 @@ def _same_file_calls(process: Process) -> set[str]:
         keep.add(current.id)
         for node in current.walk():
             called = find_process(definitions, node.called_element) if definitions else None
-            if node.kind == "callActivity" and called is not None:
+            if node.kind == Kind.CALL_ACTIVITY and called is not None:
                 stack.append(called)
     return keep
 

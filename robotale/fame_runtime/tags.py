@@ -11,12 +11,26 @@ from __future__ import annotations
 import json
 from collections.abc import Callable
 from dataclasses import dataclass
+from enum import StrEnum
+from typing import Any
+
+from robotale.fame_runtime.bus import Bus
+from robotale.fame_runtime.clock import Clock
 
 TAG_TYPE = "robotale_msgs/msg/Tag"
 
-#: the lifecycles of activity tags: started, completed, and ended without completing
-#: (interrupted by a boundary event or an event sub-process, or cancelled)
-START, COMPLETE, ABORT = "start", "complete", "ate_abort"
+
+class Lifecycle(StrEnum):
+    """The lifecycles of activity tags: started, completed, and ended without completing
+    (interrupted by a boundary event or an event sub-process, or cancelled)."""
+
+    START = "start"
+    COMPLETE = "complete"
+    ABORT = "ate_abort"
+
+
+#: the lifecycles as the plain text a tag carries
+START, COMPLETE, ABORT = Lifecycle.START.value, Lifecycle.COMPLETE.value, Lifecycle.ABORT.value
 #: the roles of message tags
 SEND, RECEIVE = "send", "receive"
 
@@ -61,21 +75,30 @@ TagSink = Callable[[Tag], None]
 class Tagger:
     """Tags one robot's events on its clock, and numbers its messages when the bus does not."""
 
-    def __init__(self, robot: str, clock, sink: TagSink | None, bus=None) -> None:
+    def __init__(
+        self, robot: str, clock: Clock, sink: TagSink | None, bus: Bus | None = None
+    ) -> None:
         self.robot, self.clock, self.sink = robot, clock, sink
-        self._bus_ids = getattr(bus, "new_msg_id", None)
+        self._bus_ids: Callable[[], str] | None = getattr(bus, "new_msg_id", None)
         self._count = 0
 
     def __call__(
-        self, activity: str, lifecycle: str, msg_id: str = "", role: str = "", payload: str = ""
+        self,
+        activity: str,
+        lifecycle: Lifecycle,
+        msg_id: str = "",
+        role: str = "",
+        payload: str = "",
     ) -> None:
         if self.sink is not None:
-            self.sink(Tag(self.clock.now(), self.robot, activity, lifecycle, msg_id, role, payload))
+            stamp = self.clock.now()
+            # the plain text: a tag is written to bags and logs as it is
+            self.sink(Tag(stamp, self.robot, activity, lifecycle.value, msg_id, role, payload))
 
     def pair(self, activity: str, msg_id: str = "", role: str = "", payload: str = "") -> None:
         """A start and a complete tag at the same instant (events, messages)."""
-        self(activity, START, msg_id, role, payload)
-        self(activity, COMPLETE, msg_id, role, payload)
+        self(activity, Lifecycle.START, msg_id, role, payload)
+        self(activity, Lifecycle.COMPLETE, msg_id, role, payload)
 
     def new_msg_id(self) -> str:
         """The bus's next message id, or ``m_<robot>_<n>``: robot namespaces are unique in a
@@ -86,7 +109,7 @@ class Tagger:
         return f"m_{self.robot}_{self._count}"
 
 
-def payload_text(data) -> str:
+def payload_text(data: Any) -> str:  # any message: JSON text, else its str
     """A message's data as the JSON text tags carry."""
     return json.dumps(data, default=str, separators=(",", ":"))
 
@@ -96,7 +119,7 @@ def tag_topic(robot: str) -> str:
     return f"/{robot}/tag"
 
 
-def bus_sink(bus) -> TagSink:
+def bus_sink(bus: Bus) -> TagSink:
     """A tag sink that publishes every tag on its robot's ``/<robot>/tag`` topic, where a
     recorder tapping the bus writes it to a bag like any other message."""
 
@@ -106,7 +129,7 @@ def bus_sink(bus) -> TagSink:
     return publish
 
 
-def register_tag_type(typestore) -> None:
+def register_tag_type(typestore: Any) -> None:  # rosbags has no type information
     """Add ``robotale_msgs/msg/Tag`` to a rosbags type store (idempotent)."""
     # rosbags is imported here, by those who read or write bags, not with the module: every
     # engine imports this module, and rosbags would add a fifth (about 30 ms) to its import

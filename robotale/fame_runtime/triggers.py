@@ -23,8 +23,9 @@ from typing import Any
 
 from robotale.errors import ModelError
 from robotale.fame_runtime.bus import Bus, Envelope, Subscription
-from robotale.fame_runtime.clock import Clock
-from robotale.fame_runtime.expressions import substitute
+from robotale.fame_runtime.clock import Clock, Timer
+from robotale.fame_runtime.expressions import Compiled, substitute
+from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import EMPTY_MSGTYPE, Trigger
 from robotale.fame_runtime.timers import parse_timer
 
@@ -39,7 +40,7 @@ def _nothing() -> None:
 class _Watch:
     __slots__ = ("condition", "fire", "last", "names", "order", "repeat")
 
-    def __init__(self, condition, fire: Fire, repeat: bool, order: int) -> None:
+    def __init__(self, condition: Compiled, fire: Fire, repeat: bool, order: int) -> None:
         self.order = order
         self.condition = condition
         self.fire = fire
@@ -86,11 +87,11 @@ class Triggers:
     def arm(
         self, trigger: Trigger, fire: Fire, *, repeat: bool = False, depth: float = 0
     ) -> Disarm:
-        if trigger.kind == "signal":
+        if trigger.kind == EventKind.SIGNAL:
             return self._signal(trigger, fire)
-        if trigger.kind == "timer":
+        if trigger.kind == EventKind.TIMER:
             return self._timer(trigger, fire, repeat)
-        if trigger.kind == "conditional":
+        if trigger.kind == EventKind.CONDITIONAL:
             return self._conditional(trigger, fire, repeat)
         return self._error(trigger, fire, depth)
 
@@ -118,7 +119,7 @@ class Triggers:
             except (ValueError, NameError) as error:
                 raise ModelError(f"timer {trigger.label} of robot {self.robot}: {error}") from None
         times = spec.fire_times(self.clock.now())
-        pending: list = []
+        pending: list[Timer] = []
         key = next(self._order)
 
         def schedule_next() -> None:
@@ -142,6 +143,7 @@ class Triggers:
         return disarm
 
     def _conditional(self, trigger: Trigger, fire: Fire, repeat: bool) -> Disarm:
+        assert trigger.condition is not None  # the deployer compiles every condition
         watch = _Watch(trigger.condition, fire, repeat, next(self._order))
         for name in watch.names:
             self._watches[name].add(watch)
@@ -176,11 +178,14 @@ class Triggers:
         catcher = _Catcher(depth, next(self._order), fire)
         self._catchers[trigger.topic].append(catcher)
         if trigger.topic and trigger.topic not in self._error_topics:
+            name = trigger.topic
+
+            def raised(envelope: Envelope) -> None:
+                self.schedule(lambda: self._error_message(name, envelope))
+
             self._error_topics[trigger.topic] = self.bus.subscribe(
                 f"/{self.robot}/{trigger.topic}",
-                lambda envelope, name=trigger.topic: self.schedule(
-                    lambda: self._error_message(name, envelope)
-                ),
+                raised,
                 msgtype=EMPTY_MSGTYPE,
                 owner=self.robot,
             )

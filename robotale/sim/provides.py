@@ -15,7 +15,8 @@ from collections.abc import Iterable
 from dataclasses import dataclass
 
 from robotale.errors import ModelError
-from robotale.fame_runtime.labels import THROWING, catches, signal_topic
+from robotale.fame_runtime.kinds import THROWING, EventKind, Kind
+from robotale.fame_runtime.labels import catches, signal_topic
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import JAVASCRIPT, Definitions, Process
 from robotale.fame_runtime.splitter import split
@@ -98,7 +99,7 @@ def needs(
         for _, pool in definitions.pools()
         for process in _with_blocks(pool, library)
         for node in process.walk()
-        if node.event_kind == "signal" and node.kind in THROWING
+        if node.event_kind == EventKind.SIGNAL and node.kind in THROWING
     }
     try:
         assignments = split(definitions, robots)
@@ -108,7 +109,7 @@ def needs(
         for process in _with_blocks(assignment.process, library):
             for node in process.walk():
                 yield from _script_needs(node, assignment.robot)
-                topic = signal_topic(node) if node.event_kind == "signal" else ""
+                topic = signal_topic(node) if node.event_kind == EventKind.SIGNAL else ""
                 if topic and catches(node) and topic not in thrown:
                     msgtype = node.message.msgtype if node.message else "std_msgs/msg/Empty"
                     by = f"{node.kind} {node.describe()}"
@@ -136,7 +137,7 @@ def _with_blocks(process: Process, library: Library | None) -> list[Process]:
             continue
         found[id(current)] = current
         for node in current.walk():
-            if node.kind == "callActivity" and node.called_element:
+            if node.kind == Kind.CALL_ACTIVITY and node.called_element:
                 called = resolve_call(node.called_element, current, library)
                 if called is not None:
                     waiting.append(called)

@@ -22,7 +22,8 @@ from typing import Any
 
 from robotale.fame_runtime.bus import InProcessBus, Network
 from robotale.fame_runtime.clock import SimClock
-from robotale.fame_runtime.labels import THROWING, error_name, signal_topic
+from robotale.fame_runtime.kinds import THROWING, EventKind, Kind
+from robotale.fame_runtime.labels import error_name, signal_topic
 from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.manifest import RunManifest, write_manifest
 from robotale.fame_runtime.mission import Mission
@@ -217,9 +218,9 @@ def model_topics(definitions: Definitions) -> tuple[dict[str, str], set[str]]:
     errors: set[str] = set()
     for _, process in definitions.pools():
         for node in process.walk():
-            if node.event_kind == "error" and error_name(node):
+            if node.event_kind == EventKind.ERROR and error_name(node):
                 errors.add(error_name(node))
-            if node.event_kind != "signal" or not signal_topic(node):
+            if node.event_kind != EventKind.SIGNAL or not signal_topic(node):
                 continue
             msgtype = node.message.msgtype if node.message else ""
             throws = node.kind in THROWING
@@ -236,7 +237,7 @@ def skill_signals(definitions: Definitions) -> frozenset[str]:
         str(node.inputs["signal"]).strip("/")
         for _, process in definitions.pools()
         for node in process.walk()
-        if node.kind == "callActivity" and isinstance(node.inputs.get("signal"), str)
+        if node.kind == Kind.CALL_ACTIVITY and isinstance(node.inputs.get("signal"), str)
     )
 
 

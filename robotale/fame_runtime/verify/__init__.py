@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Collection, Iterable
 from dataclasses import dataclass, field
 
+from robotale.fame_runtime.kinds import Kind
 from robotale.fame_runtime.library import Library, resolve_call
 from robotale.fame_runtime.model import Definitions, Process
 from robotale.fame_runtime.plan import deploy
@@ -45,7 +46,7 @@ class Verdict:
     def complete(self) -> bool:
         return not self.bound
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, object]:
         return {
             "file": self.file,
             "robots": self.robots,
@@ -121,7 +122,7 @@ def unresolved_calls(
         seen.add(id(process))
         for node in process.walk():
             name = node.called_element
-            if node.kind != "callActivity" or node.embedded_process or name in skills:
+            if node.kind != Kind.CALL_ACTIVITY or node.embedded_process or name in skills:
                 if node.embedded_process is not None:
                     pending.append(node.embedded_process)
                 continue

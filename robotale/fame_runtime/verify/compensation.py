@@ -11,6 +11,7 @@ from __future__ import annotations
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass
 
+from robotale.fame_runtime.kinds import EventKind, Kind
 from robotale.fame_runtime.plan import NodePlan, ScopePlan
 
 
@@ -37,9 +38,12 @@ def compensation(plans: Iterable[ScopePlan]) -> Compensation | None:
     hidden: set[str] = set()
     for scope in _scopes(plans):
         for node in scope.nodes.values():
-            if node.throw is not None and node.throw.kind == "compensate":
+            if node.throw is not None and node.throw.kind == EventKind.COMPENSATE:
                 throws[node.node.id] = None
-            if node.node.kind == "boundaryEvent" and node.node.event_kind == "compensate":
+            if (
+                node.node.kind == Kind.BOUNDARY_EVENT
+                and node.node.event_kind == EventKind.COMPENSATE
+            ):
                 hidden.add(node.node.id)
         named = list(scope.compensations.values())
         if scope.compensation_handler is not None:

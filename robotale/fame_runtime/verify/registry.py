@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import ast
 
+from robotale.fame_runtime.kinds import EventKind, Run
 from robotale.fame_runtime.model import Expression, Process
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan
 from robotale.fame_runtime.verify.values import (
@@ -111,8 +112,8 @@ def relevant_names(registry: Registry) -> frozenset[str]:
         for data_object in [*node.data_inputs, *node.data_outputs]:
             for name, text in data_object.parameters.items():
                 assigned(name, text)
-        for name, text in {**node.node.inputs, **node.node.outputs}.items():
-            assigned(name, text)
+        for name, value in {**node.node.inputs, **node.node.outputs}.items():
+            assigned(name, value)
         script = node.node.script
         if script is not None:
             for name, tree in script_effect(script.text, script.language).sets:
@@ -139,17 +140,21 @@ def timer_seconds(catcher: NodePlan) -> float | None:
     return spec.interval
 
 
-def node_timers(node: NodePlan) -> tuple[list, list]:
+#: the timers at a node while it runs and while it waits, with their seconds
+Timers = tuple[list[tuple[NodePlan, float | None]], list[tuple[NodePlan, float | None]]]
+
+
+def node_timers(node: NodePlan) -> Timers:
     """The timers a token at ``node`` waits on while the node runs (its boundary events)
     and while it waits there (a catch event's or an event-based gateway's too)."""
     catchers = list(node.boundaries)
     running = [(c, timer_seconds(c)) for c in catchers if _is_timer(c)]
-    if node.behaviour == "catch":
+    if node.behaviour == Run.CATCH:
         catchers.append(node)
-    if node.behaviour == "eventBasedGateway":
+    if node.behaviour == Run.EVENT_BASED_GATEWAY:
         catchers += [f.target for f in node.outgoing]
     return running, [(c, timer_seconds(c)) for c in catchers if _is_timer(c)]
 
 
 def _is_timer(node: NodePlan) -> bool:
-    return node.trigger is not None and node.trigger.kind == "timer"
+    return node.trigger is not None and node.trigger.kind == EventKind.TIMER

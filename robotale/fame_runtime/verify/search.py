@@ -9,9 +9,12 @@ from __future__ import annotations
 
 import time
 from collections import deque
+from collections.abc import Iterator
 from dataclasses import dataclass, field
+from typing import Any
 
-from robotale.fame_runtime.plan import NodePlan
+from robotale.fame_runtime.kinds import EventKind, Kind, Run
+from robotale.fame_runtime.plan import FlowPlan, NodePlan
 from robotale.fame_runtime.tags import Tag
 from robotale.fame_runtime.verify.registry import ElementKey, element_key
 from robotale.fame_runtime.verify.space import ASSUMED, Space
@@ -41,7 +44,7 @@ class Finding:
     elements: list[str] = field(default_factory=list)  # element ids to highlight
     trace: list[Tag] = field(default_factory=list)
 
-    def as_dict(self) -> dict:
+    def as_dict(self) -> dict[str, object]:
         return {
             "kind": self.kind,
             "robot": self.robot,
@@ -74,7 +77,7 @@ class Exploration:
     reached: set[ElementKey] = field(default_factory=set)
     fired: set[ElementKey] = field(default_factory=set)
     first_armed: dict[ElementKey, int] = field(default_factory=dict)  # state it is armed in
-    firsts: dict[tuple, tuple[int, Outcome, object]] = field(default_factory=dict)
+    firsts: dict[tuple[Any, ...], tuple[int, Outcome, NodePlan]] = field(default_factory=dict)
     frontier: set[int] = field(default_factory=set)  # not expanded (a bound was hit)
     bound: str = ""
     capped: bool = False  # some step left a catcher out (TOKEN_CAP, INSTANCE_CAP)
@@ -130,7 +133,7 @@ def explore(space: Space, *, max_states: int, timeout: float) -> Exploration:
     return graph
 
 
-def _successors(space: Space, state: State, stamp: int, graph: Exploration):
+def _successors(space: Space, state: State, stamp: int, graph: Exploration) -> Iterator[Outcome]:
     robots = space.thaw(state)
     events = space.events(robots)
     if not events:
@@ -182,11 +185,11 @@ def _for(node: NodePlan, waiting: str) -> str:
     if waiting == "join":
         return " for tokens on all its incoming flows"
     trigger = node.trigger
-    if trigger is not None and trigger.kind == "signal":
+    if trigger is not None and trigger.kind == EventKind.SIGNAL:
         return f" for signal {trigger.topic}"
-    if trigger is not None and trigger.kind == "conditional":
+    if trigger is not None and trigger.kind == EventKind.CONDITIONAL:
         return " for its condition, which never holds"
-    if node.behaviour == "eventBasedGateway":
+    if node.behaviour == Run.EVENT_BASED_GATEWAY:
         wanted = [f.target.trigger.topic for f in node.outgoing if f.target.trigger is not None]
         return f" for {', '.join(w for w in wanted if w)}"
     return ""
@@ -391,7 +394,7 @@ def _why(decisions: list[Decision]) -> str:
     return "; ".join(reasons)
 
 
-def _flow_name(flow) -> str:
+def _flow_name(flow: FlowPlan) -> str:
     name = next(
         (f.name for f in flow.target.scope.process.flows.values() if f.id == flow.id and f.name),
         "",
@@ -399,7 +402,7 @@ def _flow_name(flow) -> str:
     return f"{flow.id} ({name})" if name else flow.id
 
 
-def _read(read: tuple) -> str:
+def _read(read: tuple[str, Any, str, bool]) -> str:
     name, value, setter, same_step = read
     if value is UNKNOWN:
         return f"{name} (unknown)"
@@ -457,9 +460,9 @@ def _unreached(graph: Exploration) -> list[Finding]:
     seen: set[ElementKey] = set()
     for node in graph.space.registry.nodes:
         key = element_key(node)
-        if key in seen or node.behaviour == "event_subprocess":
+        if key in seen or node.behaviour == Run.EVENT_SUBPROCESS:
             continue
-        catching = node.trigger is not None and node.behaviour != "skill"
+        catching = node.trigger is not None and node.behaviour != Run.SKILL
         if (key in graph.fired) or (key in graph.reached and not catching):
             continue
         seen.add(key)
@@ -487,15 +490,15 @@ def _unreached(graph: Exploration) -> list[Finding]:
 
 def _always_armed(node: NodePlan) -> bool:
     """Start events of a process or event sub-process wait as long as it runs."""
-    return node.node.kind == "startEvent"
+    return node.node.kind == Kind.START_EVENT
 
 
 def _never_because(node: NodePlan) -> str:
-    trigger = node.trigger
-    if trigger.kind == "signal":
+    trigger = node.caught
+    if trigger.kind == EventKind.SIGNAL:
         return f"no robot throws signal {trigger.topic} while it waits"
-    if trigger.kind == "conditional":
+    if trigger.kind == EventKind.CONDITIONAL:
         return "its condition never holds while it waits"
-    if trigger.kind == "error":
+    if trigger.kind == EventKind.ERROR:
         return f"no error {trigger.topic or ''} is thrown where it catches".replace("  ", " ")
     return f"nothing {trigger.kind} reaches it while it waits"

@@ -17,12 +17,15 @@ from __future__ import annotations
 
 import itertools
 from collections.abc import Callable, Iterator
+from operator import methodcaller
 from typing import Any
 
+from robotale.fame_runtime.kinds import EventKind, Run
 from robotale.fame_runtime.model import Expression
 from robotale.fame_runtime.plan import NodePlan, ScopePlan
 from robotale.fame_runtime.verify.registry import (
     Registry,
+    Timers,
     node_timers,
     relevant_names,
     timer_seconds,
@@ -36,6 +39,17 @@ from robotale.fame_runtime.verify.values import (
 
 #: what an event does, given the step (:class:`~.step.Step`) it runs in
 Action = Callable[[Any], None]
+
+
+def _begin_all(step: Any) -> None:  # a Step (whose module imports this one)
+    for robot in step.robots:
+        step.begin(robot)
+
+
+def _fire_where_it_is(token: Tok) -> Action:
+    """Fire ``token``'s catching event where the token is when the event happens."""
+    return lambda step: step.fire(token, token.node, "")
+
 
 #: tokens one scope may hold: a non-interrupting event firing again beyond it is not explored
 TOKEN_CAP = 8
@@ -61,12 +75,12 @@ class Space:
         self.robots = robots
         self.outside = outside  # signal topics the world may throw at any time
         #: node plan id -> its timers (the plans live as long as the space)
-        self._timer_cache: dict[int, tuple[list, list]] = {}
+        self._timer_cache: dict[int, Timers] = {}
         for _, plan in robots:
             self.registry.add_scope(plan)
             for start in plan.triggered_starts:
                 self.registry.add_node(start)
-        self.inclusive = any(n.behaviour == "inclusiveGateway" for n in self.registry.nodes)
+        self.inclusive = any(n.behaviour == Run.INCLUSIVE_GATEWAY for n in self.registry.nodes)
         self.relevant = relevant_names(self.registry)
 
     def timers(self, token: Tok) -> list[tuple[NodePlan, float | None]]:
@@ -95,7 +109,7 @@ class Space:
             robots.append(robot)
         return robots
 
-    def _thaw_scope(self, robot: Robot, key: tuple, holder: Tok | None) -> Scope:
+    def _thaw_scope(self, robot: Robot, key: tuple[Any, ...], holder: Tok | None) -> Scope:
         scope_id, fired, tokens = key
         plan = None if scope_id < 0 else self.registry.scopes[scope_id]
         scope = Scope(robot, plan, holder)
@@ -122,7 +136,7 @@ class Space:
             for r in robots
         )
 
-    def _freeze_scope(self, scope: Scope, ranks: dict[int, int]) -> tuple:
+    def _freeze_scope(self, scope: Scope, ranks: dict[int, int]) -> tuple[Any, ...]:
         tokens = sorted(
             (
                 self.registry.node_id(t.node),
@@ -162,11 +176,11 @@ class Space:
         ]
         if ready:  # a loop's next round comes before anything else can happen
             for robot, token in ready:
-                yield (f"{robot.name}: {token.node.label}", lambda step, t=token: step.resume(t))
+                yield (f"{robot.name}: {token.node.label}", methodcaller("resume", token))
             return
         if not all(robot.begun for robot in robots):
             # the engines start together: every first instance runs before any timer fires
-            yield ("the mission begins", lambda step: [step.begin(r) for r in step.robots])
+            yield ("the mission begins", _begin_all)
             return
         for robot in robots:
             for scope in robot.instances:
@@ -177,13 +191,14 @@ class Space:
                 if self._may_fire(robot, start):
                     yield (
                         f"{robot.name}: {start.label}",
-                        lambda step, r=robot, s=start: step.start_instance(r, s, ""),
+                        methodcaller("start_instance", robot, start, ""),
                     )
 
-    def _scope_events(self, robot: Robot, scope: Scope) -> Iterator[tuple[str, Callable]]:
+    def _scope_events(self, robot: Robot, scope: Scope) -> Iterator[tuple[str, Action]]:
         if scope.plan is not None:
             for esp in scope.plan.event_subprocesses:
-                start = esp.child.triggered_starts[0] if esp.child.triggered_starts else None
+                starts = esp.content.triggered_starts
+                start = starts[0] if starts else None
                 if start is None or not self._may_fire(robot, start):
                     continue
                 if self.registry.node_id(esp) in scope.fired or any(
@@ -192,29 +207,29 @@ class Space:
                     continue  # a handler the world starts runs once at a time
                 yield (
                     f"{robot.name}: {start.label}",
-                    lambda step, s=scope, e=esp: step.fire_esp(s, e, ""),
+                    methodcaller("fire_esp", scope, esp, ""),
                 )
         for token in scope.tokens:
             yield from self._token_events(robot, token)
             if token.child is not None:
                 yield from self._scope_events(robot, token.child)
 
-    def _token_events(self, robot: Robot, token: Tok) -> Iterator[tuple[str, Callable]]:
+    def _token_events(self, robot: Robot, token: Tok) -> Iterator[tuple[str, Action]]:
         node = token.node
         if token.waiting == "wait":
-            if node.behaviour == "catch" and self._may_fire(robot, node, token):
+            if node.behaviour == Run.CATCH and self._may_fire(robot, node, token):
                 yield (
                     f"{robot.name}: {node.label}",
-                    lambda step, t=token: step.fire(t, t.node, ""),
+                    _fire_where_it_is(token),
                 )
-            elif node.behaviour in ("skill", "script"):
-                yield (f"{robot.name}: {node.label} ends", lambda step, t=token: step.finished(t))
-            elif node.behaviour == "eventBasedGateway":
+            elif node.behaviour in (Run.SKILL, Run.SCRIPT):
+                yield (f"{robot.name}: {node.label} ends", methodcaller("finished", token))
+            elif node.behaviour == Run.EVENT_BASED_GATEWAY:
                 for flow in node.outgoing:
                     if self._may_fire(robot, flow.target, token):
                         yield (
                             f"{robot.name}: {flow.target.label}",
-                            lambda step, t=token, c=flow.target: step.fire(t, c, ""),
+                            methodcaller("fire", token, flow.target, ""),
                         )
         if token.waiting == "wait" or token.child is not None:
             for boundary in node.boundaries:
@@ -226,7 +241,7 @@ class Space:
                     continue  # a non-interrupting event of the world: once at a time
                 yield (
                     f"{robot.name}: {boundary.label}",
-                    lambda step, t=token, b=boundary: step.fire_boundary(t, b, ""),
+                    methodcaller("fire_boundary", token, boundary, ""),
                 )
 
     def _may_fire(self, robot: Robot, catcher: NodePlan, token: Tok | None = None) -> bool:
@@ -235,13 +250,13 @@ class Space:
         trigger = catcher.trigger
         if trigger is None:
             return False
-        if trigger.kind == "timer":
+        if trigger.kind == EventKind.TIMER:
             return token is None or self._first_due(token, catcher)
-        if trigger.kind == "conditional":
+        if trigger.kind == EventKind.CONDITIONAL:
             return condition_holds(event_condition(catcher), robot) is not False
-        if trigger.kind == "error":  # a battery monitor, a skill: errors the world raises
+        if trigger.kind == EventKind.ERROR:  # a battery monitor, a skill: errors the world raises
             return f"/{trigger.topic}" in self.outside
-        return trigger.kind == "signal" and trigger.topic in self.outside
+        return trigger.kind == EventKind.SIGNAL and trigger.topic in self.outside
 
     def _first_due(self, token: Tok, catcher: NodePlan) -> bool:
         """A timer armed at or before this one with a shorter duration is due first: the

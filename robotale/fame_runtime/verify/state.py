@@ -77,7 +77,7 @@ class Robot:
 
 
 #: a robot as the state holds it
-RobotKey = tuple[bool, tuple, tuple, tuple]
+RobotKey = tuple[bool, tuple[Any, ...], tuple[Any, ...], tuple[Any, ...]]
 State = tuple[RobotKey, ...]
 
 

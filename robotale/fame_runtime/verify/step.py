@@ -6,15 +6,17 @@ followed), with the choices it is given.
 from __future__ import annotations
 
 import ast
+import functools
 from collections import deque
 from collections.abc import Callable, Iterator
 from itertools import combinations
 from typing import Any
 
 from robotale.fame_runtime.expressions import self_reference
+from robotale.fame_runtime.kinds import EventKind, LoopKind, Run
 from robotale.fame_runtime.model import Expression
 from robotale.fame_runtime.plan import FlowPlan, NodePlan, ScopePlan, reachable_flows
-from robotale.fame_runtime.tags import Tag
+from robotale.fame_runtime.tags import Lifecycle, Tag
 from robotale.fame_runtime.verify.registry import ElementKey, element_key
 from robotale.fame_runtime.verify.space import (
     ASSUMED,
@@ -100,12 +102,14 @@ class Step:
             self.urgent,
         )
 
-    def tag(self, robot: Robot, label: str, lifecycle: str, msg_id: str = "", role: str = ""):
-        self.tags.append(Tag(self.stamp, robot.name, label, lifecycle, msg_id, role))
+    def tag(
+        self, robot: Robot, label: str, lifecycle: Lifecycle, msg_id: str = "", role: str = ""
+    ) -> None:
+        self.tags.append(Tag(self.stamp, robot.name, label, lifecycle.value, msg_id, role))
 
     def pair(self, robot: Robot, label: str, msg_id: str = "", role: str = "") -> None:
-        self.tag(robot, label, "start", msg_id, role)
-        self.tag(robot, label, "complete", msg_id, role)
+        self.tag(robot, label, Lifecycle.START, msg_id, role)
+        self.tag(robot, label, Lifecycle.COMPLETE, msg_id, role)
 
     # -- events ----------------------------------------------------------------------------------
 
@@ -147,8 +151,8 @@ class Step:
     def fire_esp(self, scope: Scope, esp: NodePlan, msg_id: str) -> None:
         if scope.closed:
             return
-        start = esp.child.triggered_starts[0]
-        interrupting = start.node.interrupting or start.trigger.kind == "error"
+        start = esp.content.triggered_starts[0]
+        interrupting = start.node.interrupting or start.caught.kind == EventKind.ERROR
         if interrupting:
             scope.fired.add(self.space.registry.node_id(esp))
             for token in list(scope.tokens):
@@ -156,7 +160,7 @@ class Step:
         holder = Tok(scope, esp, waiting="wait")
         scope.tokens.append(holder)
         self.reached.add(element_key(esp))
-        self.tag(scope.robot, esp.label, "start")
+        self.tag(scope.robot, esp.label, Lifecycle.START)
         child = Scope(scope.robot, esp.child, holder)
         holder.child = child
         self.declare(scope.robot, esp.child)
@@ -180,9 +184,9 @@ class Step:
         if not token.alive:
             return
         token.waiting = ""
-        if token.node.behaviour == "skill":
+        if token.node.behaviour == Run.SKILL:
             self.forget_assumptions(token.scope.robot)
-        self.tag(token.scope.robot, token.node.label, "complete")
+        self.tag(token.scope.robot, token.node.label, Lifecycle.COMPLETE)
         self.data_out(token.scope.robot, token.node)
         self._leave(token, token.node)
 
@@ -211,6 +215,7 @@ class Step:
         """The step never waits: the engine stops the robot whose token keeps going with a
         model error; so does the step here."""
         token = self.current
+        assert token is not None  # a step that runs has moved a token
         self.work.clear()
         del self.tags[BUSY_TAGS:]  # the trace shows the loop's first rounds, not all of them
         self.failures.append(
@@ -277,7 +282,16 @@ class Step:
         )
         return chosen
 
-    def _assume(self, robot, node, flows, values, chosen, *, first: bool) -> None:
+    def _assume(
+        self,
+        robot: Robot,
+        node: NodePlan,
+        flows: list[FlowPlan],
+        values: list[Any],
+        chosen: list[FlowPlan],
+        *,
+        first: bool,
+    ) -> None:
         """An unknown variable a condition tested keeps the value the choice implies until
         something writes it (``a`` taken: a is true), so a later test of it agrees."""
         taken = {id(f) for f in chosen}
@@ -291,6 +305,8 @@ class Step:
             else:
                 continue
             expression = self.space.registry.condition(flow)
+            if expression is None:  # no condition: it holds, never unknown
+                continue
             implied = _implied(condition_tree(expression.text, expression.language), outcome)
             if implied is not None and implied[0] not in robot.later:
                 robot.variables[implied[0]] = (implied[1], ASSUMED + node.node.describe())
@@ -394,11 +410,11 @@ class Step:
         holder.child = None
         holder.waiting = ""
         node = holder.node
-        if node.behaviour == "loop":
+        if node.behaviour == Run.LOOP:
             self._loop_round(holder, node)
             return
-        self.tag(robot, node.label, "complete")
-        if node.behaviour == "event_subprocess":
+        self.tag(robot, node.label, Lifecycle.COMPLETE)
+        if node.behaviour == Run.EVENT_SUBPROCESS:
             self._consume(holder)
             return
         self.data_out(robot, node)
@@ -414,7 +430,7 @@ class Step:
 
     def _run_pass(self, token: Tok, node: NodePlan) -> None:
         throw = node.throw
-        if throw is not None and throw.kind in ("signal", "message"):
+        if throw is not None and throw.kind in (EventKind.SIGNAL, EventKind.MESSAGE):
             self._publish(token.scope.robot, node)
         elif throw is not None:
             self.pair(token.scope.robot, throw.label)
@@ -423,9 +439,9 @@ class Step:
     def _run_end(self, token: Tok, node: NodePlan) -> None:
         throw = node.throw
         robot = token.scope.robot
-        if throw is not None and throw.kind in ("signal", "message"):
+        if throw is not None and throw.kind in (EventKind.SIGNAL, EventKind.MESSAGE):
             self._publish(robot, node)
-        elif throw is not None and throw.kind == "error":
+        elif throw is not None and throw.kind == EventKind.ERROR:
             self.pair(robot, throw.label)
             self._throw_error(token, throw.topic)
             return
@@ -438,15 +454,15 @@ class Step:
 
     def _run_task(self, token: Tok, node: NodePlan) -> None:
         robot = token.scope.robot
-        self.tag(robot, node.label, "start")
+        self.tag(robot, node.label, Lifecycle.START)
         self.data_in(robot, node)
-        self.tag(robot, node.label, "complete")
+        self.tag(robot, node.label, Lifecycle.COMPLETE)
         self.data_out(robot, node)
         self._leave(token, node)
 
     def _run_script(self, token: Tok, node: NodePlan) -> None:
         robot = token.scope.robot
-        self.tag(robot, node.label, "start")
+        self.tag(robot, node.label, Lifecycle.START)
         self.data_in(robot, node)
         script = node.node.script
         effect = script_effect(script.text, script.language) if script is not None else None
@@ -470,37 +486,37 @@ class Step:
                 token.waiting = "wait"
                 self._armed(token)
                 return
-        self.tag(robot, node.label, "complete")
+        self.tag(robot, node.label, Lifecycle.COMPLETE)
         self.data_out(robot, node)
         self._leave(token, node)
 
     def _run_skill(self, token: Tok, node: NodePlan) -> None:
-        self.tag(token.scope.robot, node.label, "start")
+        self.tag(token.scope.robot, node.label, Lifecycle.START)
         self.data_in(token.scope.robot, node)
         token.waiting = "wait"
         self._armed(token)
 
     def _run_call(self, token: Tok, node: NodePlan) -> None:
         robot = token.scope.robot
-        self.tag(robot, node.label, "start")
+        self.tag(robot, node.label, Lifecycle.START)
         self.data_in(robot, node)
         token.waiting = "wait"
         self._armed(token)
         child = Scope(robot, node.child, token)
         token.child = child
         self.declare(robot, node.child)
-        if not node.child.starts:
+        if not node.content.starts:
             self._close(child)
             return
-        for start in node.child.starts:
+        for start in node.content.starts:
             self._go(Tok(child, start), start)
 
     def _run_loop(self, token: Tok, node: NodePlan) -> None:
         token.waiting = "wait"
         self._armed(token)
-        marker = node.loop.loop
+        marker = node.looping.loop
         # tested before: maybe no round at all
-        if marker.kind == "standard" and marker.test_before and not self._again(token, node):
+        if marker.kind == LoopKind.STANDARD and marker.test_before and not self._again(token, node):
             self._loop_done(token, node)
             return
         self._loop_body(token, node)
@@ -508,13 +524,13 @@ class Step:
     def _loop_body(self, token: Tok, node: NodePlan) -> None:
         child = Scope(token.scope.robot, None, token)
         token.child = child
-        body = node.loop.body
+        body = node.looping.body
         self._go(Tok(child, body), body)
 
     def _loop_round(self, token: Tok, node: NodePlan) -> None:
         """A round of a loop ended: a standard loop goes round again while its condition may
         hold (a multi-instance activity's instances are alike: one round stands for all)."""
-        again = node.loop.loop.kind == "standard" and self._again(token, node)
+        again = node.looping.loop.kind == LoopKind.STANDARD and self._again(token, node)
         if again and (id(token), "round") in self.entered:
             token.waiting = "again"  # the next round is a step of its own, as in _enter
             return
@@ -528,7 +544,7 @@ class Step:
     def _again(self, token: Tok, node: NodePlan) -> bool:
         """Whether a standard loop goes round (again): its condition, a choice when unknown
         or when a loopMaximum may end it (rounds are not counted)."""
-        marker = node.loop.loop
+        marker = node.looping.loop
         holds = condition_holds(marker.condition, token.scope.robot)
         if marker.condition is None or (holds is True and marker.maximum is not None):
             holds = UNKNOWN
@@ -537,12 +553,12 @@ class Step:
     def _loop_done(self, token: Tok, node: NodePlan) -> None:
         token.waiting = ""
         token.child = None
-        self.tag(token.scope.robot, node.label, "complete")
+        self.tag(token.scope.robot, node.label, Lifecycle.COMPLETE)
         self._leave(token, node)
 
     def _run_catch(self, token: Tok, node: NodePlan) -> None:
         trigger = node.trigger
-        conditional = trigger is not None and trigger.kind == "conditional"
+        conditional = trigger is not None and trigger.kind == EventKind.CONDITIONAL
         if conditional and condition_holds(event_condition(node), token.scope.robot) is True:
             self._caught(token, node, "")
             return
@@ -595,7 +611,7 @@ class Step:
                 for node in {
                     id(t.node): t.node for t in scope.tokens if t.waiting == "join"
                 }.values():
-                    if node.behaviour == "inclusiveGateway" and _may_merge(scope, node):
+                    if node.behaviour == Run.INCLUSIVE_GATEWAY and _may_merge(scope, node):
                         self._merge(scope, node)
 
     def _merge(self, scope: Scope, node: NodePlan) -> None:
@@ -622,16 +638,16 @@ class Step:
     # -- signals and errors ----------------------------------------------------------------------
 
     def _publish(self, robot: Robot, node: NodePlan) -> None:
-        throw = node.throw
+        throw = node.thrown
         self.messages += 1
         msg_id = f"m{int(self.stamp)}.{self.messages}"  # unique in a trace: one step a stamp
-        self.tag(robot, throw.label, "start", msg_id, "send")
+        self.tag(robot, throw.label, Lifecycle.START, msg_id, "send")
         receivers = list(self._receivers(throw.topic))
         if not receivers and not self.capped:
             self.lost.append((robot.name, node, throw.topic))
         for receive in receivers:
-            self.work.append(lambda r=receive, m=msg_id: r(m))
-        self.tag(robot, throw.label, "complete", msg_id, "send")
+            self.work.append(functools.partial(receive, msg_id))
+        self.tag(robot, throw.label, Lifecycle.COMPLETE, msg_id, "send")
 
     def _receivers(self, topic: str) -> Iterator[Callable[[str], None]]:
         """Everything armed for ``topic`` now, in every robot (a broadcast)."""
@@ -644,31 +660,31 @@ class Step:
                 if len(robot.instances) >= INSTANCE_CAP:
                     self.capped = True  # not lost: more instances than the bound keeps
                     continue
-                yield lambda m, r=robot, s=start: self.start_instance(r, s, m)
+                yield functools.partial(self.start_instance, robot, start)
 
     def _scope_receivers(self, scope: Scope, topic: str) -> Iterator[Callable[[str], None]]:
         if scope.plan is not None:
             for esp in scope.plan.event_subprocesses:
-                starts = esp.child.triggered_starts
+                starts = esp.content.triggered_starts
                 fired = self.space.registry.node_id(esp) in scope.fired
                 if not starts or not _listens(starts[0], topic) or fired:
                     continue
                 if len(scope.tokens) >= TOKEN_CAP:
                     self.capped = True
                     continue
-                yield lambda m, s=scope, e=esp: self.fire_esp(s, e, m)
+                yield functools.partial(self.fire_esp, scope, esp)
         for token in list(scope.tokens):
             node = token.node
-            if token.waiting == "wait" and node.behaviour == "catch" and _listens(node, topic):
-                yield lambda m, t=token: self.fire(t, t.node, m)
-            if token.waiting == "wait" and node.behaviour == "eventBasedGateway":
+            if token.waiting == "wait" and node.behaviour == Run.CATCH and _listens(node, topic):
+                yield _fire_where_it_is(self, token)
+            if token.waiting == "wait" and node.behaviour == Run.EVENT_BASED_GATEWAY:
                 for flow in node.outgoing:
                     if _listens(flow.target, topic):
-                        yield lambda m, t=token, c=flow.target: self.fire(t, c, m)
+                        yield functools.partial(self.fire, token, flow.target)
             if token.waiting == "wait" or token.child is not None:
                 for boundary in node.boundaries:
                     if _listens(boundary, topic):
-                        yield lambda m, t=token, b=boundary: self.fire_boundary(t, b, m)
+                        yield functools.partial(self.fire_boundary, token, boundary)
 
     def _throw_error(self, token: Tok, name: str) -> None:
         """To the nearest catcher: event sub-processes of each scope and boundary events of
@@ -678,7 +694,7 @@ class Step:
         while scope is not None:
             if scope.plan is not None:
                 for esp in scope.plan.event_subprocesses:
-                    starts = esp.child.triggered_starts
+                    starts = esp.content.triggered_starts
                     if starts and _catches_error(starts[0], name):
                         self.fire_esp(scope, esp, "")
                         return
@@ -747,12 +763,12 @@ def _implied(tree: ast.expr | None, outcome: bool) -> tuple[str, Any] | None:
 
 def _listens(node: NodePlan, topic: str) -> bool:
     trigger = node.trigger
-    return trigger is not None and trigger.kind == "signal" and trigger.topic == topic
+    return trigger is not None and trigger.kind == EventKind.SIGNAL and trigger.topic == topic
 
 
 def _catches_error(node: NodePlan, name: str) -> bool:
     trigger = node.trigger
-    return trigger is not None and trigger.kind == "error" and trigger.topic in ("", name)
+    return trigger is not None and trigger.kind == EventKind.ERROR and trigger.topic in ("", name)
 
 
 def _may_merge(scope: Scope, node: NodePlan) -> bool:
@@ -809,22 +825,27 @@ def _reads(
     return tuple(dict.fromkeys(reads))
 
 
+def _fire_where_it_is(step: Step, token: Tok) -> Callable[[str], None]:
+    """Fire ``token``'s catching event where the token is when the message arrives."""
+    return lambda msg_id: step.fire(token, token.node, msg_id)
+
+
 _BEHAVIOURS: dict[str, Callable[[Step, Tok, NodePlan], None]] = {
-    "start": Step._leave,
-    "boundary": Step._leave,
-    "pass": Step._run_pass,
-    "end": Step._run_end,
-    "terminate": Step._run_terminate,
-    "task": Step._run_task,
-    "script": Step._run_script,
-    "skill": Step._run_skill,
-    "call": Step._run_call,
-    "subprocess": Step._run_call,
-    "loop": Step._run_loop,
-    "catch": Step._run_catch,
-    "exclusiveGateway": Step._run_exclusive,
-    "inclusiveGateway": Step._run_inclusive,
-    "parallelGateway": Step._run_parallel,
-    "eventBasedGateway": Step._run_event_gateway,
-    "event_subprocess": lambda step, token, node: None,
+    Run.START: Step._leave,
+    Run.BOUNDARY: Step._leave,
+    Run.PASS: Step._run_pass,
+    Run.END: Step._run_end,
+    Run.TERMINATE: Step._run_terminate,
+    Run.TASK: Step._run_task,
+    Run.SCRIPT: Step._run_script,
+    Run.SKILL: Step._run_skill,
+    Run.CALL: Step._run_call,
+    Run.SUBPROCESS: Step._run_call,
+    Run.LOOP: Step._run_loop,
+    Run.CATCH: Step._run_catch,
+    Run.EXCLUSIVE_GATEWAY: Step._run_exclusive,
+    Run.INCLUSIVE_GATEWAY: Step._run_inclusive,
+    Run.PARALLEL_GATEWAY: Step._run_parallel,
+    Run.EVENT_BASED_GATEWAY: Step._run_event_gateway,
+    Run.EVENT_SUBPROCESS: lambda step, token, node: None,
 }
