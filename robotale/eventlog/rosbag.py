@@ -12,6 +12,8 @@ preparation); messages are read from the storage files by topic and type, so a m
 whose QoS differs from its storage's does not hide them; and each topic's first message is
 checked against its definition, so a wrong stored definition is named instead of trusted.
 
+What each type is, :mod:`robotale.eventlog.typesys` resolves; this module reads the storage.
+
 Every table has a ``time`` column (tz-aware UTC): the message's own stamp (``header.stamp`` or a
 top-level ``stamp``) when it has a non-zero one, else the time the bag recorded it. The other
 columns are the message fields asked for, by dotted path (``pose.pose.position.x``).
@@ -20,7 +22,6 @@ columns are the message fields asked for, by dotted path (``pose.pose.position.x
 from __future__ import annotations
 
 import contextlib
-import functools
 import struct
 from collections.abc import Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
@@ -30,40 +31,35 @@ from pathlib import Path
 import apsw  # rosbags' SQLite binding: a damaged database raises its errors
 import numpy as np
 import pandas as pd
-from rosbags.interfaces import Connection, MessageDefinitionFormat
+from rosbags.interfaces import Connection
 from rosbags.rosbag2 import Reader, ReaderError
 from rosbags.serde import SerdeError
-from rosbags.typesys import (
-    Stores,
-    TypesysError,
-    get_types_from_idl,
-    get_types_from_msg,
-    get_typestore,
-)
 from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
 from robotale.eventlog.cdrlayout import Layout, columns
 from robotale.eventlog.interfaces import (
-    RELEASES,
     definition_file,
     message_types,
     normalized,
-    shipped,
-    stored_types,
 )
 from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches, zstd
-from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
+from robotale.eventlog.typesys import (
+    all_fields,
+    bag_definitions,
+    check_distro,
+    field_type,
+    missing_type,
+    release_of,
+    scalar_fields,
+    stamp_path,
+    typestore_for,
+)
 
 TIME = "time"
 #: the column of a table holding when the bag recorded each message (ns since the epoch), when
 #: asked for: the recording's order of messages from different topics
 RECORDED = "_recorded"
-HEADER_TYPE = "std_msgs/msg/Header"
-TIME_TYPE = "builtin_interfaces/msg/Time"
-
-# rosbags' field descriptors are (nodetype, detail); NAME is a nested message type.
-_BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4
 
 
 def is_bag(path: Path) -> bool:
@@ -139,12 +135,14 @@ class Bag:
         self._reader = reader
         self._topics = {n: normalized(i.msgtype or "") for n, i in sorted(reader.topics.items())}
         try:
-            self.release = _release(self.distro or reader.ros_distro)
-            self._definitions = _definitions(reader, self.extra_types, self.release, self.unparsed)
+            self.release = release_of(self.distro or reader.ros_distro)
+            self._definitions = bag_definitions(
+                reader, self.extra_types, self.release, self.unparsed
+            )
             roots = {
                 normalized(c.msgtype) for c in reader.connections if c.topic not in self.unparsed
             }
-            self.typestore = _typestore(self._definitions, roots, self.path)
+            self.typestore = typestore_for(self._definitions, roots, self.path)
             self.qos_mismatch = _qos_mismatches(reader)
         except BaseException:
             self.__exit__()
@@ -236,7 +234,7 @@ class Bag:
                 f"{definition_file(msgtype)}."
             )
         if msgtype not in self.typestore.fielddefs:
-            missing = _missing(self._definitions, msgtype) or msgtype
+            missing = missing_type(self._definitions, msgtype) or msgtype
             part = "" if missing == msgtype else f", which {msgtype} contains,"
             file = definition_file(missing)
             raise InputError(
@@ -448,140 +446,6 @@ def _storage_files(reader: Reader) -> list[str]:
     return []
 
 
-def _definitions(reader: Reader, extra: Mapping, release: str, unparsed: dict) -> dict:
-    """The user's types, then the bag's, then the distribution's (rosbags' store), then those
-    robotale ships for it, then robotale's Tag.
-
-    The user's come first: they are given to correct or complete what the bag says. A stored
-    definition that cannot be parsed is noted in ``unparsed`` (topic -> reason) and left out.
-    """
-    typs: dict = dict(extra)
-    for connection in reader.connections:
-        try:
-            embedded = _embedded_types(connection)
-        except TypesysError as error:
-            reason = " ".join(str(error).split())
-            unparsed[connection.topic] = reason if len(reason) < 160 else f"{reason[:157]}..."
-            continue
-        typs.update({name: spec for name, spec in embedded.items() if name not in extra})
-    # a release rosbags has no store of yet (rolling) takes the latest it has
-    standard = get_typestore(DISTROS.get(release, [*DISTROS.values()][-1])).fielddefs
-    for source in (standard, shipped(release), get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
-        typs.update({name: spec for name, spec in source.items() if name not in typs})
-    return typs
-
-
-def _typestore(definitions: Mapping, roots: set[str], path: Path) -> Typestore:
-    """A store of the types ``roots`` need whose definitions are all there.
-
-    Only those: a distribution has hundreds of types. Stores are shared between bags that
-    need the same definitions (the runs of a batch), as building one generates code.
-    """
-    needed = _closure(definitions, roots)
-    usable = {n: spec for n, spec in needed.items() if _missing(definitions, n) is None}
-    key = repr(sorted(usable.items()))
-    if key not in _STORES:
-        store = get_typestore(Stores.EMPTY)
-        try:
-            store.register(usable)
-        except TypesysError as error:
-            raise InputError(f"{path}: its message definitions cannot be used: {error}") from None
-        if len(_STORES) >= 32:
-            _STORES.clear()
-        _STORES[key] = store
-    return _STORES[key]
-
-
-_STORES: dict[str, Typestore] = {}
-
-
-def _closure(typs: Mapping, roots: set[str]) -> dict:
-    """The definitions of ``roots`` and of every type they contain (those there are)."""
-    needed: dict = {}
-    todo = list(roots)
-    while todo:
-        name = todo.pop()
-        if name in needed or name not in typs:
-            continue
-        needed[name] = typs[name]
-        todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
-    return needed
-
-
-def _missing(typs: Mapping, msgtype: str) -> str | None:
-    """The first type ``msgtype`` needs (itself included) that has no definition, if any."""
-    seen, todo = set(), [msgtype]
-    while todo:
-        name = todo.pop(0)
-        if name in seen:
-            continue
-        if name not in typs:
-            return name
-        seen.add(name)
-        todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
-    return None
-
-
-def _references(desc: tuple) -> list[str]:
-    nodetype, detail = desc
-    if nodetype == _NAME:
-        return [detail]
-    if nodetype in (_ARRAY, _SEQUENCE):
-        return _references(detail[0])
-    return []
-
-
-def _embedded_types(connection: Connection) -> dict:
-    definition = connection.msgdef
-    if not definition.data.strip():  # what rosbag2 stores for a type it found no file of
-        return {}
-    try:
-        return dict(_parsed(definition.format, definition.data, connection.msgtype))
-    except (KeyError, IndexError, ValueError) as error:  # malformed IDL the parser trips on
-        raise TypesysError(f"{type(error).__name__}: {error}") from None
-
-
-@functools.lru_cache(maxsize=256)
-def _parsed(kind: MessageDefinitionFormat, data: str, msgtype: str) -> tuple:
-    """A stored definition parsed once: the runs of a batch all store the same ones."""
-    if kind == MessageDefinitionFormat.MSG:
-        return tuple(stored_types(data, normalized(msgtype)).items())
-    if kind == MessageDefinitionFormat.IDL:
-        separator = "=" * 80 + "\n"
-        typs: dict = {}
-        for part in data.split(separator)[1:] or [data]:
-            typs.update(
-                get_types_from_idl(part.split("\n", 1)[1] if part.startswith("IDL: ") else part)
-            )
-        return tuple(typs.items())
-    return ()
-
-
-#: the distributions whose standard types rosbags provides, by the name users give them
-DISTROS = {
-    name.removeprefix("ROS2_").lower(): store
-    for name, store in Stores.__members__.items()
-    if name.startswith("ROS2_")
-}
-DEFAULT_DISTRO = "humble"
-
-
-def _release(name: str | None) -> str:
-    """The distribution a bag's types are completed from: ``name`` if robotale knows it, else
-    Humble (what a bag that names none was most likely recorded with)."""
-    name = (name or DEFAULT_DISTRO).lower()
-    return name if name in DISTROS or name in RELEASES else DEFAULT_DISTRO
-
-
-def check_distro(name: str | None) -> str | None:
-    """``name`` if rosbags knows the distribution, else an error listing those it knows."""
-    if name is not None and name.lower() not in DISTROS:
-        raise InputError(
-            f"Unknown ROS 2 distribution {name!r}: use one of {', '.join(sorted(DISTROS))}."
-        )
-    return name and name.lower()
-
-
 def _qos_mismatches(reader: Reader) -> list[str]:
     """Topics whose QoS (or type hash) in metadata.yaml differs from what their storage says.
 
@@ -655,54 +519,10 @@ def _decompressed(raw: bytes) -> bytes:
     return zstd.decompress(raw)  # the zstd rosbags compresses with
 
 
-def all_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
-    """Dotted paths of every field, nested messages included as well as their leaves."""
-    paths = []
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        path = f"{prefix}{name}"
-        paths.append(path)
-        if nodetype == _NAME:
-            paths.extend(all_fields(detail, typestore, f"{path}."))
-    return paths
-
-
-def scalar_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
-    """Dotted paths of the scalar leaves (numbers, strings, booleans) of a message type."""
-    paths = []
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if nodetype == _BASE:
-            paths.append(f"{prefix}{name}")
-        elif nodetype == _NAME:
-            paths.extend(scalar_fields(detail, typestore, f"{prefix}{name}."))
-    return paths
-
-
-def field_type(msgtype: str, path: str, typestore: Typestore) -> str | None:
-    """The base type (``float32``, ``string`` ...) of a scalar field, ``None`` for others."""
-    head, _, rest = path.partition(".")
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if name == head:
-            if rest:
-                return field_type(detail, rest, typestore) if nodetype == _NAME else None
-            return detail[0] if nodetype == _BASE else None
-    return None
-
-
 def _shortest_float32(values: pd.Series) -> pd.Series:
     """float32 readings as the decimals they were written as (0.98, not 0.9800000190734863)."""
     as_text = values.to_numpy(np.float32).astype(str)
     return pd.Series(as_text.astype(np.float64), index=values.index)
-
-
-def stamp_path(msgtype: str, typestore: Typestore) -> str | None:
-    """Where a message type keeps its time: ``header.stamp``, ``stamp``, or nowhere."""
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if nodetype == _NAME and name == "header" and detail == HEADER_TYPE:
-            return "header.stamp"
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if nodetype == _NAME and name == "stamp" and detail == TIME_TYPE:
-            return "stamp"
-    return None
 
 
 def namespace(topic: str) -> str:

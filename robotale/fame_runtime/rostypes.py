@@ -21,7 +21,7 @@ from cyclonedds.idl import make_idl_struct, types
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.errors import ModelError
-from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type
+from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type, text_fields
 
 _BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4  # rosbags' Nodetype values
 
@@ -196,10 +196,5 @@ def tag_fields(tag: Tag) -> dict[str, Any]:
     nanoseconds = round(tag.stamp * 1e9)
     return {
         "stamp": {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000},
-        "robot": tag.robot,
-        "activity": tag.activity,
-        "lifecycle": tag.lifecycle,
-        "msg_id": tag.msg_id,
-        "msg_role": tag.msg_role,
-        "payload": tag.payload,
+        **text_fields(tag),
     }
