@@ -20,6 +20,7 @@ START, COMPLETE, ABORT = "start", "complete", "ate_abort"
 #: the roles of message tags
 SEND, RECEIVE = "send", "receive"
 
+
 @dataclass(frozen=True, slots=True)
 class Tag:
     """One tagged event.
