@@ -11,14 +11,31 @@ from neo4j import Driver
 
 from robotale.ekg.build import BuildSummary, build_ekg, why
 from robotale.ekg.connection import session_driver
+from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.results.findings import prepare
 from robotale.results.logdata import LogData
 
 
-def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> None:
-    """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
+def store(
+    log: pd.DataFrame,
+    name: str,
+    source: Path,
+    *,
+    entities: Sequence[str] | None = None,
+    aggregate: Sequence[str | Sequence[str]] = DEFAULT_AGGREGATE,
+) -> None:
+    """Store a log read elsewhere (``demo``) under ``name`` with its ``entities`` and
+    ``aggregate`` keys, replacing one of that name."""
     with session_driver() as driver:
-        summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
+        summary = build_ekg(
+            driver,
+            log,
+            name,
+            entities=entities,
+            aggregate=aggregate,
+            replace=True,
+            source=str(source),
+        )
         print(describe(summary))
         prepare_pages(driver, name)
 
