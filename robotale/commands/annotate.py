@@ -22,10 +22,12 @@ from robotale.errors import InputError
 from robotale.eventlog import schema
 from robotale.eventlog.annotated import INFO, WARN, Entry, activity_states, write_annotated
 from robotale.eventlog.enrich import pair_activities
+from robotale.eventlog.interfaces import message_types
 from robotale.eventlog.options import PrepareOptions
 from robotale.eventlog.prepare import find_runs
 from robotale.eventlog.preparing import prepare_recordings
-from robotale.eventlog.rosbag import Bag, check_distro, message_types
+from robotale.eventlog.rosbag import Bag
+from robotale.eventlog.typesys import check_distro
 
 CASE, TIME, ROBOT, ACTIVITY = schema.CASE, schema.TIMESTAMP, schema.ROBOT, schema.ACTIVITY
 

@@ -39,13 +39,9 @@ from robotale.eventlog.enrich import (
     parse_perspective,
     robots_without_samples,
 )
+from robotale.eventlog.interfaces import message_types
 from robotale.eventlog.lifecycles import LIFECYCLE_MODES
-from robotale.eventlog.rosbag import (
-    RECORDED,
-    Bag,
-    check_distro,
-    message_types,
-)
+from robotale.eventlog.rosbag import RECORDED, Bag
 from robotale.eventlog.runs import (
     find_runs,
     is_recording,
@@ -63,6 +59,7 @@ from robotale.eventlog.tagrows import (
     topic_rows,
     warn_foreign,
 )
+from robotale.eventlog.typesys import check_distro
 from robotale.executors import open_executor, parse_executor, worker_lost
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.storage import Place, place
@@ -92,7 +89,8 @@ class Job:
 
     reading: _Reading
     msg_files: tuple[Path, ...]
-    distro: str
+    #: the distribution named (None: the one each bag names)
+    distro: str | None
     rate: float
 
 
@@ -137,14 +135,14 @@ def prepare(
     if executor is not None and skip_bad is not None:
         raise InputError("Skipping bad runs reads them in this process: leave out --executor.")
     if executor is not None:
-        told: set[tuple[str, ...]] = set()
+        told: set[str] = set()
         parts = _read_in_parallel(
             runs, reading, msg_files, distro, executor, progress, _once(report, told)
         )
     else:
-        parts = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
-        runs = [run for run, part in zip(runs, parts, strict=True) if part is not None]
-        parts = [part for part in parts if part is not None]
+        read = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
+        runs = [run for run, part in zip(runs, read, strict=True) if part is not None]
+        parts = [part for part in read if part is not None]
         if not parts:
             raise InputError(f"None of the runs of {source} could be read.")
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
@@ -197,7 +195,7 @@ def _read_here(
     runs: Sequence[Path],
     reading: _Reading,
     msg_files: Sequence[str | Path],
-    distro: str,
+    distro: str | None,
     progress: bool,
     report: Callable[[str], None] | None,
     skip_bad: Callable[[Path, str], None] | None = None,
@@ -213,8 +211,8 @@ def _read_here(
         disable=not progress,
         leave=False,
     ) as bar:
-        told: set[tuple[str, ...]] = set()
-        read = []
+        told: set[str] = set()
+        read: list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None] = []
         for run in runs:
             try:
                 read.append(
@@ -232,7 +230,7 @@ def _read_in_parallel(
     runs: Sequence[Path],
     reading: _Reading,
     msg_files: Sequence[str | Path],
-    distro: str,
+    distro: str | None,
     executor: str,
     progress: bool,
     say: Callable[[str], None],
@@ -259,11 +257,13 @@ class _RunRead:
 
     tag_rows: pd.DataFrame
     samples: dict[str, pd.DataFrame]
-    warned: list[tuple[type[Warning], str]]
+    warned: list[tuple[type[PreparationWarning], str]]
     reported: list[str]
 
 
-def _read_alone(run: Path, reading: _Reading, msg_files: Sequence[Path], distro: str) -> _RunRead:
+def _read_alone(
+    run: Path, reading: _Reading, msg_files: Sequence[Path], distro: str | None
+) -> _RunRead:
     """:func:`_read_run` in a worker process: warnings and reports are kept to be said by
     the process that asked, as they would not reach its terminal from here."""
     reported: list[str] = []
@@ -289,7 +289,7 @@ class _RunPrepared:
     part: PartWritten | None
     samples: dict[str, int]
     unsampled: dict[str, list[str]]
-    warned: list[tuple[type[Warning], str]]
+    warned: list[tuple[type[PreparationWarning], str]]
     reported: list[str]
 
 
@@ -301,7 +301,7 @@ def prepare_dataset(
     report: Callable[[str], None] | None = None,
     executor: str | None = None,
     **options: Any,
-) -> dict:
+) -> dict[str, Any]:
     """The event log of :func:`prepare`, written as a Parquet dataset partitioned by case at
     ``out`` (a path or an fsspec URL; see :mod:`robotale.eventlog.dataset`); returns its
     manifest.
@@ -318,7 +318,7 @@ def prepare_dataset(
     dataset.begin(target, str(source))
     try:
         done = _runs_written(runs, job, target, executor, progress)
-        told: set[tuple[str, ...]] = set()
+        told: set[str] = set()
         say = _once(report, told)
         for run in done:
             for category, message in run.warned:
@@ -482,7 +482,7 @@ def _sources(bag: Bag, reading: _Reading, report: Callable[[str], None]) -> Sour
     return chosen
 
 
-def _once(report: Callable[[str], None] | None, told: set) -> Callable[[str], None]:
+def _once(report: Callable[[str], None] | None, told: set[str]) -> Callable[[str], None]:
     """``report`` that says each choice once (a batch's runs usually all choose the same)."""
 
     def say(text: str) -> None:

@@ -22,9 +22,10 @@ import csv
 import dataclasses
 import io
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from contextlib import suppress
 from pathlib import Path
+from typing import TypeAlias
 
 import numpy as np
 import pandas as pd
@@ -43,7 +44,7 @@ from robotale.storage import place
 
 SINGLE_CASE = "1"
 #: a duration such as ``pd.Timedelta("1h")`` or the text ``"1h"``
-Gap = pd.Timedelta | str | None
+Gap: TypeAlias = pd.Timedelta | str | None
 
 
 def parse_mapping(items: Sequence[str]) -> dict[str, str]:
@@ -317,7 +318,7 @@ def _parquet_table(path: Path) -> pa.Table:
 
 # -- XES -------------------------------------------------------------------------------------
 
-_XES_VALUES = {
+_XES_VALUES: dict[str, Callable[[str], object]] = {
     "string": str,
     "id": str,
     "date": str,  # parsed with the other timestamps

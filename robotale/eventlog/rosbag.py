@@ -23,10 +23,11 @@ from __future__ import annotations
 
 import contextlib
 import struct
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import apsw  # rosbags' SQLite binding: a damaged database raises its errors
 import numpy as np
@@ -35,6 +36,7 @@ from rosbags.interfaces import Connection
 from rosbags.rosbag2 import Reader, ReaderError
 from rosbags.serde import SerdeError
 from rosbags.typesys.store import Typestore
+from tqdm import tqdm
 
 from robotale.errors import InputError
 from robotale.eventlog.cdrlayout import Layout, columns
@@ -43,7 +45,7 @@ from robotale.eventlog.interfaces import (
     message_types,
     normalized,
 )
-from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches, zstd
+from robotale.eventlog.messages import Batch, MalformedMcap, decompressed, gathered, mcap_batches
 from robotale.eventlog.typesys import (
     all_fields,
     bag_definitions,
@@ -55,6 +57,9 @@ from robotale.eventlog.typesys import (
     stamp_path,
     typestore_for,
 )
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import Typesdict
 
 TIME = "time"
 #: the column of a table holding when the bag recorded each message (ns since the epoch), when
@@ -97,12 +102,12 @@ class Bag:
     """
 
     path: Path
-    extra_types: Mapping = field(default_factory=dict)
+    extra_types: Typesdict = field(default_factory=dict)
     #: the ROS 2 distribution whose standard types fill in what the bag does not define
     distro: str | None = None
     _reader: Reader | None = field(default=None, init=False, repr=False)
-    typestore: Typestore | None = field(default=None, init=False, repr=False)
-    _definitions: Mapping = field(default_factory=dict, init=False, repr=False)
+    _typestore: Typestore | None = field(default=None, init=False, repr=False)
+    _definitions: Typesdict = field(default_factory=dict, init=False, repr=False)
     _topics: dict[str, str] = field(default_factory=dict, init=False, repr=False)
     #: topic -> why its stored definition cannot be used (reported only if it is read)
     unparsed: dict[str, str] = field(default_factory=dict, init=False, repr=False)
@@ -142,7 +147,7 @@ class Bag:
             roots = {
                 normalized(c.msgtype) for c in reader.connections if c.topic not in self.unparsed
             }
-            self.typestore = typestore_for(self._definitions, roots, self.path)
+            self._typestore = typestore_for(self._definitions, roots, self.path)
             self.qos_mismatch = _qos_mismatches(reader)
         except BaseException:
             self.__exit__()
@@ -159,6 +164,13 @@ class Bag:
         if self._reader is None:
             raise RuntimeError("the bag is not open; use it in a with statement")
         return self._reader
+
+    @property
+    def typestore(self) -> Typestore:
+        """The types of the bag's topics (those with every definition they need)."""
+        if self._typestore is None:
+            raise RuntimeError("the bag is not open; use it in a with statement")
+        return self._typestore
 
     @property
     def name(self) -> str:
@@ -180,7 +192,7 @@ class Bag:
         *,
         bag_time: bool = False,
         recorded: bool = False,
-        progress=None,
+        progress: tqdm | None = None,
     ) -> dict[str, pd.DataFrame]:
         """One table per topic: ``time`` plus ``columns[topic]`` (column name -> field path).
 
@@ -245,10 +257,10 @@ class Bag:
             )
         return msgtype
 
-    def _decoder(self, topic: str):
+    def _decoder(self, topic: str) -> Callable[[bytes], Any]:
         msgtype, deserialize = self.topics[topic], self.typestore.deserialize_cdr
 
-        def decode(raw: bytes) -> object:
+        def decode(raw: bytes) -> Any:  # a message of a generated class
             try:
                 return deserialize(raw, msgtype)
             except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
@@ -262,7 +274,7 @@ class Bag:
 
         return decode
 
-    def _checker(self, topic: str):
+    def _checker(self, topic: str) -> Callable[[bytes, Any], None]:
         """A check of a topic's first message against the definition it is decoded with.
 
         Decoding alone trusts too much: a definition shorter than the message (a stored
@@ -272,7 +284,7 @@ class Bag:
         """
         msgtype, store = self.topics[topic], self.typestore
 
-        def check(raw: bytes, message: object) -> None:
+        def check(raw: bytes, message: Any) -> None:
             again = len(store.serialize_cdr(message, msgtype))
             if abs(len(raw) - again) > 3:  # CDR pads a message to a multiple of 4 bytes
                 raise InputError(
@@ -284,10 +296,12 @@ class Bag:
 
         return check
 
-    def _batches(self, connections: list[Connection], progress) -> Iterator[tuple[str, Batch]]:
+    def _batches(
+        self, connections: list[Connection], progress: tqdm | None
+    ) -> Iterator[tuple[str, Batch]]:
         """The messages of ``connections`` in batches, a storage file after another, and an
         error if a file's messages start before the previous file's end."""
-        spans: dict[str, list] = {}  # file -> [first time, its topic, last time]
+        spans: dict[str, list[Any]] = {}  # file -> [first time, its topic, last time]
         try:
             for file, connection, batch in _storage_batches(self.reader, connections):
                 if progress is not None:
@@ -307,11 +321,11 @@ class Bag:
             raise InputError(
                 f"{self.path} cannot be read: its storage is damaged ({reason})."
             ) from None
-        last = None
+        latest: int | None = None
         for first, topic, end in spans.values():
-            if last is not None and first < last:
-                raise InputError(_out_of_order(self.reader, self.path, topic, first, last))
-            last = end if last is None else max(last, end)
+            if latest is not None and first < latest:
+                raise InputError(_out_of_order(self.reader, self.path, topic, first, latest))
+            latest = end if latest is None else max(latest, end)
 
 
 class _TopicRows:
@@ -322,7 +336,15 @@ class _TopicRows:
     other messages, and other fields, are decoded one by one with rosbags.
     """
 
-    def __init__(self, msgtype, paths: list[str], stamped: bool, typestore, decode, check) -> None:
+    def __init__(
+        self,
+        msgtype: str,
+        paths: list[str],
+        stamped: bool,
+        typestore: Typestore,
+        decode: Callable[[bytes], Any],
+        check: Callable[[bytes, Any], None],
+    ) -> None:
         self.msgtype, self.paths, self.stamped = msgtype, paths, stamped
         self.typestore, self.decode, self.check = typestore, decode, check
         self.extract = _extractor(paths)
@@ -331,7 +353,7 @@ class _TopicRows:
         self.count = 0
         self.bulk: list[np.ndarray] = []  # the fitting messages' first layout.end bytes
         self.bulk_at: list[int] = []
-        self.one_by_one: list[tuple] = []
+        self.one_by_one: list[tuple[Any, ...]] = []
         self.one_by_one_at: list[int] = []
 
     def add(self, batch: Batch) -> None:
@@ -371,7 +393,11 @@ class _TopicRows:
     def table(self, names: list[str], bag_time: bool, with_recorded: bool = False) -> pd.DataFrame:
         count = self.count
         recorded = np.concatenate(self.recorded) if self.recorded else np.zeros(0, np.int64)
-        bulk = columns(self.layout, np.concatenate(self.bulk)) if self.bulk_at else None
+        bulk = (
+            columns(self.layout, np.concatenate(self.bulk))
+            if self.bulk_at and self.layout is not None
+            else None
+        )
         values = {}
         for k, name in enumerate(["_sec", "_nanosec"][: 2 * self.stamped] + names):
             if not self.one_by_one_at:
@@ -409,7 +435,7 @@ def read_bag(
         return bag.tables(columns, bag_time=bag_time)
 
 
-def _extractor(paths: list[str]):
+def _extractor(paths: list[str]) -> Callable[[Any], tuple[Any, ...]]:
     """A function from a message to the tuple of its values at ``paths``."""
     if not paths:
         return lambda message: ()
@@ -417,7 +443,9 @@ def _extractor(paths: list[str]):
     return get if len(paths) > 1 else lambda message: (get(message),)
 
 
-def _table(recorded: np.ndarray, values: dict, names: list[str], bag_time: bool) -> pd.DataFrame:
+def _table(
+    recorded: np.ndarray, values: dict[str, np.ndarray], names: list[str], bag_time: bool
+) -> pd.DataFrame:
     nanos = recorded
     if "_sec" in values and not bag_time:
         stamps = values["_sec"].astype(np.int64) * 1_000_000_000 + values["_nanosec"].astype(
@@ -442,7 +470,7 @@ def _out_of_order(reader: Reader, path: Path, topic: str, recorded: int, last: i
 
 def _storage_files(reader: Reader) -> list[str]:
     with contextlib.suppress(AttributeError):
-        return [str(storage.path) for storage in reader.storage.storages]
+        return [str(storage.path) for storage in _storages(reader)]
     return []
 
 
@@ -465,9 +493,11 @@ def _qos_mismatches(reader: Reader) -> list[str]:
     return sorted(mismatched)
 
 
-def _storages(reader: Reader) -> list:
+def _storages(reader: Reader) -> list[Any]:
+    """The storage files of a directory reader (rosbags' own objects, not part of its typed
+    interface), or none."""
     with contextlib.suppress(AttributeError):
-        return list(reader.storage.storages)
+        return list(getattr(reader.storage, "storages"))  # noqa: B009 -- untyped in rosbags
     return []
 
 
@@ -498,7 +528,9 @@ def _storage_batches(
             yield file, mine[key], batch
 
 
-def _file_batches(storage, mine: Mapping[int, Connection], compressed: bool):
+def _file_batches(
+    storage: Any, mine: Mapping[int, Connection], compressed: bool
+) -> Iterator[tuple[int, Batch]]:
     """One storage file's batches: straight from an indexed MCAP file's chunks, else from
     rosbags' reading message by message."""
     path = getattr(storage, "path", None)
@@ -509,14 +541,10 @@ def _file_batches(storage, mine: Mapping[int, Connection], compressed: bool):
             return
     own = [c for c in storage.connections if c.id in mine]
     plain = (
-        (c.id, t, _decompressed(raw) if compressed else raw)
+        (c.id, t, decompressed(raw) if compressed else raw)
         for c, t, raw in storage.messages(own, None, None)
     )
     yield from gathered(plain)
-
-
-def _decompressed(raw: bytes) -> bytes:
-    return zstd.decompress(raw)  # the zstd rosbags compresses with
 
 
 def _shortest_float32(values: pd.Series) -> pd.Series:
