@@ -89,7 +89,9 @@ bench: install
 
 # The packages whose types mypy checks strictly (settings in pyproject.toml's [tool.mypy]);
 # `make test` checks them too.
-TYPED_PACKAGES := robotale/fame_runtime robotale/neo4j_server robotale/queries.py robotale/files.py robotale/errors.py robotale/config.py
+TYPED_PACKAGES := robotale/fame_runtime robotale/eventlog robotale/neo4j_server robotale/queries.py \
+	robotale/files.py robotale/errors.py robotale/config.py robotale/executors.py robotale/storage.py \
+	robotale/extras.py
 typecheck: install
 	$(BIN)/mypy --strict $(TYPED_PACKAGES)
 

@@ -13,12 +13,13 @@ from __future__ import annotations
 import argparse
 import importlib
 import sys
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from pathlib import Path
 
 from robotale import __version__
 from robotale.errors import RobotaleError
 from robotale.extras import require
+from robotale.thresholds import LOW_BATTERY_PERCENT
 
 #: the namespace key holding the handler's dotted name; subparser keys begin with "_" too
 _HANDLER = "_handler"
@@ -50,6 +51,24 @@ def build_parser() -> argparse.ArgumentParser:
     _add_perspectives(commands)
     _add_report(commands)
     return parser
+
+
+class _Registered:
+    """The choices of an option, read from their registry when an option is checked (so
+    ``robotale --help`` never imports it): ``where`` names a function giving the names."""
+
+    def __init__(self, where: str) -> None:
+        self.where = where
+
+    def _names(self) -> Sequence[str]:
+        module, _, function = self.where.rpartition(".")
+        return getattr(importlib.import_module(module), function)()
+
+    def __contains__(self, name: object) -> bool:
+        return name in self._names()
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._names())
 
 
 def _handled_by(parser: argparse.ArgumentParser, target: str, *, extra: str = "") -> None:
@@ -339,7 +358,9 @@ def _add_executor(parser: argparse.ArgumentParser) -> None:
 
 
 def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
-    """How recordings become an event log; shared by ``prepare`` and ``ingest``."""
+    """How recordings become an event log; shared by ``prepare``, ``ingest`` and ``annotate``.
+    Each ``dest`` is a field of :class:`~robotale.eventlog.options.PrepareOptions` (but
+    ``skip_bad``, which says what to do with a run that cannot be read)."""
     parser.add_argument(
         "--skip-bad",
         dest="skip_bad",
@@ -397,7 +418,7 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
     )
     parser.add_argument(
         "--state-topic",
-        dest="state_topics",
+        dest="states",
         action="append",
         default=None,
         metavar="GLOB[:FIELD]",
@@ -405,6 +426,7 @@ def _add_preparation_options(parser: argparse._ActionsContainer) -> None:
     )
     parser.add_argument(
         "--bt-log",
+        dest="bt_logs",
         metavar="GLOB",
         default=None,
         help="behaviour-tree transition logs whose nodes are activities, e.g. /behavior_tree_log",
@@ -788,9 +810,16 @@ def _add_perspectives(commands: argparse._SubParsersAction) -> None:
         "--threshold",
         type=float,
         metavar="PERCENT",
-        help="battery level counted as low (default: 20)",
+        help=f"battery level counted as low (default: {LOW_BATTERY_PERCENT:g})",
     )
     _add_delay(perspectives)
+    perspectives.add_argument(
+        "--only",
+        action="append",
+        metavar="NAME",
+        choices=_Registered("robotale.enhancement.registry.names"),
+        help="only this perspective (spatial, communication ...); repeatable (default: all)",
+    )
     _handled_by(perspectives, "perspectives.perspectives_command")
 
 
@@ -823,7 +852,7 @@ def _add_report(commands: argparse._SubParsersAction) -> None:
         "--threshold",
         type=float,
         metavar="PERCENT",
-        help="battery level counted as low (default: 20)",
+        help=f"battery level counted as low (default: {LOW_BATTERY_PERCENT:g})",
     )
     _add_delay(report)
     _handled_by(report, "report.report_command")

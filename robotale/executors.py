@@ -39,7 +39,9 @@ class ExecutorSpec:
         return self.kind == DASK
 
     def describe(self) -> str:
-        return f"dask://{self.address.removeprefix('tcp://')}" if self.remote else LOCAL
+        if not self.remote or self.address is None:
+            return LOCAL
+        return f"dask://{self.address.removeprefix('tcp://')}"
 
 
 def parse_executor(text: str | None, workers: int | None = None) -> ExecutorSpec:

@@ -146,10 +146,10 @@ def test_each_option_is_a_typed_keyword_of_its_handler_and_the_library_owns_its_
     parameters = inspect.signature(handler).parameters
     forwarded = next((p for p in parameters.values() if p.kind is p.VAR_KEYWORD), None)
     if forwarded is not None:
-        # prepare and ingest hand the preparation options on to prepare_recordings
-        from robotale.commands.prepare import prepare_recordings
+        # prepare, ingest and annotate hand the preparation options on as PrepareOptions
+        from robotale.eventlog.options import PrepareOptions
 
-        parameters = {**inspect.signature(prepare_recordings).parameters, **parameters}
+        parameters = {**inspect.signature(PrepareOptions).parameters, **parameters}
     for action in _options(parser):
         assert action.dest in parameters, f"{dotted} takes no {action.dest!r}"
         parameter = parameters[action.dest]
@@ -167,6 +167,18 @@ def test_no_part_imports_argparse_the_cli_or_a_command_module():
         if _part(module) != "commands" and module not in ("robotale.cli", "robotale.__main__")
         for line, name in _imports(tree, module)
         if name == "argparse" or name.startswith(("robotale.commands", "robotale.cli"))
+    ]
+    assert found == []
+
+
+def test_no_command_module_imports_another():
+    # what two commands share lives in the part that owns it, below the commands
+    found = [
+        f"{path} imports {name}"
+        for module, path, tree in MODULES
+        if _part(module) == "commands" and module != "robotale.commands"
+        for name in _runtime_imports(tree, module)
+        if _part(name) == "commands" and name not in (module, "robotale.commands")
     ]
     assert found == []
 
@@ -301,6 +313,25 @@ def test_each_fact_is_written_in_one_module():
         and [getattr(e, "value", None) for e in node.elts] == ["robot", "msg_id"]
     ]
     assert default_entities == []
+
+
+def test_the_low_battery_level_is_written_once():
+    # a battery threshold's default is the shared constant, never a number written again
+    written = [
+        f"{path}:{default.lineno}"
+        for _, path, tree in MODULES
+        for node in ast.walk(tree)
+        if isinstance(node, ast.arguments)
+        for arg, default in [
+            *zip(reversed(node.args), reversed(node.defaults), strict=False),
+            *zip(node.kwonlyargs, node.kw_defaults, strict=True),
+        ]
+        if arg.arg == "threshold"
+        and isinstance(default, ast.Constant)
+        and default.value is not None
+    ]
+    assert written == []
+    assert _holders(lambda t: "(default: 20)" in t) == set()
 
 
 def test_labels_splitting_and_file_writes_each_have_one_function():

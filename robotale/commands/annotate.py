@@ -9,7 +9,6 @@ deviations from the BPMN model (:mod:`robotale.eventlog.annotated`).
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
@@ -23,10 +22,12 @@ from robotale.errors import InputError
 from robotale.eventlog import schema
 from robotale.eventlog.annotated import INFO, WARN, Entry, activity_states, write_annotated
 from robotale.eventlog.enrich import pair_activities
+from robotale.eventlog.interfaces import message_types
+from robotale.eventlog.options import PrepareOptions
 from robotale.eventlog.prepare import find_runs
-from robotale.eventlog.rosbag import Bag, check_distro, message_types
-
-from .prepare import prepare_recordings
+from robotale.eventlog.preparing import prepare_recordings
+from robotale.eventlog.rosbag import Bag
+from robotale.eventlog.typesys import check_distro
 
 CASE, TIME, ROBOT, ACTIVITY = schema.CASE, schema.TIMESTAMP, schema.ROBOT, schema.ACTIVITY
 
@@ -35,13 +36,12 @@ def annotate_command(
     source: Path,
     out: Path,
     model: Path | None = None,
-    msg_files: Sequence[str] = (),
-    distro: str | None = None,
     skip_bad: bool = False,
     **options: Any,
 ) -> int:
     """Write ``out/<run>/`` for every run of ``source``: an MCAP rosbag2 copy of the run with
-    the added topics; ``options`` are those of ``prepare``. With ``skip_bad`` a run that
+    the added topics; ``options`` are the fields of
+    :class:`~robotale.eventlog.options.PrepareOptions`. With ``skip_bad`` a run that
     cannot be read is named and left out, as ``prepare --skip-bad`` does."""
     runs = find_runs(source)
     taken = [out / run.name for run in runs if (out / run.name).exists()]
@@ -51,9 +51,10 @@ def annotate_command(
         raise InputError(f"The model {model} does not exist.")
     # the added topics need activities and messages only: no perspective (the odometry a
     # bag is mostly made of) is read unless one is asked for
-    options = {"perspectives": "", **options, "rate": 0.0}
+    preparation = PrepareOptions.given({"perspectives": "", **options, "rate": 0.0})
+    msg_files, distro = preparation.msg_files, preparation.distro
     skipped: list[Path] | None = [] if skip_bad else None
-    log = prepare_recordings(source, msg_files=msg_files, distro=distro, skipped=skipped, **options)
+    log = prepare_recordings(source, preparation, skipped=skipped)
     if skipped:
         runs = [run for run in runs if run not in skipped]
     names = sorted(log[ACTIVITY].dropna().astype(str).unique())

@@ -15,18 +15,17 @@ from pathlib import Path
 
 import pandas as pd
 
-from robotale.commands.ingest import store
-from robotale.commands.prepare import prepare_reporting
-from robotale.commands.simulate import print_summary
 from robotale.config import robotale_home
 from robotale.ekg.connection import connect
 from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
 from robotale.errors import InputError
+from robotale.eventlog.preparing import prepare_reporting
 from robotale.eventlog.readers import read_log
 from robotale.eventlog.writers import write_csv
 from robotale.neo4j_server.server import LocalServer, ServerOptions
+from robotale.results.storing import store
 from robotale.sim import scenarios
-from robotale.sim.batch import simulate_batch
+from robotale.sim.batch import print_summary, simulate_batch
 from robotale.sim.plans import check, plans, resolve_world
 from robotale.webapp.model_store import attach_model
 from robotale.webapp.serve import Dashboard, serve_until_interrupted

@@ -6,7 +6,6 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
-from robotale.commands.logsource import read_event_log, values
 from robotale.discovery.conformance import check_conformance
 from robotale.discovery.dfg import discover_dfg
 from robotale.discovery.ekg import discover_ekg
@@ -14,6 +13,7 @@ from robotale.discovery.filters import LogFilter
 from robotale.discovery.graph import ProcessGraph
 from robotale.discovery.output import write_texts
 from robotale.discovery.render import graph_to_svg, require_dot
+from robotale.results.eventlogs import read_event_log
 
 
 def dfg_command(
@@ -114,3 +114,8 @@ def emit_graph(
     written = " and ".join(str(path) for path, _ in outputs)
     print(f"{graph.kind.upper()}: {activities} activities, {len(graph.edges)} edges -> {written}")
     return 0
+
+
+def values(lists: Sequence[str] | None) -> tuple[str, ...]:
+    """Repeated and comma-separated option values as one tuple."""
+    return tuple(v.strip() for item in lists or [] for v in item.split(",") if v.strip())

@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import sys
 from collections.abc import Mapping, Sequence
+from functools import partial
 from pathlib import Path
 from typing import Any, TextIO
 
@@ -24,6 +25,7 @@ from robotale.fame_runtime.library import Library
 from robotale.fame_runtime.mission import Mission
 from robotale.fame_runtime.model import Definitions, Problem
 from robotale.fame_runtime.parser import ReadError, parse, parse_all
+from robotale.fame_runtime.processes import run_processes
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.splitter import split, unbound_pools, write_split
 from robotale.fame_runtime.tags import tag_line
@@ -189,7 +191,7 @@ def run_command(
     if bus == "dds":
         require("dds")  # before any robot's process is started
         # Cyclone DDS is an optional extra (robotale[dds]) and 0.9 s to import: --bus dds only
-        from robotale.commands.fame_dds import run_processes
+        from robotale.sim.live_recording import LiveRecording
 
         return run_processes(
             model,
@@ -199,7 +201,7 @@ def run_command(
             until=until,
             assignments=assignments,
             start=start,
-            record=record,
+            record=None if record is None else partial(LiveRecording, record),
             out=out,
             err=err,
         )

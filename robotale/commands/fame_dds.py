@@ -1,15 +1,12 @@
-"""``robotale fame node``, ``fame run --bus dds`` and ``robotale record``: missions as one
-process per robot over Cyclone DDS, and rosbag2 recordings of live topics."""
+"""``robotale fame node`` and ``robotale record``: one robot's engine as its own process over
+Cyclone DDS, and rosbag2 recordings of live topics."""
 
 from __future__ import annotations
 
-import signal
-import subprocess
 import sys
 import threading
 import time
 from collections.abc import Sequence
-from contextlib import suppress
 from pathlib import Path
 from typing import TYPE_CHECKING, TextIO
 
@@ -24,15 +21,12 @@ from robotale.fame_runtime.launch import (
 )
 from robotale.fame_runtime.node import Node
 from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.processes import interrupts
 from robotale.fame_runtime.skills import load_skills
-from robotale.fame_runtime.splitter import split
 from robotale.fame_runtime.tags import tag_line
 
 if TYPE_CHECKING:
     from robotale.sim.live_recording import LiveRecording
-
-#: seconds a run waits for its robots beyond ``until`` before ending them
-GRACE = 30.0
 
 
 def node_command(
@@ -74,26 +68,10 @@ def node_command(
         wait_for_recorder=recorder,
     )
     # a second Ctrl-C (a terminal's and fame run's own) must not cut the closing short
-    with _interrupts(node.interrupt):
+    with interrupts(node.interrupt):
         node.run(until=begin + until, wait=wait, warn=lambda text: print(f"# {text}", file=err))
         bus.close()
         return _node_verdict(node, begin, err)
-
-
-class _interrupts:
-    """SIGINT and SIGTERM call ``handler`` instead of ending the process at once."""
-
-    def __init__(self, handler) -> None:
-        self.handler = handler
-
-    def __enter__(self) -> None:
-        self.saved = {
-            s: signal.signal(s, lambda *_: self.handler()) for s in (signal.SIGINT, signal.SIGTERM)
-        }
-
-    def __exit__(self, *exc) -> None:
-        for number, saved in self.saved.items():
-            signal.signal(number, saved)
 
 
 def _node_verdict(node: Node, begin: float, err: TextIO) -> int:
@@ -117,101 +95,6 @@ def _node_verdict(node: Node, begin: float, err: TextIO) -> int:
     if node.interrupted:
         return 130
     return 1 if engine.failures or not engine.idle else 0
-
-
-def run_processes(
-    model: Path,
-    *,
-    robots: str | None,
-    skills: str | None,
-    library: Path | None,
-    until: float,
-    assignments: Sequence[str],
-    start: str | None,
-    record: Path | None,
-    out: TextIO,
-    err: TextIO,
-) -> int:
-    """``fame run --bus dds``: one ``fame node`` process per robot, their tags printed as
-    they come, recorded into a rosbag2 with every other topic when ``record`` is given."""
-    definitions = parse(model)
-    names = [a.robot for a in split(definitions, robot_list(robots))]
-    begin = start_time(start)
-    offset = begin - time.time()
-    recording = _recording(record, names, offset) if record is not None else None
-    command = [sys.executable, "-m", "robotale", "fame", "node", str(model)]
-    command += ["--robots", ",".join(names), "--until", repr(until)]
-    command += [f"--clock-offset={offset!r}", f"--origin={begin!r}"]
-    for option, value in (("--skills", skills), ("--library", library)):
-        if value is not None:
-            command += [option, str(value)]
-    for assignment in assignments:
-        command += ["--set", assignment]
-    if recording is not None:
-        command.append("--wait-for-recorder")
-    children = [
-        subprocess.Popen(
-            [*command, "--robot", robot], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
-        )
-        for robot in names
-    ]
-    relays = [_relay(c.stdout, out) for c in children] + [_relay(c.stderr, err) for c in children]
-    # Ctrl-C (or SIGTERM) sets a flag: an exception could cut the recording mid-write
-    interrupted = threading.Event()
-    try:
-        with _interrupts(interrupted.set):
-            _wait(children, recording, time.monotonic() + until + GRACE, interrupted)
-            if interrupted.is_set():
-                for child in children:  # each robot runs its safe-state handler, then ends
-                    with suppress(ProcessLookupError):
-                        child.send_signal(signal.SIGINT)
-                _wait(children, recording, time.monotonic() + GRACE)
-    finally:
-        for child in children:
-            if child.poll() is None:
-                child.kill()
-                child.wait()
-        for relay in relays:
-            relay.join(timeout=5)
-        if recording is not None:
-            recording.close(err)
-    # a child ended by a signal has a negative code: the shell's 128 + signal instead
-    codes = [c.returncode if c.returncode >= 0 else 128 - c.returncode for c in children]
-    return next((code for code in codes if code), 0)
-
-
-def _relay(stream, sink: TextIO) -> threading.Thread:
-    lock = _SINK_LOCKS.setdefault(id(sink), threading.Lock())
-
-    def copy() -> None:
-        for line in stream:
-            with lock:
-                sink.write(line)
-                sink.flush()
-
-    thread = threading.Thread(target=copy, daemon=True)
-    thread.start()
-    return thread
-
-
-_SINK_LOCKS: dict[int, threading.Lock] = {}
-
-
-def _wait(
-    children,
-    recording: LiveRecording | None,
-    deadline: float,
-    interrupted: threading.Event | None = None,
-) -> None:
-    """Until every child ended (or ``deadline``, or an interrupt), recording what arrives
-    meanwhile."""
-    while any(c.poll() is None for c in children) and time.monotonic() < deadline:
-        if interrupted is not None and interrupted.is_set():
-            return
-        if recording is not None:
-            recording.pump(0.05)
-        else:
-            time.sleep(0.05)
 
 
 def _recording(path: Path, robots: list[str], offset: float) -> LiveRecording:
@@ -239,7 +122,7 @@ def record_command(
     deadline = time.monotonic() + duration if duration is not None else float("inf")
     stopped = threading.Event()
     # Ctrl-C or SIGTERM ends a recording: the bag is closed whole below
-    with _interrupts(stopped.set):
+    with interrupts(stopped.set):
         print(f"# recording {out_dir} (Ctrl-C stops)", file=err, flush=True)
         try:
             while time.monotonic() < deadline and not stopped.is_set():

@@ -7,21 +7,19 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
-import pandas as pd
-from neo4j import Driver
-
-from robotale.commands.prepare import kept_runs, prepare_recordings
 from robotale.ekg.append import append_ekg
-from robotale.ekg.build import BuildSummary, build_ekg, why
+from robotale.ekg.build import build_ekg
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
-from robotale.eventlog.readers import is_parquet, parse_mapping, read_with_objects
+from robotale.eventlog.logkinds import RECORDINGS
+from robotale.eventlog.logsource import log_name, open_log
+from robotale.eventlog.options import PrepareOptions
+from robotale.eventlog.preparing import kept_runs
 from robotale.eventlog.reading import format_reading
-from robotale.results.findings import prepare
-from robotale.results.logdata import LogData
+from robotale.results.storing import describe, prepare_pages
 
 
 def ingest_command(
@@ -35,65 +33,37 @@ def ingest_command(
     case_gap: str | None = None,
     replace: bool = False,
     append: bool = False,
-    tags: str | None = None,
-    tag_fields: Sequence[str] = (),
-    perspectives: str | None = None,
-    rate: float | None = None,
-    msg_files: Sequence[str] = (),
-    bag_time: bool = False,
     objects: Path | None = None,
     skip_bad: bool = False,
-    **recording: Any,
+    **preparation: Any,
 ) -> int:
-    """Store the log at ``path`` (CSV, XES, OCEL 2.0, or recordings prepared as ``prepare``
-    does) in Neo4j as ``log`` (default: the file's or folder's name); ``recording`` holds the
-    other options of :func:`~robotale.commands.prepare.prepare_recordings` (--actions, --auto
-    ...). With ``append`` its runs are added to the stored log of that name. ``objects``: the
-    folder of a CSV log's object tables (``<Type>.csv``). An object-centric log's object types
-    are its entity types unless ``entities`` names others."""
+    """Store the log at ``path`` (CSV, XES, OCEL 2.0, Parquet, or recordings prepared as
+    ``prepare`` does) in Neo4j as ``log`` (default: the file's or folder's name);
+    ``preparation`` holds the fields of :class:`~robotale.eventlog.options.PrepareOptions`
+    (--tags, --actions, --auto ...). With ``append`` its runs are added to the stored log of
+    that name. ``objects``: the folder of a CSV log's object tables (``<Type>.csv``). An
+    object-centric log's object types are its entity types unless ``entities`` names others."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
-    found_objects = None
     if log is not None and not log.strip():
         raise InputError(
             f"--log {log!r} names no log: give it a name, or leave --log out to use "
             f"{log_name(path)!r}."
         )
-    skipped: list[Path] | None = None
-    if path.is_dir() and not is_parquet(path):
-        if objects is not None:
-            raise InputError(
-                f"{path} holds recordings: --objects applies to a CSV event log with one "
-                "column per object type."
-            )
-        if mapping or case:
-            raise InputError(
-                f"{path} holds recordings: --map and --case apply to CSV and XES files "
-                "(each run of a recording is its own case)."
-            )
-        if case_gap:
-            raise InputError(
-                f"{path} holds recordings: --case-gap applies to CSV and XES files "
-                "(each run of a recording is its own case)."
-            )
-        skipped = [] if skip_bad else None
-        events = prepare_recordings(
-            path,
-            tags=tags,
-            tag_fields=tag_fields,
-            perspectives=perspectives,
-            rate=rate,
-            msg_files=msg_files,
-            bag_time=bag_time,
-            skipped=skipped,
-            **recording,
-        )
-    else:
-        events, reading, found_objects = read_with_objects(
-            path, parse_mapping(mapping), case, case_gap, objects
-        )
+    skipped: list[Path] | None = [] if skip_bad else None
+    opened = open_log(
+        path,
+        mapping=mapping,
+        case=case,
+        case_gap=case_gap,
+        objects=objects,
+        preparation=PrepareOptions.given(preparation),
+        skipped=skipped,
+    )
+    events, found_objects = opened.events, opened.objects
+    if opened.reading is not None:
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
-        print(format_reading(reading, short=True))
+        print(format_reading(opened.reading, short=True))
     if append and found_objects is not None:
         raise InputError(
             f"{path} is object-centric: --append adds runs of a log with cases; rebuild the "
@@ -122,35 +92,9 @@ def ingest_command(
             )
         print(describe(summary, appended=append))
         prepare_pages(driver, name)
-    if skipped is not None:
+    if skipped is not None and opened.kind is RECORDINGS:
         print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
-
-
-def prepare_pages(driver: Driver, name: str) -> None:
-    """Compute what the dashboard shows first of the stored log ``name`` (its findings,
-    perspectives, runs and first timeline), kept with its build, so the first visit computes
-    nothing. The log is stored already: a failure here only leaves that work to the visit."""
-    print("preparing the dashboard's findings, perspectives and timeline ...", flush=True)
-    try:
-        prepare(driver, LogData(), name)
-    except Exception as error:  # the log is stored: a page's failure is said, not raised
-        print(f"  not prepared ({why(error)}): the dashboard computes them on the first visit")
-
-
-def store(log: pd.DataFrame, name: str, source: Path, **keys: Sequence[str]) -> None:
-    """Store a log read elsewhere (``demo``) under ``name``, replacing one of that name."""
-    with session_driver() as driver:
-        summary = build_ekg(driver, log, name, replace=True, source=str(source), **keys)
-        print(describe(summary))
-        prepare_pages(driver, name)
-
-
-def log_name(path: Path) -> str:
-    """A log's default name: the file's stem, or the folder's name (also for ``.``)."""
-    if is_parquet(path):  # a dataset folder is named like a file: agri.parquet
-        return path.resolve().stem
-    return path.resolve().name if path.is_dir() else path.stem
 
 
 def logs_list() -> int:
@@ -193,19 +137,3 @@ def logs_delete(name: str) -> int:
 
 def split_names(text: str) -> list[str]:
     return [name.strip() for name in text.split(",") if name.strip()]
-
-
-def describe(summary: BuildSummary, appended: bool = False) -> str:
-    def counts(values: dict[str, int]) -> str:
-        return ", ".join(f"{k} {v:,}" for k, v in sorted(values.items())) or "-"
-
-    what = "appended" if appended else "events"
-    return "\n".join(
-        [
-            f"Log {summary.log!r}: {summary.events:,} {what} in {summary.seconds:.1f} s",
-            f"  entities  {counts(summary.entities)} (CORR {summary.corr:,})",
-            f"  DF        {counts(summary.df)}",
-            f"  COMM      {summary.comm:,}",
-            f"  DF_C      {counts(summary.df_c)}",
-        ]
-    )

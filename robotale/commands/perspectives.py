@@ -1,14 +1,15 @@
-"""``robotale perspectives``: spatial, communication, battery and performance perspectives."""
+"""``robotale perspectives``: the perspectives of :mod:`robotale.enhancement.registry`."""
 
 from __future__ import annotations
 
 from collections.abc import Sequence
 from pathlib import Path
 
-from robotale.commands.logsource import read_event_log
+from robotale.enhancement.registry import perspective_kind
 from robotale.enhancement.report import all_perspectives, write_report
 from robotale.enhancement.spatial import Field
 from robotale.errors import InputError, require_range
+from robotale.results.eventlogs import read_event_log
 
 
 def perspectives_command(
@@ -25,8 +26,10 @@ def perspectives_command(
     field: str | None = None,
     threshold: float | None = None,
     delay: float | None = None,
+    only: Sequence[str] | None = None,
 ) -> int:
-    """The perspectives of a log (a file or ``log_name``) as HTML (``out``) and/or JSON."""
+    """The perspectives of a log (a file or ``log_name``) as HTML (``out``) and/or JSON; all
+    of them, or those named in ``only``."""
     if not out and not json_out:
         raise InputError("say where the report goes: --out report.html and/or --json report.json.")
     if threshold is not None:
@@ -38,40 +41,12 @@ def perspectives_command(
         log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
     )
     options = {"delay_threshold": delay} | ({} if threshold is None else {"threshold": threshold})
-    results = all_perspectives(events, activity=activity, robot=robot, field=area, **options)
+    results = all_perspectives(
+        events, activity=activity, robot=robot, field=area, only=only, **options
+    )
     title = f"robotale perspectives: {log_name or Path(log or '').name}"
     write_report(results, html_path=out, json_path=json_out, title=title)
     for name, result in results.items():
-        print(f"{name:>13}: {result.message or _headline(name, result.summary)}")
+        headline = perspective_kind(name).headline
+        print(f"{name:>13}: {result.message or headline(result.summary)}")
     return 0
-
-
-def _headline(name: str, summary: dict) -> str:
-    if name == "spatial":
-        covered = summary.get("field", {}).get("covered_fraction")
-        field = f", {covered:.0%} of the field covered" if covered is not None else ""
-        return f"{summary['positions']} positions{field}"
-    if name == "communication":
-        return (
-            f"{summary['messages']} messages, {summary['received']} received, "
-            f"{summary['lost']} lost, {summary.get('unobserved', 0)} not observed as received, "
-            f"{summary['resends']} resends "
-            f"({summary.get('resends_new_id', 0)} under a new id), "
-            f"{summary.get('delayed', 0)} delayed, {summary.get('channels', 0)} channels"
-        )
-    if name == "battery":
-        per_run = summary.get("used_per_run")
-        used = (
-            summary.get("battery_levels")
-            if not per_run
-            else "used per run: " + ", ".join(f"{r} {u:.1f}%" for r, u in per_run.items())
-        )
-        return f"{summary['low_battery_events']} low-battery events; {used}"
-    if name == "performance":
-        share = summary.get("waiting_share")
-        waiting = "" if share is None else f", robots wait {share:.0%} of their time"
-        return (
-            f"{summary['cases']} cases, {summary.get('variants', 0)} variants{waiting}, "
-            f"slowest transition {summary['slowest_transition']}"
-        )
-    return f"first: {summary['first']}"

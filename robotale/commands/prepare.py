@@ -1,13 +1,9 @@
-"""``robotale prepare``: rosbag2 recordings into an event log; also the preparation that
-``ingest`` and ``demo`` run on recordings."""
+"""``robotale prepare``: rosbag2 recordings into an event log (CSV, a Parquet dataset, XES,
+OCEL 2.0)."""
 
 from __future__ import annotations
 
-import sys
 import tempfile
-import warnings
-from collections.abc import Callable, Iterator, Sequence
-from contextlib import contextmanager
 from pathlib import Path
 from typing import Any
 
@@ -15,8 +11,14 @@ import pandas as pd
 
 from robotale.errors import InputError
 from robotale.eventlog import writers
-from robotale.eventlog.enrich import PreparationWarning
-from robotale.eventlog.prepare import TagFields, find_runs, prepare, prepare_dataset
+from robotale.eventlog.options import PrepareOptions
+from robotale.eventlog.prepare import find_runs, prepare_dataset
+from robotale.eventlog.preparing import (
+    kept_runs,
+    preparation_warnings,
+    prepare_recordings,
+    report_choice,
+)
 from robotale.eventlog.readers import read_log
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.storage import Place, is_url, local_path, place
@@ -36,7 +38,8 @@ def prepare_command(
     ``<source name>.csv`` when no other output is asked for) or, when ``out`` ends in
     ``.parquet``, as a Parquet dataset partitioned by run; also XES and/or OCEL 2.0.
     ``out`` may be an fsspec URL. ``executor`` (``local[:N]``, ``dask://HOST:PORT``) reads the
-    runs in parallel; ``options`` are those of :func:`prepare_recordings`. With ``skip_bad``
+    runs in parallel; ``options`` are the fields of
+    :class:`~robotale.eventlog.options.PrepareOptions`. With ``skip_bad``
     a run that cannot be read is left out, named with why on stderr."""
     if out is not None and is_dataset_name(out):
         if skip_bad:
@@ -51,7 +54,9 @@ def prepare_command(
             writers.check_target(target)
     csv_place = _csv_place(csv) if csv is not None else None
     skipped: list[Path] | None = [] if skip_bad else None
-    log = prepare_recordings(source, executor=executor, skipped=skipped, **options)
+    log = prepare_recordings(
+        source, PrepareOptions.given(options), executor=executor, skipped=skipped
+    )
     written = []
     if csv_place is not None:
         _write_csv(log, csv_place)
@@ -62,12 +67,6 @@ def prepare_command(
     if skipped is not None:
         print(kept_runs(cases, skipped))
     return 0
-
-
-def kept_runs(kept: int, skipped: Sequence[Path]) -> str:
-    """How many runs a ``--skip-bad`` preparation kept, and which it left out."""
-    left_out = f"; skipped {len(skipped)}: {', '.join(run.name for run in skipped)}"
-    return f"kept {kept} of {kept + len(skipped)} run(s){left_out if skipped else ''}"
 
 
 def _also_written(
@@ -128,9 +127,14 @@ def _prepare_dataset(
     for target in (xes, ocel):
         if target is not None:
             writers.check_target(target)
-    with _preparation_warnings():
+    with preparation_warnings():
         manifest = prepare_dataset(
-            source, out, progress=True, report=_report, executor=executor, **_given(options)
+            source,
+            out,
+            progress=True,
+            report=report_choice,
+            executor=executor,
+            **PrepareOptions.given(options).keywords(),
         )
     written = [out]
     if local is not None and (xes or ocel):
@@ -140,105 +144,3 @@ def _prepare_dataset(
         f"{', '.join(written)}"
     )
     return 0
-
-
-def prepare_recordings(
-    source: Path,
-    *,
-    tags: str | None = None,
-    tag_fields: Sequence[str] = (),
-    perspectives: str | None = None,
-    rate: float | None = None,
-    msg_files: Sequence[str] = (),
-    bag_time: bool = False,
-    lifecycle: str | None = None,
-    actions: str | None = None,
-    state_topics: Sequence[str] = (),
-    bt_log: str | None = None,
-    auto: bool = False,
-    distro: str | None = None,
-    robot: str | None = None,
-    executor: str | None = None,
-    skipped: list[Path] | None = None,
-) -> pd.DataFrame:
-    """The event log of the recordings at ``source``; an option left ``None`` takes
-    :func:`~robotale.eventlog.prepare.prepare`'s default (``executor``: read in this process).
-    Given a list ``skipped``, a run that cannot be read is left out, added to it and named
-    with why on stderr; without, it stops the preparation before anything is written."""
-    options = {
-        "tags": tags,
-        "tag_fields": tag_fields,
-        "perspectives": perspectives,
-        "rate": rate,
-        "msg_files": msg_files,
-        "bag_time": bag_time,
-        "lifecycle": lifecycle,
-        "actions": actions,
-        "state_topics": state_topics,
-        "bt_log": bt_log,
-        "auto": auto,
-        "distro": distro,
-        "robot": robot,
-    }
-    skip = None if skipped is None else _skipping(skipped)
-    return prepare_reporting(source, executor=executor, skip_bad=skip, **_given(options))
-
-
-def _skipping(skipped: list[Path]) -> Callable[[Path, str], None]:
-    def skip(run: Path, why: str) -> None:
-        skipped.append(run)
-        print(f"robotale: skipped {run.name}: {why}", file=sys.stderr)
-
-    return skip
-
-
-def _given(options: dict[str, Any]) -> dict[str, Any]:
-    """The command line's preparation options as :func:`prepare` takes them; one left
-    ``None`` takes its default."""
-    perspectives = options.get("perspectives")
-    given: dict[str, Any] = {
-        "tags": options.get("tags"),
-        "perspectives": (
-            None if perspectives is None else [p for p in perspectives.split(",") if p.strip()]
-        ),
-        "rate": options.get("rate"),
-    }
-    return {
-        "tag_fields": TagFields.parse(options.get("tag_fields") or ()),
-        "msg_files": options.get("msg_files") or (),
-        "bag_time": bool(options.get("bag_time")),
-        "lifecycle": options.get("lifecycle"),
-        "actions": options.get("actions"),
-        "states": list(options.get("state_topics") or ()),
-        "bt_logs": options.get("bt_log"),
-        "auto": bool(options.get("auto")),
-        "distro": options.get("distro"),
-        "robot": options.get("robot"),
-        **{key: value for key, value in given.items() if value is not None},
-    }
-
-
-def prepare_reporting(source: Path, **options: Any) -> pd.DataFrame:
-    """:func:`~robotale.eventlog.prepare.prepare` with a progress bar, its warnings (completes
-    without a start ...) on stderr as one ``robotale: warning:`` line each."""
-    with _preparation_warnings():
-        return prepare(source, progress=True, report=_report, **options)
-
-
-@contextmanager
-def _preparation_warnings() -> Iterator[None]:
-    """The preparation's warnings said on stderr, one ``robotale: warning:`` line each (also
-    those said before a failure)."""
-    with warnings.catch_warnings(record=True) as caught:
-        warnings.simplefilter("always", PreparationWarning)
-        try:
-            yield
-        finally:
-            for warning in caught:
-                if issubclass(warning.category, PreparationWarning):
-                    print(f"robotale: warning: {warning.message}", file=sys.stderr)
-
-
-def _report(text: str) -> None:
-    """What the preparation chose (``--auto``), on stderr so that stdout stays the summary."""
-    print(f"robotale: {text}", file=sys.stderr)

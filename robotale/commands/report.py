@@ -6,10 +6,10 @@ from __future__ import annotations
 from collections.abc import Sequence
 from pathlib import Path
 
-from robotale.commands.logsource import read_event_log
 from robotale.enhancement.findings import find
 from robotale.enhancement.findings_report import findings_text, write_findings
 from robotale.errors import require_range
+from robotale.results.eventlogs import read_event_log
 
 
 def report_command(

@@ -15,7 +15,7 @@ from typing import Any, TextIO
 from robotale.errors import InputError
 from robotale.fame_runtime.clock import EngineCost
 from robotale.sim import stopping
-from robotale.sim.batch import SUMMARY, simulate_batch
+from robotale.sim.batch import print_summary, simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world
 from robotale.sim.run import CRASHED, RunPlan
 from robotale.sim.worldspec import World
@@ -196,30 +196,6 @@ def print_table_of(world: World, cells, out: TextIO) -> None:
     what = ", ".join(f"{k} {v:g} s" for k, v in cost.as_dict().items()) if cost else "none"
     print(f"engine cost: {what}", file=out)
     stopping.print_table(cells, out)
-
-
-def print_summary(summary: dict[str, Any], target: str | Path, out: TextIO) -> None:
-    outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
-    runs, workers = summary["runs"], summary["workers"]
-    where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
-    if "executor" in summary:
-        where += f" on {summary['executor']}"
-    print(
-        f"{runs} run{'s' if runs != 1 else ''} of {summary['scenario']} "
-        f"in {summary['wall_time']:.1f} s ({where}): {outcomes}",
-        file=out,
-    )
-    for case in summary["cases"]:
-        if case["status"] != "ended":
-            reason = f": {case['reason']}" if case["reason"] else ""
-            print(f"  {case['case']} {case['status']}{reason}", file=out)
-    for kind, verb in (("weeds", "cut"), ("targets", "destroyed")):
-        totals = [c[kind] for c in summary["cases"] if kind in c]
-        if totals:
-            done = sum(t[verb] for t in totals)
-            print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
-    summary_file = f"{str(target).rstrip('/')}/{SUMMARY}"
-    print(f"recorded in {target} (summary: {summary_file})", file=out)
 
 
 def _engine_cost(text: str) -> EngineCost:

@@ -35,6 +35,7 @@ from robotale.enhancement.result import (
     no_data,
 )
 from robotale.eventlog.schema import ACTIVITY, BATTERY, CASE, ROBOT, TIMESTAMP
+from robotale.thresholds import LOW_BATTERY_PERCENT
 
 LOW_ACTIVITY = "low_battery"
 NO_LEVELS = "no battery levels"
@@ -47,7 +48,7 @@ def battery_perspective(
     *,
     activity: str | None = None,
     robot: str | None = None,
-    threshold: float = 20.0,
+    threshold: float = LOW_BATTERY_PERCENT,
     low_activity: str | None = LOW_ACTIVITY,
     following: int = 3,
 ) -> Perspective:
@@ -86,7 +87,10 @@ def battery_perspective(
 
 
 def low_battery_events(
-    log: pd.DataFrame, *, threshold: float = 20.0, low_activity: str | None = LOW_ACTIVITY
+    log: pd.DataFrame,
+    *,
+    threshold: float = LOW_BATTERY_PERCENT,
+    low_activity: str | None = LOW_ACTIVITY,
 ) -> pd.DataFrame:
     """When each robot's battery fell below ``threshold``, and the events of ``low_activity``."""
     return _low_battery_events(log, _levels(log), threshold, low_activity)

@@ -37,6 +37,7 @@ from robotale.enhancement.encounters import (
 from robotale.enhancement.performance import ARROW, performance_perspective
 from robotale.enhancement.result import Perspective
 from robotale.eventlog.schema import CASE, ROBOT, X, Y, Z
+from robotale.thresholds import LOW_BATTERY_PERCENT
 
 #: how many variants and bottlenecks an answer names
 MAIN = 3
@@ -86,7 +87,10 @@ class Findings:
 
 
 def find(
-    log: pd.DataFrame, *, threshold: float = 20.0, delay_threshold: float | None = None
+    log: pd.DataFrame,
+    *,
+    threshold: float = LOW_BATTERY_PERCENT,
+    delay_threshold: float | None = None,
 ) -> Findings:
     """The answers to the five questions for ``log`` (``threshold``: the battery level, in
     percent, below which a robot's battery counts as low; ``delay_threshold``: the latency in
@@ -382,8 +386,9 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         )
     if lows.empty:
         answer.sentences.append(
-            f"No robot's battery ran low (below {summary.get('threshold', 20):g}%), so battery "
-            "did not hold the mission back."
+            f"No robot's battery ran low (below "
+            f"{summary.get('threshold', LOW_BATTERY_PERCENT):g}%), so battery did not hold the "
+            "mission back."
         )
         return answer
     affected = sorted(lows["case"].astype(str).unique()) if "case" in lows else []

@@ -4,18 +4,17 @@ from __future__ import annotations
 
 import html
 import json
+from collections.abc import Sequence
 from pathlib import Path
 
 import pandas as pd
 
 from robotale.discovery.output import write_texts
-from robotale.enhancement.battery import battery_perspective
-from robotale.enhancement.bottlenecks import find_bottlenecks
-from robotale.enhancement.communication import communication_perspective
 from robotale.enhancement.context import LogAnalysis, analysis_of
-from robotale.enhancement.performance import performance_perspective
+from robotale.enhancement.registry import PERSPECTIVES
 from robotale.enhancement.result import Perspective
-from robotale.enhancement.spatial import Field, spatial_perspective
+from robotale.enhancement.spatial import Field
+from robotale.thresholds import LOW_BATTERY_PERCENT
 
 
 def all_perspectives(
@@ -24,22 +23,21 @@ def all_perspectives(
     activity: str | None = None,
     robot: str | None = None,
     field: Field | None = None,
-    threshold: float = 20.0,
+    threshold: float = LOW_BATTERY_PERCENT,
     delay_threshold: float | None = None,
+    only: Sequence[str] | None = None,
 ) -> dict[str, Perspective]:
-    """Spatial, communication, battery, performance and bottlenecks, for the whole log or for
-    one activity and/or robot; a message is delayed above ``delay_threshold`` seconds (else
-    by the rule of :mod:`robotale.enhancement.delays`)."""
+    """Every perspective of :data:`~robotale.enhancement.registry.PERSPECTIVES` (or those
+    named in ``only``), for the whole log or for one activity and/or robot; a message is
+    delayed above ``delay_threshold`` seconds (else by the rule of
+    :mod:`robotale.enhancement.delays`)."""
     focus = {"activity": activity, "robot": robot}
+    options = {"field": field, "threshold": threshold, "delay_threshold": delay_threshold}
     analysis = analysis_of(log)  # instances, steps, cases and messages built once for all
     return {
-        "spatial": spatial_perspective(analysis, field=field, **focus),
-        "communication": communication_perspective(
-            analysis, delay_threshold=delay_threshold, **focus
-        ),
-        "battery": battery_perspective(analysis, threshold=threshold, **focus),
-        "performance": performance_perspective(analysis, **focus),
-        "bottlenecks": find_bottlenecks(analysis, **focus),
+        kind.name: kind.compute(analysis, **focus, **kind.taken(options))
+        for kind in PERSPECTIVES
+        if only is None or kind.name in only
     }
 
 

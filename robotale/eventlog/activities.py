@@ -23,6 +23,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -91,13 +92,13 @@ def goal_events(table: pd.DataFrame, topic: str, column: str = "status_list") ->
     return events
 
 
-def _stamp(stamp) -> pd.Timestamp | None:
+def _stamp(stamp: Any) -> pd.Timestamp | None:  # a decoded builtin_interfaces/msg/Time
     nanos = int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
     return pd.Timestamp(nanos, unit="ns", tz="UTC") if nanos > 0 else None
 
 
 def state_events(
-    table: pd.DataFrame, column: str, end: pd.Timestamp, names: dict | None = None
+    table: pd.DataFrame, column: str, end: pd.Timestamp, names: Mapping[Any, str] | None = None
 ) -> list[Event]:
     """Each value of a state field an activity until the next value; the last until ``end``.
 
@@ -121,7 +122,7 @@ def state_events(
     return events
 
 
-def bt_events(changes: Iterable[tuple[pd.Timestamp, int, object]]) -> list[Event]:
+def bt_events(changes: Iterable[tuple[pd.Timestamp, int, Any]]) -> list[Event]:
     """Behaviour-tree nodes as activities, from (time, index, status change) in order.
 
     A change's own ``timestamp`` wins over the message time when it has one. A node that
@@ -143,7 +144,7 @@ def bt_events(changes: Iterable[tuple[pd.Timestamp, int, object]]) -> list[Event
     return events
 
 
-def bt_changes(table: pd.DataFrame, column: str | None) -> list[tuple[pd.Timestamp, int, object]]:
+def bt_changes(table: pd.DataFrame, column: str | None) -> list[tuple[pd.Timestamp, int, Any]]:
     """(time, index, change) of a log topic: ``column`` holds a sequence of changes per message,
     or each message is one change (``column`` None, its fields as columns)."""
     if column is not None:
@@ -251,7 +252,7 @@ def implicit(
     rows = rows.assign(**{schema.LIFECYCLE: lifecycle})
     tags = rows[is_tag].sort_values([schema.CASE, schema.ROBOT, SEQUENCE], kind="stable")
     last = float(len(rows))
-    added = []
+    added: list[dict[str, Any]] = []
     for (case, _), group in tags.groupby([schema.CASE, schema.ROBOT], sort=False):
         records = group.to_dict("records")
         for k, tag in enumerate(records):

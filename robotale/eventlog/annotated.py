@@ -17,10 +17,13 @@ from __future__ import annotations
 from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
+from typing import cast
 
 import pandas as pd
+from rosbags.interfaces import Connection, ConnectionExtRosbag2
 from rosbags.rosbag2 import Reader, StoragePlugin, Writer
 from rosbags.typesys import Stores, get_typestore
+from rosbags.typesys.store import Typestore
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
@@ -85,7 +88,7 @@ def write_annotated(
     target.parent.mkdir(parents=True, exist_ok=True)
     with Writer(target, version=9, storage_plugin=StoragePlugin.MCAP) as writer:
         copies = {c.id: _copy_connection(writer, bag, c) for c in bag.reader.connections}
-        added = []
+        added: list[tuple[int, Connection, bytes]] = []
         for robot, rows in states.groupby("robot", sort=True):
             text = writer.add_connection(f"{PREFIX}/{robot}/activity", STRING, typestore=store)
             number = writer.add_connection(
@@ -104,7 +107,12 @@ def write_annotated(
     return written
 
 
-def _merged_write(writer: Writer, reader: Reader, copies: dict, added: list) -> None:
+def _merged_write(
+    writer: Writer,
+    reader: Reader,
+    copies: dict[int, Connection],
+    added: list[tuple[int, Connection, bytes]],
+) -> None:
     """The recording's messages and the added ones (sorted) written in time order, an added
     message after the recording's of its instant; one comparison per message."""
     write, k, count = writer.write, 0, len(added)
@@ -119,7 +127,7 @@ def _merged_write(writer: Writer, reader: Reader, copies: dict, added: list) -> 
         write(target, when, raw)
 
 
-def _copy_connection(writer: Writer, bag: Bag, connection):
+def _copy_connection(writer: Writer, bag: Bag, connection: Connection) -> Connection:
     """The connection in the copy: its topic, type and QoS as recorded; its definition as the
     preparation resolved it (the bag's, or the distribution's or robotale's when it stores
     none), so viewers can decode it."""
@@ -127,26 +135,27 @@ def _copy_connection(writer: Writer, bag: Bag, connection):
     kind = normalized(connection.msgtype)
     if kind in bag.typestore.fielddefs:
         msgdef, _ = bag.typestore.generate_msgdef(kind, ros_version=2)
-    qos = getattr(connection.ext, "offered_qos_profiles", ())
+    ext = cast(ConnectionExtRosbag2, connection.ext)  # a rosbag2 reader's connection
+    qos = getattr(ext, "offered_qos_profiles", ())
     return writer.add_connection(
         connection.topic,
         connection.msgtype,
         msgdef=msgdef or "",
         rihs01=digest if str(digest).startswith("RIHS01_") else _NO_HASH,
-        serialization_format=connection.ext.serialization_format,
+        serialization_format=ext.serialization_format,
         offered_qos_profiles=qos,
     )
 
 
-def _string(store, text: str) -> bytes:
+def _string(store: Typestore, text: str) -> bytes:
     return bytes(store.serialize_cdr(store.types[STRING](data=text), STRING))
 
 
-def _int32(store, value: int) -> bytes:
+def _int32(store: Typestore, value: int) -> bytes:
     return bytes(store.serialize_cdr(store.types[INT32](data=value), INT32))
 
 
-def _log(store, entry: Entry) -> bytes:
+def _log(store: Typestore, entry: Entry) -> bytes:
     stamp = store.types["builtin_interfaces/msg/Time"](
         sec=entry.time // 1_000_000_000, nanosec=entry.time % 1_000_000_000
     )

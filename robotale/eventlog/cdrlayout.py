@@ -15,17 +15,23 @@ are decoded the ordinary way by the caller.
 from __future__ import annotations
 
 import struct
-from collections.abc import Mapping, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+from rosbags.interfaces import Nodetype
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import BaseDesc, NameDesc, Typesdict
+
+    from robotale.eventlog.messages import Batch
 
 #: CDR primitive sizes; every primitive is aligned to its size, counted from the payload start.
 _SIZES = {
     "bool": 1, "byte": 1, "char": 1, "int8": 1, "uint8": 1, "int16": 2, "uint16": 2,
     "int32": 4, "uint32": 4, "int64": 8, "uint64": 8, "float32": 4, "float64": 8,
 }  # fmt: skip
-_BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4
 _HEADER = 4  # encapsulation: 0x00 0x01 for little-endian CDR
 _LITTLE_ENDIAN = b"\x00\x01"
 
@@ -45,7 +51,7 @@ class Layout:
 
     @classmethod
     def of(
-        cls, raw: bytes, msgtype: str, paths: Sequence[str], fielddefs: Mapping
+        cls, raw: bytes, msgtype: str, paths: Sequence[str], fielddefs: Typesdict
     ) -> Layout | None:
         """The layout of ``paths`` in ``raw``, or ``None`` if they cannot be read in bulk."""
         if raw[:2] != _LITTLE_ENDIAN:
@@ -72,7 +78,7 @@ class Layout:
                 return False
         return True
 
-    def fitting(self, batch) -> tuple[np.ndarray, np.ndarray]:
+    def fitting(self, batch: Batch) -> tuple[np.ndarray, np.ndarray]:
         """:meth:`fits` for every message of a :class:`~robotale.eventlog.messages.Batch` at
         once: the rows that fit, and their first :attr:`end` bytes (what :func:`columns`
         reads), one message per row."""
@@ -108,26 +114,26 @@ def _numpy_type(kind: str) -> str:
 class _Walker:
     """Walks one message's bytes as CDR, noting wanted offsets and the lengths before them."""
 
-    def __init__(self, raw: bytes, fielddefs: Mapping, wanted: set[str]) -> None:
+    def __init__(self, raw: bytes, fielddefs: Typesdict, wanted: set[str]) -> None:
         self.raw, self.fielddefs, self.wanted = raw, fielddefs, wanted
         self.found: dict[str, tuple[int, str]] = {}
         self.checks: list[tuple[int, bytes]] = []
 
     def walk(self, msgtype: str, pos: int, prefix: str) -> int:
-        for name, (nodetype, detail) in self.fielddefs[msgtype][1]:
+        for name, desc in self.fielddefs[msgtype][1]:
             if len(self.found) == len(self.wanted):
                 return pos  # what follows the last wanted field does not matter
             path = prefix + name
-            if nodetype == _BASE:
-                pos = self._base(detail[0], pos, path)
-            elif nodetype == _NAME:
-                pos = self.walk(detail, pos, f"{path}.")
-            elif nodetype == _ARRAY:
-                pos = self._items(detail[0], detail[1], pos)
-            elif nodetype == _SEQUENCE:
-                pos = self._items(detail[0], self._length(pos), _align(pos, 4) + 4)
+            if desc[0] == Nodetype.BASE:
+                pos = self._base(desc[1][0], pos, path)
+            elif desc[0] == Nodetype.NAME:
+                pos = self.walk(desc[1], pos, f"{path}.")
+            elif desc[0] == Nodetype.ARRAY:
+                pos = self._items(desc[1][0], desc[1][1], pos)
+            elif desc[0] == Nodetype.SEQUENCE:
+                pos = self._items(desc[1][0], self._length(pos), _align(pos, 4) + 4)
             else:
-                raise _Unsupported(nodetype)
+                raise _Unsupported(desc[0])
         return pos
 
     def _base(self, kind: str, pos: int, path: str | None) -> int:
@@ -140,23 +146,22 @@ class _Walker:
             self.found[path] = (pos, kind)
         return pos + _SIZES[kind]
 
-    def _items(self, desc: tuple, count: int, pos: int) -> int:
-        nodetype, detail = desc
-        if nodetype == _BASE and detail[0] in _SIZES:
-            size = _SIZES[detail[0]]
+    def _items(self, desc: BaseDesc | NameDesc, count: int, pos: int) -> int:
+        if desc[0] == Nodetype.BASE and desc[1][0] in _SIZES:
+            size = _SIZES[desc[1][0]]
             return _align(pos, size) + count * size if count else pos
         for _ in range(count):
             pos = (
-                self._base(detail[0], pos, None)
-                if nodetype == _BASE
-                else self.walk(detail, pos, "\0")
+                self._base(desc[1][0], pos, None)
+                if desc[0] == Nodetype.BASE
+                else self.walk(desc[1], pos, "\0")
             )
         return pos
 
     def _length(self, pos: int) -> int:
         """A string's or sequence's length, which later offsets depend on."""
         pos = _align(pos, 4)
-        (length,) = struct.unpack_from("<I", self.raw, pos)
+        length: int = struct.unpack_from("<I", self.raw, pos)[0]
         self.checks.append((pos, self.raw[pos : pos + 4]))
         return length
 

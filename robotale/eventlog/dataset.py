@@ -24,6 +24,7 @@ from __future__ import annotations
 import json
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 from urllib.parse import quote
 
 import numpy as np
@@ -148,7 +149,7 @@ def begin(dataset: Place, source: str) -> None:
     dataset.child(WRITING).write_whole(json.dumps({"format": FORMAT, "source": source}) + "\n")
 
 
-def finish(dataset: Place, parts: Sequence[PartWritten], source: str) -> dict:
+def finish(dataset: Place, parts: Sequence[PartWritten], source: str) -> dict[str, Any]:
     """Write the manifest of a dataset whose parts are all written; returns it."""
     types = column_types(parts)
     manifest = {
@@ -193,7 +194,7 @@ def _kind_words(kind: str) -> str:
 # -- reading ------------------------------------------------------------------------------------
 
 
-def read_manifest(dataset: Place) -> Mapping | None:
+def read_manifest(dataset: Place) -> Mapping[str, Any] | None:
     """The manifest of a robotale dataset; None for a folder robotale did not write."""
     manifest = dataset.child(MANIFEST)
     if not manifest.exists():
@@ -204,7 +205,7 @@ def read_manifest(dataset: Place) -> Mapping | None:
             )
         return None
     try:
-        found = json.loads(manifest.read_bytes())
+        found: dict[str, Any] = json.loads(manifest.read_bytes())
         parts = found["parts"]
         columns = found["columns"]
         _ = [(p["file"], int(p["rows"])) for p in parts] + [(c["name"], c["type"]) for c in columns]
@@ -220,7 +221,7 @@ def read_manifest(dataset: Place) -> Mapping | None:
 _TYPES = {str(kind): kind for kind in (pa.string(), pa.float64(), pa.bool_(), _TIME, _TIME_US)}
 
 
-def arrow_schema(manifest: Mapping, text: str) -> pa.Schema:
+def arrow_schema(manifest: Mapping[str, Any], text: str) -> pa.Schema:
     """The columns a manifest declares; an unknown type is the manifest's damage."""
     unknown = [c["type"] for c in manifest["columns"] if c["type"] not in _TYPES]
     if unknown:
@@ -231,7 +232,7 @@ def arrow_schema(manifest: Mapping, text: str) -> pa.Schema:
     return pa.schema([pa.field(c["name"], _TYPES[c["type"]]) for c in manifest["columns"]])
 
 
-def read_table(dataset: Place, manifest: Mapping) -> pa.Table:
+def read_table(dataset: Place, manifest: Mapping[str, Any]) -> pa.Table:
     """Every part the manifest lists, in its order, checked against its row count, as one
     table with the ``case`` column first."""
     declared = arrow_schema(manifest, dataset.text)

@@ -131,8 +131,10 @@ def pair_activities(events: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.nd
     an activity name, each end closes the earliest start still
     open (events must be in time order). One pass over the tags, none over the samples.
     """
-    open_starts: defaultdict[tuple, deque[int]] = defaultdict(deque)
-    starts, completes, orphans = [], [], []
+    open_starts: defaultdict[tuple[object, ...], deque[int]] = defaultdict(deque)
+    starts: list[int] = []
+    completes: list[int] = []
+    orphans: list[int] = []
     keys = zip(events[CASE], events[ROBOT], events[ACTIVITY], strict=True)
     for position, (key, lifecycle) in enumerate(zip(keys, events[LIFECYCLE], strict=True)):
         if lifecycle == schema.START:
@@ -143,8 +145,11 @@ def pair_activities(events: pd.DataFrame) -> tuple[np.ndarray, np.ndarray, np.nd
                 completes.append(position)
             else:
                 orphans.append(position)
-    as_array = lambda values: np.asarray(values, dtype=np.int64)  # noqa: E731
-    return as_array(starts), as_array(completes), as_array(orphans)
+    return (
+        np.asarray(starts, dtype=np.int64),
+        np.asarray(completes, dtype=np.int64),
+        np.asarray(orphans, dtype=np.int64),
+    )
 
 
 def inprogress(
@@ -219,5 +224,8 @@ def _orphan_message(orphans: pd.DataFrame) -> str:
 
 def robots_without_samples(tags: pd.DataFrame, samples: pd.DataFrame) -> list[str]:
     """``case/robot`` of each robot with tags but no sample of a perspective."""
-    pairs = lambda frame: set(frame[KEYS].drop_duplicates().itertuples(index=False))  # noqa: E731
+
+    def pairs(frame: pd.DataFrame) -> set[tuple[str, str]]:
+        return set(frame[KEYS].drop_duplicates().itertuples(index=False))
+
     return sorted(f"{case}/{robot}" for case, robot in pairs(tags) - pairs(samples))

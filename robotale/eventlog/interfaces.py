@@ -19,12 +19,17 @@ from __future__ import annotations
 
 import functools
 import re
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
+from typing import TYPE_CHECKING
 
+from rosbags.interfaces import Nodetype
 from rosbags.typesys import TypesysError, get_types_from_idl, get_types_from_msg
 
 from robotale.errors import InputError
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import FieldDesc, Typesdict
 
 #: the shipped definitions
 SHIPPED = Path(__file__).parent / "definitions"
@@ -42,15 +47,13 @@ RELEASES = (
     "rolling",
 )
 EXTENSIONS = ("msg", "srv", "action", "idl")
-#: rosbags' field descriptors are (nodetype, detail); NAME is a nested message type.
-_NAME, _ARRAY, _SEQUENCE = 2, 3, 4
 _SEPARATOR = re.compile(r"^---[ \t]*$", flags=re.MULTILINE)
 
 
-def message_types(paths: Sequence[Path]) -> dict:
+def message_types(paths: Sequence[Path]) -> Typesdict:
     """Type definitions from ``.msg`` / ``.srv`` / ``.action`` / ``.idl`` files, or folders
     holding them."""
-    typs: dict = {}
+    typs: Typesdict = {}
     for path in paths:
         files = (
             [f for ext in EXTENSIONS for f in sorted(path.rglob(f"*.{ext}"))]
@@ -64,7 +67,7 @@ def message_types(paths: Sequence[Path]) -> dict:
     return typs
 
 
-def types_from_file(file: Path) -> dict:
+def types_from_file(file: Path) -> Typesdict:
     """The types one definition file defines (an error naming the file if it cannot)."""
     if not file.is_file():
         raise InputError(f"Message definition {file} does not exist.")
@@ -88,7 +91,7 @@ def types_from_file(file: Path) -> dict:
         raise InputError(f"Message definition {file} cannot be parsed: {reason}") from None
 
 
-def action_types(text: str, package: str, action: str) -> dict:
+def action_types(text: str, package: str, action: str) -> Typesdict:
     """The types of an action's ``.action`` file (goal, result and feedback, split by ``---``)
     and of the feedback topic's message, which wraps the feedback with the goal's id, as
     rosidl generates them: ``<package>/action/<action>_Goal`` ... ``_FeedbackMessage``.
@@ -100,7 +103,7 @@ def action_types(text: str, package: str, action: str) -> dict:
     if len(parts) != 3:
         raise TypesysError(f"an action has a goal, a result and a feedback, not {len(parts)} parts")
     prefix = f"{package}/action/{action}"
-    typs: dict = {}
+    typs: Typesdict = {}
     for suffix, part in zip(("_Goal", "_Result", "_Feedback"), parts, strict=True):
         typs.update(get_types_from_msg(part, prefix + suffix))
     wrapper = f"unique_identifier_msgs/UUID goal_id\n{prefix}_Feedback feedback\n"
@@ -108,7 +111,7 @@ def action_types(text: str, package: str, action: str) -> dict:
     return _in_msg_folder(typs, package, "action")
 
 
-def service_types(text: str, package: str, service: str) -> dict:
+def service_types(text: str, package: str, service: str) -> Typesdict:
     """The types of a service's ``.srv`` file (request and response, split by ``---``) and
     of its service-event message, as rosidl generates them (ROS 2 Iron and later):
     ``<package>/srv/<service>_Request``, ``_Response`` and ``_Event``, which records one call
@@ -117,7 +120,7 @@ def service_types(text: str, package: str, service: str) -> dict:
     if len(parts) != 2:
         raise TypesysError(f"a service has a request and a response, not {len(parts)} parts")
     prefix = f"{package}/srv/{service}"
-    typs: dict = {}
+    typs: Typesdict = {}
     for suffix, part in zip(("_Request", "_Response"), parts, strict=True):
         typs.update(get_types_from_msg(part, prefix + suffix))
     event = (
@@ -128,54 +131,56 @@ def service_types(text: str, package: str, service: str) -> dict:
     return _in_msg_folder(_srv_names(typs), package, "srv")
 
 
-def _srv_names(typs: dict) -> dict:
+def _srv_names(typs: Typesdict) -> Typesdict:
     """``typs`` with the names rosbags' parser gives service types (it knows ``msg`` and
     ``action`` folders only: ``pkg/srv/msg/X``) made ``pkg/srv/X``."""
 
     def name(text: str) -> str:
         return text.replace("/srv/msg/", "/srv/", 1)
 
-    def moved(desc: tuple) -> tuple:
-        nodetype, detail = desc
-        if nodetype == _NAME:
-            return nodetype, name(detail)
-        if nodetype in (_ARRAY, _SEQUENCE):
-            return nodetype, (moved(detail[0]), *detail[1:])
-        return desc
-
     return {
-        name(key): (consts, [(field, moved(desc)) for field, desc in fields])
+        name(key): (consts, [(field, _renamed(desc, name)) for field, desc in fields])
         for key, (consts, fields) in typs.items()
     }
 
 
-def _in_msg_folder(typs: dict, package: str, kind: str) -> dict:
+def _in_msg_folder(typs: Typesdict, package: str, kind: str) -> Typesdict:
     """``typs`` with their references to types of the package that are not their own
     (written without a package in the file, read as ``<package>/<kind>/X``) made
     ``<package>/msg/X``, where ROS looks for them."""
     own = set(typs)
 
-    def moved(desc: tuple) -> tuple:
-        nodetype, detail = desc
-        if nodetype == _NAME and detail.startswith(f"{package}/{kind}/") and detail not in own:
-            return nodetype, detail.replace(f"/{kind}/", "/msg/", 1)
-        if nodetype in (_ARRAY, _SEQUENCE):
-            return nodetype, (moved(detail[0]), *detail[1:])
-        return desc
+    def moved(name: str) -> str:
+        if name.startswith(f"{package}/{kind}/") and name not in own:
+            return name.replace(f"/{kind}/", "/msg/", 1)
+        return name
 
     return {
-        name: (consts, [(field, moved(desc)) for field, desc in fields])
+        name: (consts, [(field, _renamed(desc, moved)) for field, desc in fields])
         for name, (consts, fields) in typs.items()
     }
 
 
-def stored_types(data: str, msgtype: str) -> dict:
+def _renamed(desc: FieldDesc, rename: Callable[[str], str]) -> FieldDesc:
+    """A field's descriptor with the message type it refers to (its own, or its elements')
+    renamed."""
+    if desc[0] == Nodetype.NAME:
+        return (Nodetype.NAME, rename(desc[1]))
+    if desc[0] == Nodetype.ARRAY or desc[0] == Nodetype.SEQUENCE:
+        element, size = desc[1]
+        if element[0] == Nodetype.NAME:
+            element = (Nodetype.NAME, rename(element[1]))
+        return (desc[0], (element, size))
+    return desc
+
+
+def stored_types(data: str, msgtype: str) -> Typesdict:
     """The types of a definition rosbag2 stored in ``.msg`` form: the type's text, then each
     type it uses after a line of ``=`` and ``MSG: <name>``; for a service-event type the
     service's ``.srv`` text after ``SRV: <name>`` (what rosbag2 stores for those)."""
     separator = "=" * 80 + "\n"
     parts = data.split(separator)
-    typs: dict = {}
+    typs: Typesdict = {}
     if parts[0].strip():
         typs.update(get_types_from_msg(parts[0], msgtype))
     for part in parts[1:]:
@@ -213,7 +218,7 @@ def definition_file(msgtype: str) -> str:
 
 
 @functools.lru_cache(maxsize=16)
-def shipped(distro: str) -> dict:
+def shipped(distro: str) -> Typesdict:
     """The definitions robotale ships for a distribution: ``all/``, then the latest
     distribution folder at or before ``distro`` overriding it."""
     rank = RELEASES.index(distro) if distro in RELEASES else RELEASES.index("humble")
@@ -221,7 +226,7 @@ def shipped(distro: str) -> dict:
     for release in RELEASES[: rank + 1]:
         if (SHIPPED / release).is_dir():
             layers.append(SHIPPED / release)
-    typs: dict = {}
+    typs: Typesdict = {}
     for layer in layers:
         typs.update(message_types([layer]))
     return typs

@@ -25,6 +25,7 @@ import lz4.frame
 import numpy as np
 from mcap.exceptions import McapError
 from mcap.reader import make_reader
+from mcap.records import ChunkIndex
 
 try:  # the standard library's zstd from Python 3.14 on; rosbags' backport before
     from compression import zstd
@@ -88,7 +89,9 @@ def mcap_batches(path: Path, channels: Iterable[int]) -> Iterator[tuple[int, Bat
     return _indexed(path, chunks, channels)
 
 
-def _indexed(path: Path, chunks: list, channels: set[int]) -> Iterator[tuple[int, Batch]]:
+def _indexed(
+    path: Path, chunks: list[ChunkIndex], channels: set[int]
+) -> Iterator[tuple[int, Batch]]:
     with path.open("rb") as file:
         # unmapped when no batch views it any more (closing it here would break those)
         whole = np.frombuffer(mmap.mmap(file.fileno(), 0, access=mmap.ACCESS_READ), np.uint8)
@@ -101,7 +104,7 @@ def _indexed(path: Path, chunks: list, channels: set[int]) -> Iterator[tuple[int
                 yield channel, _batch(records, _message_offsets(whole, at, channel), channel)
 
 
-def _records(whole: np.ndarray, chunk) -> np.ndarray:
+def _records(whole: np.ndarray, chunk: ChunkIndex) -> np.ndarray:
     """A chunk's records, uncompressed: a view of the file when they are stored so."""
     start = chunk.chunk_start_offset + 1 + 8 + 8 + 8 + 8 + 4 + 4 + len(chunk.compression) + 8
     stored = whole[start : start + chunk.compressed_size]
@@ -117,11 +120,16 @@ def _records(whole: np.ndarray, chunk) -> np.ndarray:
     return np.frombuffer(records, dtype=np.uint8)
 
 
+def decompressed(raw: bytes) -> bytes:
+    """A message of a bag whose messages rosbag2 compressed one by one (zstd), uncompressed."""
+    return bytes(zstd.decompress(raw))
+
+
 def _decompress(compression: str, data: bytes) -> bytes:
     if compression == "zstd":
-        return zstd.decompress(data)
+        return bytes(zstd.decompress(data))
     if compression == "lz4":
-        return lz4.frame.decompress(data)
+        return bytes(lz4.frame.decompress(data))
     raise MalformedMcap(f"its chunks are compressed with {compression!r}, which is not supported")
 
 

@@ -77,7 +77,7 @@ class _Tables:
         self.o2o: list[tuple[str, str, str | None]] = []
         self.changes: list[tuple[str, pd.Timestamp, str, Any]] = []
 
-    def event(self, where: str, event_id: Any, kind: Any, time: Any, values: dict) -> str:
+    def event(self, where: str, event_id: Any, kind: Any, time: Any, values: dict[str, Any]) -> str:
         for name, given in (("id", event_id), ("type", kind), ("time", time)):
             if given is None or str(given).strip() == "":
                 raise InputError(f"{self.path}: {where} has no {name}.")
@@ -191,7 +191,7 @@ def _read_json(path: Path) -> ObjectLog:
     return tables.finish()
 
 
-def _entries(path: Path, document: Mapping, key: str) -> list[dict]:
+def _entries(path: Path, document: Mapping[str, Any], key: str) -> list[dict[str, Any]]:
     items = document.get(key) or []
     for number, item in enumerate(items, start=1):
         if not isinstance(item, dict):
@@ -199,21 +199,21 @@ def _entries(path: Path, document: Mapping, key: str) -> list[dict]:
     return items
 
 
-def _list(path: Path, item: Mapping, key: str, where: str) -> list[dict]:
+def _list(path: Path, item: Mapping[str, Any], key: str, where: str) -> list[dict[str, Any]]:
     values = item.get(key) or []
     if not isinstance(values, list) or not all(isinstance(v, dict) for v in values):
         raise InputError(f"{path}: the {key} of {where} are not a list of JSON objects.")
     return values
 
 
-def _name(path: Path, attribute: Mapping, where: str) -> str:
+def _name(path: Path, attribute: Mapping[str, Any], where: str) -> str:
     name = attribute.get("name")
     if not isinstance(name, str) or not name:
         raise InputError(f"{path}: an attribute of {where} has no name.")
     return name
 
 
-def _target(path: Path, link: Mapping, where: str) -> str:
+def _target(path: Path, link: Mapping[str, Any], where: str) -> str:
     target = link.get("objectId")
     if target is None or str(target) == "":
         raise InputError(f"{path}: a relationship of {where} names no objectId.")
@@ -297,14 +297,14 @@ def _xml_name(path: Path, attribute: Any) -> str:
     name = attribute.get("name")
     if not name:
         raise InputError(f"{path} line {attribute.sourceline}: an <attribute> has no name.")
-    return name
+    return str(name)
 
 
 def _xml_target(path: Path, link: Any) -> str:
     target = link.get("object-id")
     if not target:
         raise InputError(f"{path} line {link.sourceline}: a <relationship> has no object-id.")
-    return target
+    return str(target)
 
 
 def _xml_value(path: Path, attribute: Any, kind: str) -> Any:
@@ -393,7 +393,7 @@ def _sqlite_log(path: Path, connection: sqlite3.Connection) -> ObjectLog:
 
 def _rows(
     path: Path, connection: sqlite3.Connection, table: str, present: set[str]
-) -> Iterable[dict]:
+) -> Iterable[dict[str, Any]]:
     if table not in present:
         raise InputError(f"{path}: the OCEL 2.0 SQLite database has no table {table!r}.")
     cursor = connection.execute(f'SELECT * FROM "{table.replace(chr(34), chr(34) * 2)}"')

@@ -16,18 +16,16 @@ logs; ``auto`` picks those a bag holds.
 
 from __future__ import annotations
 
-import re
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Sequence
 from concurrent.futures import as_completed
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 import pandas as pd
-import yaml
 from tqdm import tqdm
 
 from robotale.errors import InputError
@@ -41,71 +39,33 @@ from robotale.eventlog.enrich import (
     parse_perspective,
     robots_without_samples,
 )
-from robotale.eventlog.rosbag import (
-    RECORDED,
-    TIME,
-    Bag,
-    check_distro,
-    is_bag,
-    message_types,
-    namespace,
-    storage_files,
-    without_metadata,
+from robotale.eventlog.interfaces import message_types
+from robotale.eventlog.lifecycles import LIFECYCLE_MODES
+from robotale.eventlog.rosbag import RECORDED, Bag
+from robotale.eventlog.runs import (
+    find_runs,
+    is_recording,
+    message_count,
+    message_counts,
+    robot_type,
+    robot_types,
 )
+from robotale.eventlog.samples import perspective_samples, say_missing_samples, warn_missing_samples
 from robotale.eventlog.sources import Sources
+from robotale.eventlog.tagrows import (
+    TagFields,
+    robot_of_topics,
+    tag_columns,
+    topic_rows,
+    warn_foreign,
+)
+from robotale.eventlog.typesys import check_distro
 from robotale.executors import open_executor, parse_executor, worker_lost
-from robotale.fame_runtime.manifest import RunManifest, read_manifests
+from robotale.fame_runtime.manifest import read_manifests
 from robotale.storage import Place, place
 
 TAG_TOPICS = "/*/tag"
 DEFAULT_PERSPECTIVES = ("odom", "battery")
-#: the robot of tags that name none, on a topic without a namespace (a single-robot bag).
-DEFAULT_ROBOT = "robot"
-
-
-@dataclass(frozen=True)
-class TagFields:
-    """Which field of the tag message holds what; an empty name means the message has none.
-
-    ``activity`` is required. Without a ``lifecycle`` field each tag is one event (or, with
-    ``lifecycle="implicit"``, an activity until the robot's next tag). Without a ``robot`` field
-    (or when it is empty) the robot is the tag topic's namespace.
-    """
-
-    activity: str = "activity"
-    lifecycle: str = "lifecycle"
-    robot: str = "robot"
-    msg_id: str = "msg_id"
-    msg_role: str = "msg_role"
-    payload: str = "payload"
-
-    @classmethod
-    def parse(cls, specs: Sequence[str]) -> TagFields:
-        """From ``KEY=FIELD`` strings, e.g. ``activity=action``, ``robot=`` (none)."""
-        known = {f.name for f in fields(cls)}
-        changes = {}
-        for spec in specs:
-            key, sep, value = spec.partition("=")
-            if not sep or key.strip() not in known:
-                keys = ", ".join(sorted(known))
-                raise InputError(f"Tag field {spec!r} is not KEY=FIELD with KEY one of {keys}.")
-            changes[key.strip()] = value.strip()
-        return replace(cls(), **changes)
-
-
-#: tag message field -> canonical log column
-_TAG_COLUMNS = {
-    "activity": schema.ACTIVITY,
-    "lifecycle": schema.LIFECYCLE,
-    "robot": schema.ROBOT,
-    "msg_id": schema.MSG_ID,
-    "msg_role": schema.MSG_ROLE,
-    "payload": schema.MSG_PAYLOAD,
-}
-_LIFECYCLES = {schema.START, schema.NONE, *schema.ENDINGS}
-#: how tags say when an activity ends: their lifecycle field (``explicit``), the robot's next
-#: tag (``implicit``), or not at all: each tag one event (``events``)
-LIFECYCLE_MODES = ("explicit", "implicit", "events")
 
 
 @dataclass(frozen=True)
@@ -129,7 +89,8 @@ class Job:
 
     reading: _Reading
     msg_files: tuple[Path, ...]
-    distro: str
+    #: the distribution named (None: the one each bag names)
+    distro: str | None
     rate: float
 
 
@@ -174,14 +135,14 @@ def prepare(
     if executor is not None and skip_bad is not None:
         raise InputError("Skipping bad runs reads them in this process: leave out --executor.")
     if executor is not None:
-        told: set[tuple[str, ...]] = set()
+        told: set[str] = set()
         parts = _read_in_parallel(
             runs, reading, msg_files, distro, executor, progress, _once(report, told)
         )
     else:
-        parts = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
-        runs = [run for run, part in zip(runs, parts, strict=True) if part is not None]
-        parts = [part for part in parts if part is not None]
+        read = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
+        runs = [run for run, part in zip(runs, read, strict=True) if part is not None]
+        parts = [part for part in read if part is not None]
         if not parts:
             raise InputError(f"None of the runs of {source} could be read.")
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
@@ -191,8 +152,8 @@ def prepare(
         p.name: pd.concat([sample_parts[p.name] for _, sample_parts in parts], ignore_index=True)
         for p in chosen
     }
-    _warn_missing_samples(tag_rows, samples, chosen)
-    tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, read_manifests(runs))
+    warn_missing_samples(tag_rows, samples, chosen)
+    tag_rows[schema.ROBOT_TYPE] = robot_types(tag_rows, read_manifests(runs))
     log = enrich(tag_rows, samples, rate=rate)
     return _canonical(log, chosen)
 
@@ -234,7 +195,7 @@ def _read_here(
     runs: Sequence[Path],
     reading: _Reading,
     msg_files: Sequence[str | Path],
-    distro: str,
+    distro: str | None,
     progress: bool,
     report: Callable[[str], None] | None,
     skip_bad: Callable[[Path, str], None] | None = None,
@@ -244,14 +205,14 @@ def _read_here(
     extra_types = message_types([Path(p) for p in msg_files])
     globs = [reading.tags, *(glob for p in reading.perspectives for glob in p.topic.split("|"))]
     with tqdm(
-        total=sum(_message_count(run, globs) for run in runs),
+        total=sum(message_count(run, globs) for run in runs),
         unit="msg",
         desc="prepare",
         disable=not progress,
         leave=False,
     ) as bar:
-        told: set[tuple[str, ...]] = set()
-        read = []
+        told: set[str] = set()
+        read: list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None] = []
         for run in runs:
             try:
                 read.append(
@@ -269,7 +230,7 @@ def _read_in_parallel(
     runs: Sequence[Path],
     reading: _Reading,
     msg_files: Sequence[str | Path],
-    distro: str,
+    distro: str | None,
     executor: str,
     progress: bool,
     say: Callable[[str], None],
@@ -296,11 +257,13 @@ class _RunRead:
 
     tag_rows: pd.DataFrame
     samples: dict[str, pd.DataFrame]
-    warned: list[tuple[type[Warning], str]]
+    warned: list[tuple[type[PreparationWarning], str]]
     reported: list[str]
 
 
-def _read_alone(run: Path, reading: _Reading, msg_files: Sequence[Path], distro: str) -> _RunRead:
+def _read_alone(
+    run: Path, reading: _Reading, msg_files: Sequence[Path], distro: str | None
+) -> _RunRead:
     """:func:`_read_run` in a worker process: warnings and reports are kept to be said by
     the process that asked, as they would not reach its terminal from here."""
     reported: list[str] = []
@@ -326,7 +289,7 @@ class _RunPrepared:
     part: PartWritten | None
     samples: dict[str, int]
     unsampled: dict[str, list[str]]
-    warned: list[tuple[type[Warning], str]]
+    warned: list[tuple[type[PreparationWarning], str]]
     reported: list[str]
 
 
@@ -338,7 +301,7 @@ def prepare_dataset(
     report: Callable[[str], None] | None = None,
     executor: str | None = None,
     **options: Any,
-) -> dict:
+) -> dict[str, Any]:
     """The event log of :func:`prepare`, written as a Parquet dataset partitioned by case at
     ``out`` (a path or an fsspec URL; see :mod:`robotale.eventlog.dataset`); returns its
     manifest.
@@ -355,7 +318,7 @@ def prepare_dataset(
     dataset.begin(target, str(source))
     try:
         done = _runs_written(runs, job, target, executor, progress)
-        told: set[tuple[str, ...]] = set()
+        told: set[str] = set()
         say = _once(report, told)
         for run in done:
             for category, message in run.warned:
@@ -366,7 +329,7 @@ def prepare_dataset(
         if not parts:
             raise InputError(_nothing_found(source, reading))
         chosen = reading.perspectives
-        _say_missing_samples(
+        say_missing_samples(
             {p.name: sum(run.samples[p.name] for run in done) for p in chosen},
             {p.name: [r for run in done for r in run.unsampled[p.name]] for p in chosen},
             chosen,
@@ -429,7 +392,7 @@ def _prepare_into(run: Path, job: Job, target: Place) -> _RunPrepared:
         tag_rows, samples = _read_run(bag, job.reading, None, reported.append)
         part = None
         if not tag_rows.empty:
-            tag_rows[schema.ROBOT_TYPE] = _robot_types(tag_rows, read_manifests([run]))
+            tag_rows[schema.ROBOT_TYPE] = robot_types(tag_rows, read_manifests([run]))
             log = _canonical(enrich(tag_rows, samples, rate=job.rate), perspectives)
             part = dataset.write_part(log, target)
     warned = [
@@ -444,38 +407,6 @@ def _prepare_into(run: Path, job: Job, target: Place) -> _RunPrepared:
     )
 
 
-def is_recording(path: str | Path) -> bool:
-    """Whether ``path`` is what :func:`prepare` reads: a bag directory or a folder of them."""
-    path = Path(path)
-    return is_bag(path) or (path.is_dir() and any(is_bag(c) for c in path.iterdir() if c.is_dir()))
-
-
-def find_runs(source: Path) -> list[Path]:
-    """The bag directories of ``source``: itself, or its sub-directories that are bags."""
-    if not source.exists():
-        raise InputError(f"{source} does not exist.")
-    if is_bag(source):
-        return [source]
-    if not source.is_dir():
-        raise InputError(f"{source} is not a rosbag2 directory (a folder with metadata.yaml).")
-    children = sorted(child for child in source.iterdir() if child.is_dir())
-    for child in [source, *children]:
-        if storage_files(child) and not is_bag(child):
-            raise InputError(without_metadata(child))
-    runs = [child for child in children if is_bag(child)]
-    if not runs:
-        raise InputError(
-            f"{source} is not a rosbag2 directory (it has no metadata.yaml) and holds none."
-        )
-    return runs
-
-
-def robot_type(robot: str) -> str:
-    """A robot's type from its name when nothing says otherwise: ``tractor_1`` -> ``Tractor``."""
-    base = re.sub(r"[_\-]?\d+$", "", robot) or robot
-    return base[:1].upper() + base[1:]
-
-
 def _read_run(
     opened: Bag, reading: _Reading, bar: tqdm | None, report: Callable[[str], None]
 ) -> tuple[pd.DataFrame, dict[str, pd.DataFrame]]:
@@ -488,7 +419,7 @@ def _read_run(
                 f"{run} has no tag topic matching {reading.tags!r}; its topics are "
                 f"{', '.join(bag.topics) or 'none'} (name the tag topics with --tags)."
             )
-        columns = {t: _tag_columns(bag, t, reading.tag_fields) for t in tag_topics}
+        columns = {t: tag_columns(bag, t, reading.tag_fields) for t in tag_topics}
         for topic, wanted in sources.columns(bag, chosen).items():
             columns[topic] = {**columns.get(topic, {}), **wanted}
         sample_topics = {
@@ -502,9 +433,12 @@ def _read_run(
         recorded = {topic: table.pop(RECORDED).to_numpy() for topic, table in tables.items()}
         tables = {topic: sources.numbered(table) for topic, table in tables.items()}
         end = pd.Timestamp(max(bag.reader.end_time - 1, 0), unit="ns", tz="UTC")
-        _warn_foreign(bag, columns)
-        robot_of = _robots(bag, reading)
-        parts = [_tag_rows(tables[t], t, run, reading, robot_of) for t in tag_topics]
+        warn_foreign(bag, columns)
+        robot_of = robot_of_topics(bag, reading.robot)
+        parts = [
+            topic_rows(tables[t], t, run, reading.tag_fields, reading.lifecycle, robot_of)
+            for t in tag_topics
+        ]
         parts += sources.activity_rows(bag, tables, chosen, run.name, end, robot_of)
     tag_rows = activities.in_order(parts, recorded)
     if reading.lifecycle == "implicit" and tag_topics:
@@ -512,7 +446,7 @@ def _read_run(
     tag_rows = tag_rows.drop(columns=activities.SEQUENCE)
     robots = sorted(set(tag_rows[schema.ROBOT]))
     samples = {
-        p.name: _samples(run, [(t, tables[t]) for t in sample_topics[p.name]], p, robots)
+        p.name: perspective_samples(run, [(t, tables[t]) for t in sample_topics[p.name]], p, robots)
         for p in reading.perspectives
     }
     return tag_rows, samples
@@ -548,7 +482,7 @@ def _sources(bag: Bag, reading: _Reading, report: Callable[[str], None]) -> Sour
     return chosen
 
 
-def _once(report: Callable[[str], None] | None, told: set) -> Callable[[str], None]:
+def _once(report: Callable[[str], None] | None, told: set[str]) -> Callable[[str], None]:
     """``report`` that says each choice once (a batch's runs usually all choose the same)."""
 
     def say(text: str) -> None:
@@ -565,7 +499,7 @@ def _nothing_found(source: Path | str, reading: _Reading) -> str:
     """Why no activity came out, from what the bags hold (their metadata's counts)."""
     counts: dict[str, int] = {}
     for run in find_runs(Path(source)):
-        for topic, count in _message_counts(run, [reading.tags]).items():
+        for topic, count in message_counts(run, [reading.tags]).items():
             counts[topic] = counts.get(topic, 0) + count
     tags = sum(counts.values())
     if tags:
@@ -586,221 +520,6 @@ def _nothing_found(source: Path | str, reading: _Reading) -> str:
     return f"{source} has no tags: {held}."
 
 
-def _warn_foreign(bag: Bag, columns: Mapping[str, Mapping[str, str]]) -> None:
-    """What the preparation read around in a bag robotale did not write."""
-    skipped = [t for t in bag.unparsed if t not in columns]
-    if skipped:
-        warnings.warn(
-            f"{bag.path}: the message definitions stored for {', '.join(skipped)} cannot be "
-            "parsed; those topics were not read.",
-            PreparationWarning,
-            stacklevel=4,
-        )
-    mismatched = [t for t in bag.qos_mismatch if t in columns]
-    if mismatched:
-        warnings.warn(
-            f"{bag.path}: metadata.yaml describes {', '.join(mismatched)} with other QoS "
-            "profiles (or type hashes) than its storage does; their messages were read from the "
-            "storage.",
-            PreparationWarning,
-            stacklevel=4,
-        )
-
-
-def _tag_columns(bag: Bag, topic: str, tag_fields: TagFields) -> dict[str, str]:
-    available = set(bag.fields(topic))
-    columns = {}
-    for key, column in _TAG_COLUMNS.items():
-        field = getattr(tag_fields, key)
-        if field in available:
-            columns[column] = field
-        elif key == "activity" or (key == "lifecycle" and field):
-            raise InputError(
-                f"{bag.path}: the tags on {topic} ({bag.topics[topic]}) have no field "
-                f"{field!r} for the {key}; name it with --tag-field {key}=FIELD (its fields are "
-                f"{', '.join(sorted(available))}"
-                + ("; --tag-field lifecycle= if it has none)." if key == "lifecycle" else ").")
-            )
-    return columns
-
-
-def _robots(bag: Bag, reading: _Reading) -> Callable[[str], str]:
-    """The robot of a topic's tags and activities: its namespace; for a topic without one,
-    ``--robot``, else the bag's only namespace, else :data:`DEFAULT_ROBOT`, said once per
-    topic as a warning (a wrong robot would silently split or merge robots)."""
-    spaces = sorted({namespace(t).split("/")[0] for t in bag.topics} - {""})
-    told: set[str] = set()
-
-    def robot_of(topic: str) -> str:
-        found = namespace(topic)
-        if found:
-            return found
-        if reading.robot:
-            return reading.robot
-        robot, why = (
-            (spaces[0], "the only namespace of its topics")
-            if len(spaces) == 1
-            else (DEFAULT_ROBOT, "the bag's topics have no namespace" if not spaces else
-                  f"the bag's topics have {len(spaces)} namespaces")
-        )  # fmt: skip
-        if topic not in told:
-            told.add(topic)
-            warnings.warn(
-                f"{bag.path}: {topic} ({bag.topics[topic]}) has no namespace, so its "
-                f"activities are of robot {robot!r} ({why}); name the robot with --robot NAME.",
-                PreparationWarning,
-                stacklevel=2,
-            )
-        return robot
-
-    return robot_of
-
-
-def _tag_rows(
-    table: pd.DataFrame,
-    topic: str,
-    run: Path,
-    reading: _Reading,
-    robot_of: Callable[[str], str],
-) -> pd.DataFrame:
-    rows = table.rename(columns={TIME: schema.TIMESTAMP, sources.INDEX: schema.SOURCE_INDEX})
-    rows.insert(0, schema.CASE, run.name)
-    rows[schema.SOURCE_TOPIC] = topic
-    rows = _without_empty_activities(rows, topic, run, reading.tag_fields)
-    rows[schema.LIFECYCLE] = _lifecycles(rows, topic, run, reading.lifecycle)
-    robot = rows[schema.ROBOT].astype(str).str.strip() if schema.ROBOT in rows else None
-    defaulted = robot is None or (robot == "").any()
-    fallback = robot_of(topic) if defaulted and len(rows) else namespace(topic)
-    rows[schema.ROBOT] = fallback if robot is None else robot.replace("", fallback)
-    for column in (schema.MSG_ID, schema.MSG_ROLE, schema.MSG_PAYLOAD):
-        if column in rows:
-            rows[column] = rows[column].astype(object).replace("", None)
-    return rows
-
-
-def _without_empty_activities(
-    rows: pd.DataFrame, topic: str, run: Path, tag_fields: TagFields
-) -> pd.DataFrame:
-    """The tags that name an activity; the others are left out with a warning."""
-    empty = rows[schema.ACTIVITY].astype(str).str.strip() == ""
-    if empty.any():
-        warnings.warn(
-            f"{run}: {int(empty.sum())} tag(s) on {topic} have an empty activity (field "
-            f"{tag_fields.activity!r}) and were left out; name the field holding the activity "
-            "with --tag-field activity=FIELD.",
-            PreparationWarning,
-            stacklevel=5,
-        )
-    return rows[~empty].reset_index(drop=True)
-
-
-def _lifecycles(rows: pd.DataFrame, topic: str, run: Path, mode: str | None) -> pd.Series:
-    """The tags' lifecycles: their field's, or ``complete`` for tags that are single events."""
-    if schema.LIFECYCLE not in rows or mode == "events":
-        if mode == "implicit":
-            return pd.Series(schema.START, index=rows.index, dtype=object)
-        if mode is None:
-            warnings.warn(
-                f"{run}: the tags on {topic} have no lifecycle, so each is a single event; "
-                "--lifecycle implicit makes each an activity that the robot's next tag ends.",
-                PreparationWarning,
-                stacklevel=5,
-            )
-        return pd.Series(schema.COMPLETE, index=rows.index, dtype=object)
-    given = rows[schema.LIFECYCLE].astype(str)
-    lifecycles = given.str.strip().str.lower().replace("", schema.NONE)
-    bad = ~lifecycles.isin(_LIFECYCLES)
-    if bad.any():
-        at = rows.loc[bad, schema.TIMESTAMP].iloc[0].isoformat()
-        raise InputError(
-            f"{run}: a tag on {topic} at {at} has lifecycle {given[bad].iloc[0]!r}; "
-            "expected start, complete or none (or an outcome: aborted, cancelled, ate_abort)."
-        )
-    return lifecycles
-
-
-def _samples(
-    run: Path,
-    tables: Sequence[tuple[str, pd.DataFrame]],
-    perspective: Perspective,
-    robots: Sequence[str],
-) -> pd.DataFrame:
-    columns = [schema.CASE, schema.ROBOT, schema.TIMESTAMP, *perspective.columns]
-    parts = []
-    for topic, table in tables:
-        part = table[[TIME, *perspective.columns]].rename(columns={TIME: schema.TIMESTAMP})
-        for column, factor in (perspective.scale or {}).items():
-            part[column] = part[column] * factor
-        part[schema.CASE] = run.name
-        part[schema.ROBOT] = namespace(topic) or _only_robot(run, topic, robots)
-        parts.append(part[columns])
-    if not parts:
-        return pd.DataFrame({c: pd.Series(dtype=object) for c in columns}).astype(
-            {schema.TIMESTAMP: "datetime64[ns, UTC]"}
-        )
-    return pd.concat(parts, ignore_index=True)
-
-
-def _only_robot(run: Path, topic: str, robots: Sequence[str]) -> str:
-    if len(robots) == 1:
-        return robots[0]
-    raise InputError(
-        f"{run}: {topic} has no namespace, so it cannot be told which of the robots "
-        f"({', '.join(robots)}) it belongs to; record it as /<robot>{topic}."
-    )
-
-
-def _robot_types(tags: pd.DataFrame, manifests: Mapping[str, RunManifest]) -> np.ndarray:
-    """From each run's manifest (``robots``: name -> pool), else from the robot's name."""
-    declared = {
-        (case, name): _declared_type(value)
-        for case, manifest in manifests.items()
-        for name, value in (manifest.get("robots") or {}).items()
-    }
-    pairs = zip(tags[schema.CASE], tags[schema.ROBOT], strict=True)
-    return np.array([declared.get(pair) or robot_type(pair[1]) for pair in pairs], dtype=object)
-
-
-def _declared_type(value: object) -> str | None:
-    if isinstance(value, Mapping):
-        value = value.get("type") or value.get("pool")
-    return str(value) if value else None
-
-
-def _warn_missing_samples(
-    tags: pd.DataFrame, samples: Mapping[str, pd.DataFrame], perspectives: Sequence[Perspective]
-) -> None:
-    counts = {p.name: len(samples[p.name]) for p in perspectives}
-    missing = {p.name: robots_without_samples(tags, samples[p.name]) for p in perspectives}
-    _say_missing_samples(counts, missing, perspectives)
-
-
-def _say_missing_samples(
-    counts: Mapping[str, int],
-    missing_robots: Mapping[str, Sequence[str]],
-    perspectives: Sequence[Perspective],
-) -> None:
-    """The warnings of perspectives without samples (``counts``), and of robots with tags
-    but no samples (``missing_robots``, ``run/robot``), per perspective."""
-    for p in perspectives:
-        if not counts[p.name]:
-            warnings.warn(
-                f"No bag has samples of the {p.name} perspective ({p.topic}), so the log's "
-                f"{', '.join(p.columns)} column(s) are empty.",
-                PreparationWarning,
-                stacklevel=3,
-            )
-            continue
-        missing = sorted(missing_robots[p.name])
-        if missing:
-            warnings.warn(
-                f"{len(missing)} robot(s) have tags but no {p.name} samples ({p.topic}): "
-                f"{', '.join(missing[:5])}{', ...' if len(missing) > 5 else ''}.",
-                PreparationWarning,
-                stacklevel=3,
-            )
-
-
 def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.DataFrame:
     """Known columns in the documented order, every perspective column present, event ids."""
     for column in [c for p in perspectives for c in p.columns]:
@@ -815,26 +534,6 @@ def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.Dat
     log[schema.EVENT_ID] = log[schema.CASE].astype(str) + ":" + position
     known = [c for c in schema.CSV_NAMES if c in log]
     return log[known + [c for c in log if c not in schema.CSV_NAMES]]
-
-
-def _message_count(run: Path, globs: Sequence[str]) -> int:
-    """How many messages of a bag the preparation reads, from its metadata alone."""
-    return sum(_message_counts(run, globs).values())
-
-
-def _message_counts(run: Path, globs: Sequence[str]) -> dict[str, int]:
-    """The message count of each topic of a bag matching ``globs``, from its metadata."""
-    try:
-        text = (run / "metadata.yaml").read_text(encoding="utf-8")
-        meta = yaml.load(text, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-        topics = meta["rosbag2_bagfile_information"]["topics_with_message_count"]
-        return {
-            str(t["topic_metadata"]["name"]): int(t["message_count"])
-            for t in topics
-            if any(fnmatchcase(t["topic_metadata"]["name"], g) for g in globs)
-        }
-    except (OSError, ValueError, KeyError, TypeError, yaml.YAMLError):
-        return {}  # the bag's own reader explains what is wrong with it
 
 
 __all__ = [

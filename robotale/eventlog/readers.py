@@ -22,9 +22,10 @@ import csv
 import dataclasses
 import io
 import warnings
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from contextlib import suppress
 from pathlib import Path
+from typing import TypeAlias
 
 import numpy as np
 import pandas as pd
@@ -35,7 +36,7 @@ from lxml import etree
 
 from robotale.errors import InputError
 from robotale.eventlog import dataset, ocel, reading, schema
-from robotale.eventlog.dataset import MANIFEST, WRITING
+from robotale.eventlog.logkinds import OCEL, PARQUET, XES, kind_of
 from robotale.eventlog.objects import Objects, entity_cells, entity_columns
 from robotale.eventlog.oced import read_object_tables
 from robotale.eventlog.reading import SYNONYMS, TEXT_COLUMNS, Reading, column_mapping, listing
@@ -43,7 +44,7 @@ from robotale.storage import place
 
 SINGLE_CASE = "1"
 #: a duration such as ``pd.Timedelta("1h")`` or the text ``"1h"``
-Gap = pd.Timedelta | str | None
+Gap: TypeAlias = pd.Timedelta | str | None
 
 
 def parse_mapping(items: Sequence[str]) -> dict[str, str]:
@@ -94,35 +95,27 @@ def read_with_objects(
     file (``.jsonocel``/``.json``, ``.xmlocel``/``.xml``, ``.sqlite``/``.db``), or a CSV log
     whose ``objects`` folder holds one ``<Type>.csv`` per object type (:mod:`.oced`).
 
-    This is the one place that decides what kind of log a path is.
+    What kind of log a path is, :func:`~robotale.eventlog.logkinds.kind_of` decides.
     """
     path = Path(path)
-    if ocel.encoding(path):
+    kind = kind_of(path)
+    if kind is OCEL:
         if objects is not None:
             raise InputError(
                 f"{path} is an OCEL 2.0 log, which lists its objects itself: --objects "
                 "belongs to a CSV log."
             )
         return _read_ocel(path, mapping, case, case_gap)
-    if path.suffix.lower() == ".xes":
+    if kind is XES:
         log, found = _read_xes(path, mapping, case, case_gap)
-    elif is_parquet(path):
+    elif kind is PARQUET:
         log, found = _read_parquet(path, mapping, case, case_gap)
-    else:
+    else:  # CSV, and a folder of recordings, which the CSV reader refuses with a sentence
         types = [p.stem for p in Path(objects).glob("*.csv")] if objects is not None else []
         log, found = _read_csv(path, mapping, case, case_gap, types)
     if objects is None:
         return log, found, None
     return log, found, read_object_tables(Path(objects), log, path)
-
-
-def is_parquet(path: str | Path) -> bool:
-    """Whether ``path`` is read as Parquet: a ``.parquet`` file or folder, or a folder robotale
-    wrote a dataset into (under another name)."""
-    path = Path(path)
-    if path.suffix.lower() == ".parquet":
-        return True
-    return path.is_dir() and any((path / name).exists() for name in (MANIFEST, WRITING))
 
 
 def read_csv(
@@ -325,7 +318,7 @@ def _parquet_table(path: Path) -> pa.Table:
 
 # -- XES -------------------------------------------------------------------------------------
 
-_XES_VALUES = {
+_XES_VALUES: dict[str, Callable[[str], object]] = {
     "string": str,
     "id": str,
     "date": str,  # parsed with the other timestamps

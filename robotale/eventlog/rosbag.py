@@ -12,6 +12,8 @@ preparation); messages are read from the storage files by topic and type, so a m
 whose QoS differs from its storage's does not hide them; and each topic's first message is
 checked against its definition, so a wrong stored definition is named instead of trusted.
 
+What each type is, :mod:`robotale.eventlog.typesys` resolves; this module reads the storage.
+
 Every table has a ``time`` column (tz-aware UTC): the message's own stamp (``header.stamp`` or a
 top-level ``stamp``) when it has a non-zero one, else the time the bag recorded it. The other
 columns are the message fields asked for, by dotted path (``pose.pose.position.x``).
@@ -20,50 +22,49 @@ columns are the message fields asked for, by dotted path (``pose.pose.position.x
 from __future__ import annotations
 
 import contextlib
-import functools
 import struct
-from collections.abc import Iterator, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field
 from operator import attrgetter
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 import apsw  # rosbags' SQLite binding: a damaged database raises its errors
 import numpy as np
 import pandas as pd
-from rosbags.interfaces import Connection, MessageDefinitionFormat
+from rosbags.interfaces import Connection
 from rosbags.rosbag2 import Reader, ReaderError
 from rosbags.serde import SerdeError
-from rosbags.typesys import (
-    Stores,
-    TypesysError,
-    get_types_from_idl,
-    get_types_from_msg,
-    get_typestore,
-)
 from rosbags.typesys.store import Typestore
+from tqdm import tqdm
 
 from robotale.errors import InputError
 from robotale.eventlog.cdrlayout import Layout, columns
 from robotale.eventlog.interfaces import (
-    RELEASES,
     definition_file,
     message_types,
     normalized,
-    shipped,
-    stored_types,
 )
-from robotale.eventlog.messages import Batch, MalformedMcap, gathered, mcap_batches, zstd
-from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
+from robotale.eventlog.messages import Batch, MalformedMcap, decompressed, gathered, mcap_batches
+from robotale.eventlog.typesys import (
+    all_fields,
+    bag_definitions,
+    check_distro,
+    field_type,
+    missing_type,
+    release_of,
+    scalar_fields,
+    stamp_path,
+    typestore_for,
+)
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import Typesdict
 
 TIME = "time"
 #: the column of a table holding when the bag recorded each message (ns since the epoch), when
 #: asked for: the recording's order of messages from different topics
 RECORDED = "_recorded"
-HEADER_TYPE = "std_msgs/msg/Header"
-TIME_TYPE = "builtin_interfaces/msg/Time"
-
-# rosbags' field descriptors are (nodetype, detail); NAME is a nested message type.
-_BASE, _NAME, _ARRAY, _SEQUENCE = 1, 2, 3, 4
 
 
 def is_bag(path: Path) -> bool:
@@ -101,12 +102,12 @@ class Bag:
     """
 
     path: Path
-    extra_types: Mapping = field(default_factory=dict)
+    extra_types: Typesdict = field(default_factory=dict)
     #: the ROS 2 distribution whose standard types fill in what the bag does not define
     distro: str | None = None
     _reader: Reader | None = field(default=None, init=False, repr=False)
-    typestore: Typestore | None = field(default=None, init=False, repr=False)
-    _definitions: Mapping = field(default_factory=dict, init=False, repr=False)
+    _typestore: Typestore | None = field(default=None, init=False, repr=False)
+    _definitions: Typesdict = field(default_factory=dict, init=False, repr=False)
     _topics: dict[str, str] = field(default_factory=dict, init=False, repr=False)
     #: topic -> why its stored definition cannot be used (reported only if it is read)
     unparsed: dict[str, str] = field(default_factory=dict, init=False, repr=False)
@@ -139,12 +140,14 @@ class Bag:
         self._reader = reader
         self._topics = {n: normalized(i.msgtype or "") for n, i in sorted(reader.topics.items())}
         try:
-            self.release = _release(self.distro or reader.ros_distro)
-            self._definitions = _definitions(reader, self.extra_types, self.release, self.unparsed)
+            self.release = release_of(self.distro or reader.ros_distro)
+            self._definitions = bag_definitions(
+                reader, self.extra_types, self.release, self.unparsed
+            )
             roots = {
                 normalized(c.msgtype) for c in reader.connections if c.topic not in self.unparsed
             }
-            self.typestore = _typestore(self._definitions, roots, self.path)
+            self._typestore = typestore_for(self._definitions, roots, self.path)
             self.qos_mismatch = _qos_mismatches(reader)
         except BaseException:
             self.__exit__()
@@ -161,6 +164,13 @@ class Bag:
         if self._reader is None:
             raise RuntimeError("the bag is not open; use it in a with statement")
         return self._reader
+
+    @property
+    def typestore(self) -> Typestore:
+        """The types of the bag's topics (those with every definition they need)."""
+        if self._typestore is None:
+            raise RuntimeError("the bag is not open; use it in a with statement")
+        return self._typestore
 
     @property
     def name(self) -> str:
@@ -182,7 +192,7 @@ class Bag:
         *,
         bag_time: bool = False,
         recorded: bool = False,
-        progress=None,
+        progress: tqdm | None = None,
     ) -> dict[str, pd.DataFrame]:
         """One table per topic: ``time`` plus ``columns[topic]`` (column name -> field path).
 
@@ -236,7 +246,7 @@ class Bag:
                 f"{definition_file(msgtype)}."
             )
         if msgtype not in self.typestore.fielddefs:
-            missing = _missing(self._definitions, msgtype) or msgtype
+            missing = missing_type(self._definitions, msgtype) or msgtype
             part = "" if missing == msgtype else f", which {msgtype} contains,"
             file = definition_file(missing)
             raise InputError(
@@ -247,10 +257,10 @@ class Bag:
             )
         return msgtype
 
-    def _decoder(self, topic: str):
+    def _decoder(self, topic: str) -> Callable[[bytes], Any]:
         msgtype, deserialize = self.topics[topic], self.typestore.deserialize_cdr
 
-        def decode(raw: bytes) -> object:
+        def decode(raw: bytes) -> Any:  # a message of a generated class
             try:
                 return deserialize(raw, msgtype)
             except (SerdeError, struct.error, IndexError, ValueError, AssertionError) as error:
@@ -264,7 +274,7 @@ class Bag:
 
         return decode
 
-    def _checker(self, topic: str):
+    def _checker(self, topic: str) -> Callable[[bytes, Any], None]:
         """A check of a topic's first message against the definition it is decoded with.
 
         Decoding alone trusts too much: a definition shorter than the message (a stored
@@ -274,7 +284,7 @@ class Bag:
         """
         msgtype, store = self.topics[topic], self.typestore
 
-        def check(raw: bytes, message: object) -> None:
+        def check(raw: bytes, message: Any) -> None:
             again = len(store.serialize_cdr(message, msgtype))
             if abs(len(raw) - again) > 3:  # CDR pads a message to a multiple of 4 bytes
                 raise InputError(
@@ -286,10 +296,12 @@ class Bag:
 
         return check
 
-    def _batches(self, connections: list[Connection], progress) -> Iterator[tuple[str, Batch]]:
+    def _batches(
+        self, connections: list[Connection], progress: tqdm | None
+    ) -> Iterator[tuple[str, Batch]]:
         """The messages of ``connections`` in batches, a storage file after another, and an
         error if a file's messages start before the previous file's end."""
-        spans: dict[str, list] = {}  # file -> [first time, its topic, last time]
+        spans: dict[str, list[Any]] = {}  # file -> [first time, its topic, last time]
         try:
             for file, connection, batch in _storage_batches(self.reader, connections):
                 if progress is not None:
@@ -309,11 +321,11 @@ class Bag:
             raise InputError(
                 f"{self.path} cannot be read: its storage is damaged ({reason})."
             ) from None
-        last = None
+        latest: int | None = None
         for first, topic, end in spans.values():
-            if last is not None and first < last:
-                raise InputError(_out_of_order(self.reader, self.path, topic, first, last))
-            last = end if last is None else max(last, end)
+            if latest is not None and first < latest:
+                raise InputError(_out_of_order(self.reader, self.path, topic, first, latest))
+            latest = end if latest is None else max(latest, end)
 
 
 class _TopicRows:
@@ -324,7 +336,15 @@ class _TopicRows:
     other messages, and other fields, are decoded one by one with rosbags.
     """
 
-    def __init__(self, msgtype, paths: list[str], stamped: bool, typestore, decode, check) -> None:
+    def __init__(
+        self,
+        msgtype: str,
+        paths: list[str],
+        stamped: bool,
+        typestore: Typestore,
+        decode: Callable[[bytes], Any],
+        check: Callable[[bytes, Any], None],
+    ) -> None:
         self.msgtype, self.paths, self.stamped = msgtype, paths, stamped
         self.typestore, self.decode, self.check = typestore, decode, check
         self.extract = _extractor(paths)
@@ -333,7 +353,7 @@ class _TopicRows:
         self.count = 0
         self.bulk: list[np.ndarray] = []  # the fitting messages' first layout.end bytes
         self.bulk_at: list[int] = []
-        self.one_by_one: list[tuple] = []
+        self.one_by_one: list[tuple[Any, ...]] = []
         self.one_by_one_at: list[int] = []
 
     def add(self, batch: Batch) -> None:
@@ -373,7 +393,11 @@ class _TopicRows:
     def table(self, names: list[str], bag_time: bool, with_recorded: bool = False) -> pd.DataFrame:
         count = self.count
         recorded = np.concatenate(self.recorded) if self.recorded else np.zeros(0, np.int64)
-        bulk = columns(self.layout, np.concatenate(self.bulk)) if self.bulk_at else None
+        bulk = (
+            columns(self.layout, np.concatenate(self.bulk))
+            if self.bulk_at and self.layout is not None
+            else None
+        )
         values = {}
         for k, name in enumerate(["_sec", "_nanosec"][: 2 * self.stamped] + names):
             if not self.one_by_one_at:
@@ -411,7 +435,7 @@ def read_bag(
         return bag.tables(columns, bag_time=bag_time)
 
 
-def _extractor(paths: list[str]):
+def _extractor(paths: list[str]) -> Callable[[Any], tuple[Any, ...]]:
     """A function from a message to the tuple of its values at ``paths``."""
     if not paths:
         return lambda message: ()
@@ -419,7 +443,9 @@ def _extractor(paths: list[str]):
     return get if len(paths) > 1 else lambda message: (get(message),)
 
 
-def _table(recorded: np.ndarray, values: dict, names: list[str], bag_time: bool) -> pd.DataFrame:
+def _table(
+    recorded: np.ndarray, values: dict[str, np.ndarray], names: list[str], bag_time: bool
+) -> pd.DataFrame:
     nanos = recorded
     if "_sec" in values and not bag_time:
         stamps = values["_sec"].astype(np.int64) * 1_000_000_000 + values["_nanosec"].astype(
@@ -444,142 +470,8 @@ def _out_of_order(reader: Reader, path: Path, topic: str, recorded: int, last: i
 
 def _storage_files(reader: Reader) -> list[str]:
     with contextlib.suppress(AttributeError):
-        return [str(storage.path) for storage in reader.storage.storages]
+        return [str(storage.path) for storage in _storages(reader)]
     return []
-
-
-def _definitions(reader: Reader, extra: Mapping, release: str, unparsed: dict) -> dict:
-    """The user's types, then the bag's, then the distribution's (rosbags' store), then those
-    robotale ships for it, then robotale's Tag.
-
-    The user's come first: they are given to correct or complete what the bag says. A stored
-    definition that cannot be parsed is noted in ``unparsed`` (topic -> reason) and left out.
-    """
-    typs: dict = dict(extra)
-    for connection in reader.connections:
-        try:
-            embedded = _embedded_types(connection)
-        except TypesysError as error:
-            reason = " ".join(str(error).split())
-            unparsed[connection.topic] = reason if len(reason) < 160 else f"{reason[:157]}..."
-            continue
-        typs.update({name: spec for name, spec in embedded.items() if name not in extra})
-    # a release rosbags has no store of yet (rolling) takes the latest it has
-    standard = get_typestore(DISTROS.get(release, [*DISTROS.values()][-1])).fielddefs
-    for source in (standard, shipped(release), get_types_from_msg(TAG_MSGDEF, TAG_TYPE)):
-        typs.update({name: spec for name, spec in source.items() if name not in typs})
-    return typs
-
-
-def _typestore(definitions: Mapping, roots: set[str], path: Path) -> Typestore:
-    """A store of the types ``roots`` need whose definitions are all there.
-
-    Only those: a distribution has hundreds of types. Stores are shared between bags that
-    need the same definitions (the runs of a batch), as building one generates code.
-    """
-    needed = _closure(definitions, roots)
-    usable = {n: spec for n, spec in needed.items() if _missing(definitions, n) is None}
-    key = repr(sorted(usable.items()))
-    if key not in _STORES:
-        store = get_typestore(Stores.EMPTY)
-        try:
-            store.register(usable)
-        except TypesysError as error:
-            raise InputError(f"{path}: its message definitions cannot be used: {error}") from None
-        if len(_STORES) >= 32:
-            _STORES.clear()
-        _STORES[key] = store
-    return _STORES[key]
-
-
-_STORES: dict[str, Typestore] = {}
-
-
-def _closure(typs: Mapping, roots: set[str]) -> dict:
-    """The definitions of ``roots`` and of every type they contain (those there are)."""
-    needed: dict = {}
-    todo = list(roots)
-    while todo:
-        name = todo.pop()
-        if name in needed or name not in typs:
-            continue
-        needed[name] = typs[name]
-        todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
-    return needed
-
-
-def _missing(typs: Mapping, msgtype: str) -> str | None:
-    """The first type ``msgtype`` needs (itself included) that has no definition, if any."""
-    seen, todo = set(), [msgtype]
-    while todo:
-        name = todo.pop(0)
-        if name in seen:
-            continue
-        if name not in typs:
-            return name
-        seen.add(name)
-        todo.extend(ref for _, desc in typs[name][1] for ref in _references(desc))
-    return None
-
-
-def _references(desc: tuple) -> list[str]:
-    nodetype, detail = desc
-    if nodetype == _NAME:
-        return [detail]
-    if nodetype in (_ARRAY, _SEQUENCE):
-        return _references(detail[0])
-    return []
-
-
-def _embedded_types(connection: Connection) -> dict:
-    definition = connection.msgdef
-    if not definition.data.strip():  # what rosbag2 stores for a type it found no file of
-        return {}
-    try:
-        return dict(_parsed(definition.format, definition.data, connection.msgtype))
-    except (KeyError, IndexError, ValueError) as error:  # malformed IDL the parser trips on
-        raise TypesysError(f"{type(error).__name__}: {error}") from None
-
-
-@functools.lru_cache(maxsize=256)
-def _parsed(kind: MessageDefinitionFormat, data: str, msgtype: str) -> tuple:
-    """A stored definition parsed once: the runs of a batch all store the same ones."""
-    if kind == MessageDefinitionFormat.MSG:
-        return tuple(stored_types(data, normalized(msgtype)).items())
-    if kind == MessageDefinitionFormat.IDL:
-        separator = "=" * 80 + "\n"
-        typs: dict = {}
-        for part in data.split(separator)[1:] or [data]:
-            typs.update(
-                get_types_from_idl(part.split("\n", 1)[1] if part.startswith("IDL: ") else part)
-            )
-        return tuple(typs.items())
-    return ()
-
-
-#: the distributions whose standard types rosbags provides, by the name users give them
-DISTROS = {
-    name.removeprefix("ROS2_").lower(): store
-    for name, store in Stores.__members__.items()
-    if name.startswith("ROS2_")
-}
-DEFAULT_DISTRO = "humble"
-
-
-def _release(name: str | None) -> str:
-    """The distribution a bag's types are completed from: ``name`` if robotale knows it, else
-    Humble (what a bag that names none was most likely recorded with)."""
-    name = (name or DEFAULT_DISTRO).lower()
-    return name if name in DISTROS or name in RELEASES else DEFAULT_DISTRO
-
-
-def check_distro(name: str | None) -> str | None:
-    """``name`` if rosbags knows the distribution, else an error listing those it knows."""
-    if name is not None and name.lower() not in DISTROS:
-        raise InputError(
-            f"Unknown ROS 2 distribution {name!r}: use one of {', '.join(sorted(DISTROS))}."
-        )
-    return name and name.lower()
 
 
 def _qos_mismatches(reader: Reader) -> list[str]:
@@ -601,9 +493,11 @@ def _qos_mismatches(reader: Reader) -> list[str]:
     return sorted(mismatched)
 
 
-def _storages(reader: Reader) -> list:
+def _storages(reader: Reader) -> list[Any]:
+    """The storage files of a directory reader (rosbags' own objects, not part of its typed
+    interface), or none."""
     with contextlib.suppress(AttributeError):
-        return list(reader.storage.storages)
+        return list(getattr(reader.storage, "storages"))  # noqa: B009 -- untyped in rosbags
     return []
 
 
@@ -634,7 +528,9 @@ def _storage_batches(
             yield file, mine[key], batch
 
 
-def _file_batches(storage, mine: Mapping[int, Connection], compressed: bool):
+def _file_batches(
+    storage: Any, mine: Mapping[int, Connection], compressed: bool
+) -> Iterator[tuple[int, Batch]]:
     """One storage file's batches: straight from an indexed MCAP file's chunks, else from
     rosbags' reading message by message."""
     path = getattr(storage, "path", None)
@@ -645,64 +541,16 @@ def _file_batches(storage, mine: Mapping[int, Connection], compressed: bool):
             return
     own = [c for c in storage.connections if c.id in mine]
     plain = (
-        (c.id, t, _decompressed(raw) if compressed else raw)
+        (c.id, t, decompressed(raw) if compressed else raw)
         for c, t, raw in storage.messages(own, None, None)
     )
     yield from gathered(plain)
-
-
-def _decompressed(raw: bytes) -> bytes:
-    return zstd.decompress(raw)  # the zstd rosbags compresses with
-
-
-def all_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
-    """Dotted paths of every field, nested messages included as well as their leaves."""
-    paths = []
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        path = f"{prefix}{name}"
-        paths.append(path)
-        if nodetype == _NAME:
-            paths.extend(all_fields(detail, typestore, f"{path}."))
-    return paths
-
-
-def scalar_fields(msgtype: str, typestore: Typestore, prefix: str = "") -> list[str]:
-    """Dotted paths of the scalar leaves (numbers, strings, booleans) of a message type."""
-    paths = []
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if nodetype == _BASE:
-            paths.append(f"{prefix}{name}")
-        elif nodetype == _NAME:
-            paths.extend(scalar_fields(detail, typestore, f"{prefix}{name}."))
-    return paths
-
-
-def field_type(msgtype: str, path: str, typestore: Typestore) -> str | None:
-    """The base type (``float32``, ``string`` ...) of a scalar field, ``None`` for others."""
-    head, _, rest = path.partition(".")
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if name == head:
-            if rest:
-                return field_type(detail, rest, typestore) if nodetype == _NAME else None
-            return detail[0] if nodetype == _BASE else None
-    return None
 
 
 def _shortest_float32(values: pd.Series) -> pd.Series:
     """float32 readings as the decimals they were written as (0.98, not 0.9800000190734863)."""
     as_text = values.to_numpy(np.float32).astype(str)
     return pd.Series(as_text.astype(np.float64), index=values.index)
-
-
-def stamp_path(msgtype: str, typestore: Typestore) -> str | None:
-    """Where a message type keeps its time: ``header.stamp``, ``stamp``, or nowhere."""
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if nodetype == _NAME and name == "header" and detail == HEADER_TYPE:
-            return "header.stamp"
-    for name, (nodetype, detail) in typestore.fielddefs[msgtype][1]:
-        if nodetype == _NAME and name == "stamp" and detail == TIME_TYPE:
-            return "stamp"
-    return None
 
 
 def namespace(topic: str) -> str:

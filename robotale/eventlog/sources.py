@@ -10,21 +10,26 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from fnmatch import fnmatchcase
+from typing import TYPE_CHECKING, Literal, overload
 
 import numpy as np
 import pandas as pd
+from rosbags.interfaces import Nodetype
 
 from robotale.errors import InputError
 from robotale.eventlog import activities
 from robotale.eventlog.activities import ACTION_STATUS, BT_FIELDS, INDEX, STATUS_TYPE
-from robotale.eventlog.rosbag import Bag, field_type, namespace
+from robotale.eventlog.rosbag import Bag, namespace
+from robotale.eventlog.typesys import field_type
+
+if TYPE_CHECKING:
+    from rosbags.interfaces.typing import ConstValue, Typesdict
 
 #: the field of a state topic read when none is named, in this order of preference
 STATE_FIELDS = ("data", "state", "mode", "status", "value")
 #: topic names ``--auto`` takes for state topics
 STATE_NAMES = ("mode", "state")
 _TEXT_OR_INTEGER = {"string", "int8", "uint8", "int16", "uint16", "int32", "uint32"}
-_BASE, _NAME, _SEQUENCE = 1, 2, 4
 
 
 @dataclass(frozen=True)
@@ -53,7 +58,7 @@ class Sources:
 def propose(bag: Bag) -> Sources:
     """What in ``bag`` looks like activities: action status topics, BT logs, mode/state topics."""
     actions = [t for t, kind in bag.topics.items() if kind == STATUS_TYPE]
-    bt_logs = [t for t in bag.topics if t not in bag.unparsed and _bt_column(bag, t) is not False]
+    bt_logs = [t for t in bag.topics if t not in bag.unparsed and _bt_column(bag, t) is not None]
     states = [
         f"{topic}:{state}"
         for topic in bag.topics
@@ -78,7 +83,7 @@ def columns(bag: Bag, sources: Sources) -> dict[str, dict[str, str]]:
     for topic in _matching(bag, sources.bt_logs):
         bag.fields(topic)  # a type without a definition is named as such, with the file to give
         column = _bt_column(bag, topic)
-        if column is False:
+        if column is None:
             raise InputError(
                 f"{bag.path}: {topic} ({bag.topics[topic]}) is not a behaviour-tree log: it has "
                 f"neither {', '.join(BT_FIELDS)} nor a sequence of messages with them."
@@ -128,6 +133,16 @@ def _matching(bag: Bag, globs: str | None) -> list[str]:
     return [t for t in bag.topics if any(fnmatchcase(t, g) for g in globs.split("|"))]
 
 
+@overload
+def _state_field(bag: Bag, topic: str, name: str | None, *, strict: Literal[True]) -> str: ...
+
+
+@overload
+def _state_field(
+    bag: Bag, topic: str, name: str | None, *, strict: Literal[False]
+) -> str | None: ...
+
+
 def _state_field(bag: Bag, topic: str, name: str | None, *, strict: bool) -> str | None:
     """The field of a state topic: ``name``, else the first of :data:`STATE_FIELDS` that is text
     or an integer."""
@@ -155,31 +170,35 @@ def _state_field(bag: Bag, topic: str, name: str | None, *, strict: bool) -> str
     return chosen
 
 
-def _constant_names(bag: Bag, topic: str) -> dict:
+def _constant_names(bag: Bag, topic: str) -> dict[ConstValue, str]:
     """An enum message's values -> its constants' names, where each value has one name."""
     consts = bag.typestore.fielddefs[bag.topics[topic]][0]
-    by_value: dict = {}
+    by_value: dict[ConstValue, list[str]] = {}
     for name, _, value in consts:
         by_value.setdefault(value, []).append(name)
     return {value: names[0] for value, names in by_value.items() if len(names) == 1}
 
 
-def _bt_column(bag: Bag, topic: str) -> str | bool:
+def _bt_column(bag: Bag, topic: str) -> str | None:
     """``""`` if each message is a BT status change, the name of its sequence of changes if it
-    holds one, ``False`` if it is neither."""
+    holds one, ``None`` if it is neither."""
     definitions = bag.typestore.fielddefs
     msgtype = bag.topics[topic]
     if msgtype not in definitions:
-        return False
+        return None
     if _is_change(definitions, msgtype):
         return ""
-    for name, (nodetype, detail) in definitions[msgtype][1]:
-        item = detail[0] if nodetype == _SEQUENCE else (None, None)
-        if item[0] == _NAME and _is_change(definitions, item[1]):
+    for name, desc in definitions[msgtype][1]:
+        if desc[0] != Nodetype.SEQUENCE:
+            continue
+        item = desc[1][0]
+        if item[0] == Nodetype.NAME and _is_change(definitions, item[1]):
             return name
-    return False
+    return None
 
 
-def _is_change(definitions: Mapping, msgtype: str) -> bool:
-    names = {name for name, _ in definitions.get(msgtype, ((), ()))[1]}
+def _is_change(definitions: Typesdict, msgtype: str) -> bool:
+    if msgtype not in definitions:
+        return False
+    names = {name for name, _ in definitions[msgtype][1]}
     return set(BT_FIELDS) <= names

@@ -19,8 +19,9 @@ from __future__ import annotations
 import itertools
 import json
 import math
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from pathlib import Path
+from typing import Any, cast
 
 import numpy as np
 import pandas as pd
@@ -42,6 +43,10 @@ _XES_EXTENSIONS = (
 )
 #: OCEL 2.0 objects' static attributes hold from the beginning of time.
 _EPOCH = "1970-01-01T00:00:00+00:00"
+
+
+#: a column of an XES log as written: its key, its XES type and its values, one per row
+_XesAttribute = tuple[str, str, list[str | None]]
 
 
 def check_target(path: str | Path) -> Path:
@@ -127,7 +132,8 @@ def _xes_values(series: pd.Series, kind: str) -> list[str | None]:
         if kind == "string":
             missing = missing | (text == "")
     text[missing] = None
-    return text.tolist()
+    values: list[str | None] = text.tolist()
+    return values
 
 
 def write_xes(log: pd.DataFrame, path: str | Path, name: str | None = None) -> None:
@@ -135,7 +141,7 @@ def write_xes(log: pd.DataFrame, path: str | Path, name: str | None = None) -> N
     log = _grouped_by_case(log)
     first = [TIME, ACTIVITY, schema.LIFECYCLE, schema.STATE]
     columns = [c for c in first if c in log] + [c for c in log if c not in (*first, CASE)]
-    attributes = []
+    attributes: list[_XesAttribute] = []
     for column in columns:
         kind = xes_type(log[column])
         attributes.append((column, kind, _xes_values(log[column], kind)))
@@ -186,7 +192,7 @@ def _xes_header(name: str) -> list[etree._Element]:
     return elements
 
 
-def _xes_trace(case: str, attributes: list, start: int, end: int) -> etree._Element:
+def _xes_trace(case: str, attributes: list[_XesAttribute], start: int, end: int) -> etree._Element:
     trace = etree.Element("trace")
     etree.SubElement(trace, "string", key="concept:name", value=case)
     sub = etree.SubElement
@@ -206,7 +212,7 @@ def _xes_trace(case: str, attributes: list, start: int, end: int) -> etree._Elem
     return trace
 
 
-def _event_name(attributes: list, row: int) -> str:
+def _event_name(attributes: list[_XesAttribute], row: int) -> str:
     ids = [values for key, _, values in attributes if key == schema.EVENT_ID]
     return str(ids[0][row]) if ids else f"#{row}"
 
@@ -263,10 +269,11 @@ def _ids(log: pd.DataFrame, column: str) -> np.ndarray:
     values = log[column].astype(object)
     present = values.notna() & (values.astype(str) != "")
     ids = values.astype(str) + "@" + log[CASE].astype(str)
-    return np.where(present, ids, None)
+    # numpy's stubs take three Series for the one-argument form: the ids, or None
+    return cast(np.ndarray, np.where(present, ids, None))
 
 
-def _ocel_events(log: pd.DataFrame) -> tuple[list[dict], list[dict]]:
+def _ocel_events(log: pd.DataFrame) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     attributes = [c for c in log if c not in _OCEL_STRUCTURE | _OCEL_MESSAGE]
     kinds = {c: xes_type(log[c]) for c in attributes}
     values = {c: _json_values(log[c], kinds[c]) for c in attributes}
@@ -305,7 +312,7 @@ def _ocel_events(log: pd.DataFrame) -> tuple[list[dict], list[dict]]:
     return events, event_types
 
 
-def _json_values(series: pd.Series, kind: str) -> list:
+def _json_values(series: pd.Series, kind: str) -> list[Any]:
     if kind in ("string", "date"):
         return _xes_values(series, kind)
     values = series.astype(object).where(series.notna(), None).tolist()
@@ -316,9 +323,12 @@ def _json_values(series: pd.Series, kind: str) -> list:
     return [None if v is None else bool(v) for v in values]
 
 
-def _ocel_object_types(runs: Mapping[str, RunManifest]) -> list[dict]:
+def _ocel_object_types(runs: Mapping[str, RunManifest]) -> list[dict[str, Any]]:
     run_attributes = sorted({key for manifest in runs.values() for key in _flat(manifest)})
-    string = lambda names: [{"name": n, "type": "string"} for n in names]  # noqa: E731
+
+    def string(names: Iterable[str]) -> list[dict[str, str]]:
+        return [{"name": n, "type": "string"} for n in names]
+
     return [
         {"name": "robot", "attributes": string(["name", "robot_type"])},
         {"name": "message", "attributes": string(["msg_id", "payload"])},
@@ -326,7 +336,7 @@ def _ocel_object_types(runs: Mapping[str, RunManifest]) -> list[dict]:
     ]
 
 
-def _ocel_robots(log: pd.DataFrame) -> list[dict]:
+def _ocel_robots(log: pd.DataFrame) -> list[dict[str, Any]]:
     columns = [CASE, schema.ROBOT] + ([schema.ROBOT_TYPE] if schema.ROBOT_TYPE in log else [])
     named = log[schema.ROBOT].notna() & (log[schema.ROBOT].astype(str) != "")
     robots = log.loc[named, columns].drop_duplicates([CASE, schema.ROBOT])
@@ -347,7 +357,7 @@ def _ocel_robots(log: pd.DataFrame) -> list[dict]:
     return objects
 
 
-def _ocel_messages(log: pd.DataFrame) -> list[dict]:
+def _ocel_messages(log: pd.DataFrame) -> list[dict[str, Any]]:
     if schema.MSG_ID not in log:
         return []
     messages = log.assign(_object=_ids(log, schema.MSG_ID), _robot=_ids(log, schema.ROBOT))
@@ -375,7 +385,7 @@ def _ocel_messages(log: pd.DataFrame) -> list[dict]:
     return objects
 
 
-def _ocel_runs(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> list[dict]:
+def _ocel_runs(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> list[dict[str, Any]]:
     objects = []
     for case in pd.unique(log[CASE].astype(str)):
         flat = _flat(runs.get(case, {}))
@@ -386,7 +396,7 @@ def _ocel_runs(log: pd.DataFrame, runs: Mapping[str, RunManifest]) -> list[dict]
     return objects
 
 
-def _flat(manifest: Mapping, prefix: str = "") -> dict[str, str]:
+def _flat(manifest: Mapping[str, Any], prefix: str = "") -> dict[str, str]:
     """A manifest's values as text, nested keys joined with dots (``outcome.status``)."""
     flat: dict[str, str] = {}
     for key, value in manifest.items():
@@ -400,7 +410,7 @@ def _flat(manifest: Mapping, prefix: str = "") -> dict[str, str]:
 # -- OCEL 2.0 of an object-centric log ------------------------------------------------------
 
 
-def _object_centric_document(log: pd.DataFrame, objects: Objects) -> dict:
+def _object_centric_document(log: pd.DataFrame, objects: Objects) -> dict[str, Any]:
     """The OCEL 2.0 document of a log read with its objects: its events with their own
     attributes, its objects with theirs and their changes, and the relations between them."""
     attributes = _event_attributes(log, objects)
@@ -455,7 +465,7 @@ def _event_attributes(log: pd.DataFrame, objects: Objects) -> list[str]:
     return [c for c in log.columns if c not in structure]
 
 
-def _listed_objects(objects: Objects) -> tuple[list[dict], list[dict]]:
+def _listed_objects(objects: Objects) -> tuple[list[dict[str, Any]], list[dict[str, Any]]]:
     table = objects.objects
     changes = objects.changes.groupby("object", sort=False)
     changed = {str(o): group for o, group in changes}

@@ -22,7 +22,7 @@ from cyclonedds.idl import types as idl_types
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.errors import ModelError
-from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type
+from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type, text_fields
 
 #: cyclonedds' IDL types, made by subscripting (``array[int8, 3]``), which its annotations
 #: do not express
@@ -202,10 +202,5 @@ def tag_fields(tag: Tag) -> dict[str, Any]:
     nanoseconds = round(tag.stamp * 1e9)
     return {
         "stamp": {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000},
-        "robot": tag.robot,
-        "activity": tag.activity,
-        "lifecycle": tag.lifecycle,
-        "msg_id": tag.msg_id,
-        "msg_role": tag.msg_role,
-        "payload": tag.payload,
+        **text_fields(tag),
     }

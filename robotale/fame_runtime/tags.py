@@ -10,7 +10,7 @@ from __future__ import annotations
 
 import json
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from enum import StrEnum
 from typing import Any
 
@@ -34,17 +34,6 @@ START, COMPLETE, ABORT = Lifecycle.START.value, Lifecycle.COMPLETE.value, Lifecy
 #: the roles of message tags
 SEND, RECEIVE = "send", "receive"
 
-TAG_MSGDEF = """\
-# One tagged event of a robot's mission (TALE).
-builtin_interfaces/Time stamp
-string robot
-string activity
-string lifecycle
-string msg_id
-string msg_role
-string payload
-"""
-
 
 @dataclass(frozen=True, slots=True)
 class Tag:
@@ -66,6 +55,25 @@ class Tag:
     msg_id: str = ""
     msg_role: str = ""
     payload: str = ""
+
+
+#: the tag's fields besides its stamp, in its order: the message's ``string`` fields, the columns
+#: of a printed tag line and the fields a bag's tag message is read by (``TagFields``)
+TEXT_FIELDS: tuple[str, ...] = tuple(f.name for f in fields(Tag) if f.name != "stamp")
+
+#: the ROS 2 message definition of a tag, derived from :class:`Tag`
+TAG_MSGDEF = "".join(
+    [
+        "# One tagged event of a robot's mission (TALE).\n",
+        "builtin_interfaces/Time stamp\n",
+        *(f"string {name}\n" for name in TEXT_FIELDS),
+    ]
+)
+
+
+def text_fields(tag: Tag) -> dict[str, str]:
+    """The tag's fields besides its stamp, by name (as its message carries them)."""
+    return {name: getattr(tag, name) for name in TEXT_FIELDS}
 
 
 #: where engines deliver tags: a recorder, a list's ``append``, a printer ...
@@ -141,13 +149,5 @@ def register_tag_type(typestore: Any) -> None:  # rosbags has no type informatio
 
 def tag_line(tag: Tag, begin: float = 0.0) -> str:
     """A tag as one tab-separated line, its stamp in seconds since ``begin``."""
-    fields = (
-        f"{tag.stamp - begin:10.3f}",
-        tag.robot,
-        tag.activity,
-        tag.lifecycle,
-        tag.msg_id,
-        tag.msg_role,
-        tag.payload,
-    )
-    return "\t".join(fields).rstrip()
+    cells = (f"{tag.stamp - begin:10.3f}", *(getattr(tag, name) for name in TEXT_FIELDS))
+    return "\t".join(cells).rstrip()

@@ -5,26 +5,15 @@ background, so the first visit after that computes nothing."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
 
 from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
 
-from robotale import enhancement
 from robotale.enhancement.findings import find, trusted_first
-from robotale.enhancement.result import Perspective
+from robotale.enhancement.registry import page_names, perspective_kind
 from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import InputError, RobotaleError
 from robotale.results.logdata import LogData, first_key, log_info
-
-#: the Perspectives page's sections, in the order it shows them
-PERSPECTIVES: dict[str, Callable[..., Perspective]] = {
-    "bottlenecks": enhancement.find_bottlenecks,
-    "spatial": enhancement.spatial_perspective,
-    "communication": enhancement.communication_perspective,
-    "battery": enhancement.battery_perspective,
-    "performance": enhancement.performance_perspective,
-}
 
 
 def parse_delay(text: str | None) -> float | None:
@@ -68,11 +57,12 @@ def stored_perspective(
 ) -> bytes:
     """The perspective ``which`` of the whole log, or of one activity (and robot); for the
     communication perspective, a message is delayed above ``delay`` seconds if given."""
-    options = {"delay_threshold": delay} if which == "communication" else {}
+    kind = perspective_kind(which)
+    options = kind.taken({"delay_threshold": delay})
 
     def compute() -> dict:
         frame = logs.frame(driver, name)
-        result = PERSPECTIVES[which](frame, activity=activity, robot=robot, **options)
+        result = kind.compute(frame, activity=activity, robot=robot, **options)
         if which == "bottlenecks" and result.has_data:
             # the same order as the Findings page: effects that may be chance come last
             result.tables["bottlenecks"] = trusted_first(result.tables["bottlenecks"])
@@ -122,7 +112,7 @@ def prepare(driver: Driver, logs: LogData, name: str) -> None:
         lambda: stored_findings(driver, logs, name),
         lambda: perspectives_graph(driver, logs, name),
     ]
-    steps += [lambda w=which: stored_perspective(driver, logs, name, w) for which in PERSPECTIVES]
+    steps += [lambda w=which: stored_perspective(driver, logs, name, w) for which in page_names()]
     steps += [
         lambda: stored_runs(driver, logs, name),
         lambda: stored_timeline(driver, logs, name, ""),

@@ -28,7 +28,7 @@ from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future, as_completed
 from dataclasses import replace
 from pathlib import Path
-from typing import Any
+from typing import Any, TextIO
 
 from tqdm import tqdm
 
@@ -302,3 +302,29 @@ def _line(manifest: RunManifest) -> dict[str, Any]:
         if kind in manifest:
             line[kind] = manifest[kind]
     return line
+
+
+def print_summary(summary: dict[str, Any], target: str | Path, out: TextIO) -> None:
+    """A batch's summary as ``simulate`` and ``demo`` print it: the outcomes, the runs that did
+    not end, the work done and where it was recorded."""
+    outcomes = ", ".join(f"{n} {status}" for status, n in sorted(summary["outcomes"].items()))
+    runs, workers = summary["runs"], summary["workers"]
+    where = f"{workers} worker{'s' if workers != 1 else ''}" if workers else "in this process"
+    if "executor" in summary:
+        where += f" on {summary['executor']}"
+    print(
+        f"{runs} run{'s' if runs != 1 else ''} of {summary['scenario']} "
+        f"in {summary['wall_time']:.1f} s ({where}): {outcomes}",
+        file=out,
+    )
+    for case in summary["cases"]:
+        if case["status"] != "ended":
+            reason = f": {case['reason']}" if case["reason"] else ""
+            print(f"  {case['case']} {case['status']}{reason}", file=out)
+    for kind, verb in (("weeds", "cut"), ("targets", "destroyed")):
+        totals = [c[kind] for c in summary["cases"] if kind in c]
+        if totals:
+            done = sum(t[verb] for t in totals)
+            print(f"{kind}: {done} of {sum(t['total'] for t in totals)} {verb}", file=out)
+    summary_file = f"{str(target).rstrip('/')}/{SUMMARY}"
+    print(f"recorded in {target} (summary: {summary_file})", file=out)

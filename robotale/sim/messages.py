@@ -18,7 +18,7 @@ from rosbags.typesys import Stores, get_typestore
 from rosbags.typesys.store import Typestore
 
 from robotale.errors import ModelError
-from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type
+from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type, text_fields
 
 _NUMPY = {
     "bool": np.bool_,
@@ -82,12 +82,7 @@ def tag_fields(tag: Tag) -> dict[str, Any]:
     """A Tag as ``robotale_msgs/msg/Tag`` fields."""
     return {
         "stamp": stamp(tag.stamp),
-        "robot": tag.robot,
-        "activity": tag.activity,
-        "lifecycle": tag.lifecycle,
-        "msg_id": tag.msg_id,
-        "msg_role": tag.msg_role,
-        "payload": tag.payload,
+        **text_fields(tag),
     }
 
 

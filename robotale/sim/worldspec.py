@@ -19,18 +19,16 @@ uniformly per run.
 from __future__ import annotations
 
 import datetime as dt
-from collections.abc import Mapping
-from dataclasses import dataclass, field, replace
+from collections.abc import Iterable, Mapping
+from dataclasses import dataclass, field, fields, replace
 from pathlib import Path
 from typing import Any
-
-import yaml
 
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Link, Network
 from robotale.fame_runtime.clock import EngineCost
-
-Range = tuple[float, float]
+from robotale.sim.yamlcheck import Range, YamlChecker, load_yaml
+from robotale.thresholds import LOW_BATTERY_PERCENT
 
 KINDS = ("drone", "ground")
 DEFAULT_START = "2024-05-16T10:00:00Z"
@@ -43,7 +41,7 @@ class BatterySpec:
     move_drain: Range = (0.001, 0.001)  # per second at 1 m/s
     flight_drain: Range = (0.0, 0.0)  # per second more while a drone is airborne
     charge: float = 0.02  # per second while resting on a charging base
-    low: float = 0.2  # low_battery below this
+    low: float = LOW_BATTERY_PERCENT / 100  # low_battery below this (a fraction)
     warn_period: float = 10.0  # low_battery repeats this often while low
 
 
@@ -186,30 +184,13 @@ class World:
 def load_world(path: str | Path, model: str | Path | None = None) -> World:
     """Read and check a world file; ``model`` overrides the file's ``model`` key."""
     path = Path(path)
-    try:
-        data = yaml.safe_load(path.read_text(encoding="utf-8"))
-    except OSError as error:
-        raise InputError(f"{path}: cannot read the world file ({error.strerror})") from None
-    except yaml.YAMLError as error:
-        raise InputError(f"{path}: not valid YAML ({_yaml_problem(error)})") from None
+    data = load_yaml(path, "the world file")
     reader = _Reader(path)
     return reader.world(reader.mapping(data, "the file"), model)
 
 
-def _yaml_problem(error: yaml.YAMLError) -> str:
-    mark = getattr(error, "problem_mark", None)
-    problem = getattr(error, "problem", None) or "syntax error"
-    return f"{problem} at line {mark.line + 1}" if mark else problem
-
-
-class _Reader:
+class _Reader(YamlChecker):
     """Checks one world file; every error names the file and the key."""
-
-    def __init__(self, path: Path) -> None:
-        self.path = path
-
-    def fail(self, where: str, message: str) -> InputError:
-        return InputError(f"{self.path}: {where} {message}")
 
     def world(self, data: Mapping[str, Any], model_override: str | Path | None) -> World:
         self.known(data, "the file", _WORLD_KEYS)
@@ -315,7 +296,7 @@ class _Reader:
 
     def obstacle(self, name: str, data: Mapping[str, Any]) -> ObstacleSpec:
         where = f"obstacles.{name}"
-        self.known(data, where, {"position", "size", "yaw", "color"})
+        self.known(data, where, _OBSTACLE_KEYS)
         size = self.triple(data.get("size", ObstacleSpec.size), f"{where}.size")
         if min(size) <= 0:
             raise self.fail(f"{where}.size", f"is {list(size)!r}; all three must be positive")
@@ -329,7 +310,7 @@ class _Reader:
 
     def base(self, name: str, data: Mapping[str, Any]) -> BaseSpec:
         where = f"bases.{name}"
-        self.known(data, where, {"position", "radius", "charging", "color"})
+        self.known(data, where, _BASE_KEYS)
         return BaseSpec(
             name=name,
             position=self.pair(data.get("position"), f"{where}.position"),
@@ -392,7 +373,7 @@ class _Reader:
         if data is None:
             return None
         data = self.mapping(data, where)
-        self.known(data, where, set(CameraSpec.__dataclass_fields__))
+        self.known(data, where, _keys(CameraSpec))
         return CameraSpec(
             fov=self.number(data.get("fov", 90.0), f"{where}.fov", positive=True),
             detects=str(data.get("detects", "weed")),
@@ -404,17 +385,11 @@ class _Reader:
             ),
         )
 
-    def probability(self, value: Any, where: str) -> float:
-        number = self.number(value, where)
-        if number > 1:
-            raise self.fail(where, f"is {value!r}; a probability is at most 1")
-        return number
-
     def range_sensor(self, data: Any, where: str) -> RangeSpec | None:
         if data is None:
             return None
         data = self.mapping(data, where)
-        self.known(data, where, {f for f in RangeSpec.__dataclass_fields__})
+        self.known(data, where, _keys(RangeSpec))
         direction = data.get("direction", "forward")
         if direction not in ("forward", "down"):
             raise self.fail(f"{where}.direction", f"is {direction!r}; use forward or down")
@@ -436,7 +411,7 @@ class _Reader:
 
     def battery(self, data: Mapping[str, Any], robot: str) -> BatterySpec:
         where = f"{robot}.battery"
-        self.known(data, where, {f for f in BatterySpec.__dataclass_fields__})
+        self.known(data, where, _keys(BatterySpec))
         defaults = BatterySpec()
         level = self.range(data.get("level", defaults.level), f"{where}.level")
         if not 0 <= level[0] <= level[1] <= 1:
@@ -458,7 +433,7 @@ class _Reader:
         )
 
     def objects(self, kind: str, data: Mapping[str, Any]) -> ObjectsSpec:
-        self.known(data, kind, {"count", "area", "margin", "size", "color"})
+        self.known(data, kind, _OBJECTS_KEYS)
         low, high = self.range(data.get("count", 0), f"{kind}.count")
         if low < 0 or low != int(low) or high != int(high):
             raise self.fail(f"{kind}.count", "must be a whole number or [low, high]")
@@ -490,131 +465,17 @@ class _Reader:
             moment = moment.replace(tzinfo=dt.UTC)
         return moment.timestamp()
 
-    # -- primitive values ----------------------------------------------------------------------
 
-    def known(self, data: Mapping[str, Any], where: str, keys) -> None:
-        unknown = sorted(set(data) - set(keys))
-        if unknown:
-            raise self.fail(
-                where,
-                f"has unknown key {', '.join(map(repr, unknown))} "
-                f"(known: {', '.join(sorted(keys))})",
-            )
-
-    def flag(self, value: Any, where: str) -> bool:
-        if not isinstance(value, bool):
-            raise self.fail(where, f"is {value!r}; it must be true or false")
-        return value
-
-    def mapping(self, value: Any, where: str) -> Mapping[str, Any]:
-        if value is None:
-            return {}
-        if not isinstance(value, Mapping):
-            raise self.fail(where, f"must be a mapping of names to values, not {value!r}")
-        return value
-
-    def signals(self, value: Any, where: str) -> tuple[str, ...]:
-        names = self.sequence(value, where)
-        for name in names:
-            if not isinstance(name, str) or not name.strip("/"):
-                raise self.fail(where, f"holds {name!r}; it must list signal names")
-        return tuple(name.strip("/") for name in names)
-
-    def sequence(self, value: Any, where: str) -> list[Any]:
-        if not isinstance(value, list):
-            raise self.fail(where, f"must be a list, not {value!r}")
-        return value
-
-    def number(self, value: Any, where: str, positive: bool = False) -> float:
-        if isinstance(value, bool) or not isinstance(value, int | float):
-            raise self.fail(where, f"is {value!r}, not a number")
-        if positive and value <= 0:
-            raise self.fail(where, f"is {value!r}; it must be positive")
-        if value < 0:
-            raise self.fail(where, f"is {value!r}; it must not be negative")
-        return float(value)
-
-    def numbers(self, value: Any, where: str, length: int) -> tuple[float, ...]:
-        if not isinstance(value, list | tuple) or len(value) != length:
-            raise self.fail(where, f"is {value!r}; it must be a list of {length} numbers")
-        out = []
-        for item in value:
-            if isinstance(item, bool) or not isinstance(item, int | float):
-                raise self.fail(where, f"is {value!r}; it must be a list of {length} numbers")
-            out.append(float(item))
-        return tuple(out)
-
-    def pair(self, value: Any, where: str, positive: bool = False) -> tuple[float, float]:
-        pair = self.numbers(value, where, 2)
-        if positive and min(pair) <= 0:
-            raise self.fail(where, f"is {value!r}; both numbers must be positive")
-        return pair  # type: ignore[return-value]
-
-    def triple(self, value: Any, where: str) -> tuple[float, float, float]:
-        return self.numbers(value, where, 3)  # type: ignore[return-value]
-
-    def color(self, value: Any, where: str) -> tuple[float, float, float, float]:
-        if isinstance(value, list | tuple) and len(value) == 3:
-            value = [*value, 1.0]
-        return self.numbers(value, where, 4)  # type: ignore[return-value]
-
-    def range(self, value: Any, where: str) -> Range:
-        """``x`` or ``[low, high]``."""
-        if isinstance(value, list | tuple):
-            low, high = self.numbers(value, where, 2)
-        else:
-            low = high = self.number(value, where)
-        if low > high or low < 0:
-            raise self.fail(where, f"is {value!r}; it must be [low, high] with 0 <= low <= high")
-        return (low, high)
+def _keys(spec: type, *, without: Iterable[str] = (), plus: Iterable[str] = ()) -> set[str]:
+    """The keys a part of the file may have: the fields of the dataclass it becomes."""
+    left_out = set(without)
+    return {f.name for f in fields(spec) if f.name not in left_out} | set(plus)
 
 
-_WORLD_KEYS = {
-    "model",
-    "field",
-    "bases",
-    "robots",
-    "weeds",
-    "targets",
-    "time_limit",
-    "control_rate",
-    "record_rate",
-    "latency",
-    "dynamics",
-    "physics_rate",
-    "obstacles",
-    "network",
-    "start",
-    "variables",
-    "faults",
-    "library",
-    "skills",
-    "engine_cost",
-}
-_ROBOT_KEYS = {
-    "kind",
-    "base",
-    "count",
-    "max_speed",
-    "max_turn",
-    "altitude",
-    "climb",
-    "size",
-    "color",
-    "blade",
-    "blade_radius",
-    "mass",
-    "max_force",
-    "max_torque",
-    "friction",
-    "drag",
-    "odom_drift",
-    "led",
-    "camera",
-    "range",
-    "battery",
-    "spacing",
-    "start_jitter",
-    "variables",
-    "busy_ignores",
-}
+#: the file's own keys: the world's fields but those it is given (its file, the objects, which
+#: are written as weeds and targets)
+_WORLD_KEYS = _keys(World, without={"file", "objects"}, plus={"weeds", "targets"})
+_ROBOT_KEYS = _keys(RobotSpec, without={"name"})
+_OBSTACLE_KEYS = _keys(ObstacleSpec, without={"name"})
+_BASE_KEYS = _keys(BaseSpec, without={"name"})
+_OBJECTS_KEYS = _keys(ObjectsSpec, without={"kind"})

@@ -10,18 +10,8 @@ from flask_wtf.csrf import CSRFProtect
 
 from robotale import __version__
 from robotale.webapp import defences, errors, pages, state, uploads
+from robotale.webapp.page_registry import PAGES, menu
 from robotale.webapp.settings import WebSettings
-from robotale.webapp.views import (
-    aggregation,
-    assets,
-    console,
-    discover,
-    findings,
-    logs,
-    model,
-    perspectives,
-    timeline,
-)
 
 
 def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
@@ -46,6 +36,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
     pages.init_app(app)
     _register_blueprints(app)
     app.jinja_env.globals.update(robotale_version=__version__, blueprints=app.blueprints)
+    app.jinja_env.globals["menu"] = menu()
 
     @app.get("/")
     def index():
@@ -55,15 +46,5 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
 
 
 def _register_blueprints(app: Flask) -> None:
-    for module in (
-        assets,
-        logs,
-        findings,
-        discover,
-        aggregation,
-        perspectives,
-        timeline,
-        model,
-        console,
-    ):
-        app.register_blueprint(module.blueprint)
+    for page in PAGES:
+        app.register_blueprint(page.view.blueprint)

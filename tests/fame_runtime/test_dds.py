@@ -94,8 +94,8 @@ def matched(endpoint, seconds: float = 10.0) -> None:
 
 
 def test_two_engine_processes_run_agri_into_one_bag_whose_comm_edges_match(tmp_path, capsys):
-    from robotale.commands.prepare import prepare_recordings
     from robotale.ekg.tables import graph_tables
+    from robotale.eventlog.preparing import prepare_recordings
 
     bag = tmp_path / "run"
     skills = str(MODELS / "agri_skills.py")
@@ -314,7 +314,7 @@ def test_ctrl_c_stops_every_robot_through_its_safe_state_and_closes_the_bag(tmp_
     import subprocess
     import sys
 
-    from robotale.commands.prepare import prepare_recordings
+    from robotale.eventlog.preparing import prepare_recordings
 
     model = tmp_path / "patrol.bpmn"
     processes = "\n  ".join(PATROLLER.format(pool=pool) for pool in ("Rover", "Drone"))
@@ -373,7 +373,7 @@ def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
 
     from rosbags.highlevel import AnyReader
 
-    from robotale.commands.prepare import prepare_recordings
+    from robotale.eventlog.preparing import prepare_recordings
 
     model = MODELS / "hello_at_once.bpmn"
     bag = tmp_path / "bag"
@@ -441,9 +441,9 @@ def test_robotale_record_keeps_what_nodes_started_by_hand_say_at_once(tmp_path):
 def test_a_live_run_ingests_with_its_comm_edges(tmp_path, capsys, neo4j_driver, log_name):
     """``fame run --bus dds --record`` then ``robotale ingest`` of the bag, as of a simulated
     run: the stored COMM edge joins the send and the receive the robots printed."""
-    from robotale.commands.prepare import prepare_recordings
     from robotale.ekg.connection import database
     from robotale.ekg.logs import log_summary
+    from robotale.eventlog.preparing import prepare_recordings
     from robotale.queries import cypher
 
     bag = tmp_path / "live"

@@ -7,13 +7,15 @@ from __future__ import annotations
 
 from flask import Blueprint, Response, abort, render_template, request
 
-from robotale.results.findings import PERSPECTIVES, parse_delay, stored_perspective
+from robotale.enhancement.registry import page_names
+from robotale.results.findings import parse_delay, stored_perspective
 from robotale.webapp import pages
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("perspectives", __name__)
 
-NAMES = tuple(PERSPECTIVES)
+#: the page's sections, in the order the registry gives them
+NAMES = page_names()
 
 
 @blueprint.get("/perspectives")
@@ -30,7 +32,7 @@ def page():
 
 @blueprint.get("/api/perspectives/<name>")
 def perspective(name: str):
-    if name not in PERSPECTIVES:
+    if name not in NAMES:
         abort(404, f"There is no {name!r} perspective; there are {', '.join(NAMES)}.")
     data = stored_perspective(
         driver(),

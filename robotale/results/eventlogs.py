@@ -1,4 +1,5 @@
-"""The event log a ``discover`` or ``perspectives`` command reads: a file or a stored log."""
+"""The event log an analysis reads (``discover``, ``perspectives``, ``report``): a file, or a
+log stored in Neo4j by its name."""
 
 from __future__ import annotations
 
@@ -39,8 +40,3 @@ def read_event_log(
 def report_reading(reading: Reading) -> None:
     """The short form of how a file was read, on stderr so it never mixes with the output."""
     print(format_reading(reading, short=True), file=sys.stderr)
-
-
-def values(lists: Sequence[str] | None) -> tuple[str, ...]:
-    """Repeated and comma-separated option values as one tuple."""
-    return tuple(v.strip() for item in lists or [] for v in item.split(",") if v.strip())
