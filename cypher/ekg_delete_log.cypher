@@ -1,8 +1,10 @@
-// Delete one event log: its events, entities, classes and aggregates with all their relationships, then
-// its Log node. Batched: run it as an auto-commit query (in Neo4j Browser: prefix :auto).
+// Delete one event log: its events, entities (and their objects' attribute changes), classes
+// and aggregates with all their relationships, then its Log node. Batched: run it as an auto-commit query (in Neo4j Browser: prefix :auto).
 // The `IS NOT NULL` tests let the (log, ...) key indexes find the nodes.
 MATCH (e:Event) WHERE e.log = $log AND e.id IS NOT NULL
 CALL (e) { DETACH DELETE e } IN TRANSACTIONS OF 10000 ROWS;
+MATCH (c:AttributeChange) WHERE c.log = $log
+CALL (c) { DETACH DELETE c } IN TRANSACTIONS OF 10000 ROWS;
 MATCH (n:Entity) WHERE n.log = $log AND n.type IS NOT NULL AND n.id IS NOT NULL
 CALL (n) { DETACH DELETE n } IN TRANSACTIONS OF 10000 ROWS;
 MATCH (c:Class) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL

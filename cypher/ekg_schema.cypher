@@ -14,3 +14,5 @@ CREATE CONSTRAINT ekg_aggregate_key IF NOT EXISTS
 FOR (a:Aggregate) REQUIRE (a.log, a.step, a.id) IS UNIQUE;
 CREATE CONSTRAINT ekg_aggregation_step_key IF NOT EXISTS
 FOR (s:AggregationStep) REQUIRE (s.log, s.step) IS UNIQUE;
+CREATE INDEX ekg_attribute_change_log IF NOT EXISTS
+FOR (c:AttributeChange) ON (c.log);

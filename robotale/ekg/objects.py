@@ -5,8 +5,9 @@ entity type per object type). :func:`write_objects` then adds what only an objec
 log says: each object's attributes as properties of its Entity node (an object no event
 relates to gets its node here), the qualifiers of each event's CORR edge to an object (a
 list: OCEL lets one event relate to one object in several roles), and the object-to-object
-relations as REL edges with their qualifier. Attribute changes over time stay in the log's
-files; the Entity keeps each attribute's value from the beginning.
+relations as REL edges with their qualifier. The Entity keeps each attribute's value from the
+beginning; each later change is an ``AttributeChange`` node (field, value, time) the Entity
+has a CHANGED edge to.
 """
 
 from __future__ import annotations
@@ -33,6 +34,7 @@ def write_objects(loader: Loader, objects: Objects, entity_types: list[str]) -> 
     kinds = table.set_index("id")["type"]
     _write_qualifiers(loader, objects.e2o, kinds)
     _write_relations(loader, objects.o2o, kinds)
+    _write_changes(loader, objects.changes, kinds)
 
 
 def _write_qualifiers(loader: Loader, e2o: pd.DataFrame, kinds: pd.Series) -> None:
@@ -67,5 +69,21 @@ def _write_relations(loader: Loader, o2o: pd.DataFrame, kinds: pd.Series) -> Non
             "targets": relations["target"].astype(str).tolist(),
             "targetTypes": relations["target"].map(kinds).tolist(),
             "qualifiers": qualifiers.where(qualifiers.notna(), None).tolist(),
+        },
+    )
+
+
+def _write_changes(loader: Loader, changes: pd.DataFrame, kinds: pd.Series) -> None:
+    found = changes[changes["object"].isin(kinds.index)].reset_index(drop=True)
+    if found.empty:
+        return
+    loader.run(
+        "ekg_object_changes",
+        {
+            "objects": found["object"].astype(str).tolist(),
+            "types": found["object"].map(kinds).tolist(),
+            "fields": found["field"].astype(str).tolist(),
+            "values": neo4j_values(found["value"].astype(object)),
+            "times": neo4j_values(pd.to_datetime(found["time"], utc=True)),
         },
     )

@@ -4,12 +4,15 @@ and pm4py."""
 
 from __future__ import annotations
 
+import json
+
 import pandas as pd
 import pm4py
 import pytest
 from object_logs import logistics_csv, order_log, plain, pm4py_view
 
 from robotale.cli import main
+from robotale.ekg.logs import delete_log
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::FutureWarning")
 
@@ -115,3 +118,73 @@ def test_ocel_file_with_relations_and_qualifiers(tmp_path, capsys, neo4j_driver,
     }
     prices = {eid: a.get("price") for eid, (_, _, a) in expected["events"].items()}
     assert {r["id"]: r["price"] for r in events} == prices
+
+
+# Two objects; o1's status changes twice after its first value, i1's weight once, and one
+# value at the beginning of time is no change. By hand: three AttributeChange nodes.
+CHANGES = {
+    "objectTypes": [
+        {"name": "order", "attributes": [{"name": "status", "type": "string"}]},
+        {"name": "item", "attributes": [{"name": "weight", "type": "float"}]},
+    ],
+    "eventTypes": [{"name": "pay", "attributes": []}, {"name": "ship", "attributes": []}],
+    "objects": [
+        {
+            "id": "o1",
+            "type": "order",
+            "attributes": [
+                {"name": "status", "time": "1970-01-01T00:00:00Z", "value": "new"},
+                {"name": "status", "time": "2024-05-01T10:00:00Z", "value": "paid"},
+                {"name": "status", "time": "2024-05-02T09:30:00Z", "value": "shipped"},
+            ],
+        },
+        {
+            "id": "i1",
+            "type": "item",
+            "attributes": [
+                {"name": "weight", "time": "1970-01-01T00:00:00Z", "value": 1.5},
+                {"name": "weight", "time": "2024-05-01T12:00:00Z", "value": 2.25},
+            ],
+        },
+    ],
+    "events": [
+        {"id": "e1", "type": "pay", "time": "2024-05-01T10:00:00Z", "attributes": [],
+         "relationships": [{"objectId": "o1", "qualifier": "paid"}]},
+        {"id": "e2", "type": "ship", "time": "2024-05-02T09:30:00Z", "attributes": [],
+         "relationships": [{"objectId": "o1", "qualifier": "shipped"},
+                           {"objectId": "i1", "qualifier": "content"}]},
+    ],
+}  # fmt: skip
+
+
+def test_attribute_changes_are_nodes_of_their_entities(tmp_path, capsys, neo4j_driver, log_name):
+    path = tmp_path / "changes.jsonocel"
+    path.write_text(json.dumps(CHANGES))
+    code = main(["ingest", str(path), "--log", log_name])
+    _, err = capsys.readouterr()
+    assert code == 0, err
+    rows = _rows(
+        neo4j_driver,
+        "MATCH (n:Entity {log: $log})-[:CHANGED]->(c:AttributeChange {log: $log}) "
+        "RETURN n.id AS id, n.type AS type, c.field AS field, c.value AS value, "
+        "toString(c.time) AS time",
+        log=log_name,
+    )
+    found = sorted((r["id"], r["field"], r["value"], r["time"]) for r in rows)
+    assert found == [
+        ("i1", "weight", 2.25, "2024-05-01T12:00:00Z"),
+        ("o1", "status", "paid", "2024-05-01T10:00:00Z"),
+        ("o1", "status", "shipped", "2024-05-02T09:30:00Z"),
+    ]
+    # the Entity keeps the value from the beginning
+    assert _entities(neo4j_driver, log_name) == {
+        ("object:order", "o1"): {"status": "new"},
+        ("item", "i1"): {"weight": 1.5},
+    }
+    delete_log(neo4j_driver, log_name)
+    left = _rows(
+        neo4j_driver,
+        "MATCH (c:AttributeChange {log: $log}) RETURN count(c) AS n",
+        log=log_name,
+    )
+    assert left == [{"n": 0}]
