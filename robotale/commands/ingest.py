@@ -66,8 +66,10 @@ def ingest_command(
         print(format_reading(opened.reading, short=True))
     if append and found_objects is not None:
         raise InputError(
-            f"{path} is object-centric: --append adds runs of a log with cases; rebuild the "
-            "log with --replace instead."
+            f"{path} is object-centric, and --append adds only new runs (cases), whose "
+            "directly-follows chains start afresh, while an object-centric log is one run in "
+            "which each object's chain would have to continue from its stored events; "
+            "rebuild the log with --replace instead."
         )
     name = log or log_name(path)
     chosen = split_names(entities) if entities else None
