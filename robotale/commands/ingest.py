@@ -22,6 +22,7 @@ from robotale.eventlog.readers import is_parquet, parse_mapping, read_with_objec
 from robotale.eventlog.reading import format_reading
 from robotale.results.findings import prepare
 from robotale.results.logdata import LogData
+from robotale.results.site import keep_sites, run_sites
 
 
 def ingest_command(
@@ -121,6 +122,9 @@ def ingest_command(
                 **names,
             )
         print(describe(summary, appended=append))
+        if path.is_dir() and not is_parquet(path):
+            # the Mission page's map: the simulated runs' fields, bases and objects
+            keep_sites(driver, name, run_sites(path))
         prepare_pages(driver, name)
     if skipped is not None:
         print(kept_runs(events["case:concept:name"].nunique(), skipped))

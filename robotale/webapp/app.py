@@ -18,6 +18,7 @@ from robotale.webapp.views import (
     discover,
     findings,
     logs,
+    mission,
     model,
     perspectives,
     timeline,
@@ -63,6 +64,7 @@ def _register_blueprints(app: Flask) -> None:
         aggregation,
         perspectives,
         timeline,
+        mission,
         model,
         console,
     ):
