@@ -110,8 +110,8 @@ def cursor_times(run: StoredRun, count: int = 3) -> list[float]:
     bounds = sorted({a[k] - start for a in activities for k in ("start", "end")})
     named = {a for pool in model_activities(run.model).values() for a in pool}
     end = bounds[-1]
-    chosen: list[float] = []
-    for share in [i / 40 for i in range(4, 38)]:
+    candidates: list[tuple[float, str]] = []
+    for share in [i / 80 for i in range(8, 76)]:
         t = round(share * end, 2)
         if min(abs(t - b) for b in bounds) < MARGIN:
             continue
@@ -120,9 +120,15 @@ def cursor_times(run: StoredRun, count: int = 3) -> list[float]:
             a in named for a in (a for names in running.values() for a in names)
         ):
             continue
-        if not chosen or t - chosen[-1] > end / 8:
+        candidates.append((t, repr(sorted(running.items()))))
+    # spread over the run, each moment with other activities running than the one before
+    chosen: list[float] = []
+    doing: list[str] = []
+    for t, running in candidates:
+        if not chosen or (t - chosen[-1] > end / 10 and running != doing[-1]):
             chosen.append(t)
-    assert len(chosen) >= count, chosen
+            doing.append(running)
+    assert len(chosen) >= count, candidates
     return chosen[:count]
 
 
@@ -299,3 +305,188 @@ def test_a_log_without_positions_or_model_still_answers(client, stored_run, neo4
     assert all(f["pose"] is None and f["heading"] is None for f in state["robots"].values())
     assert "elements" not in state
     assert "x" not in summary["signals"] and "battery" in summary["signals"]
+
+
+# -- the page, in a real browser -------------------------------------------------------------
+
+SHOWN = "document.getElementById('mission').dataset.shown"
+
+
+def move_cursor(page, t: float) -> None:
+    page.fill("#cursor", str(t))
+    wait_for_shown(page, t)
+
+
+def wait_for_shown(page, t: float) -> None:
+    from browser import wait_for
+
+    wait_for(page, f"Number({SHOWN}) === {t}")
+
+
+def expected_view(run: StoredRun, t: float) -> dict:
+    """What the page must show at ``t``, from the stored log with pandas and the model file
+    with lxml (and the truth for the running activities)."""
+    events, start = run_events(run)
+    upto = events[events["time:timestamp"] <= start + pd.Timedelta(seconds=t)]
+    positions = {}
+    batteries = {}
+    for robot, mine in upto.groupby("robot"):
+        placed = mine.dropna(subset=["x"])
+        if not placed.empty:
+            last = placed.iloc[-1]
+            positions[robot] = (last["x"], last["y"], last["z"])
+        levels = mine["battery"].dropna()
+        if not levels.empty:
+            batteries[robot] = levels.iloc[-1]
+    activities = model_activities(run.model)
+    active = sorted(
+        {
+            element
+            for robot, names in truth_active(run, t).items()
+            for name in names
+            for element in activities[pool_of(robot)].get(name, [])
+        }
+    )
+    return {"positions": positions, "battery": batteries, "active": active}
+
+
+def shown_view(page) -> dict:
+    robots = page.eval_on_selector_all(
+        "#map g.robot",
+        "els => els.map(e => [e.dataset.robot, +e.dataset.x, +e.dataset.y, +e.dataset.z])",
+    )
+    values = page.eval_on_selector_all(
+        "#plot-values tr[data-robot]", "els => els.map(e => [e.dataset.robot, e.dataset.value])"
+    )
+    marked = page.eval_on_selector_all(
+        "#canvas .djs-element.active", "els => els.map(e => e.dataset.elementId)"
+    )
+    return {
+        "positions": {robot: (x, y, z) for robot, x, y, z in robots},
+        "battery": {robot: float(value) for robot, value in values if value},
+        "active": sorted(marked),
+        "timeline": page.evaluate(
+            "document.getElementById('mission-timeline').layout.shapes[0].x0"
+        ),
+    }
+
+
+@pytest.mark.browser
+def test_mission_page_shows_the_run_at_the_cursor_in_every_view(page, stored_run, screenshot):
+    from browser import wait_for
+    from playwright.sync_api import expect
+
+    times = cursor_times(stored_run)
+    _, start = run_events(stored_run)
+    page.goto(f"{page.base_url}/mission?log={stored_run.name}&case={CASE}&t={times[0]}")
+    wait_for_shown(page, times[0])
+    expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")
+    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
+    expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
+    expect(page.locator("#mission-missing")).to_be_hidden()
+    assert page.locator("#map rect.field").count() == 1
+    assert page.locator("#map g.base").count() == 2
+    seen = []
+    for t in times:
+        move_cursor(page, t)
+        wait_for(page, "document.getElementById('canvas').dataset.active !== undefined")
+        expected = expected_view(stored_run, t)
+        shown = shown_view(page)
+        assert shown["positions"].keys() == expected["positions"].keys(), t
+        for robot, where in expected["positions"].items():
+            assert shown["positions"][robot] == pytest.approx(where), (robot, t)
+        assert shown["battery"] == pytest.approx(expected["battery"]), t
+        assert shown["active"] == expected["active"], t
+        at = start + pd.Timedelta(seconds=t)
+        assert pd.Timestamp(shown["timeline"], tz="UTC") == pytest.approx(
+            at, abs=pd.Timedelta("2ms")
+        )
+        assert f"t={t:.2f}" in page.url
+        seen.append(shown)
+    screenshot(page, "mission")
+    # one cursor, every view: the timeline's line moved each time, the map and the plot's
+    # readings with the log (each equal to it above, and not the same at every moment)
+    assert len({view["timeline"] for view in seen}) == len(times)
+    for key in ("positions", "battery", "active"):
+        assert len({repr(view[key]) for view in seen}) > 1, key
+
+
+@pytest.mark.browser
+def test_clicking_a_bar_a_finding_or_a_key_moves_the_cursor(page, stored_run):
+    from browser import wait_for
+
+    truth_start = stored_run.truth[0]["start"]
+    # the Timeline page links to the run's replay
+    page.goto(f"{page.base_url}/timeline?log={stored_run.name}&case={CASE}")
+    page.click("#mission-link")
+    wait_for_shown(page, 0)
+    assert f"case={CASE}" in page.url and f"log={stored_run.name}" in page.url
+    wait_for(page, "document.getElementById('mission-timeline').dataset.drawn")
+
+    # the longest bar of the timeline: the cursor goes to its start, an activity's true start
+    index = page.evaluate(
+        """() => {
+            const bars = document.getElementById('mission-timeline')._fullData
+                .filter((trace) => trace.type === 'bar');
+            let best = null;
+            bars.forEach((trace, k) => Array.from(trace.x).forEach((ms, j) => {
+                if (!best || ms > best.ms) best = { k, j, ms }; }));
+            return best;
+        }"""
+    )
+    bar = page.locator("#mission-timeline g.trace.bars").nth(index["k"]).locator("g.point path")
+    bar.nth(index["j"]).scroll_into_view_if_needed()
+    box = bar.nth(index["j"]).bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    wait_for(page, f"{SHOWN} !== '0'")
+    moved = float(page.evaluate(SHOWN))
+    starts = [a["start"] - truth_start for a in truth_activities(stored_run)]
+    assert min(abs(moved - s) for s in starts) < 1e-3
+
+    # the lost message, listed near the cursor: clicking it goes where the truth sent it
+    lost = next(
+        r["t"] - truth_start
+        for r in stored_run.truth
+        if r["kind"] == "send"
+        and not any(
+            d["kind"] == "delivery" and d["msg_id"] == r["msg_id"] and d["outcome"] == "delivered"
+            for d in stored_run.truth
+        )
+    )
+    move_cursor(page, round(lost + 10, 2))
+    page.click("#moments li[data-kind='lost message']")
+    wait_for(page, f"Math.abs(Number({SHOWN}) - {lost}) < 1e-3")
+
+    # the arrow keys step to the next and the previous event of the log
+    events, start = run_events(stored_run)
+    control = events[events["lifecycle:transition"] != "none"]
+    times = sorted(set(((control["time:timestamp"] - start).dt.total_seconds()).round(6)))
+    here = float(page.evaluate(SHOWN))
+    page.locator("body").press("ArrowRight")
+    following = next(s for s in times if s > here + 1e-6)
+    wait_for(page, f"Math.abs(Number({SHOWN}) - {following}) < 1e-6")
+    page.locator("body").press("ArrowLeft")
+    before = [s for s in times if s < following - 1e-6][-1]
+    wait_for(page, f"Math.abs(Number({SHOWN}) - {before}) < 1e-6")
+
+
+@pytest.mark.browser
+def test_the_page_says_what_a_run_without_positions_or_model_lacks(
+    page, stored_run, neo4j_driver, log_name
+):
+    from browser import wait_for
+    from playwright.sync_api import expect
+
+    from robotale.ekg.build import build_ekg
+
+    build_ekg(neo4j_driver, stored_run.log.drop(columns=["x", "y", "z"]), log_name, replace=True)
+    page.goto(f"{page.base_url}/mission?log={log_name}&case={CASE}&t=30")
+    wait_for_shown(page, 30)
+    expect(page.locator("#mission-missing")).to_contain_text("records no positions")
+    expect(page.locator("#mission-missing")).to_contain_text("No model is linked")
+    expect(page.locator("#map")).to_contain_text("no positions in this run")
+    assert page.locator("#map g.robot").count() == 0
+    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
+    wait_for(page, "document.querySelectorAll('#plot-values tr[data-robot]').length === 3")
+    assert page.locator("#robots table tbody tr").count() == 3
