@@ -416,7 +416,10 @@ def test_clicking_a_bar_a_finding_or_a_key_moves_the_cursor(page, stored_run):
     from browser import wait_for
 
     truth_start = stored_run.truth[0]["start"]
-    # the Timeline page links to the run's replay
+    # the Findings page's runs and the Timeline page link to the run's replay
+    page.goto(f"{page.base_url}/findings?log={stored_run.name}")
+    page.click(f"#runs-table a.mission-link[href*='case={CASE}']")
+    wait_for_shown(page, 0)
     page.goto(f"{page.base_url}/timeline?log={stored_run.name}&case={CASE}")
     page.click("#mission-link")
     wait_for_shown(page, 0)
