@@ -18,7 +18,7 @@ from neo4j import Driver
 from robotale.ekg.columnar import results_folder
 from robotale.errors import InputError
 from robotale.eventlog.prepare import find_runs
-from robotale.fame_runtime.manifest import RunManifest, read_manifests
+from robotale.fame_runtime.manifest import RunManifest, read_manifest
 from robotale.files import write_file
 from robotale.results.logdata import current_build
 from robotale.sim import scenarios
@@ -31,8 +31,17 @@ SHIPPED = "robotale/sim/scenarios/"
 
 
 def run_sites(root: Path) -> dict[str, dict[str, Any]]:
-    """The site of every run under ``root`` that has a manifest, by case."""
-    return {case: site_of(manifest) for case, manifest in read_manifests(find_runs(root)).items()}
+    """The site of every run under ``root`` that has a readable manifest, by case (the log is
+    stored by then: a damaged manifest costs its run's map, not the log)."""
+    sites = {}
+    for run in find_runs(root):
+        try:
+            manifest = read_manifest(run)
+        except (InputError, OSError):
+            continue
+        if manifest is not None:
+            sites[run.name] = site_of(manifest)
+    return sites
 
 
 def site_of(manifest: RunManifest) -> dict[str, Any]:
