@@ -19,6 +19,7 @@ from robotale.eventlog.logsource import log_name, open_log
 from robotale.eventlog.options import PrepareOptions
 from robotale.eventlog.preparing import kept_runs
 from robotale.eventlog.reading import format_reading
+from robotale.results.site import keep_sites, run_sites
 from robotale.results.storing import describe, prepare_pages
 
 
@@ -93,6 +94,9 @@ def ingest_command(
                 **names,
             )
         print(describe(summary, appended=append))
+        if opened.kind is RECORDINGS:
+            # the Mission page's map: the simulated runs' fields, bases and objects
+            keep_sites(driver, name, run_sites(path))
         prepare_pages(driver, name)
     if skipped is not None and opened.kind is RECORDINGS:
         print(kept_runs(events["case:concept:name"].nunique(), skipped))

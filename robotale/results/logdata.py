@@ -93,6 +93,8 @@ class LogData:
     def __init__(self, keep: int = KEEP) -> None:
         self.frames = Cache(keep)
         self.graphs = Cache(4 * keep)
+        #: the runs the Mission page replays, and the models' elements they map to
+        self.missions = Cache(4 * keep)
         #: how often each kind of result of each log was computed (not read from disk), by
         #: (log, kind): what the tests count
         self.computed: Counter[tuple[str, str]] = Counter()
@@ -158,6 +160,7 @@ class LogData:
         """Drop what is kept in memory of ``name`` (it was deleted or rebuilt)."""
         self.frames.forget(name)
         self.graphs.forget(name)
+        self.missions.forget(name)
 
 
 def _file_name(what: Sequence[str]) -> str:

@@ -29,6 +29,7 @@ from robotale.eventlog.readers import read_log_with_reading
 from robotale.eventlog.reading import format_reading
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.results.logdata import LogData, first_key
+from robotale.results.site import keep_sites, run_sites
 from robotale.sim import scenarios
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
@@ -54,6 +55,8 @@ class Pending:
     reading: str = ""
     #: the case gap the column-choice page offers (a log of several days without cases)
     session_gap: str | None = None
+    #: the simulated runs' sites (field, bases, objects) by case, for the Mission page's map
+    sites: dict[str, Any] = field(default_factory=dict)
 
 
 @dataclass(frozen=True)
@@ -108,7 +111,9 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
     job.step("reading " + upload.filename)
     try:
         if upload.kind == "zip":
-            pending.log, pending.model_id = _read_bags(upload, limit_bytes, models, job)
+            pending.log, pending.model_id, pending.sites = _read_bags(
+                upload, limit_bytes, models, job
+            )
         else:
             pending.log, reading = read_log_with_reading(
                 upload.path, mapping=pending.mapping, case_gap=pending.case_gap
@@ -130,7 +135,7 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
 
 def _read_bags(
     upload: uploads.Upload, limit_bytes: int, models: ModelStore, job: Job
-) -> tuple[pd.DataFrame, str | None]:
+) -> tuple[pd.DataFrame, str | None, dict[str, Any]]:
     folder = uploads.unpack(upload, limit_bytes * UNPACK_FACTOR)
     try:
         job.step("preparing the recordings")
@@ -138,7 +143,7 @@ def _read_bags(
         log = prepare(root)
         model = next(iter(sorted(folder.rglob("*.bpmn"))), None) or shipped_model(root)
         model_id = models.add(model.read_bytes(), model.name).id if model else None
-        return log, model_id
+        return log, model_id, run_sites(root)
     finally:
         shutil.rmtree(folder, ignore_errors=True)
 
@@ -225,6 +230,7 @@ def ingest(
         uploads.discard(pending.upload)
     if pending.model_id:
         models.link(name, pending.model_id)
+    keep_sites(driver, name, pending.sites)
     job.step("drawing its process")
     logs.forget(name)
     logs.class_graph(driver, name, first_key(entities))  # the Discover page's first view, ready

@@ -17,6 +17,7 @@ from robotale.webapp.views import (
     discover,
     findings,
     logs,
+    mission,
     model,
     perspectives,
     timeline,
@@ -45,6 +46,7 @@ PAGES: tuple[Page, ...] = (
     Page(aggregation),  # the Discover page's aggregation requests
     Page(perspectives, "Perspectives"),
     Page(timeline, "Timeline"),
+    Page(mission, "Mission"),
     Page(model, "Model"),
     Page(console, "Cypher"),
 )

@@ -5,6 +5,7 @@ from __future__ import annotations
 import csv
 import html
 import io
+import json
 import re
 import subprocess
 import sys
@@ -275,6 +276,15 @@ def test_a_zipped_bag_folder_is_prepared_and_linked_to_its_mission(
     model_id = re.search(r'data-model="(\w+)"', model_page).group(1)
     # stored and served re-serialised without web content (test_web_security.py)
     assert client.get(f"/api/models/{model_id}.bpmn").data == sanitised(agri)
+
+    # the runs' sites are kept for the Mission page's map: the world's field, each run's weeds
+    for case in ("run_0001", "run_0002"):
+        site = client.get(f"/api/mission/{log_name}/{case}").json["site"]
+        manifest = json.loads((simulated_runs / case / "robotale-run.json").read_text())
+        assert site["source"] == "world" and site["field"] == [10, 10]
+        assert [(o["x"], o["y"]) for o in site["objects"]] == [
+            (o["x"], o["y"]) for o in manifest["setup"]["objects"]
+        ]
 
 
 def test_the_reading_is_shown_and_the_findings_are_ready_once_stored(

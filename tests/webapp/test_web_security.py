@@ -13,7 +13,16 @@ from lxml import etree, html
 from robotale.webapp import create_app
 from robotale.webapp.settings import WebSettings
 
-PAGES = ["/findings", "/logs", "/discover", "/perspectives", "/timeline", "/model", "/cypher"]
+PAGES = [
+    "/findings",
+    "/logs",
+    "/discover",
+    "/perspectives",
+    "/timeline",
+    "/mission",
+    "/model",
+    "/cypher",
+]
 XHTML = "http://www.w3.org/1999/xhtml"
 
 

@@ -1,5 +1,5 @@
 // The Findings page: the five answers with links to their evidence, and the runs, each a link
-// to its timeline.
+// to its timeline and to its replay on the Mission page.
 "use strict";
 
 (() => {
@@ -40,8 +40,10 @@
     const rows = runs.map((run) => {
       const params = new URLSearchParams({ log, case: run.case });
       const link = robotale.el("a", { href: `/timeline?${params}`, text: String(run.case) });
+      params.set("t", "0");
+      const replay = robotale.el("a", { href: `/mission?${params}`, class: "mission-link", text: "replay" });
       return robotale.el("tr", {},
-        robotale.el("td", {}, link),
+        robotale.el("td", {}, link, " · ", replay),
         robotale.el("td", { text: run.start || "" }),
         robotale.el("td", { class: "number", text: run.duration === null ? "" : run.duration.toFixed(1) }));
     });

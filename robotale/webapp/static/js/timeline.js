@@ -15,6 +15,14 @@
     return parts.join(" · ");
   }
 
+  // the run's replay on the Mission page, from its start
+  const replay = document.getElementById("mission-link");
+  function showReplayLink(run, seconds) {
+    const params = new URLSearchParams({ log, case: run, t: seconds.toFixed(2) });
+    replay.href = `/mission?${params}`;
+    replay.hidden = false;
+  }
+
   async function show(run) {
     status.textContent = "loading…";
     box.dataset.state = "loading";
@@ -28,6 +36,7 @@
       box.dataset.case = data.case;
       box.dataset.lost = String(data.lost);
       box.dataset.state = "shown";
+      showReplayLink(data.case, 0);
       const url = new URL(window.location.href);
       url.search = params.toString();
       window.history.replaceState(null, "", url);

@@ -1,0 +1,389 @@
+"""One run as a mission replay: what every robot was doing at any moment, and what happened
+between two moments.
+
+Times are seconds since the run's first event, as the Mission page's cursor counts them. At a
+moment ``t`` a robot's pose and battery are its last recorded ones at or before ``t`` (a
+recording samples them, so nothing is interpolated that was not recorded); its heading is the
+direction of its last move; an activity is active from its start up to (not including) its end,
+or to the end of the run when the log never ends it; its last message is the latest it sent or
+received by ``t``.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+import pandas as pd
+
+from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
+from robotale.enhancement.timeline import NO_ROBOT, case_timeline
+from robotale.errors import InputError
+from robotale.eventlog.schema import (
+    ACTIVITY,
+    BATTERY,
+    CASE,
+    LIFECYCLE,
+    MSG_ID,
+    NONE,
+    ROBOT,
+    TIMESTAMP,
+    X,
+    Y,
+    Z,
+)
+
+#: columns that are numbers but no signal to plot: positions in a recording, ids
+NOT_SIGNALS = frozenset({"source_index", "event_id", "execution_id", "index"})
+#: a battery below this share (percent) is a low-battery moment, as the simulator warns
+LOW_BATTERY = 20.0
+#: an activity instance longer than this quantile of its activity's instances by the same
+#: robot in the whole log is a slow one
+SLOW_QUANTILE = 0.95
+#: seconds a slow instance takes at least beyond its kind's median
+SLOW_MARGIN = 1.0
+#: a move shorter than this (metres) gives no heading: a standing robot's noise
+MIN_MOVE = 1e-3
+
+
+@dataclass(frozen=True)
+class MissionRun:
+    """The run ``case`` of a log, ready to be asked about any moment."""
+
+    case: str
+    start: pd.Timestamp
+    duration: float
+    robots: list[str]
+    #: the run's events with ``s`` (seconds since ``start``), in time order
+    events: pd.DataFrame
+    #: robot, activity, start, end (seconds; end NaN when the log never ends it)
+    instances: pd.DataFrame
+    #: msg_id, sender, receiver, sent, received (seconds), lost, delayed
+    messages: pd.DataFrame
+    #: robot, s, x, y, z of every event that carries a position
+    positions: pd.DataFrame
+    #: numeric columns one can plot
+    signals: list[str]
+    #: moments worth a look: s, kind, robot, text
+    moments: pd.DataFrame
+
+    # -- one moment ------------------------------------------------------------------------
+
+    def state(self, t: float) -> dict[str, Any]:
+        """Every robot at ``t`` seconds: pose, heading, battery, active activities and its
+        last message."""
+        return {
+            "case": self.case,
+            "t": t,
+            "time": _iso(self.start + pd.Timedelta(seconds=t)),
+            "duration": self.duration,
+            "robots": {robot: self._robot_state(robot, t) for robot in self.robots},
+        }
+
+    def _robot_state(self, robot: str, t: float) -> dict[str, Any]:
+        return {
+            "pose": self._pose(robot, t),
+            "heading": self._heading(robot, t),
+            "battery": self._last_value(robot, BATTERY, t),
+            "activities": self.active(robot, t),
+            "last_message": self._last_message(robot, t),
+        }
+
+    def active(self, robot: str, t: float) -> list[str]:
+        """The activities of ``robot`` running at ``t``, in start order."""
+        mine = self.instances[self.instances["robot"] == robot]
+        end = mine["end"].fillna(math.inf)
+        running = mine[(mine["start"] <= t) & (t < end)]
+        return running["activity"].tolist()
+
+    def active_instances(self, t: float) -> pd.DataFrame:
+        end = self.instances["end"].fillna(math.inf)
+        return self.instances[(self.instances["start"] <= t) & (t < end)]
+
+    def _pose(self, robot: str, t: float) -> dict[str, float] | None:
+        mine = self.positions[(self.positions["robot"] == robot) & (self.positions["s"] <= t)]
+        if mine.empty:
+            return None
+        last = mine.iloc[-1]
+        return {axis: _number(last[axis]) for axis in ("x", "y", "z")}
+
+    def _heading(self, robot: str, t: float) -> float | None:
+        """Radians, counter-clockwise from +x, of the robot's last move by ``t``."""
+        mine = self.positions[(self.positions["robot"] == robot) & (self.positions["s"] <= t)]
+        xy = mine[["x", "y"]].to_numpy(float)
+        if len(xy) < 2:
+            return None
+        steps = np.diff(xy, axis=0)
+        moved = np.flatnonzero(np.hypot(steps[:, 0], steps[:, 1]) > MIN_MOVE)
+        if not len(moved):
+            return None
+        dx, dy = steps[moved[-1]]
+        return float(math.atan2(dy, dx))
+
+    def _last_value(self, robot: str, column: str, t: float) -> float | None:
+        if column not in self.events.columns:
+            return None
+        mine = self.events[(self.events[ROBOT] == robot) & (self.events["s"] <= t)]
+        values = pd.to_numeric(mine[column], errors="coerce").dropna()
+        return _number(values.iloc[-1]) if not values.empty else None
+
+    def _last_message(self, robot: str, t: float) -> dict[str, Any] | None:
+        messages = self.messages
+        sent = messages[(messages["sender"] == robot) & (messages["sent"] <= t)]
+        received = messages[(messages["receiver"] == robot) & (messages["received"] <= t)]
+        candidates = [(row.sent, "sent", row) for row in sent.itertuples(index=False)]
+        candidates += [(row.received, "received", row) for row in received.itertuples()]
+        if not candidates:
+            return None
+        at, role, row = max(candidates, key=lambda item: item[0])
+        other = row.receiver if role == "sent" else row.sender
+        return {
+            "msg_id": str(row.msg_id),
+            "role": role,
+            "with": None if pd.isna(other) else str(other),
+            "s": float(at),
+            "lost": bool(row.lost),
+        }
+
+    # -- between two moments ---------------------------------------------------------------
+
+    def window(self, start: float, end: float) -> dict[str, Any]:
+        """The events, messages, positions and moments between ``start`` and ``end`` s."""
+        if end < start:
+            raise InputError(f"the window ends ({end} s) before it starts ({start} s).")
+        events = self.events[(self.events["s"] >= start) & (self.events["s"] <= end)]
+        control = events[events[LIFECYCLE].astype("string").fillna("") != NONE]
+        messages = self.messages
+        sent_in = messages["sent"].between(start, end)
+        received_in = messages["received"].between(start, end)
+        positions = self.positions[self.positions["s"].between(start, end)]
+        moments = self.moments[self.moments["s"].between(start, end)]
+        return {
+            "case": self.case,
+            "from": start,
+            "to": end,
+            "events": [
+                {
+                    "s": float(row.s),
+                    "robot": str(row.robot),
+                    "activity": str(row.activity),
+                    "lifecycle": None if pd.isna(row.lifecycle) else str(row.lifecycle),
+                    "msg_id": None if pd.isna(row.msg_id) else str(row.msg_id),
+                }
+                for row in _event_rows(control)
+            ],
+            "messages": _records(messages[sent_in | received_in]),
+            "positions": {
+                str(robot): rows[["s", "x", "y", "z"]].to_numpy(float).tolist()
+                for robot, rows in positions.groupby("robot", sort=True)
+            },
+            "moments": _records(moments),
+        }
+
+    def series(self, column: str) -> dict[str, list[list[float]]]:
+        """``{robot: [[s, value], ...]}`` of a numeric column, for a plot."""
+        if column not in self.signals:
+            known = ", ".join(self.signals) or "none"
+            raise InputError(f"the run has no numeric field {column!r}; it has {known}.")
+        values = pd.to_numeric(self.events[column], errors="coerce")
+        table = pd.DataFrame({"robot": self.events[ROBOT], "s": self.events["s"], "v": values})
+        table = table.dropna(subset=["v"])
+        return {
+            str(robot): rows[["s", "v"]].to_numpy(float).tolist()
+            for robot, rows in table.groupby("robot", sort=True)
+        }
+
+    def summary(self) -> dict[str, Any]:
+        """What the page needs before it asks about a moment."""
+        control = self.events[self.events[LIFECYCLE].astype("string").fillna("") != NONE]
+        return {
+            "case": self.case,
+            "start": _iso(self.start),
+            "duration": self.duration,
+            "robots": self.robots,
+            "signals": self.signals,
+            "has_positions": not self.positions.empty,
+            "event_times": sorted(set(control["s"].round(6).tolist())),
+            "instances": _records(self.instances),
+            "moments": _records(self.moments),
+        }
+
+
+def mission_run(log: pd.DataFrame, case: str) -> MissionRun:
+    """The run ``case`` of ``log`` (an :class:`InputError` naming some runs when it has none)."""
+    timeline = case_timeline(log, case)  # also checks the run exists
+    cases = log[CASE].astype("string")
+    events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
+    events = events.sort_values(TIMESTAMP, kind="stable")
+    robots_column = (
+        events[ROBOT].astype("string").fillna(NO_ROBOT)
+        if ROBOT in events.columns
+        else pd.Series(NO_ROBOT, index=events.index)
+    )
+    events = events.assign(**{ROBOT: robots_column.astype(str)})
+    start = events[TIMESTAMP].iloc[0]
+    events = events.assign(s=_seconds(events[TIMESTAMP], start))
+    instances = _instances(events, start)
+    messages = _messages(timeline.messages, start)
+    positions = _positions(events)
+    robots = sorted(set(timeline.robots) | set(positions["robot"]))
+    return MissionRun(
+        case=str(case),
+        start=start,
+        duration=float(events["s"].iloc[-1]),
+        robots=robots,
+        events=events.reset_index(drop=True),
+        instances=instances,
+        messages=messages,
+        positions=positions,
+        signals=_signals(events),
+        moments=_moments(log, events, instances, messages, start),
+    )
+
+
+def _seconds(times: pd.Series, start: pd.Timestamp) -> pd.Series:
+    return (times - start).dt.total_seconds()
+
+
+def _instances(events: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
+    found = activity_instances(events)
+    if found.empty:
+        return pd.DataFrame(columns=["robot", "activity", "start", "end"])
+    ends = _seconds(found[TIMESTAMP], start).where(found[FINISHED].astype(bool))
+    table = pd.DataFrame(
+        {
+            "robot": found[ROBOT].astype(str),
+            "activity": found[ACTIVITY].astype(str),
+            "start": _seconds(found[START_TIMESTAMP], start),
+            "end": ends,
+        }
+    )
+    return table.sort_values(["start", "robot"], kind="stable").reset_index(drop=True)
+
+
+def _messages(messages: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
+    columns = ["msg_id", "sender", "receiver", "sent", "received", "lost", "delayed"]
+    if messages.empty:
+        return pd.DataFrame(columns=columns)
+    table = messages[columns].copy()
+    for column in ("sent", "received"):
+        table[column] = _seconds(pd.to_datetime(table[column], utc=True), start)
+    return table.reset_index(drop=True)
+
+
+def _positions(events: pd.DataFrame) -> pd.DataFrame:
+    if X not in events.columns or Y not in events.columns:
+        return pd.DataFrame(columns=["robot", "s", "x", "y", "z"])
+    x = pd.to_numeric(events[X], errors="coerce")
+    y = pd.to_numeric(events[Y], errors="coerce")
+    z = pd.to_numeric(events[Z], errors="coerce") if Z in events.columns else 0.0
+    table = pd.DataFrame({"robot": events[ROBOT], "s": events["s"], "x": x, "y": y, "z": z})
+    return table.dropna(subset=["x", "y"]).reset_index(drop=True)
+
+
+def _signals(events: pd.DataFrame) -> list[str]:
+    """The log's numeric columns (battery, positions, any perspective or topic field)."""
+    found = []
+    for column in events.columns:
+        if column in NOT_SIGNALS or column == "s" or column.startswith("_"):
+            continue
+        values = events[column]
+        if pd.api.types.is_bool_dtype(values):
+            continue
+        if pd.api.types.is_numeric_dtype(values) and values.notna().any():
+            found.append(str(column))
+    return found
+
+
+def _moments(
+    log: pd.DataFrame,
+    events: pd.DataFrame,
+    instances: pd.DataFrame,
+    messages: pd.DataFrame,
+    start: pd.Timestamp,
+) -> pd.DataFrame:
+    """The run's moments worth a look: a lost or delayed message (where it was sent), a
+    robot's battery first falling below :data:`LOW_BATTERY` percent, an activity instance
+    slower than :data:`SLOW_QUANTILE` of its kind in the whole log (where it started)."""
+    rows: list[dict[str, Any]] = []
+    for row in messages.itertuples(index=False):
+        if row.lost or row.delayed:
+            what = "lost" if row.lost else "delayed"
+            text = f"message {row.msg_id} from {row.sender} {what}"
+            rows.append(
+                {"s": row.sent, "kind": f"{what} message", "robot": row.sender, "text": text}
+            )
+    if BATTERY in events.columns:
+        levels = pd.to_numeric(events[BATTERY], errors="coerce")
+        low = events[levels < LOW_BATTERY]
+        for robot, first in low.groupby(ROBOT, sort=True)["s"].min().items():
+            text = f"{robot}'s battery below {LOW_BATTERY:g}%"
+            rows.append({"s": first, "kind": "low battery", "robot": robot, "text": text})
+    rows += _slow(log, instances)
+    table = pd.DataFrame(rows, columns=["s", "kind", "robot", "text"])
+    return table.sort_values("s", kind="stable").reset_index(drop=True)
+
+
+def _slow(log: pd.DataFrame, instances: pd.DataFrame) -> list[dict[str, Any]]:
+    every = activity_instances(log)
+    every = every[every[FINISHED].astype(bool)]
+    if every.empty or ROBOT not in every.columns:
+        return []
+    seconds = (every[TIMESTAMP] - every[START_TIMESTAMP]).dt.total_seconds()
+    keys = [every[ROBOT].astype(str), every[ACTIVITY].astype(str)]
+    groups = seconds.groupby(keys)
+    limits = groups.quantile(SLOW_QUANTILE)
+    medians = groups.median()
+    counts = groups.size()
+    found = []
+    for row in instances.dropna(subset=["end"]).itertuples(index=False):
+        key = (row.robot, row.activity)
+        if counts.get(key, 0) < 3:  # too few to say what is slow
+            continue
+        took = row.end - row.start
+        # a second past the typical one, not a rounding of an instant one
+        if took > limits[key] + 1e-9 and took - medians[key] >= SLOW_MARGIN:
+            text = f"{row.activity} by {row.robot} took {took:.1f} s"
+            found.append(
+                {"s": row.start, "kind": "slow activity", "robot": row.robot, "text": text}
+            )
+    return found
+
+
+def _event_rows(events: pd.DataFrame):
+    msg = events[MSG_ID] if MSG_ID in events.columns else pd.Series(None, index=events.index)
+    table = pd.DataFrame(
+        {
+            "s": events["s"],
+            "robot": events[ROBOT],
+            "activity": events[ACTIVITY],
+            "lifecycle": events[LIFECYCLE] if LIFECYCLE in events.columns else None,
+            "msg_id": msg,
+        }
+    )
+    return table.itertuples(index=False)
+
+
+def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
+    return [{k: _plain(v) for k, v in row.items()} for row in table.to_dict(orient="records")]
+
+
+def _plain(value: Any) -> Any:
+    if isinstance(value, (np.bool_, bool)):
+        return bool(value)
+    if isinstance(value, (np.integer, np.floating, float, int)):
+        return _number(value)
+    if value is None or (not isinstance(value, str) and pd.isna(value)):
+        return None
+    return str(value)
+
+
+def _number(value: Any) -> float | None:
+    number = float(value)
+    return number if math.isfinite(number) else None
+
+
+def _iso(moment: pd.Timestamp) -> str:
+    return moment.isoformat()

@@ -1,0 +1,136 @@
+"""A stored run as the Mission page replays it: the run's state at a moment and its window
+(:mod:`robotale.enhancement.mission`), the site it took place in (:mod:`robotale.results.site`)
+and, with the model that drove it, the BPMN elements each robot was in and the sequence flows
+it took so far.
+
+A log's activities are the labels the engines tag (:func:`element_label`), so an element is
+found by its label among the events of the robot its pool binds, as on the Model page.
+"""
+
+from __future__ import annotations
+
+from collections import Counter, deque
+from dataclasses import dataclass
+from itertools import pairwise
+from pathlib import Path
+from typing import Any
+
+from neo4j import Driver
+
+from robotale.enhancement.mission import MissionRun, mission_run
+from robotale.errors import InputError, ModelError
+from robotale.fame_runtime.labels import element_label
+from robotale.fame_runtime.model import Flow, Scope
+from robotale.fame_runtime.parser import parse
+from robotale.fame_runtime.splitter import split
+from robotale.results.logdata import LogData, current_build
+from robotale.results.site import stored_site
+
+#: gateways and unlabelled events a path between two tagged elements may pass through
+MAX_HOPS = 8
+
+
+def stored_mission(driver: Driver, logs: LogData, name: str, case: str) -> MissionRun:
+    """The run ``case`` of the stored log ``name``, kept in memory per build."""
+    if not case:
+        raise InputError("Name the run to replay (?case=).")
+    build = current_build(driver, name)
+    return logs.missions.get(
+        (name, build.key, str(case)), lambda: mission_run(logs.frame(driver, name), case)
+    )
+
+
+def mission_site(driver: Driver, name: str, run: MissionRun) -> dict[str, Any]:
+    """The map's extent and fixed places: the run's site when it was simulated (its
+    ``source`` is ``world``), else the extent of its positions (``positions``), else none."""
+    site = stored_site(driver, name, run.case)
+    if site is not None:
+        return {**site, "source": "world" if site.get("field") else "manifest"}
+    if run.positions.empty:
+        return {"source": None}
+    x, y = run.positions["x"], run.positions["y"]
+    return {
+        "source": "positions",
+        "extent": [float(x.min()), float(y.min()), float(x.max()), float(y.max())],
+    }
+
+
+@dataclass(frozen=True)
+class ModelMap:
+    """Which elements of a model each robot's activities are."""
+
+    #: robot -> label -> element ids
+    labels: dict[str, dict[str, list[str]]]
+    #: robot -> the scopes (process, sub-processes) of its pool
+    scopes: dict[str, list[Scope]]
+
+    def active(self, run: MissionRun, t: float) -> dict[str, list[str]]:
+        """``{robot: [element id, ...]}`` of the activities running at ``t``."""
+        found: dict[str, list[str]] = {}
+        for row in run.active_instances(t).itertuples(index=False):
+            ids = self.labels.get(row.robot, {}).get(row.activity, [])
+            found.setdefault(row.robot, [])
+            found[row.robot] += [i for i in ids if i not in found[row.robot]]
+        return found
+
+    def flows_taken(self, run: MissionRun, t: float) -> dict[str, int]:
+        """``{flow id: times}``: for each robot and each scope of its pool (the process, a
+        sub-process), the flows on the shortest path (through gateways and events it does
+        not tag) from each element of the scope it started to the next one it started there
+        by ``t``. Elements that run side by side in one scope have no path between them and
+        add nothing."""
+        taken: Counter[str] = Counter()
+        started = run.instances[run.instances["start"] <= t]
+        for robot, rows in started.groupby("robot", sort=False):
+            labels = self.labels.get(str(robot), {})
+            ids = [labels[a][0] for a in rows["activity"] if a in labels]
+            # a path passes through what the robot never tags (gateways, plain events)
+            seen = set(run.instances.loc[run.instances["robot"] == robot, "activity"])
+            tagged = {i for label, found in labels.items() if label in seen for i in found}
+            for scope in self.scopes.get(str(robot), []):
+                inside = [i for i in ids if i in scope.nodes]
+                for source, target in pairwise(inside):
+                    taken.update(_path(scope, source, target, tagged))
+        return dict(taken)
+
+
+def model_map(model: Path, robots: list[str]) -> ModelMap:
+    """The elements of ``model`` the log's ``robots`` are bound to."""
+    try:
+        assignments = split(parse(model), robots)
+    except ModelError as error:
+        raise InputError(f"{error}; the run's robots are {', '.join(robots)}.") from None
+    labels: dict[str, dict[str, list[str]]] = {}
+    scopes: dict[str, list[Scope]] = {}
+    for assignment in assignments:
+        mine = labels.setdefault(assignment.robot, {})
+        for node in assignment.process.walk():
+            mine.setdefault(element_label(node), []).append(node.id)
+        process = assignment.process
+        scopes[assignment.robot] = [process] + [
+            n.scope for n in process.walk() if n.scope is not None
+        ]
+    return ModelMap(labels, scopes)
+
+
+def _path(scope: Scope, source: str, target: str, tagged: set[str]) -> list[str]:
+    """The flow ids of the shortest path from ``source`` to ``target`` in ``scope`` that
+    passes only through elements nothing tags; [] when there is none."""
+    if source not in scope.nodes or target not in scope.nodes:
+        return []
+    outgoing: dict[str, list[Flow]] = {}
+    for flow in scope.flows.values():
+        outgoing.setdefault(flow.source, []).append(flow)
+    queue: deque[tuple[str, list[str]]] = deque([(source, [])])
+    seen = {source}
+    while queue:
+        node, flows = queue.popleft()
+        if len(flows) >= MAX_HOPS:
+            continue
+        for flow in outgoing.get(node, []):
+            if flow.target == target:
+                return [*flows, flow.id]
+            if flow.target not in seen and flow.target not in tagged:
+                seen.add(flow.target)
+                queue.append((flow.target, [*flows, flow.id]))
+    return []

@@ -1,0 +1,106 @@
+"""The Mission page: one run replayed under one time cursor, over a map, the timeline, the
+model's active elements, plots of any numeric field and the findings near the cursor; and the
+data API it (and anyone) reads: a run's state at a moment and what happened in a window."""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+from flask import Blueprint, jsonify, render_template, request
+
+from robotale.enhancement.timeline import NO_ROBOT
+from robotale.errors import InputError
+from robotale.results.mission import ModelMap, mission_site, model_map, stored_mission
+from robotale.webapp import pages
+from robotale.webapp.model_store import StoredModel
+from robotale.webapp.state import driver, state
+
+blueprint = Blueprint("mission", __name__)
+
+
+@blueprint.get("/mission")
+def page():
+    context = pages.context("mission.page")
+    model = _model(context["log"]) if context["log"] else None
+    return render_template(
+        "mission.html",
+        case=request.args.get("case", ""),
+        t=request.args.get("t", ""),
+        model=model.id if model else "",
+        **context,
+    )
+
+
+@blueprint.get("/api/mission/<log>/<case>")
+def summary(log: str, case: str):
+    """The run's length, robots, fields, activity instances, moments and site."""
+    run = stored_mission(driver(), state().logs, log, case)
+    model = _model(log)
+    return jsonify(
+        {
+            **run.summary(),
+            "site": mission_site(driver(), log, run),
+            "model": model.id if model else None,
+        }
+    )
+
+
+@blueprint.get("/api/mission/<log>/<case>/state")
+def state_at(log: str, case: str):
+    """Every robot at ``?t=`` seconds since the run's start; with a model, the elements
+    each robot is in and the flows taken so far."""
+    t = _seconds("t", request.args.get("t"))
+    run = stored_mission(driver(), state().logs, log, case)
+    found: dict[str, Any] = run.state(t)
+    elements = _elements(log, case, run.robots)
+    if elements is not None:
+        found["elements"] = elements.active(run, t)
+        found["flows"] = elements.flows_taken(run, t)
+    return jsonify(found)
+
+
+@blueprint.get("/api/mission/<log>/<case>/window")
+def window(log: str, case: str):
+    """The events, messages, positions and moments from ``?from=`` to ``?to=`` seconds."""
+    start = _seconds("from", request.args.get("from"))
+    end = _seconds("to", request.args.get("to"))
+    run = stored_mission(driver(), state().logs, log, case)
+    return jsonify(run.window(start, end))
+
+
+@blueprint.get("/api/mission/<log>/<case>/series")
+def series(log: str, case: str):
+    """One numeric field (``?field=``) over the run, per robot."""
+    run = stored_mission(driver(), state().logs, log, case)
+    field = request.args.get("field", "")
+    return jsonify({"field": field, "robots": run.series(field)})
+
+
+def _seconds(name: str, text: str | None) -> float:
+    try:
+        value = float(text) if text is not None else math.nan
+    except ValueError:
+        value = math.nan
+    if not math.isfinite(value):
+        raise InputError(
+            f"?{name}= must be a number of seconds since the run's start, not {text!r}."
+        )
+    return value
+
+
+def _model(log: str) -> StoredModel | None:
+    """The model asked for (``?model=``), else the one linked to the log."""
+    asked = request.args.get("model")
+    models = state().models
+    return models.get(asked) if asked else models.linked(log)
+
+
+def _elements(log: str, case: str, robots: list[str]) -> ModelMap | None:
+    model = _model(log)
+    if model is None:
+        return None
+    known = [robot for robot in robots if robot != NO_ROBOT]
+    return state().logs.missions.get(
+        (log, "model", model.id, case), lambda: model_map(model.path, known)
+    )

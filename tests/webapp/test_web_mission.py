@@ -1,0 +1,495 @@
+"""The Mission page's data API on a simulated run stored with ``robotale ingest``: every answer
+set against the log read with pandas and against the run's truth (what the simulator knew)."""
+
+from __future__ import annotations
+
+import json
+import math
+import re
+from dataclasses import dataclass
+from itertools import pairwise
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from lxml import etree
+
+CASE = "run_0001"
+#: a message the drone sends a tractor, dropped once: a lost message to find near the cursor
+FAULT = "drop:/closest_tractor,nth=1"
+#: the truth samples poses at 2 Hz, the log at its own events: robots move up to 1 m/s
+POSE_METRES = 0.6
+#: a cursor this far from every activity's start and end tells active from not
+MARGIN = 0.05
+BPMN = "{http://www.omg.org/spec/BPMN/20100524/MODEL}"
+#: the BPMN elements whose names are the activities the engines tag
+ACTIVITY_TAGS = {"callActivity", "subProcess", "task", "scriptTask", "serviceTask", "userTask"}
+
+
+@dataclass(frozen=True)
+class StoredRun:
+    name: str
+    folder: Path
+    log: pd.DataFrame
+    truth: list[dict]
+    model: Path
+
+
+@pytest.fixture(scope="module")
+def stored_run(app, neo4j_driver, tmp_path_factory) -> StoredRun:
+    """One agri run (a message dropped) simulated, stored by ``robotale ingest`` and linked to
+    its model, as a user does it."""
+    from robotale.cli import main
+    from robotale.ekg.columnar import stored_table
+    from robotale.ekg.logs import delete_log
+    from robotale.sim import scenarios
+    from robotale.sim.batch import simulate_batch
+    from robotale.sim.plans import plans
+    from robotale.sim.worldspec import load_world
+    from robotale.webapp.state import state
+
+    folder = tmp_path_factory.mktemp("mission") / "agri"
+    world = load_world(scenarios.world_file("agri"))
+    simulate_batch(plans(world, "agri", runs=1, seed=2, faults=[FAULT]), folder, workers=0)
+    name = "mission_agri"
+    assert main(["ingest", str(folder), "--log", name, "--replace", "--rate", "2"]) == 0
+    model = next(m for m in state(app).models.all() if m.name == "agri.bpmn")
+    state(app).models.link(name, model.id)
+    log = stored_table(neo4j_driver, name)
+    truth_file = folder / CASE / "robotale-truth.jsonl"
+    truth = [json.loads(line) for line in truth_file.read_text().splitlines()]
+    yield StoredRun(name, folder, log, truth, scenarios.model_file("agri"))
+    delete_log(neo4j_driver, name)
+
+
+def api(client, path: str):
+    response = client.get(path)
+    assert response.status_code == 200, response.get_data(as_text=True)
+    return response.get_json()
+
+
+def run_events(run: StoredRun) -> tuple[pd.DataFrame, pd.Timestamp]:
+    events = run.log[run.log["case:concept:name"] == CASE].sort_values(
+        "time:timestamp", kind="stable"
+    )
+    return events, events["time:timestamp"].iloc[0]
+
+
+def truth_activities(run: StoredRun) -> list[dict]:
+    return [r for r in run.truth if r["kind"] == "activity"]
+
+
+def normalised(name: str) -> str:
+    return re.sub(r"[^a-z0-9]+", "_", name.lower()).strip("_")
+
+
+def model_activities(model: Path) -> dict[str, dict[str, list[str]]]:
+    """``{pool name: {activity: [element ids]}}`` read from the BPMN file with lxml."""
+    tree = etree.parse(str(model))
+    processes = {p.get("id"): p for p in tree.iter(f"{BPMN}process")}
+    found: dict[str, dict[str, list[str]]] = {}
+    for pool in tree.iter(f"{BPMN}participant"):
+        names: dict[str, list[str]] = {}
+        for element in processes[pool.get("processRef")].iter():
+            tag = etree.QName(element).localname
+            if tag in ACTIVITY_TAGS and element.get("name"):
+                names.setdefault(normalised(element.get("name")), []).append(element.get("id"))
+        found[pool.get("name")] = names
+    return found
+
+
+def pool_of(robot: str) -> str:
+    return robot.split("_")[0].capitalize()
+
+
+def cursor_times(run: StoredRun, count: int = 3) -> list[float]:
+    """Moments spread over the run, away from every activity's start and end, at which every
+    running activity is a named activity of the model (not a catch event or a timer)."""
+    activities = truth_activities(run)
+    start = run.truth[0]["start"]
+    bounds = sorted({a[k] - start for a in activities for k in ("start", "end")})
+    named = {a for pool in model_activities(run.model).values() for a in pool}
+    end = bounds[-1]
+    candidates: list[tuple[float, str]] = []
+    for share in [i / 80 for i in range(8, 76)]:
+        t = round(share * end, 2)
+        if min(abs(t - b) for b in bounds) < MARGIN:
+            continue
+        running = truth_active(run, t)
+        if not any(running.values()) or not all(
+            a in named for a in (a for names in running.values() for a in names)
+        ):
+            continue
+        candidates.append((t, repr(sorted(running.items()))))
+    # spread over the run, each moment with other activities running than the one before
+    chosen: list[float] = []
+    doing: list[str] = []
+    for t, running in candidates:
+        if not chosen or (t - chosen[-1] > end / 10 and running != doing[-1]):
+            chosen.append(t)
+            doing.append(running)
+    assert len(chosen) >= count, candidates
+    return chosen[:count]
+
+
+def truth_active(run: StoredRun, t: float) -> dict[str, list[str]]:
+    start = run.truth[0]["start"]
+    running: dict[str, list[str]] = {robot: [] for robot in run.truth[0]["robots"]}
+    for a in truth_activities(run):
+        end = a["end"] if a["end"] is not None else math.inf
+        if a["start"] - start <= t < end - start:
+            running[a["robot"]].append(a["activity"])
+    return running
+
+
+def truth_pose(run: StoredRun, robot: str, t: float) -> dict:
+    """The truth's sample of ``robot`` nearest to ``t``."""
+    start = run.truth[0]["start"]
+    samples = [r for r in run.truth if r["kind"] == "sample" and r["robot"] == robot]
+    return min(samples, key=lambda s: abs(s["t"] - start - t))
+
+
+def test_state_at_three_moments_is_the_logs_and_the_truths(client, stored_run):
+    events, start = run_events(stored_run)
+    activities = model_activities(stored_run.model)
+    base = f"/api/mission/{stored_run.name}/{CASE}"
+    posed = 0
+    for t in cursor_times(stored_run):
+        state = api(client, f"{base}/state?t={t}")
+        assert state["t"] == t
+        assert set(state["robots"]) == set(stored_run.truth[0]["robots"])
+        running = truth_active(stored_run, t)
+        for robot, facts in state["robots"].items():
+            mine = events[
+                (events["robot"] == robot)
+                & (events["time:timestamp"] <= start + pd.Timedelta(seconds=t))
+            ]
+            placed = mine.dropna(subset=["x"])
+            if placed.empty:  # nothing recorded of it yet: the map does not guess
+                assert facts["pose"] is None and facts["battery"] is None
+            else:
+                last = placed.iloc[-1]
+                assert facts["pose"] == pytest.approx(
+                    {"x": last["x"], "y": last["y"], "z": last["z"]}
+                )
+                # true where and when it was recorded (the log holds a robot's last record)
+                recorded = (last["time:timestamp"] - start).total_seconds()
+                sample = truth_pose(stored_run, robot, recorded)
+                where = (facts["pose"]["x"], facts["pose"]["y"], facts["pose"]["z"])
+                assert math.dist(where, (sample["x"], sample["y"], sample["z"])) < POSE_METRES
+                assert facts["battery"] == pytest.approx(mine["battery"].dropna().iloc[-1])
+                assert facts["battery"] == pytest.approx(100 * sample["battery"], abs=1.0)
+                posed += 1
+            assert sorted(facts["activities"]) == sorted(running[robot]), (robot, t)
+            expected = sorted(
+                i for a in running[robot] for i in activities[pool_of(robot)].get(a, [])
+            )
+            assert sorted(state["elements"].get(robot, [])) == expected, (robot, t)
+    assert posed >= 6  # most robots are on the map at most of the three moments
+
+
+def test_heading_is_the_direction_of_the_last_move(client, stored_run):
+    events, start = run_events(stored_run)
+    t = cursor_times(stored_run)[1]
+    state = api(client, f"/api/mission/{stored_run.name}/{CASE}/state?t={t}")
+    for robot, facts in state["robots"].items():
+        mine = events[
+            (events["robot"] == robot)
+            & (events["time:timestamp"] <= start + pd.Timedelta(seconds=t))
+        ]
+        xy = mine.dropna(subset=["x"])[["x", "y"]]
+        moves = xy.diff().dropna()
+        moves = moves[(moves["x"] ** 2 + moves["y"] ** 2) ** 0.5 > 1e-3]
+        if moves.empty:
+            assert facts["heading"] is None
+        else:
+            dx, dy = moves.iloc[-1]
+            assert facts["heading"] == pytest.approx(math.atan2(dy, dx))
+
+
+def test_flows_taken_grow_and_lie_in_the_model(client, stored_run):
+    tree = etree.parse(str(stored_run.model))
+    flows = {f.get("id") for f in tree.iter(f"{BPMN}sequenceFlow")}
+    base = f"/api/mission/{stored_run.name}/{CASE}/state"
+    counts = [api(client, f"{base}?t={t}")["flows"] for t in cursor_times(stored_run)]
+    assert counts[-1] and set(counts[-1]) <= flows
+    for earlier, later in pairwise(counts):
+        assert all(later.get(flow, 0) >= n for flow, n in earlier.items())
+    # by hand, from the model: the drone takes off (Drone_Flow_2 into the merge), explores
+    # (Drone_Flow_Explore out of it) and explores again through Drone_Flow_Again
+    start = stored_run.truth[0]["start"]
+    last = cursor_times(stored_run)[-1]
+    explores = [
+        a
+        for a in truth_activities(stored_run)
+        if a["robot"] == "drone" and a["activity"] == "explore" and a["start"] - start <= last
+    ]
+    assert counts[-1]["Drone_Flow_2"] == 1
+    assert counts[-1]["Drone_Flow_Explore"] == len(explores)
+    assert counts[-1].get("Drone_Flow_Again", 0) == len(explores) - 1
+
+
+def test_window_holds_what_the_log_holds_between_two_moments(client, stored_run):
+    events, start = run_events(stored_run)
+    seconds = (events["time:timestamp"] - start).dt.total_seconds()
+    low, high = 20.0, 40.0
+    window = api(client, f"/api/mission/{stored_run.name}/{CASE}/window?from={low}&to={high}")
+    inside = events[seconds.between(low, high)]
+    control = inside[inside["lifecycle:transition"] != "none"]
+    assert len(window["events"]) == len(control)
+    assert [e["activity"] for e in window["events"]] == control["concept:name"].tolist()
+    for robot, rows in window["positions"].items():
+        assert len(rows) == inside[(inside["robot"] == robot) & inside["x"].notna()].shape[0]
+    start_truth = stored_run.truth[0]["start"]
+    sent = {
+        r["msg_id"]
+        for r in stored_run.truth
+        if r["kind"] == "send" and low <= r["t"] - start_truth <= high
+    }
+    assert sent <= {m["msg_id"] for m in window["messages"]}
+
+
+def test_the_lost_message_is_a_moment_where_the_truth_sent_it(client, stored_run):
+    summary = api(client, f"/api/mission/{stored_run.name}/{CASE}")
+    start = stored_run.truth[0]["start"]
+    delivered = {
+        r["msg_id"]
+        for r in stored_run.truth
+        if r["kind"] == "delivery" and r["outcome"] == "delivered"
+    }
+    lost = [r for r in stored_run.truth if r["kind"] == "send" and r["msg_id"] not in delivered]
+    moments = [m for m in summary["moments"] if m["kind"] == "lost message"]
+    assert [m["s"] for m in moments] == pytest.approx([r["t"] - start for r in lost], abs=1e-3)
+    assert summary["site"]["source"] == "world"
+    assert summary["site"]["field"] == [10, 10]
+    manifest = json.loads((stored_run.folder / CASE / "robotale-run.json").read_text())
+    assert [(o["x"], o["y"]) for o in summary["site"]["objects"]] == [
+        (o["x"], o["y"]) for o in manifest["setup"]["objects"]
+    ]
+
+
+def test_series_is_the_logs_column_per_robot(client, stored_run):
+    events, _ = run_events(stored_run)
+    data = api(client, f"/api/mission/{stored_run.name}/{CASE}/series?field=battery")
+    for robot, points in data["robots"].items():
+        mine = events[(events["robot"] == robot) & events["battery"].notna()]
+        assert [v for _, v in points] == pytest.approx(mine["battery"].tolist())
+
+
+def test_bad_requests_say_what_is_wrong(client, stored_run):
+    base = f"/api/mission/{stored_run.name}"
+    cases = {
+        f"{base}/{CASE}/state?t=soon": "?t= must be a number",
+        f"{base}/{CASE}/state": "?t= must be a number",
+        f"{base}/{CASE}/window?from=5&to=1": "ends (1.0 s) before it starts",
+        f"{base}/{CASE}/series?field=colour": "no numeric field 'colour'",
+        f"{base}/run_9999/state?t=1": "no run 'run_9999'",
+        f"/api/mission/no_such_log/{CASE}/state?t=1": "no_such_log",
+    }
+    for path, sentence in cases.items():
+        response = client.get(path, headers={"Accept": "application/json"})
+        assert response.status_code in (400, 404), path
+        assert sentence in response.get_json()["error"], (path, response.get_json())
+
+
+def test_a_log_without_positions_or_model_still_answers(client, stored_run, neo4j_driver, log_name):
+    from robotale.ekg.build import build_ekg
+
+    bare = stored_run.log.drop(columns=["x", "y", "z"])
+    build_ekg(neo4j_driver, bare, log_name, replace=True)
+    summary = api(client, f"/api/mission/{log_name}/{CASE}")
+    assert summary["has_positions"] is False
+    assert summary["site"] == {"source": None}
+    assert summary["model"] is None
+    state = api(client, f"/api/mission/{log_name}/{CASE}/state?t=30")
+    assert all(f["pose"] is None and f["heading"] is None for f in state["robots"].values())
+    assert "elements" not in state
+    assert "x" not in summary["signals"] and "battery" in summary["signals"]
+
+
+# -- the page, in a real browser -------------------------------------------------------------
+
+SHOWN = "document.getElementById('mission').dataset.shown"
+
+
+def move_cursor(page, t: float) -> None:
+    page.fill("#cursor", str(t))
+    wait_for_shown(page, t)
+
+
+def wait_for_shown(page, t: float) -> None:
+    from browser import wait_for
+
+    wait_for(page, f"Number({SHOWN}) === {t}")
+
+
+def expected_view(run: StoredRun, t: float) -> dict:
+    """What the page must show at ``t``, from the stored log with pandas and the model file
+    with lxml (and the truth for the running activities)."""
+    events, start = run_events(run)
+    upto = events[events["time:timestamp"] <= start + pd.Timedelta(seconds=t)]
+    positions = {}
+    batteries = {}
+    for robot, mine in upto.groupby("robot"):
+        placed = mine.dropna(subset=["x"])
+        if not placed.empty:
+            last = placed.iloc[-1]
+            positions[robot] = (last["x"], last["y"], last["z"])
+        levels = mine["battery"].dropna()
+        if not levels.empty:
+            batteries[robot] = levels.iloc[-1]
+    activities = model_activities(run.model)
+    active = sorted(
+        {
+            element
+            for robot, names in truth_active(run, t).items()
+            for name in names
+            for element in activities[pool_of(robot)].get(name, [])
+        }
+    )
+    return {"positions": positions, "battery": batteries, "active": active}
+
+
+def shown_view(page) -> dict:
+    robots = page.eval_on_selector_all(
+        "#map g.robot",
+        "els => els.map(e => [e.dataset.robot, +e.dataset.x, +e.dataset.y, +e.dataset.z])",
+    )
+    values = page.eval_on_selector_all(
+        "#plot-values tr[data-robot]", "els => els.map(e => [e.dataset.robot, e.dataset.value])"
+    )
+    marked = page.eval_on_selector_all(
+        "#canvas .djs-element.active", "els => els.map(e => e.dataset.elementId)"
+    )
+    return {
+        "positions": {robot: (x, y, z) for robot, x, y, z in robots},
+        "battery": {robot: float(value) for robot, value in values if value},
+        "active": sorted(marked),
+        "timeline": page.evaluate(
+            "document.getElementById('mission-timeline').layout.shapes[0].x0"
+        ),
+    }
+
+
+@pytest.mark.browser
+def test_mission_page_shows_the_run_at_the_cursor_in_every_view(page, stored_run, screenshot):
+    from browser import wait_for
+    from playwright.sync_api import expect
+
+    times = cursor_times(stored_run)
+    _, start = run_events(stored_run)
+    page.goto(f"{page.base_url}/mission?log={stored_run.name}&case={CASE}&t={times[0]}")
+    wait_for_shown(page, times[0])
+    expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")
+    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
+    expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
+    expect(page.locator("#mission-missing")).to_be_hidden()
+    assert page.locator("#map rect.field").count() == 1
+    assert page.locator("#map g.base").count() == 2
+    seen = []
+    for t in times:
+        move_cursor(page, t)
+        wait_for(page, "document.getElementById('canvas').dataset.active !== undefined")
+        expected = expected_view(stored_run, t)
+        shown = shown_view(page)
+        assert shown["positions"].keys() == expected["positions"].keys(), t
+        for robot, where in expected["positions"].items():
+            assert shown["positions"][robot] == pytest.approx(where), (robot, t)
+        assert shown["battery"] == pytest.approx(expected["battery"]), t
+        assert shown["active"] == expected["active"], t
+        at = start + pd.Timedelta(seconds=t)
+        assert pd.Timestamp(shown["timeline"], tz="UTC") == pytest.approx(
+            at, abs=pd.Timedelta("2ms")
+        )
+        assert f"t={t:.2f}" in page.url
+        seen.append(shown)
+    screenshot(page, "mission")
+    # one cursor, every view: the timeline's line moved each time, the map and the plot's
+    # readings with the log (each equal to it above, and not the same at every moment)
+    assert len({view["timeline"] for view in seen}) == len(times)
+    for key in ("positions", "battery", "active"):
+        assert len({repr(view[key]) for view in seen}) > 1, key
+
+
+@pytest.mark.browser
+def test_clicking_a_bar_a_finding_or_a_key_moves_the_cursor(page, stored_run):
+    from browser import wait_for
+
+    truth_start = stored_run.truth[0]["start"]
+    # the Findings page's runs and the Timeline page link to the run's replay
+    page.goto(f"{page.base_url}/findings?log={stored_run.name}")
+    page.click(f"#runs-table a.mission-link[href*='case={CASE}']")
+    wait_for_shown(page, 0)
+    page.goto(f"{page.base_url}/timeline?log={stored_run.name}&case={CASE}")
+    page.click("#mission-link")
+    wait_for_shown(page, 0)
+    assert f"case={CASE}" in page.url and f"log={stored_run.name}" in page.url
+    wait_for(page, "document.getElementById('mission-timeline').dataset.drawn")
+
+    # the longest bar of the timeline: the cursor goes to its start, an activity's true start
+    index = page.evaluate(
+        """() => {
+            const bars = document.getElementById('mission-timeline')._fullData
+                .filter((trace) => trace.type === 'bar');
+            let best = null;
+            bars.forEach((trace, k) => Array.from(trace.x).forEach((ms, j) => {
+                if (!best || ms > best.ms) best = { k, j, ms }; }));
+            return best;
+        }"""
+    )
+    bar = page.locator("#mission-timeline g.trace.bars").nth(index["k"]).locator("g.point path")
+    bar.nth(index["j"]).scroll_into_view_if_needed()
+    box = bar.nth(index["j"]).bounding_box()
+    page.mouse.move(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    page.mouse.click(box["x"] + box["width"] / 2, box["y"] + box["height"] / 2)
+    wait_for(page, f"{SHOWN} !== '0'")
+    moved = float(page.evaluate(SHOWN))
+    starts = [a["start"] - truth_start for a in truth_activities(stored_run)]
+    assert min(abs(moved - s) for s in starts) < 1e-3
+
+    # the lost message, listed near the cursor: clicking it goes where the truth sent it
+    lost = next(
+        r["t"] - truth_start
+        for r in stored_run.truth
+        if r["kind"] == "send"
+        and not any(
+            d["kind"] == "delivery" and d["msg_id"] == r["msg_id"] and d["outcome"] == "delivered"
+            for d in stored_run.truth
+        )
+    )
+    move_cursor(page, round(lost + 10, 2))
+    page.click("#moments li[data-kind='lost message']")
+    wait_for(page, f"Math.abs(Number({SHOWN}) - {lost}) < 1e-3")
+
+    # the arrow keys step to the next and the previous event of the log
+    events, start = run_events(stored_run)
+    control = events[events["lifecycle:transition"] != "none"]
+    times = sorted(set(((control["time:timestamp"] - start).dt.total_seconds()).round(6)))
+    here = float(page.evaluate(SHOWN))
+    page.locator("body").press("ArrowRight")
+    following = next(s for s in times if s > here + 1e-6)
+    wait_for(page, f"Math.abs(Number({SHOWN}) - {following}) < 1e-6")
+    page.locator("body").press("ArrowLeft")
+    before = [s for s in times if s < following - 1e-6][-1]
+    wait_for(page, f"Math.abs(Number({SHOWN}) - {before}) < 1e-6")
+
+
+@pytest.mark.browser
+def test_the_page_says_what_a_run_without_positions_or_model_lacks(
+    page, stored_run, neo4j_driver, log_name
+):
+    from browser import wait_for
+    from playwright.sync_api import expect
+
+    from robotale.ekg.build import build_ekg
+
+    build_ekg(neo4j_driver, stored_run.log.drop(columns=["x", "y", "z"]), log_name, replace=True)
+    page.goto(f"{page.base_url}/mission?log={log_name}&case={CASE}&t=30")
+    wait_for_shown(page, 30)
+    expect(page.locator("#mission-missing")).to_contain_text("records no positions")
+    expect(page.locator("#mission-missing")).to_contain_text("No model is linked")
+    expect(page.locator("#map")).to_contain_text("no positions in this run")
+    assert page.locator("#map g.robot").count() == 0
+    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
+    wait_for(page, "document.querySelectorAll('#plot-values tr[data-robot]').length === 3")
+    assert page.locator("#robots table tbody tr").count() == 3
