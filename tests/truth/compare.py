@@ -312,7 +312,7 @@ def _battery(runs, log) -> list[Disagreement]:
         return [Disagreement("battery", "all", "energy table", "per robot and run", "none")]
     said = {(row["case"], row["robot"]): float(row["used"]) for _, row in energy.iterrows()}
     found = []
-    for key, used in sorted(oracle.battery_use(runs).items()):
+    for key, used in sorted(oracle.battery_use(runs, _observed(log)).items()):
         got = said.get(key)
         if got is None or abs(got - used) > max(BATTERY_POINTS, BATTERY_SHARE * used):
             found.append(
@@ -329,6 +329,21 @@ def _battery(runs, log) -> list[Disagreement]:
         if isinstance(summary.get(name), int | float) and summary[name] < 0:
             found.append(Disagreement("battery", "all", name, ">= 0", summary[name]))
     return found
+
+
+#: the battery topic's period: a log's level at an event is the robot's next reading, up to
+#: this many seconds later
+BATTERY_PERIOD = 1.0
+
+
+def _observed(log: pd.DataFrame) -> dict[tuple[str, str], tuple[float, float]]:
+    """Per (case, robot), the time from the robot's first level in the log to its last (and
+    the reading that last level is): a log has levels only at a robot's events, so that is
+    the time whose battery use it can show; a robot without events has none."""
+    rows = log.dropna(subset=["battery"])
+    times = rows["time:timestamp"].map(pd.Timestamp.timestamp)
+    span = times.groupby([rows[CASE_COLUMN].astype(str), rows["robot"]]).agg(["min", "max"])
+    return {key: (low, high + BATTERY_PERIOD) for key, (low, high) in span.iterrows()}
 
 
 # -- space ---------------------------------------------------------------------------------------
