@@ -460,7 +460,7 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
     # case -> robot -> the robot's unanswered messages (rows), oldest first; a message
     # received stays unanswered where what its receiver sent back was lost
     waiting: dict[object, dict[object, list[int]]] = {}
-    unheard: set[int] = set()
+    unheard: dict[int, set] = {}  # message row -> the robots whose answers to it were lost
     for row, robot, kind in zip(rows, robots, kinds, strict=True):
         in_case = waiting.setdefault(cases[row], {})
         if kind == ARRIVED:  # ``row`` reached ``robot``: an answer to its messages
@@ -472,7 +472,7 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
         sender, at = senders[row], sent_at[row]
         mine = in_case.setdefault(sender, [])
         if mine:
-            mine[:] = [a for a in mine if received_at[a] > at or a in unheard]
+            mine[:] = [a for a in mine if received_at[a] > at or unheard.get(a) == receivers[a]]
         candidates = [
             a
             for a in mine
@@ -592,20 +592,19 @@ def _answer(waiting: dict, sender, receiver, receivers: list[frozenset]) -> None
 
 
 def _unheard(
-    waiting: dict, sender, receiver, receivers, received_at, at: int, unheard: set[int]
+    waiting: dict, sender, receiver, receivers, received_at, at: int, unheard: dict[int, set]
 ) -> None:
     """A message from ``sender`` to ``receiver`` (``unknown``: any robot but the sender) was
     lost at ``at``: the receiver's messages to ``sender`` that ``sender`` had received by then
-    are unanswered still (its answer never came), though received."""
+    lost an answer. One whose every receiver's answer was lost is unanswered still, though
+    received: its sender heard nothing back where everyone answered."""
     known = isinstance(receiver, str) and receiver != UNKNOWN
     for other, theirs in waiting.items():
         if other == sender or (known and other != receiver):
             continue
-        unheard.update(
-            a
-            for a in theirs
-            if received_at[a] <= at and (not receivers[a] or sender in receivers[a])
-        )
+        for a in theirs:
+            if received_at[a] <= at and (not receivers[a] or sender in receivers[a]):
+                unheard.setdefault(a, set()).add(sender)
 
 
 def _integer_times(times: pd.Series) -> np.ndarray:

@@ -312,9 +312,12 @@ def _battery(runs, log) -> list[Disagreement]:
         return [Disagreement("battery", "all", "energy table", "per robot and run", "none")]
     said = {(row["case"], row["robot"]): float(row["used"]) for _, row in energy.iterrows()}
     found = []
-    for key, used in sorted(oracle.battery_use(runs, _observed(log)).items()):
+    windows = _observed(runs, log)
+    truth = oracle.battery_use(runs, {key: window[:2] for key, window in windows.items()})
+    for key, used in sorted(truth.items()):
         got = said.get(key)
-        if got is None or abs(got - used) > max(BATTERY_POINTS, BATTERY_SHARE * used):
+        margin = max(BATTERY_POINTS, BATTERY_SHARE * used, windows[key][2])
+        if got is None or abs(got - used) > margin:
             found.append(
                 Disagreement(
                     "battery",
@@ -336,14 +339,41 @@ def _battery(runs, log) -> list[Disagreement]:
 BATTERY_PERIOD = 1.0
 
 
-def _observed(log: pd.DataFrame) -> dict[tuple[str, str], tuple[float, float]]:
-    """Per (case, robot), the time from the robot's first level in the log to its last (and
-    the reading that last level is): a log has levels only at a robot's events, so that is
-    the time whose battery use it can show; a robot without events has none."""
-    rows = log.dropna(subset=["battery"])
+def _observed(runs, log: pd.DataFrame) -> dict[tuple[str, str], tuple[float, float, float]]:
+    """Per (case, robot), the time from the robot's first level in the log to its last: a log
+    has levels only at a robot's events, so that is the time whose battery use it can show (a
+    robot without events has none). Each level is a battery reading near its event: the
+    window runs between the true samples nearest those readings; the third value is how
+    much the true level moved around the two readings (a margin for where they fell)."""
+    rows = log.dropna(subset=["battery"]).sort_values("time:timestamp", kind="stable")
+    keys = [rows[CASE_COLUMN].astype(str), rows["robot"]]
     times = rows["time:timestamp"].map(pd.Timestamp.timestamp)
-    span = times.groupby([rows[CASE_COLUMN].astype(str), rows["robot"]]).agg(["min", "max"])
-    return {key: (low, high + BATTERY_PERIOD) for key, (low, high) in span.iterrows()}
+    first = rows.assign(t=times).groupby(keys)[["t", "battery"]].first()
+    last = rows.assign(t=times).groupby(keys)[["t", "battery"]].last()
+    samples: dict[tuple[str, str], list[tuple[float, float]]] = {}
+    for run in runs:
+        for sample in run.samples:
+            key = (run.case, sample["robot"])
+            samples.setdefault(key, []).append((sample["t"], sample["battery"] * 100.0))
+    windows = {}
+    for key in first.index:
+        own = samples.get(key, [])
+        begin, begin_spread = _reading(own, *first.loc[key])
+        end, end_spread = _reading(own, *last.loc[key])
+        windows[key] = (begin, end, begin_spread + end_spread)
+    return windows
+
+
+def _reading(samples: list[tuple[float, float]], at: float, level: float) -> tuple[float, float]:
+    """The time of the true sample nearest the reading a log's ``level`` at ``at`` shows: the
+    one closest to that level within a battery period of ``at`` (the next reading, or the
+    last one where the run ended before another came); and how far the true level moved
+    within that period, the uncertainty a reading between two samples leaves."""
+    near = [(abs(b - level), t, b) for t, b in samples if abs(t - at) <= BATTERY_PERIOD]
+    if not near:
+        return at, 0.0
+    levels = [b for _, _, b in near]
+    return min(near)[1], max(levels) - min(levels)
 
 
 # -- space ---------------------------------------------------------------------------------------
