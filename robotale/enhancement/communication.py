@@ -20,13 +20,20 @@ type, else ``unknown``. A channel is a sender -> receiver pair. Per message:
 - resends: attempts - 1 (``resends_same_id``), plus one when the sender sent it again under a
   new id (``resends_new_id``): a later message of the same case and sender, sent while this
   one had no answer, to the same receiver (of any type: a resend may change its type), or of
-  the same type where either receiver is unknown. An answer is a receive of it, or any message
-  from its receiver (from anyone, when its receiver is unknown) to its sender, so the next
-  task sent after a reply is news. Each resend names the message it repeats (``repeats``; the
-  repeated one names it in ``resent_as``); a message is repeated at most once (a chain of
-  resends repeats one after the other). The payload is a hint, never a requirement: when several
-  unanswered messages could be the repeated one, the one with the same payload wins, else the
-  latest (payloads are often constant or carry a stamp, so they neither make nor break one);
+  the same type where either receiver is unknown (a message nobody received may have been
+  meant for any robot that received its sender's other messages of its type). An answer is a
+  message from its receiver (from anyone, when its receiver is unknown) that reached its
+  sender: when it was received, or sent where its type has no receive tags; a lost answer
+  answers nothing. A receive of it answers it too, unless every robot that received it
+  answered and every answer was lost (its sender heard nothing back). At one moment receives
+  come before sends, so a robot's reply to a question it just heard is no resend of its
+  earlier reply. Each resend names the message it repeats (``repeats``; the repeated one
+  names it in ``resent_as``); a message is repeated at most once (a chain of resends repeats
+  one after the other). The payload is a hint, never a requirement: when several unanswered
+  messages could be the repeated one, the one with the same payload wins, else the latest
+  (payloads are often constant or carry a stamp, so they neither make nor break one); only
+  where a sender's payloads of a type name their content (one of them was sent twice) is a
+  message of that type with another payload the next task rather than a resend;
 - latency: from its first send to its first receive (per receiver on the channels);
 - delayed: see :mod:`robotale.enhancement.delays` (an explicit threshold, or the slow mode of
   a two-mode latency distribution per channel: sender, receiver and type; the channels table
