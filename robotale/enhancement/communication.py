@@ -591,11 +591,18 @@ def _answer(waiting: dict, sender, receiver, receivers: list[frozenset]) -> None
     """A message from ``sender`` reached ``receiver`` (``unknown``: any robot but the
     sender): it answers the receiver's unanswered messages of its case sent to ``sender``
     (or to nobody known)."""
-    known = isinstance(receiver, str) and receiver != UNKNOWN
-    for other, theirs in waiting.items():
-        if not theirs or other == sender or (known and other != receiver):
-            continue
-        theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+    for theirs in _waiting_for(waiting, sender, receiver):
+        if theirs:
+            theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+
+
+def _waiting_for(waiting: dict, sender, receiver) -> list[list[int]]:
+    """The unanswered messages of ``receiver`` (``unknown``: of every robot but ``sender``),
+    one list per robot."""
+    if isinstance(receiver, str) and receiver != UNKNOWN:
+        theirs = waiting.get(receiver)
+        return [] if theirs is None or receiver == sender else [theirs]
+    return [theirs for other, theirs in waiting.items() if other != sender]
 
 
 def _unheard(
@@ -605,10 +612,7 @@ def _unheard(
     lost at ``at``: the receiver's messages to ``sender`` that ``sender`` had received by then
     lost an answer. One whose every receiver's answer was lost is unanswered still, though
     received: its sender heard nothing back where everyone answered."""
-    known = isinstance(receiver, str) and receiver != UNKNOWN
-    for other, theirs in waiting.items():
-        if other == sender or (known and other != receiver):
-            continue
+    for theirs in _waiting_for(waiting, sender, receiver):
         for a in theirs:
             if received_at[a] <= at and (not receivers[a] or sender in receivers[a]):
                 unheard.setdefault(a, set()).add(sender)

@@ -89,18 +89,23 @@ def disagreements(
 # -- messages ------------------------------------------------------------------------------------
 
 
-_TABLES: dict[tuple[int, float], pd.DataFrame] = {}  # one analysis per log and threshold
+#: one analysis per log and threshold; the log is kept with its table, since an id is only
+#: unique while its object lives (another seed's log could otherwise be given this one's)
+_TABLES: dict[tuple[int, float], tuple[pd.DataFrame, pd.DataFrame]] = {}
 
 
 def _message_table(log: pd.DataFrame, delay: float) -> pd.DataFrame:
     from robotale.enhancement.communication import communication_perspective
 
     key = (id(log), delay)
-    if key not in _TABLES:
+    cached = _TABLES.get(key)
+    if cached is None or cached[0] is not log:
         perspective = communication_perspective(log, delay_threshold=delay)
         table = perspective.tables.get("messages")
-        _TABLES[key] = pd.DataFrame(columns=["case", "msg_id"]) if table is None else table
-    return _TABLES[key]
+        table = pd.DataFrame(columns=["case", "msg_id"]) if table is None else table
+        _TABLES.clear()  # another log or threshold: the earlier ones are done with
+        _TABLES[key] = cached = (log, table)
+    return cached[1]
 
 
 def _by_id(table: pd.DataFrame) -> dict[tuple[str, str], pd.Series]:
