@@ -92,6 +92,7 @@ def disagreements(
 #: one analysis per log and threshold; the log is kept with its table, since an id is only
 #: unique while its object lives (another seed's log could otherwise be given this one's)
 _TABLES: dict[tuple[int, float], tuple[pd.DataFrame, pd.DataFrame]] = {}
+KEPT_TABLES = 16
 
 
 def _message_table(log: pd.DataFrame, delay: float) -> pd.DataFrame:
@@ -103,7 +104,8 @@ def _message_table(log: pd.DataFrame, delay: float) -> pd.DataFrame:
         perspective = communication_perspective(log, delay_threshold=delay)
         table = perspective.tables.get("messages")
         table = pd.DataFrame(columns=["case", "msg_id"]) if table is None else table
-        _TABLES.clear()  # another log or threshold: the earlier ones are done with
+        if len(_TABLES) >= KEPT_TABLES:  # the oldest go: many seeds in one process
+            del _TABLES[next(iter(_TABLES))]
         _TABLES[key] = cached = (log, table)
     return cached[1]
 
