@@ -249,6 +249,8 @@ def meetings(runs: list[Run], distance: float) -> Counter:
         for together in by_time.values():
             for i, a in enumerate(together):
                 for b in together[i + 1 :]:
+                    if a["robot"] == b["robot"]:
+                        continue  # one robot sampled twice at one instant (the run's end)
                     apart = math.dist((a["x"], a["y"], a["z"]), (b["x"], b["y"], b["z"]))
                     if apart <= distance:
                         pair = tuple(sorted((a["robot"], b["robot"])))
@@ -268,6 +270,8 @@ def closest(runs: list[Run], seen=None) -> dict[tuple[str, str, str], float]:
         for together in by_time.values():
             for i, a in enumerate(together):
                 for b in together[i + 1 :]:
+                    if a["robot"] == b["robot"]:
+                        continue  # one robot sampled twice at one instant (the run's end)
                     apart = math.dist((a["x"], a["y"], a["z"]), (b["x"], b["y"], b["z"]))
                     key = (run.case, *sorted((a["robot"], b["robot"])))
                     nearest[key] = min(apart, nearest.get(key, math.inf))
