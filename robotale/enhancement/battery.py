@@ -8,8 +8,10 @@ idle drain never lands on the activity that follows. A low-battery event is the 
 robot's level falls below the threshold (once per fall, per case), or an event of the activity
 that tags it, such as the thesis' ``low_battery``; for each the perspective lists what the
 robot did next. Energy per case: per robot, the percentage points it used (every fall of its
-level added up) and charged (every rise). A log without battery levels says so; its figures
-are missing, never 0.
+level added up) and charged (every rise) from its first level in the log to its last: a log
+has levels only at a robot's events, so a robot charging on its base before its first event,
+or driving on after its last, used what the log cannot show, and a robot without events has
+no figures. A log without battery levels says so; its figures are missing, never 0.
 
 A battery belongs to one robot: every figure is per robot (and run), never a sum over robots,
 whose batteries differ. Use is never negative: where a level rose (a robot charging during an
@@ -148,7 +150,9 @@ def activity_consumption(
 
 def case_energy(levels: pd.DataFrame) -> pd.DataFrame:
     """Per case and robot: levels at its first and last sample, lowest level, percentage
-    points used (falls added up) and charged (rises added up)."""
+    points used (falls added up) and charged (rises added up), and the time they cover
+    (``observed_from`` and ``observed_to``: a log has levels only at a robot's events, so
+    what it used before its first event or after its last is not in it)."""
     keys = [k for k in (CASE, ROBOT) if k in levels.columns]
     if levels.empty or not keys:
         return pd.DataFrame()
@@ -162,6 +166,8 @@ def case_energy(levels: pd.DataFrame) -> pd.DataFrame:
         lowest_level=(BATTERY, "min"),
         used=("_fall", "sum"),
         charged=("_rise", "sum"),
+        observed_from=(TIMESTAMP, "first"),
+        observed_to=(TIMESTAMP, "last"),
     ).reset_index()
 
 

@@ -20,13 +20,20 @@ type, else ``unknown``. A channel is a sender -> receiver pair. Per message:
 - resends: attempts - 1 (``resends_same_id``), plus one when the sender sent it again under a
   new id (``resends_new_id``): a later message of the same case and sender, sent while this
   one had no answer, to the same receiver (of any type: a resend may change its type), or of
-  the same type where either receiver is unknown. An answer is a receive of it, or any message
-  from its receiver (from anyone, when its receiver is unknown) to its sender, so the next
-  task sent after a reply is news. Each resend names the message it repeats (``repeats``; the
-  repeated one names it in ``resent_as``); a message is repeated at most once (a chain of
-  resends repeats one after the other). The payload is a hint, never a requirement: when several
-  unanswered messages could be the repeated one, the one with the same payload wins, else the
-  latest (payloads are often constant or carry a stamp, so they neither make nor break one);
+  the same type where either receiver is unknown (a message nobody received may have been
+  meant for any robot that received its sender's other messages of its type). An answer is a
+  message from its receiver (from anyone, when its receiver is unknown) that reached its
+  sender: when it was received, or sent where its type has no receive tags; a lost answer
+  answers nothing. A receive of it answers it too, unless every robot that received it
+  answered and every answer was lost (its sender heard nothing back). At one moment receives
+  come before sends, so a robot's reply to a question it just heard is no resend of its
+  earlier reply. Each resend names the message it repeats (``repeats``; the repeated one
+  names it in ``resent_as``); a message is repeated at most once (a chain of resends repeats
+  one after the other). The payload is a hint, never a requirement: when several unanswered
+  messages could be the repeated one, the one with the same payload wins, else the latest
+  (payloads are often constant or carry a stamp, so they neither make nor break one); only
+  where a sender's payloads of a type name their content (one of them was sent twice) is a
+  message of that type with another payload the next task rather than a resend;
 - latency: from its first send to its first receive (per receiver on the channels);
 - delayed: see :mod:`robotale.enhancement.delays` (an explicit threshold, or the slow mode of
   a two-mode latency distribution per channel: sender, receiver and type; the channels table
@@ -163,7 +170,7 @@ def message_tables(
     table["delayed"] = _lookup(numbered, ids, late).fillna(False).astype(bool)
     _split_lost(table, deliveries, numbered, ids)
     keys = _keys(table)
-    return _with_resends(table), _with_keys(deliveries, table, keys)
+    return _with_resends(table, deliveries), _with_keys(deliveries, table, keys)
 
 
 def _with_keys(rows: pd.DataFrame, table: pd.DataFrame, keys: list[str]) -> pd.DataFrame:
@@ -408,11 +415,11 @@ def untagged_types(messages: pd.DataFrame) -> list[str]:
     return sorted({str(t) for t in sent[TYPE].dropna() if t not in received})
 
 
-def _with_resends(table: pd.DataFrame) -> pd.DataFrame:
+def _with_resends(table: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame:
     """Adds which message each message was sent again as (``resent_as``) and repeats
     (``repeats``), the resends by id reuse and by new id, and ``recovered``: lost, but a
     resend got through."""
-    resent_as, repeats = _repeated(table)
+    resent_as, repeats = _repeated(table, deliveries)
     table["resent_as"] = resent_as
     table["repeats"] = repeats
     table["resends_same_id"] = (table["attempts"] - 1).clip(lower=0)
@@ -434,7 +441,7 @@ def _resend_rows(table: pd.DataFrame, ids: pd.Series) -> np.ndarray:
     return found.fillna(-1).to_numpy(np.int64)
 
 
-def _repeated(table: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
+def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
     """Per message, the id of the message that repeated it and of the one it repeats (see
     the module: same case and sender, same receiver or type, sent while it had no answer)."""
     n = len(table)
@@ -449,23 +456,36 @@ def _repeated(table: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
     never = np.iinfo(np.int64).max
     received = table["received"].to_numpy(bool)
     received_at = np.where(received, _integer_times(table["received_at"]), never)
-    order = np.flatnonzero(sent)[np.argsort(sent_at[sent], kind="stable")].tolist()
-    sent_at, received_at = sent_at.tolist(), received_at.tolist()
     senders = table["sender"].astype(object).tolist()
     types = table[TYPE].astype(object).tolist()
     ids = table[MSG_ID].astype(object).tolist()
-    receivers = [_receiver_set(r) for r in table["receiver"].astype(object).tolist()]
+    receivers = _possible_receivers(table)
     payloads = table["payload"].astype(object).tolist() if "payload" in table else None
-    # case -> sender -> the sender's unanswered messages (rows), oldest first
+    named = _naming_payloads(table)
+    rows, robots, kinds = _conversation(sent, sent_at, deliveries)
+    sent_at, received_at = sent_at.tolist(), received_at.tolist()
+    # case -> robot -> the robot's unanswered messages (rows), oldest first; a message
+    # received stays unanswered where what its receiver sent back was lost
     waiting: dict[object, dict[object, list[int]]] = {}
-    for row in order:
-        case, sender, at = cases[row], senders[row], sent_at[row]
-        in_case = waiting.setdefault(case, {})
-        _answer(in_case, sender, receivers[row], receivers)
+    unheard: dict[int, set] = {}  # message row -> the robots whose answers to it were lost
+    for row, robot, kind in zip(rows, robots, kinds, strict=True):
+        in_case = waiting.setdefault(cases[row], {})
+        if kind == ARRIVED:  # ``row`` reached ``robot``: an answer to its messages
+            _answer(in_case, senders[row], robot, receivers)
+            continue
+        if kind == LOST:  # ``row``, meant for ``robot``, never reached it
+            _unheard(in_case, senders[row], robot, receivers, received_at, sent_at[row], unheard)
+            continue
+        sender, at = senders[row], sent_at[row]
         mine = in_case.setdefault(sender, [])
         if mine:
-            mine[:] = [a for a in mine if received_at[a] > at]
-        candidates = [a for a in mine if _may_repeat(a, row, types, receivers)]
+            mine[:] = [a for a in mine if received_at[a] > at or unheard.get(a) == receivers[a]]
+        candidates = [
+            a
+            for a in mine
+            if _may_repeat(a, row, types, receivers)
+            and not (named[row] and _other_payload(payloads, a, row, types))
+        ]
         if candidates:
             same = [
                 a
@@ -479,6 +499,40 @@ def _repeated(table: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
     return pd.Series(resent_as, index=table.index), pd.Series(repeats, index=table.index)
 
 
+#: the steps of a conversation (:func:`_conversation`), in their order at one instant
+ARRIVED, SENT, LOST = 0, 1, 2
+
+
+def _conversation(
+    sent: np.ndarray, sent_at: np.ndarray, deliveries: pd.DataFrame
+) -> tuple[list[int], list, list[int]]:
+    """The steps of a log's conversations in time order, as (message row, robot, step): its
+    sends (the robot None); its arrivals: a message its receiver got (where the log tags it)
+    or may have got (sent, of a type whose receives the log does not tag: at its send); and
+    its losses, at the send, with the robot it was meant for. At one instant arrivals come
+    first (what a robot sends as it hears something answers what it heard), losses last (a
+    reply lost at once still replies to what was sent then)."""
+    message = deliveries[MESSAGE].to_numpy(np.int64)
+    got = deliveries["received"].to_numpy(bool)
+    unobserved = deliveries["unobserved"].to_numpy(bool) & ~got
+    lost = deliveries["lost"].to_numpy(bool) & ~got & ~unobserved
+    arrived = got | unobserved
+    when = np.where(got, _integer_times(deliveries["received_at"]), sent_at[message])
+    sends = np.flatnonzero(sent)
+    steps = np.concatenate([arrived, lost])
+    times = np.concatenate([when, sent_at[message], sent_at[sends]])
+    kinds = np.concatenate(
+        [np.full(len(message), ARRIVED), np.full(len(message), LOST), np.full(len(sends), SENT)]
+    )
+    keep = np.concatenate([steps, np.ones(len(sends), bool)])
+    order = np.flatnonzero(keep)[np.lexsort((kinds[keep], times[keep]))]
+    robots = deliveries["receiver"].astype(object).to_numpy()
+    none = np.full(len(sends), None, dtype=object)
+    rows = np.concatenate([message, message, sends])[order].tolist()
+    by = np.concatenate([robots, robots, none])[order].tolist()
+    return rows, by, kinds[order].tolist()
+
+
 def _may_repeat(earlier: int, later: int, types, receivers: list[frozenset]) -> bool:
     """Whether ``later`` may repeat ``earlier`` by their ends and types alone: the same
     receiver, whatever the type; or the same type where a receiver is unknown (a message to
@@ -489,17 +543,79 @@ def _may_repeat(earlier: int, later: int, types, receivers: list[frozenset]) -> 
     return types[earlier] == types[later]
 
 
+def _possible_receivers(table: pd.DataFrame) -> list[frozenset]:
+    """Per message, the robots it went to; for one no robot is known to have received, the
+    robots that received its sender's other messages of its type (a message nobody got may
+    have been meant for any of them), else none known."""
+    named = [_receiver_set(r) for r in table["receiver"].astype(object).tolist()]
+    usual: dict[tuple, frozenset] = {}
+    for sender, kind, robots in zip(table["sender"], table[TYPE], named, strict=True):
+        if robots:
+            usual[(sender, kind)] = usual.get((sender, kind), frozenset()) | robots
+    pairs = zip(table["sender"], table[TYPE], strict=True)
+    return [robots or usual.get(pair, robots) for pair, robots in zip(pairs, named, strict=True)]
+
+
+def _naming_payloads(table: pd.DataFrame) -> list[bool]:
+    """Per message, whether the payloads of its sender's messages of its type name their
+    content: some payload was sent more than once. Payloads that are all different (a stamp,
+    a counter) say nothing about a resend."""
+    if "payload" not in table:
+        return [False] * len(table)
+    frame = pd.DataFrame(
+        {
+            "sender": table["sender"].astype(object).to_numpy(),
+            "type": table[TYPE].astype(object).to_numpy(),
+            "payload": table["payload"].astype(object).to_numpy(),
+        }
+    )
+    frame["again"] = frame["payload"].notna() & frame.duplicated(keep=False)
+    again = frame.groupby(["sender", "type"], dropna=False)["again"].transform("any")
+    return again.to_numpy(bool).tolist()
+
+
+def _other_payload(payloads, earlier: int, later: int, types) -> bool:
+    """Whether ``later`` carries other content than ``earlier`` of its type (both payloads
+    given and different): the next task, not the same one again."""
+    if payloads is None or types[earlier] != types[later]:
+        return False
+    one, two = payloads[earlier], payloads[later]
+    return isinstance(one, str) and isinstance(two, str) and one != two
+
+
 def _same_payload(earlier, later) -> bool:
     return isinstance(earlier, str) and isinstance(later, str) and earlier == later
 
 
-def _answer(waiting: dict, sender, to: frozenset, receivers: list[frozenset]) -> None:
-    """A message from ``sender`` to ``to`` (empty: unknown) answers the unanswered messages
-    of its case sent to ``sender`` (or to nobody known) by the robots it may be for."""
-    for other, theirs in waiting.items():
-        if not theirs or other == sender or (to and other not in to):
-            continue
-        theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+def _answer(waiting: dict, sender, receiver, receivers: list[frozenset]) -> None:
+    """A message from ``sender`` reached ``receiver`` (``unknown``: any robot but the
+    sender): it answers the receiver's unanswered messages of its case sent to ``sender``
+    (or to nobody known)."""
+    for theirs in _waiting_for(waiting, sender, receiver):
+        if theirs:
+            theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+
+
+def _waiting_for(waiting: dict, sender, receiver) -> list[list[int]]:
+    """The unanswered messages of ``receiver`` (``unknown``: of every robot but ``sender``),
+    one list per robot."""
+    if isinstance(receiver, str) and receiver != UNKNOWN:
+        theirs = waiting.get(receiver)
+        return [] if theirs is None or receiver == sender else [theirs]
+    return [theirs for other, theirs in waiting.items() if other != sender]
+
+
+def _unheard(
+    waiting: dict, sender, receiver, receivers, received_at, at: int, unheard: dict[int, set]
+) -> None:
+    """A message from ``sender`` to ``receiver`` (``unknown``: any robot but the sender) was
+    lost at ``at``: the receiver's messages to ``sender`` that ``sender`` had received by then
+    lost an answer. One whose every receiver's answer was lost is unanswered still, though
+    received: its sender heard nothing back where everyone answered."""
+    for theirs in _waiting_for(waiting, sender, receiver):
+        for a in theirs:
+            if received_at[a] <= at and (not receivers[a] or sender in receivers[a]):
+                unheard.setdefault(a, set()).add(sender)
 
 
 def _integer_times(times: pd.Series) -> np.ndarray:

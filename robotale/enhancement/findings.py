@@ -381,8 +381,8 @@ def battery_answer(battery: Perspective, runs: pd.DataFrame) -> Answer:
         each = ", ".join(f"{robot} {used:.1f}%" for robot, used in per_run.items())
         most = summary.get("most_used_by")
         answer.sentences.append(
-            f"Battery used per run, each robot its own (mean): {each}"
-            + (f"; the activity that used most: {most}." if most else ".")
+            "Battery used per run from each robot's first event to its last, each robot its "
+            f"own (mean): {each}" + (f"; the activity that used most: {most}." if most else ".")
         )
     if lows.empty:
         answer.sentences.append(

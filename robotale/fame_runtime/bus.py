@@ -15,7 +15,10 @@ come later and ask for them; only best-effort deliveries are lost at random (``l
 A :class:`Network` makes the in-process bus behave like a radio link: each delivery waits a
 latency drawn per message and is lost with a probability that can grow with the distance
 between sender and receiver; a reliable delivery that is lost is resent every ``retry`` seconds
-until it arrives or its ``deadline`` passes, a best-effort one is gone.
+until it arrives or its ``deadline`` passes, a best-effort one is gone. A robot's messages to
+itself (a skill's commands to its own drivers, its odometry to its skills) keep their order, as
+one writer's samples do for a DDS reader: a stop command never overtakes the drive command
+published before it, which would leave the robot driving on.
 """
 
 from __future__ import annotations
@@ -57,6 +60,9 @@ class Subscription:
     owner: str = ""
     active: bool = field(default=True)
     _bus: Any = field(default=None, repr=False)
+    #: when the last delivery from its own robot is due (a robot's messages to itself keep
+    #: their order)
+    _local_due: float = field(default=float("-inf"), repr=False, compare=False)
 
     def unsubscribe(self) -> None:
         if self.active:
@@ -281,10 +287,20 @@ class InProcessBus:
         for attempt in range(tries):
             if self._random.random() >= chance:
                 delay = attempt * link.retry + self._latency(link)
+                if sender and sender == receiver:
+                    delay = self._in_order(subscription, delay)
                 self.pending += 1
                 self.clock.call_later(delay, self._delivery(subscription, envelope))
                 return
         self._observe(LOSS, envelope, subscription)
+
+    def _in_order(self, subscription: Subscription, delay: float) -> float:
+        """``delay``, or longer so a robot's message to itself arrives after the one it
+        published before on the same topic (the latency is still drawn: the other links'
+        draws stay as they were)."""
+        now = self.clock.now()
+        subscription._local_due = max(now + delay, subscription._local_due)
+        return subscription._local_due - now
 
     def _latency(self, link: Link) -> float:
         if not link.jitter:

@@ -136,6 +136,8 @@ def simulate_run(
         reason = f"{type(error).__name__}: {error}"
         detail = traceback.format_exc(limit=8)
     finally:
+        if sim is not None and truth.sampled_at != clock.now():
+            _samples(truth, sim)  # the last moments too: the run rarely ends on a tick
         truth.ended(status)
         if recorder is not None:
             recorder.close()
@@ -246,13 +248,18 @@ def _sample(truth: Truth, sim: SimWorld, clock: SimClock, rate: float) -> None:
     period = 1.0 / rate if rate and rate > 0 else 0.5
 
     def tick() -> None:
-        for name, robot in sim.robots.items():
-            if robot.alive:
-                pose = robot.pose
-                truth.sample(name, pose.x, pose.y, pose.z, robot.battery.level)
+        _samples(truth, sim)
         clock.call_later(period, tick)
 
     tick()
+
+
+def _samples(truth: Truth, sim: SimWorld) -> None:
+    """Every living robot's true pose and battery now."""
+    for name, robot in sim.robots.items():
+        if robot.alive:
+            pose = robot.pose
+            truth.sample(name, pose.x, pose.y, pose.z, robot.battery.level)
 
 
 def _schedule(

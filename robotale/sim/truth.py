@@ -14,7 +14,7 @@ Unix epoch (simulated time, as the tags'):
 - ``activity``: one activity instance (``robot``, ``instance``, ``activity``, ``start``, ``end``,
   ``outcome``: ``completed``, ``interrupted``, ``cancelled``, ``died`` or ``running`` at the end);
 - ``sample``: a robot's true pose and battery (``t``, ``robot``, ``x``, ``y``, ``z``,
-  ``battery`` 0-1), ``record_rate`` times a second;
+  ``battery`` 0-1), ``record_rate`` times a second and once more as the run ends;
 - ``death``: a robot died (``t``, ``robot``);
 - ``end``: the run ended (``t``, ``status``).
 
@@ -55,6 +55,8 @@ class Truth:
         self._deliveries: dict[tuple[str, str], dict[str, Any]] = {}  # the last per receiver
         #: the robots that died, and when
         self.dead: dict[str, float] = {}
+        #: when the robots were last sampled (None: never)
+        self.sampled_at: float | None = None
 
     # -- what the bus, the engines and the world report ---------------------------------------
 
@@ -135,6 +137,7 @@ class Truth:
                 record["end"], record["outcome"] = now, "died"
 
     def sample(self, robot: str, x: float, y: float, z: float, battery: float) -> None:
+        self.sampled_at = self.clock.now()
         self.records.append(
             {
                 "kind": "sample",

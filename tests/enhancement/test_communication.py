@@ -32,14 +32,23 @@ def by_hand(log: pd.DataFrame) -> pd.DataFrame:
 
 def new_id_resends(log: pd.DataFrame) -> pd.Series:
     """Per message type: messages the sender sent again under another id of the same type
-    while they had no answer (no receive, and no message of another robot since), counted
-    with a plain loop over the thesis' sends (every sender there is one robot)."""
+    while they had no answer (no receive, and no message of another robot since), with the
+    same payload where the type's payloads name their content (one of them was sent twice: a
+    weed's position), counted with a plain loop over the thesis' sends (every sender there
+    is one robot)."""
     found: dict[str, int] = {}
     with_id = log.dropna(subset=["msg_id"])
     sends = with_id[with_id[ACTIVITY].str.endswith("!")]
     firsts = sends.groupby("msg_id").agg(
-        type=(ACTIVITY, "first"), sender=(ROBOT, "first"), sent=(TIMESTAMP, "min")
+        type=(ACTIVITY, "first"),
+        sender=(ROBOT, "first"),
+        sent=(TIMESTAMP, "min"),
+        payload=("msg_payload", "first"),
     )
+    naming = {
+        key: group["payload"].dropna().duplicated().any()
+        for key, group in firsts.groupby(["sender", "type"])
+    }
     receives = with_id[with_id[ACTIVITY].str.endswith("?")].groupby("msg_id")[TIMESTAMP].min()
     firsts["received"] = receives.reindex(firsts.index)
     ordered = list(firsts.sort_values("sent").itertuples())
@@ -52,7 +61,8 @@ def new_id_resends(log: pd.DataFrame) -> pd.Series:
                 other.sender != this.sender and this.sent < other.sent < after.sent
                 for other in ordered
             )
-            if not answered and not replied:
+            news = naming[(this.sender, this.type)] and this.payload != after.payload
+            if not answered and not replied and not news:
                 found[after.type] = found.get(after.type, 0) + 1
             break
     return pd.Series(found, dtype=int)

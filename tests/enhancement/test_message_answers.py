@@ -112,6 +112,40 @@ def test_a_reply_from_someone_else_is_no_answer(events):
     assert named.loc["m3", "repeats"] == "m1" and pd.isna(named.loc["m2", "repeats"])
 
 
+def test_an_answer_lost_on_the_way_leaves_the_question_unanswered(events):
+    """A coordinator asks a worker (ask!, payload the task), the worker answers (reply!):
+
+    - m1 "task 0" at 0, received at 0.1; the reply m2 at 0.1 is lost (reply! is receive-tagged);
+    - m3 "task 0" at 5, received at 5.1; the reply m4 at 5.1 arrives at 5.2;
+    - m5 "task 1" at 5.2, received at 5.3; the reply m6 at 5.3 is lost;
+    - m7 "task 2" at 10 (the coordinator gave task 1 up), received at 10.1; the reply m8 at
+      10.1 is lost;
+    - m9 "task 3" at 10.2, received at 10.25; the reply m10 at 10.25 arrives at 10.3.
+
+    By hand: m3 repeats m1 (received, but its answer never came back); m5 follows an answer;
+    m7 and m9 carry other tasks (ask!'s payloads name their task: "task 0" went twice); m10
+    answers the question the worker heard after m8, it repeats nothing. One resend: m3."""
+    ask = {"msg_receiver": "worker"}
+    rows = []
+    for msg, t, task, got, reply, back in (
+        ("m1", 0, "task 0", 0.1, "m2", None),
+        ("m3", 5, "task 0", 5.1, "m4", 5.2),
+        ("m5", 5.2, "task 1", 5.3, "m6", None),
+        ("m7", 10, "task 2", 10.1, "m8", None),
+        ("m9", 10.2, "task 3", 10.25, "m10", 10.3),
+    ):
+        rows.append(message(events, "1", msg, "ask!", t, "coordinator", msg_payload=task, **ask))
+        rows.append(message(events, "1", msg, "ask?", got, "worker"))
+        rows.append(message(events, "1", reply, "reply!", got, "worker", msg_payload=task))
+        if back is not None:
+            rows.append(message(events, "1", reply, "reply?", back, "coordinator"))
+    messages = communication_perspective(events(*rows)).tables["messages"]
+    repeats = messages.dropna(subset=["repeats"]).set_index("msg_id")["repeats"].to_dict()
+    assert repeats == {"m3": "m1"}
+    named = messages.set_index("msg_id")
+    assert sorted(named.index[named["lost"]]) == ["m2", "m6", "m8"]
+
+
 def _latency_log(events, latencies: list[float]):
     rows = []
     for n, latency in enumerate(latencies):

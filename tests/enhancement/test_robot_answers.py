@@ -50,9 +50,14 @@ def test_battery_per_robot_and_run_never_summed_never_negative(two_robots):
         ("2", "drone"): 37.0,
         ("2", "ugv"): 10.0,
     }
+    # what the figures cover: each robot's first event to its last (0-100 s of each run)
+    span = (energy["observed_to"] - energy["observed_from"]).dt.total_seconds()
+    assert span.tolist() == [100.0] * 4
+    assert energy["observed_from"].min() == two_robots["time:timestamp"].min()
     answer = find(two_robots).answer("battery")
     assert answer.sentences[0] == (
-        "Battery used per run, each robot its own (mean): drone 37.0%, ugv 10.0%; "
+        "Battery used per run from each robot's first event to its last, each robot its own "
+        "(mean): drone 37.0%, ugv 10.0%; "
         "the activity that used most: fly."
     )
 

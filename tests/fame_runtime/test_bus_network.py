@@ -67,3 +67,23 @@ def test_latency_is_drawn_per_message_and_links_can_differ():
     assert send(network, RELIABLE, count=2000, seed=3) == send(
         network, RELIABLE, count=2000, seed=3
     )
+
+
+def test_a_robots_messages_to_itself_keep_their_order_others_may_overtake():
+    """A skill's stop command must not arrive before the drive command published earlier (the
+    robot would drive on); between two robots jitter may reorder messages."""
+    network = Network(Link(latency=0.04, jitter=0.03))
+    clock = SimClock(0.0)
+    bus = InProcessBus(clock, network=network, seed=2)
+    arrived: dict[str, list[int]] = {"a": [], "b": []}
+    for owner in arrived:
+        bus.subscribe(
+            "/a/cmd", lambda e, o=owner: arrived[o].append(e.data["n"]), msgtype="x", owner=owner
+        )
+    for n in range(500):
+        clock.call_at(
+            n * 0.01, lambda n=n: bus.publish("/a/cmd", {"n": n}, msgtype="x", sender="a")
+        )
+    clock.run()
+    assert arrived["a"] == list(range(500))
+    assert sorted(arrived["b"]) == list(range(500)) and arrived["b"] != list(range(500))

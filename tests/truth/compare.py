@@ -89,18 +89,25 @@ def disagreements(
 # -- messages ------------------------------------------------------------------------------------
 
 
-_TABLES: dict[tuple[int, float], pd.DataFrame] = {}  # one analysis per log and threshold
+#: one analysis per log and threshold; the log is kept with its table, since an id is only
+#: unique while its object lives (another seed's log could otherwise be given this one's)
+_TABLES: dict[tuple[int, float], tuple[pd.DataFrame, pd.DataFrame]] = {}
+KEPT_TABLES = 16
 
 
 def _message_table(log: pd.DataFrame, delay: float) -> pd.DataFrame:
     from robotale.enhancement.communication import communication_perspective
 
     key = (id(log), delay)
-    if key not in _TABLES:
+    cached = _TABLES.get(key)
+    if cached is None or cached[0] is not log:
         perspective = communication_perspective(log, delay_threshold=delay)
         table = perspective.tables.get("messages")
-        _TABLES[key] = pd.DataFrame(columns=["case", "msg_id"]) if table is None else table
-    return _TABLES[key]
+        table = pd.DataFrame(columns=["case", "msg_id"]) if table is None else table
+        if len(_TABLES) >= KEPT_TABLES:  # the oldest go: many seeds in one process
+            del _TABLES[next(iter(_TABLES))]
+        _TABLES[key] = cached = (log, table)
+    return cached[1]
 
 
 def _by_id(table: pd.DataFrame) -> dict[tuple[str, str], pd.Series]:
@@ -312,9 +319,12 @@ def _battery(runs, log) -> list[Disagreement]:
         return [Disagreement("battery", "all", "energy table", "per robot and run", "none")]
     said = {(row["case"], row["robot"]): float(row["used"]) for _, row in energy.iterrows()}
     found = []
-    for key, used in sorted(oracle.battery_use(runs).items()):
+    windows = _observed(runs, log)
+    truth = oracle.battery_use(runs, {key: window[:2] for key, window in windows.items()})
+    for key, used in sorted(truth.items()):
         got = said.get(key)
-        if got is None or abs(got - used) > max(BATTERY_POINTS, BATTERY_SHARE * used):
+        margin = max(BATTERY_POINTS, BATTERY_SHARE * used, windows[key][2])
+        if got is None or abs(got - used) > margin:
             found.append(
                 Disagreement(
                     "battery",
@@ -329,6 +339,48 @@ def _battery(runs, log) -> list[Disagreement]:
         if isinstance(summary.get(name), int | float) and summary[name] < 0:
             found.append(Disagreement("battery", "all", name, ">= 0", summary[name]))
     return found
+
+
+#: the battery topic's period: a log's level at an event is the robot's next reading, up to
+#: this many seconds later
+BATTERY_PERIOD = 1.0
+
+
+def _observed(runs, log: pd.DataFrame) -> dict[tuple[str, str], tuple[float, float, float]]:
+    """Per (case, robot), the time from the robot's first level in the log to its last: a log
+    has levels only at a robot's events, so that is the time whose battery use it can show (a
+    robot without events has none). Each level is a battery reading near its event: the
+    window runs between the true samples nearest those readings; the third value is how
+    much the true level moved around the two readings (a margin for where they fell)."""
+    rows = log.dropna(subset=["battery"]).sort_values("time:timestamp", kind="stable")
+    keys = [rows[CASE_COLUMN].astype(str), rows["robot"]]
+    times = rows["time:timestamp"].map(pd.Timestamp.timestamp)
+    first = rows.assign(t=times).groupby(keys)[["t", "battery"]].first()
+    last = rows.assign(t=times).groupby(keys)[["t", "battery"]].last()
+    samples: dict[tuple[str, str], list[tuple[float, float]]] = {}
+    for run in runs:
+        for sample in run.samples:
+            key = (run.case, sample["robot"])
+            samples.setdefault(key, []).append((sample["t"], sample["battery"] * 100.0))
+    windows = {}
+    for key in first.index:
+        own = samples.get(key, [])
+        begin, begin_spread = _reading(own, *first.loc[key])
+        end, end_spread = _reading(own, *last.loc[key])
+        windows[key] = (begin, end, begin_spread + end_spread)
+    return windows
+
+
+def _reading(samples: list[tuple[float, float]], at: float, level: float) -> tuple[float, float]:
+    """The time of the true sample nearest the reading a log's ``level`` at ``at`` shows: the
+    one closest to that level within a battery period of ``at`` (the next reading, or the
+    last one where the run ended before another came); and how far the true level moved
+    within that period, the uncertainty a reading between two samples leaves."""
+    near = [(abs(b - level), t, b) for t, b in samples if abs(t - at) <= BATTERY_PERIOD]
+    if not near:
+        return at, 0.0
+    levels = [b for _, _, b in near]
+    return min(near)[1], max(levels) - min(levels)
 
 
 # -- space ---------------------------------------------------------------------------------------

@@ -19,7 +19,8 @@ Definitions (what "true" means here):
 - an activity instance's **duration** is its true interval; its **outcome** says whether it
   completed, was interrupted or cancelled, or its robot died;
 - a robot's **battery use** in a run is the sum of the drops of its true battery level
-  between consecutive samples, in percent (charging does not make it negative);
+  between consecutive samples, in percent (charging does not make it negative); over a
+  window, the drops between the samples in it;
 - two robots **met** when their true positions were within a distance in 3D at the same
   sample instant.
 """
@@ -214,14 +215,22 @@ def activity_effect(runs: list[Run], activity: str) -> float | None:
 # -- battery and space ---------------------------------------------------------------------------
 
 
-def battery_use(runs: list[Run]) -> dict[tuple[str, str], float]:
-    """Percent of battery each robot used in each run (drops only; never summed over robots)."""
+def battery_use(
+    runs: list[Run], windows: dict[tuple[str, str], tuple[float, float]] | None = None
+) -> dict[tuple[str, str], float]:
+    """Percent of battery each robot used in each run (drops only; never summed over robots);
+    with ``windows``, only between the two times given per (case, robot), and only for the
+    robots given."""
     used: dict[tuple[str, str], float] = {}
     for run in runs:
         last: dict[str, float] = {}
         for sample in run.samples:
             robot, level = sample["robot"], sample["battery"] * 100.0
             key = (run.case, robot)
+            if windows is not None:
+                window = windows.get(key)
+                if window is None or not window[0] <= sample["t"] <= window[1]:
+                    continue
             used.setdefault(key, 0.0)
             if robot in last and level < last[robot]:
                 used[key] += last[robot] - level
@@ -240,6 +249,8 @@ def meetings(runs: list[Run], distance: float) -> Counter:
         for together in by_time.values():
             for i, a in enumerate(together):
                 for b in together[i + 1 :]:
+                    if a["robot"] == b["robot"]:
+                        continue  # one robot sampled twice at one instant (the run's end)
                     apart = math.dist((a["x"], a["y"], a["z"]), (b["x"], b["y"], b["z"]))
                     if apart <= distance:
                         pair = tuple(sorted((a["robot"], b["robot"])))
@@ -259,6 +270,8 @@ def closest(runs: list[Run], seen=None) -> dict[tuple[str, str, str], float]:
         for together in by_time.values():
             for i, a in enumerate(together):
                 for b in together[i + 1 :]:
+                    if a["robot"] == b["robot"]:
+                        continue  # one robot sampled twice at one instant (the run's end)
                     apart = math.dist((a["x"], a["y"], a["z"]), (b["x"], b["y"], b["z"]))
                     key = (run.case, *sorted((a["robot"], b["robot"])))
                     nearest[key] = min(apart, nearest.get(key, math.inf))
