@@ -39,12 +39,7 @@ def prepare_command(
     runs in parallel; ``options`` are those of :func:`prepare_recordings`. With ``skip_bad``
     a run that cannot be read is left out, named with why on stderr."""
     if out is not None and is_dataset_name(out):
-        if skip_bad:
-            raise InputError(
-                "--skip-bad writes one CSV of the runs that could be read: give --out a .csv "
-                "name, or leave out --skip-bad."
-            )
-        return _prepare_dataset(source, str(out), xes, ocel, executor, options)
+        return _prepare_dataset(source, str(out), xes, ocel, executor, options, skip_bad)
     csv = out or (None if xes or ocel else f"{source.resolve().name}.csv")
     for target in (xes, ocel):  # all refused before hours of preparation, not after
         if target is not None:
@@ -116,9 +111,11 @@ def _prepare_dataset(
     ocel: Path | None,
     executor: str | None,
     options: dict[str, Any],
+    skip_bad: bool = False,
 ) -> int:
     """``prepare --out NAME.parquet``: every run written by the process that prepares it; XES
-    and OCEL, if asked for, from the dataset read back."""
+    and OCEL, if asked for, from the dataset read back. With ``skip_bad`` a run that cannot
+    be read is left out of the dataset, named with why on stderr."""
     local = local_path(out)
     if (xes or ocel) and local is None:
         raise InputError(
@@ -128,10 +125,13 @@ def _prepare_dataset(
     for target in (xes, ocel):
         if target is not None:
             writers.check_target(target)
+    skipped: list[Path] | None = [] if skip_bad else None
+    skip = None if skipped is None else _skipping(skipped)
     with _preparation_warnings():
         manifest = prepare_dataset(
-            source, out, progress=True, report=_report, executor=executor, **_given(options)
-        )
+            source, out, progress=True, report=_report, executor=executor, skip_bad=skip,
+            **_given(options),
+        )  # fmt: skip
     written = [out]
     if local is not None and (xes or ocel):
         written += _also_written(read_log(local), source, xes, ocel)
@@ -139,6 +139,8 @@ def _prepare_dataset(
         f"{manifest['rows']} events from {len(manifest['parts'])} run(s) written to "
         f"{', '.join(written)}"
     )
+    if skipped is not None:
+        print(kept_runs(len(manifest["parts"]), skipped))
     return 0
 
 
