@@ -18,6 +18,7 @@ from robotale.eventlog.preparing import (
     preparation_warnings,
     prepare_recordings,
     report_choice,
+    skipping,
 )
 from robotale.eventlog.readers import read_log
 from robotale.fame_runtime.manifest import read_manifests
@@ -42,12 +43,7 @@ def prepare_command(
     :class:`~robotale.eventlog.options.PrepareOptions`. With ``skip_bad``
     a run that cannot be read is left out, named with why on stderr."""
     if out is not None and is_dataset_name(out):
-        if skip_bad:
-            raise InputError(
-                "--skip-bad writes one CSV of the runs that could be read: give --out a .csv "
-                "name, or leave out --skip-bad."
-            )
-        return _prepare_dataset(source, str(out), xes, ocel, executor, options)
+        return _prepare_dataset(source, str(out), xes, ocel, executor, options, skip_bad)
     csv = out or (None if xes or ocel else f"{source.resolve().name}.csv")
     for target in (xes, ocel):  # all refused before hours of preparation, not after
         if target is not None:
@@ -115,9 +111,11 @@ def _prepare_dataset(
     ocel: Path | None,
     executor: str | None,
     options: dict[str, Any],
+    skip_bad: bool,
 ) -> int:
     """``prepare --out NAME.parquet``: every run written by the process that prepares it; XES
-    and OCEL, if asked for, from the dataset read back."""
+    and OCEL, if asked for, from the dataset read back. With ``skip_bad`` a run that cannot be
+    read is left out, named with why on stderr."""
     local = local_path(out)
     if (xes or ocel) and local is None:
         raise InputError(
@@ -127,6 +125,7 @@ def _prepare_dataset(
     for target in (xes, ocel):
         if target is not None:
             writers.check_target(target)
+    skipped: list[Path] | None = [] if skip_bad else None
     with preparation_warnings():
         manifest = prepare_dataset(
             source,
@@ -134,6 +133,7 @@ def _prepare_dataset(
             progress=True,
             report=report_choice,
             executor=executor,
+            skip_bad=None if skipped is None else skipping(skipped),
             **PrepareOptions.given(options).keywords(),
         )
     written = [out]
@@ -143,4 +143,6 @@ def _prepare_dataset(
         f"{manifest['rows']} events from {len(manifest['parts'])} run(s) written to "
         f"{', '.join(written)}"
     )
+    if skipped is not None:
+        print(kept_runs(len(manifest["parts"]), skipped))
     return 0

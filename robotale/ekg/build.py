@@ -24,6 +24,7 @@ from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
 from tqdm import tqdm
 
+from robotale.ekg import disk_full
 from robotale.ekg.aggregate import aggregation_key
 from robotale.ekg.columnar import store_copy
 from robotale.ekg.connection import database
@@ -191,10 +192,13 @@ class _Job:
 
 def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
     target = job.target
+    since = disk_full.log_position()
     try:
         with DeferredInterrupt() as interrupt:
             return _write(driver, job, interrupt.check)
     except BaseException as error:
+        if isinstance(error, Neo4jError) and (full := disk_full.out_of_disk(since)):
+            _undo_after_full_disk(driver, job, full, error)
         if isinstance(error, Neo4jError | DriverError | OSError) and not _answers(driver):
             # Retrying the undo against a server that is gone would only take minutes.
             raise ServerError(
@@ -208,6 +212,23 @@ def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
             f"Writing the log {target!r} to Neo4j failed",
             f"`robotale logs delete {shlex.quote(target)}`",
         )
+
+
+def _undo_after_full_disk(driver: Driver, job: _Job, full: str, error: Neo4jError) -> NoReturn:
+    # Neo4j stops a database whose disk filled until it is restarted: the undo is tried, but
+    # usually what was written can only be removed after a restart, with space freed.
+    target, remover = job.target, f"`robotale logs delete {shlex.quote(job.target)}`"
+    try:
+        _undo(driver, target, job.run)
+    except (Neo4jError, DriverError, OSError):
+        raise ServerError(
+            f"{full}: the log {target!r} was not completed; free space there, restart Neo4j "
+            f"(`robotale neo4j stop`, then `robotale neo4j start`) and remove what was written "
+            f"with {remover}."
+        ) from error
+    raise ServerError(
+        f"{full}: the log {target!r} was not stored; nothing of it was kept."
+    ) from error
 
 
 def undo_after_failure(

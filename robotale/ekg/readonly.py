@@ -170,15 +170,61 @@ def _check_integers(name: str, value: Any) -> None:
 # -- the plan -------------------------------------------------------------------------------
 
 
-def refuse_plan(session: neo4j.Session, statement: str, parameters: dict, database: str) -> None:
+def refuse_plan(
+    session: neo4j.Session,
+    statement: str,
+    parameters: dict,
+    database: str,
+    verdicts: PlanVerdicts | None = None,
+) -> None:
     """Ask Neo4j for the plan of ``statement`` (nothing runs) and refuse what it would do
-    beyond reading ``database`` (:func:`robotale.ekg.plan_check.check_plan`)."""
+    beyond reading ``database`` (:func:`robotale.ekg.plan_check.check_plan`); a plan
+    ``verdicts`` has accepted before is not asked for again."""
+    key = verdicts.key(statement, parameters, database) if verdicts else None
+    if verdicts is not None and key in verdicts:
+        return
     code = code_only(statement)
     leading = _LEADING_MODE.match(code)
     body = statement[leading.end() :] if leading else statement
     summary = session.run("EXPLAIN " + body, parameters).consume()
     server = summary.server
     check_plan(summary.plan or {}, database, built_in_functions(session, server.address))
+    if verdicts is not None and key is not None:
+        verdicts.accept(key)
+
+
+class PlanVerdicts:
+    """The plans one server and user accepted, by statement, parameter values and database.
+
+    An ``EXPLAIN`` is a round trip per statement on every request; the console's users ask
+    the same questions again and again. The key holds the parameter values, not only their
+    types: ``USE graph.byName($name)`` reads a database named by a value, so only the same
+    values make the same plan. Refusals are not kept (they cost no query), nor requests whose
+    parameters are large (:data:`KEY_BYTES`); at most :data:`SIZE` verdicts, the oldest
+    forgotten first."""
+
+    SIZE = 512
+    KEY_BYTES = 4096
+
+    def __init__(self) -> None:
+        self._accepted: dict[tuple[str, str, str], None] = {}
+
+    def key(self, statement: str, parameters: dict, database: str) -> tuple[str, str, str] | None:
+        try:
+            values = json.dumps(parameters, sort_keys=True, allow_nan=False)
+        except (TypeError, ValueError):  # not plain JSON: ask Neo4j every time
+            return None
+        if len(values) + len(statement) > self.KEY_BYTES:
+            return None
+        return (database, statement, values)
+
+    def __contains__(self, key: object) -> bool:
+        return key is not None and key in self._accepted
+
+    def accept(self, key: tuple[str, str, str]) -> None:
+        self._accepted[key] = None
+        while len(self._accepted) > self.SIZE:
+            del self._accepted[next(iter(self._accepted))]
 
 
 def built_in_functions(session: neo4j.Session, server: object) -> frozenset[str]:
@@ -206,9 +252,11 @@ def run_read_only(
     byte_limit: int = Limits.bytes,
     database: str | None = None,
     metadata: Mapping[str, Any] | None = None,
+    verdicts: PlanVerdicts | None = None,
 ) -> list[StatementResult]:
     """Run each statement of ``text`` (separated by ``;``) in its own read transaction,
-    which carries ``metadata`` (``SHOW TRANSACTIONS`` finds it by that).
+    which carries ``metadata`` (``SHOW TRANSACTIONS`` finds it by that); ``verdicts`` keeps
+    the plans accepted on this driver's server as its user.
 
     Every statement is checked (text, then plan) before the first one runs. Raises
     :class:`QueryRefused` (:class:`WriteRefused` for writes) for what the console does not
@@ -225,7 +273,7 @@ def run_read_only(
     with driver.session(database=database, default_access_mode=neo4j.READ_ACCESS) as session:
         try:
             for statement in statements:
-                refuse_plan(session, statement, values, database)
+                refuse_plan(session, statement, values, database, verdicts)
             return [_run(session, statement, values, limits, metadata) for statement in statements]
         except (ServiceUnavailable, SessionExpired):
             raise
@@ -343,17 +391,20 @@ def _path_elements(path: Path) -> list[Node | Relationship]:
 REQUEST_KEY = "robotale_console"
 
 
-def answer(request: Mapping[str, Any], drivers: dict[tuple[str, str, str], Driver]) -> dict:
+def answer(
+    request: Mapping[str, Any], drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]]
+) -> dict:
     """Run one console request (connection, text, parameters, limits) and say how it went:
     ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``. ``drivers`` keeps
-    one connected driver per server and user across requests."""
+    one connected driver per server and user across requests, with the plans it accepted."""
     where = Settings(request["uri"], request["user"], request["password"], True)
     key = (where.uri, where.user, where.password)
     try:
         if key not in drivers:
-            drivers[key] = connect(where)
+            drivers[key] = (connect(where), PlanVerdicts())
+        driver, verdicts = drivers[key]
         results = run_read_only(
-            drivers[key],
+            driver,
             request["text"],
             request.get("parameters"),
             row_limit=request["rows"],
@@ -361,11 +412,12 @@ def answer(request: Mapping[str, Any], drivers: dict[tuple[str, str, str], Drive
             byte_limit=request["bytes"],
             database=request["database"],
             metadata={REQUEST_KEY: request.get("id", "")},
+            verdicts=verdicts,
         )
     except RobotaleError as error:
         return {"error": str(error), "kind": type(error).__name__}
     except (ServiceUnavailable, SessionExpired):
-        drivers.pop(key).close()
+        drivers.pop(key)[0].close()
         return {"error": unreachable_message(where), "kind": ServerError.__name__}
     return {"results": [result.to_dict() for result in results]}
 
@@ -377,7 +429,7 @@ def serve(megabytes: int) -> None:
     # The cap is on top of what Python and the driver already map (their size varies).
     limit = _mapped_bytes() + megabytes * 1024 * 1024
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-    drivers: dict[tuple[str, str, str], Driver] = {}
+    drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]] = {}
     sys.stdout.write("ready\n")  # the pool counts a request's time from here on
     sys.stdout.flush()
     for line in sys.stdin:

@@ -132,19 +132,17 @@ def prepare(
     reading, msg_files, distro, rate = job.reading, job.msg_files, job.distro, job.rate
     chosen = list(reading.perspectives)
     runs = find_runs(Path(source))
-    if executor is not None and skip_bad is not None:
-        raise InputError("Skipping bad runs reads them in this process: leave out --executor.")
     if executor is not None:
         told: set[str] = set()
-        parts = _read_in_parallel(
-            runs, reading, msg_files, distro, executor, progress, _once(report, told)
+        read = _read_in_parallel(
+            runs, reading, msg_files, distro, executor, progress, _once(report, told), skip_bad
         )
     else:
         read = _read_here(runs, reading, msg_files, distro, progress, report, skip_bad)
-        runs = [run for run, part in zip(runs, read, strict=True) if part is not None]
-        parts = [part for part in read if part is not None]
-        if not parts:
-            raise InputError(f"None of the runs of {source} could be read.")
+    runs = [run for run, part in zip(runs, read, strict=True) if part is not None]
+    parts = [part for part in read if part is not None]
+    if not parts:
+        raise InputError(_none_read(source))
     tag_rows = pd.concat([tag_part for tag_part, _ in parts], ignore_index=True)
     if tag_rows.empty:
         raise InputError(_nothing_found(source, reading))
@@ -234,43 +232,66 @@ def _read_in_parallel(
     executor: str,
     progress: bool,
     say: Callable[[str], None],
-) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]]]:
+    skip_bad: Callable[[Path, str], None] | None = None,
+) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None]:
     """Every run read by the executor's workers, a progress bar over runs as they finish;
-    what the workers warned and reported is said here, run by run in order."""
+    what the workers warned and reported is said here, run by run in order. None for a run
+    that could not be read when ``skip_bad`` was told of it."""
     files = tuple(Path(p).resolve() for p in msg_files)
+    skipping = skip_bad is not None
     with tqdm(
         total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False
     ) as bar:
-        read = _on_executor(executor, runs, bar, "reading", _read_alone, reading, files, distro)
+        read = _on_executor(
+            executor, runs, bar, "reading", _read_alone, reading, files, distro, skipping
+        )
     done = dict(zip(runs, read, strict=True))
+    parts: list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None] = []
     for run in runs:
         for category, message in done[run].warned:
             warnings.warn(message, category, stacklevel=2)
         for text in done[run].reported:
             say(text)
-    return [(done[run].tag_rows, done[run].samples) for run in runs]
+        if done[run].unreadable and skip_bad is not None:
+            skip_bad(run, done[run].unreadable)
+            parts.append(None)
+        else:
+            parts.append((done[run].tag_rows, done[run].samples))
+    return parts
 
 
 @dataclass
 class _RunRead:
-    """One run as a worker read it, with what it warned and reported on the way."""
+    """One run as a worker read it, with what it warned and reported on the way; or why it
+    could not be read (``unreadable``: the batch skips it)."""
 
     tag_rows: pd.DataFrame
     samples: dict[str, pd.DataFrame]
     warned: list[tuple[type[PreparationWarning], str]]
     reported: list[str]
+    unreadable: str = ""
 
 
 def _read_alone(
-    run: Path, reading: _Reading, msg_files: Sequence[Path], distro: str | None
+    run: Path,
+    reading: _Reading,
+    msg_files: Sequence[Path],
+    distro: str | None,
+    skipping: bool = False,
 ) -> _RunRead:
     """:func:`_read_run` in a worker process: warnings and reports are kept to be said by
-    the process that asked, as they would not reach its terminal from here."""
+    the process that asked, as they would not reach its terminal from here. ``skipping``: a
+    run that cannot be read is returned with why, for the batch to skip, instead of raised."""
     reported: list[str] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PreparationWarning)
-        bag = Bag(run, message_types(list(msg_files)), distro)
-        tag_rows, samples = _read_run(bag, reading, None, reported.append)
+        try:
+            bag = Bag(run, message_types(list(msg_files)), distro)
+            tag_rows, samples = _read_run(bag, reading, None, reported.append)
+        except InputError as error:
+            if not skipping:
+                raise
+            return _RunRead(pd.DataFrame(), {}, [], [], unreadable=str(error))
     warned = [
         (w.category, str(w.message)) for w in caught if issubclass(w.category, PreparationWarning)
     ]
@@ -291,6 +312,8 @@ class _RunPrepared:
     unsampled: dict[str, list[str]]
     warned: list[tuple[type[PreparationWarning], str]]
     reported: list[str]
+    #: why the run could not be read ("" when it was): the batch skips it
+    unreadable: str = ""
 
 
 def prepare_dataset(
@@ -300,6 +323,7 @@ def prepare_dataset(
     progress: bool = False,
     report: Callable[[str], None] | None = None,
     executor: str | None = None,
+    skip_bad: Callable[[Path, str], None] | None = None,
     **options: Any,
 ) -> dict[str, Any]:
     """The event log of :func:`prepare`, written as a Parquet dataset partitioned by case at
@@ -309,7 +333,8 @@ def prepare_dataset(
     Each run is prepared and written by whoever reads it: this process, or with ``executor``
     a worker, so the events of a batch never travel to this process. Its rows are those
     :func:`prepare` gives the run (enrichment works within a case). A failure removes what
-    was written.
+    was written. ``skip_bad`` hears of each run that cannot be read (the run, why), which is
+    then left out of the dataset; without it such a run stops the preparation.
     """
     job = preparation(**options)
     reading = job.reading
@@ -317,14 +342,19 @@ def prepare_dataset(
     target = place(out)
     dataset.begin(target, str(source))
     try:
-        done = _runs_written(runs, job, target, executor, progress)
+        done = _runs_written(runs, job, target, executor, progress, skip_bad is not None)
         told: set[str] = set()
         say = _once(report, told)
-        for run in done:
+        for path, run in zip(runs, done, strict=True):
             for category, message in run.warned:
                 warnings.warn(message, category, stacklevel=2)
             for text in run.reported:
                 say(text)
+            if run.unreadable and skip_bad is not None:
+                skip_bad(path, run.unreadable)
+        if all(run.unreadable for run in done):
+            raise InputError(_none_read(source))
+        done = [run for run in done if not run.unreadable]
         parts = [run.part for run in done if run.part is not None]
         if not parts:
             raise InputError(_nothing_found(source, reading))
@@ -341,18 +371,24 @@ def prepare_dataset(
 
 
 def _runs_written(
-    runs: Sequence[Path], job: Job, target: Place, executor: str | None, progress: bool
+    runs: Sequence[Path],
+    job: Job,
+    target: Place,
+    executor: str | None,
+    progress: bool,
+    skipping: bool = False,
 ) -> list[_RunPrepared]:
-    """Every run prepared into ``target``, here or by the executor's workers, in run order."""
+    """Every run prepared into ``target``, here or by the executor's workers, in run order;
+    ``skipping``: a run that cannot be read comes back with why instead of stopping them."""
     bar = tqdm(total=len(runs), unit="run", desc="prepare", disable=not progress, leave=False)
     with bar:
         if executor is None:
             written = []
             for run in runs:
-                written.append(_prepare_into(run, job, target))
+                written.append(_prepare_into(run, job, target, skipping))
                 bar.update()
             return written
-        return _on_executor(executor, runs, bar, "preparing", _prepare_into, job, target)
+        return _on_executor(executor, runs, bar, "preparing", _prepare_into, job, target, skipping)
 
 
 def _on_executor(
@@ -381,15 +417,22 @@ def _on_executor(
     return [done[run] for run in runs]
 
 
-def _prepare_into(run: Path, job: Job, target: Place) -> _RunPrepared:
+def _prepare_into(run: Path, job: Job, target: Place, skipping: bool = False) -> _RunPrepared:
     """One run read, enriched and written as its part of ``target`` (in a worker process or
-    here); its warnings and reports are kept to be said by the process that asked."""
+    here); its warnings and reports are kept to be said by the process that asked.
+    ``skipping``: a run that cannot be read is returned with why (nothing of it written)
+    instead of raised; a failure to write stays one."""
     reported: list[str] = []
     perspectives = job.reading.perspectives
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PreparationWarning)
-        bag = Bag(run, message_types(list(job.msg_files)), job.distro)
-        tag_rows, samples = _read_run(bag, job.reading, None, reported.append)
+        try:
+            bag = Bag(run, message_types(list(job.msg_files)), job.distro)
+            tag_rows, samples = _read_run(bag, job.reading, None, reported.append)
+        except InputError as error:
+            if not skipping:
+                raise
+            return _RunPrepared(None, {}, {}, [], [], unreadable=str(error))
         part = None
         if not tag_rows.empty:
             tag_rows[schema.ROBOT_TYPE] = robot_types(tag_rows, read_manifests([run]))
@@ -405,6 +448,10 @@ def _prepare_into(run: Path, job: Job, target: Place) -> _RunPrepared:
         warned,
         reported,
     )
+
+
+def _none_read(source: str | Path) -> str:
+    return f"None of the runs of {source} could be read."
 
 
 def _read_run(

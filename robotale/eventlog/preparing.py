@@ -30,7 +30,7 @@ def prepare_recordings(
     and named with why on stderr; without, it stops the preparation before anything is
     written."""
     keywords = (options or PrepareOptions()).keywords()
-    skip = None if skipped is None else _skipping(skipped)
+    skip = None if skipped is None else skipping(skipped)
     return prepare_reporting(source, executor=executor, skip_bad=skip, **keywords)
 
 
@@ -47,7 +47,7 @@ def kept_runs(kept: int, skipped: Sequence[Path]) -> str:
     return f"kept {kept} of {kept + len(skipped)} run(s){left_out if skipped else ''}"
 
 
-def _skipping(skipped: list[Path]) -> Callable[[Path, str], None]:
+def skipping(skipped: list[Path]) -> Callable[[Path, str], None]:
     def skip(run: Path, why: str) -> None:
         skipped.append(run)
         print(f"robotale: skipped {run.name}: {why}", file=sys.stderr)

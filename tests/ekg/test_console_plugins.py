@@ -8,12 +8,11 @@ all."""
 
 from __future__ import annotations
 
-import http.server
-import threading
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from counting_service import counting_service
 from neo4j import Driver, GraphDatabase
 
 from robotale.ekg import plan_check, readonly
@@ -124,26 +123,8 @@ SPELLINGS: dict[str, tuple[str, list | None]] = {
 @pytest.fixture(scope="module")
 def service() -> Iterator[dict]:
     """An HTTP service on 127.0.0.1 that counts what it is asked (``hits``)."""
-    seen = {"hits": 0}
-
-    class Handler(http.server.BaseHTTPRequestHandler):
-        def do_GET(self) -> None:
-            seen["hits"] += 1
-            body = b'{"secret": 1}\n'
-            self.send_response(200)
-            self.send_header("Content-Length", str(len(body)))
-            self.end_headers()
-            self.wfile.write(body)
-
-        def log_message(self, *args: object) -> None:
-            pass
-
-    server = http.server.HTTPServer(("127.0.0.1", 0), Handler)
-    threading.Thread(target=server.serve_forever, daemon=True).start()
-    seen["url"] = f"http://127.0.0.1:{server.server_port}/secret.csv"
-    yield seen
-    server.shutdown()
-    server.server_close()
+    with counting_service(b'{"secret": 1}\n') as seen:
+        yield seen
 
 
 def _server_with_apoc(home: Path, overlay: str) -> Iterator[tuple[Driver, Driver]]:

@@ -115,6 +115,53 @@ def test_skip_bad_keeps_the_good_runs_and_names_the_bad_one(tmp_path, bag_builde
     pd.testing.assert_frame_equal(written, pd.read_csv(alone))
 
 
+@pytest.mark.parametrize(
+    ("suffix", "executor"), [(".csv", "local:2"), (".parquet", None), (".parquet", "local:2")]
+)
+def test_skip_bad_keeps_the_good_runs_on_workers_and_in_datasets(
+    tmp_path, bag_builder, capsys, suffix, executor
+):
+    from robotale.eventlog.readers import read_log
+
+    bad = _four_runs_one_corrupted(tmp_path / "runs", bag_builder)
+    out = tmp_path / f"log{suffix}"
+    options = ["--executor", executor] if executor else []
+    assert main(["prepare", str(tmp_path / "runs"), "--out", str(out), "--skip-bad", *options]) == 0
+    captured = capsys.readouterr()
+    [skipped] = [line for line in captured.err.splitlines() if "skipped" in line]
+    assert skipped.split("robotale: ")[-1].startswith(
+        f"skipped run_0003: {bad} is not a readable rosbag2 directory"
+    )
+    assert captured.out.strip().splitlines()[-1] == "kept 3 of 4 run(s); skipped 1: run_0003"
+    # exactly what the three good runs give alone, read back by robotale's own reader
+    (tmp_path / "good").mkdir()
+    for run in ("run_0001", "run_0002", "run_0004"):
+        (tmp_path / "good" / run).symlink_to(tmp_path / "runs" / run)
+    alone = tmp_path / f"alone{suffix}"
+    assert main(["prepare", str(tmp_path / "good"), "--out", str(alone)]) == 0
+    written = read_log(out)
+    assert sorted(written["case:concept:name"].unique()) == ["run_0001", "run_0002", "run_0004"]
+    pd.testing.assert_frame_equal(written, read_log(alone))
+    if suffix == ".parquet":  # nothing of the bad run was written
+        assert sorted(p.name for p in out.glob("case=*")) == [
+            "case=run_0001",
+            "case=run_0002",
+            "case=run_0004",
+        ]
+
+
+def test_a_corrupted_run_stops_a_dataset_on_workers_and_leaves_nothing(
+    tmp_path, bag_builder, capsys
+):
+    bad = _four_runs_one_corrupted(tmp_path / "runs", bag_builder)
+    out = tmp_path / "log.parquet"
+    arguments = ["prepare", str(tmp_path / "runs"), "--out", str(out), "--executor", "local:2"]
+    assert main(arguments) == 1
+    error = capsys.readouterr().err.strip().splitlines()[-1]
+    assert error.startswith(f"robotale: {bad} is not a readable rosbag2 directory")
+    assert not out.exists()
+
+
 def test_a_full_disk_is_one_sentence_and_leaves_nothing(tmp_path, bag_builder, small_disk, capsys):
     runs = tmp_path / "runs"
     for number in (1, 2):

@@ -71,6 +71,26 @@ def test_rows_beyond_the_limit_are_counted_not_sent(neo4j_driver):
     assert result.total == 25
 
 
+def test_accepted_plans_are_remembered_by_text_and_values_never_refusals(neo4j_driver):
+    from robotale.ekg.connection import database
+    from robotale.ekg.readonly import PlanVerdicts
+
+    verdicts = PlanVerdicts()
+    text = "UNWIND range(1, $n) AS i RETURN i"
+    for _ in range(2):
+        [result] = console.run_read_only(neo4j_driver, text, {"n": 3}, verdicts=verdicts)
+        assert [row[0] for row in result.rows] == [1, 2, 3]
+    assert verdicts.key(text, {"n": 3}, database()) in verdicts
+    # other values are another question: its plan is asked for, not taken from the first
+    assert verdicts.key(text, {"n": 4}, database()) not in verdicts
+    write = "UNWIND range(1, $n) AS i CREATE (:Probe {i: i})"
+    for _ in range(2):
+        with pytest.raises(console.WriteRefused):
+            console.run_read_only(neo4j_driver, write, {"n": 3}, verdicts=verdicts)
+    assert verdicts.key(write, {"n": 3}, database()) not in verdicts
+    assert verdicts.key(text, {"n": "x" * PlanVerdicts.KEY_BYTES}, database()) is None
+
+
 def test_graph_values_are_shown_like_neo4j_browser(neo4j_driver, log_name):
     neo4j_driver.execute_query(
         "CREATE (:Event {log: $log, id: 'e1', activity: 'takeoff'})"

@@ -4,18 +4,17 @@ transactions, exhausting memory, and answers that are not JSON."""
 
 from __future__ import annotations
 
-import http.server
 import json
 import os
 import resource
 import stat
-import threading
 import time
 import uuid
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
+from counting_service import counting_service
 
 from robotale.ekg import readonly
 from robotale.neo4j_server.server import (
@@ -50,27 +49,10 @@ def refused(response) -> str:
 @pytest.fixture
 def loopback_service() -> Iterator[dict]:
     """An HTTP service on 127.0.0.1 holding a secret; ``hits`` counts the requests it got."""
-    seen = {"hits": 0, "secret": uuid.uuid4().hex}
-
-    class Handler(http.server.BaseHTTPRequestHandler):
-        def do_GET(self) -> None:
-            seen["hits"] += 1
-            body = f"secret\n{seen['secret']}\n".encode()
-            self.send_response(200)
-            self.send_header("Content-Length", str(len(body)))
-            self.end_headers()
-            self.wfile.write(body)
-
-        def log_message(self, *args: object) -> None:
-            pass
-
-    server = http.server.HTTPServer(("127.0.0.1", 0), Handler)
-    thread = threading.Thread(target=server.serve_forever, daemon=True)
-    thread.start()
-    seen["url"] = f"http://127.0.0.1:{server.server_port}/secret.csv"
-    yield seen
-    server.shutdown()
-    server.server_close()
+    secret = uuid.uuid4().hex
+    with counting_service(f"secret\n{secret}\n".encode()) as seen:
+        seen["secret"] = secret
+        yield seen
 
 
 def test_load_csv_reads_no_file(client, tmp_path):
