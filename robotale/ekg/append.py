@@ -86,7 +86,7 @@ def append_ekg(
         _check_new_cases(tables.events, stored["case"], name)
         _check_new_event_ids(driver, tables.events, name)
         classes = [class_tables(tables, key) for key in keys]
-        summary = {"events": int(info["events"]) + len(tables.events)}
+        summary: dict[str, Any] = {"events": int(info["events"]) + len(tables.events)}
         summary |= _merged_values(stored, table_values(tables.events))
         _write_or_keep(driver, name, tables, classes, summary)
     result = summarise(name, tables, classes)

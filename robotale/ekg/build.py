@@ -450,7 +450,8 @@ def _observed(
     if not classes:
         return [[] for _ in range(events)]
     columns = [nodes[c.observed] for c, nodes in zip(classes, class_nodes, strict=True)]
-    return np.column_stack(columns).tolist()
+    ids: list[list[str]] = np.column_stack(columns).tolist()
+    return ids
 
 
 def _swap(driver: Driver, new: str, name: str) -> None:

@@ -112,7 +112,8 @@ def _inside(x: np.ndarray, y: np.ndarray, corners: np.ndarray) -> np.ndarray:
 
 
 def _numbers(values: pd.Series) -> np.ndarray:
-    return pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
+    numbers: np.ndarray = pd.to_numeric(values, errors="coerce").to_numpy(dtype=float)
+    return numbers
 
 
 def _iso(nanoseconds: pd.Series) -> pd.Series:
@@ -160,7 +161,7 @@ def attribute_values(
 def _extreme(found: pd.Series, is_time: bool) -> list[object]:
     values = [None if _missing(v) else _plain(v) for v in found]
     if is_time:  # the earliest or latest time, as a time again
-        return [None if v is None else _moment(int(v)) for v in values]
+        return [None if v is None else _moment(int(v)) for v in values]  # type: ignore[call-overload]
     return values
 
 

@@ -69,7 +69,7 @@ class Loader:
 
         def write(start: int) -> list[str]:
             self.between_batches()
-            params = {name: _slice(values, start) for name, values in columns.items()}
+            params: dict[str, Any] = {n: _slice(values, start) for n, values in columns.items()}
             for name, columns_of_map in (maps or {}).items():
                 params[name] = {k: _slice(v, start) for k, v in columns_of_map.items()}
             for name, values in (batches or {}).items():
@@ -137,10 +137,13 @@ class Loader:
 def within_batches(edges: pd.DataFrame) -> np.ndarray:
     """Which rows of ``edges`` (``source``, ``target``: event positions) join two events of
     the same batch, so that :meth:`Loader.events` writes them with their events."""
-    return (edges["source"].to_numpy() // BATCH) == (edges["target"].to_numpy() // BATCH)
+    same: np.ndarray = (edges["source"].to_numpy() // BATCH) == (
+        edges["target"].to_numpy() // BATCH
+    )
+    return same
 
 
-def _per_batch(edges: pd.DataFrame, count: int, **properties: str) -> list[dict[str, list]]:
+def _per_batch(edges: pd.DataFrame, count: int, **properties: str) -> list[dict[str, list[Any]]]:
     """For each of ``count`` batches, its edges of ``edges`` as columns: ``sources`` and
     ``targets`` by position in the batch, and each of ``properties`` (parameter: column)."""
     batch = edges["source"].to_numpy() // BATCH
@@ -185,13 +188,13 @@ def _slice(values: Sequence[Any], start: int) -> Sequence[Any]:
 def neo4j_values(column: pd.Series) -> list[Any]:
     """The column as Python values Neo4j can store; missing values become None."""
     if pd.api.types.is_bool_dtype(column) or pd.api.types.is_integer_dtype(column):
-        return column.astype(object).where(column.notna(), None).tolist()
+        return list(column.astype(object).where(column.notna(), None).tolist())
     if pd.api.types.is_float_dtype(column):
         return [None if math.isnan(v) else v for v in column.to_numpy(float).tolist()]
     if pd.api.types.is_datetime64_any_dtype(column):
         return [None if pd.isna(v) else v.to_pydatetime() for v in column]
     if pd.api.types.infer_dtype(column, skipna=True) == "string":  # the usual log's columns
-        return column.astype(object).where(column.notna(), None).tolist()
+        return list(column.astype(object).where(column.notna(), None).tolist())
     return [_storable(v) for v in column.astype(object).tolist()]
 
 

@@ -32,7 +32,7 @@ import resource
 import sys
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
-from typing import Any
+from typing import Any, cast
 
 import neo4j
 from neo4j import Driver
@@ -115,7 +115,8 @@ class StatementResult:
 def refuse_text(statement: str) -> None:
     """Raise :class:`QueryRefused` for what the console never sends to Neo4j."""
     code = code_only(statement)
-    body = code[_LEADING_OPTIONS.match(code).end() :]
+    leading = _LEADING_OPTIONS.match(code)
+    body = code[leading.end() if leading else 0 :]
     if _LOAD_CSV.search(code):
         raise QueryRefused(f"{_ONLY_READS}: LOAD CSV (reading files and URLs) is refused.")
     if _IN_TRANSACTIONS.search(code):
@@ -173,7 +174,7 @@ def _check_integers(name: str, value: Any) -> None:
 def refuse_plan(
     session: neo4j.Session,
     statement: str,
-    parameters: dict,
+    parameters: dict[str, Any],
     database: str,
     verdicts: PlanVerdicts | None = None,
 ) -> None:
@@ -209,7 +210,9 @@ class PlanVerdicts:
     def __init__(self) -> None:
         self._accepted: dict[tuple[str, str, str], None] = {}
 
-    def key(self, statement: str, parameters: dict, database: str) -> tuple[str, str, str] | None:
+    def key(
+        self, statement: str, parameters: dict[str, Any], database: str
+    ) -> tuple[str, str, str] | None:
         try:
             values = json.dumps(parameters, sort_keys=True, allow_nan=False)
         except (TypeError, ValueError):  # not plain JSON: ask Neo4j every time
@@ -284,7 +287,7 @@ def run_read_only(
 def _run(
     session: neo4j.Session,
     statement: str,
-    parameters: dict,
+    parameters: dict[str, Any],
     limits: Limits,
     metadata: Mapping[str, Any] | None = None,
 ) -> StatementResult:
@@ -378,9 +381,10 @@ def _literal(value: Any) -> str:
 
 
 def _path_elements(path: Path) -> list[Node | Relationship]:
+    # a path's relationships always have both ends (the driver types their ends as optional)
     elements: list[Node | Relationship] = [path.start_node]
     for relationship in path.relationships:
-        elements += [relationship, relationship.end_node]
+        elements += [relationship, cast(Node, relationship.end_node)]
     return elements
 
 
@@ -393,7 +397,7 @@ REQUEST_KEY = "robotale_console"
 
 def answer(
     request: Mapping[str, Any], drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]]
-) -> dict:
+) -> dict[str, Any]:
     """Run one console request (connection, text, parameters, limits) and say how it went:
     ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``. ``drivers`` keeps
     one connected driver per server and user across requests, with the plans it accepted."""

@@ -212,7 +212,7 @@ def _area(name: Any, shape: Any, what: str) -> tuple[str, tuple[tuple[float, flo
     try:
         if isinstance(shape, dict) and list(shape) == ["box"]:
             x0, y0, x1, y1 = (float(v) for v in shape["box"])
-            corners = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+            corners: tuple[tuple[float, float], ...] = ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
         else:
             corners = tuple((float(p[0]), float(p[1])) for p in shape)
     except (TypeError, ValueError, IndexError, KeyError):

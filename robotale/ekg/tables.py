@@ -79,7 +79,7 @@ def property_name(column: str) -> str:
 
 def check_name(name: object, what: str) -> str:
     """``name`` if it can be a property / type name, else an :class:`InputError`."""
-    if not schema.is_property_name(name):
+    if not isinstance(name, str) or not schema.is_property_name(name):
         raise InputError(
             f"The {what} {name!r} cannot be used as a Neo4j name: use letters, digits, "
             "_ : . - and blanks, starting with a letter."
@@ -266,9 +266,13 @@ def communication_roles(events: pd.DataFrame) -> np.ndarray:
     """
     names = events["activity"].astype("string")
     if names.str.endswith(("!", "?")).fillna(False).any():
-        return schema.message_roles(pd.DataFrame({schema.ACTIVITY: names})).to_numpy()
+        roles_named: np.ndarray = schema.message_roles(
+            pd.DataFrame({schema.ACTIVITY: names})
+        ).to_numpy()
+        return roles_named
     roles = events[schema.MSG_ROLE]
-    return roles.astype(object).where(roles.notna(), None).to_numpy()
+    given: np.ndarray = roles.astype(object).where(roles.notna(), None).to_numpy()
+    return given
 
 
 def _communication(events: pd.DataFrame) -> pd.DataFrame:
@@ -342,7 +346,8 @@ def _neo4j_text(values: pd.Series) -> pd.Series:
 def _seconds_between(events: pd.DataFrame, source: np.ndarray, target: np.ndarray) -> np.ndarray:
     nanos = events["timestamp"].dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
     seconds, part = np.divmod(nanos, 1_000_000_000)
-    return (seconds[target] - seconds[source]) + (part[target] - part[source]) / 1e9
+    between: np.ndarray = (seconds[target] - seconds[source]) + (part[target] - part[source]) / 1e9
+    return between
 
 
 def _df_c(tables: GraphTables, codes: np.ndarray) -> pd.DataFrame:

@@ -22,7 +22,7 @@ import datetime as dt
 import re
 from collections.abc import Collection
 from dataclasses import dataclass
-from typing import Any
+from typing import Any, NoReturn
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
@@ -205,7 +205,7 @@ class _Parser:
         self.parameters[name] = value
         return f"${name}"
 
-    def fail(self, expected: str, token: _Token | None = None) -> Any:
+    def fail(self, expected: str, token: _Token | None = None) -> NoReturn:
         if token is None and self.position < len(self.tokens):
             token = self.tokens[self.position]
         where = f"at character {token.at + 1} ({token.text!r})" if token else "at its end"
