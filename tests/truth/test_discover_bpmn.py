@@ -18,7 +18,7 @@ from robotale.discovery.conformance import check_conformance
 from robotale.fame_runtime.labels import activity_label
 
 sys.path.insert(0, str(Path(__file__).parents[1] / "discovery"))
-from collaboration_checks import (  # noqa: E402
+from collaboration_checks import (
     check_problems_besides_skills,
     handlers,
     overlaps,
