@@ -90,3 +90,29 @@ def test_robot_type_filter_keeps_one_pool(thesis_days, tmp_path):
     collaboration = discover_collaboration(thesis_days, LogFilter(robot_types=["Tractor"]))
     assert [p.name for p in collaboration.pools] == ["Tractor"]
     assert collaboration.pool("Tractor").robots == ["tractor_1", "tractor_2"]
+
+
+def test_conformance_reports_precision_one_only_where_the_model_allows_nothing_more(
+    thesis_days, discovered, tmp_path
+):
+    import pandas as pd
+
+    from robotale.discovery.bpmn_writer import write_bpmn
+
+    # three runs of one robot doing a, b, c in order: the mined model is that sequence
+    times = pd.date_range("2024-01-01", periods=9, freq="s", tz="UTC")
+    log = pd.DataFrame(
+        {
+            "case:concept:name": [str(i // 3) for i in range(9)],
+            "concept:name": ["a", "b", "c"] * 3,
+            "time:timestamp": times,
+            "robot": "rover",
+        }
+    )
+    model = tmp_path / "sequence.bpmn"
+    model.write_text(write_bpmn(discover_collaboration(log)))
+    exact = check_conformance(log, model).robots
+    assert exact["fitness"].tolist() == [1.0] and exact["precision"].tolist() == [1.0]
+    # the thesis' tractors' model allows any interleaving of their loops: far from exact
+    loose = check_conformance(thesis_days, discovered).robots
+    assert (loose["precision"] < 0.9).all() and (loose["precision"] > 0).all()
