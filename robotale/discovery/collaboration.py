@@ -220,13 +220,21 @@ def _recorded_triggers(instances: pd.DataFrame, aborted: pd.DataFrame) -> set[st
     return found
 
 
+def _traces(instances: pd.DataFrame, column: str) -> list[list]:
+    """``column``'s values per trace (case and robot), the instances being in trace order:
+    one pass over arrays, not a DataFrame per trace."""
+    keys = instances[CASE].astype(str).to_numpy(object) + "\x00" + instances[ROBOT].to_numpy(object)
+    bounds = np.flatnonzero(keys[1:] != keys[:-1]) + 1 if len(keys) else np.array([], int)
+    values = instances[column].to_numpy(object)
+    return [part.tolist() for part in np.split(values, bounds)] if len(keys) else []
+
+
 def _behaving_triggers(instances: pd.DataFrame) -> set[str]:
     follows: Counter[tuple[str, str]] = Counter()
     occurs: Counter[str] = Counter()
     candidates: dict[str, bool] = {}
-    for _, trace in instances.groupby([CASE, ROBOT], sort=False):
-        labels = trace[ACTIVITY].astype(str).tolist()
-        roles = trace["_role"].tolist()
+    traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
+    for labels, roles in zip(traces, _traces(instances, "_role"), strict=True):
         counts = Counter(labels)
         for position, (label, role) in enumerate(zip(labels, roles, strict=True)):
             occurs[label] += 1
@@ -235,8 +243,7 @@ def _behaving_triggers(instances: pd.DataFrame) -> set[str]:
             ok = counts[label] == 1 and position > 0 and role != SEND
             candidates[label] = candidates.get(label, True) and ok
     found = set()
-    for _, trace in instances.groupby([CASE, ROBOT], sort=False):
-        labels = trace[ACTIVITY].astype(str).tolist()
+    for labels in traces:
         for before, label in itertools.pairwise(labels):
             if candidates.get(label) and follows[(before, label)] * 2 < occurs[before]:
                 found.add(label)
@@ -262,11 +269,12 @@ def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
     at the trigger's moment before it (the event sub-process the engine tags first) belong to
     the handler too."""
     result = _Split()
-    firsts = set(instances.groupby([CASE, ROBOT], sort=False)[ACTIVITY].first().astype(str))
-    for _, trace in instances.groupby([CASE, ROBOT], sort=False):
-        labels = trace[ACTIVITY].astype(str).tolist()
-        starts = trace[START_TIMESTAMP].tolist()
-        aborted = trace["_aborted"].tolist()
+    traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
+    firsts = {trace[0] for trace in traces}
+    columns = zip(
+        traces, _traces(instances, START_TIMESTAMP), _traces(instances, "_aborted"), strict=True
+    )
+    for labels, starts, aborted in columns:
         main: list[str] = []
         position = resumed = 0
         while position < len(labels):
