@@ -736,19 +736,23 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
 
     dfg = actions.add_parser("dfg", help="directly-follows graph (pm4py)")
     _add_log_source(dfg, stored=True)
-    for flag, dest, text in (
-        ("--case", "cases", "keep these cases (runs)"),
-        ("--robot", "robots", "keep these robots"),
-        ("--robot-type", "robot_types", "keep these robot types (pools)"),
-        ("--activity", "activities", "keep these activities"),
-    ):
-        dfg.add_argument(
-            flag, dest=dest, action="append", metavar="A,B", help=f"{text}. Repeatable"
-        )
-    dfg.add_argument("--since", metavar="TIME", help="keep events at or after this ISO time")
-    dfg.add_argument("--until", metavar="TIME", help="keep events at or before this ISO time")
+    _add_log_filters(dfg)
     _add_graph_output(dfg)
     _handled_by(dfg, "discover.dfg_command")
+
+    bpmn = actions.add_parser(
+        "bpmn", help="the robots' collaboration as a BPMN model: pools, signals, event handlers"
+    )
+    _add_log_source(bpmn, stored=True)
+    _add_log_filters(bpmn)
+    bpmn.add_argument("--out", type=Path, required=True, metavar="BPMN", help="the file to write")
+    bpmn.add_argument(
+        "--noise",
+        type=float,
+        metavar="SHARE",
+        help="the inductive miner's noise threshold, 0-1 (default 0: every trace fits)",
+    )
+    _handled_by(bpmn, "discover.bpmn_command")
 
     ekg = actions.add_parser("ekg", help="aggregated event knowledge graph from Neo4j")
     ekg.add_argument("--log", dest="log_name", required=True, metavar="NAME", help="stored log")
@@ -773,6 +777,21 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
         "--json", dest="json_out", type=Path, metavar="FILE", help="also write the report as JSON"
     )
     _handled_by(conformance, "discover.conformance_command")
+
+
+def _add_log_filters(parser: argparse.ArgumentParser) -> None:
+    """The filters of ``discover dfg`` and ``discover bpmn``."""
+    for flag, dest, text in (
+        ("--case", "cases", "keep these cases (runs)"),
+        ("--robot", "robots", "keep these robots"),
+        ("--robot-type", "robot_types", "keep these robot types (pools)"),
+        ("--activity", "activities", "keep these activities"),
+    ):
+        parser.add_argument(
+            flag, dest=dest, action="append", metavar="A,B", help=f"{text}. Repeatable"
+        )
+    parser.add_argument("--since", metavar="TIME", help="keep events at or after this ISO time")
+    parser.add_argument("--until", metavar="TIME", help="keep events at or before this ISO time")
 
 
 def _add_graph_output(parser: argparse.ArgumentParser) -> None:

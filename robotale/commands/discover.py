@@ -6,6 +6,8 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
+from robotale.discovery.bpmn_writer import write_bpmn
+from robotale.discovery.collaboration import discover_collaboration
 from robotale.discovery.conformance import check_conformance
 from robotale.discovery.dfg import discover_dfg
 from robotale.discovery.ekg import discover_ekg
@@ -13,6 +15,7 @@ from robotale.discovery.filters import LogFilter
 from robotale.discovery.graph import ProcessGraph
 from robotale.discovery.output import write_texts
 from robotale.discovery.render import graph_to_svg, require_dot
+from robotale.errors import InputError
 from robotale.results.eventlogs import read_event_log
 
 
@@ -36,7 +39,50 @@ def dfg_command(
     """The directly-follows graph of a log, filtered; JSON to ``out`` (else printed), SVG."""
     if svg:
         require_dot()  # before any work, so a missing Graphviz costs nothing
-    selection = LogFilter(
+    selection = _selection(cases, robots, robot_types, activities, since, until)
+    events = read_event_log(
+        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
+    )
+    return emit_graph(discover_dfg(events, selection), out=out, svg=svg, labels=labels)
+
+
+def bpmn_command(
+    log: Path | None = None,
+    *,
+    out: Path,
+    log_name: str | None = None,
+    mapping: Sequence[str] = (),
+    case_column: str | None = None,
+    case_gap: str | None = None,
+    cases: Sequence[str] | None = None,
+    robots: Sequence[str] | None = None,
+    robot_types: Sequence[str] | None = None,
+    activities: Sequence[str] | None = None,
+    since: str | None = None,
+    until: str | None = None,
+    noise: float = 0.0,
+) -> int:
+    """The robots' collaboration as a BPMN file with its diagram (``out``)."""
+    if not 0.0 <= noise <= 1.0:
+        raise InputError(f"--noise must lie between 0 and 1, not {noise:g}.")
+    selection = _selection(cases, robots, robot_types, activities, since, until)
+    events = read_event_log(
+        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
+    )
+    collaboration = discover_collaboration(events, selection, noise=noise)
+    write_texts([(out, write_bpmn(collaboration))])
+    for pool in collaboration.pools:
+        robots_text = ", ".join(pool.robots)
+        handlers = ", ".join(h.name for h in pool.handlers) or "none"
+        print(f"pool {pool.name} ({robots_text}): event sub-processes on {handlers}")
+    for signal in collaboration.signals.values():
+        print(f"signal {signal.name}: {signal.text()}")
+    print(f"-> {out}")
+    return 0
+
+
+def _selection(cases, robots, robot_types, activities, since, until) -> LogFilter:
+    return LogFilter(
         cases=values(cases),
         robots=values(robots),
         robot_types=values(robot_types),
@@ -44,10 +90,6 @@ def dfg_command(
         start=since,
         end=until,
     )
-    events = read_event_log(
-        log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
-    )
-    return emit_graph(discover_dfg(events, selection), out=out, svg=svg, labels=labels)
 
 
 def ekg_command(

@@ -84,6 +84,7 @@ class _Builder:
         self.net = PetriNet("process")
         self.initial = Marking()
         self.observed = set(observed)
+        self.merged: set[str] = set()  # event sub-process starts tagged as their sub-process
         self.resolve = resolve
         self.counter = itertools.count()
         self.calling: list[str] = []  # call activities being expanded (stops recursion)
@@ -172,6 +173,13 @@ class _Builder:
             entries[start.id] = self.place(inner, f"triggered_{start.id}")
             cancels = [self.cancel(parent)] if start.interrupting else []
             label = element_label(node)
+            trigger = self.event_label(start)
+            if label not in self.observed and trigger is not None:
+                # a source that does not tag the sub-process itself (the thesis' log) tags
+                # only its trigger: the sub-process starts under the trigger's label, and its
+                # start event passes the token on silently
+                label = trigger
+                self.merged.add(start.id)
             self.transition(f"esp_{node.id}", label, [], [entries[start.id], *cancels])
         self.scope(node.scope, inner, entry=None, entries=entries)
 
@@ -199,7 +207,7 @@ class _Builder:
             self.split(scope, node.id, done, outs, conditional)
 
     def start(self, node, scope: _Scope, entry, outs) -> None:
-        label = self.event_label(node)
+        label = None if node.id in self.merged else self.event_label(node)
         if entry is not None:
             self.transition(f"start_{node.id}", label, [entry], outs)
         elif node.event_kind == EventKind.NONE:

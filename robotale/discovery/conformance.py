@@ -44,7 +44,8 @@ class RobotModel(NamedTuple):
 class ConformanceReport:
     """Fitness per robot and per run, and the deviating activities.
 
-    ``robots``: robot, pool, runs, fitness (mean over its runs), fitting runs, method.
+    ``robots``: robot, pool, runs, fitness (mean over its runs), precision (pm4py's
+    token-based ETConformance over its runs), fitting runs, method.
     ``runs``: case, robot, fitness, fits, method (alignment or token replay), deviations.
     ``deviations``: robot, activity, kind (unexpected / missing), count, runs. ``outside``:
     robot, activity, instances of the messages a robot sent or received that its process does
@@ -92,14 +93,16 @@ def replay(
 ) -> ConformanceReport:
     """Align each robot's traces with its model (``models`` maps robot -> model)."""
     runs = []
+    precision: dict[str, float | None] = {}
     for robot, model in tqdm(sorted(models.items()), desc="replaying robots", leave=False):
         mine = traces[traces[ROBOT] == robot]
-        runs += _replay_robot(robot, model, mine, seconds_per_trace)
+        rows, precision[robot] = _replay_robot(robot, model, mine, seconds_per_trace)
+        runs += rows
     run_table = pd.DataFrame(
         runs, columns=[CASE, ROBOT, "fitness", "fits", "method", "deviations", "_moves"]
     )
     deviations = _deviation_table(run_table)
-    robots = _robot_table(run_table, models)
+    robots = _robot_table(run_table, models, precision)
     report = ConformanceReport(
         robots=robots,
         runs=run_table.drop(columns="_moves").rename(columns={CASE: "case"}),
@@ -121,7 +124,7 @@ def _replay_robot(robot: str, model: RobotModel, traces: pd.DataFrame, seconds: 
     from pm4py.algo.conformance.tokenreplay import algorithm as token_replay
 
     if traces.empty:
-        return []
+        return [], None
     event_log = pm4py.convert_to_event_log(
         traces.rename(columns={START_TIMESTAMP: TIMESTAMP}).astype({CASE: str})
     )
@@ -131,6 +134,7 @@ def _replay_robot(robot: str, model: RobotModel, traces: pd.DataFrame, seconds: 
         warnings.simplefilter("ignore", PendingDeprecationWarning)
         aligned = alignments.apply(event_log, model.net, model.initial, model.final, limits)
         replayed = token_replay.apply(event_log, model.net, model.initial, model.final, quiet)
+        precision = _precision(event_log, model)
     rows = []
     for trace, alignment, tokens in zip(event_log, aligned, replayed, strict=True):
         case = trace.attributes["concept:name"]
@@ -144,7 +148,20 @@ def _replay_robot(robot: str, model: RobotModel, traces: pd.DataFrame, seconds: 
         fitness = float(alignment["fitness"])
         text = "; ".join(f"{kind} {activity}" for kind, activity in moves)
         rows.append((case, robot, fitness, not moves, "alignment", text, moves))
-    return rows
+    return rows, precision
+
+
+def _precision(event_log, model: RobotModel) -> float:
+    """How little the model allows beyond what the robot did: pm4py's token-based precision
+    (ETConformance), 1 when the model permits nothing the log does not show."""
+    from pm4py.algo.evaluation.precision import algorithm as precision_evaluator  # pm4py: 2 s
+
+    variant = precision_evaluator.Variants.ETCONFORMANCE_TOKEN
+    quiet = {"show_progress_bar": False}
+    value = precision_evaluator.apply(
+        event_log, model.net, model.initial, model.final, variant=variant, parameters=quiet
+    )
+    return float(value)
 
 
 def _deviating_moves(alignment: list[tuple[str, str | None]]) -> list[tuple[str, str]]:
@@ -172,7 +189,9 @@ def _deviation_table(runs: pd.DataFrame) -> pd.DataFrame:
     return pd.DataFrame(rows, columns=["robot", "activity", "kind", "count", "runs"])
 
 
-def _robot_table(runs: pd.DataFrame, models: dict[str, RobotModel]) -> pd.DataFrame:
+def _robot_table(
+    runs: pd.DataFrame, models: dict[str, RobotModel], precision: dict[str, float | None]
+) -> pd.DataFrame:
     rows = []
     for robot, model in sorted(models.items()):
         mine = runs[runs[ROBOT] == robot]
@@ -182,11 +201,12 @@ def _robot_table(runs: pd.DataFrame, models: dict[str, RobotModel]) -> pd.DataFr
                 "pool": model.pool,
                 "runs": len(mine),
                 "fitness": float(mine["fitness"].mean()) if len(mine) else None,
+                "precision": precision.get(robot),
                 "fitting_runs": int(mine["fits"].sum()),
                 "method": " + ".join(sorted(set(mine["method"]))),
             }
         )
-    columns = ["robot", "pool", "runs", "fitness", "fitting_runs", "method"]
+    columns = ["robot", "pool", "runs", "fitness", "precision", "fitting_runs", "method"]
     return pd.DataFrame(rows, columns=columns)
 
 

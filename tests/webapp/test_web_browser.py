@@ -218,3 +218,37 @@ def test_model_page_shades_frequencies_and_outlines_deviations(page, screenshot,
     expect(page.locator("#model-summary table")).to_contain_text("drone")
     assert not page.locator(".count-badge.deviating[data-element=Tractor_CutGrass]").count()
     screenshot(page, "model")
+
+
+def test_a_discovered_collaboration_is_drawn_whole_without_overlaps(page, thesis_csv, tmp_path):
+    """``discover bpmn`` on the thesis log, drawn by the Model page's bpmn-js: every element
+    of the file has its shape, and no two shapes (pools and sub-processes apart from what
+    they contain) cover each other on the screen."""
+    from robotale.discovery.bpmn_writer import write_bpmn
+    from robotale.discovery.collaboration import discover_collaboration
+    from robotale.eventlog.readers import read_log
+    from robotale.fame_runtime.parser import parse
+
+    model = tmp_path / "discovered.bpmn"
+    model.write_text(write_bpmn(discover_collaboration(read_log(thesis_csv, case_gap="1h"))))
+    upload_model(page, model)
+    boxes = page.eval_on_selector_all(
+        ".djs-shape[data-element-id]",
+        """els => els.map(e => {
+            const r = e.getBoundingClientRect();
+            return [e.dataset.elementId, r.x, r.y, r.width, r.height];
+        })""",
+    )
+    drawn = {box[0] for box in boxes}
+    expected = {node.id for _, process in parse(model).pools() for node in process.walk()}
+    assert expected and expected <= drawn
+    containers = {i for i in drawn if i.startswith("Pool_") or "_subprocess_" in i}
+    shapes = [b for b in boxes if b[0] not in containers and not b[0].endswith("_label")]
+    overlapping = [
+        (a[0], b[0])
+        for n, a in enumerate(shapes)
+        for b in shapes[n + 1 :]
+        if a[1] < b[1] + b[3] - 1 and b[1] < a[1] + a[3] - 1
+        and a[2] < b[2] + b[4] - 1 and b[2] < a[2] + a[4] - 1
+    ]  # fmt: skip
+    assert overlapping == []

@@ -1,0 +1,84 @@
+"""How long ``discover bpmn`` takes against pm4py's ``discover_bpmn_inductive``.
+
+    python benchmarks/discover_bpmn.py [--sizes 10000 100000] [--runs 3]
+
+On the synthetic multi-robot logs of ``benchmarks/discovery.py`` (start and complete events,
+10 robots of two types, a third of the activities exchanging messages), in the same run,
+interleaved (robotale, pm4py, robotale, pm4py ...), the best of ``--runs``:
+
+- robotale: ``discover_collaboration`` (activity instances, robot types, triggers, one
+  inductive miner per pool, signals, statistics) and ``write_bpmn`` (the XML and its diagram);
+- pm4py: ``pm4py.discover_bpmn_inductive`` on the same log's activity instances (one process,
+  no pools, signals or diagram), the instances paired by robotale beforehand and not timed.
+
+Both outputs are checked to hold the same activities. The target is a ratio of at most 2.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import time
+import warnings
+
+import numpy as np
+from discovery import synthetic_log
+
+from robotale.discovery.bpmn_writer import write_bpmn
+from robotale.discovery.collaboration import discover_collaboration
+from robotale.discovery.instances import START_TIMESTAMP, activity_instances
+from robotale.eventlog import schema
+
+
+def typed(log):
+    """Two robot types: robots 0-4 scouts, 5-9 workers."""
+    number = log[schema.ROBOT].str.removeprefix("robot_").astype(int)
+    return log.assign(**{schema.ROBOT_TYPE: np.where(number < 5, "Scout", "Worker")})
+
+
+def robotale_run(log) -> set[str]:
+    collaboration = discover_collaboration(log)
+    write_bpmn(collaboration)
+    return {label for pool in collaboration.pools for label in pool.stats}
+
+
+def pm4py_run(intervals) -> set[str]:
+    import pm4py
+
+    model = pm4py.discover_bpmn_inductive(intervals)
+    return {node.get_name() for node in model.get_nodes() if type(node).__name__ == "Task"}
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000])
+    parser.add_argument("--runs", type=int, default=3)
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")
+    print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+    for size in args.sizes:
+        log = typed(synthetic_log(size))
+        instances = activity_instances(log)
+        intervals = instances[[schema.CASE, schema.ACTIVITY]].assign(
+            **{schema.TIMESTAMP: instances[START_TIMESTAMP]}
+        )
+        best = {"robotale": float("inf"), "pm4py": float("inf")}
+        outputs = {}
+        for _ in range(args.runs):
+            for name, run, data in (
+                ("robotale", robotale_run, log),
+                ("pm4py", pm4py_run, intervals),
+            ):
+                began = time.perf_counter()
+                outputs[name] = run(data)
+                best[name] = min(best[name], time.perf_counter() - began)
+        same = outputs["robotale"] == outputs["pm4py"]
+        print(
+            f"{size:>9,} events: robotale {best['robotale']:.2f} s, pm4py {best['pm4py']:.2f} s, "
+            f"ratio {best['robotale'] / best['pm4py']:.2f}; same activities: {same}"
+        )
+    print(f"load average: {' '.join(f'{v:.2f}' for v in os.getloadavg())}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,367 @@
+"""A discovered collaboration as a BPMN 2.0 file with its diagram (BPMN DI).
+
+The file is what a FAME designer would write (thesis 4.1.1): a participant per pool (with a
+multiplicity where robots share it), each activity a call activity of the skill its name
+says (``take_off`` calls ``TakeOff``), each message a signal throw or catch event, each
+handler an event sub-process. Activities, signals and handlers carry what the log says about
+them as ``documentation``: how often, by whom, how long. Choices are drawn at random when the
+model runs (a Python condition on each branch of an exclusive split, the last one the default),
+loops repeated as often on average as the log did; the engine needs some rule and the log
+says how often, not why.
+"""
+
+from __future__ import annotations
+
+import itertools
+import re
+from xml.sax.saxutils import escape, quoteattr
+
+from robotale.discovery.collaboration import Collaboration, Handler, Pool, signal_of
+from robotale.discovery.layout import (
+    EVENT,
+    GAP_X,
+    GAP_Y,
+    Block,
+    Builder,
+    Flow,
+    Fragment,
+    Kind,
+    Operator,
+    Shape,
+    leaves,
+)
+from robotale.eventlog.schema import RECEIVE, SEND
+from robotale.fame_runtime.labels import activity_label
+
+POOL_HEADER = 30  # the band bpmn-js draws a pool's name in
+PADDING = 20  # inside an event sub-process' box
+NS = (
+    'xmlns:bpmn="http://www.omg.org/spec/BPMN/20100524/MODEL" '
+    'xmlns:bpmndi="http://www.omg.org/spec/BPMN/20100524/DI" '
+    'xmlns:dc="http://www.omg.org/spec/DD/20100524/DC" '
+    'xmlns:di="http://www.omg.org/spec/DD/20100524/DI" '
+    'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"'
+)
+
+
+def skill_name(label: str) -> str:
+    """The skill an activity calls: ``take_off`` -> ``TakeOff`` (the inverse of the engine's
+    tag names, :func:`activity_label`)."""
+    return "".join(part[:1].upper() + part[1:] for part in re.split(r"[^0-9a-zA-Z]+", label))
+
+
+def display_name(label: str) -> str:
+    """``take_off`` -> ``Take Off`` where the engine would tag that name as ``label`` again."""
+    name = " ".join(part[:1].upper() + part[1:] for part in label.split("_") if part)
+    return name if activity_label(name) == label else label
+
+
+class _Ids:
+    def __init__(self, prefix: str) -> None:
+        self.prefix = prefix
+        self.counter = itertools.count(1)
+
+    def __call__(self, kind: str) -> str:
+        return f"{self.prefix}_{kind}_{next(self.counter)}"
+
+
+class _PoolDrawing:
+    """One pool's process: the shapes and flows of its main flow and of each handler."""
+
+    def __init__(self, pool: Pool, key: str) -> None:
+        self.pool = pool
+        self.key = key
+        self.builder = Builder(_Ids(key), self.kind_of)
+        self.conditions: dict[str, str] = {}
+        self.defaults: dict[str, str] = {}
+        self.main = self.framed(pool.block, self.builder.node("start"))
+        self.handlers = [
+            (handler, self.framed(handler.block, self.builder.node("start", handler.trigger)))
+            for handler in pool.handlers
+        ]
+        self.boxes: list[Shape] = []
+        self.w = self.h = self.y = 0.0
+
+    def kind_of(self, label: str) -> Kind:
+        role = self.pool.stats[label].role if label in self.pool.stats else None
+        return {SEND: "throw", RECEIVE: "catch"}.get(role or "", "task")
+
+    def framed(self, block: Block, start: Fragment) -> Fragment:
+        body = self.builder.fragment(block)
+        fragment = self.builder.sequence([start, body, self.builder.node("end")])
+        self._choose(block, fragment)
+        return fragment
+
+    def _choose(self, block: Block, fragment: Fragment) -> None:
+        """Conditions for the exclusive splits of ``fragment`` (built from ``block``)."""
+        splits = [s for s in fragment.shapes if s.kind == "xor"]
+        outgoing: dict[str, list[Flow]] = {}
+        for flow in fragment.flows:
+            outgoing.setdefault(flow.source, []).append(flow)
+        for split in splits:
+            flows = outgoing.get(split.id, [])
+            if len(flows) < 2:
+                continue
+            redo = self._redo_share(block, split, fragment)
+            for number, flow in enumerate(flows[:-1]):
+                share = redo if redo is not None else 1 / (len(flows) - number)
+                self.conditions[flow.id] = f'__import__("random").random() < {share:.3f}'
+            self.defaults[split.id] = flows[-1].id
+
+    def _redo_share(self, block: Block, split: Shape, fragment: Fragment) -> float | None:
+        """For a loop's split: the share of passes that went round again, from the counts of
+        the first activity of the body against the traces (capped so a run ends)."""
+        ids = [s.id for s in fragment.shapes]
+        position = ids.index(split.id)
+        before = [s for s in fragment.shapes[:position] if s.kind in ("task", "throw", "catch")]
+        loop = _loop_of(block, before[-1].label if before else None)
+        if loop is None or not self.pool.traces:
+            return None
+        first = leaves(loop.children[0]) or leaves(loop.children[1])
+        if not first or first[0] not in self.pool.stats:
+            return None
+        passes = self.pool.stats[first[0]].count / self.pool.traces
+        return min(0.9, max(0.0, 1 - 1 / passes)) if passes > 1 else 0.1
+
+
+def _loop_of(block: Block, label: str | None) -> Operator | None:
+    """The innermost loop whose body holds ``label`` last (the loop a split closes)."""
+    if label is None or not isinstance(block, Operator):
+        return None
+    for child in block.children:
+        found = _loop_of(child, label)
+        if found is not None:
+            return found
+    if block.kind == "loop" and (leaves(block.children[0])[-1:] == [label]):
+        return block
+    return None
+
+
+def write_bpmn(collaboration: Collaboration) -> str:
+    """The collaboration as BPMN XML text with its diagram."""
+    drawings = [_PoolDrawing(pool, f"P{n}") for n, pool in enumerate(collaboration.pools, 1)]
+    _place(drawings)
+    signals = sorted(collaboration.signals)
+    errors = sorted({h.name for d in drawings for h in d.pool.handlers if h.kind == "error"})
+    parts = ['<?xml version="1.0" encoding="UTF-8"?>']
+    parts.append(
+        f'<bpmn:definitions {NS} id="Definitions_discovered" '
+        'targetNamespace="http://bpmn.io/schema/bpmn" exporter="robotale discover bpmn">'
+    )
+    parts.append('<bpmn:collaboration id="Collaboration_discovered">')
+    parts.append(_documentation(_summary(collaboration)))
+    for drawing in drawings:
+        parts.append(_participant(drawing))
+    parts.append("</bpmn:collaboration>")
+    for drawing in drawings:
+        parts.append(_process(drawing, collaboration))
+    for name in signals:
+        parts.append(f'<bpmn:signal id="{_signal_id(name)}" name={quoteattr(name)} />')
+    for name in errors:
+        parts.append(
+            f'<bpmn:error id="{_error_id(name)}" name={quoteattr(name)} '
+            f"errorCode={quoteattr(name)} />"
+        )
+    parts.append(_diagram(drawings))
+    parts.append("</bpmn:definitions>")
+    return "\n".join(parts) + "\n"
+
+
+def _summary(collaboration: Collaboration) -> str:
+    info = collaboration.info
+    return (
+        f"Discovered by robotale from {info.get('events')} events in {info.get('cases')} "
+        f"runs with the {info.get('miner')}."
+    )
+
+
+def _participant(drawing: _PoolDrawing) -> str:
+    pool = drawing.pool
+    robots = len(pool.robots)
+    multiplicity = (
+        f'<bpmn:participantMultiplicity minimum="1" maximum="{robots}" />'
+        if pool.multi_instance
+        else ""
+    )
+    return (
+        f'<bpmn:participant id="Pool_{drawing.key}" name={quoteattr(pool.name)} '
+        f'processRef="Process_{drawing.key}">'
+        + _documentation(f"robots {', '.join(pool.robots)}; {pool.traces} traces")
+        + multiplicity
+        + "</bpmn:participant>"
+    )
+
+
+def _process(drawing: _PoolDrawing, collaboration: Collaboration) -> str:
+    pool = drawing.pool
+    out = [
+        f'<bpmn:process id="Process_{drawing.key}" name={quoteattr(pool.name)} isExecutable="true">'
+    ]
+    out += _elements(drawing, drawing.main, collaboration, None)
+    for (handler, fragment), box in zip(drawing.handlers, drawing.boxes, strict=True):
+        out.append(
+            f'<bpmn:subProcess id="{box.id}" name={quoteattr(box.label)} triggeredByEvent="true">'
+        )
+        out.append(_documentation(handler.text()))
+        out += _elements(drawing, fragment, collaboration, handler)
+        out.append("</bpmn:subProcess>")
+    out.append("</bpmn:process>")
+    return "\n".join(out)
+
+
+def _elements(
+    drawing: _PoolDrawing, fragment: Fragment, collaboration: Collaboration, handler: Handler | None
+) -> list[str]:
+    out = []
+    for shape in fragment.shapes:
+        out.append(_element(drawing, shape, collaboration, handler))
+    for flow in fragment.flows:
+        condition = drawing.conditions.get(flow.id)
+        body = (
+            '<bpmn:conditionExpression xsi:type="bpmn:tFormalExpression" language="python">'
+            f"{escape(condition)}</bpmn:conditionExpression>"
+            if condition
+            else ""
+        )
+        out.append(
+            f'<bpmn:sequenceFlow id="{flow.id}" sourceRef="{flow.source}" '
+            f'targetRef="{flow.target}">{body}</bpmn:sequenceFlow>'
+        )
+    return out
+
+
+def _element(
+    drawing: _PoolDrawing, shape: Shape, collaboration: Collaboration, handler: Handler | None
+) -> str:
+    stats = drawing.pool.stats.get(shape.label)
+    doc = _documentation(stats.text()) if stats and shape.kind in ("task", "throw", "catch") else ""
+    ident = shape.id
+    if shape.kind == "task":
+        return (
+            f'<bpmn:callActivity id="{ident}" name={quoteattr(display_name(shape.label))} '
+            f"calledElement={quoteattr(skill_name(shape.label))}>{doc}</bpmn:callActivity>"
+        )
+    if shape.kind in ("throw", "catch"):
+        tag = "intermediateThrowEvent" if shape.kind == "throw" else "intermediateCatchEvent"
+        name = signal_of(shape.label)
+        signal = collaboration.signals.get(name)
+        if signal is not None:
+            doc = _documentation(f"{stats.text() if stats else ''}. Signal {name}: {signal.text()}")
+        return (
+            f'<bpmn:{tag} id="{ident}" name={quoteattr(name)}>{doc}'
+            f'<bpmn:signalEventDefinition signalRef="{_signal_id(name)}" /></bpmn:{tag}>'
+        )
+    if shape.kind == "start":
+        if handler is None or not shape.label:
+            return f'<bpmn:startEvent id="{ident}" />'
+        interrupting = "true" if handler.interrupting else "false"
+        definition = (
+            f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
+            if handler.kind == "signal"
+            else f'<bpmn:errorEventDefinition errorRef="{_error_id(handler.name)}" />'
+        )
+        return (
+            f'<bpmn:startEvent id="{ident}" name={quoteattr(handler.name)} '
+            f'isInterrupting="{interrupting}">{definition}</bpmn:startEvent>'
+        )
+    if shape.kind == "end":
+        return f'<bpmn:endEvent id="{ident}" />'
+    tag = {"xor": "exclusiveGateway", "and": "parallelGateway", "or": "inclusiveGateway"}[
+        shape.kind
+    ]
+    default = drawing.defaults.get(ident)
+    attr = f' default="{default}"' if default else ""
+    return f'<bpmn:{tag} id="{ident}"{attr} />'
+
+
+def _documentation(text: str) -> str:
+    return f"<bpmn:documentation>{escape(text)}</bpmn:documentation>" if text else ""
+
+
+def _signal_id(name: str) -> str:
+    return "Signal_" + re.sub(r"[^0-9A-Za-z_]", "_", name)
+
+
+def _error_id(name: str) -> str:
+    return "Error_" + re.sub(r"[^0-9A-Za-z_]", "_", name)
+
+
+# -- placing pools and handlers ----------------------------------------------------------------
+
+
+def _place(drawings: list[_PoolDrawing]) -> None:
+    """Pools one below the other; in each, the main flow on top and the event sub-processes
+    below it, left to right as the main flow."""
+    y = 0.0
+    for drawing in drawings:
+        left = POOL_HEADER + GAP_X
+        top = y + GAP_Y
+        drawing.main.moved(left, top)
+        bottom = top + drawing.main.h
+        right = left + drawing.main.w
+        x = left
+        for handler, fragment in drawing.handlers:
+            box_top = bottom + GAP_Y
+            fragment.moved(x + PADDING, box_top + PADDING + EVENT / 2)
+            box = Shape(
+                drawing.builder.ids("subprocess"),
+                "subprocess",
+                display_name(handler.tag) if handler.tag else f"on {handler.name}",
+                x,
+                box_top,
+                fragment.w + 2 * PADDING,
+                fragment.h + 2 * PADDING + EVENT / 2,
+            )
+            drawing.boxes.append(box)
+            x += box.w + GAP_X
+            right = max(right, x - GAP_X)
+        if drawing.boxes:
+            bottom = max(b.y + b.h for b in drawing.boxes)
+        drawing.w = right + GAP_X
+        drawing.h = bottom + GAP_Y - y
+        drawing.y = y
+        y += drawing.h + GAP_Y
+    width = max(d.w for d in drawings)
+    for drawing in drawings:
+        drawing.w = width
+
+
+def _diagram(drawings: list[_PoolDrawing]) -> str:
+    out = ['<bpmndi:BPMNDiagram id="Diagram_discovered">']
+    out.append('<bpmndi:BPMNPlane id="Plane_discovered" bpmnElement="Collaboration_discovered">')
+    for drawing in drawings:
+        out.append(
+            _bounds(f"Pool_{drawing.key}", 0, drawing.y, drawing.w, drawing.h, horizontal=True)
+        )
+        fragments = [drawing.main] + [fragment for _, fragment in drawing.handlers]
+        for box in drawing.boxes:
+            out.append(_bounds(box.id, box.x, box.y, box.w, box.h, expanded=True))
+        for fragment in fragments:
+            for shape in fragment.shapes:
+                out.append(_bounds(shape.id, shape.x, shape.y, shape.w, shape.h))
+            for flow in fragment.flows:
+                points = "".join(f'<di:waypoint x="{x:.0f}" y="{y:.0f}" />' for x, y in flow.points)
+                edge = f'<bpmndi:BPMNEdge id="{flow.id}_di" bpmnElement="{flow.id}">'
+                out.append(f"{edge}{points}</bpmndi:BPMNEdge>")
+    out.append("</bpmndi:BPMNPlane>")
+    out.append("</bpmndi:BPMNDiagram>")
+    return "\n".join(out)
+
+
+def _bounds(
+    ident: str,
+    x: float,
+    y: float,
+    w: float,
+    h: float,
+    *,
+    horizontal: bool = False,
+    expanded: bool = False,
+) -> str:
+    attrs = ' isHorizontal="true"' if horizontal else ""
+    attrs += ' isExpanded="true"' if expanded else ""
+    return (
+        f'<bpmndi:BPMNShape id="{ident}_di" bpmnElement="{ident}"{attrs}>'
+        f'<dc:Bounds x="{x:.0f}" y="{y:.0f}" width="{w:.0f}" height="{h:.0f}" />'
+        "</bpmndi:BPMNShape>"
+    )

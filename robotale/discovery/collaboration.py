@@ -1,0 +1,441 @@
+"""Discover the robots' collaboration: a BPMN pool per robot type, signals, event handlers.
+
+What the robots did becomes the model FAME would have them run (thesis 4.1.1, G1-G4):
+
+- **pools** (G1): one per robot type; several robots of one type share a multi-instance
+  pool (G1.2). Each pool's process is mined with pm4py's inductive miner from the traces of
+  that type's robots (a robot's activity instances in a run, in start order). The inductive
+  miner returns a process tree, block-structured by construction, so the BPMN made from it is
+  sound (every run can complete, no dead parts) and, without a noise threshold, replays every
+  trace it was mined from;
+- **signals** (G3): a message activity (``weed_position!`` sent, ``weed_position?``
+  received) is an intermediate throw or catch event of the signal of its type, where the
+  traces have it; a type sent and never received is said so in its documentation;
+- **event handlers** (G2.2, G4): an activity after which a robot abandons what it was doing
+  is a trigger, and what the robot did next the event sub-process it starts (see
+  :func:`triggers`). A received message triggers a signal start event, anything else an error
+  start event (FAME's ``low_battery``). The sub-process is interrupting when the robot never
+  went back to its process after it, non-interrupting when it did.
+"""
+
+from __future__ import annotations
+
+import itertools
+from collections import Counter, defaultdict
+from dataclasses import dataclass, field
+from typing import Literal
+
+import numpy as np
+import pandas as pd
+
+from robotale.discovery.filters import LogFilter, filter_log
+from robotale.discovery.instances import (
+    DURATION,
+    FINISHED,
+    START_TIMESTAMP,
+    activity_instances,
+    interrupted,
+)
+from robotale.discovery.layout import Block, Tau, from_process_tree
+from robotale.errors import InputError
+from robotale.eventlog.prepare import robot_type
+from robotale.eventlog.schema import (
+    ACTIVITY,
+    CASE,
+    RECEIVE,
+    REQUIRED,
+    ROBOT,
+    ROBOT_TYPE,
+    SEND,
+    TIMESTAMP,
+    message_roles,
+)
+from robotale.fame_runtime.labels import RECEIVE as CAUGHT
+from robotale.fame_runtime.labels import SEND as THROWN
+
+#: instances of one robot this close (seconds) to an interruption happened at its moment
+SAME_MOMENT = 0.5
+TRIGGER_KIND = Literal["signal", "error"]
+
+
+@dataclass(slots=True)
+class ActivityStats:
+    """How often an activity (or message) happened in a pool, and how long it took."""
+
+    count: int
+    robots: list[str]
+    mean: float | None
+    median: float | None
+    role: str | None = None  # send / receive / None
+
+    def text(self) -> str:
+        robots = ", ".join(self.robots)
+        if self.mean is None:
+            return f"{self.count} times by {robots}"
+        return (
+            f"{self.count} times by {robots}; duration mean {self.mean:.3f} s, "
+            f"median {self.median:.3f} s"
+        )
+
+
+@dataclass(slots=True)
+class Handler:
+    """An event sub-process: its trigger, what it does, how often it ran."""
+
+    trigger: str  # the activity label that triggers it (``low_battery``, ``recall?``)
+    kind: TRIGGER_KIND
+    interrupting: bool
+    block: Block
+    count: int
+    abandoned: dict[str, int] = field(default_factory=dict)  # activity -> times cut short
+    #: what the engine tagged the sub-process itself with, when the log has it
+    tag: str | None = None
+
+    @property
+    def name(self) -> str:
+        return self.trigger.rstrip(THROWN + CAUGHT)
+
+    def text(self) -> str:
+        cut = ", ".join(f"{a} ({n}x)" for a, n in sorted(self.abandoned.items()))
+        went_on = "never went back to its process" if self.interrupting else "went on after"
+        shown = f"; it cut short {cut}" if cut else ""
+        return f"triggered {self.count} times; the robot {went_on}{shown}"
+
+
+@dataclass(slots=True)
+class Pool:
+    name: str  # the robot type
+    robots: list[str]
+    block: Block
+    handlers: list[Handler]
+    stats: dict[str, ActivityStats]
+    traces: int
+
+    @property
+    def multi_instance(self) -> bool:
+        return len(self.robots) > 1
+
+
+@dataclass(slots=True)
+class Signal:
+    name: str
+    sent: int
+    received: int
+    senders: list[str]  # pools
+    receivers: list[str]
+
+    def text(self) -> str:
+        if not self.received:
+            return f"sent {self.sent} times by {', '.join(self.senders)}; never received"
+        if not self.sent:
+            receivers = ", ".join(self.receivers)
+            return f"received {self.received} times by {receivers}; sent by no robot of the log"
+        return (
+            f"sent {self.sent} times by {', '.join(self.senders)}, received {self.received} "
+            f"times by {', '.join(self.receivers)}"
+        )
+
+
+@dataclass(slots=True)
+class Collaboration:
+    pools: list[Pool]
+    signals: dict[str, Signal]
+    info: dict[str, object] = field(default_factory=dict)
+
+    def pool(self, name: str) -> Pool:
+        return next(p for p in self.pools if p.name == name)
+
+
+# -- traces ------------------------------------------------------------------------------------
+
+
+def typed_instances(log: pd.DataFrame) -> pd.DataFrame:
+    """Every activity instance with its robot's type and message role, in the order of the
+    robots' traces (case, robot, start)."""
+    missing = [c for c in (*REQUIRED, ROBOT) if c not in log.columns]
+    if missing:
+        raise InputError(
+            f"discovering a collaboration needs the {', '.join(missing)} of every event; "
+            "the log has no such column."
+        )
+    instances = activity_instances(log)
+    instances = instances[instances[ROBOT].notna()]
+    if instances.empty:
+        raise InputError("the selected events contain no activity of a robot.")
+    robots = instances[ROBOT].astype(str)
+    if ROBOT_TYPE in instances.columns:
+        types = instances[ROBOT_TYPE].astype("string").fillna(robots.map(robot_type))
+    else:
+        types = robots.map(robot_type)
+    instances = instances.assign(**{ROBOT: robots, ROBOT_TYPE: types.astype(str)})
+    instances["_role"] = _roles(instances)
+    instances["_aborted"] = interrupted(instances).to_numpy()
+    ordered = instances.sort_values([CASE, ROBOT], kind="stable").reset_index(drop=True)
+    return ordered
+
+
+def _roles(instances: pd.DataFrame) -> pd.Series:
+    """Each instance's message role as most instances of its activity have it: a log may
+    mark a step next to a message with the message's role (the thesis' log marks one of
+    ``select_closest_tractor``'s two starts as sending ``closest_tractor``)."""
+    roles = message_roles(instances).fillna("")
+    labels = instances[ACTIVITY].astype(str)
+    majority = (
+        pd.DataFrame({"label": labels, "role": roles})
+        .groupby("label")["role"]
+        .agg(lambda values: values.mode().iloc[0])
+    )
+    return labels.map(majority).replace("", None)
+
+
+def triggers(instances: pd.DataFrame, *, records_aborts: bool) -> set[str]:
+    """The activities of one robot type that interrupt what the robot was doing.
+
+    Where the log records interruptions (an instance ending ``ate_abort``, aborted or
+    cancelled), the trigger of each is the robot's instance that started at that moment
+    (within :data:`SAME_MOMENT`), the shortest of them: the event rather than the handler
+    the engine tags at the same instant. Where the log records none at all (the thesis' log),
+    an activity is a trigger when it comes at most once in a trace, never first, not sent,
+    and cuts in: the activity just before it is followed by it in less than half of its
+    occurrences, so it happens between steps rather than as one.
+    """
+    aborted = instances[instances["_aborted"]]
+    if records_aborts:
+        return _recorded_triggers(instances, aborted) if not aborted.empty else set()
+    return _behaving_triggers(instances)
+
+
+def _recorded_triggers(instances: pd.DataFrame, aborted: pd.DataFrame) -> set[str]:
+    found = set()
+    by_robot = {key: group for key, group in instances.groupby([CASE, ROBOT], sort=False)}
+    for index, row in aborted.iterrows():
+        mine = by_robot[(row[CASE], row[ROBOT])]
+        gap = (mine[START_TIMESTAMP] - row[TIMESTAMP]).dt.total_seconds().abs()
+        near = mine[(gap <= SAME_MOMENT) & (mine.index != index) & ~mine["_aborted"]]
+        near = near[near["_role"] != SEND]
+        if near.empty:
+            continue
+        order = np.lexsort((near[DURATION].fillna(np.inf).to_numpy(), gap[near.index].to_numpy()))
+        found.add(str(near[ACTIVITY].iloc[order[0]]))
+    return found
+
+
+def _traces(instances: pd.DataFrame, column: str) -> list[list]:
+    """``column``'s values per trace (case and robot), the instances being in trace order:
+    one pass over arrays, not a DataFrame per trace."""
+    keys = instances[CASE].astype(str).to_numpy(object) + "\x00" + instances[ROBOT].to_numpy(object)
+    bounds = np.flatnonzero(keys[1:] != keys[:-1]) + 1 if len(keys) else np.array([], int)
+    values = instances[column].to_numpy(object)
+    return [part.tolist() for part in np.split(values, bounds)] if len(keys) else []
+
+
+def _behaving_triggers(instances: pd.DataFrame) -> set[str]:
+    follows: Counter[tuple[str, str]] = Counter()
+    occurs: Counter[str] = Counter()
+    candidates: dict[str, bool] = {}
+    traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
+    for labels, roles in zip(traces, _traces(instances, "_role"), strict=True):
+        counts = Counter(labels)
+        for position, (label, role) in enumerate(zip(labels, roles, strict=True)):
+            occurs[label] += 1
+            if position + 1 < len(labels):
+                follows[(label, labels[position + 1])] += 1
+            ok = counts[label] == 1 and position > 0 and role != SEND
+            candidates[label] = candidates.get(label, True) and ok
+    found = set()
+    for labels in traces:
+        for before, label in itertools.pairwise(labels):
+            if candidates.get(label) and follows[(before, label)] * 2 < occurs[before]:
+                found.add(label)
+    return found
+
+
+@dataclass(slots=True)
+class _Split:
+    """A type's traces cut into the process part and the handlers' parts."""
+
+    main: list[list[str]] = field(default_factory=list)
+    handled: dict[str, list[list[str]]] = field(default_factory=lambda: defaultdict(list))
+    tags: dict[str, list[tuple[str, ...]]] = field(default_factory=lambda: defaultdict(list))
+    went_on: dict[str, bool] = field(default_factory=lambda: defaultdict(bool))
+    abandoned: dict[str, Counter] = field(default_factory=lambda: defaultdict(Counter))
+
+
+def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
+    """Each trace's instances outside the handlers (the process), and each handler's own.
+
+    A handler runs from its trigger to the end of the trace, or to the first activity that
+    begins a trace of its type (the robot took up its process again); instances that started
+    at the trigger's moment before it (the event sub-process the engine tags first) belong to
+    the handler too."""
+    result = _Split()
+    traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
+    firsts = {trace[0] for trace in traces}
+    columns = zip(
+        traces, _traces(instances, START_TIMESTAMP), _traces(instances, "_aborted"), strict=True
+    )
+    for labels, starts, aborted in columns:
+        main: list[str] = []
+        position = resumed = 0
+        while position < len(labels):
+            label = labels[position]
+            if label not in found:
+                main.append(label)
+                position += 1
+                continue
+            same = position
+            while same > resumed and starts[same - 1] == starts[position]:
+                same -= 1
+            moved = labels[same:position]
+            del main[len(main) - len(moved) :]
+            for before in range(position - 1, -1, -1):
+                if aborted[before]:
+                    result.abandoned[label][labels[before]] += 1
+                    break
+            end = position + 1
+            while end < len(labels) and labels[end] not in firsts:
+                end += 1
+            result.tags[label].append(tuple(moved))
+            result.handled[label].append(labels[position + 1 : end])
+            result.went_on[label] |= end < len(labels)
+            position = resumed = end
+        result.main.append(main)
+    return result
+
+
+# -- mining ------------------------------------------------------------------------------------
+
+
+def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
+    """The inductive miner's process tree of ``traces`` as blocks (an empty trace is a run
+    that does nothing, which the tree allows by a skip)."""
+    import pm4py  # 2 s to import and a banner: discovery only
+
+    if not noise:
+        # without a noise threshold the miner's cuts depend on which steps follow which, not
+        # on how often: each variant once gives the same tree, faster
+        traces = [list(variant) for variant in dict.fromkeys(tuple(t) for t in traces)]
+    rows = [
+        (str(number), label, position)
+        for number, trace in enumerate(traces)
+        for position, label in enumerate(trace)
+    ]
+    if not rows:
+        return Tau()
+    frame = pd.DataFrame(rows, columns=[CASE, ACTIVITY, "_position"])
+    frame[TIMESTAMP] = pd.to_datetime(frame["_position"], unit="s", utc=True)
+    tree = pm4py.discover_process_tree_inductive(frame, noise_threshold=noise)
+    block = from_process_tree(tree)
+    if any(not trace for trace in traces) and rows:
+        from robotale.discovery.layout import Operator  # the one place a run may be empty
+
+        block = Operator("xor", [block, Tau()])
+    return block
+
+
+def discover_collaboration(
+    log: pd.DataFrame, selection: LogFilter | None = None, *, noise: float = 0.0
+) -> Collaboration:
+    """The BPMN collaboration the robots of ``log`` followed (see the module's text)."""
+    if ROBOT in log.columns and ROBOT_TYPE not in log.columns:  # so --robot-type can filter
+        log = log.assign(
+            **{ROBOT_TYPE: log[ROBOT].astype("string").map(robot_type, na_action="ignore")}
+        )
+    events = filter_log(log, selection)
+    instances = typed_instances(events)
+    pools = []
+    for name, mine_ in instances.groupby(ROBOT_TYPE, sort=False):
+        pools.append(_pool(str(name), mine_, noise, bool(instances["_aborted"].any())))
+    pools.sort(
+        key=lambda pool: instances.loc[instances[ROBOT_TYPE] == pool.name, START_TIMESTAMP].min()
+    )
+    info = {
+        "filter": selection.describe() if selection else {},
+        "events": len(events),
+        "cases": int(events[CASE].nunique()),
+        "miner": "pm4py inductive miner" + (f" (noise {noise:g})" if noise else ""),
+    }
+    return Collaboration(pools, _signals(instances), info)
+
+
+def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool) -> Pool:
+    found = triggers(instances, records_aborts=records_aborts)
+    parts = split_traces(instances, found)
+    handlers = [
+        _handler(label, instances, parts, noise) for label in sorted(found) if parts.handled[label]
+    ]
+    return Pool(
+        name=name,
+        robots=sorted(instances[ROBOT].unique()),
+        block=mine(parts.main, noise),
+        handlers=handlers,
+        stats=_stats(instances),
+        traces=len(parts.main),
+    )
+
+
+def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -> Handler:
+    tag = _tag(parts.tags[label])
+    traces = parts.handled[label]
+    if tag is None:  # instances at the trigger's moment are the handler's own work
+        traces = [[*moved, *rest] for moved, rest in zip(parts.tags[label], traces, strict=True)]
+    received = label.endswith(CAUGHT) and _role(instances, label) == RECEIVE
+    return Handler(
+        trigger=label,
+        kind="signal" if received else "error",
+        interrupting=not parts.went_on[label],
+        block=mine(traces, noise),
+        count=len(traces),
+        abandoned=dict(parts.abandoned[label]),
+        tag=tag,
+    )
+
+
+def _tag(moved: list[tuple[str, ...]]) -> str | None:
+    """The sub-process' own tag: the one instance every occurrence started at the trigger's
+    moment just before it (the engine tags an event sub-process before its start event)."""
+    kinds = set(moved)
+    if len(kinds) == 1 and len(next(iter(kinds))) == 1:
+        return next(iter(kinds))[0]
+    return None
+
+
+def _role(instances: pd.DataFrame, label: str) -> str | None:
+    roles = instances.loc[instances[ACTIVITY].astype(str) == label, "_role"].dropna()
+    return str(roles.iloc[0]) if len(roles) else None
+
+
+def _stats(instances: pd.DataFrame) -> dict[str, ActivityStats]:
+    stats = {}
+    for label, group in instances.groupby(ACTIVITY, sort=True):
+        done = group.loc[group[FINISHED], DURATION].dropna()
+        roles = group["_role"].dropna()
+        stats[str(label)] = ActivityStats(
+            count=len(group),
+            robots=sorted(group[ROBOT].unique()),
+            mean=float(done.mean()) if len(done) else None,
+            median=float(done.median()) if len(done) else None,
+            role=str(roles.iloc[0]) if len(roles) else None,
+        )
+    return stats
+
+
+def signal_of(label: str) -> str:
+    """The signal a message activity is about: ``weed_position!`` -> ``weed_position``."""
+    return label.rstrip(THROWN + CAUGHT)
+
+
+def _signals(instances: pd.DataFrame) -> dict[str, Signal]:
+    messages = instances[instances["_role"].isin([SEND, RECEIVE])]
+    signals = {}
+    for name, group in messages.groupby(messages[ACTIVITY].astype(str).map(signal_of), sort=True):
+        sent = group[group["_role"] == SEND]
+        got = group[group["_role"] == RECEIVE]
+        signals[str(name)] = Signal(
+            name=str(name),
+            sent=len(sent),
+            received=len(got),
+            senders=sorted(sent[ROBOT_TYPE].unique()),
+            receivers=sorted(got[ROBOT_TYPE].unique()),
+        )
+    return signals
