@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shlex
 from collections.abc import Sequence
 from pathlib import Path
@@ -15,13 +16,17 @@ from robotale.ekg.append import append_ekg
 from robotale.ekg.build import BuildSummary, build_ekg, why
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
-from robotale.ekg.keys import DEFAULT_AGGREGATE
+from robotale.ekg.keys import built_keys, default_entities
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import is_parquet, parse_mapping, read_with_objects
 from robotale.eventlog.reading import format_reading
-from robotale.results.findings import prepare
-from robotale.results.logdata import LogData
+from robotale.results import background
+
+#: when ``robotale ingest`` prepares the dashboard's pages (see :func:`prepare_pages`)
+PAGES = ("background", "now", "visit")
+#: the environment variable that chooses it when ``--pages`` is not given
+PAGES_ENV = "ROBOTALE_PAGES"
 
 
 def ingest_command(
@@ -43,6 +48,7 @@ def ingest_command(
     bag_time: bool = False,
     objects: Path | None = None,
     skip_bad: bool = False,
+    pages: str | None = None,
     **recording: Any,
 ) -> int:
     """Store the log at ``path`` (CSV, XES, OCEL 2.0, or recordings prepared as ``prepare``
@@ -53,6 +59,7 @@ def ingest_command(
     are its entity types unless ``entities`` names others."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
+    pages = pages_when(pages)
     found_objects = None
     if log is not None and not log.strip():
         raise InputError(
@@ -114,26 +121,61 @@ def ingest_command(
                 driver,
                 events,
                 name,
-                aggregate=aggregate or DEFAULT_AGGREGATE,
+                aggregate=aggregate or default_keys(events, chosen),
                 replace=replace,
                 source=str(path),
                 objects=found_objects,
                 **names,
             )
         print(describe(summary, appended=append))
-        prepare_pages(driver, name)
+        prepare_pages(driver, name, pages)
     if skipped is not None:
         print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
 
 
-def prepare_pages(driver: Driver, name: str) -> None:
+def default_keys(events: pd.DataFrame, entities: Sequence[str] | None) -> list[str]:
+    """The class graphs built with a log when ``--aggregate`` names none: those the dashboard
+    builds with an upload, so the Discover and Perspectives pages' first class graph is
+    computed with the build's own tables instead of aggregated in Neo4j on the first visit."""
+    return built_keys(default_entities(events.columns) if entities is None else entities)
+
+
+def pages_when(pages: str | None) -> str:
+    """When to prepare the pages: ``pages``, else ``$ROBOTALE_PAGES``, else in the background;
+    checked before anything is stored."""
+    chosen = pages or os.environ.get(PAGES_ENV) or "background"
+    if chosen not in PAGES:
+        raise InputError(
+            f"--pages (or ${PAGES_ENV}) {chosen!r} is not a time to prepare the pages: give "
+            f"one of {', '.join(PAGES)}."
+        )
+    return chosen
+
+
+def prepare_pages(driver: Driver, name: str, pages: str | None = None) -> None:
     """Compute what the dashboard shows first of the stored log ``name`` (its findings,
     perspectives, runs and first timeline), kept with its build, so the first visit computes
-    nothing. The log is stored already: a failure here only leaves that work to the visit."""
+    nothing: in a process of its own that outlives the command (``background``, the default,
+    or ``$ROBOTALE_PAGES``), before returning (``now``) or not at all (``visit``: the first
+    visit computes them). The log is stored already: a failure only leaves that work to it."""
+    pages = pages_when(pages)
+    if pages == "visit":
+        return
+    if pages == "background":
+        try:
+            process = background.start(name)
+        except OSError as error:  # no process to be had: prepare here instead
+            print(f"  not started in the background ({why(error)}): preparing now")
+        else:
+            print(
+                "preparing the dashboard's findings, perspectives and timeline in the "
+                f"background (process {process.pid}); a page visited before computes its own"
+            )
+            return
     print("preparing the dashboard's findings, perspectives and timeline ...", flush=True)
     try:
-        prepare(driver, LogData(), name)
+        background.prepare_now(driver, name)
     except Exception as error:  # the log is stored: a page's failure is said, not raised
         print(f"  not prepared ({why(error)}): the dashboard computes them on the first visit")
 
