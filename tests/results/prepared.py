@@ -1,7 +1,8 @@
 """The prepared results of a stored log as digests, to tell whether a faster preparation still
 prepares the same: every result file the preparation keeps for a build, each canonicalised
-(numbers to 9 significant digits, plotly's packed arrays unpacked, the log's name replaced)
-and hashed. Also runnable, to write the digests of the current code into the fixture:
+(numbers to 30 binary digits, about 9 decimal ones; plotly's packed arrays unpacked; the
+log's name replaced) and hashed. Also runnable, to write the digests of the current code into
+the fixture:
 
     python tests/results/prepared.py   (needs NEO4J_URI / NEO4J_PASSWORD of a running Neo4j)
 """
@@ -12,6 +13,7 @@ import base64
 import hashlib
 import importlib.util
 import json
+import math
 import sys
 from pathlib import Path
 from typing import Any
@@ -29,9 +31,9 @@ ROOT = Path(__file__).resolve().parents[2]
 #: the digests of the prepared results of the benchmark's synthetic logs, by size
 FIXTURE = Path(__file__).with_name("prepared_digests.json")
 SIZES = (10_000, 100_000)
-#: significant digits a number keeps in the digest: sums taken in another order may differ
-#: in the last bits, a different result differs long before
-DIGITS = 9
+#: binary digits a number keeps in the digest (about 9 decimal ones): sums taken in another
+#: order may differ in the last bits, a different result differs long before
+BITS = 30
 
 
 def synthetic_log(events: int) -> pd.DataFrame:
@@ -44,9 +46,11 @@ def synthetic_log(events: int) -> pd.DataFrame:
     return module.synthetic_log(events)
 
 
-def store(driver: Driver, log: pd.DataFrame, name: str) -> None:
-    """Store ``log`` as ``robotale ingest`` does with its defaults (no preparation)."""
-    build_ekg(driver, log, name, aggregate=list(DEFAULT_AGGREGATE), progress=False)
+def store(driver: Driver, log: pd.DataFrame, name: str, aggregate=None) -> None:
+    """Store ``log`` (its class graphs by ``aggregate``, default: activity, as the digests
+    were written), without preparing its pages."""
+    keys = list(aggregate or DEFAULT_AGGREGATE)
+    build_ekg(driver, log, name, aggregate=keys, progress=False)
 
 
 def result_files(driver: Driver, name: str) -> dict[str, bytes]:
@@ -77,7 +81,13 @@ def canonical(value: Any, name: str) -> Any:
     if isinstance(value, list):
         return [canonical(item, name) for item in value]
     if isinstance(value, float):
-        return float(f"{value:.{DIGITS}g}") if np.isfinite(value) else str(value)
+        if not math.isfinite(value) or value == 0.0:
+            return str(value)
+        # the mantissa to BITS binary digits: a decimal rounding has its ties exactly where
+        # a mean of nanoseconds falls (x.5 ns), and so differs for a difference in the
+        # last bit; a binary one has them where times in nanoseconds never fall
+        mantissa, exponent = math.frexp(value)
+        return [round(mantissa * 2**BITS), exponent]
     if isinstance(value, str):
         return value.replace(name, "<log>") if name in value else value
     return value
