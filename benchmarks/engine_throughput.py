@@ -127,20 +127,10 @@ def interleaved(ours: Callable[[], None], theirs: Callable[[], None], seconds: f
 def outcomes(path: Path) -> tuple[dict, dict]:
     """The variables one instance leaves, as robotale and SpiffWorkflow run ``path``."""
     from SpiffWorkflow.bpmn import BpmnWorkflow
-    from SpiffWorkflow.bpmn.parser import BpmnParser
 
-    clock = SimClock()
-    engine = Engine(
-        deploy(parse(path).processes["bench"]),
-        robot="bench",
-        bus=InProcessBus(clock),
-        clock=clock,
-        tag_sink=[].append,
-    )
+    engine = robotale_engine(path)
     engine.start_instance()
-    parser = BpmnParser()
-    parser.add_bpmn_file(str(path))
-    workflow = BpmnWorkflow(parser.get_spec("bench"))
+    workflow = BpmnWorkflow(spiff_spec(path))
     workflow.do_engine_steps()
     return dict(engine.variables), dict(workflow.data)
 
@@ -152,15 +142,27 @@ def same_outcome(ours: dict, theirs: dict) -> list[str]:
             if ours.get(k) != theirs.get(k)]  # fmt: skip
 
 
-def robotale_runner(path: Path) -> Callable[[], None]:
+def robotale_engine(path: Path) -> Engine:
     clock = SimClock()
-    engine = Engine(
+    return Engine(
         deploy(parse(path).processes["bench"]),
         robot="bench",
         bus=InProcessBus(clock),
         clock=clock,
         tag_sink=[].append,
     )
+
+
+def spiff_spec(path: Path):
+    from SpiffWorkflow.bpmn.parser import BpmnParser
+
+    parser = BpmnParser()
+    parser.add_bpmn_file(str(path))
+    return parser.get_spec("bench")
+
+
+def robotale_runner(path: Path) -> Callable[[], None]:
+    engine = robotale_engine(path)
 
     def run_once() -> None:
         engine.start_instance()
@@ -173,11 +175,8 @@ def robotale_runner(path: Path) -> Callable[[], None]:
 
 def spiff_runner(path: Path) -> Callable[[], None]:
     from SpiffWorkflow.bpmn import BpmnWorkflow
-    from SpiffWorkflow.bpmn.parser import BpmnParser
 
-    parser = BpmnParser()
-    parser.add_bpmn_file(str(path))
-    spec = parser.get_spec("bench")
+    spec = spiff_spec(path)
 
     def run_once() -> None:
         workflow = BpmnWorkflow(spec)
