@@ -59,6 +59,13 @@ def main(sizes: list[int], repeat: int, heap: str) -> int:
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
         work = Path(folder)
+        # the ingests' columnar copies and prepared pages in a home of the benchmark's own;
+        # the download cache (the Neo4j jars) stays the user's
+        from robotale.config import cache_dir
+
+        os.environ["ROBOTALE_CACHE"] = str(cache_dir())
+        (work / "robotale-home").mkdir()
+        os.environ["ROBOTALE_HOME"] = str(work / "robotale-home")
         python, why_not = peers.promg_environment(work / "venv")
         with peers.private_neo4j(work, heap) as (driver, server):
             for size in sizes:
