@@ -119,11 +119,14 @@ def main() -> int:
         help="time whole `robotale ingest` processes against PromG's whole build instead "
         "(benchmarks/whole_ingest.py)",
     )
+    parser.add_argument(
+        "--promg-venv", type=Path, help="with --whole-command: a virtual environment with PromG"
+    )
     args = parser.parse_args()
     if args.whole_command:
         from whole_ingest import main as whole_command
 
-        return whole_command(args.sizes, max(args.repeat, 2), args.heap)
+        return whole_command(args.sizes, max(args.repeat, 2), args.heap, args.promg_venv)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with private_neo4j(args.heap) as driver:
         # Neo4j compiles each query once and its JIT warms up: measure a warm server.

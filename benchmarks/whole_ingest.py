@@ -55,7 +55,7 @@ class Run:
     pages: float | None = None
 
 
-def main(sizes: list[int], repeat: int, heap: str) -> int:
+def main(sizes: list[int], repeat: int, heap: str, venv: Path | None = None) -> int:
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
         work = Path(folder)
@@ -66,7 +66,10 @@ def main(sizes: list[int], repeat: int, heap: str) -> int:
         os.environ["ROBOTALE_CACHE"] = str(cache_dir())
         (work / "robotale-home").mkdir()
         os.environ["ROBOTALE_HOME"] = str(work / "robotale-home")
-        python, why_not = peers.promg_environment(work / "venv")
+        if venv is not None:  # one that has PromG already
+            python, why_not = venv / "bin" / "python", None
+        else:
+            python, why_not = peers.promg_environment(work / "venv")
         with peers.private_neo4j(work, heap) as (driver, server):
             for size in sizes:
                 measure(size, repeat, work, driver, server, python, why_not)
