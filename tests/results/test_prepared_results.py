@@ -30,7 +30,7 @@ def prepared_digests(driver, name: str, size: int, aggregate=None) -> tuple[dict
     return digests(result_files(driver, name), name), seconds
 
 
-@pytest.mark.parametrize("keys", ["activity", "built"])
+@pytest.mark.parametrize("keys", [pytest.param("activity", marks=pytest.mark.slow), "built"])
 def test_the_pages_of_10000_events_are_those_prepared_before(neo4j_driver, log_name, keys):
     # "activity": the class graph is aggregated in Neo4j on preparing, as it was;
     # "built": the ingest's default keys build it from the tables in memory: the same graph
