@@ -156,13 +156,15 @@ def robotale_ingest(csv: Path, driver, server) -> Run:
     run, status, stdout, stderr = timed_process(command, server, env=environment)
     if status != 0:
         raise SystemExit(f"robotale ingest failed: {stderr.strip()}")
+    # the graph the command built, counted before the pages' preparation adds the class
+    # graph the Perspectives page shows (by activity and robot)
+    run.counts = peers.counts(driver)
     # the pages are prepared after the command: awaited, so they slow neither side's next run
     preparing = re.search(r"in the background \(process (\d+)\)", stdout)
     done = done_file(driver, "whole")
     while preparing and not done.exists() and alive(int(preparing.group(1))):
         time.sleep(0.2)
     run.pages = json.loads(done.read_text())["seconds"] if done.exists() else None
-    run.counts = peers.counts(driver)
     return run
 
 
