@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import argparse
 import itertools
+import os
 import statistics
 import sys
 import tempfile
@@ -104,15 +105,64 @@ def rate(run_once: Callable[[], None], seconds: float) -> float:
             return count / elapsed
 
 
-def robotale_runner(path: Path) -> Callable[[], None]:
+def interleaved(ours: Callable[[], None], theirs: Callable[[], None], seconds: float, rounds: int):
+    """Both runners' runs per CPU second and per wall second, measured in turns (A B A B ...,
+    ``rounds`` each) so a busy machine slows both alike: medians of each, and the median of
+    the CPU ratios."""
+    ours(), theirs()  # warm up caches and lazy imports
+    turns = [
+        (cpu_rate(ours, seconds / rounds), cpu_rate(theirs, seconds / rounds))
+        for _ in range(rounds)
+    ]
+    walls = [(rate(ours, seconds / rounds), rate(theirs, seconds / rounds)) for _ in range(rounds)]
+    return (
+        statistics.median(a for a, _ in turns),
+        statistics.median(b for _, b in turns),
+        statistics.median(a / b for a, b in turns),
+        statistics.median(a for a, _ in walls),
+        statistics.median(b for _, b in walls),
+    )
+
+
+def outcomes(path: Path) -> tuple[dict, dict]:
+    """The variables one instance leaves, as robotale and SpiffWorkflow run ``path``."""
+    from SpiffWorkflow.bpmn import BpmnWorkflow
+
+    engine = robotale_engine(path)
+    engine.start_instance()
+    workflow = BpmnWorkflow(spiff_spec(path))
+    workflow.do_engine_steps()
+    return dict(engine.variables), dict(workflow.data)
+
+
+def same_outcome(ours: dict, theirs: dict) -> list[str]:
+    """The script variables (``value_<i>``, ``last``) the two engines left differently."""
+    names = {k for k in set(ours) | set(theirs) if k.startswith("value_") or k == "last"}
+    return [f"{k}: {ours.get(k)!r} against {theirs.get(k)!r}" for k in sorted(names)
+            if ours.get(k) != theirs.get(k)]  # fmt: skip
+
+
+def robotale_engine(path: Path) -> Engine:
     clock = SimClock()
-    engine = Engine(
+    return Engine(
         deploy(parse(path).processes["bench"]),
         robot="bench",
         bus=InProcessBus(clock),
         clock=clock,
         tag_sink=[].append,
     )
+
+
+def spiff_spec(path: Path):
+    from SpiffWorkflow.bpmn.parser import BpmnParser
+
+    parser = BpmnParser()
+    parser.add_bpmn_file(str(path))
+    return parser.get_spec("bench")
+
+
+def robotale_runner(path: Path) -> Callable[[], None]:
+    engine = robotale_engine(path)
 
     def run_once() -> None:
         engine.start_instance()
@@ -125,11 +175,8 @@ def robotale_runner(path: Path) -> Callable[[], None]:
 
 def spiff_runner(path: Path) -> Callable[[], None]:
     from SpiffWorkflow.bpmn import BpmnWorkflow
-    from SpiffWorkflow.bpmn.parser import BpmnParser
 
-    parser = BpmnParser()
-    parser.add_bpmn_file(str(path))
-    spec = parser.get_spec("bench")
+    spec = spiff_spec(path)
 
     def run_once() -> None:
         workflow = BpmnWorkflow(spec)
@@ -234,17 +281,27 @@ def main() -> int:
     with tempfile.TemporaryDirectory() as folder:
         models = {"sequential, 10 script tasks": (sequential(), TASKS + 2)}
         models["parallel split of 10 branches"] = (parallel(), TASKS + 4)
-        print(f"{'model':32} {'engine':12} {'instances/s':>12} {'nodes/s':>12} {'ratio':>7}")
+        print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+        print(f"{'model':32} {'engine':14} {'inst./CPU s':>12} {'inst./wall s':>13} "
+              f"{'nodes/CPU s':>12} {'ratio':>7}")  # fmt: skip
         for label, (text, nodes) in tqdm(
             models.items(), desc="throughput", file=sys.stderr, leave=False
         ):
             path = Path(folder) / "bench.bpmn"
             path.write_text(text)
-            ours = rate(robotale_runner(path), options.seconds)
-            spiff = rate(spiff_runner(path), options.seconds)
-            for engine, value in (("robotale", ours), ("SpiffWorkflow", spiff)):
-                ratio = value / spiff
-                print(f"{label:32} {engine:12} {value:12.0f} {value * nodes:12.0f} {ratio:6.1f}x")
+            differences = same_outcome(*outcomes(path))
+            ours, spiff, ratio, ours_wall, spiff_wall = interleaved(
+                robotale_runner(path), spiff_runner(path), options.seconds * 2, rounds=5
+            )
+            for engine, cpu, wall in (
+                ("robotale", ours, ours_wall),
+                ("SpiffWorkflow", spiff, spiff_wall),
+            ):
+                shown = f"{ratio:6.1f}x" if engine == "robotale" else ""
+                print(f"{label:32} {engine:14} {cpu:12.0f} {wall:13.0f} {cpu * nodes:12.0f} "
+                      f"{shown:>7}")  # fmt: skip
+            check = "same variables" if not differences else f"DIFFERENT: {differences[:3]}"
+            print(f"{'':32} (interleaved A B A B, median of 5 CPU ratios; {check})")
         js, ratio = javascript_ratio(Path(folder), options.seconds)
         print(
             f"{'sequential, JavaScript':32} {'robotale':12} {js:12.0f} {js * (TASKS + 2):12.0f} "
@@ -264,6 +321,7 @@ def main() -> int:
         f"signal throw -> catch across engines: median {median:.1f} us, p95 {p95:.1f} us "
         f"({len(latencies)} signals; target median < 100 us: {median / 100:.2f} of it)"
     )
+    print(f"load average after: {os.getloadavg()[0]:.1f}")
     return 0
 
 

@@ -490,7 +490,8 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
         action="append",
         metavar="KEY",
         help="an aggregation key: activity, or activity plus entity columns such as "
-        "activity,robot; repeat for several (default: activity)",
+        "activity,robot; repeat for several (default: activity, and activity,robot when "
+        "robots are entities, as the dashboard builds an upload)",
     )
     _add_mapping(ingest)
     ingest.add_argument("--case", metavar="COLUMN", help="the column that tells cases apart")
@@ -503,6 +504,14 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
         action="store_true",
         default=None,
         help="add new runs (cases) to a log that exists, with its entities and keys",
+    )
+    ingest.add_argument(
+        "--pages",
+        metavar="WHEN",
+        default=None,
+        help="when the dashboard's first pages of the log are prepared: by a process of its "
+        "own after the command ends (background, the default, or $ROBOTALE_PAGES), before it "
+        "ends (now), or on their first visit (visit)",
     )
     _add_preparation_options(ingest.add_argument_group("recordings (rosbag2 directories)"))
     _handled_by(ingest, "ingest.ingest_command")

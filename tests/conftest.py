@@ -57,13 +57,17 @@ EXAMPLES = REPO / "examples"
 @pytest.fixture(scope="session", autouse=True)
 def robotale_home(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     """A robotale home of this session's own, so no test writes into the user's (uploads,
-    models, demo runs); the download cache stays the user's, so the Neo4j jars are reused."""
+    models, demo runs); the download cache stays the user's, so the Neo4j jars are reused.
+    Ingests prepare the dashboard's pages before they return."""
     from robotale.config import cache_dir
 
     environment = pytest.MonkeyPatch()
     environment.setenv("ROBOTALE_CACHE", str(cache_dir()))
     home = tmp_path_factory.mktemp("home")
     environment.setenv("ROBOTALE_HOME", str(home))
+    # an ingest prepares the dashboard's pages before it returns, so no process outlives the
+    # test that started it (tests/results/test_background.py tests the background)
+    environment.setenv("ROBOTALE_PAGES", "now")
     try:
         yield home
     finally:

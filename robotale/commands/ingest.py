@@ -11,7 +11,6 @@ from robotale.ekg.append import append_ekg
 from robotale.ekg.build import build_ekg
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
-from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.logkinds import RECORDINGS
@@ -20,7 +19,7 @@ from robotale.eventlog.options import PrepareOptions
 from robotale.eventlog.preparing import kept_runs
 from robotale.eventlog.reading import format_reading
 from robotale.results.site import keep_sites, run_sites
-from robotale.results.storing import describe, prepare_pages
+from robotale.results.storing import default_keys, describe, pages_when, prepare_pages
 
 
 def ingest_command(
@@ -36,6 +35,7 @@ def ingest_command(
     append: bool = False,
     objects: Path | None = None,
     skip_bad: bool = False,
+    pages: str | None = None,
     **preparation: Any,
 ) -> int:
     """Store the log at ``path`` (CSV, XES, OCEL 2.0, Parquet, or recordings prepared as
@@ -46,6 +46,7 @@ def ingest_command(
     object-centric log's object types are its entity types unless ``entities`` names others."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
+    pages = pages_when(pages)
     if log is not None and not log.strip():
         raise InputError(
             f"--log {log!r} names no log: give it a name, or leave --log out to use "
@@ -87,7 +88,7 @@ def ingest_command(
                 driver,
                 events,
                 name,
-                aggregate=aggregate or DEFAULT_AGGREGATE,
+                aggregate=aggregate or default_keys(events, chosen),
                 replace=replace,
                 source=str(path),
                 objects=found_objects,
@@ -97,7 +98,7 @@ def ingest_command(
         if opened.kind is RECORDINGS:
             # the Mission page's map: the simulated runs' fields, bases and objects
             keep_sites(driver, name, run_sites(path))
-        prepare_pages(driver, name)
+        prepare_pages(driver, name, pages)
     if skipped is not None and opened.kind is RECORDINGS:
         print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0

@@ -119,9 +119,24 @@ def format_seconds(seconds: float | None) -> str:
     return f"{hours}h{minutes:02d}m"
 
 
+#: values JSON writes as they are
+_PLAIN = frozenset({str, int, bool, type(None)})
+
+
 def json_ready(value: Any) -> Any:
     """``value`` with NaN, NaT, NA and infinities as ``None``, timestamps as ISO text and
     numpy scalars as Python numbers, so ``json.dumps`` writes strict JSON."""
+    # the exact plain types first: a result holds hundreds of thousands of them, and the
+    # general checks below cost a dozen calls each
+    kind = type(value)
+    if kind in _PLAIN:
+        return value
+    if kind is float:
+        return value if math.isfinite(value) else None
+    if kind is dict:
+        return {k if type(k) is str else str(k): json_ready(v) for k, v in value.items()}
+    if kind is list:
+        return [json_ready(v) for v in value]
     if isinstance(value, dict):
         return {str(k): json_ready(v) for k, v in value.items()}
     if isinstance(value, (list, tuple)):

@@ -353,6 +353,9 @@ def _levels_figure(levels: pd.DataFrame, lows: pd.DataFrame):
     robots = levels.groupby(ROBOT, sort=True) if ROBOT in levels.columns else [("all", levels)]
     for name, mine in robots if BATTERY in levels.columns else []:  # tagged lows, no levels
         times, values = broken_between_runs(mine)
+        # as the text plotly writes for a time: it copies each time object it is given,
+        # which takes longer than the rest of the figure
+        times = np.array([t if t is None else t.isoformat() for t in times], dtype=object)
         figure.add_scatter(x=times, y=values, mode="lines", name=str(name), connectgaps=False)
     if not lows.empty:
         figure.add_scatter(

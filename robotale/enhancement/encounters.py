@@ -84,20 +84,34 @@ def _meet(mine_key, mine_xyz, theirs_key, theirs_xyz, metres: float, seconds: fl
 
 def _episodes(rows: pd.DataFrame, met: np.ndarray, distance: np.ndarray, robot: str, other: str):
     """Consecutive meeting positions of ``robot`` (in run and time order) as encounters."""
-    near = rows[[CASE, TIMESTAMP, *AXES]].reset_index(drop=True).assign(_distance=distance)
     # a new encounter wherever a meeting position follows one that did not meet (or a new run)
-    cases = near[CASE].to_numpy(object)
+    cases = rows[CASE].to_numpy(object)
     new_run = np.r_[True, cases[1:] != cases[:-1]]
     begins = met & (new_run | ~np.r_[False, met[:-1]])
-    episode = np.cumsum(begins)
-    meeting = near[met].assign(_episode=episode[met])
-    grouped = meeting.groupby("_episode", sort=True)
-    table = grouped.agg(
-        **{CASE: (CASE, "first"), "start": (TIMESTAMP, "min"), "end": (TIMESTAMP, "max")},
-        closest=("_distance", "min"),
+    # each encounter is a contiguous stretch of the meeting positions, in time order within
+    # one run: its first and last rows are its start and end, reduced with numpy at once
+    # (a groupby per pair of robots costs more than the positions it groups)
+    meeting = np.flatnonzero(met)
+    first = np.flatnonzero(begins[meeting])
+    last = np.r_[first[1:], len(meeting)] - 1
+    near = distance[meeting]
+    closest = np.minimum.reduceat(near, first)
+    episode = np.cumsum(begins[meeting]) - 1
+    # the first position of each encounter at its closest distance, as idxmin picks it
+    at_closest = np.flatnonzero(near == closest[episode])
+    _, chosen = np.unique(episode[at_closest], return_index=True)
+    where = meeting[at_closest[chosen]]
+    times = rows[TIMESTAMP].array  # the column's own type (zone-aware times stay so)
+    table = pd.DataFrame(
+        {
+            CASE: rows[CASE].array[meeting[first]],
+            "start": times[meeting[first]],
+            "end": times[meeting[last]],
+            "closest": closest,
+        }
     )
-    table[list(AXES)] = meeting.loc[grouped["_distance"].idxmin(), list(AXES)].to_numpy()
-    return table.reset_index(drop=True).assign(robot=robot, other=other)
+    table[list(AXES)] = rows[list(AXES)].to_numpy()[where]
+    return table.assign(robot=robot, other=other)
 
 
 def _run_time_keys(placed: pd.DataFrame, seconds: float) -> np.ndarray:
@@ -138,11 +152,28 @@ def region_overlaps(regions: pd.DataFrame) -> list[dict[str, Any]]:
         shared[axis] = (low, high)
         overlap &= low <= high
     pairs = pairs[overlap].sort_values([CASE, ROBOT, f"{ROBOT}_other"], kind="stable")
+    # whole columns to Python values at once: a row at a time costs a Series per pair
+    at = pairs.index
+    ends = {
+        axis: zip(
+            shared[axis][0].loc[at].to_numpy(float).tolist(),
+            shared[axis][1].loc[at].to_numpy(float).tolist(),
+            strict=True,
+        )
+        for axis in AXES
+    }
+    columns = zip(
+        pairs[CASE].tolist(),
+        pairs[ROBOT].tolist(),
+        pairs[f"{ROBOT}_other"].tolist(),
+        *ends.values(),
+        strict=True,
+    )
     return [
         {
-            "case": str(row[CASE]),
-            "robots": [str(row[ROBOT]), str(row[f"{ROBOT}_other"])],
-            **{axis: [float(shared[axis][0][i]), float(shared[axis][1][i])] for axis in AXES},
+            "case": str(case),
+            "robots": [str(robot), str(other)],
+            **{axis: list(span) for axis, span in zip(AXES, spans, strict=True)},
         }
-        for i, row in pairs.iterrows()
+        for case, robot, other, *spans in columns
     ]

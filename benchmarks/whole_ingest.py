@@ -1,0 +1,236 @@
+"""The command a user runs, whole, against PromG's whole build of the same log.
+
+    python benchmarks/ekg_build.py --whole-command [--sizes 100000 1000000] [--repeat 2]
+
+For each size, ``ekg_build.py``'s synthetic log is written once as a CSV (robotale's input)
+and once as PromG's records (``peers.py``); then, interleaved (robotale, PromG, robotale,
+PromG ...) on an emptied database of one private Neo4j with APOC (``peers.py``'s):
+
+- robotale: the process ``python -m robotale ingest LOG.csv --entities robot,msg_id
+  --aggregate activity`` from its start to its exit (reading the CSV, the build, the columnar
+  copy; the dashboard's pages are prepared afterwards by a process of their own, whose time
+  until done is printed apart and awaited before the next build);
+- PromG: the process ``peers_promg.py`` (PromG's import, records, events, entities, CORR, DF,
+  classes, DF_A) from its start to its exit.
+
+Printed per size: each side's best wall time, its CPU time (the process and the Neo4j server,
+read from ``/proc``), PromG's time over robotale's, the peak memory of robotale's process, the
+load average, and the graphs' counts side by side, checked equal where both build the same
+thing (events, entities, CORR, classes, OBSERVED).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import resource
+import subprocess
+import sys
+import tempfile
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import pandas as pd
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+import peers  # noqa: E402
+from ekg_build import synthetic_log  # noqa: E402
+
+#: the rows both builders make the same of one log: (row, robotale's key, PromG's key)
+SAME_ROWS = ("events", "entities", "CORR", "classes", "OBSERVED")
+SAME = [row for row in peers.ROWS if row[0] in SAME_ROWS]
+
+
+@dataclass
+class Run:
+    wall: float
+    cpu: float
+    server_cpu: float
+    counts: dict[str, int] = field(default_factory=dict)
+    peak_mb: float = 0.0
+    pages: float | None = None
+
+
+def main(sizes: list[int], repeat: int, heap: str, venv: Path | None = None) -> int:
+    print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
+        work = Path(folder)
+        # the ingests' columnar copies and prepared pages in a home of the benchmark's own;
+        # the download cache (the Neo4j jars) stays the user's
+        from robotale.config import cache_dir
+
+        os.environ["ROBOTALE_CACHE"] = str(cache_dir())
+        (work / "robotale-home").mkdir()
+        os.environ["ROBOTALE_HOME"] = str(work / "robotale-home")
+        if venv is not None:  # one that has PromG already
+            python, why_not = venv / "bin" / "python", None
+        else:
+            python, why_not = peers.promg_environment(work / "venv")
+        with peers.private_neo4j(work, heap) as (driver, server):
+            for size in sizes:
+                measure(size, repeat, work, driver, server, python, why_not)
+    print(f"load average after: {os.getloadavg()[0]:.1f}")
+    return 0
+
+
+def measure(size: int, repeat: int, work: Path, driver, server, python, why_not) -> None:
+    log = synthetic_log(size)
+    csv = work / f"log{size}.csv"
+    canonical_csv(log).to_csv(csv, index=False)
+    ours: list[Run] = []
+    theirs: list[Run] = []
+    for _ in range(repeat):
+        ours.append(robotale_ingest(csv, driver, server))
+        if python is not None:
+            run, why_not = promg_whole(python, driver, server, log, work)
+            if run is not None:
+                theirs.append(run)
+    report(size, ours, theirs, why_not)
+
+
+def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
+    """The log as robotale's CSV names it (``time``, ``activity``, ``robot`` ...)."""
+    from robotale.eventlog import schema
+
+    return schema.to_csv_names(log)
+
+
+def server_cpu(server) -> float:
+    """CPU seconds the Neo4j server's process has used so far."""
+    running = server.running()
+    fields = Path(f"/proc/{running.pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+
+
+def children_cpu() -> float:
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def timed_process(command: list[str], server, **options) -> tuple[Run, int, str, str]:
+    """Run ``command`` to its end: its wall and CPU time, the server's CPU time meanwhile and
+    the process's peak resident memory (its high-water mark, read while it runs); its exit
+    status, stdout and stderr (in files: a full pipe would stop it)."""
+    with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
+        cpu, neo4j = children_cpu(), server_cpu(server)
+        started = time.perf_counter()
+        process = subprocess.Popen(command, stdout=out, stderr=err, text=True, **options)
+        peak = 0.0
+        while process.poll() is None:
+            peak = max(peak, high_water_mb(process.pid))
+            time.sleep(0.05)
+        wall = time.perf_counter() - started
+        run = Run(wall, children_cpu() - cpu, server_cpu(server) - neo4j, peak_mb=peak)
+        out.seek(0)
+        err.seek(0)
+        return run, process.returncode, out.read(), err.read()
+
+
+def high_water_mb(pid: int) -> float:
+    """The peak resident memory of the process ``pid`` so far (0 when it is gone)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return 0.0
+    found = re.search(r"VmHWM:\s+(\d+) kB", status)
+    return int(found.group(1)) / 1024 if found else 0.0
+
+
+def robotale_ingest(csv: Path, driver, server) -> Run:
+    from robotale.results.background import done_file
+
+    peers.clear(driver)
+    running = server.running()
+    environment = os.environ | {
+        "NEO4J_URI": running.bolt_uri,
+        "NEO4J_USER": "neo4j",
+        "NEO4J_PASSWORD": server.password() or "",
+        "ROBOTALE_PAGES": "background",
+    }
+    command = [sys.executable, "-m", "robotale", "ingest", str(csv), "--log", "whole"]
+    command += ["--entities", "robot,msg_id", "--aggregate", "activity", "--replace"]
+    run, status, stdout, stderr = timed_process(command, server, env=environment)
+    if status != 0:
+        raise SystemExit(f"robotale ingest failed: {stderr.strip()}")
+    # the graph the command built, counted before the pages' preparation adds the class
+    # graph the Perspectives page shows (by activity and robot)
+    run.counts = peers.counts(driver)
+    # the pages are prepared after the command: awaited, so they slow neither side's next run
+    preparing = re.search(r"in the background \(process (\d+)\)", stdout)
+    done = done_file(driver, "whole")
+    while preparing and not done.exists() and alive(int(preparing.group(1))):
+        time.sleep(0.2)
+    run.pages = json.loads(done.read_text())["seconds"] if done.exists() else None
+    return run
+
+
+def alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    return True
+
+
+def promg_whole(python: Path, driver, server, log: pd.DataFrame, work: Path):
+    """PromG's whole build as a process; None and why when it failed."""
+    cpu, neo4j = children_cpu(), server_cpu(server)
+    build, why_not = peers.promg_build(python, driver, server, log, work, PromgOptions())
+    if build is None:
+        return None, why_not
+    spent, served = children_cpu() - cpu, server_cpu(server) - neo4j
+    return Run(build.process_seconds, spent, served, counts=build.counts), None
+
+
+@dataclass(frozen=True)
+class PromgOptions:
+    batch_size: int = 10_000
+
+
+def best(runs: list[Run]) -> Run:
+    return min(runs, key=lambda run: run.wall)
+
+
+def same_counts(ours: dict[str, int], theirs: dict[str, int]) -> list[str]:
+    """The rows both builders make the same of a log whose counts differ (empty: none)."""
+    return [
+        f"{row}: robotale {peers._count(ours, mine):,}, PromG {peers._count(theirs, other):,}"
+        for row, mine, other in SAME
+        if peers._count(ours, mine) != peers._count(theirs, other)
+    ]
+
+
+def report(size: int, ours: list[Run], theirs: list[Run], why_not: str | None) -> None:
+    mine = best(ours)
+    pages = (
+        f"{mine.pages:.1f} s after it, in the background"
+        if mine.pages is not None
+        else "NOT: the background preparation ended without finishing"
+    )
+    print(
+        f"\n{size:,} events, whole `robotale ingest` (CSV read to exit): {mine.wall:.1f} s wall, "
+        f"{mine.cpu:.1f} s CPU (+ Neo4j {mine.server_cpu:.1f} s), peak memory "
+        f"{mine.peak_mb:,.0f} MB; pages prepared {pages} (best of {len(ours)}; load "
+        f"average {os.getloadavg()[0]:.1f})"
+    )
+    if not theirs:
+        print(f"  PromG: not run. {why_not}")
+        return
+    other = best(theirs)
+    differences = same_counts(mine.counts, other.counts)
+    print(
+        f"  PromG's whole build (process start to exit): {other.wall:.1f} s wall, "
+        f"{other.cpu:.1f} s CPU (+ Neo4j {other.server_cpu:.1f} s): ratio "
+        f"{other.wall / mine.wall:.2f} wall, "
+        f"{(other.cpu + other.server_cpu) / (mine.cpu + mine.server_cpu):.2f} CPU "
+        f"(PromG's / robotale's; target >= 2.5); interleaved, best of {len(theirs)}"
+    )
+    print(
+        "  same events, entities, CORR, classes, OBSERVED: "
+        + ("yes" if not differences else f"NO: {'; '.join(differences)}")
+    )
+    peers._table(peers.Build(mine.wall, mine.counts), peers.Build(other.wall, other.counts, ""))

@@ -1,0 +1,80 @@
+"""The benchmarks' "same output" checks tell the same work from other work: each on a small
+input, once where both sides compute the same and once where one computes something else."""
+
+from __future__ import annotations
+
+import importlib.util
+import sys
+from pathlib import Path
+
+import pytest
+
+BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+
+
+def benchmark(name: str):
+    """A module of ``benchmarks/`` (they import each other by name, as scripts)."""
+    if str(BENCHMARKS) not in sys.path:
+        sys.path.insert(0, str(BENCHMARKS))
+    spec = importlib.util.spec_from_file_location(name, BENCHMARKS / f"{name}.py")
+    module = importlib.util.module_from_spec(spec)
+    sys.modules[name] = module
+    spec.loader.exec_module(module)
+    return module
+
+
+@pytest.fixture(scope="module")
+def ekg_build():
+    return benchmark("ekg_build")
+
+
+def test_the_directly_follows_counts_of_robotale_and_pm4py_are_checked_equal(ekg_build):
+    log = ekg_build.synthetic_log(3_000)
+    ours, theirs = ekg_build.robotale_dfg(log), ekg_build.pm4py_dfg(log)
+    assert len(ours) > 50 and sum(ours.values()) > 2_000
+    assert ekg_build.same_dfg(ours, theirs) == []
+
+
+def test_a_dfg_of_other_flows_is_told_apart(ekg_build):
+    import pm4py
+
+    from robotale.eventlog import schema
+
+    log = ekg_build.synthetic_log(3_000)
+    # each robot's flow across all runs: pm4py computing other work than robotale's DF_C
+    dfg, _, _ = pm4py.discover_dfg(log, case_id_key=schema.ROBOT)
+    across = {(str(a), str(b)): int(n) for (a, b), n in dfg.items()}
+    assert ekg_build.same_dfg(ekg_build.robotale_dfg(log), across) != []
+    # one activity named otherwise on one side only
+    renamed = log.assign(**{schema.ACTIVITY: log[schema.ACTIVITY].replace("scan", "look")})
+    differences = ekg_build.same_dfg(ekg_build.robotale_dfg(log), ekg_build.pm4py_dfg(renamed))
+    assert any("scan" in line or "look" in line for line in differences)
+
+
+def test_the_whole_ingests_graphs_are_checked_equal_where_both_build_the_same(
+    neo4j_driver, log_name, thesis_csv
+):
+    from robotale.ekg.build import build_ekg
+    from robotale.ekg.logs import graph_counts
+    from robotale.eventlog.readers import read_log
+
+    whole = benchmark("whole_ingest")
+    build_ekg(
+        neo4j_driver, read_log(thesis_csv), log_name, entities=["robot", "msg_id"], progress=False
+    )
+    ours = graph_counts(neo4j_driver)
+    # the benchmark's counts (Neo4j's count store) are those of a scan
+    assert benchmark("peers").counts(neo4j_driver) == ours
+    # PromG's names for the same nodes and edges: the check compares them row by row
+    theirs = {
+        "node:Event": ours["node:Event"],
+        "node:Entity": ours["node:Entity"],
+        "relationship:CORR": ours["relationship:CORR"],
+        "node:Activity": ours["node:Class"],
+        "relationship:OBSERVED": ours["relationship:OBSERVED"],
+    }
+    assert whole.same_counts(ours, theirs) == []
+    fewer = theirs | {"relationship:CORR": theirs["relationship:CORR"] - 1}
+    assert whole.same_counts(ours, fewer) == [
+        f"CORR: robotale {ours['relationship:CORR']:,}, PromG {fewer['relationship:CORR']:,}"
+    ]
