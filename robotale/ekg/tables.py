@@ -265,8 +265,8 @@ _MISSING = np.iinfo(np.int64).max
 
 def _ranks(values: pd.Series) -> np.ndarray:
     """Each value's rank among the distinct values in pandas' sort order (missing last)."""
-    codes, _ = pd.factorize(values, sort=True)
-    codes = codes.astype(np.int64)
+    factorized, _ = pd.factorize(values, sort=True)
+    codes: np.ndarray = factorized.astype(np.int64)
     codes[codes < 0] = _MISSING
     return codes
 
