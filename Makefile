@@ -89,7 +89,7 @@ bench: install
 
 # The packages whose types mypy checks strictly (settings in pyproject.toml's [tool.mypy]);
 # `make test` checks them too.
-TYPED_PACKAGES := robotale/fame_runtime robotale/eventlog robotale/neo4j_server robotale/ekg \
+TYPED_PACKAGES := robotale/fame_runtime robotale/eventlog robotale/neo4j_server robotale/ekg robotale/results \
 	robotale/queries.py \
 	robotale/files.py robotale/errors.py robotale/config.py robotale/executors.py robotale/storage.py \
 	robotale/extras.py

@@ -36,7 +36,7 @@ DONE = "prepared.done"
 NICENESS = 10
 
 
-def start(name: str) -> subprocess.Popen:
+def start(name: str) -> subprocess.Popen[bytes]:
     """Start preparing the pages of the stored log ``name`` in a process of its own that
     outlives the caller (same Neo4j and robotale home, from the environment)."""
     return subprocess.Popen(

@@ -5,6 +5,9 @@ background, so the first visit after that computes nothing."""
 from __future__ import annotations
 
 import math
+from collections.abc import Callable
+from functools import partial
+from typing import Any
 
 from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
@@ -30,7 +33,7 @@ def parse_delay(text: str | None) -> float | None:
     return seconds
 
 
-def _delay_key(delay: float | None) -> tuple:
+def _delay_key(delay: float | None) -> tuple[str, ...]:
     return () if delay is None else ("delay", repr(delay))
 
 
@@ -38,7 +41,7 @@ def stored_findings(driver: Driver, logs: LogData, name: str, delay: float | Non
     """The answers for the stored log ``name`` and its runs (case, start, duration); a message
     is delayed above ``delay`` seconds (else by the default rule)."""
 
-    def compute() -> dict:
+    def compute() -> dict[str, Any]:
         result = find(logs.frame(driver, name), delay_threshold=delay)
         runs = result.runs.reindex(columns=["case", "start", "duration"])
         return {**result.to_dict(), "runs": runs.to_dict(orient="records")}
@@ -60,7 +63,7 @@ def stored_perspective(
     kind = perspective_kind(which)
     options = kind.taken({"delay_threshold": delay})
 
-    def compute() -> dict:
+    def compute() -> dict[str, Any]:
         frame = logs.frame(driver, name)
         result = kind.compute(frame, activity=activity, robot=robot, **options)
         if which == "bottlenecks" and result.has_data:
@@ -68,7 +71,9 @@ def stored_perspective(
             result.tables["bottlenecks"] = trusted_first(result.tables["bottlenecks"])
         return result.to_dict()
 
-    focus = ("activity", activity or "", "robot", robot or "") if activity or robot else ()
+    focus: tuple[str, ...] = (
+        ("activity", activity or "", "robot", robot or "") if activity or robot else ()
+    )
     if options:
         focus += _delay_key(delay)
     return logs.result(driver, name, ("perspective", which, *focus), compute)
@@ -87,7 +92,7 @@ def stored_runs(driver: Driver, logs: LogData, name: str) -> bytes:
 def stored_timeline(driver: Driver, logs: LogData, name: str, case: str) -> bytes:
     """The timeline of the run ``case`` (the first run when empty)."""
 
-    def compute() -> dict:
+    def compute() -> dict[str, Any]:
         frame = logs.frame(driver, name)
         if case:
             return case_timeline(frame, case).to_dict()
@@ -97,7 +102,7 @@ def stored_timeline(driver: Driver, logs: LogData, name: str, case: str) -> byte
     return logs.result(driver, name, ("timeline", case), compute)
 
 
-def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict:
+def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict[str, Any]:
     """The class graph the Perspectives page draws beside its sections: by activity and
     robot when the log has robots as entities (``perspectives.js`` asks for the same)."""
     types = log_info(driver, name).get("entityTypes") or []
@@ -108,11 +113,11 @@ def prepare(driver: Driver, logs: LogData, name: str) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
     perspectives of the whole log, the class graph beside them, the runs and the first run's
     timeline."""
-    steps = [
+    steps: list[Callable[[], object]] = [
         lambda: stored_findings(driver, logs, name),
         lambda: perspectives_graph(driver, logs, name),
     ]
-    steps += [lambda w=which: stored_perspective(driver, logs, name, w) for which in page_names()]
+    steps += [partial(stored_perspective, driver, logs, name, which) for which in page_names()]
     steps += [
         lambda: stored_runs(driver, logs, name),
         lambda: stored_timeline(driver, logs, name, ""),

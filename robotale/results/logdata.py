@@ -45,11 +45,11 @@ class Cache:
 
     def __init__(self, size: int) -> None:
         self.size = size
-        self.items: OrderedDict[Hashable, Any] = OrderedDict()
+        self.items: OrderedDict[tuple[Hashable, ...], Any] = OrderedDict()
         self.lock = threading.Lock()
-        self.loading: dict[Hashable, threading.Lock] = {}
+        self.loading: dict[tuple[Hashable, ...], threading.Lock] = {}
 
-    def get(self, key: Hashable, load: Callable[[], Any]) -> Any:
+    def get(self, key: tuple[Hashable, ...], load: Callable[[], Any]) -> Any:
         with self.lock:
             if key in self.items:
                 self.items.move_to_end(key)
@@ -152,9 +152,11 @@ class LogData:
                 what,
                 lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
             )
-            return json.loads(data)
+            graph: dict[str, Any] = json.loads(data)
+            return graph
 
-        return self.graphs.get((name, version, tuple(key), shown), compute)
+        found: dict[str, Any] = self.graphs.get((name, version, tuple(key), shown), compute)
+        return found
 
     def forget(self, name: str) -> None:
         """Drop what is kept in memory of ``name`` (it was deleted or rebuilt)."""

@@ -35,9 +35,10 @@ def stored_mission(driver: Driver, logs: LogData, name: str, case: str) -> Missi
     if not case:
         raise InputError("Name the run to replay (?case=).")
     build = current_build(driver, name)
-    return logs.missions.get(
+    run: MissionRun = logs.missions.get(
         (name, build.key, str(case)), lambda: mission_run(logs.frame(driver, name), case)
     )
+    return run
 
 
 def mission_site(driver: Driver, name: str, run: MissionRun) -> dict[str, Any]:
