@@ -223,8 +223,11 @@ def test_the_model_page_offers_only_models_that_bind_the_robots(client, mission_
 
     page = client.get(f"/model?log={mission_log}").get_data(as_text=True)
     offered = re.findall(r'<option value="\w+"[^>]*>([^<(]+) \(', page)
-    # other tests may have stored another copy of the agri mission: each is offered, no other
-    assert {name.strip() for name in offered} == {"agri.bpmn"}
+    # other tests may have stored another copy of the agri mission, and the browser tests a
+    # collaboration discovered from the thesis log, whose Drone and Tractor pools bind this
+    # mission's robots too: each is offered, no other
+    names = {name.strip() for name in offered}
+    assert "agri.bpmn" in names and names <= {"agri.bpmn", "discovered.bpmn"}
     assert "rexdingo.bpmn" not in page and "none binds this log" not in page
 
 
