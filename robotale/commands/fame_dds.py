@@ -8,7 +8,7 @@ import threading
 import time
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, TextIO
+from typing import TextIO
 
 from robotale.errors import InputError
 from robotale.fame_runtime.clock import WallClock
@@ -24,9 +24,6 @@ from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.processes import interrupts
 from robotale.fame_runtime.skills import load_skills
 from robotale.fame_runtime.tags import tag_line
-
-if TYPE_CHECKING:
-    from robotale.sim.live_recording import LiveRecording
 
 
 def node_command(
@@ -97,14 +94,6 @@ def _node_verdict(node: Node, begin: float, err: TextIO) -> int:
     return 1 if engine.failures or not engine.idle else 0
 
 
-def _recording(path: Path, robots: list[str], offset: float) -> LiveRecording:
-    # A node process never records: the simulator's recorder (1.2 s to import) is loaded by a
-    # recording only.
-    from robotale.sim.live_recording import LiveRecording
-
-    return LiveRecording(path, robots, offset)
-
-
 def record_command(
     out_dir: Path,
     *,
@@ -118,7 +107,11 @@ def record_command(
     names = robot_list(robots)
     if not names:
         raise InputError("--robots names no robot (for example drone,tractor_1)")
-    recording = _recording(out_dir, names, 0.0)
+    # A node process never records: the simulator's recorder (1.2 s to import) is loaded by a
+    # recording only.
+    from robotale.sim.live_recording import LiveRecording
+
+    recording = LiveRecording(out_dir, names, 0.0)
     deadline = time.monotonic() + duration if duration is not None else float("inf")
     stopped = threading.Event()
     # Ctrl-C or SIGTERM ends a recording: the bag is closed whole below
