@@ -2,6 +2,7 @@
 
     python benchmarks/ekg_build.py [--sizes 100000 1000000] [--baseline-sizes 20000 100000]
     python benchmarks/ekg_build.py --whole-command --sizes 100000 1000000 10000000
+    python benchmarks/ekg_build.py --df-c-only --sizes 100000 1000000 [--repeat 5]
 
 ``--whole-command`` times whole ``robotale ingest`` processes against PromG's whole build
 instead (``benchmarks/whole_ingest.py``). Otherwise:
@@ -122,12 +123,23 @@ def main() -> int:
     parser.add_argument(
         "--promg-venv", type=Path, help="with --whole-command: a virtual environment with PromG"
     )
+    parser.add_argument(
+        "--df-c-only",
+        action="store_true",
+        help="only part 3, at each of --sizes: directly-follows counts against pm4py",
+    )
     args = parser.parse_args()
     if args.whole_command:
         from whole_ingest import main as whole_command
 
         return whole_command(args.sizes, max(args.repeat, 2), args.heap, args.promg_venv)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    if args.df_c_only:
+        with private_neo4j(args.heap) as driver:
+            for size in args.sizes:
+                compare_df_c_with_pm4py(driver, size, args.repeat)
+        print(f"load average after: {os.getloadavg()[0]:.1f}")
+        return 0
     with private_neo4j(args.heap) as driver:
         # Neo4j compiles each query once and its JIT warms up: measure a warm server.
         timed_build(driver, synthetic_log(10_000), "warmup", ["case", "robot", "msg_id"])

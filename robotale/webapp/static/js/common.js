@@ -103,6 +103,27 @@ const robotale = (() => {
     }
   }
 
+  // Resolves once what the page `page` shows of `log` is prepared. A log nobody prepared
+  // yet gets its preparation started by the first question; until the page's results are
+  // ready it says how far the preparation is ("preparing … N of M"), then the page goes on
+  // to show them.
+  async function prepared(log, page) {
+    const asked = `/api/preparation?${new URLSearchParams({ log, page })}`;
+    let status = await api(asked);
+    if (status.ready) return;
+    const box = document.getElementById("preparing");
+    box.hidden = false;
+    while (!status.ready) {
+      const steps = status.total ? ` ${status.done} of ${status.total}` : "";
+      const last = status.step ? ` (${status.step} done)` : "";
+      box.textContent = `preparing the pages of ${log} …${steps}${last}`;
+      await new Promise((resolve) => setTimeout(resolve, 250));
+      status = await api(asked);
+    }
+    box.hidden = true;
+    performance.mark("robotale-prepared");
+  }
+
   document.addEventListener("DOMContentLoaded", fillPicker);
-  return { api, showError, clearError, el, table, logs, currentLog };
+  return { api, showError, clearError, el, table, logs, currentLog, prepared };
 })();
