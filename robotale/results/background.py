@@ -60,10 +60,12 @@ def start(name: str) -> subprocess.Popen[bytes]:
     )
 
 
-def prepare_now(driver: Driver, name: str, logs: LogData | None = None) -> float:
-    """Prepare the pages of ``name`` here (with the logs ``logs`` keeps in memory, if given);
-    returns the seconds it took, keeps :data:`PROGRESS` and leaves :data:`DONE` in the
-    build's results folder."""
+def prepare_now(
+    driver: Driver, name: str, logs: LogData | None = None, first: Sequence[str] = ()
+) -> float:
+    """Prepare the pages of ``name`` here (with the logs ``logs`` keeps in memory, if given;
+    the steps ``first`` first); returns the seconds it took, keeps :data:`PROGRESS` and
+    leaves :data:`DONE` in the build's results folder."""
     started = time.perf_counter()
     build = current_build(driver, name)
     folder = results_folder(build)
@@ -77,7 +79,7 @@ def prepare_now(driver: Driver, name: str, logs: LogData | None = None) -> float
             write_file(folder / PROGRESS, json.dumps(known))
 
     progress(0, 0, "")
-    prepare(driver, logs or LogData(), name, progress)
+    prepare(driver, logs or LogData(), name, progress, first)
     seconds = time.perf_counter() - started
     if current_build(driver, name).complete:
         write_file(folder / DONE, json.dumps({"seconds": seconds}))
@@ -122,19 +124,21 @@ class Preparations:
             if running is not None and not running.is_alive():
                 return Preparation(ready=True)  # ours ended without DONE: the pages say why
             if running is None and not _fresh(folder / PROGRESS):  # none under way anywhere
+                # the steps of the page that asked first: it shows them as soon as they are kept
+                first = PAGE_STEPS.get(page, ())
                 running = threading.Thread(
-                    target=_prepare_quietly, args=(driver, name, logs), daemon=True
+                    target=_prepare_quietly, args=(driver, name, logs, first), daemon=True
                 )
                 self._running[(name, build.key)] = running
                 running.start()
         return _progress(folder / PROGRESS, PAGE_STEPS.get(page))
 
 
-def _prepare_quietly(driver: Driver, name: str, logs: LogData) -> None:
+def _prepare_quietly(driver: Driver, name: str, logs: LogData, first: Sequence[str]) -> None:
     """:func:`prepare_now` in a thread: a failure leaves the pages to compute what they show
     (and say why), so it is not raised."""
     with contextlib.suppress(Exception):
-        prepare_now(driver, name, logs)
+        prepare_now(driver, name, logs, first)
 
 
 def _fresh(path: Path) -> bool:

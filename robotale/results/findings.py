@@ -5,7 +5,7 @@ background, so the first visit after that computes nothing."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any
 
@@ -119,10 +119,17 @@ PAGE_STEPS: dict[str, tuple[str, ...]] = {
 }
 
 
-def prepare(driver: Driver, logs: LogData, name: str, progress: Progress | None = None) -> None:
+def prepare(
+    driver: Driver,
+    logs: LogData,
+    name: str,
+    progress: Progress | None = None,
+    first: Sequence[str] = (),
+) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
     perspectives of the whole log, the class graph beside them, the runs and the first run's
-    timeline; ``progress`` hears of each step as it is done."""
+    timeline, the steps named in ``first`` before the others (those of a page waiting for
+    them); ``progress`` hears of each step as it is done."""
     steps: list[tuple[str, Callable[[], object]]] = [
         ("findings", lambda: stored_findings(driver, logs, name)),
         ("class graph", lambda: perspectives_graph(driver, logs, name)),
@@ -134,6 +141,7 @@ def prepare(driver: Driver, logs: LogData, name: str, progress: Progress | None 
         ("runs", lambda: stored_runs(driver, logs, name)),
         ("timeline", lambda: stored_timeline(driver, logs, name, "")),
     ]
+    steps.sort(key=lambda named: named[0] not in first)  # stable: the others keep their order
     for done, (what, step) in enumerate(steps, start=1):
         try:
             step()

@@ -15,7 +15,7 @@ from playwright.sync_api import expect
 
 from robotale.enhancement.registry import page_names
 from robotale.results.background import DONE, PROGRESS
-from robotale.results.findings import stored_findings
+from robotale.results.findings import PAGE_STEPS, stored_findings
 from robotale.results.logdata import LogData
 
 
@@ -47,7 +47,7 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
 
     folder = results(neo4j_driver, unprepared_log)
     assert not (folder / DONE).exists()
-    asked = f"/api/preparation?log={unprepared_log}&page=findings"
+    asked = f"/api/preparation?log={unprepared_log}&page=perspectives"
     first = client.get(asked).json
     assert first["ready"] is False
     seen = [first]
@@ -60,7 +60,11 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
     steps = 2 + len(page_names()) + 2
     progress = json.loads((folder / PROGRESS).read_text())
     assert (progress["done"], progress["total"]) == (steps, steps)
-    assert progress["steps"][0] == "findings" and len(set(progress["steps"])) == steps
+    assert len(set(progress["steps"])) == steps
+    # the page that asked gets its own steps first, then the others in their order
+    wanted = PAGE_STEPS["perspectives"]
+    assert set(progress["steps"][: len(wanted)]) == set(wanted)
+    assert progress["steps"][len(wanted)] == "findings"
     counted = [(s["done"], s["total"]) for s in seen if s["total"]]
     assert counted == sorted(counted) and all(done <= total for done, total in counted)
     assert client.get(asked).json["ready"] is True
