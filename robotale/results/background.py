@@ -127,18 +127,25 @@ class Preparations:
                 # the steps of the page that asked first: it shows them as soon as they are kept
                 first = PAGE_STEPS.get(page, ())
                 running = threading.Thread(
-                    target=_prepare_quietly, args=(driver, name, logs, first), daemon=True
+                    target=self._prepare,
+                    args=((name, build.key), driver, logs, first),
+                    daemon=True,
                 )
                 self._running[(name, build.key)] = running
                 running.start()
         return _progress(folder / PROGRESS, PAGE_STEPS.get(page))
 
-
-def _prepare_quietly(driver: Driver, name: str, logs: LogData, first: Sequence[str]) -> None:
-    """:func:`prepare_now` in a thread: a failure leaves the pages to compute what they show
-    (and say why), so it is not raised."""
-    with contextlib.suppress(Exception):
-        prepare_now(driver, name, logs, first)
+    def _prepare(
+        self, key: tuple[str, str], driver: Driver, logs: LogData, first: Sequence[str]
+    ) -> None:
+        """:func:`prepare_now` in a thread. A failure is not raised: its thread stays on
+        record, so the pages compute what they show (and say why) instead of trying again."""
+        try:
+            prepare_now(driver, key[0], logs, first)
+        except Exception:  # whatever failed, the pages report it themselves
+            return
+        with self._lock:  # done: a later visit starts another only if the results went
+            self._running.pop(key, None)
 
 
 def _fresh(path: Path) -> bool:

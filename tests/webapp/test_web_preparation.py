@@ -5,6 +5,7 @@ they are ready; in a real Neo4j and a real headless Chromium."""
 from __future__ import annotations
 
 import json
+import shutil
 import time
 import uuid
 
@@ -75,6 +76,14 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
     kept = LogData()
     stored_findings(neo4j_driver, kept, unprepared_log)
     assert not kept.computed  # read from what the preparation kept
+    # its kept results removed (by hand, say): the next question prepares them again
+    shutil.rmtree(folder)
+    assert client.get(asked).json["ready"] is False
+    deadline = time.monotonic() + 600
+    while not (folder / DONE).exists():
+        assert time.monotonic() < deadline, "the second preparation did not finish"
+        time.sleep(0.2)
+    assert computed[(unprepared_log, "findings")] == 2
 
 
 browser = pytest.mark.browser
