@@ -13,6 +13,11 @@ stored is refused before the database is touched, and the writes are plain batch
   the same message in the same case.
 - ``starts``: ``event``, ``entity``: where each entity begins in each case (the first event of
   its chain, the one no DF edge of that entity leads to).
+- ``follows``: ``source``, ``target``, ``entityType``: consecutive activity instances of one
+  entity in one case. An activity instance is counted once, by the event that ends it (a
+  completion, an aborted or cancelled end, or an instant event); a start and an in-progress
+  sample (continuous data between them) are never instances, so DF_C counts instances as
+  pm4py's DFG of the activity instances does, not the samples recorded while one ran.
 
 :func:`class_tables` aggregates them by a key (``activity``, ``activity+robot``): the classes,
 the class of each event (OBSERVED), DF_C with counts and durations, and the entry classes,
@@ -57,6 +62,9 @@ class GraphTables:
     df: pd.DataFrame
     comm: pd.DataFrame
     starts: pd.DataFrame
+    #: ``source``, ``target`` (event positions), ``entityType``: consecutive activity
+    #: instances of one entity in one case (see :func:`instance_ends`), what DF_C aggregates
+    follows: pd.DataFrame
     first: int = 0  # the position of the first event in the stored log (> 0 when appended)
 
 
@@ -93,19 +101,14 @@ def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> 
     stored when it is appended)."""
     events = event_table(log, first)
     types = entity_types([property_name(c) for c in log.columns], entities)
-    corr_ids = _correlations(events, types)
-    if len(events) and corr_ids.empty:
+    corr, entity_table = _correlations(events, types)
+    if len(events) and corr.empty:
         raise InputError(
             f"None of the log's {len(events)} events has a value in its entity column(s) "
             f"{', '.join(types)}, so no entity and no DF edge would be built; name the columns "
             "that identify what the events belong to with --entities (e.g. --entities case)."
         )
-    entity_table = corr_ids[["type", "id"]].drop_duplicates().reset_index(drop=True)
-    position = pd.MultiIndex.from_frame(entity_table).get_indexer(
-        pd.MultiIndex.from_frame(corr_ids[["type", "id"]])
-    )
-    corr = pd.DataFrame({"event": corr_ids["event"].to_numpy(), "entity": position})
-    df, starts = _directly_follows(events, corr_ids.assign(entity=position))
+    df, starts, follows = _directly_follows(events, corr, entity_table)
     return GraphTables(
         events=events,
         entities=entity_table,
@@ -114,6 +117,7 @@ def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> 
         comm=_communication(events),
         starts=starts,
         first=first,
+        follows=follows,
     )
 
 
@@ -142,7 +146,8 @@ def event_table(log: pd.DataFrame, first: int = 0) -> pd.DataFrame:
     if "id" not in events.columns:
         events["id"] = [str(i) for i in range(first, first + len(events))]
     events["id"] = events["id"].astype("string")
-    if events["id"].isna().any() or events["id"].duplicated().any():
+    # is_unique costs about half of duplicated(), which only the message needs
+    if events["id"].isna().any() or not events["id"].is_unique:
         bad = events["id"][events["id"].isna() | events["id"].duplicated()].iloc[0]
         raise InputError(
             f"The event id {bad!r} is missing or not unique; event ids must be unique."
@@ -202,73 +207,109 @@ def _check_timestamps(times: pd.Series) -> None:
         raise InputError(f"The event log has no timestamp in row {int(times.isna().argmax())}.")
 
 
-def _correlations(events: pd.DataFrame, types: list[str]) -> pd.DataFrame:
-    parts = []
+def _correlations(events: pd.DataFrame, types: list[str]) -> tuple[pd.DataFrame, pd.DataFrame]:
+    """The CORR rows (``event``, ``entity``: positions in the events and in the entity table)
+    and the entity table (``type``, ``id``, in the order the events first name them)."""
+    corr, entities, known = [], [], 0
     for entity_type in types:
         ids = entity_ids(events[entity_type])
-        parts.append(
-            pd.DataFrame({"event": ids.index.to_numpy(), "type": entity_type, "id": ids.to_numpy()})
-        )
-    if not parts:
-        return pd.DataFrame(
-            {
-                "event": pd.Series(dtype=int),
-                "type": pd.Series(dtype="string"),
-                "id": pd.Series(dtype="string"),
-            }
-        )
-    corr = pd.concat(parts, ignore_index=True)
-    corr["type"] = corr["type"].astype("string")
-    corr["id"] = corr["id"].astype("string")
-    return corr.drop_duplicates(["event", "type", "id"]).reset_index(drop=True)
+        codes, uniques = pd.factorize(ids)
+        event = ids.index.to_numpy().astype(np.int64)
+        if ids.index.has_duplicates:  # a cell that names one entity twice: one CORR edge
+            _, unique_rows = np.unique(event * len(uniques) + codes, return_index=True)
+            keep = np.sort(unique_rows)
+            event, codes = event[keep], codes[keep]
+        corr.append(pd.DataFrame({"event": event, "entity": codes.astype(np.int64) + known}))
+        entities.append(pd.DataFrame({"type": entity_type, "id": np.asarray(uniques, object)}))
+        known += len(uniques)
+    if not corr:
+        corr.append(pd.DataFrame({"event": pd.Series(dtype=np.int64), "entity": 0}))
+        entities.append(pd.DataFrame({"type": pd.Series(dtype=object), "id": None}))
+    entity_table = pd.concat(entities, ignore_index=True).astype("string")
+    return pd.concat(corr, ignore_index=True), entity_table
 
 
 def _directly_follows(
-    events: pd.DataFrame, corr: pd.DataFrame
-) -> tuple[pd.DataFrame, pd.DataFrame]:
-    """DF edges, and the events that begin each entity's chain in each case."""
-    # as naive UTC datetime64: a zone-aware column's to_numpy() is one object per event
-    times = events["timestamp"].dt.tz_convert("UTC").dt.tz_localize(None)
-    at = corr["event"].to_numpy()
-    event = at.astype(np.int64)
-    # sorted by type, id, case and time as integers (each text's rank among its values) in
-    # one lexsort: sorting the texts themselves costs several times more. Sorting by event
-    # position last makes the log order break ties between equal times.
-    kinds, ids = _ranks(corr["type"]), _ranks(corr["id"])
-    cases = _ranks(pd.Series(events["case"].astype("string").to_numpy()[at]))
-    order = np.lexsort((event, times.to_numpy().view(np.int64)[at], cases, ids, kinds))
-    kinds, ids, cases = kinds[order], ids[order], cases[order]
-    # two rows follow each other when type, id and case are equal (a missing case never is)
-    same = np.zeros(len(order), dtype=bool)
-    same[:-1] = (kinds[1:] == kinds[:-1]) & (ids[1:] == ids[:-1]) & (cases[1:] == cases[:-1])
-    same[:-1] &= cases[:-1] != _MISSING
-    ordered_event = event[order]
-    sources = order[same]
+    events: pd.DataFrame, corr: pd.DataFrame, entities: pd.DataFrame
+) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
+    """DF edges, the events that begin each entity's chain in each case, and the DF edges of
+    the activity instances (the chains without the events that end no instance)."""
+    event = corr["event"].to_numpy().astype(np.int64)
+    entity = corr["entity"].to_numpy().astype(np.int64)
+    # one integer per entity and case: two rows are in one chain when it is equal (a missing
+    # case is in none); integers sort several times faster than the texts they stand for
+    cases, names = pd.factorize(events["case"].astype("string"))
+    case = cases.astype(np.int64)[event]
+    chain = entity * (len(names) + 1) + case
+    chain[case < 0] = -1 - np.arange(int((case < 0).sum()))  # each a chain of its own
+    # sorting by event position last makes the log order break ties between equal times
+    order = np.lexsort((event, _utc_ticks(events)[event], chain))
+    ordered_event, ordered_entity, ordered_chain = event[order], entity[order], chain[order]
+    same = ordered_chain[1:] == ordered_chain[:-1]
+    # each entity's type and id taken from the entity table's own arrays: an array of
+    # Python strings would be converted into one again, which costs more than the rest
+    kinds = entities["type"].array
+    sources = ordered_entity[:-1][same]
     df = pd.DataFrame(
         {
-            "source": ordered_event[same],
-            "target": ordered_event[1:][same[:-1]],
-            "entityType": corr["type"].to_numpy()[sources],
-            "entityId": corr["id"].to_numpy()[sources],
+            "source": ordered_event[:-1][same],
+            "target": ordered_event[1:][same],
+            "entityType": kinds.take(sources),
+            "entityId": entities["id"].array.take(sources),
         }
     )
     # A chain begins where no DF edge arrives: the first row, and every row after a last one.
-    begins = np.concatenate([[True], ~same[:-1]]) if len(same) else same
-    return df, pd.DataFrame(
-        {"event": ordered_event[begins], "entity": corr["entity"].to_numpy()[order[begins]]}
+    begins = np.concatenate([[True], ~same]) if len(order) else np.zeros(0, dtype=bool)
+    starts = pd.DataFrame({"event": ordered_event[begins], "entity": ordered_entity[begins]})
+    return (
+        df,
+        starts,
+        _instance_follows(events, ordered_event, ordered_entity, ordered_chain, kinds),
     )
 
 
-#: the rank :func:`_ranks` gives a missing value: after every other
-_MISSING = np.iinfo(np.int64).max
+def _instance_follows(
+    events: pd.DataFrame,
+    ordered_event: np.ndarray,
+    ordered_entity: np.ndarray,
+    ordered_chain: np.ndarray,
+    kinds: pd.api.extensions.ExtensionArray,
+) -> pd.DataFrame:
+    """Consecutive activity instances of each chain: the chains in their order, without the
+    events that end no instance."""
+    kept = instance_ends(events)[ordered_event]
+    event, entity, chain = ordered_event[kept], ordered_entity[kept], ordered_chain[kept]
+    same = chain[1:] == chain[:-1]
+    return pd.DataFrame(
+        {
+            "source": event[:-1][same],
+            "target": event[1:][same],
+            "entityType": kinds.take(entity[:-1][same]),
+        }
+    )
 
 
-def _ranks(values: pd.Series) -> np.ndarray:
-    """Each value's rank among the distinct values in pandas' sort order (missing last)."""
-    factorized, _ = pd.factorize(values, sort=True)
-    codes: np.ndarray = factorized.astype(np.int64)
-    codes[codes < 0] = _MISSING
-    return codes
+def instance_ends(events: pd.DataFrame) -> np.ndarray:
+    """Which events end an activity instance: every event but a start (lifecycle ``start``)
+    and an in-progress sample (state ``inprogress``), as ``cypher/discover_classes.cypher``
+    and ``cypher/ekg_aggregate_df_c.cypher`` tell them in a stored log."""
+    ends = np.ones(len(events), dtype=bool)
+    for column, value in (("lifecycle", schema.START), ("state", schema.INPROGRESS)):
+        if column in events.columns:
+            # a log repeats a handful of values: compare each distinct one once
+            codes, uniques = pd.factorize(events[column])
+            matches = np.append(np.asarray(uniques, dtype=object) == value, False)
+            ends &= ~matches[codes]
+    return ends
+
+
+def _utc_ticks(events: pd.DataFrame) -> np.ndarray:
+    """The events' times as nanoseconds since the epoch (UTC), compared as integers."""
+    times = events["timestamp"].dt.tz_convert("UTC").dt.as_unit("ns")
+    ticks: np.ndarray = (
+        times.array.asi8 if hasattr(times.array, "asi8") else times.astype("int64").to_numpy()
+    )
+    return ticks
 
 
 def communication_roles(events: pd.DataFrame) -> np.ndarray:
@@ -326,8 +367,14 @@ def class_tables(tables: GraphTables, key: Sequence[str]) -> ClassTables:
     interpolates between the middle two, as ``percentileCont(x, 0.5)`` does.
     """
     events = tables.events
-    codes, ids = pd.factorize(_class_ids(events, key))
-    first = pd.Series(np.arange(len(codes))).groupby(codes).first().to_numpy()
+    codes = _class_codes(events, key)
+    first = np.zeros(int(codes.max()) + 1 if len(codes) else 0, dtype=np.int64)
+    first[codes[::-1]] = np.arange(len(codes))[::-1]  # each class's first event
+    ids = _class_ids(events.iloc[first], key)
+    if ids.duplicated().any():  # values told apart whose texts are the same: one class
+        codes, unique_ids = pd.factorize(_class_ids(events, key))
+        first = pd.Series(np.arange(len(codes))).groupby(codes).first().to_numpy()
+        ids = pd.Series(unique_ids)
     classes = events[list(key)].iloc[first].reset_index(drop=True).assign(id=ids.to_numpy())
     return ClassTables(
         type="+".join(key),
@@ -337,6 +384,20 @@ def class_tables(tables: GraphTables, key: Sequence[str]) -> ClassTables:
         df_c=_df_c(tables, codes),
         entries=_entries(tables.starts, codes),
     )
+
+
+def _class_codes(events: pd.DataFrame, key: Sequence[str]) -> np.ndarray:
+    """Each event's class, numbered in the order the classes first appear. The key's values
+    are compared as they are: writing every value as text first costs several times more
+    (values of mixed types, compared as objects, are compared as their text)."""
+    combined = np.zeros(len(events), dtype=np.int64)
+    for name in key:
+        values = events[name]
+        if pd.api.types.is_object_dtype(values):
+            values = _neo4j_text(values)
+        codes, uniques = pd.factorize(values, use_na_sentinel=False)
+        combined = pd.factorize(combined * len(uniques) + codes)[0].astype(np.int64)
+    return pd.factorize(combined)[0]
 
 
 def _class_ids(events: pd.DataFrame, key: Sequence[str]) -> pd.Series:
@@ -359,26 +420,42 @@ def _neo4j_text(values: pd.Series) -> pd.Series:
 
 
 def _seconds_between(events: pd.DataFrame, source: np.ndarray, target: np.ndarray) -> np.ndarray:
-    nanos = events["timestamp"].dt.tz_convert("UTC").dt.as_unit("ns").astype("int64").to_numpy()
-    seconds, part = np.divmod(nanos, 1_000_000_000)
+    seconds, part = np.divmod(_utc_ticks(events), 1_000_000_000)
     between: np.ndarray = (seconds[target] - seconds[source]) + (part[target] - part[source]) / 1e9
     return between
 
 
 def _df_c(tables: GraphTables, codes: np.ndarray) -> pd.DataFrame:
-    df = tables.df
-    source, target = df["source"].to_numpy(), df["target"].to_numpy()
-    edges = pd.DataFrame(
+    """DF_C: the instance DF edges grouped by their classes and entity type, with their
+    count and the mean and median seconds between the two instances' ends."""
+    follows = tables.follows
+    source, target = follows["source"].to_numpy(), follows["target"].to_numpy()
+    kinds, names = pd.factorize(follows["entityType"])
+    classes = int(codes.max()) + 1 if len(codes) else 0
+    # one integer per (source class, target class, entity type): numpy groups it faster than
+    # pandas groups three columns
+    key = (codes[source].astype(np.int64) * classes + codes[target]) * max(len(names), 1) + kinds
+    seconds = _seconds_between(tables.events, source, target)
+    # by key, each key's seconds in order (for the median): two argsorts cost half a lexsort
+    by_seconds = np.argsort(seconds)
+    order = by_seconds[np.argsort(key[by_seconds], kind="stable")]
+    key, seconds = key[order], seconds[order]
+    first = np.flatnonzero(np.concatenate([[True], key[1:] != key[:-1]])) if len(key) else key
+    count = np.diff(np.append(first, len(key)))
+    # the median of each group's sorted seconds: the middle one, or halfway between the two
+    median = (seconds[first + (count - 1) // 2] + seconds[first + count // 2]) / 2
+    groups = key[first]
+    pair, kind = np.divmod(groups, max(len(names), 1))
+    return pd.DataFrame(
         {
-            "source": codes[source],
-            "target": codes[target],
-            "entityType": df["entityType"].to_numpy(),
-            "seconds": _seconds_between(tables.events, source, target),
+            "source": pair // max(classes, 1),
+            "target": pair % max(classes, 1),
+            "entityType": np.asarray(names, dtype=object)[kind] if len(names) else kind,
+            "count": count,
+            "meanSeconds": np.add.reduceat(seconds, first) / count if len(key) else seconds,
+            "medianSeconds": median,
         }
     )
-    grouped = edges.groupby(["source", "target", "entityType"], sort=True)["seconds"]
-    result = grouped.agg(["count", "mean", "median"]).reset_index()
-    return result.rename(columns={"mean": "meanSeconds", "median": "medianSeconds"})
 
 
 def _entries(starts: pd.DataFrame, codes: np.ndarray) -> pd.DataFrame:

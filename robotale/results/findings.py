@@ -5,7 +5,7 @@ background, so the first visit after that computes nothing."""
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any
 
@@ -109,23 +109,45 @@ def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict[str, An
     return logs.class_graph(driver, name, first_key(types))
 
 
-def prepare(driver: Driver, logs: LogData, name: str) -> None:
+#: what :func:`prepare` reports after each step: steps done, steps in all, the step done
+Progress = Callable[[int, int, str], None]
+#: the steps of :func:`prepare` each page shows the results of, by page
+PAGE_STEPS: dict[str, tuple[str, ...]] = {
+    "findings": ("findings",),
+    "perspectives": ("class graph", *page_names()),
+    "timeline": ("runs", "timeline"),
+}
+
+
+def prepare(
+    driver: Driver,
+    logs: LogData,
+    name: str,
+    progress: Progress | None = None,
+    first: Sequence[str] = (),
+) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
     perspectives of the whole log, the class graph beside them, the runs and the first run's
-    timeline."""
-    steps: list[Callable[[], object]] = [
-        lambda: stored_findings(driver, logs, name),
-        lambda: perspectives_graph(driver, logs, name),
+    timeline, the steps named in ``first`` before the others (those of a page waiting for
+    them); ``progress`` hears of each step as it is done."""
+    steps: list[tuple[str, Callable[[], object]]] = [
+        ("findings", lambda: stored_findings(driver, logs, name)),
+        ("class graph", lambda: perspectives_graph(driver, logs, name)),
     ]
-    steps += [partial(stored_perspective, driver, logs, name, which) for which in page_names()]
     steps += [
-        lambda: stored_runs(driver, logs, name),
-        lambda: stored_timeline(driver, logs, name, ""),
+        (which, partial(stored_perspective, driver, logs, name, which)) for which in page_names()
     ]
-    for step in steps:
+    steps += [
+        ("runs", lambda: stored_runs(driver, logs, name)),
+        ("timeline", lambda: stored_timeline(driver, logs, name, "")),
+    ]
+    steps.sort(key=lambda named: named[0] not in first)  # stable: the others keep their order
+    for done, (what, step) in enumerate(steps, start=1):
         try:
             step()
         except RobotaleError:  # the page says why when it is visited; the rest is still useful
-            continue
+            pass
         except (Neo4jError, DriverError, OSError):  # Neo4j or the log went away: a visit says so
             return
+        if progress is not None:
+            progress(done, len(steps), what)

@@ -20,6 +20,7 @@ from robotale.webapp.views import (
     mission,
     model,
     perspectives,
+    preparation,
     timeline,
 )
 
@@ -44,6 +45,7 @@ PAGES: tuple[Page, ...] = (
     Page(findings, "Findings"),
     Page(discover, "Discover"),
     Page(aggregation),  # the Discover page's aggregation requests
+    Page(preparation),  # how far a log's pages are prepared
     Page(perspectives, "Perspectives"),
     Page(timeline, "Timeline"),
     Page(mission, "Mission"),

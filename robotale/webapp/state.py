@@ -14,6 +14,7 @@ from dataclasses import dataclass, field
 from flask import Flask, current_app
 from neo4j import Driver
 
+from robotale.results.background import Preparations
 from robotale.results.logdata import Cache, LogData
 from robotale.webapp.console_pool import Pool
 from robotale.webapp.ingest import PendingLogs
@@ -38,6 +39,8 @@ class AppState:
     pending: PendingLogs = field(default_factory=PendingLogs)
     #: stored logs' DataFrames, class graphs and the results the pages show
     logs: LogData = field(default_factory=LogData)
+    #: the preparations of logs' pages this dashboard started (a page visited first)
+    preparations: Preparations = field(default_factory=Preparations)
     #: the Model page's frequencies and deviations
     overlays: Cache = field(default_factory=lambda: Cache(OVERLAYS_KEPT))
 

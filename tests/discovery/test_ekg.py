@@ -7,6 +7,7 @@ import uuid
 import pandas as pd
 import pm4py
 import pytest
+from instance_frames import instance_frame
 
 from robotale.cli import main
 from robotale.discovery import discover_ekg
@@ -36,7 +37,9 @@ def by_robot(stored, neo4j_driver):
 
 
 def test_per_robot_df_counts_equal_pm4py(by_robot, thesis_log):
-    for robot, events in thesis_log.groupby(ROBOT):
+    """DF_C aggregated in Neo4j for a key the log was not stored with, against pm4py's DFG of
+    each robot's activity instances."""
+    for robot, events in instance_frame(thesis_log).groupby(ROBOT):
         expected, _, _ = pm4py.discover_dfg(events.assign(**{"case:concept:name": robot}))
         activity = {n.id: n.properties.get("activity") for n in by_robot.nodes}
         edges = {

@@ -7,13 +7,16 @@ import uuid
 import pandas as pd
 import pm4py
 import pytest
+from instance_frames import instance_frame
 
+from robotale.discovery.ekg import discover_ekg
 from robotale.ekg import build_ekg
 from robotale.ekg.aggregate import aggregate
 from robotale.ekg.connection import database
 from robotale.ekg.logs import delete_log, list_logs, log_summary
 from robotale.errors import InputError
 from robotale.eventlog import schema
+from robotale.eventlog.readers import read_csv
 from robotale.queries import cypher
 
 
@@ -59,43 +62,140 @@ def test_counts_match_the_log(neo4j_driver, thesis_ekg, thesis_log, thesis_csv):
     )
 
 
-def test_df_c_of_activities_per_robot_equals_pm4py(neo4j_driver, thesis_ekg, thesis_log):
-    name, _ = thesis_ekg
-    edges = query(neo4j_driver, "ekg_class_graph", log=name, type="activity", entityType="robot")
-    ours = {(e["source"]["activity"], e["target"]["activity"]): e["count"] for e in edges}
-    dfg, _, _ = pm4py.discover_dfg(
-        thesis_log,
-        case_id_key=schema.ROBOT,
-        activity_key=schema.ACTIVITY,
-        timestamp_key=schema.TIMESTAMP,
-    )
-    assert ours == dict(dfg)
-    assert len(ours) > 20
+def class_graph(driver, name: str, kind: str, entity_type: str) -> dict:
+    edges = query(driver, "ekg_class_graph", log=name, type=kind, entityType=entity_type)
+    return {
+        (e["source"]["id"], e["target"]["id"]): (e["count"], e["meanSeconds"], e["medianSeconds"])
+        for e in edges
+    }
 
 
-def test_df_c_durations_are_the_mean_and_median_of_the_df_edges(
+def test_df_c_of_activities_per_robot_equals_pm4py_on_the_activity_instances(
     neo4j_driver, thesis_ekg, thesis_log
 ):
+    """Counts, mean and median seconds of every DF_C edge against pm4py's DFG and performance
+    DFG of the activity instances, each robot's flow a case (the thesis' log is one case)."""
     name, _ = thesis_ekg
-    # Independently: consecutive events per robot in pandas, time then file order.
-    log = thesis_log.assign(order=range(len(thesis_log)))
-    log = log.sort_values([schema.ROBOT, schema.TIMESTAMP, "order"], kind="stable")
-    after = log.groupby(schema.ROBOT).shift(-1)
+    instances = instance_frame(thesis_log)
+    keys = {
+        "case_id_key": schema.ROBOT,
+        "activity_key": schema.ACTIVITY,
+        "timestamp_key": schema.TIMESTAMP,
+    }
+    dfg, _, _ = pm4py.discover_dfg(instances, **keys)
+    performance, _, _ = pm4py.discover_performance_dfg(instances, **keys)
+    ours = class_graph(neo4j_driver, name, "activity", "robot")
+    assert {pair: count for pair, (count, _, _) in ours.items()} == dict(dfg)
+    for pair, (_, mean, median) in ours.items():
+        assert mean == pytest.approx(performance[pair]["mean"], abs=1e-6)
+        assert median == pytest.approx(performance[pair]["median"], abs=1e-6)
+    # figure 7.4's edge: an Explore the low battery interrupted is an instance too
+    assert len(ours) > 20 and sum(count for count, _, _ in ours.values()) == len(instances) - 3
+
+
+def test_df_c_of_messages_counts_consecutive_instances(neo4j_driver, thesis_ekg, thesis_log):
+    """Each message's instances in pandas, in time then log order (pm4py orders the events
+    of one instant otherwise, and a message's send and receive often share one)."""
+    name, _ = thesis_ekg
+    instances = instance_frame(thesis_log).dropna(subset=[schema.MSG_ID])
+    instances = instances.sort_values(schema.MSG_ID, kind="stable")
+    after = instances.groupby(schema.MSG_ID)[[schema.ACTIVITY, schema.TIMESTAMP]].shift(-1)
     pairs = pd.DataFrame(
         {
-            "a": log[schema.ACTIVITY],
+            "a": instances[schema.ACTIVITY],
             "b": after[schema.ACTIVITY],
-            "seconds": (after[schema.TIMESTAMP] - log[schema.TIMESTAMP]).dt.total_seconds(),
+            "seconds": (after[schema.TIMESTAMP] - instances[schema.TIMESTAMP]).dt.total_seconds(),
         }
     ).dropna()
     expected = pairs.groupby(["a", "b"])["seconds"].agg(["count", "mean", "median"])
-    edges = query(neo4j_driver, "ekg_class_graph", log=name, type="activity", entityType="robot")
-    assert len(edges) == len(expected)
-    for edge in edges:
-        row = expected.loc[(edge["source"]["activity"], edge["target"]["activity"])]
-        assert edge["count"] == row["count"]
-        assert edge["meanSeconds"] == pytest.approx(row["mean"], abs=1e-3)
-        assert edge["medianSeconds"] == pytest.approx(row["median"], abs=1e-3)
+    ours = class_graph(neo4j_driver, name, "activity", "msg_id")
+    assert set(ours) == set(expected.index)
+    for pair, (count, mean, median) in ours.items():
+        assert count == expected.loc[pair, "count"], pair
+        assert (mean, median) == pytest.approx(tuple(expected.loc[pair, ["mean", "median"]]))
+
+
+def test_df_c_in_cypher_equals_df_c_at_ingest(neo4j_driver, thesis_ekg, thesis_log, log_name):
+    """A stored log aggregated again in Neo4j (cypher/ekg_aggregate_df_c.cypher) gets the DF_C
+    the ingest computed in pandas, edge by edge."""
+    name, _ = thesis_ekg
+    build_ekg(
+        neo4j_driver,
+        thesis_log,
+        log_name,
+        entities=["robot", "msg_id"],
+        aggregate=[],
+        progress=False,
+    )
+    aggregate(neo4j_driver, log_name, "activity,robot")
+    for entity_type in ("robot", "msg_id"):
+        at_ingest = class_graph(neo4j_driver, name, "activity+robot", entity_type)
+        in_cypher = class_graph(neo4j_driver, log_name, "activity+robot", entity_type)
+        assert in_cypher.keys() == at_ingest.keys() and len(at_ingest) > 10
+        for pair, (count, mean, median) in at_ingest.items():
+            assert in_cypher[pair][0] == count, pair
+            assert in_cypher[pair][1:] == pytest.approx((mean, median), abs=1e-6), pair
+
+
+#: a robot exploring with in-progress samples, scanning, exploring again until its battery
+#: runs low (the Explore aborted at that instant), then starting an Explore that never ends;
+#: another robot moving twice. Seconds after 10:00.
+SAMPLED = [
+    (0, "explore", "start", "", "r1"),
+    (1, "explore", "", "inprogress", "r1"),
+    (2, "explore", "", "inprogress", "r1"),
+    (3, "explore", "complete", "", "r1"),
+    (4, "scan", "start", "", "r1"),
+    (5, "scan", "complete", "", "r1"),
+    (6, "explore", "start", "", "r1"),
+    (7, "explore", "", "inprogress", "r1"),
+    (8, "explore", "ate_abort", "", "r1"),
+    (8, "low_battery", "instant", "", "r1"),
+    (9, "explore", "start", "", "r1"),
+    (1, "move", "start", "", "r2"),
+    (2, "move", "", "inprogress", "r2"),
+    (4, "move", "complete", "", "r2"),
+    (5, "move", "start", "", "r2"),
+    (6, "move", "complete", "", "r2"),
+]
+
+
+def test_df_c_and_class_counts_by_hand_keep_instances_and_samples_apart(
+    neo4j_driver, log_name, tmp_path
+):
+    """Counted by hand from SAMPLED: each robot's consecutive activity instances (an
+    instance counted once, by the event that ends it; samples and starts none), at ingest
+    (pandas) and aggregated again in Neo4j (Cypher) alike."""
+    rows = [
+        f"2024-01-01T10:00:{second:02d}+00:00,{activity},{lifecycle},{state},{robot}"
+        for second, activity, lifecycle, state, robot in SAMPLED
+    ]
+    path = tmp_path / "sampled.csv"
+    path.write_text("\n".join(["time,activity,lifecycle,state,robot", *rows]) + "\n")
+    build_ekg(
+        neo4j_driver,
+        read_csv(path),
+        log_name,
+        entities=["robot"],
+        aggregate=["activity"],
+        progress=False,
+    )
+    expected = {
+        ("explore", "scan"): (1, 2.0, 2.0),
+        ("scan", "explore"): (1, 3.0, 3.0),
+        ("explore", "low_battery"): (1, 0.0, 0.0),
+        ("move", "move"): (1, 2.0, 2.0),
+    }
+    assert class_graph(neo4j_driver, log_name, "activity", "robot") == expected
+    aggregate(neo4j_driver, log_name, "activity")
+    assert class_graph(neo4j_driver, log_name, "activity", "robot") == expected
+    graph = discover_ekg(log_name, "activity", driver=neo4j_driver)
+    counts = {
+        node.label: (node.count, node.properties["samples"])
+        for node in graph.nodes
+        if node.kind != "entity"
+    }
+    assert counts == {"explore": (2, 3), "scan": (1, 0), "low_battery": (1, 0), "move": (2, 1)}
 
 
 def test_comm_joins_each_send_to_each_receive_of_its_message(neo4j_driver, thesis_ekg, thesis_csv):
@@ -131,7 +231,7 @@ def test_classes_per_activity_and_robot(neo4j_driver, thesis_ekg, thesis_log):
         assert edge["source"]["robot"] == edge["target"]["robot"]
         assert edge["source"]["id"] == f"{edge['source']['activity']}|{edge['source']['robot']}"
     per_robot = {}
-    for robot, part in thesis_log.groupby(schema.ROBOT):
+    for robot, part in instance_frame(thesis_log).groupby(schema.ROBOT):
         dfg, _, _ = pm4py.discover_dfg(part, case_id_key=schema.ROBOT)
         per_robot |= {(a, b, robot): n for (a, b), n in dfg.items()}
     ours = {
@@ -171,28 +271,3 @@ def test_reaggregating_a_stored_log(neo4j_driver, thesis_ekg, graph_counts):
         aggregate(neo4j_driver, name, "activity,battery")
     with pytest.raises(InputError, match="There is no log named 'no such log'"):
         aggregate(neo4j_driver, "no such log", "activity")
-
-
-@pytest.mark.parametrize("entity_type", ["robot", "msg_id"])
-def test_df_c_written_at_ingest_equals_pm4py_per_entity_type(
-    neo4j_driver, thesis_ekg, thesis_log, entity_type
-):
-    """Counts, mean and median seconds of every DF_C edge, against pm4py's DFG and
-    performance DFG with the entity as the case (the thesis' log is one case)."""
-    name, _ = thesis_ekg
-    column = {"robot": schema.ROBOT, "msg_id": schema.MSG_ID}[entity_type]
-    events = thesis_log.dropna(subset=[column])
-    keys = {"case_id_key": column, "activity_key": schema.ACTIVITY}
-    dfg, _, _ = pm4py.discover_dfg(events, timestamp_key=schema.TIMESTAMP, **keys)
-    performance, _, _ = pm4py.discover_performance_dfg(
-        events, timestamp_key=schema.TIMESTAMP, **keys
-    )
-    edges = query(
-        neo4j_driver, "ekg_class_graph", log=name, type="activity", entityType=entity_type
-    )
-    ours = {(e["source"]["id"], e["target"]["id"]): e for e in edges}
-    assert {pair: e["count"] for pair, e in ours.items()} == dict(dfg)
-    for pair, edge in ours.items():
-        assert edge["meanSeconds"] == pytest.approx(performance[pair]["mean"], abs=1e-6)
-        assert edge["medianSeconds"] == pytest.approx(performance[pair]["median"], abs=1e-6)
-    assert len(ours) > 10 and any(e["medianSeconds"] != e["meanSeconds"] for e in edges)

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import shutil
 
 import pandas as pd
@@ -31,7 +32,17 @@ def test_ingest_list_show_delete(tmp_path, capsys, neo4j_driver, log_name, thesi
     )
     assert code == 0, err
     assert f"Log '{log_name}': 3,648 events" in out
-    assert "DF_C      activity+robot 93" in out
+    # the edges between consecutive activity instances of each robot and each message, by
+    # activity and robot, counted in pandas from the completions (the log has no samples)
+    ends = pd.read_csv(thesis_csv).query("lifecycle != 'start'")
+    ends = ends.sort_values("time", kind="stable")  # one offset: the text sorts as the time
+    pairs = set()
+    for column in ("resource", "msg_id"):
+        chains = ends.dropna(subset=[column]).groupby(column, sort=False)
+        for _, chain in chains:
+            classes = list(zip(chain["activity"], chain["resource"], strict=True))
+            pairs |= {(column, *a, *b) for a, b in itertools.pairwise(classes)}
+    assert f"DF_C      activity+robot {len(pairs)}" in out
 
     code, out, _ = run(capsys, "logs", "list")
     line = next(line for line in out.splitlines() if line.startswith(log_name))

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import threading
-
 from flask import (
     Blueprint,
     abort,
@@ -19,7 +17,6 @@ from robotale.ekg.columnar import delete_copies
 from robotale.ekg.logs import delete_log, list_logs, require_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping
-from robotale.results.findings import prepare
 from robotale.webapp import ingest, pages, uploads
 from robotale.webapp.jobs import Jobs
 from robotale.webapp.settings import WebSettings
@@ -126,12 +123,13 @@ def start_ingest(token: str):
     pending_logs().pop(token)
     replace = request.form.get("replace") == "on"
     connected, models, logs = driver(), state().models, state().logs
+    preparations = state().preparations
 
     def work(job):
         stored = ingest.ingest(connected, pending, name, entities, replace, models, logs, job)
         # the findings, perspectives and timeline, prepared while the user reads that the log
-        # is stored (a visit before they are ready waits for this one computation)
-        threading.Thread(target=prepare, args=(connected, logs, name), daemon=True).start()
+        # is stored (a page visited before they are ready shows how far they are)
+        preparations.status(connected, logs, name)
         return stored
 
     job = jobs().submit(f"Storing {name}", work)

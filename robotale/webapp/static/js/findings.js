@@ -57,6 +57,8 @@
       status.textContent = "No log yet: upload one on the Logs page.";
       return;
     }
+    // a log nobody prepared: wait for its preparation (its requests then say what is wrong)
+    await robotale.prepared(log, "findings").catch(() => {});
     try {
       const asked = new URLSearchParams({ log });
       const delay = new URLSearchParams(window.location.search).get("delay");

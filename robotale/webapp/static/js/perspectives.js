@@ -154,6 +154,8 @@
       focusLabel.textContent = "no log yet: upload one on the Logs page";
       return;
     }
+    // a log nobody prepared: wait for its preparation (its requests then say what is wrong)
+    await robotale.prepared(log, "perspectives").catch(() => {});
     const info = (await robotale.logs()).find((l) => l.name === log) || { entityTypes: [] };
     const by = (info.entityTypes || []).includes("robot") ? "&by=robot" : "";
     robotalePerspective.preload();

@@ -53,6 +53,8 @@
       status.textContent = "No log yet: upload one on the Logs page.";
       return;
     }
+    // a log nobody prepared: wait for its preparation (its requests then say what is wrong)
+    await robotale.prepared(log, "timeline").catch(() => {});
     try {
       const { runs } = await robotale.api(`/api/timeline/runs?log=${encodeURIComponent(log)}`);
       picker.replaceChildren(...runs.map((run) => robotale.el("option", { value: String(run.case), text: String(run.case) })));
