@@ -46,6 +46,7 @@ import tempfile
 import time
 from pathlib import Path
 
+import importer_bound
 import numpy as np
 import pandas as pd
 
@@ -220,6 +221,7 @@ def measure_build(driver, size: int, repeat: int) -> None:
         f"{event_properties(log)} properties each and {edges:,} relationships by trivial "
         f"UNWIND ... CREATE batches: {plain:6.1f} s; the build takes {seconds / plain:.2f}x that"
     )
+    importer_bound.print_bound(nodes, event_properties(log), edges, seconds)
 
 
 def event_properties(log: pd.DataFrame) -> int:

@@ -37,8 +37,9 @@ import pandas as pd
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
+import importer_bound  # noqa: E402
 import peers  # noqa: E402
-from ekg_build import synthetic_log  # noqa: E402
+from ekg_build import event_properties, synthetic_log  # noqa: E402
 
 #: the rows both builders make the same of one log: (row, robotale's key, PromG's key)
 SAME_ROWS = ("events", "entities", "CORR", "classes", "OBSERVED")
@@ -89,7 +90,7 @@ def measure(size: int, repeat: int, work: Path, driver, server, python, why_not)
             run, why_not = promg_whole(python, driver, server, log, work)
             if run is not None:
                 theirs.append(run)
-    report(size, ours, theirs, why_not)
+    report(size, ours, theirs, why_not, event_properties(log))
 
 
 def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
@@ -204,7 +205,9 @@ def same_counts(ours: dict[str, int], theirs: dict[str, int]) -> list[str]:
     ]
 
 
-def report(size: int, ours: list[Run], theirs: list[Run], why_not: str | None) -> None:
+def report(
+    size: int, ours: list[Run], theirs: list[Run], why_not: str | None, properties: int
+) -> None:
     mine = best(ours)
     pages = (
         f"{mine.pages:.1f} s after it, in the background"
@@ -217,6 +220,8 @@ def report(size: int, ours: list[Run], theirs: list[Run], why_not: str | None) -
         f"{mine.peak_mb:,.0f} MB; pages prepared {pages} (best of {len(ours)}; load "
         f"average {os.getloadavg()[0]:.1f})"
     )
+    nodes, edges = importer_bound.shape(mine.counts)
+    importer_bound.print_bound(nodes, properties, edges, mine.wall)
     if not theirs:
         print(f"  PromG: not run. {why_not}")
         return

@@ -78,3 +78,29 @@ def test_the_whole_ingests_graphs_are_checked_equal_where_both_build_the_same(
     assert whole.same_counts(ours, fewer) == [
         f"CORR: robotale {ours['relationship:CORR']:,}, PromG {fewer['relationship:CORR']:,}"
     ]
+
+
+def test_the_importers_bound_checks_what_it_imported():
+    importer_bound = benchmark("importer_bound")
+    done = importer_bound.importer_seconds(200, 5, 700)
+    # the importer's own report, read back: the graph asked for, counted by Neo4j
+    assert done.imported == (200, 700, 1000)
+    assert 0 < done.own <= done.wall
+
+
+def test_the_importers_report_is_read_and_a_short_one_is_refused():
+    importer_bound = benchmark("importer_bound")
+    report = (
+        "IMPORT DONE in 1m 2s 500ms. \nImported:\n  12 nodes\n  30 relationships\n  60 properties"
+    )
+    done = importer_bound.parse_report(report)
+    assert (done.own, done.imported) == (62.5, (12, 30, 60))
+    with pytest.raises(SystemExit, match="not understood"):
+        importer_bound.parse_report("IMPORT DONE in 3s 1ms. \nImported:\n  12 nodes")
+
+
+def test_the_graphs_shape_counts_each_node_once_and_every_relationship():
+    importer_bound = benchmark("importer_bound")
+    counts = {"node:Event": 10, "node:Entity": 3, "node:Class": 2, "node:Robot": 3}
+    counts |= {"relationship:DF": 9, "relationship:CORR": 12}
+    assert importer_bound.shape(counts) == (15, 21)
