@@ -290,7 +290,8 @@ def _write(
         loader.run("aggr_create_members", {"members": members, "aggregates": owners})
         lifted = edges.lift(members, owners)
         if len(lifted):
-            loader.run(
+            # every lifted edge reaches one of this step's few aggregates: one batch at a time
+            Loader(driver, log, None, between_batches, workers=1).run(
                 "aggr_create_lifted",
                 {
                     "kinds": lifted["kind"].tolist(),
