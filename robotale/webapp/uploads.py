@@ -21,20 +21,17 @@ from pathlib import Path, PurePosixPath
 from typing import BinaryIO
 
 from robotale.errors import InputError
+from robotale.eventlog import ocel
 
+#: an OCEL 2.0 encoding -> the kind (and stored ending) of its uploads
+_OCEL_KINDS = {"json": "jsonocel", "xml": "xmlocel", "sqlite": "sqlite"}
 #: extension -> kind of upload
 KINDS = {
     ".csv": "csv",
     ".xes": "xes",
     ".zip": "zip",
-    # OCEL 2.0: the stored copy's ending tells the OCEL reader the encoding
-    ".jsonocel": "jsonocel",
-    ".json": "jsonocel",
-    ".xmlocel": "xmlocel",
-    ".xml": "xmlocel",
-    ".sqlite": "sqlite",
-    ".sqlite3": "sqlite",
-    ".db": "sqlite",
+    # OCEL 2.0, by the endings its reader knows; the stored copy's ending tells it the encoding
+    **{suffix: _OCEL_KINDS[encoding] for suffix, encoding in ocel.SUFFIXES.items()},
 }
 #: what a text upload of each kind is, for messages
 _TEXT_KINDS = {
