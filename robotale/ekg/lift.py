@@ -1,7 +1,7 @@
 """The edges an aggregation step lifts, computed in memory from one reading of the log.
 
-The CORR, DF and COMM edges the build wrote are read once per run (element ids, as columns)
-and kept as integer codes; so is which aggregate holds each node already collapsed. A step
+The CORR, DF and COMM edges the build wrote are read once per run (element ids, as columns,
+a range of events per query) and kept as integer codes; so is which aggregate holds each node already collapsed. A step
 then needs no reading at all: the edges that touch its members are found with numpy, their
 other ends mapped to what stands for them at this level (the aggregate holding the node, else
 the node), counted per pair, kind and entity type with pandas, and written in batches
@@ -25,6 +25,8 @@ from robotale.queries import cypher
 
 #: a node no aggregate holds
 FREE = -1
+#: events whose edges are read in one query
+EDGE_PAGE = 100_000
 
 
 @dataclass
@@ -40,10 +42,7 @@ class LogEdges:
 
     @classmethod
     def read(cls, driver: Driver, log: str) -> LogEdges:
-        records, _, _ = driver.execute_query(
-            cypher("aggr_read_edges"), log=log, database_=database()
-        )
-        row = records[0]
+        row = _read_edges(driver, log)
         members, _, _ = driver.execute_query(
             cypher("aggr_read_memberships"), log=log, database_=database()
         )
@@ -114,3 +113,22 @@ class LogEdges:
         lifted["target"] = self.ids[lifted["target"].to_numpy()].to_numpy()
         lifted["entityType"] = lifted["entityType"].where(lifted["entityType"] != "", None)
         return lifted
+
+
+def _read_edges(driver: Driver, log: str) -> dict[str, list[str]]:
+    """The log's liftable edges as columns, read :data:`EDGE_PAGE` events at a time."""
+    records, _, _ = driver.execute_query(
+        cypher("aggr_event_positions"), log=log, database_=database()
+    )
+    columns: dict[str, list[str]] = {"kinds": [], "sources": [], "targets": [], "entityTypes": []}
+    for first in range(0, int(records[0]["end"]), EDGE_PAGE):
+        page, _, _ = driver.execute_query(
+            cypher("aggr_read_edges"),
+            log=log,
+            first=first,
+            last=first + EDGE_PAGE,
+            database_=database(),
+        )
+        for name, values in columns.items():
+            values.extend(page[0][name])
+    return columns
