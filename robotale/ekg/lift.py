@@ -1,10 +1,11 @@
 """The edges an aggregation step lifts, computed in memory from one reading of the log.
 
 The CORR, DF and COMM edges the build wrote are read once per run (element ids, as columns,
-a range of events per query) and kept as integer codes; so is which aggregate holds each node already collapsed. A step
-then needs no reading at all: the edges that touch its members are found with numpy, their
-other ends mapped to what stands for them at this level (the aggregate holding the node, else
-the node), counted per pair, kind and entity type with pandas, and written in batches
+a range of events per query) and kept as integer codes; so is which aggregate holds each
+node already collapsed. A step then needs no reading at all: the edges that touch its
+members are found with numpy, their other ends mapped to what stands for them at this level
+(the aggregate holding the node, else the node), counted per pair, kind and entity type with
+pandas, and written in batches
 (``cypher/aggr_create_lifted.cypher``). The rules are those of a step lifted in Cypher: an
 edge from a member becomes an edge from its aggregate; an edge into a member from a node no
 aggregate of the same step holds becomes an edge into its aggregate (so an edge between two
