@@ -11,7 +11,8 @@ splitting the orders by a where, an event step grouped by activity and the order
 aggregates, a time-split event step; attributes with MULTISET, AVG, MINMAX, SUM, MIN, MAX):
 
 - robotale: ``robotale.ekg.steps.run_spec`` (nodes read and grouped in pandas, aggregates
-  and memberships written in batches, edges lifted per batch of aggregates);
+  and memberships written in batches, the log's edges read once and lifted in memory, the
+  lifted edges written in batches);
 - plain: the same steps as the field writes them, one ``MATCH ... CREATE`` per step and one
   query per kind of lifted edge (``benchmarks/aggregate_plain.cypher``).
 

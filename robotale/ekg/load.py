@@ -40,6 +40,7 @@ class Loader:
         progress: tqdm | None = None,
         between_batches: Callable[[], None] = lambda: None,
         tx: ManagedTransaction | None = None,
+        workers: int = WORKERS,
     ) -> None:
         self.driver = driver
         self.log = log
@@ -48,6 +49,8 @@ class Loader:
         # With a transaction every batch goes into it, one after the other: an append is
         # kept or undone as a whole.
         self.tx = tx
+        # batches that all reach the same few nodes only wait on each other's locks: one
+        self.workers = workers
 
     def run(
         self,
@@ -82,7 +85,7 @@ class Loader:
 
         if self.tx is not None:
             return [node for start in range(0, size, BATCH) for node in write(start)]
-        return _in_flight(write, range(0, size, BATCH))
+        return _in_flight(write, range(0, size, BATCH), self.workers)
 
     def _execute(self, text: str, parameters: dict[str, Any]) -> list[Any]:
         if self.tx is not None:
@@ -162,19 +165,21 @@ def _per_batch(edges: pd.DataFrame, count: int, **properties: str) -> list[dict[
     return parts
 
 
-def _in_flight(write: Callable[[int], list[str]], starts: range) -> list[str]:
-    """``write`` for each start, :data:`WORKERS` at a time, results in order.
+def _in_flight(
+    write: Callable[[int], list[str]], starts: range, workers: int = WORKERS
+) -> list[str]:
+    """``write`` for each start, ``workers`` at a time, results in order.
 
     Neo4j runs each transaction on one core; with two in flight it uses two. Batches that
     collide on a node are retried by the driver's managed transactions. Nothing new starts
     once one batch has failed.
     """
     nodes: list[str] = []
-    with ThreadPoolExecutor(max_workers=WORKERS) as pool:
+    with ThreadPoolExecutor(max_workers=workers) as pool:
         running: deque[Future[list[str]]] = deque()
         for start in starts:
             running.append(pool.submit(write, start))
-            if len(running) == WORKERS:
+            if len(running) == workers:
                 nodes.extend(running.popleft().result())
         while running:
             nodes.extend(running.popleft().result())

@@ -5,7 +5,8 @@ no earlier step collapsed and that pass its ``where`` into ``Aggregate`` nodes, 
 group: the nodes are read with their properties, grouped in pandas
 (:mod:`robotale.ekg.groups`) and the aggregates written in batches with an ``AGGREGATED_IN``
 edge from each node they replace. Then the CORR, DF and COMM edges of those nodes are lifted
-to the aggregates (``cypher/aggr_lift_edges.cypher``), counted. The graph after steps 1 .. k
+to the aggregates, counted: computed in memory from one reading of the log's edges per run
+(:mod:`robotale.ekg.lift`) and written in batches. The graph after steps 1 .. k
 is level k: its aggregates and the lifted edges between them.
 
 A step is kept or undone as a unit: if writing it fails, what it wrote is removed again, and
@@ -29,6 +30,7 @@ from robotale.ekg.build import ensure_schema, undo_after_failure
 from robotale.ekg.connection import database
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
+from robotale.ekg.lift import LogEdges
 from robotale.ekg.load import Loader, neo4j_values
 from robotale.ekg.logs import log_info
 from robotale.ekg.spec import AggrStep
@@ -43,8 +45,6 @@ OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")
 KEY_SAMPLE = 10_000
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
-#: aggregates per lifting transaction: few enough that a batch of large ones stays small
-LIFT_BATCH = 200
 
 
 @dataclass(frozen=True)
@@ -73,11 +73,13 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
     ensure_schema(driver)
     with log_write_lock(driver, log, "aggregating"):
         first = _last_step(driver, log) + 1
-        plans = [_plan(driver, log, info, step, n) for n, step in enumerate(steps, first)]
+        keys: dict[str | None, tuple[set[str], list[str]]] = {}
+        plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
         events, entities = _unaggregated(driver, log)
+        edges = LogEdges.read(driver, log)
         for plan in plans:
-            result = _run_or_undo(driver, log, plan, (events, entities))
+            result = _run_or_undo(driver, log, plan, (events, entities), edges)
             events, entities = result.final_events, result.final_entities
             results.append(result)
         return results
@@ -123,14 +125,16 @@ def level_graph(driver: Driver, log: str, level: int) -> dict[str, list[dict[str
     }
 
 
-def _run_or_undo(driver: Driver, log: str, plan: _Plan, before: tuple[int, int]) -> StepResult:
+def _run_or_undo(
+    driver: Driver, log: str, plan: _Plan, before: tuple[int, int], edges: LogEdges
+) -> StepResult:
     step, number = plan.step, plan.number
     started = time.perf_counter()
     nodes = _read_nodes(driver, log, plan)
     table = aggregate_table(step, number, nodes, set(plan.times) & set(plan.reads))
     try:
         with DeferredInterrupt() as interrupt:
-            _write(driver, log, step, number, table, interrupt.check)
+            _write(driver, log, step, number, table, edges, interrupt.check)
     except BaseException as error:
         undo_after_failure(
             error,
@@ -166,8 +170,16 @@ class _Plan:
     times: list[str]  # the properties that hold zoned times
 
 
-def _plan(driver: Driver, log: str, info: dict[str, Any], step: AggrStep, number: int) -> _Plan:
-    """Check every name ``step`` uses against the log; what it will read."""
+def _plan(
+    driver: Driver,
+    log: str,
+    info: dict[str, Any],
+    step: AggrStep,
+    number: int,
+    known: dict[str | None, tuple[set[str], list[str]]],
+) -> _Plan:
+    """Check every name ``step`` uses against the log; what it will read. ``known``: the
+    node keys already read in this run, by entity type (None: events)."""
     what = f"step {number}"
     entity_types = list(info.get("entityTypes") or [])
     if step.origin == "Entity" and step.ent_type not in entity_types:
@@ -175,7 +187,10 @@ def _plan(driver: Driver, log: str, info: dict[str, Any], step: AggrStep, number
             f"The log {log!r} has no entities of type {step.ent_type!r} for {what}; it has "
             f"{', '.join(entity_types) or 'none'}."
         )
-    keys, times = _node_keys(driver, log, step.ent_type)
+    if step.ent_type not in known:  # the entities' keys are read from all of them: once
+        known[step.ent_type] = _node_keys(driver, log, step.ent_type)
+    found, times = known[step.ent_type]
+    keys = set(found)
     resolved: list[str] = []
     if step.origin == "Event":  # a property the sampled events lack may be on later ones
         keys |= set(info.get("properties") or []) | {"id", "order", "timestamp"}
@@ -246,6 +261,7 @@ def _write(
     step: AggrStep,
     number: int,
     table: pd.DataFrame,
+    edges: LogEdges,
     between_batches: Callable[[], None],
 ) -> None:
     driver.execute_query(
@@ -272,7 +288,20 @@ def _write(
         owners = [node for node, size in zip(created, sizes, strict=True) for _ in range(size)]
         members = [str(m) for group in table["members"] for m in group]
         loader.run("aggr_create_members", {"members": members, "aggregates": owners})
-        _lift(driver, created, number, between_batches)
+        lifted = edges.lift(members, owners)
+        if len(lifted):
+            # every lifted edge reaches one of this step's few aggregates: one batch at a time
+            Loader(driver, log, None, between_batches, workers=1).run(
+                "aggr_create_lifted",
+                {
+                    "kinds": lifted["kind"].tolist(),
+                    "sources": lifted["source"].tolist(),
+                    "targets": lifted["target"].tolist(),
+                    "entityTypes": lifted["entityType"].tolist(),
+                    "counts": lifted["count"].astype(int).tolist(),
+                },
+                step=number,
+            )
     driver.execute_query(
         cypher("aggr_step_finish"),
         log=log,
@@ -287,21 +316,6 @@ def _storable(column: pd.Series) -> list[Any]:
     if any(isinstance(v, DateTime) for v in column):
         return [v if isinstance(v, DateTime) else None for v in column]
     return neo4j_values(column)
-
-
-def _lift(
-    driver: Driver, aggregates: list[str], number: int, between_batches: Callable[[], None]
-) -> None:
-    # One batch after the other: batches running side by side would wait on each other's
-    # locks of the nodes that both reach.
-    for start in range(0, len(aggregates), LIFT_BATCH):
-        between_batches()
-        driver.execute_query(
-            cypher("aggr_lift_edges"),
-            aggregates=aggregates[start : start + LIFT_BATCH],
-            step=number,
-            database_=database(),
-        )
 
 
 def _last_step(driver: Driver, log: str) -> int:

@@ -1,8 +1,9 @@
 """From an uploaded file to a log in Neo4j, in the two steps of thesis figure 7.3.
 
-1. :func:`read_upload` turns the upload into the canonical event log (a CSV or XES log with
-   ``robotale.eventlog.readers``, a zipped folder of rosbag2 recordings with
-   ``robotale.eventlog.prepare``) and keeps it in memory as a :class:`Pending` log.
+1. :func:`read_upload` turns the upload into the canonical event log (a CSV, XES or OCEL 2.0
+   log with ``robotale.eventlog.readers``, an OCEL log's objects kept beside it; a zipped
+   folder of rosbag2 recordings with ``robotale.eventlog.prepare``) and keeps it in memory as
+   a :class:`Pending` log.
 2. The user picks the columns to store as event properties and those that are entities;
    :func:`ingest` stores the log with :func:`robotale.ekg.build.build_ekg` and deletes the upload.
 """
@@ -24,8 +25,9 @@ from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
 from robotale.ekg.logs import stored_events
 from robotale.errors import InputError, RobotaleError
 from robotale.eventlog import schema
+from robotale.eventlog.objects import Objects
 from robotale.eventlog.prepare import find_runs, prepare
-from robotale.eventlog.readers import read_log_with_reading
+from robotale.eventlog.readers import read_with_objects
 from robotale.eventlog.reading import format_reading
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.results.logdata import LogData, first_key
@@ -57,6 +59,8 @@ class Pending:
     session_gap: str | None = None
     #: the simulated runs' sites (field, bases, objects) by case, for the Mission page's map
     sites: dict[str, Any] = field(default_factory=dict)
+    #: an object-centric log's objects (attributes, qualifiers, relations), stored with it
+    objects: Objects | None = None
 
 
 @dataclass(frozen=True)
@@ -115,8 +119,8 @@ def read_upload(pending: Pending, limit_bytes: int, models: ModelStore, job: Job
                 upload, limit_bytes, models, job
             )
         else:
-            pending.log, reading = read_log_with_reading(
-                upload.path, mapping=pending.mapping, case_gap=pending.case_gap
+            pending.log, reading, pending.objects = read_with_objects(
+                upload.path, pending.mapping, case_gap=pending.case_gap
             )
             # the reading names our stored copy; the user knows the file by its own name
             pending.reading = format_reading(reading).replace(str(upload.path), upload.filename)
@@ -166,9 +170,11 @@ def bag_root(folder: Path) -> Path:
     return folder
 
 
-def columns(log: pd.DataFrame) -> list[Column]:
+def columns(log: pd.DataFrame, objects: Objects | None = None) -> list[Column]:
     """The log's columns with the default choice: store everything; the default entity
-    columns (robot and msg_id, as in thesis figure 7.3) are entities where the log has them."""
+    columns (robot and msg_id, as in thesis figure 7.3), or an object-centric log's object
+    types, are entities where the log has them."""
+    defaults = objects.entity_types if objects is not None else DEFAULT_ENTITIES
     found = []
     for canonical in log.columns:
         name = schema.CSV_NAMES.get(canonical, canonical)
@@ -179,7 +185,7 @@ def columns(log: pd.DataFrame) -> list[Column]:
                 name=name,
                 required=canonical in ALWAYS_STORED,
                 store=True,
-                entity=name in DEFAULT_ENTITIES and values.nunique() > 0,
+                entity=name in defaults and values.nunique() > 0,
                 distinct=int(values.nunique()),
                 examples=shown,
             )
@@ -187,15 +193,19 @@ def columns(log: pd.DataFrame) -> list[Column]:
     return found
 
 
-def chosen_log(log: pd.DataFrame, store: list[str], entities: list[str]) -> pd.DataFrame:
-    """The log with only the columns to store (required ones and entities always kept)."""
+def chosen_log(
+    log: pd.DataFrame, store: list[str], entities: list[str], objects: Objects | None = None
+) -> pd.DataFrame:
+    """The log with only the columns to store (required ones and entities always kept; the
+    event ids too where ``objects`` relate events to objects by them)."""
     short = {schema.CSV_NAMES.get(c, c): c for c in log.columns}
     unknown = [name for name in [*store, *entities] if name not in short]
     if unknown:
         raise InputError(f"The log has no column {unknown[0]!r}.")
     if not entities:
         raise InputError("Tick at least one entity column (robot, for instance).")
-    keep = {short[n] for n in [*store, *entities]} | {c for c in ALWAYS_STORED if c in log}
+    always = (*ALWAYS_STORED, schema.EVENT_ID) if objects is not None else ALWAYS_STORED
+    keep = {short[n] for n in [*store, *entities]} | {c for c in always if c in log}
     return log[[c for c in log.columns if c in keep]]
 
 
@@ -225,6 +235,7 @@ def ingest(
                 replace=replace,
                 source=pending.upload.filename,
                 progress=False,
+                objects=pending.objects,
             )
     finally:
         uploads.discard(pending.upload)

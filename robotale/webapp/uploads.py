@@ -2,9 +2,9 @@
 
 An upload is kept as ``<token>.<kind>`` in the upload folder, never under the name the browser
 sent, and only if its content is what its extension says (a CSV with a header line, an XES
-document, a zip archive). A zipped bag folder is unpacked member by member: absolute paths,
-``..``, links and archives that unpack to more than a limit (or than the free disk) are
-refused, and unpacking counts every byte it writes.
+document, an OCEL 2.0 log in JSON, XML or SQLite, a zip archive). A zipped bag folder is
+unpacked member by member: absolute paths, ``..``, links and archives that unpack to more
+than a limit (or than the free disk) are refused, and unpacking counts every byte it writes.
 """
 
 from __future__ import annotations
@@ -21,9 +21,27 @@ from pathlib import Path, PurePosixPath
 from typing import BinaryIO
 
 from robotale.errors import InputError
+from robotale.eventlog import ocel
 
+#: an OCEL 2.0 encoding -> the kind (and stored ending) of its uploads
+_OCEL_KINDS = {"json": "jsonocel", "xml": "xmlocel", "sqlite": "sqlite"}
 #: extension -> kind of upload
-KINDS = {".csv": "csv", ".xes": "xes", ".zip": "zip"}
+KINDS = {
+    ".csv": "csv",
+    ".xes": "xes",
+    ".zip": "zip",
+    # OCEL 2.0, by the endings its reader knows; the stored copy's ending tells it the encoding
+    **{suffix: _OCEL_KINDS[encoding] for suffix, encoding in ocel.SUFFIXES.items()},
+}
+#: what a text upload of each kind is, for messages
+_TEXT_KINDS = {
+    "csv": "CSV event log",
+    "xes": "XES event log",
+    "jsonocel": "OCEL 2.0 JSON log",
+    "xmlocel": "OCEL 2.0 XML log",
+}
+#: how an SQLite database file begins
+_SQLITE_HEADER = b"SQLite format 3\0"
 _TOKEN = re.compile(r"[0-9a-f]{32}")
 _SNIFF = 64 * 1024
 #: uploads nobody ingested are removed after this many seconds
@@ -57,8 +75,9 @@ def kind_of(filename: str) -> str:
     suffix = PurePosixPath(filename.lower()).suffix
     if suffix not in KINDS:
         raise InputError(
-            f"{filename!r} is not an event log robotale reads: upload a .csv or .xes log, or a "
-            ".zip of a folder of rosbag2 recordings."
+            f"{filename!r} is not an event log robotale reads: upload a .csv or .xes log, an "
+            "OCEL 2.0 log (.jsonocel, .xmlocel or .sqlite), or a .zip of a folder of rosbag2 "
+            "recordings."
         )
     return KINDS[suffix]
 
@@ -117,10 +136,14 @@ def _check_content(path: Path, kind: str, filename: str) -> None:
         if not zipfile.is_zipfile(path):
             raise InputError(f"{filename!r} is not a zip archive.")
         return
+    if kind == "sqlite":
+        if not head.startswith(_SQLITE_HEADER):
+            raise InputError(f"{filename!r} is not an SQLite database, so it is no OCEL 2.0 log.")
+        return
     if not head.strip():
         raise InputError(f"{filename!r} is empty.")
     if b"\0" in head:
-        raise InputError(f"{filename!r} is not a text file, so it is no {kind.upper()} event log.")
+        raise InputError(f"{filename!r} is not a text file, so it is no {_TEXT_KINDS[kind]}.")
     text = head.decode("utf-8", errors="replace").lstrip("\ufeff \t\r\n")
     if not text:
         raise InputError(
@@ -128,6 +151,10 @@ def _check_content(path: Path, kind: str, filename: str) -> None:
         )
     if kind == "xes" and not (text.startswith("<?xml") or text.startswith("<log")):
         raise InputError(f"{filename!r} is not an XES document: it does not start with XML.")
+    if kind == "jsonocel" and not text.startswith("{"):
+        raise InputError(f"{filename!r} is not an OCEL 2.0 JSON log: it does not start with {{.")
+    if kind == "xmlocel" and not text.startswith("<"):
+        raise InputError(f"{filename!r} is not an OCEL 2.0 XML log: it does not start with XML.")
     if kind == "csv" and ("," not in text.splitlines()[0] and ";" not in text.splitlines()[0]):
         raise InputError(
             f"{filename!r} does not start with a header line of comma-separated column names."

@@ -56,7 +56,7 @@ def api_logs():
 def upload():
     file = request.files.get("file")
     if file is None or not file.filename:
-        raise InputError("Choose a CSV, XES or zipped bag folder to upload.")
+        raise InputError("Choose a CSV, XES or OCEL 2.0 log or a zipped bag folder to upload.")
     pairs = [pair for pair in request.form.get("mapping", "").split(",") if pair.strip()]
     mapping = parse_mapping(pairs)
     uploads.remove_stale(settings().upload_dir)
@@ -106,7 +106,7 @@ def choose(token: str):
         events=len(pending.log),
         reading=pending.reading,
         session_gap=pending.session_gap,
-        columns=ingest.columns(pending.log),
+        columns=ingest.columns(pending.log, pending.objects),
         **context,
     )
 
@@ -118,7 +118,7 @@ def start_ingest(token: str):
     if not name:
         raise InputError("Give the log a name.")
     entities = request.form.getlist("entity")
-    log = ingest.chosen_log(pending.log, request.form.getlist("store"), entities)
+    log = ingest.chosen_log(pending.log, request.form.getlist("store"), entities, pending.objects)
     pending.log = log
     pending_logs().pop(token)
     replace = request.form.get("replace") == "on"
