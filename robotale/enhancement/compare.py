@@ -450,9 +450,9 @@ def _sentences(
     if robots:
         sentences.append(robots)
     others = changes[changes["ranked"] & changes["measure"].ne("run duration")]
-    run = _run_sentence(changes)
+    run, cause = _run_sentence(changes)
     if _run_row(changes)["ranked"]:
-        sentences += [run, *others["sentence"]]
+        sentences += [run, *others["sentence"].drop(index=cause, errors="ignore")]
     else:
         sentences += [*others["sentence"], run]
     sentences.append(_variant_sentence(variants, first, second))
@@ -488,21 +488,23 @@ def _run_row(changes: pd.DataFrame) -> dict:
     return changes[changes["measure"] == "run duration"].iloc[0].to_dict()
 
 
-def _run_sentence(changes: pd.DataFrame) -> str:
+def _run_sentence(changes: pd.DataFrame) -> tuple[str, Any]:
     """How the runs' duration changed and, when it did, the largest change that goes the
-    same way."""
+    same way (its row's label, None without one)."""
     row = _run_row(changes)
     if not row["ranked"]:
         how = "longer" if row["difference"] > 0 else "shorter"
         return (
             f"Runs are not significantly {how}: {_pair(row['b'], row['a'])} (mean, "
-            f"{_evidence(row['q_value'])})."
+            f"{_evidence(row['q_value'])}).",
+            None,
         )
     # more often or longer both make a run longer: the sign of the difference is the way
     same_way = np.sign(changes["difference"]).eq(np.sign(row["difference"]))
     why = changes[changes["ranked"] & changes["measure"].isin(TIMED[1:]) & same_way]
-    cause = f": {_lower(why.iloc[0]['sentence'])}" if not why.empty else "."
-    return f"{change_sentence(row).rstrip('.')}{cause}"
+    if why.empty:
+        return change_sentence(row), None
+    return f"{change_sentence(row).rstrip('.')}: {why.iloc[0]['sentence']}", why.index[0]
 
 
 def change_sentence(row: dict) -> str:
@@ -611,8 +613,3 @@ def _short(variant: str, limit: int = 6) -> str:
     steps = variant.split(ARROW)
     shown = " → ".join(steps[:limit])
     return shown + (f" … ({len(steps)} activities)" if len(steps) > limit else "")
-
-
-def _lower(text: str) -> str:
-    """A sentence continued after a colon: its first letter small unless it starts a name."""
-    return text[:1].lower() + text[1:] if text[:1].isupper() and text[1:2].islower() else text
