@@ -6,7 +6,8 @@ measure is therefore reduced to one value per run first (a run's duration; the m
 of an activity in the run, per robot type; how often the run does it; the mean wait of a
 transition; the mean latency and the share lost of a message type; the battery a robot used;
 whether the run follows a variant), and B's runs are compared with A's by the Mann-Whitney U
-test of :func:`robotale.enhancement.effects.compare_cases`.
+test (:func:`mann_whitney`: the statistic of :mod:`robotale.enhancement.effects`, for every
+measure at once).
 
 A comparison of two batches asks many questions at once, so some p-values come out small by
 chance alone; the p-values are adjusted by the Benjamini-Hochberg procedure across all of
@@ -25,6 +26,7 @@ relative to A; for a share (of messages lost, of runs following a variant), the 
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
@@ -38,7 +40,6 @@ from robotale.enhancement.battery import battery_perspective
 from robotale.enhancement.bottlenecks import ALPHA, MIN_SHARE, find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
 from robotale.enhancement.context import LogAnalysis
-from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.findings import seconds_text, trusted_first
 from robotale.enhancement.performance import (
     ARROW,
@@ -247,10 +248,10 @@ def _battery_values(analysis: LogAnalysis) -> pd.DataFrame:
 def _long(subject, who, run, value) -> pd.DataFrame:
     return pd.DataFrame(
         {
-            "subject": pd.Series(subject, dtype=object),
-            "who": pd.Series(who, dtype=object),
-            "run": pd.Series(run, dtype=object),
-            "value": pd.Series(value, dtype=float),
+            "subject": np.asarray(subject, dtype=object),
+            "who": np.asarray(who, dtype=object),
+            "run": np.asarray(run, dtype=object),
+            "value": np.asarray(value, dtype=float),
         }
     )
 
@@ -259,11 +260,8 @@ def _long(subject, who, run, value) -> pd.DataFrame:
 
 
 def _changes(first: Batch, second: Batch) -> pd.DataFrame:
-    rows = [_test("run duration", "runs", "", first.runs, second.runs)]
-    for measure in MEASURES[1:-1]:
-        rows += _measure_rows(measure, first.values[measure], second.values[measure])
-    rows += _variant_rows(first, second)
-    table = pd.DataFrame([row for row in rows if row is not None], columns=COLUMNS[:-3])
+    long = pd.concat([_values(first, second, 0), _values(second, first, 1)], ignore_index=True)
+    table = mann_whitney(long).reset_index()
     table["q_value"] = benjamini_hochberg(table["p_value"])
     table["share"] = _shares(table, first, second)
     table["ranked"] = (table["q_value"].lt(ALPHA) & table["share"].ge(MIN_SHARE)).to_numpy(bool)
@@ -273,69 +271,97 @@ def _changes(first: Batch, second: Batch) -> pd.DataFrame:
     return table[COLUMNS]
 
 
-def _measure_rows(measure: str, a: pd.DataFrame, b: pd.DataFrame) -> list[dict | None]:
-    keys = sorted({*_keys(a), *_keys(b)})
-    mine, theirs = a.groupby(["subject", "who"]), b.groupby(["subject", "who"])
-    rows = []
-    for key in keys:
-        values_a = _series(mine, key)
-        values_b = _series(theirs, key)
-        rows.append(_test(measure, key[0], key[1], values_a, values_b))
-    return rows
+def _values(part: Batch, other: Batch, side: int) -> pd.DataFrame:
+    """Every value per run of ``part`` (``side`` 0 for A, 1 for B) in one long table."""
+    count = len(part.runs)
+    tables = [_long(["runs"] * count, [""] * count, part.runs.index, part.runs.to_numpy())]
+    tables[0].insert(0, "measure", "run duration")
+    for measure in MEASURES[1:-1]:
+        values = part.values[measure]
+        if measure == "activity frequency":
+            # a run without an activity did it 0 times, even when no run of its batch did it
+            values = _with_zeros(values, other.values[measure], part.runs.index)
+        tables.append(values.assign(measure=measure))
+    tables.append(_variant_values(part, other))
+    long = pd.concat(tables, ignore_index=True)
+    return long.assign(side=side)
 
 
-def _keys(values: pd.DataFrame) -> list[tuple[str, str]]:
-    return list(zip(values["subject"], values["who"], strict=True))
+def _with_zeros(mine: pd.DataFrame, theirs: pd.DataFrame, runs: pd.Index) -> pd.DataFrame:
+    missing = (
+        theirs[["subject", "who"]]
+        .drop_duplicates()
+        .merge(mine[["subject", "who"]].drop_duplicates(), how="left", indicator=True)
+    )
+    missing = missing[missing["_merge"] == "left_only"].drop(columns="_merge")
+    if missing.empty:
+        return mine
+    zeros = missing.merge(pd.DataFrame({"run": runs}), how="cross").assign(value=0.0)
+    return pd.concat([mine, zeros], ignore_index=True)
 
 
-def _series(grouped, key: tuple[str, str]) -> pd.Series:
-    if key not in grouped.groups:
-        return pd.Series(dtype=float)
-    rows = grouped.get_group(key)
-    return pd.Series(rows["value"].to_numpy(float), index=rows["run"].to_numpy())
+def _variant_values(part: Batch, other: Batch) -> pd.DataFrame:
+    """Whether each run follows each variant of two runs or more (in both batches), 1 or
+    0."""
+    counts = pd.concat([part.variants, other.variants]).value_counts()
+    tested = counts[counts >= VARIANT_RUNS].index
+    if not len(tested) or part.variants.empty:
+        return _long([], [], [], []).assign(measure="variant share")
+    follows = part.variants.to_numpy()[:, None] == tested.to_numpy()[None, :]
+    return pd.DataFrame(
+        {
+            "measure": "variant share",
+            "subject": np.tile(tested.astype(str), len(part.variants)),
+            "who": "",
+            "run": np.repeat(part.variants.index.to_numpy(), len(tested)),
+            "value": follows.ravel().astype(float),
+        }
+    )
 
 
-def _variant_rows(first: Batch, second: Batch) -> list[dict | None]:
-    """Whether each run follows the variant, 1 or 0, for the variants of two runs or more."""
-    counts = pd.concat([first.variants, second.variants]).value_counts()
-    rows = []
-    for variant in counts[counts >= VARIANT_RUNS].index:
-        a = (first.variants == variant).astype(float)
-        b = (second.variants == variant).astype(float)
-        rows.append(_test("variant share", str(variant), "", a, b))
-    return rows
-
-
-def _test(measure: str, subject: str, who: str, a: pd.Series, b: pd.Series) -> dict | None:
-    """B's values against A's: their means, the difference and its p-value (Mann-Whitney U);
-    ``None`` when neither batch has a value."""
-    a, b = a.dropna(), b.dropna()
-    if a.empty and b.empty:
-        return None
-    mean_a = float(a.mean()) if len(a) else np.nan
-    mean_b = float(b.mean()) if len(b) else np.nan
-    p_value = np.nan
-    if len(a) and len(b):
-        values = pd.Series(
-            np.concatenate([a.to_numpy(float), b.to_numpy(float)]),
-            index=[f"a{i}" for i in range(len(a))] + [f"b{i}" for i in range(len(b))],
-        )
-        members = pd.DataFrame({"batch": "b", CASE: values.index[len(a) :]})
-        p_value = float(compare_cases(members, "batch", values)["p_value"].iloc[0])
-    difference = mean_b - mean_a
-    relative = difference / mean_a if mean_a else np.nan
-    return {
-        "measure": measure,
-        "subject": subject,
-        "who": who,
-        "runs_a": len(a),
-        "runs_b": len(b),
-        "a": mean_a,
-        "b": mean_b,
-        "difference": difference,
-        "relative": relative,
-        "p_value": p_value,
-    }
+def mann_whitney(long: pd.DataFrame) -> pd.DataFrame:
+    """Per measure, subject and robot (``who``): the runs and mean of A (``side`` 0) and of B
+    (``side`` 1), the difference and the two-sided p-value of the Mann-Whitney U test of B
+    against A (normal approximation with tie and continuity corrections, as in
+    :mod:`robotale.enhancement.effects`; NaN when a side has no run or all values are equal).
+    All keys at once: the ranks are taken within each key."""
+    keys = ["measure", "subject", "who"]
+    long = long.dropna(subset=["value"])
+    grouped = long.groupby(keys, sort=False)
+    ranks = grouped["value"].rank()
+    n = grouped["value"].transform("size")
+    # the tie term of each key: sum over its distinct values of t^3 - t
+    tied = long.groupby([*keys, "value"], sort=False)["value"].transform("size").astype(float)
+    frame = long.assign(
+        _b=long["side"].eq(1).astype(float),
+        _rank_b=ranks.where(long["side"].eq(1), 0.0),
+        _a_value=long["value"].where(long["side"].eq(0)),
+        _b_value=long["value"].where(long["side"].eq(1)),
+        _tie=(tied**3 - tied) / tied,  # each of the t rows adds its 1/t share of t^3 - t
+        _n=n,
+    )
+    table = frame.groupby(keys, sort=False).agg(
+        runs_b=("_b", "sum"),
+        runs=("_n", "first"),
+        rank_b=("_rank_b", "sum"),
+        ties=("_tie", "sum"),
+        a=("_a_value", "mean"),
+        b=("_b_value", "mean"),
+    )
+    n_b, n_all = table["runs_b"], table["runs"].astype(float)
+    n_a = n_all - n_b
+    u_b = table["rank_b"] - n_b * (n_b + 1) / 2
+    u = np.maximum(u_b, n_a * n_b - u_b)
+    tie_term = table["ties"] / (n_all * (n_all - 1)).where(n_all > 1)
+    sigma = np.sqrt(n_a * n_b / 12 * ((n_all + 1) - tie_term))
+    z = (u - n_a * n_b / 2 - 0.5) / sigma.where(sigma > 0)
+    table["p_value"] = z.map(
+        lambda x: min(1.0, math.erfc(x / math.sqrt(2))) if pd.notna(x) else math.nan
+    )
+    table["runs_a"], table["runs_b"] = n_a.astype(int), n_b.astype(int)
+    table["difference"] = table["b"] - table["a"]
+    table["relative"] = table["difference"] / table["a"].where(table["a"] != 0)
+    return table[["runs_a", "runs_b", "a", "b", "difference", "relative", "p_value"]]
 
 
 def benjamini_hochberg(p_values: pd.Series) -> pd.Series:
@@ -452,9 +478,10 @@ def _sentences(
     others = changes[changes["ranked"] & changes["measure"].ne("run duration")]
     run, cause = _run_sentence(changes)
     if _run_row(changes)["ranked"]:
-        sentences += [run, *others["sentence"].drop(index=cause, errors="ignore")]
+        sentences += [run, *others["sentence"][others.index != cause]]
     else:
         sentences += [*others["sentence"], run]
+    sentences += _activity_sentences(first, second)
     sentences.append(_variant_sentence(variants, first, second))
     sentences.append(_bottleneck_sentence(bottlenecks, first.name, second.name))
     tested = int(changes["q_value"].notna().sum())
@@ -551,14 +578,45 @@ def change_sentence(row: dict) -> str:
     )
 
 
+def _activity_sentences(first: Batch, second: Batch) -> list[str]:
+    """The activities (of a robot type) only one batch did, with the runs that did them."""
+    done = [_done(part) for part in (first, second)]
+    sentences = []
+    for only, other, word in ((1, 0, "New in"), (0, 1, "Gone from")):
+        keys = sorted(set(done[only]) - set(done[other]))
+        if not keys:
+            continue
+        part = (first, second)[only]
+        listed = ", ".join(
+            f"{subject}" + (f" by {who}" if who else "") + f" (in {done[only][(subject, who)]} "
+            f"of {len(part.runs)} runs of {part.name})"
+            for subject, who in keys
+        )
+        sentences.append(f"{word} {second.name}: {listed}.")
+    return sentences
+
+
+def _done(part: Batch) -> dict[tuple[str, str], int]:
+    """How many runs did each activity (per robot type)."""
+    counts = part.values["activity frequency"]
+    if counts.empty:
+        return {}
+    did = counts[counts["value"] > 0].groupby(["subject", "who"])["run"].nunique()
+    return {key: int(n) for key, n in did.items()}
+
+
+def _plural(number: int, noun: str) -> str:
+    return f"{number} {noun}{'' if number == 1 else 's'}"
+
+
 def _variant_sentence(variants: pd.DataFrame, first: Batch, second: Batch) -> str:
     new = variants[variants["status"] == "appeared"]
     gone = variants[variants["status"] == "vanished"]
     if new.empty and gone.empty:
         return f"The runs of {first.name} and {second.name} follow the same variants."
     return (
-        f"{len(new)} variants appeared ({int(new['runs_b'].sum())} of {len(second.variants)} "
-        f"runs of {second.name} follow one), {len(gone)} vanished "
+        f"{_plural(len(new), 'variant')} appeared ({int(new['runs_b'].sum())} of "
+        f"{len(second.variants)} runs of {second.name} follow one), {len(gone)} vanished "
         f"({int(gone['runs_a'].sum())} of {len(first.variants)} runs of {first.name} "
         "followed one)."
     )

@@ -13,6 +13,7 @@ from types import ModuleType
 from robotale.webapp.views import (
     aggregation,
     assets,
+    compare,
     console,
     discover,
     findings,
@@ -46,6 +47,7 @@ PAGES: tuple[Page, ...] = (
     Page(aggregation),  # the Discover page's aggregation requests
     Page(perspectives, "Perspectives"),
     Page(timeline, "Timeline"),
+    Page(compare, "Compare"),
     Page(mission, "Mission"),
     Page(model, "Model"),
     Page(console, "Cypher"),

@@ -11,12 +11,14 @@ import warnings
 from dataclasses import replace
 from pathlib import Path
 
+import numpy as np
 import pandas as pd
 import pytest
 
 from robotale.cli import main
 from robotale.enhancement.bottlenecks import ALPHA
-from robotale.enhancement.compare import benjamini_hochberg, compare_logs
+from robotale.enhancement.compare import benjamini_hochberg, compare_logs, mann_whitney
+from robotale.enhancement.effects import compare_cases
 from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, ROBOT_TYPE, TIMESTAMP
 from robotale.sim.batch import simulate_batch
 from robotale.sim.plans import adjust, plans, resolve_world
@@ -130,6 +132,29 @@ def test_benjamini_hochberg_by_hand():
     expected = [0.04, 0.04 * 4 / 3, 0.04 * 4 / 3, 0.5]
     assert benjamini_hochberg(p).iloc[:4].tolist() == pytest.approx(expected)
     assert pd.isna(benjamini_hochberg(p).iloc[4])
+
+
+def test_mann_whitney_of_all_keys_at_once_is_the_effects_test_of_each():
+    """The grouped test against :func:`compare_cases` (the bottlenecks' test) key by key, on
+    values with ties, with a key only one side has and a key whose values are all equal."""
+    rng = np.random.default_rng(3)
+    rows = []
+    for key, shift, size in (("k1", 0.0, 9), ("k2", 2.0, 14), ("k3", 0.5, 5)):
+        for side in (0, 1):
+            values = np.round(rng.normal(shift * side, 1.0, size + side * 3), 0)  # ties
+            rows += [(key, side, f"r{side}_{i}", v) for i, v in enumerate(values)]
+    rows += [("only_a", 0, "r0_0", 1.0), ("flat", 0, "r0_0", 2.0), ("flat", 1, "r1_0", 2.0)]
+    long = pd.DataFrame(rows, columns=["subject", "side", "run", "value"])
+    long = long.assign(measure="m", who="")
+    table = mann_whitney(long).reset_index().set_index("subject")
+    for key in ("k1", "k2", "k3"):
+        mine = long[long["subject"] == key]
+        values = pd.Series(mine["value"].to_numpy(), index=mine["side"].astype(str) + mine["run"])
+        members = pd.DataFrame({"b": "b", CASE: values.index[mine["side"].to_numpy() == 1]})
+        expected = compare_cases(members, "b", values).iloc[0]
+        assert table.loc[key, "p_value"] == pytest.approx(expected["p_value"])
+        assert table.loc[key, "difference"] == pytest.approx(expected["extra_mean"])
+    assert pd.isna(table.loc["only_a", "p_value"]) and pd.isna(table.loc["flat", "p_value"])
 
 
 def test_cli_prints_sentences_and_writes_json(batches, tmp_path, capsys):
