@@ -11,6 +11,7 @@ import pytest
 from playwright.sync_api import expect
 
 from robotale.enhancement.compare import compare_logs
+from robotale.eventlog.schema import CASE
 
 
 @pytest.fixture(scope="module")
@@ -69,3 +70,23 @@ def test_compare_page_shows_the_sentences_and_tables(page, two_logs, screenshot)
     expect(rows).to_have_count(len(expected.changes))
     expect(page.locator("#compare-variants tbody tr")).to_have_count(len(expected.variants))
     screenshot(page, "compare")
+
+
+def test_compare_command_reads_stored_logs_and_files(two_logs, tmp_path, capsys):
+    """``robotale compare`` of the two stored logs, then of A's file against B's stored log:
+    the same runs compared, counted here from the logs themselves."""
+    import json
+
+    from robotale.cli import main
+
+    names, calm, full = two_logs
+    out = tmp_path / "compare.json"
+    assert main(["compare", names[0], names[1], "--json", str(out)]) == 0
+    stored = json.loads(out.read_text(encoding="utf-8"))
+    assert stored["facts"]["runs"] == [calm[CASE].nunique(), full[CASE].nunique()]
+    assert stored["sentences"][0] in capsys.readouterr().out
+    path = tmp_path / "a.csv"
+    calm.to_csv(path, index=False)
+    assert main(["compare", str(path), names[1], "--json", str(out)]) == 0
+    mixed = json.loads(out.read_text(encoding="utf-8"))
+    assert mixed["sentences"] == stored["sentences"]
