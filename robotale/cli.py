@@ -788,6 +788,24 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
     )
     _handled_by(conformance, "discover.conformance_command")
 
+    diff = actions.add_parser(
+        "diff",
+        help="the driving model against the discovered one: what the robots never used, "
+        "what they did beyond it, signals never caught",
+    )
+    diff.add_argument("driving", type=Path, help="the .bpmn collaboration that drove the robots")
+    diff.add_argument("discovered", type=Path, help="the .bpmn discovered from their runs")
+    diff.add_argument(
+        "--json", dest="json_out", type=Path, metavar="FILE", help="also write it as JSON"
+    )
+    diff.add_argument(
+        "--out",
+        type=Path,
+        metavar="BPMN",
+        help="write the driving model with what was never used drawn red",
+    )
+    _handled_by(diff, "discover.diff_command")
+
 
 def _add_log_filters(parser: argparse.ArgumentParser) -> None:
     """The filters of ``discover dfg`` and ``discover bpmn``."""
