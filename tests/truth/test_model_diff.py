@@ -102,23 +102,14 @@ def test_diff_names_the_branch_the_robots_never_took(mission, tmp_path, capsys):
 
 def test_the_marked_model_draws_what_was_never_used(tmp_path, capsys):
     """The agri scenario's model (it has a diagram) against two runs of it."""
-    from compare import prepared
+    from discovered_agri import agri_discovered
 
-    from robotale.sim.batch import simulate_batch
-    from robotale.sim.plans import plans, resolve_world
-
-    world = resolve_world("agri")[0]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        simulate_batch(plans(world, "agri", runs=2, seed=3), tmp_path / "runs", workers=0)
-        log = prepared(tmp_path / "runs")
-    discovered = tmp_path / "discovered.bpmn"
-    discovered.write_text(write_bpmn(discover_collaboration(log, LogFilter())))
+    model, discovered, log = agri_discovered(tmp_path)
     out, data = tmp_path / "marked.bpmn", tmp_path / "diff.json"
-    assert main(["discover", "diff", str(world.model), str(discovered),
+    assert main(["discover", "diff", str(model), str(discovered),
                  "--json", str(data), "--out", str(out)]) == 0  # fmt: skip
     found = json.loads(data.read_text(encoding="utf-8"))
-    expected = _never_done(world.model, log)
+    expected = _never_done(model, log)
     assert expected and _unused(found) == expected
     marked = etree.parse(str(out))
     red = {
@@ -126,7 +117,7 @@ def test_the_marked_model_draws_what_was_never_used(tmp_path, capsys):
         for shape in marked.iter("{http://www.omg.org/spec/BPMN/20100524/DI}BPMNShape")
         if shape.get(f"{BIOC}stroke")
     }
-    named = _named_without_signal(etree.parse(str(world.model)))
+    named = _named_without_signal(etree.parse(str(model)))
     assert {named[pool][key] for pool, key in expected} <= red
     assert red == {i for row in found["unused_elements"] for i in row["ids"]}
 
