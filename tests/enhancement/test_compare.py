@@ -77,6 +77,7 @@ def _percent(a: pd.Series, b: pd.Series) -> float:
     return 100 * (b.mean() - a.mean()) / a.mean()
 
 
+@pytest.mark.slow
 def test_slower_tractors_are_the_first_sentence_with_their_size(batches):
     base, slow = batches["base"], batches["slow"]
     comparison = compare_logs(base, slow)
@@ -92,6 +93,7 @@ def test_slower_tractors_are_the_first_sentence_with_their_size(batches):
         assert said and abs(int(said.group(1)) - runs) <= 1.5, (first, runs)
 
 
+@pytest.mark.slow
 def test_one_tractor_less_is_the_first_sentence(batches):
     base, one = batches["base"], batches["one"]
     comparison = compare_logs(base, one)
@@ -102,6 +104,7 @@ def test_one_tractor_less_is_the_first_sentence(batches):
     )
 
 
+@pytest.mark.slow
 def test_same_settings_call_no_more_than_chance(batches):
     """Different seeds, same settings: nothing changed, so the changes called significant
     may not exceed what chance gives at the level ``ALPHA`` (the procedure keeps the chance
@@ -115,6 +118,7 @@ def test_same_settings_call_no_more_than_chance(batches):
     assert comparison.sentences[0].startswith("Runs are not significantly")
 
 
+@pytest.mark.slow
 def test_the_run_durations_compared_are_the_runs(batches):
     base, slow = batches["base"], batches["slow"]
     row = compare_logs(base, slow).changes.query("measure == 'run duration'").iloc[0]
@@ -157,6 +161,7 @@ def test_mann_whitney_of_all_keys_at_once_is_the_effects_test_of_each():
     assert pd.isna(table.loc["only_a", "p_value"]) and pd.isna(table.loc["flat", "p_value"])
 
 
+@pytest.mark.slow
 def test_cli_prints_sentences_and_writes_json(batches, tmp_path, capsys):
     paths = []
     for name in ("base", "slow"):
