@@ -50,6 +50,7 @@ def build_parser() -> argparse.ArgumentParser:
     _add_discover(commands)
     _add_perspectives(commands)
     _add_report(commands)
+    _add_compare(commands)
     return parser
 
 
@@ -787,6 +788,24 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
     )
     _handled_by(conformance, "discover.conformance_command")
 
+    diff = actions.add_parser(
+        "diff",
+        help="the driving model against the discovered one: what the robots never used, "
+        "what they did beyond it, signals never caught",
+    )
+    diff.add_argument("driving", type=Path, help="the .bpmn collaboration that drove the robots")
+    diff.add_argument("discovered", type=Path, help="the .bpmn discovered from their runs")
+    diff.add_argument(
+        "--json", dest="json_out", type=Path, metavar="FILE", help="also write it as JSON"
+    )
+    diff.add_argument(
+        "--out",
+        type=Path,
+        metavar="BPMN",
+        help="write the driving model with what was never used drawn red",
+    )
+    _handled_by(diff, "discover.diff_command")
+
 
 def _add_log_filters(parser: argparse.ArgumentParser) -> None:
     """The filters of ``discover dfg`` and ``discover bpmn``."""
@@ -884,6 +903,33 @@ def _add_report(commands: argparse._SubParsersAction) -> None:
     )
     _add_delay(report)
     _handled_by(report, "report.report_command")
+
+
+def _add_compare(commands: argparse._SubParsersAction) -> None:
+    compare = commands.add_parser(
+        "compare",
+        help="what changed between two batches of runs: durations, frequencies, variants, "
+        "bottlenecks, messages, battery",
+        description="Compare two batches of runs (A, the reference, and B): plain sentences "
+        "of what changed, largest and surest first, each difference tested run against run "
+        "(Mann-Whitney U, Benjamini-Hochberg adjusted), then the table of changes.",
+    )
+    for name, which in (("log_a", "A, the reference"), ("log_b", "B")):
+        compare.add_argument(
+            name,
+            metavar=name.upper(),
+            help=f"batch {which}: an event log file (.csv or .xes), or the name of a log "
+            "stored in Neo4j when no such file exists",
+        )
+    _add_mapping(compare)
+    _add_case_options(compare)
+    compare.add_argument(
+        "--json", dest="json_out", type=Path, metavar="JSON", help="also write it as JSON"
+    )
+    compare.add_argument(
+        "--top", type=int, metavar="N", help="how many changes the table lists (default 20)"
+    )
+    _handled_by(compare, "compare.compare_command")
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -13,6 +13,7 @@ from robotale.discovery.dfg import discover_dfg
 from robotale.discovery.ekg import discover_ekg
 from robotale.discovery.filters import LogFilter
 from robotale.discovery.graph import ProcessGraph
+from robotale.discovery.model_diff import diff_models, marked_model
 from robotale.discovery.output import write_texts
 from robotale.discovery.render import graph_to_svg, require_dot
 from robotale.errors import InputError
@@ -161,3 +162,20 @@ def emit_graph(
 def values(lists: Sequence[str] | None) -> tuple[str, ...]:
     """Repeated and comma-separated option values as one tuple."""
     return tuple(v.strip() for item in lists or [] for v in item.split(",") if v.strip())
+
+
+def diff_command(
+    driving: Path, discovered: Path, *, json_out: Path | None = None, out: Path | None = None
+) -> int:
+    """What the robots never used of the ``driving`` model and what they did beyond it
+    (``discovered``): printed, as JSON (``json_out``) and as the driving model marked
+    (``out``)."""
+    found = diff_models(driving, discovered)
+    outputs = []
+    if out is not None:  # first: a model without a diagram writes nothing
+        outputs.append((out, marked_model(driving, found).decode("utf-8")))
+    if json_out is not None:
+        outputs.append((json_out, json.dumps(found.to_dict(), indent=2)))
+    write_texts(outputs)
+    print(found.text())
+    return 0

@@ -163,10 +163,12 @@ def typed_instances(log: pd.DataFrame) -> pd.DataFrame:
     if instances.empty:
         raise InputError("the selected events contain no activity of a robot.")
     robots = instances[ROBOT].astype(str)
+    # a name's type once per robot, not once per instance
+    named = robots.map({robot: robot_type(robot) for robot in robots.unique()})
     if ROBOT_TYPE in instances.columns:
-        types = instances[ROBOT_TYPE].astype("string").fillna(robots.map(robot_type))
+        types = instances[ROBOT_TYPE].astype("string").fillna(named)
     else:
-        types = robots.map(robot_type)
+        types = named
     instances = instances.assign(**{ROBOT: robots, ROBOT_TYPE: types.astype(str)})
     instances["_role"] = _roles(instances)
     instances["_aborted"] = interrupted(instances).to_numpy()

@@ -13,6 +13,7 @@ from types import ModuleType
 from robotale.webapp.views import (
     aggregation,
     assets,
+    compare,
     console,
     discover,
     findings,
@@ -48,6 +49,7 @@ PAGES: tuple[Page, ...] = (
     Page(preparation),  # how far a log's pages are prepared
     Page(perspectives, "Perspectives"),
     Page(timeline, "Timeline"),
+    Page(compare, "Compare"),
     Page(mission, "Mission"),
     Page(model, "Model"),
     Page(console, "Cypher"),

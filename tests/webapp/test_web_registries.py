@@ -20,7 +20,16 @@ def test_the_rendered_menu_is_the_page_registry(app, client):
     labelled = [p for p in PAGES if p.label is not None]
     assert [label for _, _, label in entries] == [p.label for p in labelled]
     # the pages the dashboard's documentation lists, in its order
-    pages = ["Logs", "Findings", "Discover", "Perspectives", "Timeline", "Mission", "Model"]
+    pages = [
+        "Logs",
+        "Findings",
+        "Discover",
+        "Perspectives",
+        "Timeline",
+        "Compare",
+        "Mission",
+        "Model",
+    ]
     assert [label for _, _, label in entries] == [*pages, "Cypher"]
     for href, _, _ in entries:  # each entry leads to a page that renders
         assert client.get(href).status_code == 200, href

@@ -9,6 +9,7 @@ from typing import Any
 import pandas as pd
 from flask import Blueprint, Response, jsonify, redirect, render_template, request, url_for
 
+from robotale.discovery.model_diff import diff_models
 from robotale.ekg.logs import log_robots
 from robotale.errors import InputError, ModelError
 from robotale.fame_runtime.library import Library
@@ -37,6 +38,7 @@ def page():
     return render_template(
         "model.html",
         models=models,
+        others=store.all(),
         model=chosen,
         robots=robots,
         none_binds=bool(log) and not models,
@@ -107,6 +109,18 @@ def verification(model_id: str):
             ).as_dict(),
         )
     )
+
+
+@blueprint.get("/api/models/<model_id>/diff")
+def difference(model_id: str):
+    """The model as the driving one against the stored model ``against`` (one discovered from
+    the runs): what the robots never used, what they did beyond it, signals never caught."""
+    current = state()
+    driving, discovered = (
+        current.models.get(model_id),
+        current.models.get(request.args.get("against", "")),
+    )
+    return jsonify(diff_models(driving.path, discovered.path).to_dict())
 
 
 @blueprint.get("/api/models/<model_id>/frequencies")

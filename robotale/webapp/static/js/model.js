@@ -121,6 +121,40 @@
     }
   });
 
+  // Diff: this model, which drove the robots, against a stored model discovered from their
+  // runs (robotale discover diff); what the robots never used is outlined, dashed.
+  function listDiff(found) {
+    const canvas = viewer.get("canvas");
+    const registry = viewer.get("elementRegistry");
+    const unused = [...new Set(found.unused_elements.flatMap((row) => row.ids)
+      .concat(found.unused_flows.flatMap((row) => row.flows)))].filter((id) => registry.get(id));
+    for (const id of unused) canvas.addMarker(id, "unused");
+    canvasBox.dataset.unused = unused.join(" ");
+    const part = (title, rows, text) => [robotale.el("h3", { text: `${title}: ${rows.length}` }),
+      robotale.el("ul", {}, ...rows.map((row) => robotale.el("li", { text: text(row) })))];
+    const element = (row) => `${row.pool}: ${row.name}`;
+    const flow = (row) => `${row.pool}: ${row.source} → ${row.target}`;
+    document.getElementById("diff-findings").replaceChildren(
+      robotale.el("h2", { text: "Against the discovered model" }),
+      ...part("Never used by the robots", found.unused_elements, element),
+      ...part("Shown by the robots, not in this model", found.extra_elements, element),
+      ...part("Flows never taken", found.unused_flows, flow),
+      ...part("Flows taken, not in this model", found.extra_flows, flow),
+      ...part("Signals thrown but never caught", found.uncaught_signals, (name) => name));
+  }
+
+  document.getElementById("diff").addEventListener("click", async () => {
+    const against = document.getElementById("diff-picker").value;
+    status.textContent = "comparing…";
+    try {
+      listDiff(await robotale.api(`/api/models/${modelId}/diff?against=${encodeURIComponent(against)}`));
+      status.textContent = "what the robots never used is outlined, dashed";
+    } catch (error) {
+      status.textContent = "";
+      robotale.showError(error);
+    }
+  });
+
   async function show() {
     if (!modelId) return;
     try {

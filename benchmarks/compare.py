@@ -1,0 +1,138 @@
+"""How long ``robotale compare`` takes on two batches of 100,000 events, against reading the
+findings of both batches side by side.
+
+    python benchmarks/compare.py [--sizes 10000 100000] [--runs 3]
+
+The batches are twelve simulated runs of the agri scenario (simulated and prepared first,
+untimed) repeated as further runs until they have the given number of events, each run's
+clock stretched by a factor of its own (0.8 to 1.2 in A, so the runs of a batch differ; 0.9
+to 1.3 in B: a change to find). In the same process,
+interleaved (compare, findings, compare, findings ...), best of ``--runs``:
+
+- *compare*: ``robotale.enhancement.compare.compare_logs(A, B)``, every measure per run and
+  its test, the variants, the bottlenecks of both batches and the sentences;
+- *findings of A and B*: ``robotale.enhancement.findings.find`` of each batch, the analysis
+  one would otherwise read twice and set side by side (its bottlenecks and perspectives are
+  the same work the comparison does on each batch, without the tests between them).
+
+The runs' mean duration the comparison reports is checked equal to the findings' for each
+batch. Target: compare under 5 s at 100,000 events per batch; the ratio to the findings is
+printed beside it.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import tempfile
+import time
+import warnings
+from functools import partial
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+
+TARGET_SECONDS = 5.0
+
+
+def simulated(folder: Path) -> pd.DataFrame:
+    """Twelve runs of the agri scenario, prepared."""
+    from robotale.eventlog.prepare import prepare
+    from robotale.sim.batch import simulate_batch
+    from robotale.sim.plans import plans, resolve_world
+
+    world = resolve_world("agri")[0]
+    simulate_batch(plans(world, "agri", runs=12, seed=1), folder, workers=0)
+    return prepare(folder)
+
+
+def repeated(template: pd.DataFrame, events: int) -> pd.DataFrame:
+    """``template``'s runs repeated, a day apart, as further runs until ``events`` events."""
+    from robotale.eventlog import schema
+
+    copies, total, copy = [], 0, 0
+    while total < events:
+        run = template.copy()
+        run[schema.CASE] = f"{copy}_" + run[schema.CASE].astype(str)
+        run[schema.TIMESTAMP] = run[schema.TIMESTAMP] + pd.Timedelta(days=copy)
+        for column in (schema.MSG_ID, schema.EVENT_ID):
+            run[column] = (f"{copy}_" + run[column].astype("string")).where(run[column].notna())
+        copies.append(run)
+        total += len(run)
+        copy += 1
+    return pd.concat(copies, ignore_index=True).head(events)
+
+
+def batch(template: pd.DataFrame, events: int, seed: int, slower: float) -> pd.DataFrame:
+    """``template`` repeated, each run's clock stretched by its own factor, ``slower`` times
+    one between 0.8 and 1.2."""
+    from robotale.eventlog import schema
+
+    log = repeated(template, events)
+    rng = np.random.default_rng(seed)
+    runs = log[schema.CASE]
+    start = log.groupby(runs)[schema.TIMESTAMP].transform("min")
+    factors = slower * rng.uniform(0.8, 1.2, runs.nunique())
+    factor = runs.map(dict(zip(runs.unique(), factors, strict=True)))
+    offset = (log[schema.TIMESTAMP] - start) * factor.to_numpy()
+    log[schema.TIMESTAMP] = start + offset
+    return log.sort_values([schema.CASE, schema.TIMESTAMP], kind="stable").reset_index(drop=True)
+
+
+def best_of(runs: int, *functions):
+    """Each function's least wall-clock seconds and its last result, called in turns."""
+    times: list[list[float]] = [[] for _ in functions]
+    results: list[object] = [None] * len(functions)
+    for _ in range(runs):
+        for index, function in enumerate(functions):
+            began = time.perf_counter()
+            results[index] = function()
+            times[index].append(time.perf_counter() - began)
+    return [min(t) for t in times], results
+
+
+def _both(function, first, second):
+    return function(first), function(second)
+
+
+def main() -> int:
+    from robotale.enhancement.compare import compare_logs
+    from robotale.enhancement.findings import find
+
+    parser = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000])
+    parser.add_argument("--runs", type=int, default=3, help="turns of each (best)")
+    args = parser.parse_args()
+    warnings.simplefilter("ignore")
+    with tempfile.TemporaryDirectory(prefix="robotale-bench-compare-") as scratch:
+        template = simulated(Path(scratch) / "runs")
+    small = batch(template, 2_000, 0, 1.0)
+    compare_logs(small, small)  # imports and first calls stay out of the figures
+    print("load average (1, 5, 15 min): " + ", ".join(f"{n:.1f}" for n in os.getloadavg()))
+    for size in args.sizes:
+        first, second = batch(template, size, 1, 1.0), batch(template, size, 2, 1.1)
+        (ours, theirs), (comparison, findings) = best_of(
+            args.runs,
+            partial(compare_logs, first, second),
+            partial(_both, find, first, second),
+        )
+        row = comparison.changes.query("measure == 'run duration'").iloc[0]
+        means = [float(f.runs["duration"].mean()) for f in findings]
+        assert np.allclose([row["a"], row["b"]], means), (row["a"], row["b"], means)
+        print(f"== two batches of {size:,} events ({first['case:concept:name'].nunique()} runs "
+              f"each; runs' mean durations checked equal to the findings')")  # fmt: skip
+        print(f"  {'compare A B':40} {ours:7.2f} s  (target < {TARGET_SECONDS:g} s: "
+              f"{'met' if ours < TARGET_SECONDS else 'MISSED'})")  # fmt: skip
+        print(f"  {'findings of A and of B':40} {theirs:7.2f} s")
+        print(f"  {'compare / findings':40} {ours / theirs:7.2f} x")
+        print(f"  first sentence: {comparison.sentences[0]}")
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

@@ -1,0 +1,75 @@
+"""The Compare page: what changed between two stored logs (two batches of runs), in plain
+sentences first, then the changes, variants and bottlenecks as tables."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import pandas as pd
+from flask import Blueprint, render_template, request
+
+from robotale.enhancement.compare import compare_logs
+from robotale.webapp import pages
+from robotale.webapp.state import driver, state
+
+blueprint = Blueprint("compare", __name__)
+
+#: the changes table's columns, as the page heads them
+CHANGE_COLUMNS = {
+    "measure": "measure",
+    "subject": "what",
+    "who": "robot",
+    "a": "A (mean)",
+    "b": "B (mean)",
+    "relative": "change",
+    "q_value": "p (adjusted)",
+    "ranked": "ranked",
+}
+VARIANT_COLUMNS = {"variant": "variant", "runs_a": "runs of A", "runs_b": "runs of B", "status": ""}
+
+
+@blueprint.get("/compare")
+def page():
+    first, second = request.args.get("a", ""), request.args.get("b", "")
+    shown: dict[str, Any] = {}
+    if first and second:
+        logs = state().logs
+        comparison = compare_logs(
+            logs.frame(driver(), first), logs.frame(driver(), second), names=("A", "B")
+        )
+        shown = {
+            "sentences": comparison.sentences,
+            "changes": _rows(comparison.changes, CHANGE_COLUMNS),
+            "variants": _rows(comparison.variants, VARIANT_COLUMNS),
+        }
+    return render_template(
+        "compare.html",
+        first=first,
+        second=second,
+        change_heads=list(CHANGE_COLUMNS.values()),
+        variant_heads=list(VARIANT_COLUMNS.values()),
+        **shown,
+        **pages.context("compare.page"),
+    )
+
+
+def _rows(table: pd.DataFrame, columns: dict[str, str]) -> list[list[str]]:
+    """The table's cells as text, in the order of ``columns``."""
+    return [
+        [_cell(name, value) for name, value in row.items()]
+        for row in table[list(columns)].to_dict("records")
+    ]
+
+
+def _cell(name: str, value: Any) -> str:
+    if value is None or (not isinstance(value, str) and pd.isna(value)):
+        return ""
+    if name == "relative":
+        return f"{value:+.0%}"
+    if name == "q_value":
+        return "< 0.001" if value < 0.001 else f"{value:.3f}"
+    if isinstance(value, bool):
+        return "yes" if value else ""
+    if isinstance(value, float):
+        return f"{value:.3g}"
+    return str(value)

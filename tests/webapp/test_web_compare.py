@@ -1,0 +1,92 @@
+"""The Compare page on two stored logs: the mission with injected findings
+(``tests/mission_findings.py``) and the same mission without the runs that wait for a refill;
+in a real Neo4j and, for the page itself, a real headless Chromium."""
+
+from __future__ import annotations
+
+import uuid
+
+import mission_findings as mission
+import pytest
+from playwright.sync_api import expect
+
+from robotale.enhancement.compare import compare_logs
+from robotale.eventlog.schema import CASE
+
+
+@pytest.fixture(scope="module")
+def two_logs(neo4j_driver, tmp_path_factory):
+    """(A, B): A without the refill runs, B all twelve runs; stored once for this module."""
+    from robotale.ekg.build import build_ekg
+    from robotale.ekg.keys import built_keys
+    from robotale.ekg.logs import delete_log
+    from robotale.eventlog.readers import read_log
+
+    path = mission.write_injected("robotale.csv", tmp_path_factory.mktemp("c") / "mission.csv")
+    full = read_log(path)
+    calm = full[~full["case:concept:name"].isin(mission.REFILL_RUNS)].reset_index(drop=True)
+    names = []
+    for prefix, log in (("test_compare_a", calm), ("test_compare_b", full)):
+        name = f"{prefix}_{uuid.uuid4().hex[:8]}"
+        entities = ["robot", "msg_id"]
+        build_ekg(
+            neo4j_driver,
+            log,
+            name,
+            entities=entities,
+            aggregate=built_keys(entities),
+            progress=False,
+        )
+        names.append(name)
+    yield names, calm, full
+    for name in names:
+        delete_log(neo4j_driver, name)
+
+
+def test_compare_page_refuses_an_unknown_log(client, two_logs):
+    names, _, _ = two_logs
+    answer = client.get(f"/compare?a={names[0]}&b=no_such_log_here")
+    assert answer.status_code in (400, 404)
+    assert b"no_such_log_here" in answer.data
+
+
+@pytest.mark.browser
+def test_compare_page_shows_the_sentences_and_tables(page, two_logs, screenshot):
+    names, calm, full = two_logs
+    expected = compare_logs(calm, full)
+    # the refill runs are a third of B: their variant appeared, the others are in both
+    refill = [v for v in expected.variants.itertuples() if mission.REFILL in v.variant]
+    assert refill and all(v.status == "appeared" for v in refill)
+    assert sum(v.runs_b for v in refill) == len(mission.REFILL_RUNS)
+    page.goto(f"{page.base_url}/compare")
+    expect(page.locator("nav a[data-endpoint='compare.page']")).to_have_text("Compare")
+    page.select_option("select[name=a]", names[0])
+    page.select_option("select[name=b]", names[1])
+    page.click("form.compare-form button[type=submit]")
+    items = page.locator("#compare-sentences li")
+    expect(items).to_have_count(len(expected.sentences))
+    assert items.all_inner_texts() == expected.sentences
+    rows = page.locator("#compare-changes tbody tr")
+    expect(rows).to_have_count(len(expected.changes))
+    expect(page.locator("#compare-variants tbody tr")).to_have_count(len(expected.variants))
+    screenshot(page, "compare")
+
+
+def test_compare_command_reads_stored_logs_and_files(two_logs, tmp_path, capsys):
+    """``robotale compare`` of the two stored logs, then of A's file against B's stored log:
+    the same runs compared, counted here from the logs themselves."""
+    import json
+
+    from robotale.cli import main
+
+    names, calm, full = two_logs
+    out = tmp_path / "compare.json"
+    assert main(["compare", names[0], names[1], "--json", str(out)]) == 0
+    stored = json.loads(out.read_text(encoding="utf-8"))
+    assert stored["facts"]["runs"] == [calm[CASE].nunique(), full[CASE].nunique()]
+    assert stored["sentences"][0] in capsys.readouterr().out
+    path = tmp_path / "a.csv"
+    calm.to_csv(path, index=False)
+    assert main(["compare", str(path), names[1], "--json", str(out)]) == 0
+    mixed = json.loads(out.read_text(encoding="utf-8"))
+    assert mixed["sentences"] == stored["sentences"]
