@@ -544,3 +544,70 @@ def test_the_models_qos_is_live_a_pair_fame_check_refuses_never_talks_over_dds(c
     ) in captured.err
     assert "# drone is at intermediateCatchEvent d_position (tractor_position)" in captured.err
     assert "starts with no peer" not in captured.err
+
+
+@pytest.mark.slow
+def test_monitor_stores_the_tags_as_heard_and_alerts_on_silence(tmp_path, capsys, neo4j_driver):
+    """``robotale monitor`` watching a ``fame run --bus dds --record``: Neo4j holds each tag
+    the robots printed, in each robot's order, and the same events ``prepare`` makes of the
+    run's bag; once the robots are done they are silent, and a plain cyclonedds reader of
+    /robotale/alerts gets one silence alert per robot, the same ones the monitor stored."""
+    import json
+    import signal
+    import subprocess
+    import sys
+    import uuid
+
+    from cyclonedds.core import Policy, Qos
+
+    from robotale.ekg.live import delete_live, live_alerts, live_tags
+    from robotale.eventlog.preparing import prepare_recordings
+
+    name = f"test_monitor_{uuid.uuid4().hex[:8]}"
+    model = str(MODELS / "hello_at_once.bpmn")
+    alerts = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    kept = Qos(Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal)
+    reader = DataReader(alerts, Topic(alerts, "rt/robotale/alerts", String_), qos=kept)
+    watch = [sys.executable, "-m", "robotale", "monitor", model, "--robots", "caller,listener"]
+    monitor = subprocess.Popen(
+        [*watch, "--log", name, "--silence", "3"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert monitor.stderr.readline().startswith("# monitoring "), monitor.stderr.read()
+        bag = tmp_path / "live"
+        run = ["fame", "run", model, "--robots", "caller,listener", "--bus", "dds"]
+        assert main([*run, "--record", str(bag), "--until", "60"]) == 0
+        printed = rows(capsys.readouterr().out)
+        heard: list = []
+        deadline = time.monotonic() + patience(30)
+        while len(heard) < 2 and time.monotonic() < deadline:
+            heard += [json.loads(s.data) for s in reader.take(N=10)]
+            time.sleep(0.1)
+        monitor.send_signal(signal.SIGINT)
+        said, complaints = monitor.communicate(timeout=patience(60))
+        assert monitor.returncode == 0, complaints
+        stored = live_tags(neo4j_driver, name)
+        stored_alerts = live_alerts(neo4j_driver, name)
+    finally:
+        if monitor.poll() is None:
+            monitor.kill()
+        delete_live(neo4j_driver, name)
+    fields = [(t.robot, t.activity, t.lifecycle, t.msg_id, t.msg_role) for t in stored]
+    for robot in ("caller", "listener"):
+        assert [f for f in fields if f[0] == robot] == [
+            tuple(r[1:6] + [""] * (6 - len(r)))[:5] for r in printed if r[1] == robot
+        ]
+    log = prepare_recordings(bag)
+    prepared = log[["robot", "concept:name", "lifecycle:transition"]]
+    assert Counter(prepared.itertuples(index=False, name=None)) == Counter(f[:3] for f in fields)
+    assert sorted((a["kind"], a["robot"]) for a in heard) == [
+        ("silence", "caller"),
+        ("silence", "listener"),
+    ]
+    assert sorted((a.kind, a.robot, a.text) for a in stored_alerts) == sorted(
+        (a["kind"], a["robot"], a["text"]) for a in heard
+    )
+    assert "# alert silence caller" in said
