@@ -310,8 +310,10 @@ def _add_monitor(commands: argparse._SubParsersAction) -> None:
     monitor.add_argument("--robots", help="the robots' namespaces, e.g. drone,tractor_1")
     monitor.add_argument("--log", required=True, help="the name the live run is stored under")
     monitor.add_argument(
-        "--silence", type=float, metavar="SECONDS", help="alert when a robot says nothing "
-        "this long (default 10)"
+        "--silence",
+        type=float,
+        metavar="SECONDS",
+        help="alert when a robot says nothing this long (default 10)",
     )
     monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
     _handled_by(monitor, "monitor.monitor_command", extra="dds")

@@ -12,6 +12,7 @@ from dataclasses import asdict
 from pathlib import Path
 from typing import TextIO
 
+from robotale.discovery.online import PoolReplay, pool_replays
 from robotale.ekg.connection import session_driver
 from robotale.ekg.live import Alert, LiveLog
 from robotale.errors import InputError
@@ -20,9 +21,7 @@ from robotale.fame_runtime.clock import WallClock
 from robotale.fame_runtime.dds import DdsBus
 from robotale.fame_runtime.launch import robot_list
 from robotale.fame_runtime.node import KEEP_ALL
-from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.processes import interrupts
-from robotale.fame_runtime.splitter import split
 from robotale.fame_runtime.tags import TAG_TYPE, Tag, tag_line, tag_topic
 
 #: where alerts are published, as JSON text in a std_msgs/msg/String
@@ -36,9 +35,16 @@ class Monitor:
     """The robots' tags as they are heard: stored, printed, and their silences watched."""
 
     def __init__(
-        self, bus: DdsBus, live: LiveLog, robots: list[str], silence: float, out: TextIO
+        self,
+        bus: DdsBus,
+        live: LiveLog,
+        replays: dict[str, PoolReplay],
+        silence: float,
+        out: TextIO,
     ) -> None:
         self.bus, self.live, self.silence, self.out = bus, live, silence, out
+        self.replays = replays
+        robots = list(replays)
         self.begin = bus.clock.now()
         self.heard = dict.fromkeys(robots, self.begin)
         self.silent: set[str] = set()
@@ -55,6 +61,13 @@ class Monitor:
         self.heard[tag.robot] = self.bus.clock.now()
         self.silent.discard(tag.robot)
         print(tag_line(tag, self.begin), file=self.out, flush=True)
+        replay = self.replays[tag.robot]
+        if not replay.allows(tag):
+            text = (
+                f"{tag.robot} started {tag.activity!r} (tag stamped {tag.stamp:.3f}) where "
+                f"its pool {replay.pool} does not allow it"
+            )
+            self.raise_alert(Alert(self.bus.clock.now(), "deviation", tag.robot, text))
 
     def watch(self) -> None:
         """Alert once for each robot silent longer than the limit (again after it spoke)."""
@@ -94,17 +107,19 @@ def monitor_command(
     out, err = out or sys.stdout, err or sys.stderr
     if silence <= 0:
         raise InputError(f"--silence {silence} is not a time: give seconds above 0")
-    names = [a.robot for a in split(parse(model), robot_list(robots))]
+    replays = pool_replays(model, robot_list(robots))
     deadline = time.monotonic() + duration if duration is not None else float("inf")
     stopped = threading.Event()
     with session_driver() as driver:
         bus = DdsBus(WallClock(offset=0.0), node="monitor")
         try:
-            monitor = Monitor(bus, LiveLog(driver, log), names, silence, out)
+            monitor = Monitor(bus, LiveLog(driver, log), replays, silence, out)
             # Ctrl-C or SIGTERM ends the watch between two tags, never inside a store
             with interrupts(stopped.set):
                 print(
-                    f"# monitoring {', '.join(names)} as {log} (Ctrl-C stops)", file=err, flush=True
+                    f"# monitoring {', '.join(replays)} as {log} (Ctrl-C stops)",
+                    file=err,
+                    flush=True,
                 )
                 while time.monotonic() < deadline and not stopped.is_set():
                     monitor.pump(min(TICK, max(0.0, deadline - time.monotonic())))
