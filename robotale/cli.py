@@ -315,6 +315,9 @@ def _add_monitor(commands: argparse._SubParsersAction) -> None:
         metavar="SECONDS",
         help="alert when a robot says nothing this long (default 10)",
     )
+    monitor.add_argument(
+        "--battery", type=float, metavar="PERCENT", help="alert below this charge (default 20)"
+    )
     monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
     _handled_by(monitor, "monitor.monitor_command", extra="dds")
 

@@ -4,11 +4,12 @@ published on ``/robotale/alerts``."""
 
 from __future__ import annotations
 
+import functools
 import json
 import sys
 import threading
 import time
-from dataclasses import asdict
+from dataclasses import asdict, replace
 from pathlib import Path
 from typing import TextIO
 
@@ -22,11 +23,15 @@ from robotale.fame_runtime.dds import DdsBus
 from robotale.fame_runtime.launch import robot_list
 from robotale.fame_runtime.node import KEEP_ALL
 from robotale.fame_runtime.processes import interrupts
+from robotale.fame_runtime.qos import DEFAULT_QOS
 from robotale.fame_runtime.tags import TAG_TYPE, Tag, tag_line, tag_topic
 
 #: where alerts are published, as JSON text in a std_msgs/msg/String
 ALERT_TOPIC = "/robotale/alerts"
 ALERT_TYPE = "std_msgs/msg/String"
+BATTERY_TYPE = "sensor_msgs/msg/BatteryState"
+#: what a battery reader asks for: any writer's samples, reliable or not
+BATTERY_QOS = replace(DEFAULT_QOS, reliability="best_effort")
 #: seconds between two looks at the robots' silence
 TICK = 0.1
 
@@ -40,9 +45,12 @@ class Monitor:
         live: LiveLog,
         replays: dict[str, PoolReplay],
         silence: float,
+        battery: float,
         out: TextIO,
     ) -> None:
         self.bus, self.live, self.silence, self.out = bus, live, silence, out
+        self.battery = battery
+        self.low: set[str] = set()
         self.replays = replays
         robots = list(replays)
         self.begin = bus.clock.now()
@@ -50,6 +58,12 @@ class Monitor:
         self.silent: set[str] = set()
         for robot in robots:
             bus.subscribe(tag_topic(robot), self._tag, msgtype=TAG_TYPE, qos=KEEP_ALL)
+            bus.subscribe(
+                f"/{robot}/battery",
+                functools.partial(self._battery, robot),
+                msgtype=BATTERY_TYPE,
+                qos=BATTERY_QOS,
+            )
         # written now, so readers match it before the first alert; kept for late joiners
         bus.writer(ALERT_TOPIC, ALERT_TYPE, KEEP_ALL, "monitor")
 
@@ -68,6 +82,16 @@ class Monitor:
                 f"its pool {replay.pool} does not allow it"
             )
             self.raise_alert(Alert(self.bus.clock.now(), "deviation", tag.robot, text))
+
+    def _battery(self, robot: str, envelope: Envelope) -> None:
+        """Alert once when the charge falls below the threshold (again after it rose)."""
+        percent = 100.0 * float(envelope.data.get("percentage", 0.0))
+        if percent >= self.battery:
+            self.low.discard(robot)
+        elif robot not in self.low:
+            self.low.add(robot)
+            text = f"{robot}'s battery at {percent:.1f} %, below {self.battery:g} %"
+            self.raise_alert(Alert(self.bus.clock.now(), "battery", robot, text))
 
     def watch(self) -> None:
         """Alert once for each robot silent longer than the limit (again after it spoke)."""
@@ -98,12 +122,14 @@ def monitor_command(
     log: str,
     robots: str | None = None,
     silence: float = 10.0,
+    battery: float = 20.0,
     duration: float | None = None,
     out: TextIO | None = None,
     err: TextIO | None = None,
 ) -> int:
     """Watch the mission's robots until Ctrl-C or ``duration`` seconds, storing their tags
-    as the live log ``log`` and alerting when one is silent longer than ``silence``."""
+    as the live log ``log`` and alerting when one is silent longer than ``silence`` or its
+    battery (``/<robot>/battery``) is below ``battery`` percent."""
     out, err = out or sys.stdout, err or sys.stderr
     if silence <= 0:
         raise InputError(f"--silence {silence} is not a time: give seconds above 0")
@@ -113,7 +139,7 @@ def monitor_command(
     with session_driver() as driver:
         bus = DdsBus(WallClock(offset=0.0), node="monitor")
         try:
-            monitor = Monitor(bus, LiveLog(driver, log), replays, silence, out)
+            monitor = Monitor(bus, LiveLog(driver, log), replays, silence, battery, out)
             # Ctrl-C or SIGTERM ends the watch between two tags, never inside a store
             with interrupts(stopped.set):
                 print(
