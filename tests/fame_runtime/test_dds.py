@@ -566,7 +566,9 @@ def test_monitor_stores_the_tags_as_heard_and_alerts_on_silence(tmp_path, capsys
     name = f"test_monitor_{uuid.uuid4().hex[:8]}"
     model = str(MODELS / "hello_at_once.bpmn")
     alerts = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
-    kept = Qos(Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal)
+    kept = Qos(
+        Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal, Policy.History.KeepAll
+    )
     reader = DataReader(alerts, Topic(alerts, "rt/robotale/alerts", String_), qos=kept)
     watch = [sys.executable, "-m", "robotale", "monitor", model, "--robots", "caller,listener"]
     monitor = subprocess.Popen(
@@ -636,7 +638,9 @@ def test_monitor_alerts_a_skipped_activity_within_a_second_of_its_tag(neo4j_driv
 
     name = f"test_deviation_{uuid.uuid4().hex[:8]}"
     alerts = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
-    kept = Qos(Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal)
+    kept = Qos(
+        Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal, Policy.History.KeepAll
+    )
     reader = DataReader(alerts, Topic(alerts, "rt/robotale/alerts", String_), qos=kept)
     watch = [sys.executable, "-m", "robotale", "monitor", str(MODELS / "sequence.bpmn")]
     monitor = subprocess.Popen(
