@@ -37,6 +37,7 @@ def build_parser() -> argparse.ArgumentParser:
     # One line per command group, in the order of the data flow (see docs/architecture.md).
     _add_fame(commands)
     _add_record(commands)
+    _add_monitor(commands)
     _add_simulate(commands)
     _add_prepare(commands)
     _add_annotate(commands)
@@ -296,6 +297,30 @@ def _add_record(commands: argparse._SubParsersAction) -> None:
     )
     record.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
     _handled_by(record, "fame_dds.record_command", extra="dds")
+
+
+def _add_monitor(commands: argparse._SubParsersAction) -> None:
+    monitor = commands.add_parser(
+        "monitor",
+        help="watch live robots over DDS: their tags stored in Neo4j as they come, alerts",
+        description="Subscribe to the mission's robots' tags on the DDS domain (ROS_DOMAIN_ID), "
+        "store each in Neo4j as it arrives under --log, print it, and raise an alert (printed, "
+        "stored, published on /robotale/alerts) when a robot is silent too long.",
+    )
+    monitor.add_argument("model", type=Path, metavar="MISSION.bpmn")
+    monitor.add_argument("--robots", help="the robots' namespaces, e.g. drone,tractor_1")
+    monitor.add_argument("--log", required=True, help="the name the live run is stored under")
+    monitor.add_argument(
+        "--silence",
+        type=float,
+        metavar="SECONDS",
+        help="alert when a robot says nothing this long (default 10)",
+    )
+    monitor.add_argument(
+        "--battery", type=float, metavar="PERCENT", help="alert below this charge (default 20)"
+    )
+    monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
+    _handled_by(monitor, "monitor.monitor_command", extra="dds")
 
 
 def _add_prepare(commands: argparse._SubParsersAction) -> None:

@@ -544,3 +544,153 @@ def test_the_models_qos_is_live_a_pair_fame_check_refuses_never_talks_over_dds(c
     ) in captured.err
     assert "# drone is at intermediateCatchEvent d_position (tractor_position)" in captured.err
     assert "starts with no peer" not in captured.err
+
+
+@pytest.mark.slow
+def test_monitor_stores_the_tags_as_heard_and_alerts_on_silence(tmp_path, capsys, neo4j_driver):
+    """``robotale monitor`` watching a ``fame run --bus dds --record``: Neo4j holds each tag
+    the robots printed, in each robot's order, and the same events ``prepare`` makes of the
+    run's bag; once the robots are done they are silent, and a plain cyclonedds reader of
+    /robotale/alerts gets one silence alert per robot, the same ones the monitor stored."""
+    import json
+    import signal
+    import subprocess
+    import sys
+    import uuid
+
+    from cyclonedds.core import Policy, Qos
+
+    from robotale.ekg.live import delete_live, live_alerts, live_tags
+    from robotale.eventlog.preparing import prepare_recordings
+
+    name = f"test_monitor_{uuid.uuid4().hex[:8]}"
+    model = str(MODELS / "hello_at_once.bpmn")
+    alerts = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    kept = Qos(
+        Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal, Policy.History.KeepAll
+    )
+    reader = DataReader(alerts, Topic(alerts, "rt/robotale/alerts", String_), qos=kept)
+    watch = [sys.executable, "-m", "robotale", "monitor", model, "--robots", "caller,listener"]
+    monitor = subprocess.Popen(
+        [*watch, "--log", name, "--silence", "3"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert monitor.stderr.readline().startswith("# monitoring "), monitor.stderr.read()
+        bag = tmp_path / "live"
+        run = ["fame", "run", model, "--robots", "caller,listener", "--bus", "dds"]
+        assert main([*run, "--record", str(bag), "--until", "60"]) == 0
+        ended = time.time()  # the monitor's clock: the wall clock
+        printed = rows(capsys.readouterr().out)
+        heard: list = []
+        # both robots ended, so silent: by then the monitor called each silent (and maybe once
+        # before, when a robot was slow to start)
+        while time.time() < ended + 3 + patience(2):
+            heard += [json.loads(s.data) for s in reader.take(N=10)]
+            time.sleep(0.1)
+        monitor.send_signal(signal.SIGINT)
+        said, complaints = monitor.communicate(timeout=patience(60))
+        assert monitor.returncode == 0, complaints
+        stored = live_tags(neo4j_driver, name)
+        stored_alerts = live_alerts(neo4j_driver, name)
+        heard += [json.loads(s.data) for s in reader.take(N=10)]
+    finally:
+        if monitor.poll() is None:
+            monitor.kill()
+        delete_live(neo4j_driver, name)
+    fields = [(t.robot, t.activity, t.lifecycle, t.msg_id, t.msg_role) for t in stored]
+    for robot in ("caller", "listener"):
+        assert [f for f in fields if f[0] == robot] == [
+            tuple(r[1:6] + [""] * (6 - len(r)))[:5] for r in printed if r[1] == robot
+        ]
+    log = prepare_recordings(bag)
+    prepared = log[["robot", "concept:name", "lifecycle:transition"]]
+    assert Counter(prepared.itertuples(index=False, name=None)) == Counter(f[:3] for f in fields)
+    assert {a["kind"] for a in heard} == {"silence"}
+    for robot in ("caller", "listener"):
+        last = max(t.stamp for t in stored if t.robot == robot)
+        assert any(a["robot"] == robot and a["stamp"] >= last + 3 for a in heard), heard
+    # what was published was stored (one raised as the monitor closed may not reach the reader)
+    kept = {(a.stamp, a.kind, a.robot, a.text) for a in stored_alerts}
+    assert {(a["stamp"], a["kind"], a["robot"], a["text"]) for a in heard} <= kept
+    assert "# alert silence caller" in said
+
+
+def test_monitor_alerts_a_skipped_activity_within_a_second_of_its_tag(neo4j_driver):
+    """A rover that skips Measure (its tags published here over DDS, as a faulty robot's
+    engine would): the monitor replays them on the rover's pool and alerts the start of
+    Carry On as a deviation, soon after the tag's stamp; Prepare, which the model allows,
+    raises nothing. Its battery falling to 15 % raises a battery alert (30 % does not). A
+    plain cyclonedds reader of /robotale/alerts gets the alerts."""
+    import json
+    import signal
+    import subprocess
+    import sys
+    import uuid
+
+    from cyclonedds.core import Policy, Qos
+
+    from robotale.ekg.live import delete_live, live_alerts
+    from robotale.fame_runtime.node import KEEP_ALL
+    from robotale.fame_runtime.tags import TAG_TYPE, Tag, tag_topic
+
+    name = f"test_deviation_{uuid.uuid4().hex[:8]}"
+    alerts = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    kept = Qos(
+        Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal, Policy.History.KeepAll
+    )
+    reader = DataReader(alerts, Topic(alerts, "rt/robotale/alerts", String_), qos=kept)
+    watch = [sys.executable, "-m", "robotale", "monitor", str(MODELS / "sequence.bpmn")]
+    monitor = subprocess.Popen(
+        [*watch, "--robots", "rover", "--log", name, "--silence", "600"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    clock = WallClock()
+    bus = DdsBus(clock, node="rover")
+    try:
+        assert monitor.stderr.readline().startswith("# monitoring "), monitor.stderr.read()
+        writer = bus.writer(tag_topic("rover"), TAG_TYPE, KEEP_ALL, "rover")
+        matched(writer, patience(30))
+        # the labels its engine tags Prepare and Carry On with
+        faulty = [("prepare", "start"), ("prepare", "complete"), ("carry_on", "start")]
+        stamps = {}
+        for activity, lifecycle in faulty:
+            stamps[activity] = clock.now()
+            tag = Tag(stamps[activity], "rover", activity, lifecycle)
+            bus.publish(tag_topic("rover"), tag, msgtype=TAG_TYPE, sender="rover", qos=KEEP_ALL)
+        # its battery, written by plain cyclonedds: 30 % is fine, 15 % is below the threshold
+        battery_type = "sensor_msgs/msg/BatteryState"
+        battery = DataWriter(alerts, Topic(alerts, "rt/rover/battery", idl_type(battery_type)))
+        matched(battery, patience(30))
+        for level in (0.3, 0.15):
+            battery.write(to_sample(battery_type, {"percentage": level}))
+        heard: list = []
+        deadline = time.monotonic() + patience(30)
+        while len(heard) < 2 and time.monotonic() < deadline:
+            heard += [json.loads(s.data) for s in reader.take(N=10)]
+            time.sleep(0.05)
+        time.sleep(0.5)  # an alert about Prepare or 30 %, were there one, would be here now
+        heard += [json.loads(s.data) for s in reader.take(N=10)]
+        monitor.send_signal(signal.SIGINT)
+        said, complaints = monitor.communicate(timeout=patience(60))
+        assert monitor.returncode == 0, complaints
+        stored = live_alerts(neo4j_driver, name)
+    finally:
+        if monitor.poll() is None:
+            monitor.kill()
+        delete_live(neo4j_driver, name)
+    kinds = sorted((a["kind"], a["robot"]) for a in heard)
+    assert kinds == [("battery", "rover"), ("deviation", "rover")], said + complaints
+    low, deviation = sorted(heard, key=lambda a: a["kind"])
+    assert "15.0 %" in low["text"]
+    assert "'carry_on'" in deviation["text"] and "Rover" in deviation["text"]
+    # within a second of the tag's stamp on a quiet machine; stretched by the load here
+    assert 0 <= deviation["stamp"] - stamps["carry_on"] < patience(1.0)
+    assert sorted((a.kind, a.robot, a.text) for a in stored) == sorted(
+        (a["kind"], a["robot"], a["text"]) for a in heard
+    )
+    assert "# alert deviation rover" in said
