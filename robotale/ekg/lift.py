@@ -76,7 +76,7 @@ class LogEdges:
 
     def codes(self, element_ids: Sequence[str]) -> np.ndarray:
         """The codes of nodes by element id (nodes with no liftable edge get new codes)."""
-        found = self.ids.get_indexer(pd.Index(element_ids, dtype=object))
+        found: np.ndarray = self.ids.get_indexer(pd.Index(element_ids, dtype=object))
         new = found < 0
         if new.any():
             first = len(self.ids)

@@ -397,7 +397,8 @@ def _class_codes(events: pd.DataFrame, key: Sequence[str]) -> np.ndarray:
             values = _neo4j_text(values)
         codes, uniques = pd.factorize(values, use_na_sentinel=False)
         combined = pd.factorize(combined * len(uniques) + codes)[0].astype(np.int64)
-    return pd.factorize(combined)[0]
+    numbered: np.ndarray = pd.factorize(combined)[0]
+    return numbered
 
 
 def _class_ids(events: pd.DataFrame, key: Sequence[str]) -> pd.Series:
