@@ -133,6 +133,13 @@ def _add_serve(commands: argparse._SubParsersAction) -> None:
     serve.add_argument("--host", help="address to listen on (127.0.0.1: this machine only)")
     serve.add_argument("--port", type=int, help="port to listen on (5000)")
     serve.add_argument("--log", help="print the address of this stored log's Discover page")
+    serve.add_argument(
+        "--bag",
+        type=Path,
+        metavar="DIR",
+        help="replay this rosbag2 recording (a run folder, or a folder of runs) on the "
+        "Mission page without storing it",
+    )
     _handled_by(serve, "serve.serve_command")
 
 

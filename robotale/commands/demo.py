@@ -28,7 +28,7 @@ from robotale.sim import scenarios
 from robotale.sim.batch import print_summary, simulate_batch
 from robotale.sim.plans import check, plans, resolve_world
 from robotale.webapp.model_store import attach_model
-from robotale.webapp.serve import Dashboard, serve_until_interrupted
+from robotale.webapp.serve import Dashboard, discover_path, serve_until_interrupted
 from robotale.webapp.settings import DEFAULT_PORT
 
 DEFAULT_RUNS = 20
@@ -161,5 +161,5 @@ def _dashboard(port: int) -> Dashboard:
 
 def _serve(dashboard: Dashboard) -> None:
     print("\nThe dashboard is up; open the address below.", flush=True)
-    serve_until_interrupted(dashboard, AGRI_LOG)
+    serve_until_interrupted(dashboard, discover_path(AGRI_LOG))
     print("Dashboard stopped; the logs stay in Neo4j (`robotale serve` shows them again).")

@@ -24,7 +24,6 @@ from robotale.fame_runtime.model import Flow, Scope
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.splitter import split
 from robotale.results.logdata import LogData, current_build
-from robotale.results.site import stored_site
 
 #: gateways and unlabelled events a path between two tagged elements may pass through
 MAX_HOPS = 8
@@ -41,10 +40,9 @@ def stored_mission(driver: Driver, logs: LogData, name: str, case: str) -> Missi
     return run
 
 
-def mission_site(driver: Driver, name: str, run: MissionRun) -> dict[str, Any]:
-    """The map's extent and fixed places: the run's site when it was simulated (its
+def mission_site(site: dict[str, Any] | None, run: MissionRun) -> dict[str, Any]:
+    """The map's extent and fixed places: the run's ``site`` when it was simulated (its
     ``source`` is ``world``), else the extent of its positions (``positions``), else none."""
-    site = stored_site(driver, name, run.case)
     if site is not None:
         return {**site, "source": "world" if site.get("field") else "manifest"}
     if run.positions.empty:

@@ -14,6 +14,7 @@ from flask import Flask
 from werkzeug.serving import BaseWSGIServer, make_server
 
 from robotale.errors import ServerError
+from robotale.results.replay import Replay
 from robotale.webapp import console
 from robotale.webapp.app import create_app
 from robotale.webapp.settings import DEFAULT_HOST, DEFAULT_PORT
@@ -71,16 +72,44 @@ def _bind(app: Flask, host: str, port: int) -> BaseWSGIServer:
         return make_server(host, port, app, threaded=True, fd=listening.fileno())
 
 
-def serve(host: str = DEFAULT_HOST, port: int = DEFAULT_PORT, log: str | None = None) -> None:
-    """Serve the dashboard until Ctrl-C; with ``log``, point at that log's Discover page."""
-    serve_until_interrupted(Dashboard(host=host, port=port), log)
+def serve(
+    host: str = DEFAULT_HOST,
+    port: int = DEFAULT_PORT,
+    log: str | None = None,
+    replay: Replay | None = None,
+) -> None:
+    """Serve the dashboard until Ctrl-C; with ``log``, point at that log's Discover page; with
+    ``replay``, serve it and point at its first run's Mission page."""
+    dashboard = Dashboard(host=host, port=port)
+    where = None
+    if replay is not None:
+        add_replay(dashboard.app, replay)
+        where = mission_path(replay)
+    elif log:
+        where = discover_path(log)
+    serve_until_interrupted(dashboard, where)
 
 
-def serve_until_interrupted(dashboard: Dashboard, log: str | None = None) -> None:
+def add_replay(app: Flask, replay: Replay) -> None:
+    """Serve ``replay`` on the Mission page of ``app`` under its name."""
+    state(app).replays[replay.name] = replay
+
+
+def discover_path(log: str) -> str:
+    """The Discover page of the stored log ``log``."""
+    return f"/discover?{urlencode({'log': log})}"
+
+
+def mission_path(replay: Replay) -> str:
+    """The Mission page of the replay's first run."""
+    return f"/mission?{urlencode({'log': replay.name, 'case': replay.cases[0]})}"
+
+
+def serve_until_interrupted(dashboard: Dashboard, path: str | None = None) -> None:
     """Serve a dashboard bound earlier in this thread until Ctrl-C (which werkzeug turns into
-    a normal return)."""
+    a normal return); ``path``: the page to print the address of."""
     url = dashboard.url
-    where = f"{url}/discover?{urlencode({'log': log})}" if log else url
+    where = f"{url}{path}" if path else url
     print(f"robotale dashboard at {where}  (Ctrl-C stops it)", file=sys.stderr, flush=True)
     if not _is_loopback(dashboard.server.host):
         print(

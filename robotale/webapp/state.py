@@ -16,6 +16,7 @@ from neo4j import Driver
 
 from robotale.results.background import Preparations
 from robotale.results.logdata import Cache, LogData
+from robotale.results.replay import Replay
 from robotale.webapp.console_pool import Pool
 from robotale.webapp.ingest import PendingLogs
 from robotale.webapp.jobs import Jobs
@@ -41,6 +42,8 @@ class AppState:
     logs: LogData = field(default_factory=LogData)
     #: the preparations of logs' pages this dashboard started (a page visited first)
     preparations: Preparations = field(default_factory=Preparations)
+    #: recordings replayed without storing them (``robotale serve --bag``), by name
+    replays: dict[str, Replay] = field(default_factory=dict)
     #: the Model page's frequencies and deviations
     overlays: Cache = field(default_factory=lambda: Cache(OVERLAYS_KEPT))
 

@@ -9,9 +9,11 @@ from typing import Any
 
 from flask import Blueprint, jsonify, render_template, request
 
+from robotale.enhancement.mission import MissionRun
 from robotale.enhancement.timeline import NO_ROBOT
 from robotale.errors import InputError
 from robotale.results.mission import ModelMap, mission_site, model_map, stored_mission
+from robotale.results.site import stored_site
 from robotale.webapp import pages
 from robotale.webapp.model_store import StoredModel
 from robotale.webapp.state import driver, state
@@ -35,12 +37,12 @@ def page():
 @blueprint.get("/api/mission/<log>/<case>")
 def summary(log: str, case: str):
     """The run's length, robots, fields, activity instances, moments and site."""
-    run = stored_mission(driver(), state().logs, log, case)
+    run = _run(log, case)
     model = _model(log)
     return jsonify(
         {
             **run.summary(),
-            "site": mission_site(driver(), log, run),
+            "site": mission_site(_site(log, run), run),
             "model": model.id if model else None,
         }
     )
@@ -51,7 +53,7 @@ def state_at(log: str, case: str):
     """Every robot at ``?t=`` seconds since the run's start; with a model, the elements
     each robot is in and the flows taken so far."""
     t = _seconds("t", request.args.get("t"))
-    run = stored_mission(driver(), state().logs, log, case)
+    run = _run(log, case)
     found: dict[str, Any] = run.state(t)
     elements = _elements(log, case, run.robots)
     if elements is not None:
@@ -65,16 +67,32 @@ def window(log: str, case: str):
     """The events, messages, positions and moments from ``?from=`` to ``?to=`` seconds."""
     start = _seconds("from", request.args.get("from"))
     end = _seconds("to", request.args.get("to"))
-    run = stored_mission(driver(), state().logs, log, case)
+    run = _run(log, case)
     return jsonify(run.window(start, end))
 
 
 @blueprint.get("/api/mission/<log>/<case>/series")
 def series(log: str, case: str):
     """One numeric field (``?field=``) over the run, per robot."""
-    run = stored_mission(driver(), state().logs, log, case)
+    run = _run(log, case)
     field = request.args.get("field", "")
     return jsonify({"field": field, "robots": run.series(field)})
+
+
+def _run(log: str, case: str) -> MissionRun:
+    """The run from the replay named ``log`` this dashboard serves (a replay hides a stored
+    log of the same name), else from the stored log."""
+    replay = state().replays.get(log)
+    if replay is not None:
+        return replay.run(case)
+    return stored_mission(driver(), state().logs, log, case)
+
+
+def _site(log: str, run: MissionRun) -> dict[str, Any] | None:
+    replay = state().replays.get(log)
+    if replay is not None:
+        return replay.sites.get(run.case)
+    return stored_site(driver(), log, run.case)
 
 
 def _seconds(name: str, text: str | None) -> float:
