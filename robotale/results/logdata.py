@@ -114,7 +114,7 @@ class LogData:
         so the section a page asks for first is ready first) and kept."""
         build = current_build(driver, name)
         if not build.complete:  # being written or failed: nothing to keep it for
-            return _json(compute())
+            return result_json(compute())
         path = results_folder(build) / _file_name(what)
         with self._lock:
             computing = self._computing.setdefault(name, threading.Lock())
@@ -124,7 +124,7 @@ class LogData:
         with computing:
             data = _read(path)
             if data is None:
-                data = _json(compute())
+                data = result_json(compute())
                 write_file(path, data)
                 self.computed[(name, what[0])] += 1
         return data
@@ -173,7 +173,8 @@ def _file_name(what: Sequence[str]) -> str:
     return f"{words}-{digest}.json"
 
 
-def _json(value: Any) -> bytes:
+def result_json(value: Any) -> bytes:
+    """A result as the pages receive it: compact JSON, with what JSON lacks made plain."""
     return json.dumps(json_ready(value), separators=(",", ":")).encode("utf-8")
 
 

@@ -11,11 +11,13 @@ from typing import Any
 import pandas as pd
 
 from robotale.enhancement.mission import MissionRun, mission_run
+from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import InputError
 from robotale.eventlog.logkinds import RECORDINGS, kind_of
 from robotale.eventlog.logsource import log_name, open_log
 from robotale.eventlog.runs import find_runs
 from robotale.eventlog.schema import CASE, TIMESTAMP
+from robotale.results.logdata import result_json
 from robotale.results.site import run_sites
 
 
@@ -42,6 +44,14 @@ class Replay:
         if case not in self.runs:
             self.runs[case] = mission_run(self.events, case)
         return self.runs[case]
+
+    def runs_json(self) -> bytes:
+        """Its runs in start order, as the Timeline API answers for a stored log."""
+        return result_json({"runs": run_list(self.events).to_dict(orient="records")})
+
+    def timeline_json(self, case: str) -> bytes:
+        """The timeline of run ``case`` (the first run when empty), as for a stored log."""
+        return result_json(case_timeline(self.events, case or self.cases[0]).to_dict())
 
 
 def open_replay(path: Path) -> Replay:

@@ -100,6 +100,9 @@ def test_the_replay_answers_as_the_stored_log(served, recorded, client):
         poses.append({robot: found["pose"] for robot, found in state["robots"].items()})
     assert len(poses[-1]) == 3 and all(poses[-1].values())  # every robot has moved by the end
     assert poses[0] != poses[-1]
+    for path in ("/api/timeline/runs?log={}", "/api/timeline?log={}&case=" + CASE):
+        found = fetched(served.url + path.format(served.bag.name))
+        assert found == client.get(path.format(name)).get_json(), path
     window = fetched(f"{replayed}/window?from=5&to=30")
     assert window == client.get(f"/api/mission/{name}/{CASE}/window?from=5&to=30").get_json()
     assert window["events"], "the window holds events"
@@ -117,3 +120,35 @@ def test_a_path_that_is_no_recording_is_one_sentence(tmp_path, capsys, kind):
     assert code == 1
     assert message.startswith("robotale: ") and "\n" not in message, message
     assert str(path) in message, message
+
+
+@pytest.mark.browser
+def test_the_mission_page_draws_a_replayed_bag(page, app, recorded):
+    """The page itself on a replay, in headless Chromium: every view drawn, the robots on the
+    map where the replay's state API puts them."""
+    from browser import wait_for
+    from playwright.sync_api import expect
+
+    from robotale.results.replay import open_replay
+    from robotale.webapp.serve import add_replay, mission_path
+    from robotale.webapp.state import state
+
+    replay = open_replay(recorded[0] / CASE)
+    add_replay(app, replay)
+    try:
+        page.goto(f"{page.base_url}{mission_path(replay)}&t=20")
+        wait_for(page, "Number(document.getElementById('mission').dataset.shown) === 20")
+        expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
+        expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
+        assert page.locator("#map rect.field").count() == 1
+        shown = page.eval_on_selector_all(
+            "#map g.robot", "els => els.map(e => [e.dataset.robot, +e.dataset.x, +e.dataset.y])"
+        )
+        robots = replay.run(CASE).state(20.0)["robots"]
+        expected = {r: (s["pose"]["x"], s["pose"]["y"]) for r, s in robots.items() if s["pose"]}
+        drawn = {r: (x, y) for r, x, y in shown}
+        assert expected and drawn.keys() == expected.keys()
+        for robot, where in expected.items():
+            assert drawn[robot] == pytest.approx(where), robot
+    finally:
+        state(app).replays.pop(replay.name)

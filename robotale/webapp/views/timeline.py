@@ -22,7 +22,11 @@ def page():
 @blueprint.get("/api/timeline/runs")
 def runs():
     """The log's runs in start order, for the run picker."""
-    data = stored_runs(driver(), state().logs, request.args.get("log", ""))
+    name = request.args.get("log", "")
+    replay = state().replays.get(name)
+    if replay is not None:  # served by ``robotale serve --bag``, hiding a stored log
+        return Response(replay.runs_json(), mimetype="application/json")
+    data = stored_runs(driver(), state().logs, name)
     return Response(data, mimetype="application/json")
 
 
@@ -30,6 +34,9 @@ def runs():
 def timeline():
     """One run's timeline (the first run when none is named)."""
     name, case = request.args.get("log", ""), request.args.get("case", "")
+    replay = state().replays.get(name)
+    if replay is not None:
+        return Response(replay.timeline_json(case), mimetype="application/json")
     return Response(
         stored_timeline(driver(), state().logs, name, case), mimetype="application/json"
     )
