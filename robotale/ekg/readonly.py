@@ -17,10 +17,10 @@ covers, checked in this order:
 4. The answer: at most ``rows`` rows and ``bytes`` bytes of JSON are kept; the rest is counted
    up to :data:`COUNTED` rows. Every value becomes valid JSON (:func:`cell`).
 
-``python -m robotale.ekg.readonly <megabytes>`` answers requests (a JSON line each on stdin)
-in a process whose memory is capped, so that a single enormous value (``RETURN range(1, 1e8)``)
-costs that process, not the dashboard; the dashboard keeps a few such workers
-(:mod:`robotale.webapp.console_pool`).
+``python -m robotale.ekg.readonly <megabytes> <threads>`` answers requests (a JSON line each
+on stdin, several at once on threads) in a process whose memory is capped, so that a single
+enormous value (``RETURN range(1, 1e8)``) costs that process, not the dashboard; the
+dashboard keeps a few such workers (:mod:`robotale.webapp.console_pool`).
 """
 
 from __future__ import annotations
@@ -30,7 +30,10 @@ import math
 import re
 import resource
 import sys
+import threading
+import time
 from collections.abc import Mapping
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import asdict, dataclass
 from typing import Any, cast
 
@@ -209,6 +212,8 @@ class PlanVerdicts:
 
     def __init__(self) -> None:
         self._accepted: dict[tuple[str, str, str], None] = {}
+        # a worker's threads share the verdicts: forgetting the oldest iterates the dict
+        self._lock = threading.Lock()
 
     def key(
         self, statement: str, parameters: dict[str, Any], database: str
@@ -225,9 +230,10 @@ class PlanVerdicts:
         return key is not None and key in self._accepted
 
     def accept(self, key: tuple[str, str, str]) -> None:
-        self._accepted[key] = None
-        while len(self._accepted) > self.SIZE:
-            del self._accepted[next(iter(self._accepted))]
+        with self._lock:
+            self._accepted[key] = None
+            while len(self._accepted) > self.SIZE:
+                del self._accepted[next(iter(self._accepted))]
 
 
 def built_in_functions(session: neo4j.Session, server: object) -> frozenset[str]:
@@ -395,18 +401,13 @@ def _path_elements(path: Path) -> list[Node | Relationship]:
 REQUEST_KEY = "robotale_console"
 
 
-def answer(
-    request: Mapping[str, Any], drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]]
-) -> dict[str, Any]:
+def answer(request: Mapping[str, Any], drivers: Connections) -> dict[str, Any]:
     """Run one console request (connection, text, parameters, limits) and say how it went:
     ``{"results": [...]}`` or ``{"error": sentence, "kind": class name}``. ``drivers`` keeps
     one connected driver per server and user across requests, with the plans it accepted."""
     where = Settings(request["uri"], request["user"], request["password"], True)
-    key = (where.uri, where.user, where.password)
     try:
-        if key not in drivers:
-            drivers[key] = (connect(where), PlanVerdicts())
-        driver, verdicts = drivers[key]
+        driver, verdicts = drivers.get(where)
         results = run_read_only(
             driver,
             request["text"],
@@ -421,31 +422,72 @@ def answer(
     except RobotaleError as error:
         return {"error": str(error), "kind": type(error).__name__}
     except (ServiceUnavailable, SessionExpired):
-        drivers.pop(key)[0].close()
+        drivers.forget(where)
         return {"error": unreachable_message(where), "kind": ServerError.__name__}
     return {"results": [result.to_dict() for result in results]}
 
 
-def serve(megabytes: int) -> None:
-    """Answer requests, one JSON line each on stdin, with one JSON line each on stdout, in a
-    process whose memory may grow by ``megabytes``; end at the end of stdin, or after a
-    request that ran out of memory (what it left behind is not worth keeping)."""
-    # The cap is on top of what Python and the driver already map (their size varies).
-    limit = _mapped_bytes() + megabytes * 1024 * 1024
+class Connections:
+    """One connected driver per server and user, with the plans it accepted, shared by the
+    threads of a worker (the driver is thread-safe; each request opens its own session)."""
+
+    def __init__(self) -> None:
+        self._drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]] = {}
+        self._lock = threading.Lock()
+
+    def get(self, where: Settings) -> tuple[Driver, PlanVerdicts]:
+        key = (where.uri, where.user, where.password)
+        with self._lock:
+            if key not in self._drivers:
+                self._drivers[key] = (connect(where), PlanVerdicts())
+            return self._drivers[key]
+
+    def forget(self, where: Settings) -> None:
+        with self._lock:
+            found = self._drivers.pop((where.uri, where.user, where.password), None)
+        if found:
+            found[0].close()
+
+
+#: the C stack of each of a worker's threads (a deeply nested value is walked recursively)
+THREAD_STACK = 8 * 1024 * 1024
+
+
+def serve(megabytes: int, threads: int) -> None:
+    """Answer requests, one JSON line each on stdin, with one JSON line each on stdout (with
+    the request's ``id``), up to ``threads`` at once, in a process whose memory may grow by
+    ``megabytes``; end at the end of stdin (the pool ends a process after a request ran out
+    of memory: what it left behind is not worth keeping)."""
+    threading.stack_size(THREAD_STACK)
+    # The cap is on top of what Python and the driver already map (their size varies), and
+    # of the threads' stacks, which are address space whether used or not.
+    limit = _mapped_bytes() + megabytes * 1024 * 1024 + threads * THREAD_STACK
     resource.setrlimit(resource.RLIMIT_AS, (limit, limit))
-    drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]] = {}
+    drivers = Connections()
+    output = threading.Lock()
     sys.stdout.write("ready\n")  # the pool counts a request's time from here on
     sys.stdout.flush()
-    for line in sys.stdin:
-        try:
-            reply = answer(json.loads(line), drivers)
-        except MemoryError:
-            reply = {"error": "memory", "kind": "MemoryError"}
+    with ThreadPoolExecutor(threads, thread_name_prefix="console") as executor:
+        for line in sys.stdin:
+            executor.submit(_reply, line, drivers, output)
+
+
+def _reply(line: str, drivers: Connections, output: threading.Lock) -> None:
+    started = time.monotonic()
+    request_id = ""
+    try:
+        request = json.loads(line)
+        request_id = request.get("id", "")
+        reply = answer(request, drivers)
         # allow_nan=False: a value cell() let through as NaN would be invalid JSON; fail loudly.
-        sys.stdout.write(json.dumps(reply, allow_nan=False) + "\n")
+        text = json.dumps(
+            {"id": request_id, "seconds": time.monotonic() - started, **reply}, allow_nan=False
+        )
+    except MemoryError:
+        text = json.dumps({"id": request_id, "error": "memory", "kind": "MemoryError"})
+    with output:
+        sys.stdout.write(text + "\n")
         sys.stdout.flush()
-        if reply.get("kind") == "MemoryError":
-            return
 
 
 def _mapped_bytes() -> int:
@@ -457,4 +499,4 @@ def _mapped_bytes() -> int:
 
 
 if __name__ == "__main__":
-    serve(int(sys.argv[1]))
+    serve(int(sys.argv[1]), int(sys.argv[2]))

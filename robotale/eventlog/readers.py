@@ -210,6 +210,8 @@ def _csv_table(
                 na_values=sorted(reading.MISSING_MARKERS),
                 index_col=False,
             )
+            if huge := [c for c in reading.huge_integer_columns(table) if c not in text_columns]:
+                return _csv_table(path, text, [*text_columns, *huge])
     except pd.errors.ParserWarning:
         raise InputError(_long_row(path, text)) from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as error:

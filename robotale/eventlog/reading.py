@@ -277,8 +277,31 @@ def typed_columns(table: pd.DataFrame, text: list[str]) -> pd.DataFrame:
         if column in text:
             continue
         with contextlib.suppress(ValueError, TypeError):  # names or mixed values stay text
-            table[column] = pd.to_numeric(table[column])
+            numbers = pd.to_numeric(table[column])
+            if not _beyond_int64(numbers):
+                table[column] = numbers
     return table
+
+
+#: the integers Neo4j (and numpy) can hold; a longer run of digits is an id, kept as text
+_INT64 = (-(2**63), 2**63 - 1)
+
+
+def huge_integer_columns(table: pd.DataFrame) -> list[str]:
+    """The columns pandas read as integers too large for 64 bits (a serial number, a hash in
+    digits): they cannot be stored as numbers, so they are read again as text."""
+    return [str(column) for column in table.columns if _beyond_int64(table[column])]
+
+
+def _beyond_int64(column: pd.Series) -> bool:
+    if column.dtype != object:
+        return False
+    return any(
+        isinstance(value, int)
+        and not isinstance(value, bool)
+        and not _INT64[0] <= value <= _INT64[1]
+        for value in column
+    )
 
 
 # -- lifecycle ---------------------------------------------------------------------------------

@@ -126,7 +126,7 @@ def run(
         reply = pool.ask(request, web.console_timeout + web.console_grace, web.console_timeout)
     except queue.Empty:
         raise InputError(
-            f"The console is busy ({pool.size} queries are running): try again in a moment."
+            f"The console is busy ({pool.capacity} queries are running): try again in a moment."
         ) from None
     except NoAnswer:
         outcome = console_watchdog.stop(watchdog_driver(), request["id"])

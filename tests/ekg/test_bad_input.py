@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import csv
 import signal
 import subprocess
 import sys
@@ -105,6 +106,26 @@ def test_existing_log_name(tmp_path, capsys, graph_counts, log_name):
     assert code == 1 and one_sentence(message), message
     assert f"A log named '{log_name}' already exists in Neo4j; use --replace" in message
     assert graph_counts() == before
+
+
+def test_digits_beyond_64_bits_are_stored_as_text(tmp_path, capsys, neo4j_driver, log_name):
+    """A column of digits too long for Neo4j's integers (a serial number) is stored as the
+    file writes it, as text; the column's short numbers become text too, one type a column."""
+    path = tmp_path / "log.csv"
+    path.write_text(
+        "time,activity,robot,serial\n"
+        "2023-05-16T10:00:00Z,takeoff,drone,123456789012345678901234567890\n"
+        "2023-05-16T10:00:05Z,land,drone,-99999999999999999999\n"
+        "2023-05-16T10:00:09Z,charge,drone,7\n"
+    )
+    assert ingest(capsys, str(path), "--log", log_name) == (0, "")
+    with open(path, newline="") as file:
+        in_file = sorted(row["serial"] for row in csv.DictReader(file))
+    records = neo4j_driver.execute_query(
+        "MATCH (e:Event {log: $log}) WHERE e.serial IS NOT NULL RETURN e.serial AS serial",
+        log=log_name,
+    ).records
+    assert sorted(record["serial"] for record in records) == in_file
 
 
 def test_neo4j_not_reachable(tmp_path, capsys, monkeypatch):
