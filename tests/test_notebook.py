@@ -66,5 +66,7 @@ def test_notebook_runs_and_counts_the_thesis_log(neo4j_server, log_name, monkeyp
     comm = sum(sends[m] * receives[m] for m in messages)
     assert counts["COMM"] == comm
     assert sum(tagged_output(notebook, "messages").values()) == comm
-    # every DF step of a robot between its activity classes, summed per robot
-    assert tagged_output(notebook, "robot-steps") == {r: n - 1 for r, n in robots.items()}
+    # DF_C counts activity instances, each once by the event that ends it (every instance of
+    # this log completes): a robot's steps are one fewer than its completions
+    completions = Counter(row["resource"] for row in thesis_rows if row["lifecycle"] == "complete")
+    assert tagged_output(notebook, "robot-steps") == {r: n - 1 for r, n in completions.items()}

@@ -43,7 +43,12 @@
     return `/api/discover/dfg?${params}`;
   }
 
+  // Each call numbers its request: an answer that arrives after a newer call (a slow first
+  // graph, then a tab clicked) is dropped instead of drawing over what the user asked for last.
+  let latest = 0;
+
   async function discover() {
+    const mine = ++latest;
     robotale.clearError();
     if (state.view === "aggregation" && !levelBox.value) {
       status.textContent = "No aggregation steps yet: run a specification.";
@@ -52,13 +57,17 @@
     }
     status.textContent = "discovering…";
     state.robotFilter = state.view === "dfg" ? selected("robot") : [];
+    let graph;
     try {
-      state.graph = await robotale.api(graphUrl());
+      graph = await robotale.api(graphUrl());
     } catch (error) {
+      if (mine !== latest) return;
       status.textContent = "";
       robotale.showError(error);
       return;
     }
+    if (mine !== latest) return;
+    state.graph = graph;
     draw();
   }
 
