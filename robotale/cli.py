@@ -312,7 +312,8 @@ def _add_monitor(commands: argparse._SubParsersAction) -> None:
         help="watch live robots over DDS: their tags stored in Neo4j as they come, alerts",
         description="Subscribe to the mission's robots' tags on the DDS domain (ROS_DOMAIN_ID), "
         "store each in Neo4j as it arrives under --log, print it, and raise an alert (printed, "
-        "stored, published on /robotale/alerts) when a robot is silent too long.",
+        "stored, published on /robotale/alerts) when a robot does what its pool does not "
+        "allow, is silent too long, or its battery falls below the threshold.",
     )
     monitor.add_argument("model", type=Path, metavar="MISSION.bpmn")
     monitor.add_argument("--robots", help="the robots' namespaces, e.g. drone,tractor_1")
@@ -324,7 +325,10 @@ def _add_monitor(commands: argparse._SubParsersAction) -> None:
         help="alert when a robot says nothing this long (default 10)",
     )
     monitor.add_argument(
-        "--battery", type=float, metavar="PERCENT", help="alert below this charge (default 20)"
+        "--battery",
+        type=float,
+        metavar="PERCENT",
+        help=f"alert below this charge (default {LOW_BATTERY_PERCENT:g})",
     )
     monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
     _handled_by(monitor, "monitor.monitor_command", extra="dds")

@@ -25,6 +25,7 @@ from robotale.fame_runtime.node import KEEP_ALL
 from robotale.fame_runtime.processes import interrupts
 from robotale.fame_runtime.qos import DEFAULT_QOS
 from robotale.fame_runtime.tags import TAG_TYPE, Tag, tag_line, tag_topic
+from robotale.thresholds import LOW_BATTERY_PERCENT
 
 #: where alerts are published, as JSON text in a std_msgs/msg/String
 ALERT_TOPIC = "/robotale/alerts"
@@ -122,7 +123,7 @@ def monitor_command(
     log: str,
     robots: str | None = None,
     silence: float = 10.0,
-    battery: float = 20.0,
+    battery: float = LOW_BATTERY_PERCENT,
     duration: float | None = None,
     out: TextIO | None = None,
     err: TextIO | None = None,
