@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys
 from robotale.enhancement.delays import delay_rule, delayed, slow_mode_starts
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.followed import what_followed
@@ -401,14 +401,11 @@ def _split_lost(table, deliveries, numbered, ids) -> None:
 
 def _pairs_in(first: pd.Series, second: pd.Series, chosen: np.ndarray) -> np.ndarray:
     """Which rows' (``first``, ``second``) pair is also the pair of a ``chosen`` row."""
-    one, _ = pd.factorize(first)
-    two, seconds = pd.factorize(second)
-    if (one < 0).any() or (two < 0).any():  # a missing value: matched as an index matches it
+    keys = row_keys([first, second], [])
+    if keys is None:  # a missing value: matched as an index of pairs matches it
         known = pd.MultiIndex.from_arrays([first[chosen], second[chosen]])
         return pd.MultiIndex.from_arrays([first, second]).isin(known)
-    # one integer per pair of codes: the rows are matched without an index of pairs
-    pair = one.astype(np.int64) * (len(seconds) + 1) + two
-    return np.isin(pair, pair[chosen])
+    return np.isin(keys[0], keys[0][chosen])
 
 
 def _channel_of(rows: pd.DataFrame) -> pd.Series:
