@@ -490,7 +490,9 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
     waiting: dict[object, dict[object, list[int]]] = {}
     unheard: dict[int, set] = {}  # message row -> the robots whose answers to it were lost
     for row, robot, kind in zip(rows, robots, kinds, strict=True):
-        in_case = waiting.setdefault(cases[row], {})
+        in_case = waiting.get(cases[row])
+        if in_case is None:  # not ``setdefault``: that makes a new dict at every step
+            in_case = waiting[cases[row]] = {}
         if kind == ARRIVED:  # ``row`` reached ``robot``: an answer to its messages
             if isinstance(robot, str) and robot != UNKNOWN:  # most steps: one named robot
                 theirs = in_case.get(robot)
@@ -503,7 +505,9 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
             _unheard(in_case, senders[row], robot, receivers, received_at, sent_at[row], unheard)
             continue
         sender, at = senders[row], sent_at[row]
-        mine = in_case.setdefault(sender, [])
+        mine = in_case.get(sender)
+        if mine is None:
+            mine = in_case[sender] = []
         if mine:
             mine[:] = [a for a in mine if received_at[a] > at or unheard.get(a) == receivers[a]]
         candidates = [

@@ -58,11 +58,14 @@ def encounters(
     xyz = placed[list(AXES)].to_numpy(float)[order]
     key = keys[order]
     # the columns an encounter reports, read once (a copy of the rows per pair cost more)
+    runs = pd.factorize(placed[CASE])[0]
+    if (runs < 0).any():  # a position without a run: its run compared as the value is
+        runs = placed[CASE].to_numpy(object)
     read = {
         CASE: placed[CASE].array,
         TIMESTAMP: placed[TIMESTAMP].array,  # the column's own type: zone-aware times stay so
-        "runs": placed[CASE].to_numpy(object)[order],
-        "xyz": placed[list(AXES)].to_numpy()[order],
+        "runs": runs[order],
+        "xyz": xyz,
     }
     found = []
     for i in range(len(names)):
