@@ -48,11 +48,16 @@ START_KNOWN = "start_known"
 
 def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
     """The start, complete and instant events of ``log`` (no ``inprogress`` rows)."""
-    lifecycle = _lifecycle(log)
+    return log[_control_flow(log, _lifecycle(log))]
+
+
+def _control_flow(log: pd.DataFrame, lifecycle: pd.Series) -> np.ndarray:
+    """Which rows of ``log`` (``lifecycle``: their meanings) are starts, completes or
+    instants."""
     keep = lifecycle.isin([START, COMPLETE, "none"])
     if STATE in log.columns:
         keep &= log[STATE].astype("string").fillna("").str.lower().ne(INPROGRESS).to_numpy(bool)
-    return log[keep.to_numpy(bool)]
+    return keep.to_numpy(bool)
 
 
 def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
@@ -65,12 +70,17 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     start that never completes is an unfinished instance (no completion, no duration); a
     completion without a start, and an instant event, starts when it completes.
     """
-    events = control_flow_events(log)
+    # the lifecycle's meanings worked out once and kept beside the rows as they are chosen
+    # and ordered
+    lifecycle = _lifecycle(log)
+    keep = _control_flow(log, lifecycle)
+    events, lifecycle = log[keep], lifecycle[keep]
     if events.empty:
         return _empty_instances(log)
-    events = in_tie_order(events)
+    order = _tie_positions(events, lifecycle)
+    if order is not None:
+        events, lifecycle = events.iloc[order], lifecycle.iloc[order]
     events = events.assign(_order=np.arange(len(events)))
-    lifecycle = _lifecycle(events)
     group = events.groupby(_pairing_keys(events), dropna=False, sort=False).ngroup()
     starts = (lifecycle == START).to_numpy()
     completes = (lifecycle == COMPLETE).to_numpy()
@@ -110,26 +120,36 @@ def in_tie_order(events: pd.DataFrame) -> pd.DataFrame:
     order stays: a robot's engine tags its events one after the other, so a sequence of
     activities that take no time (a simulated clock) keeps its order, which the activities'
     names would not."""
+    order = _tie_positions(events, _lifecycle(events))
+    return events if order is None else events.iloc[order]
+
+
+def _tie_positions(events: pd.DataFrame, lifecycle: pd.Series) -> np.ndarray | None:
+    """The positions of ``events`` (``lifecycle``: their meanings) in the order of
+    :func:`in_tie_order`; ``None`` when they are in it already."""
+    order = None
     if not events[TIMESTAMP].is_monotonic_increasing:  # logs usually come in time order
-        events = events.sort_values(TIMESTAMP, kind="stable")
-    times = _ticks(events[TIMESTAMP])
+        # as a stable sort of the column orders them (a missing time last)
+        stamps = events[TIMESTAMP].reset_index(drop=True)
+        order = stamps.sort_values(kind="stable").index.to_numpy()
+    times = _ticks(events[TIMESTAMP] if order is None else events[TIMESTAMP].iloc[order])
     same = times[1:] == times[:-1]
     if not same.any():
-        return events
+        return order
     tied = np.zeros(len(events), dtype=bool)
     tied[1:] |= same
     tied[:-1] |= same
     rows = np.flatnonzero(tied)
-    part = events.iloc[rows]
+    at = rows if order is None else order[rows]  # the tied rows' positions in ``events``
     keys = [np.arange(len(rows))]  # the file's order: the last tie-break
-    if ROBOT in part.columns:
-        values = part[ROBOT].astype("string").fillna("")
+    if ROBOT in events.columns:
+        values = events[ROBOT].iloc[at].astype("string").fillna("")
         keys.append(pd.factorize(values, sort=True)[0])
-    keys.append((_lifecycle(part) != START).to_numpy(np.int8))
+    keys.append((lifecycle.iloc[at] != START).to_numpy(np.int8))
     keys.append(times[rows])
-    order = np.arange(len(events))
-    order[rows] = rows[np.lexsort(keys)]
-    return events.iloc[order]
+    ordered = np.arange(len(events)) if order is None else order.copy()
+    ordered[rows] = at[np.lexsort(keys)]
+    return ordered
 
 
 def _ticks(times: pd.Series) -> np.ndarray:

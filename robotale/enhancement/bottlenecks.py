@@ -53,7 +53,7 @@ import pandas as pd
 from robotale.discovery.graph import format_seconds
 from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, interrupted
 from robotale.enhancement.communication import TYPE, event_roles, shared_latencies
-from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.performance import (
     ARROW,
@@ -390,12 +390,16 @@ def _busy_union(group: np.ndarray, begin: np.ndarray, end: np.ndarray, span: flo
 def _rework(steps: pd.DataFrame, instances: pd.DataFrame) -> pd.DataFrame:
     repeats = steps[_repeats(steps)]
     # the repeated instance: the one that starts at this step's target start
-    durations = instances.set_index([CASE, ROBOT, ACTIVITY, START_TIMESTAMP])[DURATION]
+    columns = [instances[c] for c in (CASE, ROBOT, ACTIVITY, START_TIMESTAMP)]
+    wanted = [repeats[c] for c in (CASE, ROBOT, "target", "target_start")]
+    keys = row_keys(columns, wanted)
+    if keys is None:  # a missing value: matched as the index of tuples matches it
+        durations = instances.set_index([CASE, ROBOT, ACTIVITY, START_TIMESTAMP])[DURATION]
+        at = pd.MultiIndex.from_arrays(wanted)
+    else:
+        durations, at = pd.Series(instances[DURATION].to_numpy(), index=keys[0]), keys[1]
     durations = durations[~durations.index.duplicated()]
-    keys = pd.MultiIndex.from_arrays(
-        [repeats[CASE], repeats[ROBOT], repeats["target"], repeats["target_start"]]
-    )
-    repeat_time = durations.reindex(keys).fillna(0).to_numpy()
+    repeat_time = durations.reindex(at).fillna(0).to_numpy()
     return _excess_rows(repeats, "rework", repeats["target"], repeats[WAIT] + repeat_time)
 
 

@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.enhancement.context import LogAnalysis, analysis_of
+from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys
 from robotale.enhancement.delays import delay_rule, delayed, slow_mode_starts
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.followed import what_followed
@@ -384,11 +384,9 @@ def _meant_for(missing, events, reached, keys) -> np.ndarray:
 def _split_lost(table, deliveries, numbered, ids) -> None:
     """An unreceived delivery is lost only where the log tags receives of its type (by its
     receiver, when named); else it is ``unobserved``: it may have arrived untagged."""
-    reached = deliveries[deliveries["received"]]
     tagged_types = set(table.loc[table["received"], TYPE].dropna())
-    known = pd.MultiIndex.from_arrays([reached[TYPE], reached["receiver"].astype(object)])
     receiver = deliveries["receiver"].astype(object)
-    pairs = pd.MultiIndex.from_arrays([deliveries[TYPE], receiver]).isin(known)
+    pairs = _pairs_in(deliveries[TYPE], receiver, deliveries["received"].to_numpy(bool))
     tagged = deliveries[TYPE].isin(tagged_types) & (receiver.eq(UNKNOWN) | pairs)
     # a message received by a robot the log does not name has a delivery without a receiver
     arrived = table["received"].to_numpy(bool)[deliveries[MESSAGE].to_numpy()]
@@ -401,10 +399,27 @@ def _split_lost(table, deliveries, numbered, ids) -> None:
     table["unobserved"] = table["sent"] & ~table["received"] & ~table["lost"]
 
 
+def _pairs_in(first: pd.Series, second: pd.Series, chosen: np.ndarray) -> np.ndarray:
+    """Which rows' (``first``, ``second``) pair is also the pair of a ``chosen`` row."""
+    keys = row_keys([first, second], [])
+    if keys is None:  # a missing value: matched as an index of pairs matches it
+        known = pd.MultiIndex.from_arrays([first[chosen], second[chosen]])
+        return pd.MultiIndex.from_arrays([first, second]).isin(known)
+    return np.isin(keys[0], keys[0][chosen])
+
+
 def _channel_of(rows: pd.DataFrame) -> pd.Series:
     """Each row's channel (sender, receiver and type) as one text, to group by."""
-    parts = [rows[c].astype(object).where(rows[c].notna(), "").astype(str) for c in CHANNEL]
-    return parts[0] + "\x1f" + parts[1] + "\x1f" + parts[2]
+    # the text is made once per distinct channel (a log has a few, with many messages each)
+    combination = np.zeros(len(rows), dtype=np.int64)
+    for column in CHANNEL:
+        codes, uniques = pd.factorize(rows[column], use_na_sentinel=False)
+        combination = combination * (len(uniques) + 1) + codes
+    _, firsts, codes = np.unique(combination, return_index=True, return_inverse=True)
+    distinct = rows.iloc[firsts]
+    parts = [distinct[c].astype(object).where(distinct[c].notna(), "").astype(str) for c in CHANNEL]
+    texts = (parts[0] + "\x1f" + parts[1] + "\x1f" + parts[2]).to_numpy(object)
+    return pd.Series(texts[codes.reshape(-1)], index=rows.index, dtype=object)
 
 
 def untagged_types(messages: pd.DataFrame) -> list[str]:
@@ -434,11 +449,17 @@ def _with_resends(table: pd.DataFrame, deliveries: pd.DataFrame) -> pd.DataFrame
 
 def _resend_rows(table: pd.DataFrame, ids: pd.Series) -> np.ndarray:
     """Per message, the row of the message it was resent as (-1: none)."""
-    keys = [k for k in (CASE,) if k in table.columns]
-    by_id = pd.Series(ids.to_numpy(), index=pd.MultiIndex.from_frame(table[[*keys, MSG_ID]]))
-    wanted = table[keys].assign(**{MSG_ID: table["resent_as"]})
-    found = by_id.reindex(pd.MultiIndex.from_frame(wanted[[*keys, MSG_ID]]))
-    return found.fillna(-1).to_numpy(np.int64)
+    # (case, id) numbered as one integer: the table's ids and the ids resent as, coded together
+    n = len(table)
+    codes, names = pd.factorize(
+        pd.concat([table[MSG_ID].astype(object), table["resent_as"].astype(object)],
+                  ignore_index=True)
+    )  # fmt: skip
+    cases = pd.factorize(table[CASE])[0] if CASE in table.columns else np.zeros(n, np.int64)
+    keys = np.tile(cases.astype(np.int64), 2) * (len(names) + 1) + codes
+    found = pd.Index(keys[:n]).get_indexer(keys[n:])
+    found[(codes[n:] < 0) | (np.tile(cases, 2)[n:] < 0)] = -1  # no id resent as, or no case
+    return np.where(found >= 0, ids.to_numpy(np.int64)[np.maximum(found, 0)], -1)
 
 
 def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series, pd.Series]:
@@ -469,15 +490,24 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
     waiting: dict[object, dict[object, list[int]]] = {}
     unheard: dict[int, set] = {}  # message row -> the robots whose answers to it were lost
     for row, robot, kind in zip(rows, robots, kinds, strict=True):
-        in_case = waiting.setdefault(cases[row], {})
+        in_case = waiting.get(cases[row])
+        if in_case is None:  # not ``setdefault``: that makes a new dict at every step
+            in_case = waiting[cases[row]] = {}
         if kind == ARRIVED:  # ``row`` reached ``robot``: an answer to its messages
-            _answer(in_case, senders[row], robot, receivers)
+            if isinstance(robot, str) and robot != UNKNOWN:  # most steps: one named robot
+                theirs = in_case.get(robot)
+                if theirs and robot != senders[row]:
+                    _answered(theirs, senders[row], receivers)
+            else:
+                _answer(in_case, senders[row], robot, receivers)
             continue
         if kind == LOST:  # ``row``, meant for ``robot``, never reached it
             _unheard(in_case, senders[row], robot, receivers, received_at, sent_at[row], unheard)
             continue
         sender, at = senders[row], sent_at[row]
-        mine = in_case.setdefault(sender, [])
+        mine = in_case.get(sender)
+        if mine is None:
+            mine = in_case[sender] = []
         if mine:
             mine[:] = [a for a in mine if received_at[a] > at or unheard.get(a) == receivers[a]]
         candidates = [
@@ -547,12 +577,16 @@ def _possible_receivers(table: pd.DataFrame) -> list[frozenset]:
     """Per message, the robots it went to; for one no robot is known to have received, the
     robots that received its sender's other messages of its type (a message nobody got may
     have been meant for any of them), else none known."""
-    named = [_receiver_set(r) for r in table["receiver"].astype(object).tolist()]
+    # each distinct receiver text split once (a log has a few, on many messages)
+    codes, uniques = pd.factorize(table["receiver"].astype(object), use_na_sentinel=False)
+    sets = [_receiver_set(r) for r in uniques.tolist()]
+    named = [sets[c] for c in codes.tolist()]
+    senders, kinds = table["sender"].tolist(), table[TYPE].tolist()
     usual: dict[tuple, frozenset] = {}
-    for sender, kind, robots in zip(table["sender"], table[TYPE], named, strict=True):
+    for sender, kind, robots in zip(senders, kinds, named, strict=True):
         if robots:
             usual[(sender, kind)] = usual.get((sender, kind), frozenset()) | robots
-    pairs = zip(table["sender"], table[TYPE], strict=True)
+    pairs = zip(senders, kinds, strict=True)
     return [robots or usual.get(pair, robots) for pair, robots in zip(pairs, named, strict=True)]
 
 
@@ -593,7 +627,13 @@ def _answer(waiting: dict, sender, receiver, receivers: list[frozenset]) -> None
     (or to nobody known)."""
     for theirs in _waiting_for(waiting, sender, receiver):
         if theirs:
-            theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
+            _answered(theirs, sender, receivers)
+
+
+def _answered(theirs: list[int], sender, receivers: list[frozenset]) -> None:
+    """Drops from ``theirs`` the messages a message from ``sender`` answers: those sent to
+    ``sender`` (or to nobody known)."""
+    theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
 
 
 def _waiting_for(waiting: dict, sender, receiver) -> list[list[int]]:

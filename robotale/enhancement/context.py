@@ -12,6 +12,7 @@ from __future__ import annotations
 from collections.abc import Callable, Hashable, Sequence
 from typing import Any
 
+import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import INSTANCE_KEYS, activity_instances
@@ -77,3 +78,22 @@ class LogAnalysis:
 def analysis_of(source: pd.DataFrame | LogAnalysis) -> LogAnalysis:
     """``source`` itself when it is an analysis already, else a fresh one of the log."""
     return source if isinstance(source, LogAnalysis) else LogAnalysis(source)
+
+
+def row_keys(
+    left: Sequence[pd.Series], right: Sequence[pd.Series]
+) -> tuple[np.ndarray, np.ndarray] | None:
+    """One integer per row of ``left`` and of ``right`` (columns of two tables, in the same
+    order; ``right`` may be empty), equal where the rows' values are: rows matched by
+    integers instead of an index of tuples. ``None`` when a value is missing (a caller matches
+    those as its index would)."""
+    n = len(left[0]) if left else 0
+    keys = np.zeros(n + (len(right[0]) if right else 0), dtype=np.int64)
+    for at, one in enumerate(left):
+        parts = [one.reset_index(drop=True)] + ([right[at].reset_index(drop=True)] if right else [])
+        codes, uniques = pd.factorize(pd.concat(parts, ignore_index=True) if right else parts[0])
+        if (codes < 0).any():
+            return None
+        # renumbered after each column, so the combined key never outgrows an integer
+        keys = pd.factorize(keys * (len(uniques) + 1) + codes)[0].astype(np.int64)
+    return keys[:n], keys[n:]

@@ -57,13 +57,25 @@ def encounters(
     bounds = np.searchsorted(robot_code[order], np.arange(len(names) + 1))
     xyz = placed[list(AXES)].to_numpy(float)[order]
     key = keys[order]
+    # the columns an encounter reports, read once (a copy of the rows per pair cost more)
+    runs = pd.factorize(placed[CASE])[0]
+    if (runs < 0).any():  # a position without a run: its run compared as the value is
+        runs = placed[CASE].to_numpy(object)
+    read = {
+        CASE: placed[CASE].array,
+        TIMESTAMP: placed[TIMESTAMP].array,  # the column's own type: zone-aware times stay so
+        "runs": runs[order],
+        "xyz": xyz,
+    }
     found = []
     for i in range(len(names)):
         for j in range(i + 1, len(names)):
             mine, theirs = slice(bounds[i], bounds[i + 1]), slice(bounds[j], bounds[j + 1])
             met, distance = _meet(key[mine], xyz[mine], key[theirs], xyz[theirs], metres, seconds)
             if met.any():
-                rows = placed.iloc[order[mine]]
+                rows = {"order": order[mine], "runs": read["runs"][mine],
+                        "xyz": read["xyz"][mine], CASE: read[CASE],
+                        TIMESTAMP: read[TIMESTAMP]}  # fmt: skip
                 found.append(_episodes(rows, met, distance, str(names[i]), str(names[j])))
     if not found:
         return pd.DataFrame(columns=columns)
@@ -82,10 +94,12 @@ def _meet(mine_key, mine_xyz, theirs_key, theirs_xyz, metres: float, seconds: fl
     return close_in_time & (distance <= metres), distance
 
 
-def _episodes(rows: pd.DataFrame, met: np.ndarray, distance: np.ndarray, robot: str, other: str):
-    """Consecutive meeting positions of ``robot`` (in run and time order) as encounters."""
+def _episodes(rows: dict, met: np.ndarray, distance: np.ndarray, robot: str, other: str):
+    """Consecutive meeting positions of ``robot`` (in run and time order) as encounters;
+    ``rows``: its positions' rows in the placed table (``order``), their runs and x, y, z in
+    that order (``runs``, ``xyz``), and the placed table's case and time columns."""
     # a new encounter wherever a meeting position follows one that did not meet (or a new run)
-    cases = rows[CASE].to_numpy(object)
+    cases = rows["runs"]
     new_run = np.r_[True, cases[1:] != cases[:-1]]
     begins = met & (new_run | ~np.r_[False, met[:-1]])
     # each encounter is a contiguous stretch of the meeting positions, in time order within
@@ -101,17 +115,18 @@ def _episodes(rows: pd.DataFrame, met: np.ndarray, distance: np.ndarray, robot: 
     at_closest = np.flatnonzero(near == closest[episode])
     _, chosen = np.unique(episode[at_closest], return_index=True)
     where = meeting[at_closest[chosen]]
-    times = rows[TIMESTAMP].array  # the column's own type (zone-aware times stay so)
-    table = pd.DataFrame(
+    order, times, xyz = rows["order"], rows[TIMESTAMP], rows["xyz"][where]
+    return pd.DataFrame(
         {
-            CASE: rows[CASE].array[meeting[first]],
-            "start": times[meeting[first]],
-            "end": times[meeting[last]],
+            CASE: rows[CASE][order[meeting[first]]],
+            "start": times[order[meeting[first]]],
+            "end": times[order[meeting[last]]],
             "closest": closest,
+            **{axis: xyz[:, i] for i, axis in enumerate(AXES)},
+            "robot": robot,
+            "other": other,
         }
     )
-    table[list(AXES)] = rows[list(AXES)].to_numpy()[where]
-    return table.assign(robot=robot, other=other)
 
 
 def _run_time_keys(placed: pd.DataFrame, seconds: float) -> np.ndarray:

@@ -286,12 +286,20 @@ def robot_answer(log: pd.DataFrame, performance: Perspective) -> Answer:
     placed = positions(log)
     met = encounters(placed)
     overlaps = region_overlaps(run_regions(placed))
-    answer.facts["encounters"] = met.to_dict("records")
+    answer.facts["encounters"] = _records(met)
     answer.facts["overlaps"] = overlaps
     answer.facts["same_place"] = {"metres": METRES, "seconds": SECONDS}
     answer.sentences += _encounter_sentences(met)
     answer.sentences.append(_overlap_sentence(overlaps, placed))
     return answer
+
+
+def _records(table: pd.DataFrame) -> list[dict[str, Any]]:
+    """The rows as ``to_dict("records")`` gives them, converted a column at a time (a row at
+    a time boxes every value on its own)."""
+    columns = [table[c].tolist() for c in table.columns]
+    names = list(table.columns)
+    return [dict(zip(names, values, strict=True)) for values in zip(*columns, strict=True)]
 
 
 def _encounter_sentences(met: pd.DataFrame) -> list[str]:

@@ -8,6 +8,10 @@ import sys
 from pathlib import Path
 
 import pytest
+from pandas import Timedelta
+
+from robotale.enhancement.findings import find
+from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, MSG_ID, TIMESTAMP
 
 BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 
@@ -104,3 +108,43 @@ def test_the_graphs_shape_counts_each_node_once_and_every_relationship():
     counts = {"node:Event": 10, "node:Entity": 3, "node:Class": 2, "node:Robot": 3}
     counts |= {"relationship:DF": 9, "relationship:CORR": 12}
     assert importer_bound.shape(counts) == (15, 21)
+
+
+# -- findings_against.py: the findings of two revisions ----------------------------------------
+
+
+@pytest.fixture(scope="module")
+def runs():
+    return benchmark("dashboard").thesis_runs(3_000)
+
+
+@pytest.fixture(scope="module")
+def against():
+    return benchmark("findings_against")
+
+
+def test_the_same_answers_are_checked_equal(runs, against):
+    ours = against.comparable(find(runs))
+    # the sent messages by hand: the distinct message ids of the log, per run
+    assert ours["sent"] == runs.dropna(subset=[MSG_ID]).drop_duplicates([CASE, MSG_ID]).shape[0]
+    assert against.compared(ours, against.comparable(find(runs.copy()))).startswith("equal")
+
+
+def test_a_longer_activity_is_told_apart(runs, against):
+    ours = against.comparable(find(runs))
+    # the last completion of an activity whose starts the log has: its instance ends later
+    started = set(runs.loc[runs[LIFECYCLE].eq("start").fillna(False), ACTIVITY])
+    ends = runs[LIFECYCLE].eq("complete").fillna(False) & runs[ACTIVITY].isin(started)
+    last = runs[ends].index[-1]
+    later = runs.copy()
+    later.loc[last, TIMESTAMP] = later.loc[last, TIMESTAMP] + Timedelta(seconds=5)
+    verdict = against.compared(ours, against.comparable(find(later)))
+    assert verdict.startswith("DIFFERENT") and "activities" in verdict
+
+
+def test_a_missing_message_is_told_apart(runs, against):
+    ours = against.comparable(find(runs))
+    first = runs[MSG_ID].dropna().iloc[0]
+    fewer = runs[runs[MSG_ID].ne(first).fillna(True)].reset_index(drop=True)
+    verdict = against.compared(ours, against.comparable(find(fewer)))
+    assert verdict.startswith("DIFFERENT") and "sent" in verdict
