@@ -25,3 +25,13 @@ def test_the_estimate_counts_events_relationships_and_values_as_the_build_writes
         + values * disk_space.PER_VALUE_BYTE
     )
     assert disk_space.needed_bytes(events, ["robot", "msg_id", "absent"], 2) == int(expected)
+
+
+def test_a_large_logs_values_are_measured_on_every_nth_row():
+    rows = 3 * disk_space.SAMPLE + 2
+    events = pd.DataFrame({"activity": ["abcd", "efghij"] * (rows // 2)})  # 5 bytes a row
+    expected = (
+        disk_space.MARGIN * (rows * disk_space.PER_EVENT + rows * disk_space.PER_RELATIONSHIP)
+        + disk_space.MARGIN * disk_space.PER_VALUE_BYTE * 5 * rows
+    )
+    assert abs(disk_space.needed_bytes(events, [], 1) - expected) / expected < 0.01
