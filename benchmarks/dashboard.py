@@ -49,6 +49,9 @@ included) and loading the Discover page, in turn (A B C A B C), over HTTP; every
 answer is checked equal to the same query run directly. Printed: the median and 99th
 percentile of each, and of each example, the examples' ratio to Discover, errors and the load
 average. Target: console median under 1 s at 20 clients, no error; the baseline is Discover.
+The console keeps its answers while the database is unchanged (``robotale.ekg.answer_cache``):
+each worker computes an example once, in the first round (the p99), and answers it from memory
+after that; the expected answers are computed directly on the driver, apart from the console.
 """
 
 from __future__ import annotations

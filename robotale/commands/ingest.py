@@ -11,6 +11,8 @@ from robotale.ekg.append import append_ekg
 from robotale.ekg.build import build_ekg
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
+from robotale.ekg.disk_space import check_space
+from robotale.ekg.keys import default_entities
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
 from robotale.errors import InputError
 from robotale.eventlog.logkinds import RECORDINGS
@@ -78,7 +80,10 @@ def ingest_command(
     if chosen is None and found_objects is not None:
         chosen = found_objects.entity_types
     names = {"entities": chosen}
+    keys = aggregate or default_keys(events, chosen)
     with session_driver() as driver:
+        entity_columns = chosen if chosen is not None else default_entities(events.columns)
+        check_space(driver, events, name, entity_columns, len(keys))
         if append:
             # the log's columnar copy no longer matches its build: the next analysis reads
             # the whole log back from the graph and keeps that copy instead
@@ -88,7 +93,7 @@ def ingest_command(
                 driver,
                 events,
                 name,
-                aggregate=aggregate or default_keys(events, chosen),
+                aggregate=keys,
                 replace=replace,
                 source=str(path),
                 objects=found_objects,

@@ -56,7 +56,7 @@ def out_of_disk(since: int) -> str | None:
     found = _OUT_OF_SPACE.search(text)
     if found is not None:
         store = Path(found.group("file"))
-        asked = f"it could not grow {store.name} to {_size(int(found.group('size')))}"
+        asked = f"it could not grow {store.name} to {size_text(int(found.group('size')))}"
         return f"Neo4j's disk is full: {asked} on the disk of {_where(store.parent)}"
     if _NO_SPACE in text:  # a transaction log's write: Neo4j names neither file nor size
         data = log.parent.parent / "data"
@@ -69,7 +69,7 @@ def _where(folder: Path) -> str:
     if not folder.exists():
         return str(folder)
     usage = shutil.disk_usage(folder)
-    return f"{_mount_point(folder)} ({_size(usage.free)} of its {_size(usage.total)} free)"
+    return f"{_mount_point(folder)} ({size_text(usage.free)} of its {size_text(usage.total)} free)"
 
 
 def _mount_point(path: Path) -> Path:
@@ -79,7 +79,8 @@ def _mount_point(path: Path) -> Path:
     return path
 
 
-def _size(count: int) -> str:
+def size_text(count: int) -> str:
+    """``count`` bytes as people read them (``1.5 GB``)."""
     for unit, size in (("GB", 1024**3), ("MB", 1024**2), ("kB", 1024)):
         if count >= size:
             return f"{count / size:.1f} {unit}"

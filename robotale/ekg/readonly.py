@@ -17,6 +17,9 @@ covers, checked in this order:
 4. The answer: at most ``rows`` rows and ``bytes`` bytes of JSON are kept; the rest is counted
    up to :data:`COUNTED` rows. Every value becomes valid JSON (:func:`cell`).
 
+An answer that passed all four is kept (:mod:`robotale.ekg.answer_cache`) and given again to
+the same text, parameters and limits while Neo4j says the database is unchanged.
+
 ``python -m robotale.ekg.readonly <megabytes> <threads>`` answers requests (a JSON line each
 on stdin, several at once on threads) in a process whose memory is capped, so that a single
 enormous value (``RETURN range(1, 1e8)``) costs that process, not the dashboard; the
@@ -42,6 +45,8 @@ from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError, ServiceUnavailable, SessionExpired
 from neo4j.graph import Node, Path, Relationship
 
+from robotale.ekg import answer_cache
+from robotale.ekg.answer_cache import AnswerCache
 from robotale.ekg.connection import Settings, connect, unreachable_message
 from robotale.ekg.connection import database as default_database
 from robotale.ekg.plan_check import (
@@ -180,21 +185,25 @@ def refuse_plan(
     parameters: dict[str, Any],
     database: str,
     verdicts: PlanVerdicts | None = None,
-) -> None:
+) -> bool:
     """Ask Neo4j for the plan of ``statement`` (nothing runs) and refuse what it would do
     beyond reading ``database`` (:func:`robotale.ekg.plan_check.check_plan`); a plan
-    ``verdicts`` has accepted before is not asked for again."""
+    ``verdicts`` has accepted before is not asked for again. Returns whether the plan calls
+    a function whose value changes by itself (:func:`robotale.ekg.answer_cache.volatile`)."""
     key = verdicts.key(statement, parameters, database) if verdicts else None
     if verdicts is not None and key in verdicts:
-        return
+        return verdicts.volatile(key)
     code = code_only(statement)
     leading = _LEADING_MODE.match(code)
     body = statement[leading.end() :] if leading else statement
     summary = session.run("EXPLAIN " + body, parameters).consume()
     server = summary.server
-    check_plan(summary.plan or {}, database, built_in_functions(session, server.address))
+    plan = summary.plan or {}
+    check_plan(plan, database, built_in_functions(session, server.address))
+    changing = answer_cache.volatile(plan)
     if verdicts is not None and key is not None:
-        verdicts.accept(key)
+        verdicts.accept(key, changing)
+    return changing
 
 
 class PlanVerdicts:
@@ -211,7 +220,8 @@ class PlanVerdicts:
     KEY_BYTES = 4096
 
     def __init__(self) -> None:
-        self._accepted: dict[tuple[str, str, str], None] = {}
+        #: accepted plans, each with whether it calls a volatile function
+        self._accepted: dict[tuple[str, str, str], bool] = {}
         # a worker's threads share the verdicts: forgetting the oldest iterates the dict
         self._lock = threading.Lock()
 
@@ -229,9 +239,12 @@ class PlanVerdicts:
     def __contains__(self, key: object) -> bool:
         return key is not None and key in self._accepted
 
-    def accept(self, key: tuple[str, str, str]) -> None:
+    def volatile(self, key: tuple[str, str, str]) -> bool:
+        return self._accepted.get(key, True)
+
+    def accept(self, key: tuple[str, str, str], volatile: bool) -> None:
         with self._lock:
-            self._accepted[key] = None
+            self._accepted[key] = volatile
             while len(self._accepted) > self.SIZE:
                 del self._accepted[next(iter(self._accepted))]
 
@@ -262,10 +275,12 @@ def run_read_only(
     database: str | None = None,
     metadata: Mapping[str, Any] | None = None,
     verdicts: PlanVerdicts | None = None,
+    answers: AnswerCache | None = None,
 ) -> list[StatementResult]:
     """Run each statement of ``text`` (separated by ``;``) in its own read transaction,
     which carries ``metadata`` (``SHOW TRANSACTIONS`` finds it by that); ``verdicts`` keeps
-    the plans accepted on this driver's server as its user.
+    the plans accepted on this driver's server as its user, ``answers`` the answers given
+    on it (:mod:`robotale.ekg.answer_cache`: only while the database is unchanged).
 
     Every statement is checked (text, then plan) before the first one runs. Raises
     :class:`QueryRefused` (:class:`WriteRefused` for writes) for what the console does not
@@ -279,15 +294,49 @@ def run_read_only(
         refuse_text(statement)
     limits = Limits(row_limit, byte_limit, timeout)
     database = database or default_database()
+    key = (
+        answers.key(database, text, values, row_limit, byte_limit) if answers is not None else None
+    )
     with driver.session(database=database, default_access_mode=neo4j.READ_ACCESS) as session:
         try:
-            for statement in statements:
-                refuse_plan(session, statement, values, database, verdicts)
-            return [_run(session, statement, values, limits, metadata) for statement in statements]
+            if answers is None or key is None:
+                return _checked_and_run(session, statements, values, limits, database, verdicts,
+                                        metadata)[0]  # fmt: skip
+            with answers.alone(key, timeout):
+                before = answer_cache.mark(session)
+                kept = answers.get(key, before)
+                if kept is not None:
+                    return [StatementResult(**result) for result in kept]
+                results, changing = _checked_and_run(
+                    session, statements, values, limits, database, verdicts, metadata
+                )
+                # kept only when nothing was committed while it ran (the bookmark is the same)
+                if not changing and answer_cache.mark(session) == before:
+                    answers.put(key, before, [result.to_dict() for result in results])
+                return results
         except (ServiceUnavailable, SessionExpired):
             raise
         except (Neo4jError, DriverError) as error:
             raise explain(error) from None
+
+
+def _checked_and_run(
+    session: neo4j.Session,
+    statements: list[str],
+    values: dict[str, Any],
+    limits: Limits,
+    database: str,
+    verdicts: PlanVerdicts | None,
+    metadata: Mapping[str, Any] | None,
+) -> tuple[list[StatementResult], bool]:
+    """The statements' results, once every plan was accepted, and whether any plan calls a
+    volatile function."""
+    changing = False
+    for statement in statements:
+        changing = refuse_plan(session, statement, values, database, verdicts) or changing
+    return [
+        _run(session, statement, values, limits, metadata) for statement in statements
+    ], changing
 
 
 def _run(
@@ -407,7 +456,7 @@ def answer(request: Mapping[str, Any], drivers: Connections) -> dict[str, Any]:
     one connected driver per server and user across requests, with the plans it accepted."""
     where = Settings(request["uri"], request["user"], request["password"], True)
     try:
-        driver, verdicts = drivers.get(where)
+        driver, verdicts, answers = drivers.get(where)
         results = run_read_only(
             driver,
             request["text"],
@@ -418,6 +467,7 @@ def answer(request: Mapping[str, Any], drivers: Connections) -> dict[str, Any]:
             database=request["database"],
             metadata={REQUEST_KEY: request.get("id", "")},
             verdicts=verdicts,
+            answers=answers,
         )
     except RobotaleError as error:
         return {"error": str(error), "kind": type(error).__name__}
@@ -428,18 +478,19 @@ def answer(request: Mapping[str, Any], drivers: Connections) -> dict[str, Any]:
 
 
 class Connections:
-    """One connected driver per server and user, with the plans it accepted, shared by the
-    threads of a worker (the driver is thread-safe; each request opens its own session)."""
+    """One connected driver per server and user, with the plans it accepted and the answers
+    it gave, shared by the threads of a worker (the driver is thread-safe; each request opens
+    its own session)."""
 
     def __init__(self) -> None:
-        self._drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts]] = {}
+        self._drivers: dict[tuple[str, str, str], tuple[Driver, PlanVerdicts, AnswerCache]] = {}
         self._lock = threading.Lock()
 
-    def get(self, where: Settings) -> tuple[Driver, PlanVerdicts]:
+    def get(self, where: Settings) -> tuple[Driver, PlanVerdicts, AnswerCache]:
         key = (where.uri, where.user, where.password)
         with self._lock:
             if key not in self._drivers:
-                self._drivers[key] = (connect(where), PlanVerdicts())
+                self._drivers[key] = (connect(where), PlanVerdicts(), AnswerCache())
             return self._drivers[key]
 
     def forget(self, where: Settings) -> None:

@@ -21,6 +21,7 @@ import pandas as pd
 from neo4j import Driver
 
 from robotale.ekg.build import build_ekg
+from robotale.ekg.disk_space import check_space
 from robotale.ekg.keys import DEFAULT_ENTITIES, built_keys
 from robotale.ekg.logs import stored_events
 from robotale.errors import InputError, RobotaleError
@@ -224,6 +225,7 @@ def ingest(
     if log is None:
         raise InputError("That upload has not been read yet: wait for it, then choose again.")
     try:
+        check_space(driver, log, name, entities, len(built_keys(entities)))
         job.step("writing to Neo4j", 0, len(log))
         with _ProgressWatch(driver, name, job, enabled=not replace):
             summary = build_ekg(

@@ -1,13 +1,19 @@
-"""A disk that fills under robotale's local Neo4j while a log is stored: a real small
-filesystem (tmpfs) as the server's data directory, and a log larger than it."""
+"""A disk too small for a log under robotale's local Neo4j: a real small filesystem (tmpfs)
+as the server's data directory, and a log larger than it. The free-space check refuses the
+log before anything is written; past the check, the disk fills while the log is written and
+the unfinished log is named with the command that removes it."""
 
 from __future__ import annotations
+
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
 import pytest
 
 from robotale.cli import main
+from robotale.commands import ingest
 from robotale.neo4j_server.server import LocalServer, PortInUse, ServerOptions, free_ports
 
 pytestmark = pytest.mark.slow
@@ -40,17 +46,28 @@ def test_a_full_disk_under_neo4j_is_one_sentence_naming_it(
         monkeypatch.delenv(name, raising=False)
     monkeypatch.setenv("ROBOTALE_HOME", str(home))
     server = LocalServer(home)
-    for attempt in range(3):  # a free port can be taken before Neo4j binds it
-        try:
-            server.start(ServerOptions(*free_ports(2), heap="512m", pagecache="64m"))
-            break
-        except PortInUse:
-            if attempt == 2:
-                raise
+    _start(server)
     try:
         log = tmp_path / "big.csv"
         _larger_than_the_disk(log, 60_000)
         assert log.stat().st_size > 48 * 1024**2 / 3
+
+        # the check before the write: one sentence, and nothing of the log in Neo4j
+        free = shutil.disk_usage(disk).free
+        assert main(["ingest", str(log), "--log", "big"]) == 1
+        refused = capsys.readouterr().err.strip().splitlines()[-1]
+        assert refused.startswith("robotale: Neo4j's data folder "), refused
+        assert "'big' (60,000 events) needs about " in refused
+        data = refused.split("Neo4j's data folder ", 1)[1].split(" has ", 1)[0]
+        assert Path(data).resolve() == disk.resolve()
+        said_free = float(refused.split(" has ", 1)[1].split(" MB free", 1)[0])
+        assert abs(said_free - free / 1024**2) < 4  # Neo4j writes a little meanwhile
+        assert main(["logs", "list"]) == 0
+        assert "big" not in capsys.readouterr().out
+
+        # Past the check (the fault it guards against is what is tested now, so the check is
+        # replaced, at the one place the command calls it): Neo4j's own full disk.
+        monkeypatch.setattr(ingest, "check_space", lambda *args, **kwargs: None)
         assert main(["ingest", str(log), "--log", "big"]) == 1
         error = capsys.readouterr().err.strip().splitlines()[-1]
         said = [line for line in _debug_log(server) if "space" in line.lower()][:5]
@@ -60,6 +77,16 @@ def test_a_full_disk_under_neo4j_is_one_sentence_naming_it(
         assert "robotale logs delete big" in error or "nothing of it was kept" in error
     finally:
         server.stop()
+
+
+def _start(server: LocalServer) -> None:
+    for attempt in range(3):  # a free port can be taken before Neo4j binds it
+        try:
+            server.start(ServerOptions(*free_ports(2), heap="512m", pagecache="64m"))
+            return
+        except PortInUse:
+            if attempt == 2:
+                raise
 
 
 def _debug_log(server: LocalServer) -> list[str]:

@@ -364,3 +364,31 @@ def test_a_log_stored_with_robotale_ingest_is_ready_for_its_first_visit(
     assert computed[(log_name, "findings")] == 0  # read from what the ingest kept
     assert client.get(f"/api/timeline/runs?log={log_name}").status_code == 200
     assert computed[(log_name, "runs")] == 0
+
+
+def test_an_upload_larger_than_neo4js_free_disk_is_refused_before_writing(
+    client, thesis_csv, log_name, graph_counts, monkeypatch, web_settings
+):
+    import shutil
+    from collections import namedtuple
+
+    from robotale.ekg import disk_space
+
+    before = graph_counts()
+    token, _ = read_step(client, "robotic_data.csv", thesis_csv.read_bytes())
+    # The session's Neo4j cannot be moved onto a small disk: its disk's free space is the one
+    # fact replaced (the command's check is tested on a real small disk, test_neo4j_full_disk).
+    usage = namedtuple("usage", "total used free")
+    monkeypatch.setattr(
+        disk_space.shutil, "disk_usage", lambda path: usage(10**9, 10**9 - 100_000, 100_000)
+    )
+    try:
+        job, _ = ingest(client, token, {"name": log_name, "entity": ["robot"]})
+    finally:
+        monkeypatch.setattr(disk_space.shutil, "disk_usage", shutil.disk_usage)
+    assert job["error"].startswith("Neo4j's data folder "), job["error"]
+    assert "has 97.7 kB free and storing the log" in job["error"]
+    assert f"{log_name!r} (3,648 events) needs about " in job["error"]
+    assert graph_counts() == before
+    assert log_name not in stored(client)
+    assert list(web_settings.upload_dir.iterdir()) == []
