@@ -9,6 +9,7 @@ events are rebuilt only when that number grew.
 
 from __future__ import annotations
 
+import math
 import threading
 
 import numpy as np
@@ -40,7 +41,7 @@ def live_events(driver: Driver, name: str) -> pd.DataFrame:
     heard them (a robot's start before its own completion), its robot's tag topic and the
     tag's position there as its source; then enriched as :func:`tags_log` does."""
     tags = live_tags(driver, name)
-    nanos = np.array([round(t.stamp * 1e9) for t in tags], dtype=np.int64)
+    nanos = np.array([_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
     robots = [t.robot for t in tags]
     frame = pd.DataFrame(
         {
@@ -58,6 +59,13 @@ def live_events(driver: Driver, name: str) -> pd.DataFrame:
     frame[schema.SOURCE_INDEX] = frame.groupby(schema.ROBOT, sort=False).cumcount()
     frame = frame.iloc[np.argsort(nanos, kind="stable")].reset_index(drop=True)
     return tags_log(frame)
+
+
+def _nanoseconds(stamp: float) -> int:
+    """``stamp`` in whole nanoseconds, its seconds and its fraction apart (their product in one
+    float would be off by hundreds of nanoseconds)."""
+    seconds = math.floor(stamp)
+    return seconds * 1_000_000_000 + round((stamp - seconds) * 1e9)
 
 
 def live_replay(driver: Driver, name: str) -> Replay | None:
