@@ -897,9 +897,10 @@ def test_a_robot_killed_mid_run_raises_a_silence_alert_and_leaves_the_live_log_w
 ):
     """The agri mission's robots as two ``fame node`` processes, watched by ``robotale
     monitor --silence 3``: once the tractor's first tags are stored, its process is killed
-    (SIGKILL, no goodbye). The monitor calls the tractor silent, 3 s or more after its last
-    stored tag; the tractor's stored tags are the ones its process printed, in its order (the
-    one it was printing when killed aside); the live log stays readable as an event log."""
+    (SIGKILL, no goodbye). The monitor calls the tractor silent once, within 3 s of the kill
+    (stretched by the load); the tractor's stored tags are the ones its process printed, in
+    its order (the one it was printing when killed aside); the live log stays readable as an
+    event log."""
     import signal
     import subprocess
     import sys
@@ -932,17 +933,17 @@ def test_a_robot_killed_mid_run_raises_a_silence_alert_and_leaves_the_live_log_w
             assert len(stored) >= 3, (
                 nodes["tractor_1"].stderr.read() if nodes["tractor_1"].poll() else ""
             )
+            # the monitor's clock is the wall clock: its alerts after this are about the kill
+            killed = time.time()
             nodes["tractor_1"].send_signal(signal.SIGKILL)
             printed = rows(nodes["tractor_1"].communicate(timeout=patience(60))[0])
-            # what it was silent for before the kill (waiting for the drone) aside
-            last = max(t.stamp for t in live_tags(neo4j_driver, name) if t.robot == "tractor_1")
             heard: list = []
             deadline = time.monotonic() + patience(30)
             while not heard and time.monotonic() < deadline:
                 heard = [
                     a
                     for a in alerts_heard(reader, 1, settle=0.5)
-                    if a["robot"] == "tractor_1" and a["stamp"] > last
+                    if a["robot"] == "tractor_1" and a["stamp"] > killed
                 ]
             interrupted(monitor)
             stored = [t for t in live_tags(neo4j_driver, name) if t.robot == "tractor_1"]
@@ -953,9 +954,7 @@ def test_a_robot_killed_mid_run_raises_a_silence_alert_and_leaves_the_live_log_w
                     run.kill()
     assert nodes["tractor_1"].returncode == -signal.SIGKILL
     assert [a["kind"] for a in heard] == ["silence"], heard
-    # tags in flight when it was killed may be stored after ``last`` was read
-    last = max(t.stamp for t in stored)
-    assert last + 3 <= heard[0]["stamp"] < last + 3 + patience(2.0)
+    assert heard[0]["stamp"] < killed + 3 + patience(2.0)
     fields = [(t.activity, t.lifecycle) for t in stored]
     said = [(r[2], r[3]) for r in printed if r[1] == "tractor_1"]
     shorter = min(len(fields), len(said))
