@@ -19,7 +19,7 @@ from pathlib import Path
 from robotale import __version__
 from robotale.errors import RobotaleError
 from robotale.extras import require
-from robotale.thresholds import LOW_BATTERY_PERCENT
+from robotale.thresholds import LOW_BATTERY_PERCENT, MESSAGE_TIMEOUT
 
 #: the namespace key holding the handler's dotted name; subparser keys begin with "_" too
 _HANDLER = "_handler"
@@ -329,6 +329,20 @@ def _add_monitor(commands: argparse._SubParsersAction) -> None:
         type=float,
         metavar="PERCENT",
         help=f"alert below this charge (default {LOW_BATTERY_PERCENT:g})",
+    )
+    monitor.add_argument(
+        "--message-timeout",
+        action="append",
+        metavar="[TYPE=]SECONDS",
+        help="alert when a message (of the type: its send's label) is not received within "
+        f"this long (default {MESSAGE_TIMEOUT:g}); repeatable",
+    )
+    monitor.add_argument(
+        "--durations-from",
+        action="append",
+        metavar="LOG",
+        help="alert when an activity runs longer than the 95th percentile of its durations "
+        "in this stored log (earlier runs of the mission); repeatable",
     )
     monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
     _handled_by(monitor, "monitor.monitor_command", extra="dds")

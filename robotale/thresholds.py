@@ -9,3 +9,8 @@ from __future__ import annotations
 #: simulated robots warn ``low_battery`` unless a world says otherwise, and where the battery
 #: perspective and the findings see a low-battery moment unless told another
 LOW_BATTERY_PERCENT = 20.0
+
+#: seconds a message may take from its send to its receive before ``robotale monitor`` alerts,
+#: unless told another per message type: a message on a robot network arrives within
+#: milliseconds, or its sender retries within seconds
+MESSAGE_TIMEOUT = 5.0

@@ -228,7 +228,8 @@ def mission_run(log: pd.DataFrame, case: str) -> MissionRun:
     instances = _instances(events, start)
     messages = _messages(timeline.messages, start)
     positions = _positions(events)
-    robots = sorted(set(timeline.robots) | set(positions["robot"]))
+    # a robot whose only activity is still running (a live run's) has no bar yet, but a lane
+    robots = sorted(set(timeline.robots) | set(positions["robot"]) | set(instances["robot"]))
     return MissionRun(
         case=str(case),
         start=start,

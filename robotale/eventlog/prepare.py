@@ -567,6 +567,14 @@ def _nothing_found(source: Path | str, reading: _Reading) -> str:
     return f"{source} has no tags: {held}."
 
 
+def tags_log(tag_rows: pd.DataFrame) -> pd.DataFrame:
+    """The log ``prepare`` makes, with its defaults, of tags heard with no recording around
+    them (a live run's): the same enrichment (``inprogress`` events at the default rate) and
+    columns, its perspectives' columns empty, since no samples were read."""
+    job = preparation()
+    return _canonical(enrich(tag_rows, {}, rate=job.rate), job.reading.perspectives)
+
+
 def _canonical(log: pd.DataFrame, perspectives: Sequence[Perspective]) -> pd.DataFrame:
     """Known columns in the documented order, every perspective column present, event ids."""
     for column in [c for p in perspectives for c in p.columns]:
@@ -595,4 +603,5 @@ __all__ = [
     "prepare",
     "prepare_dataset",
     "robot_type",
+    "tags_log",
 ]

@@ -2,6 +2,7 @@
 two engine processes run the agri mission into one bag, plain DDS code that knows only the
 ROS 2 names talks to robotale, and DDS itself keeps QoS-incompatible pairs apart."""
 
+import contextlib
 import gc
 import itertools
 import os
@@ -128,6 +129,57 @@ def test_two_engine_processes_run_agri_into_one_bag_whose_comm_edges_match(tmp_p
         {(robot_of[s], robot_of[t], m) for s, t, m in tables.comm.itertuples(index=False)}
     )
     assert comm == expected
+
+
+def alerts_heard(reader, count: int, settle: float) -> list[dict]:
+    """The alerts a /robotale/alerts reader gets: until ``count`` came (or a long wait), then
+    those ``settle`` seconds more bring."""
+    import json
+
+    heard: list = []
+    deadline = time.monotonic() + patience(30)
+    while len(heard) < count and time.monotonic() < deadline:
+        heard += [json.loads(s.data) for s in reader.take(N=10)]
+        time.sleep(0.05)
+    time.sleep(settle)
+    return heard + [json.loads(s.data) for s in reader.take(N=10)]
+
+
+@contextlib.contextmanager
+def monitored(driver, name: str, args: list[str]):
+    """A ``robotale monitor`` process storing the live run ``name`` (``args``: the model and
+    options) and a plain cyclonedds reader of /robotale/alerts; the live run forgotten after."""
+    import subprocess
+    import sys
+
+    from cyclonedds.core import Policy, Qos
+
+    from robotale.ekg.live import delete_live
+
+    participant = DomainParticipant(int(os.environ["ROS_DOMAIN_ID"]))
+    kept = Qos(
+        Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal, Policy.History.KeepAll
+    )
+    reader = DataReader(participant, Topic(participant, "rt/robotale/alerts", String_), qos=kept)
+    command = [sys.executable, "-m", "robotale", "monitor", *args, "--log", name]
+    monitor = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+    try:
+        assert monitor.stderr.readline().startswith("# monitoring "), monitor.stderr.read()
+        yield monitor, reader
+    finally:
+        if monitor.poll() is None:
+            monitor.kill()
+        delete_live(driver, name)
+
+
+def interrupted(monitor) -> tuple[str, str]:
+    """What a ``robotale monitor`` process printed (out, err) until Ctrl-C ended it well."""
+    import signal
+
+    monitor.send_signal(signal.SIGINT)
+    said, complaints = monitor.communicate(timeout=patience(60))
+    assert monitor.returncode == 0, complaints
+    return said, complaints
 
 
 def rows(text: str) -> list[list[str]]:
@@ -624,8 +676,6 @@ def test_monitor_alerts_a_skipped_activity_within_a_second_of_its_tag(neo4j_driv
     Carry On as a deviation, soon after the tag's stamp; Prepare, which the model allows,
     raises nothing. Its battery falling to 15 % raises a battery alert (30 % does not). A
     plain cyclonedds reader of /robotale/alerts gets the alerts."""
-    import json
-    import signal
     import subprocess
     import sys
     import uuid
@@ -668,16 +718,9 @@ def test_monitor_alerts_a_skipped_activity_within_a_second_of_its_tag(neo4j_driv
         matched(battery, patience(30))
         for level in (0.3, 0.15):
             battery.write(to_sample(battery_type, {"percentage": level}))
-        heard: list = []
-        deadline = time.monotonic() + patience(30)
-        while len(heard) < 2 and time.monotonic() < deadline:
-            heard += [json.loads(s.data) for s in reader.take(N=10)]
-            time.sleep(0.05)
-        time.sleep(0.5)  # an alert about Prepare or 30 %, were there one, would be here now
-        heard += [json.loads(s.data) for s in reader.take(N=10)]
-        monitor.send_signal(signal.SIGINT)
-        said, complaints = monitor.communicate(timeout=patience(60))
-        assert monitor.returncode == 0, complaints
+        # an alert about Prepare or 30 %, were there one, would be here 0.5 s after the others
+        heard = alerts_heard(reader, 2, settle=0.5)
+        said, complaints = interrupted(monitor)
         stored = live_alerts(neo4j_driver, name)
     finally:
         if monitor.poll() is None:
@@ -694,3 +737,229 @@ def test_monitor_alerts_a_skipped_activity_within_a_second_of_its_tag(neo4j_driv
         (a["kind"], a["robot"], a["text"]) for a in heard
     )
     assert "# alert deviation rover" in said
+
+
+def test_monitor_alerts_a_late_message_and_an_overlong_activity_once_each(tmp_path, neo4j_driver):
+    """A rover played here over DDS: of its three messages, the one of type ``report`` no one
+    receives within its 1.5 s raises one alert, the received one and the ``chat`` one (30 s
+    default) none; its Measure, running longer than the 95th percentile of Measure's durations
+    in an earlier run stored in Neo4j (numpy's, from the durations written here), raises one
+    alert after that long, its Prepare, shorter than Prepare's, none."""
+    import uuid
+
+    import numpy as np
+    import pandas as pd
+
+    from robotale.ekg.live import live_alerts
+    from robotale.ekg.logs import delete_log
+    from robotale.fame_runtime.node import KEEP_ALL
+    from robotale.fame_runtime.tags import TAG_TYPE, Tag, tag_topic
+
+    suffix = uuid.uuid4().hex[:8]
+    name, earlier = f"test_timing_{suffix}", f"test_earlier_{suffix}"
+    measures = [0.5 + 0.15 * i for i in range(10)]
+    rows_ = []
+    begin = pd.Timestamp("2026-01-01T00:00:00Z")
+    for i, measure in enumerate(measures):
+        at = begin + pd.Timedelta(minutes=i)
+        spans = [("prepare", at, 3.0), ("measure", at + pd.Timedelta(seconds=3), measure)]
+        for activity, start, seconds in spans:
+            end = start + pd.Timedelta(seconds=seconds)
+            rows_ += [(f"run{i}", start, activity, "start"), (f"run{i}", end, activity, "complete")]
+    csv = tmp_path / "earlier.csv"
+    frame = pd.DataFrame(rows_, columns=["case", "time", "activity", "lifecycle"])
+    frame.assign(robot="rover").to_csv(csv, index=False)
+    assert main(["ingest", str(csv), "--log", earlier, "--replace"]) == 0
+    limit = float(np.percentile(measures, 95))
+
+    watch = [str(MODELS / "sequence.bpmn"), "--robots", "rover", "--silence", "600"]
+    watch += ["--durations-from", earlier, "--message-timeout", "30"]
+    watch += ["--message-timeout", "report=1.5"]
+    clock = WallClock()
+    bus = DdsBus(clock, node="rover")
+
+    def tag(activity, lifecycle, msg_id="", role=""):
+        stamp = clock.now()
+        sent = Tag(stamp, "rover", activity, lifecycle, msg_id, role)
+        bus.publish(tag_topic("rover"), sent, msgtype=TAG_TYPE, sender="rover", qos=KEEP_ALL)
+        return stamp
+
+    try:
+        with monitored(neo4j_driver, name, watch) as (monitor, reader):
+            writer = bus.writer(tag_topic("rover"), TAG_TYPE, KEEP_ALL, "rover")
+            matched(writer, patience(30))
+            tag("prepare", "start")
+            time.sleep(0.2)
+            tag("prepare", "complete")
+            measured = tag("measure", "start")
+            sent = {
+                m: tag(kind, "start", m, "send") for m, kind in [("m1", "report"), ("m2", "report")]
+            }
+            tag("chat", "start", "m3", "send")
+            tag("listen", "start", "m2", "receive")
+            # a second alert of either kind, were there one, would be here 2 s after the first
+            heard = alerts_heard(reader, 2, settle=2.0)
+            said, complaints = interrupted(monitor)
+            stored = live_alerts(neo4j_driver, name)
+    finally:
+        delete_log(neo4j_driver, earlier)
+    assert sorted(a["kind"] for a in heard) == ["duration", "message"], said + complaints
+    long, late = sorted(heard, key=lambda a: a["kind"])
+    assert "message m1 ('report') sent by rover" in late["text"], late
+    assert "within 1.5 s" in late["text"]
+    assert 1.5 <= late["stamp"] - sent["m1"] < 1.5 + patience(1.0)
+    assert "'measure'" in long["text"] and f"{limit:.1f} s" in long["text"], long
+    assert limit <= long["stamp"] - measured < limit + patience(1.0)
+    assert sorted((a.kind, a.text) for a in stored) == sorted((a["kind"], a["text"]) for a in heard)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(900)
+def test_the_live_log_is_the_prepared_recording_and_the_state_api_answers_on_it_mid_run(
+    tmp_path, neo4j_driver
+):
+    """``robotale monitor`` beside a ``fame run --bus dds --record`` of the agri mission: while
+    the run goes on, the dashboard's Mission API answers on the growing live log; when it has
+    ended, the live log's events are, row by row, those ``prepare`` makes of the run's bag
+    (robot, activity, lifecycle, message, order and time), and the Mission API on the bag
+    stored by ``robotale ingest`` answers at the times asked mid-run as the live log did."""
+    import subprocess
+    import sys
+    import uuid
+
+    import pandas as pd
+
+    from robotale.ekg.logs import delete_log
+    from robotale.eventlog.preparing import prepare_recordings
+    from robotale.results.live import live_events
+    from robotale.webapp import create_app
+    from robotale.webapp.settings import WebSettings
+
+    suffix = uuid.uuid4().hex[:8]
+    name, stored = f"test_live_{suffix}", f"test_prepared_{suffix}"
+    settings = WebSettings(tmp_path / "uploads", tmp_path / "models", secret_key="test")
+    client = create_app(settings).test_client()
+    robots = "drone,tractor_1"
+    bag = tmp_path / "run"
+    skills = str(MODELS / "agri_skills.py")
+    run = [sys.executable, "-m", "robotale", "fame", "run", str(AGRI), "--robots", robots]
+    run += ["--skills", skills, "--bus", "dds", "--record", str(bag), "--until", "60"]
+    asked: list[tuple[float, dict]] = []  # (t, the state API's answer) mid-run
+    api = f"/api/mission/{name}/{name}"
+    with monitored(neo4j_driver, name, [str(AGRI), "--robots", robots]) as (monitor, _):
+        fame = subprocess.Popen(run, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True)
+        try:
+            while fame.poll() is None:
+                time.sleep(0.5)
+                summary = client.get(api)
+                if summary.status_code != 200:  # no tag stored yet
+                    continue
+                assert summary.json["live"] is True
+                t = round(summary.json["duration"] * 0.9, 3)
+                state = client.get(f"{api}/state?t={t}")
+                assert state.status_code == 200, state.json
+                asked.append((t, state.json))
+            complaints = fame.communicate(timeout=patience(60))[1]
+            assert fame.returncode == 0, complaints
+        finally:
+            if fame.poll() is None:
+                fame.kill()
+        interrupted(monitor)
+        events = live_events(neo4j_driver, name)
+    prepared = prepare_recordings(bag)
+    columns = ["robot", "concept:name", "lifecycle:transition", "lifecycle:state"]
+    columns += ["msg_id", "msg_role", "msg_payload", "source_topic", "source_index"]
+    assert len(events) == len(prepared) > 20
+    live_rows = events[columns].astype(object).fillna("").to_numpy().tolist()
+    assert live_rows == prepared[columns].astype(object).fillna("").to_numpy().tolist()
+    lag = (events["time:timestamp"] - prepared["time:timestamp"]).abs().max()
+    assert lag <= pd.Timedelta(microseconds=1), lag
+    # the answers mid-run grew with the run, and are those on the stored recording
+    assert len(asked) >= 3 and asked[0][1]["duration"] < asked[-1][1]["duration"]
+    assert main(["ingest", str(bag), "--log", stored, "--replace"]) == 0
+    try:
+        for t, live in asked:
+            answer = client.get(f"/api/mission/{stored}/{bag.name}/state?t={t}").json
+            for robot in live["robots"]:
+                mine, theirs = live["robots"][robot], answer["robots"][robot]
+                assert mine["activities"] == theirs["activities"], (t, robot)
+                assert (mine["last_message"] or {}).get("msg_id") == (
+                    theirs["last_message"] or {}
+                ).get("msg_id"), (t, robot)
+    finally:
+        delete_log(neo4j_driver, stored)
+
+
+@pytest.mark.slow
+@pytest.mark.timeout(600)
+def test_a_robot_killed_mid_run_raises_a_silence_alert_and_leaves_the_live_log_whole(
+    neo4j_driver,
+):
+    """The agri mission's robots as two ``fame node`` processes, watched by ``robotale
+    monitor --silence 3``: once the tractor's first tags are stored, its process is killed
+    (SIGKILL, no goodbye). The monitor calls the tractor silent once, within 3 s of the kill
+    (stretched by the load); the tractor's stored tags are the ones its process printed, in
+    its order (the one it was printing when killed aside); the live log stays readable as an
+    event log."""
+    import signal
+    import subprocess
+    import sys
+    import uuid
+
+    from robotale.ekg.live import live_tags
+    from robotale.results.live import live_events
+
+    name = f"test_killed_{uuid.uuid4().hex[:8]}"
+    robots = "drone,tractor_1"
+    node = [sys.executable, "-m", "robotale", "fame", "node", str(AGRI), "--robots", robots]
+    node += ["--skills", str(MODELS / "agri_skills.py"), "--until", "120"]
+    with monitored(neo4j_driver, name, [str(AGRI), "--robots", robots, "--silence", "3"]) as (
+        monitor,
+        reader,
+    ):
+        nodes = {
+            robot: subprocess.Popen(
+                [*node, "--robot", robot], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+            )
+            for robot in robots.split(",")
+        }
+        try:
+            deadline = time.monotonic() + patience(120)
+            while time.monotonic() < deadline:
+                stored = [t for t in live_tags(neo4j_driver, name) if t.robot == "tractor_1"]
+                if len(stored) >= 3:
+                    break
+                time.sleep(0.1)
+            assert len(stored) >= 3, (
+                nodes["tractor_1"].stderr.read() if nodes["tractor_1"].poll() else ""
+            )
+            # the monitor's clock is the wall clock: its alerts after this are about the kill
+            killed = time.time()
+            nodes["tractor_1"].send_signal(signal.SIGKILL)
+            printed = rows(nodes["tractor_1"].communicate(timeout=patience(60))[0])
+            heard: list = []
+            deadline = time.monotonic() + patience(30)
+            while not heard and time.monotonic() < deadline:
+                heard = [
+                    a
+                    for a in alerts_heard(reader, 1, settle=0.5)
+                    if a["robot"] == "tractor_1" and a["stamp"] > killed
+                ]
+            interrupted(monitor)
+            stored = [t for t in live_tags(neo4j_driver, name) if t.robot == "tractor_1"]
+            events = live_events(neo4j_driver, name)
+        finally:
+            for run in nodes.values():
+                if run.poll() is None:
+                    run.kill()
+    assert nodes["tractor_1"].returncode == -signal.SIGKILL
+    assert [a["kind"] for a in heard] == ["silence"], heard
+    assert heard[0]["stamp"] < killed + 3 + patience(2.0)
+    fields = [(t.activity, t.lifecycle) for t in stored]
+    said = [(r[2], r[3]) for r in printed if r[1] == "tractor_1"]
+    shorter = min(len(fields), len(said))
+    assert fields[:shorter] == said[:shorter] and abs(len(fields) - len(said)) <= 1, (fields, said)
+    mine = events[events["robot"] == "tractor_1"]
+    tagged = mine[mine["lifecycle:state"] != "inprogress"]
+    assert tagged["source_index"].tolist() == list(range(len(stored)))
+    assert mine["time:timestamp"].is_monotonic_increasing

@@ -17,6 +17,7 @@ from robotale.results.site import stored_site
 from robotale.webapp import pages
 from robotale.webapp.model_store import StoredModel
 from robotale.webapp.state import driver, state
+from robotale.webapp.unstored import is_live, unstored
 
 blueprint = Blueprint("mission", __name__)
 
@@ -44,6 +45,7 @@ def summary(log: str, case: str):
             **run.summary(),
             "site": mission_site(_site(log, run), run),
             "model": model.id if model else None,
+            "live": is_live(log),
         }
     )
 
@@ -81,15 +83,15 @@ def series(log: str, case: str):
 
 def _run(log: str, case: str) -> MissionRun:
     """The run from the replay named ``log`` this dashboard serves (a replay hides a stored
-    log of the same name), else from the stored log."""
-    replay = state().replays.get(log)
+    log of the same name) or the live run of that name, else from the stored log."""
+    replay = unstored(log)
     if replay is not None:
         return replay.run(case)
     return stored_mission(driver(), state().logs, log, case)
 
 
 def _site(log: str, run: MissionRun) -> dict[str, Any] | None:
-    replay = state().replays.get(log)
+    replay = unstored(log)
     if replay is not None:
         return replay.sites.get(run.case)
     return stored_site(driver(), log, run.case)

@@ -8,6 +8,7 @@ from flask import Blueprint, Response, render_template, request
 from robotale.results.findings import stored_runs, stored_timeline
 from robotale.webapp import pages
 from robotale.webapp.state import driver, state
+from robotale.webapp.unstored import unstored
 
 blueprint = Blueprint("timeline", __name__)
 
@@ -23,8 +24,8 @@ def page():
 def runs():
     """The log's runs in start order, for the run picker."""
     name = request.args.get("log", "")
-    replay = state().replays.get(name)
-    if replay is not None:  # served by ``robotale serve --bag``, hiding a stored log
+    replay = unstored(name)
+    if replay is not None:  # a replayed recording (hiding a stored log) or a live run
         return Response(replay.runs_json(), mimetype="application/json")
     data = stored_runs(driver(), state().logs, name)
     return Response(data, mimetype="application/json")
@@ -34,7 +35,7 @@ def runs():
 def timeline():
     """One run's timeline (the first run when none is named)."""
     name, case = request.args.get("log", ""), request.args.get("case", "")
-    replay = state().replays.get(name)
+    replay = unstored(name)
     if replay is not None:
         return Response(replay.timeline_json(case), mimetype="application/json")
     return Response(

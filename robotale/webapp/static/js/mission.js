@@ -210,9 +210,10 @@
 
   async function loadTimeline() {
     const data = await robotale.api(`/api/timeline?${new URLSearchParams({ log, case: run })}`);
+    const first = !timelineBox.dataset.drawn;
     await robotalePerspective.plot(timelineBox, data.figure);
     timelineBox.dataset.drawn = "1";
-    timelineBox.on("plotly_click", (event) => {
+    if (first) timelineBox.on("plotly_click", (event) => {
       const point = event.points[0];
       if (!point) return;
       const at = point.base !== undefined ? point.base : point.x;
@@ -383,6 +384,33 @@
     });
   }
 
+  // ---- a live run: the page follows now -----------------------------------------------------
+
+  // seconds between two looks at a live run; the timeline is redrawn every TIMELINE_EVERY looks
+  const LIVE_POLL = 1, TIMELINE_EVERY = 5;
+  let looks = 0;
+  // the cursor follows the run's end while it is there; moved back, it stays where it was put
+  const following = () => summary.duration - t < 1e-6;
+
+  async function followLive() {
+    const stay = !following();
+    const fresh = await robotale.api(base());
+    whole = await robotale.api(`${base()}/window?from=0&to=${fresh.duration}`);
+    summary = fresh;
+    slider.max = String(summary.duration);
+    root.dataset.duration = String(summary.duration);
+    root.dataset.following = stay ? "0" : "1";
+    if (!playing) setCursor(stay ? t : summary.duration);
+    looks += 1;
+    if (looks % TIMELINE_EVERY === 0) await loadTimeline();
+  }
+
+  function watchLive() {
+    root.dataset.live = "1";
+    const look = () => followLive().catch(robotale.showError).finally(() => setTimeout(look, LIVE_POLL * 1000));
+    setTimeout(look, LIVE_POLL * 1000);
+  }
+
   async function start() {
     log = await robotale.currentLog().catch(() => "");
     if (!log) { say("No log yet: upload one on the Logs page."); root.dataset.state = "empty"; return; }
@@ -405,9 +433,11 @@
       fieldPicker.replaceChildren(...summary.signals.map((f) => robotale.el("option", { value: f, text: f })));
       if (summary.signals.includes("battery")) fieldPicker.value = "battery";
       wire();
-      setCursor(Number(root.dataset.t) || 0);
+      const asked = root.dataset.t === "" ? (summary.live ? summary.duration : 0) : Number(root.dataset.t);
+      setCursor(asked || 0);
       await Promise.all([loadModel(summary.model), loadTimeline(), loadSeries(fieldPicker.value)]);
       setCursor(t);
+      if (summary.live) watchLive();
     } catch (error) {
       root.dataset.state = "failed";
       robotale.showError(error);

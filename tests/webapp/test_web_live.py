@@ -1,0 +1,77 @@
+"""A live run on the dashboard: tags stored one by one by the monitor's own writer
+(:class:`robotale.ekg.live.LiveLog`), the Mission API answering on what is stored so far, set
+against the tags written here, and the Mission page following the run's end in a real
+Chromium unless the user moved the cursor back."""
+
+from __future__ import annotations
+
+import uuid
+
+import pytest
+
+from robotale.fame_runtime.tags import Tag
+
+#: the run's first tag, seconds since the Unix epoch
+T0 = 1_800_000_000.0
+
+
+@pytest.fixture
+def live(neo4j_driver):
+    from robotale.ekg.live import LiveLog, delete_live
+
+    log = LiveLog(neo4j_driver, f"live_{uuid.uuid4().hex[:8]}")
+    yield log
+    delete_live(neo4j_driver, log.name)
+
+
+def tags(log, rows: list[tuple[float, str, str, str]]) -> None:
+    for s, robot, activity, lifecycle in rows:
+        log.append(Tag(T0 + s, robot, activity, lifecycle))
+
+
+def test_the_mission_api_answers_on_what_the_monitor_stored_so_far(client, live):
+    api = f"/api/mission/{live.name}/{live.name}"
+    assert client.get(api).status_code == 400  # nothing stored yet: no run of that name
+    tags(live, [(0, "rover", "survey", "start"), (1.5, "drone", "scan", "start")])
+    first = client.get(api).json
+    assert first["live"] is True and first["duration"] == 1.5
+    state = client.get(f"{api}/state?t=1.0").json
+    assert state["robots"]["rover"]["activities"] == ["survey"]
+    assert state["robots"]["drone"]["activities"] == []
+    tags(live, [(4.0, "rover", "survey", "complete"), (5.25, "rover", "dock", "start")])
+    grown = client.get(api).json
+    assert grown["duration"] == 5.25
+    state = client.get(f"{api}/state?t=4.5").json
+    assert state["robots"]["rover"]["activities"] == []
+    assert state["robots"]["drone"]["activities"] == ["scan"]
+    state = client.get(f"{api}/state?t=5.25").json
+    assert state["robots"]["rover"]["activities"] == ["dock"]
+    runs = client.get(f"/api/timeline/runs?log={live.name}").json["runs"]
+    assert [r["case"] for r in runs] == [live.name]
+
+
+@pytest.mark.browser
+def test_the_mission_page_follows_a_live_run_until_moved_back(page, live):
+    from browser import wait_for
+
+    root = "document.getElementById('mission')"
+    tags(live, [(0, "rover", "survey", "start"), (2.0, "rover", "survey", "complete")])
+    page.goto(f"{page.base_url}/mission?log={live.name}")
+    wait_for(page, f"{root}.dataset.live === '1' && Number({root}.dataset.t) === 2")
+    tags(live, [(6.0, "rover", "dock", "start")])
+    # the cursor follows the run's end as it grows, and the robot's table says what it does
+    wait_for(page, f"Number({root}.dataset.t) === 6 && Number({root}.dataset.shown) === 6")
+    assert "dock" in page.inner_text("#robots")
+    # moved back, the cursor stays where it was put while the run grows
+    page.evaluate(
+        "() => { const s = document.getElementById('cursor'); s.value = '1';"
+        " s.dispatchEvent(new Event('input')); }"
+    )
+    tags(live, [(9.0, "rover", "dock", "complete")])
+    wait_for(page, "Number(document.getElementById('cursor').max) === 9")
+    assert page.evaluate(f"Number({root}.dataset.t)") == 1
+    assert page.evaluate(f"{root}.dataset.following") == "0"
+    # back at the end, it follows again
+    page.keyboard.press("End")
+    tags(live, [(12.0, "rover", "survey", "start")])
+    wait_for(page, f"Number({root}.dataset.t) === 12")
