@@ -190,7 +190,7 @@ def _roles(instances: pd.DataFrame) -> pd.Series:
     return labels.map(majority).replace("", None)
 
 
-def triggers(instances: pd.DataFrame, *, records_aborts: bool) -> set[str]:
+def triggers(instances: pd.DataFrame, traces: Traces, *, records_aborts: bool) -> set[str]:
     """The activities of one robot type that interrupt what the robot was doing.
 
     Where the log records interruptions (an instance ending ``ate_abort``, aborted or
@@ -204,7 +204,7 @@ def triggers(instances: pd.DataFrame, *, records_aborts: bool) -> set[str]:
     aborted = instances[instances["_aborted"]]
     if records_aborts:
         return _recorded_triggers(instances, aborted) if not aborted.empty else set()
-    return _behaving_triggers(instances)
+    return _behaving_triggers(traces)
 
 
 def _recorded_triggers(instances: pd.DataFrame, aborted: pd.DataFrame) -> set[str]:
@@ -222,30 +222,57 @@ def _recorded_triggers(instances: pd.DataFrame, aborted: pd.DataFrame) -> set[st
     return found
 
 
-def _traces(instances: pd.DataFrame, column: str) -> list[list]:
-    """``column``'s values per trace (case and robot), the instances being in trace order:
-    one pass over arrays, not a DataFrame per trace."""
-    keys = instances[CASE].astype(str).to_numpy(object) + "\x00" + instances[ROBOT].to_numpy(object)
-    bounds = np.flatnonzero(keys[1:] != keys[:-1]) + 1 if len(keys) else np.array([], int)
-    values = instances[column].to_numpy(object)
-    return [part.tolist() for part in np.split(values, bounds)] if len(keys) else []
+@dataclass(slots=True)
+class Traces:
+    """A type's traces (case and robot) as plain lists, built once for the trigger search
+    and the split: labels, message roles, start times and whether each instance ended
+    interrupted, position by position."""
+
+    labels: list[list[str]]
+    roles: list[list[str | None]]
+    starts: list[np.ndarray]
+    aborted: list[list[bool]]
 
 
-def _behaving_triggers(instances: pd.DataFrame) -> set[str]:
+def per_trace(instances: pd.DataFrame) -> Traces:
+    """The instances (in trace order) cut into traces in one pass over integer codes."""
+    if instances.empty:
+        return Traces([], [], [], [])
+    cases = pd.factorize(instances[CASE].astype(str))[0]
+    robots = pd.factorize(instances[ROBOT])[0]
+    bounds = np.flatnonzero((cases[1:] != cases[:-1]) | (robots[1:] != robots[:-1])) + 1
+
+    def cut(values: np.ndarray) -> list[list]:
+        return [part.tolist() for part in np.split(values, bounds)]
+
+    starts = instances[START_TIMESTAMP]
+    # compared only where a trigger is: numpy datetimes (NaT unequal to itself, as a Timestamp
+    # is) rather than a Timestamp object per instance
+    if pd.api.types.is_datetime64_any_dtype(starts):
+        start_values = starts.to_numpy("datetime64[ns]")
+    else:  # times of several offsets, kept as objects
+        start_values = starts.to_numpy(object)
+    return Traces(
+        labels=cut(instances[ACTIVITY].astype(str).to_numpy(object)),
+        roles=cut(instances["_role"].to_numpy(object)),
+        starts=list(np.split(start_values, bounds)),
+        aborted=cut(instances["_aborted"].to_numpy(bool)),
+    )
+
+
+def _behaving_triggers(traces: Traces) -> set[str]:
     follows: Counter[tuple[str, str]] = Counter()
     occurs: Counter[str] = Counter()
     candidates: dict[str, bool] = {}
-    traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
-    for labels, roles in zip(traces, _traces(instances, "_role"), strict=True):
+    for labels, roles in zip(traces.labels, traces.roles, strict=True):
         counts = Counter(labels)
+        occurs.update(labels)
+        follows.update(itertools.pairwise(labels))
         for position, (label, role) in enumerate(zip(labels, roles, strict=True)):
-            occurs[label] += 1
-            if position + 1 < len(labels):
-                follows[(label, labels[position + 1])] += 1
             ok = counts[label] == 1 and position > 0 and role != SEND
             candidates[label] = candidates.get(label, True) and ok
     found = set()
-    for labels in traces:
+    for labels in traces.labels:
         for before, label in itertools.pairwise(labels):
             if candidates.get(label) and follows[(before, label)] * 2 < occurs[before]:
                 found.add(label)
@@ -263,7 +290,7 @@ class _Split:
     abandoned: dict[str, Counter] = field(default_factory=lambda: defaultdict(Counter))
 
 
-def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
+def split_traces(traces: Traces, found: set[str]) -> _Split:
     """Each trace's instances outside the handlers (the process), and each handler's own.
 
     A handler runs from its trigger to the end of the trace, or to the first activity that
@@ -271,12 +298,11 @@ def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
     at the trigger's moment before it (the event sub-process the engine tags first) belong to
     the handler too."""
     result = _Split()
-    traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
-    firsts = {trace[0] for trace in traces}
-    columns = zip(
-        traces, _traces(instances, START_TIMESTAMP), _traces(instances, "_aborted"), strict=True
-    )
-    for labels, starts, aborted in columns:
+    firsts = {trace[0] for trace in traces.labels}
+    for labels, starts, aborted in zip(traces.labels, traces.starts, traces.aborted, strict=True):
+        if not found.intersection(labels):  # most traces: nothing to cut
+            result.main.append(list(labels))
+            continue
         main: list[str] = []
         position = resumed = 0
         while position < len(labels):
@@ -311,28 +337,44 @@ def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
 def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
     """The inductive miner's process tree of ``traces`` as blocks (an empty trace is a run
     that does nothing, which the tree allows by a skip)."""
-    import pm4py  # 2 s to import and a banner: discovery only
-
     if not noise:
         # without a noise threshold the miner's cuts depend on which steps follow which, not
         # on how often: each variant once gives the same tree, faster
         traces = [list(variant) for variant in dict.fromkeys(tuple(t) for t in traces)]
-    rows = [
-        (str(number), label, position)
-        for number, trace in enumerate(traces)
-        for position, label in enumerate(trace)
-    ]
-    if not rows:
+    if not any(traces):
         return Tau()
-    frame = pd.DataFrame(rows, columns=[CASE, ACTIVITY, "_position"])
-    frame[TIMESTAMP] = pd.to_datetime(frame["_position"], unit="s", utc=True)
-    tree = pm4py.discover_process_tree_inductive(frame, noise_threshold=noise)
+    tree = _inductive_tree(traces, noise)
     block = from_process_tree(tree)
-    if any(not trace for trace in traces) and rows:
+    if any(not trace for trace in traces):
         from robotale.discovery.layout import Operator  # the one place a run may be empty
 
         block = Operator("xor", [block, Tau()])
     return block
+
+
+def _inductive_tree(traces: list[list[str]], noise: float) -> object:
+    """pm4py's inductive miner (IMf with a noise threshold) on the traces' variants, given to
+    it as the variant counter it builds from a DataFrame, without building one: the cases in
+    the order pm4py sorts their ids (as text), so the tree is the one its DataFrame route
+    gives."""
+    # pm4py: 2 s to import and a banner: discovery only
+    from pm4py.algo.discovery.inductive.dtypes.im_ds import IMDataStructureUVCL
+    from pm4py.algo.discovery.inductive.variants.im import IMUVCL
+    from pm4py.algo.discovery.inductive.variants.imf import IMFUVCL
+    from pm4py.objects.process_tree.utils.generic import fold, tree_sort
+    from pm4py.util import constants
+
+    order = sorted((number for number, trace in enumerate(traces) if trace), key=str)
+    variants = Counter(tuple(traces[number]) for number in order)
+    parameters = {
+        "noise_threshold": noise,
+        "multiprocessing": constants.ENABLE_MULTIPROCESSING_DEFAULT,
+        "disable_fallthroughs": False,
+    }
+    miner = IMFUVCL(parameters) if noise > 0 else IMUVCL(parameters)
+    tree = fold(miner.apply(IMDataStructureUVCL(variants), parameters))
+    tree_sort(tree)
+    return tree
 
 
 def discover_collaboration(
@@ -361,8 +403,9 @@ def discover_collaboration(
 
 
 def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool) -> Pool:
-    found = triggers(instances, records_aborts=records_aborts)
-    parts = split_traces(instances, found)
+    traces = per_trace(instances)
+    found = triggers(instances, traces, records_aborts=records_aborts)
+    parts = split_traces(traces, found)
     handlers = [
         _handler(label, instances, parts, noise) for label in sorted(found) if parts.handled[label]
     ]

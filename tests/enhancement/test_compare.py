@@ -17,7 +17,13 @@ import pytest
 
 from robotale.cli import main
 from robotale.enhancement.bottlenecks import ALPHA
-from robotale.enhancement.compare import benjamini_hochberg, compare_logs, mann_whitney
+from robotale.enhancement.compare import (
+    benjamini_hochberg,
+    compare_logs,
+    either,
+    mann_whitney,
+    welch,
+)
 from robotale.enhancement.effects import compare_cases
 from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, ROBOT, ROBOT_TYPE, TIMESTAMP
 from robotale.sim.batch import simulate_batch
@@ -183,3 +189,58 @@ def test_cli_refuses_a_missing_file(tmp_path, capsys):
     missing = tmp_path / "nowhere.csv"
     assert main(["compare", str(missing), str(missing)]) == 1
     assert capsys.readouterr().err.strip() == f"robotale: {missing}: there is no such file."
+
+
+def _outlier_batches(runs: int, waited: int) -> pd.DataFrame:
+    """``runs`` runs a side of one measure; in B, ``waited`` of them waited 300 s more."""
+    rng = np.random.default_rng(11)
+    a = rng.normal(100.0, 5.0, runs)
+    b = rng.normal(100.0, 5.0, runs)
+    b[:waited] += 300.0
+    rows = [(0, f"a{i}", v) for i, v in enumerate(a)] + [(1, f"b{i}", v) for i, v in enumerate(b)]
+    long = pd.DataFrame(rows, columns=["side", "run", "value"])
+    return long.assign(measure="run duration", subject="", who="")
+
+
+def test_welch_of_all_keys_at_once_is_scipys_test_of_each():
+    """The grouped test against scipy's Welch t-test on the per-run values pandas selects,
+    key by key, with a key only one side has and a key without spread."""
+    from scipy.stats import ttest_ind
+
+    rng = np.random.default_rng(5)
+    rows = []
+    for key, shift, size in (("k1", 0.0, 9), ("k2", 2.0, 14), ("k3", 0.5, 5)):
+        for side in (0, 1):
+            values = rng.normal(shift * side, 1.0 + side, size + side * 3)
+            rows += [(key, side, f"r{side}_{i}", v) for i, v in enumerate(values)]
+    rows += [("only_a", 0, "r0_0", 1.0), ("only_a", 0, "r0_1", 2.0)]
+    rows += [("flat", 0, f"r0_{i}", 2.0) for i in range(3)]
+    rows += [("flat", 1, f"r1_{i}", 2.0) for i in range(3)]
+    long = pd.DataFrame(rows, columns=["subject", "side", "run", "value"])
+    long = long.assign(measure="m", who="")
+    p = welch(long).droplevel(["measure", "who"])
+    for key in ("k1", "k2", "k3"):
+        mine = long[long["subject"] == key]
+        a, b = (mine.loc[mine["side"] == side, "value"].to_numpy() for side in (0, 1))
+        assert p[key] == pytest.approx(ttest_ind(b, a, equal_var=False).pvalue)
+    assert pd.isna(p["only_a"]) and pd.isna(p["flat"])
+
+
+@pytest.mark.parametrize(("runs", "waited", "called"), [(24, 6, True), (12, 4, False)])
+def test_a_mean_moved_by_a_few_runs(runs, waited, called):
+    """A few runs waiting 300 s: the ranks alone call it not significant; the combined test
+    (the smaller p-value, doubled) is scipy's tests on the runs and calls 6 runs of 24. With
+    4 of 12 it cannot: the permutation test of the mean difference gives about 0.08 (about
+    the chance that a random split puts all four long runs on one side), and Welch's 0.04
+    doubled is 0.08."""
+    from scipy.stats import mannwhitneyu, ttest_ind
+
+    long = _outlier_batches(runs, waited)
+    a, b = (long.loc[long["side"] == side, "value"] for side in (0, 1))
+    rank_p = mann_whitney(long)["p_value"]
+    assert rank_p.iloc[0] == pytest.approx(mannwhitneyu(b, a).pvalue)
+    assert rank_p.iloc[0] >= ALPHA
+    combined = either(rank_p, welch(long).reindex(rank_p.index))
+    expected = 2 * min(rank_p.iloc[0], ttest_ind(b, a, equal_var=False).pvalue)
+    assert combined.iloc[0] == pytest.approx(expected)
+    assert bool(combined.iloc[0] < ALPHA) == called
