@@ -102,7 +102,8 @@ class AnswerCache:
                 return None
             self._kept.move_to_end(key)
             answer = found[1]
-        return json.loads(answer)
+        kept: list[dict[str, Any]] = json.loads(answer)
+        return kept
 
     def put(self, key: Key, at: str, answer: list[dict[str, Any]]) -> None:
         text = json.dumps(answer, allow_nan=False)

@@ -191,7 +191,7 @@ def refuse_plan(
     ``verdicts`` has accepted before is not asked for again. Returns whether the plan calls
     a function whose value changes by itself (:func:`robotale.ekg.answer_cache.volatile`)."""
     key = verdicts.key(statement, parameters, database) if verdicts else None
-    if verdicts is not None and key in verdicts:
+    if verdicts is not None and key is not None and key in verdicts:
         return verdicts.volatile(key)
     code = code_only(statement)
     leading = _LEADING_MODE.match(code)
