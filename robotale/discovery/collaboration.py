@@ -23,7 +23,7 @@ from __future__ import annotations
 import itertools
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -267,29 +267,29 @@ def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
     """Each trace's instances outside the handlers (the process), and each handler's own.
 
     A handler runs from its trigger to the end of the trace, or to the first activity that
-    begins a trace of its type (the robot took up its process again); instances that started
-    at the trigger's moment before it (the event sub-process the engine tags first) belong to
-    the handler too."""
+    begins a trace of its type (the robot took up its process again). The event sub-process'
+    own instance, where the engine tags one, is recorded apart (:func:`_own_instance`)."""
     result = _Split()
     traces = _traces(instances.assign(**{ACTIVITY: instances[ACTIVITY].astype(str)}), ACTIVITY)
     firsts = {trace[0] for trace in traces}
+    # an instance that never ended runs on past everything after it
+    until = instances[TIMESTAMP].where(instances[FINISHED].astype(bool))
     columns = zip(
-        traces, _traces(instances, START_TIMESTAMP), _traces(instances, "_aborted"), strict=True
+        traces,
+        _traces(instances, START_TIMESTAMP),
+        _traces(instances.assign(_until=until), "_until"),
+        _traces(instances, "_aborted"),
+        strict=True,
     )
-    for labels, starts, aborted in columns:
+    for labels, starts, ends, aborted in columns:
         main: list[str] = []
-        position = resumed = 0
+        position = 0
         while position < len(labels):
             label = labels[position]
             if label not in found:
                 main.append(label)
                 position += 1
                 continue
-            same = position
-            while same > resumed and starts[same - 1] == starts[position]:
-                same -= 1
-            moved = labels[same:position]
-            del main[len(main) - len(moved) :]
             for before in range(position - 1, -1, -1):
                 if aborted[before]:
                     result.abandoned[label][labels[before]] += 1
@@ -297,12 +297,33 @@ def split_traces(instances: pd.DataFrame, found: set[str]) -> _Split:
             end = position + 1
             while end < len(labels) and labels[end] not in firsts:
                 end += 1
-            result.tags[label].append(tuple(moved))
+            result.tags[label].append(_own_instance(labels, starts, ends, position, end))
             result.handled[label].append(labels[position + 1 : end])
             result.went_on[label] |= end < len(labels)
-            position = resumed = end
+            position = end
         result.main.append(main)
     return result
+
+
+def _own_instance(labels: list, starts: list, ends: list, trigger: int, end: int) -> tuple:
+    """The event sub-process' own instance in a handler's part ``trigger + 1 .. end`` of a
+    trace, as a 1-tuple (empty when there is none): the engine tags the sub-process right
+    after its trigger, at the same moment, and it lasts as long as the work inside it."""
+    first = trigger + 1
+    if first >= end or starts[first] != starts[trigger]:
+        return ()
+    rest = ends[first + 1 : end]
+    if not rest or not all(_no_later(until, ends[first]) for until in rest):
+        return ()
+    return (labels[first],)
+
+
+def _no_later(until: Any, bound: Any) -> bool:
+    """Whether an instance ending at ``until`` ended no later than ``bound`` (NaT: never
+    ended, so later than any time)."""
+    if pd.isna(bound):
+        return True
+    return not pd.isna(until) and until <= bound
 
 
 # -- mining ------------------------------------------------------------------------------------
@@ -379,8 +400,8 @@ def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool
 def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -> Handler:
     tag = _tag(parts.tags[label])
     traces = parts.handled[label]
-    if tag is None:  # instances at the trigger's moment are the handler's own work
-        traces = [[*moved, *rest] for moved, rest in zip(parts.tags[label], traces, strict=True)]
+    if tag is not None:  # the sub-process itself, not a step inside it
+        traces = [rest[1:] for rest in traces]
     received = label.endswith(CAUGHT) and _role(instances, label) == RECEIVE
     return Handler(
         trigger=label,
@@ -394,8 +415,8 @@ def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -
 
 
 def _tag(moved: list[tuple[str, ...]]) -> str | None:
-    """The sub-process' own tag: the one instance every occurrence started at the trigger's
-    moment just before it (the engine tags an event sub-process before its start event)."""
+    """The sub-process' own tag: the one instance every occurrence has as its own (the
+    engine tags an event sub-process right after its start event catches)."""
     kinds = set(moved)
     if len(kinds) == 1 and len(next(iter(kinds))) == 1:
         return next(iter(kinds))[0]
