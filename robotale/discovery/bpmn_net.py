@@ -84,7 +84,7 @@ class _Builder:
         self.net = PetriNet("process")
         self.initial = Marking()
         self.observed = set(observed)
-        self.merged: set[str] = set()  # event sub-process starts tagged as their sub-process
+        self.merged: set[str] = set()  # event sub-process starts translated before it
         self.resolve = resolve
         self.counter = itertools.count()
         self.calling: list[str] = []  # call activities being expanded (stops recursion)
@@ -165,22 +165,31 @@ class _Builder:
             self.cancellations.append((scope.places, scope.cancel, after))
 
     def event_subprocess(self, node, parent: _Scope) -> None:
-        """An event sub-process starts (and is tagged with its own name) each time one of
-        its start events' triggers fires; an interrupting one cancels its parent scope."""
+        """An event sub-process starts each time one of its start events' triggers fires:
+        the trigger is tagged first, then the sub-process under its own name (the engine's
+        order); an interrupting one cancels its parent scope."""
         inner = _Scope(done=None)
         entries = {}
+        label = element_label(node)
         for start in (n for n in node.scope.nodes.values() if n.kind == Kind.START_EVENT):
             entries[start.id] = self.place(inner, f"triggered_{start.id}")
             cancels = [self.cancel(parent)] if start.interrupting else []
-            label = element_label(node)
             trigger = self.event_label(start)
-            if label not in self.observed and trigger is not None:
+            if trigger is None:
+                # an untagged trigger: the sub-process' own tag is the first sign of it
+                self.transition(f"esp_{node.id}", label, [], [entries[start.id], *cancels])
+                continue
+            # the start event is translated here, before its sub-process; in the scope below
+            # it only passes the token on
+            self.merged.add(start.id)
+            if label not in self.observed:
                 # a source that does not tag the sub-process itself (the thesis' log) tags
-                # only its trigger: the sub-process starts under the trigger's label, and its
-                # start event passes the token on silently
-                label = trigger
-                self.merged.add(start.id)
-            self.transition(f"esp_{node.id}", label, [], [entries[start.id], *cancels])
+                # only its trigger
+                self.transition(f"esp_{node.id}", trigger, [], [entries[start.id], *cancels])
+                continue
+            caught = self.place(inner, f"caught_{start.id}")
+            self.transition(f"catch_{start.id}", trigger, [], [caught, *cancels])
+            self.transition(f"esp_{node.id}", label, [caught], [entries[start.id]])
         self.scope(node.scope, inner, entry=None, entries=entries)
 
     def flow_node(self, node, scope: _Scope, entry, ins, outs, conditional: bool) -> None:

@@ -23,7 +23,7 @@ from __future__ import annotations
 import itertools
 from collections import Counter, defaultdict
 from dataclasses import dataclass, field
-from typing import Literal
+from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
@@ -231,13 +231,14 @@ class Traces:
     labels: list[list[str]]
     roles: list[list[str | None]]
     starts: list[np.ndarray]
+    ends: list[np.ndarray]
     aborted: list[list[bool]]
 
 
 def per_trace(instances: pd.DataFrame) -> Traces:
     """The instances (in trace order) cut into traces in one pass over integer codes."""
     if instances.empty:
-        return Traces([], [], [], [])
+        return Traces([], [], [], [], [])
     cases = pd.factorize(instances[CASE].astype(str))[0]
     robots = pd.factorize(instances[ROBOT])[0]
     bounds = np.flatnonzero((cases[1:] != cases[:-1]) | (robots[1:] != robots[:-1])) + 1
@@ -245,19 +246,23 @@ def per_trace(instances: pd.DataFrame) -> Traces:
     def cut(values: np.ndarray) -> list[list]:
         return [part.tolist() for part in np.split(values, bounds)]
 
-    starts = instances[START_TIMESTAMP]
-    # compared only where a trigger is: numpy datetimes (NaT unequal to itself, as a Timestamp
-    # is) rather than a Timestamp object per instance
-    if pd.api.types.is_datetime64_any_dtype(starts):
-        start_values = starts.to_numpy("datetime64[ns]")
-    else:  # times of several offsets, kept as objects
-        start_values = starts.to_numpy(object)
+    # an instance that never ended runs on past everything after it
+    until = instances[TIMESTAMP].where(instances[FINISHED].astype(bool))
     return Traces(
         labels=cut(instances[ACTIVITY].astype(str).to_numpy(object)),
         roles=cut(instances["_role"].to_numpy(object)),
-        starts=list(np.split(start_values, bounds)),
+        starts=list(np.split(_times(instances[START_TIMESTAMP]), bounds)),
+        ends=list(np.split(_times(until), bounds)),
         aborted=cut(instances["_aborted"].to_numpy(bool)),
     )
+
+
+def _times(times: pd.Series) -> np.ndarray:
+    """Times compared only where a trigger is: numpy datetimes (NaT unequal to itself, as a
+    Timestamp is) rather than a Timestamp object per instance."""
+    if pd.api.types.is_datetime64_any_dtype(times):
+        return times.to_numpy("datetime64[ns]")
+    return times.to_numpy(object)  # times of several offsets, kept as objects
 
 
 def _behaving_triggers(traces: Traces) -> set[str]:
@@ -294,28 +299,23 @@ def split_traces(traces: Traces, found: set[str]) -> _Split:
     """Each trace's instances outside the handlers (the process), and each handler's own.
 
     A handler runs from its trigger to the end of the trace, or to the first activity that
-    begins a trace of its type (the robot took up its process again); instances that started
-    at the trigger's moment before it (the event sub-process the engine tags first) belong to
-    the handler too."""
+    begins a trace of its type (the robot took up its process again). The event sub-process'
+    own instance, where the engine tags one, is recorded apart (:func:`_own_instance`)."""
     result = _Split()
     firsts = {trace[0] for trace in traces.labels}
-    for labels, starts, aborted in zip(traces.labels, traces.starts, traces.aborted, strict=True):
+    columns = zip(traces.labels, traces.starts, traces.ends, traces.aborted, strict=True)
+    for labels, starts, ends, aborted in columns:
         if not found.intersection(labels):  # most traces: nothing to cut
             result.main.append(list(labels))
             continue
         main: list[str] = []
-        position = resumed = 0
+        position = 0
         while position < len(labels):
             label = labels[position]
             if label not in found:
                 main.append(label)
                 position += 1
                 continue
-            same = position
-            while same > resumed and starts[same - 1] == starts[position]:
-                same -= 1
-            moved = labels[same:position]
-            del main[len(main) - len(moved) :]
             for before in range(position - 1, -1, -1):
                 if aborted[before]:
                     result.abandoned[label][labels[before]] += 1
@@ -323,12 +323,35 @@ def split_traces(traces: Traces, found: set[str]) -> _Split:
             end = position + 1
             while end < len(labels) and labels[end] not in firsts:
                 end += 1
-            result.tags[label].append(tuple(moved))
+            result.tags[label].append(_own_instance(labels, starts, ends, position, end))
             result.handled[label].append(labels[position + 1 : end])
             result.went_on[label] |= end < len(labels)
-            position = resumed = end
+            position = end
         result.main.append(main)
     return result
+
+
+def _own_instance(
+    labels: list[str], starts: np.ndarray, ends: np.ndarray, trigger: int, end: int
+) -> tuple[str, ...]:
+    """The event sub-process' own instance in a handler's part ``trigger + 1 .. end`` of a
+    trace, as a 1-tuple (empty when there is none): the engine tags the sub-process right
+    after its trigger, at the same moment, and it lasts as long as the work inside it."""
+    first = trigger + 1
+    if first >= end or starts[first] != starts[trigger]:
+        return ()
+    rest = ends[first + 1 : end]
+    if len(rest) == 0 or not all(_no_later(until, ends[first]) for until in rest):
+        return ()
+    return (labels[first],)
+
+
+def _no_later(until: Any, bound: Any) -> bool:
+    """Whether an instance ending at ``until`` ended no later than ``bound`` (NaT: never
+    ended, so later than any time)."""
+    if pd.isna(bound):
+        return True
+    return not pd.isna(until) and until <= bound
 
 
 # -- mining ------------------------------------------------------------------------------------
@@ -422,8 +445,8 @@ def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool
 def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -> Handler:
     tag = _tag(parts.tags[label])
     traces = parts.handled[label]
-    if tag is None:  # instances at the trigger's moment are the handler's own work
-        traces = [[*moved, *rest] for moved, rest in zip(parts.tags[label], traces, strict=True)]
+    if tag is not None:  # the sub-process itself, not a step inside it
+        traces = [rest[1:] for rest in traces]
     received = label.endswith(CAUGHT) and _role(instances, label) == RECEIVE
     return Handler(
         trigger=label,
@@ -437,8 +460,8 @@ def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -
 
 
 def _tag(moved: list[tuple[str, ...]]) -> str | None:
-    """The sub-process' own tag: the one instance every occurrence started at the trigger's
-    moment just before it (the engine tags an event sub-process before its start event)."""
+    """The sub-process' own tag: the one instance every occurrence has as its own (the
+    engine tags an event sub-process right after its start event catches)."""
     kinds = set(moved)
     if len(kinds) == 1 and len(next(iter(kinds))) == 1:
         return next(iter(kinds))[0]

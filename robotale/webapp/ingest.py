@@ -37,6 +37,7 @@ from robotale.sim import scenarios
 from robotale.webapp import uploads
 from robotale.webapp.jobs import Job
 from robotale.webapp.model_store import ModelStore
+from robotale.webapp.opened_run import opened_run
 
 #: columns every stored log keeps, whatever the user unticks
 ALWAYS_STORED = (*schema.REQUIRED, schema.LIFECYCLE)
@@ -247,7 +248,8 @@ def ingest(
     job.step("drawing its process")
     logs.forget(name)
     logs.class_graph(driver, name, first_key(entities))  # the Discover page's first view, ready
-    return {"log": summary.log, "events": summary.events, "seconds": round(summary.seconds, 2)}
+    result = {"log": summary.log, "events": summary.events, "seconds": round(summary.seconds, 2)}
+    return {**result, **opened_run(pending.upload.kind, log)}
 
 
 class _ProgressWatch:

@@ -58,14 +58,15 @@ def survey(robot, *, interrupting):
 
 
 def handler(robot, name, event, work):
-    return [(0, robot, name, "start"), *pair(0, robot, event), *pair(0, robot, work)]
+    """An event sub-process ``name``: its start ``event`` caught, then it starts."""
+    return [*pair(0, robot, event), (0, robot, name, "start"), *pair(0, robot, work)]
 
 
 def test_escalations_caught_by_boundary_events_and_event_sub_processes():
     mission, tags = run("escalations.bpmn")
     patrol = [*pair(0, "patrol", "patrol"), *pair(0, "patrol", "obstacle")]
-    patrol += [(0, "patrol", "handler", "start"), *pair(0, "patrol", "obstacle")]
-    patrol += pair(0, "patrol", "resume") + pair(0, "patrol", "log_obstacle")
+    patrol += handler("patrol", "handler", "obstacle", "resume")
+    patrol += pair(0, "patrol", "log_obstacle")
     patrol += [(0, "patrol", "handler", "complete")]
     # halt: the escalation end event starts the interrupting handler, which cancels the
     # 10 s timer of the other branch: nothing happens at 10 s

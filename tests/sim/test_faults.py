@@ -76,9 +76,10 @@ def test_an_emptying_battery_warns_low_battery_and_the_drone_goes_home(short_agr
     # the Explore the low battery interrupted never completes (earlier ones ended on a weed)
     explores = [t.lifecycle for t in drone if t.activity == "explore"]
     assert explores.count("complete") == explores.count("start") - 1
-    assert activities[activities.index("end_handler") :] == [
-        "end_handler",
+    # caught first, then the interrupting sub-process it starts
+    assert activities[activities.index("low_battery") :] == [
         "low_battery",
+        "end_handler",
         "return_to_base",
         "land",
     ]

@@ -101,8 +101,9 @@ def test_every_drone_run_ends_on_a_low_battery_with_part_of_the_field_seen(two_r
     for case, activities in drone.groupby(CASE)[ACTIVITY]:
         steps = activities.tolist()
         assert "field_cleaned!" not in steps, case  # the thesis' drone never cleaned the field
-        handler = steps.index("end_handler")  # the interrupting sub-process the error starts
-        assert steps[handler:] == ["end_handler", "low_battery", "return_to_base", "land"], case
+        # the error is caught, then starts the interrupting sub-process that handles it
+        handler = steps.index("low_battery")
+        assert steps[handler:] == ["low_battery", "end_handler", "return_to_base", "land"], case
         assert steps[0] == "take_off" and "weed_position!" in steps[:handler]
     assert sorted(manifests) == sorted(drone[CASE].unique())
     for case, manifest in manifests.items():

@@ -287,6 +287,44 @@ def test_a_zipped_bag_folder_is_prepared_and_linked_to_its_mission(
         ]
 
 
+def first_run(folder: Path) -> str:
+    """The case of the run whose truth begins first (its first line: case and start), read
+    with the standard library."""
+    heads = []
+    for truth in sorted(folder.glob("*/robotale-truth.jsonl")):
+        with truth.open() as lines:
+            head = json.loads(lines.readline())
+        heads.append((head["start"], head["case"]))
+    assert len(heads) == 2
+    return min(heads)[1]
+
+
+@pytest.mark.browser
+@pytest.mark.slow
+def test_an_uploaded_recording_opens_its_first_run_on_the_mission_page(
+    page, simulated_runs, log_name, tmp_path
+):
+    from playwright.sync_api import expect  # only the browser tests need playwright
+
+    archive = tmp_path / "agri.zip"
+    archive.write_bytes(zipped_folder(simulated_runs))
+    expected = first_run(simulated_runs)
+
+    page.goto(page.base_url + "/logs")
+    page.set_input_files("input[name=file]", str(archive))
+    page.click("#upload-form button[type=submit]")
+    expect(page.locator("#columns-form")).to_be_visible(timeout=120_000)
+    page.fill("#log-name", log_name)
+    page.click("#ingest")
+    page.wait_for_url(re.compile(r"/mission\?"), timeout=180_000)
+    query = page.url.split("?", 1)[1].split("&")
+    assert f"log={log_name}" in query and f"case={expected}" in query
+    mission = page.locator("#mission")
+    expect(mission).to_have_attribute("data-case", expected)
+    expect(mission).to_have_attribute("data-state", "shown", timeout=60_000)
+    expect(page.locator("#run-picker")).to_have_value(expected)
+
+
 def test_the_reading_is_shown_and_the_findings_are_ready_once_stored(
     client, app, web_settings, thesis_csv, log_name
 ):

@@ -5,9 +5,9 @@ one fires, an interrupting one cancels what it interrupts first (BPMN 2.0 sectio
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
-from robotale.fame_runtime.behaviours.catching import caught
+from robotale.fame_runtime.behaviours.catching import caught, received
 from robotale.fame_runtime.bus import Envelope
 from robotale.fame_runtime.kinds import EventKind
 from robotale.fame_runtime.plan import NodePlan
@@ -89,7 +89,12 @@ def event_subprocess(
     triggered: bool = True,
 ) -> None:
     """Start event sub-process ``esp`` in ``scope`` (an interrupting one cancels the rest of
-    the scope first); ``triggered``: its start event is tagged as caught."""
+    the scope first); ``triggered``: its start event is tagged as caught.
+
+    The catch is tagged before the sub-process starts, as for a boundary event: the trigger
+    is what starts it, and the thesis' log has the trigger (``low_battery``) right after what
+    it interrupted, so a directly-follows graph draws ``explore -> low_battery``.
+    """
     if interrupting and esp.id in scope.armed:
         scope.armed.pop(esp.id)()  # an interrupting handler runs once per scope
     if esp is scope.plan.safe_state:
@@ -100,12 +105,22 @@ def event_subprocess(
             for token in list(scope.tokens):
                 if token is not holder:
                     engine.cancel(token)
-    engine.activities.begin(holder, esp.label)
     assert esp.child is not None
-    child = engine.open_scope(esp.child, scope, holder)
     start = esp.child.triggered_starts[0]
+    values = _caught_start(engine, holder, start, envelope) if triggered else None
+    engine.activities.begin(holder, esp.label)
+    child = engine.open_scope(esp.child, scope, holder)
     token = engine.new_token(child, start)
-    if triggered:
-        caught(engine, token, start, envelope)
-    else:
-        engine.go_on(token, start)
+    if values is not None:
+        engine.enter_token(token)
+        engine.data.outputs(start, values)
+    engine.go_on(token, start)
+
+
+def _caught_start(
+    engine: Engine, holder: Token, start: NodePlan, envelope: Envelope | None
+) -> dict[str, Any]:
+    """Tag the start event of ``holder``'s event sub-process as caught; the message's fields
+    (for the start event's outputs once the sub-process runs)."""
+    engine.enter_token(holder)
+    return received(engine, start, envelope)

@@ -159,6 +159,8 @@ class Step:
                 self._cancel(token)
         holder = Tok(scope, esp, waiting="wait")
         scope.tokens.append(holder)
+        # as the engine tags it: the trigger is caught first, then the sub-process starts
+        self._catch(scope.robot, start, msg_id)
         self.reached.add(element_key(esp))
         self.tag(scope.robot, esp.label, Lifecycle.START)
         child = Scope(scope.robot, esp.child, holder)
@@ -166,7 +168,8 @@ class Step:
         self.declare(scope.robot, esp.child)
         token = Tok(child, start)
         child.tokens.append(token)
-        self._caught(token, start, msg_id)
+        self.data_out(scope.robot, start)
+        self._leave(token, start)
 
     def resume(self, token: Tok) -> None:
         """A token paused at the next round of a loop goes on."""
@@ -199,17 +202,21 @@ class Step:
 
     def _caught(self, token: Tok, catcher: NodePlan, msg_id: str) -> None:
         robot = token.scope.robot
+        token.node = catcher
+        self._catch(robot, catcher, msg_id)
+        self.data_out(robot, catcher)
+        self._leave(token, catcher)
+
+    def _catch(self, robot: Robot, catcher: NodePlan, msg_id: str) -> None:
+        """``catcher`` fires for ``robot``: tagged, its message in the variables."""
         if msg_id:
             self.forget_assumptions(robot)
-        token.node = catcher
         self.reached.add(element_key(catcher))
         self.fired.add(element_key(catcher))
         self.pair(robot, catcher.label, msg_id, "receive" if msg_id else "")
         if msg_id:  # the message becomes the variable named after its signal
             topic = catcher.trigger.topic if catcher.trigger is not None else ""
             robot.variables.pop(topic.strip("/").replace("/", "_"), None)
-        self.data_out(robot, catcher)
-        self._leave(token, catcher)
 
     def _busy(self) -> None:
         """The step never waits: the engine stops the robot whose token keeps going with a

@@ -58,6 +58,11 @@
     document.getElementById("job-done").hidden = false;
     localStorage.setItem("robotale.log", job.result.log);
     box.dataset.state = "done";
+    if (job.result.mission && box.dataset.mission) {
+      // a recording is replayed: its first run opens on the Mission page
+      const query = `log=${encodeURIComponent(job.result.log)}&case=${encodeURIComponent(job.result.mission)}`;
+      window.location.assign(`/mission?${query}`);
+    }
   }
 
   poll();
