@@ -211,8 +211,9 @@ class MissionRun:
         }
 
 
-def mission_run(log: pd.DataFrame, case: str) -> MissionRun:
-    """The run ``case`` of ``log`` (an :class:`InputError` naming some runs when it has none)."""
+def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) -> MissionRun:
+    """The run ``case`` of ``log`` (an :class:`InputError` naming some runs when it has none);
+    ``slow`` is :func:`slow_limits` of ``log`` when it was kept, else it is computed here."""
     timeline = case_timeline(log, case)  # also checks the run exists
     cases = log[CASE].astype("string")
     events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
@@ -240,7 +241,9 @@ def mission_run(log: pd.DataFrame, case: str) -> MissionRun:
         messages=messages,
         positions=positions,
         signals=_signals(events),
-        moments=_moments(log, events, instances, messages, start),
+        moments=_moments(
+            slow_limits(log) if slow is None else slow, events, instances, messages, start
+        ),
     )
 
 
@@ -299,7 +302,7 @@ def _signals(events: pd.DataFrame) -> list[str]:
 
 
 def _moments(
-    log: pd.DataFrame,
+    slow: pd.DataFrame,
     events: pd.DataFrame,
     instances: pd.DataFrame,
     messages: pd.DataFrame,
@@ -322,30 +325,55 @@ def _moments(
         for robot, first in low.groupby(ROBOT, sort=True)["s"].min().items():
             text = f"{robot}'s battery below {LOW_BATTERY:g}%"
             rows.append({"s": first, "kind": "low battery", "robot": robot, "text": text})
-    rows += _slow(log, instances)
+    rows += _slow(slow, instances)
     table = pd.DataFrame(rows, columns=["s", "kind", "robot", "text"])
     return table.sort_values("s", kind="stable").reset_index(drop=True)
 
 
-def _slow(log: pd.DataFrame, instances: pd.DataFrame) -> list[dict[str, Any]]:
+#: the columns of :func:`slow_limits`
+SLOW_COLUMNS = ["robot", "activity", "limit", "median", "count"]
+
+
+def slow_limits(log: pd.DataFrame) -> pd.DataFrame:
+    """What counts as slow for each robot and activity of the whole ``log``: the
+    :data:`SLOW_QUANTILE` (``limit``), the ``median`` and the ``count`` of the seconds its
+    finished instances took. The same for every run of the log, so it can be kept."""
     every = activity_instances(log)
     every = every[every[FINISHED].astype(bool)]
     if every.empty or ROBOT not in every.columns:
-        return []
+        return pd.DataFrame(columns=SLOW_COLUMNS)
     seconds = (every[TIMESTAMP] - every[START_TIMESTAMP]).dt.total_seconds()
-    keys = [every[ROBOT].astype(str), every[ACTIVITY].astype(str)]
+    keys = [
+        every[ROBOT].astype(str).rename("robot"),
+        every[ACTIVITY].astype(str).rename("activity"),
+    ]
     groups = seconds.groupby(keys)
-    limits = groups.quantile(SLOW_QUANTILE)
-    medians = groups.median()
-    counts = groups.size()
+    table = pd.DataFrame(
+        {
+            "limit": groups.quantile(SLOW_QUANTILE),
+            "median": groups.median(),
+            "count": groups.size(),
+        }
+    )
+    return table.reset_index()[SLOW_COLUMNS]
+
+
+def _slow(slow: pd.DataFrame, instances: pd.DataFrame) -> list[dict[str, Any]]:
+    """The run's instances slower than ``slow`` (:func:`slow_limits`) says of their kind."""
+    kinds = {
+        (str(robot), str(activity)): (float(limit), float(median), int(count))
+        for robot, activity, limit, median, count in zip(
+            *(slow[column] for column in SLOW_COLUMNS), strict=True
+        )
+    }
     found = []
     for row in instances.dropna(subset=["end"]).itertuples(index=False):
-        key = (row.robot, row.activity)
-        if counts.get(key, 0) < 3:  # too few to say what is slow
+        limit, median, count = kinds.get((row.robot, row.activity), (math.nan, math.nan, 0))
+        if count < 3:  # too few to say what is slow
             continue
         took = row.end - row.start
         # a second past the typical one, not a rounding of an instant one
-        if took > limits[key] + 1e-9 and took - medians[key] >= SLOW_MARGIN:
+        if took > limit + 1e-9 and took - median >= SLOW_MARGIN:
             text = f"{row.activity} by {row.robot} took {took:.1f} s"
             found.append(
                 {"s": row.start, "kind": "slow activity", "robot": row.robot, "text": text}

@@ -4,15 +4,18 @@ background, so the first visit after that computes nothing."""
 
 from __future__ import annotations
 
+import json
 import math
 from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any
 
+import pandas as pd
 from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
 
 from robotale.enhancement.findings import find, trusted_first
+from robotale.enhancement.mission import SLOW_COLUMNS, slow_limits
 from robotale.enhancement.registry import page_names, perspective_kind
 from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import InputError, RobotaleError
@@ -102,6 +105,18 @@ def stored_timeline(driver: Driver, logs: LogData, name: str, case: str) -> byte
     return logs.result(driver, name, ("timeline", case), compute)
 
 
+def stored_slow_limits(driver: Driver, logs: LogData, name: str) -> pd.DataFrame:
+    """What counts as a slow activity in the whole log (:func:`slow_limits`), the same for
+    each of its runs the Mission page replays: kept once per build, not computed per run."""
+    data = logs.result(
+        driver,
+        name,
+        ("slow-limits",),
+        lambda: {"limits": slow_limits(logs.frame(driver, name)).to_dict(orient="records")},
+    )
+    return pd.DataFrame(json.loads(data)["limits"], columns=SLOW_COLUMNS)
+
+
 def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict[str, Any]:
     """The class graph the Perspectives page draws beside its sections: by activity and
     robot when the log has robots as entities (``perspectives.js`` asks for the same)."""
@@ -128,8 +143,9 @@ def prepare(
 ) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
     perspectives of the whole log, the class graph beside them, the runs and the first run's
-    timeline, the steps named in ``first`` before the others (those of a page waiting for
-    them); ``progress`` hears of each step as it is done."""
+    timeline, what counts as a slow activity on the Mission page, the steps named in
+    ``first`` before the others (those of a page waiting for them); ``progress`` hears of
+    each step as it is done."""
     steps: list[tuple[str, Callable[[], object]]] = [
         ("findings", lambda: stored_findings(driver, logs, name)),
         ("class graph", lambda: perspectives_graph(driver, logs, name)),
@@ -140,6 +156,7 @@ def prepare(
     steps += [
         ("runs", lambda: stored_runs(driver, logs, name)),
         ("timeline", lambda: stored_timeline(driver, logs, name, "")),
+        ("slow limits", lambda: stored_slow_limits(driver, logs, name)),
     ]
     steps.sort(key=lambda named: named[0] not in first)  # stable: the others keep their order
     for done, (what, step) in enumerate(steps, start=1):

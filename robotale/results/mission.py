@@ -23,6 +23,7 @@ from robotale.fame_runtime.labels import element_label
 from robotale.fame_runtime.model import Flow, Scope
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.splitter import split
+from robotale.results.findings import stored_slow_limits
 from robotale.results.logdata import LogData, current_build
 
 #: gateways and unlabelled events a path between two tagged elements may pass through
@@ -34,9 +35,13 @@ def stored_mission(driver: Driver, logs: LogData, name: str, case: str) -> Missi
     if not case:
         raise InputError("Name the run to replay (?case=).")
     build = current_build(driver, name)
-    run: MissionRun = logs.missions.get(
-        (name, build.key, str(case)), lambda: mission_run(logs.frame(driver, name), case)
-    )
+
+    def load() -> MissionRun:
+        # the whole log's slow limits are kept with the prepared results, not computed per run
+        slow = stored_slow_limits(driver, logs, name)
+        return mission_run(logs.frame(driver, name), case, slow)
+
+    run: MissionRun = logs.missions.get((name, build.key, str(case)), load)
     return run
 
 
