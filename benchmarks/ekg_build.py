@@ -125,6 +125,14 @@ def main() -> int:
         "--promg-venv", type=Path, help="with --whole-command: a virtual environment with PromG"
     )
     parser.add_argument(
+        "--pages",
+        default="background",
+        choices=("background", "visit"),
+        help="with --whole-command: when the ingests prepare the dashboard's pages; "
+        "background (the default) awaits that process after each ingest, visit prepares none "
+        "(the command's own time is the same: it never waits for them)",
+    )
+    parser.add_argument(
         "--df-c-only",
         action="store_true",
         help="only part 3, at each of --sizes: directly-follows counts against pm4py",
@@ -133,7 +141,9 @@ def main() -> int:
     if args.whole_command:
         from whole_ingest import main as whole_command
 
-        return whole_command(args.sizes, max(args.repeat, 2), args.heap, args.promg_venv)
+        return whole_command(
+            args.sizes, max(args.repeat, 1), args.heap, args.promg_venv, args.pages
+        )
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     if args.df_c_only:
         with private_neo4j(args.heap) as driver:

@@ -1,6 +1,7 @@
 """The command a user runs, whole, against PromG's whole build of the same log.
 
     python benchmarks/ekg_build.py --whole-command [--sizes 100000 1000000] [--repeat 2]
+        [--pages background|visit] [--promg-venv VENV]
 
 For each size, ``ekg_build.py``'s synthetic log is written once as a CSV (robotale's input)
 and once as PromG's records (``peers.py``); then, interleaved (robotale, PromG, robotale,
@@ -9,7 +10,9 @@ PromG ...) on an emptied database of one private Neo4j with APOC (``peers.py``'s
 - robotale: the process ``python -m robotale ingest LOG.csv --entities robot,msg_id
   --aggregate activity`` from its start to its exit (reading the CSV, the build, the columnar
   copy; the dashboard's pages are prepared afterwards by a process of their own, whose time
-  until done is printed apart and awaited before the next build);
+  until done is printed apart and awaited before the next build; with ``--pages visit`` none
+  is started, which leaves the command's own work unchanged and keeps a large size's
+  preparation from taking the machine between the timed runs);
 - PromG: the process ``peers_promg.py`` (PromG's import, records, events, entities, CORR, DF,
   classes, DF_A) from its start to its exit.
 
@@ -56,7 +59,13 @@ class Run:
     pages: float | None = None
 
 
-def main(sizes: list[int], repeat: int, heap: str, venv: Path | None = None) -> int:
+def main(
+    sizes: list[int],
+    repeat: int,
+    heap: str,
+    venv: Path | None = None,
+    pages: str = "background",
+) -> int:
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
         work = Path(folder)
@@ -73,24 +82,27 @@ def main(sizes: list[int], repeat: int, heap: str, venv: Path | None = None) -> 
             python, why_not = peers.promg_environment(work / "venv")
         with peers.private_neo4j(work, heap) as (driver, server):
             for size in sizes:
-                measure(size, repeat, work, driver, server, python, why_not)
+                measure(size, repeat, work, driver, server, python, why_not, pages)
     print(f"load average after: {os.getloadavg()[0]:.1f}")
     return 0
 
 
-def measure(size: int, repeat: int, work: Path, driver, server, python, why_not) -> None:
+def measure(
+    size: int, repeat: int, work: Path, driver, server, python, why_not, pages: str
+) -> None:
+    print(f"{size:,} events: load average {os.getloadavg()[0]:.1f} at the start", flush=True)
     log = synthetic_log(size)
     csv = work / f"log{size}.csv"
     canonical_csv(log).to_csv(csv, index=False)
     ours: list[Run] = []
     theirs: list[Run] = []
     for _ in range(repeat):
-        ours.append(robotale_ingest(csv, driver, server))
+        ours.append(robotale_ingest(csv, driver, server, pages))
         if python is not None:
             run, why_not = promg_whole(python, driver, server, log, work)
             if run is not None:
                 theirs.append(run)
-    report(size, ours, theirs, why_not, event_properties(log))
+    report(size, ours, theirs, why_not, event_properties(log), pages)
 
 
 def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
@@ -141,7 +153,7 @@ def high_water_mb(pid: int) -> float:
     return int(found.group(1)) / 1024 if found else 0.0
 
 
-def robotale_ingest(csv: Path, driver, server) -> Run:
+def robotale_ingest(csv: Path, driver, server, pages: str = "background") -> Run:
     from robotale.results.background import done_file
 
     peers.clear(driver)
@@ -150,7 +162,7 @@ def robotale_ingest(csv: Path, driver, server) -> Run:
         "NEO4J_URI": running.bolt_uri,
         "NEO4J_USER": "neo4j",
         "NEO4J_PASSWORD": server.password() or "",
-        "ROBOTALE_PAGES": "background",
+        "ROBOTALE_PAGES": pages,
     }
     command = [sys.executable, "-m", "robotale", "ingest", str(csv), "--log", "whole"]
     command += ["--entities", "robot,msg_id", "--aggregate", "activity", "--replace"]
@@ -206,13 +218,23 @@ def same_counts(ours: dict[str, int], theirs: dict[str, int]) -> list[str]:
 
 
 def report(
-    size: int, ours: list[Run], theirs: list[Run], why_not: str | None, properties: int
+    size: int,
+    ours: list[Run],
+    theirs: list[Run],
+    why_not: str | None,
+    properties: int,
+    when: str = "background",
 ) -> None:
     mine = best(ours)
-    pages = (
-        f"{mine.pages:.1f} s after it, in the background"
-        if mine.pages is not None
-        else "NOT: the background preparation ended without finishing"
+    if when == "visit":
+        pages = "on first visit (--pages visit)"
+    elif mine.pages is not None:
+        pages = f"{mine.pages:.1f} s after it, in the background"
+    else:
+        pages = "NOT: the background preparation ended without finishing"
+    print(
+        f"  walls: robotale {[round(r.wall, 1) for r in ours]}, PromG "
+        f"{[round(r.wall, 1) for r in theirs]} (in turns)"
     )
     print(
         f"\n{size:,} events, whole `robotale ingest` (CSV read to exit): {mine.wall:.1f} s wall, "
