@@ -111,6 +111,9 @@ class Comparison:
     variants: pd.DataFrame
     bottlenecks: pd.DataFrame
     facts: dict[str, Any]
+    #: every value per run behind ``changes`` (``measure``, ``subject``, ``who``, ``run``,
+    #: ``value``, ``side``: 0 for A, 1 for B), for figures of the two batches' spread
+    per_run: pd.DataFrame = field(default_factory=pd.DataFrame)
 
     def to_dict(self) -> dict[str, Any]:
         return json_ready(
@@ -130,7 +133,8 @@ def compare_logs(
 ) -> Comparison:
     """What changed from ``log_a`` to ``log_b`` (two canonical event logs)."""
     first, second = batch(log_a, names[0]), batch(log_b, names[1])
-    changes = _changes(first, second)
+    per_run = per_run_values(first, second)
+    changes = _changes(per_run, first, second)
     variants = variant_table(first, second)
     bottlenecks = bottleneck_table(first, second)
     facts = {
@@ -141,7 +145,7 @@ def compare_logs(
         "alpha": ALPHA,
     }
     sentences = _sentences(first, second, changes, variants, bottlenecks)
-    return Comparison(names, sentences, changes, variants, bottlenecks, facts)
+    return Comparison(names, sentences, changes, variants, bottlenecks, facts, per_run)
 
 
 # -- the values per run ------------------------------------------------------------------------
@@ -261,8 +265,12 @@ def _long(subject, who, run, value) -> pd.DataFrame:
 # -- the tests ---------------------------------------------------------------------------------
 
 
-def _changes(first: Batch, second: Batch) -> pd.DataFrame:
-    long = pd.concat([_values(first, second, 0), _values(second, first, 1)], ignore_index=True)
+def per_run_values(first: Batch, second: Batch) -> pd.DataFrame:
+    """Every value per run of both batches in one long table (``side`` 0 for A, 1 for B)."""
+    return pd.concat([_values(first, second, 0), _values(second, first, 1)], ignore_index=True)
+
+
+def _changes(long: pd.DataFrame, first: Batch, second: Batch) -> pd.DataFrame:
     table = mann_whitney(long)
     table["p_value"] = either(table["p_value"], welch(long).reindex(table.index))
     table = table.reset_index()

@@ -90,3 +90,30 @@ def test_compare_command_reads_stored_logs_and_files(two_logs, tmp_path, capsys)
     assert main(["compare", str(path), names[1], "--json", str(out)]) == 0
     mixed = json.loads(out.read_text(encoding="utf-8"))
     assert mixed["sentences"] == stored["sentences"]
+
+
+@pytest.mark.browser
+def test_compare_page_draws_each_batchs_runs(page, two_logs):
+    """The first figure is the runs' durations: its A and B boxes hold one point per run, each
+    the run's first to last event, counted here by pandas from the two logs; the figures after
+    it are the first tested changes, each with a box per batch."""
+    names, calm, full = two_logs
+    expected = compare_logs(calm, full)
+    page.goto(f"{page.base_url}/compare?a={names[0]}&b={names[1]}")
+    expect(page.locator("#compare-figures[data-shown]")).to_have_count(1, timeout=60_000)
+    drawn = page.evaluate(
+        """() => [...document.querySelectorAll('#compare-figures .compare-figure')].map(
+            (box) => box.data.map((trace) => ({name: trace.name, y: trace.y, runs: trace.text})))"""
+    )
+    tested = expected.changes[
+        expected.changes["q_value"].notna() & (expected.changes["measure"] != "run duration")
+    ]
+    assert len(drawn) == min(6, 1 + len(tested))
+    assert all([trace["name"] for trace in figure] == ["A", "B"] for figure in drawn)
+    for log, trace in zip((calm, full), drawn[0], strict=True):
+        times = log.groupby(log[CASE].astype(str))["time:timestamp"]
+        spans = (times.max() - times.min()).dt.total_seconds()
+        got = dict(zip(trace["runs"], trace["y"], strict=True))
+        assert sorted(got) == sorted(spans.index)
+        for run, seconds in spans.items():
+            assert got[run] == pytest.approx(seconds, abs=1e-3)

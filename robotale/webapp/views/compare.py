@@ -8,7 +8,7 @@ from typing import Any
 import pandas as pd
 from flask import Blueprint, render_template, request
 
-from robotale.enhancement.compare import compare_logs
+from robotale.enhancement.compare import TIMED, Comparison, compare_logs
 from robotale.webapp import pages
 from robotale.webapp.state import driver, state
 
@@ -26,6 +26,8 @@ CHANGE_COLUMNS = {
     "ranked": "ranked",
 }
 VARIANT_COLUMNS = {"variant": "variant", "runs_a": "runs of A", "runs_b": "runs of B", "status": ""}
+#: how many changes the page draws as figures: the runs' durations, then the first changes
+FIGURES = 6
 
 
 @blueprint.get("/compare")
@@ -41,6 +43,7 @@ def page():
             "sentences": comparison.sentences,
             "changes": _rows(comparison.changes, CHANGE_COLUMNS),
             "variants": _rows(comparison.variants, VARIANT_COLUMNS),
+            "figures": figures(comparison),
         }
     return render_template(
         "compare.html",
@@ -51,6 +54,52 @@ def page():
         **shown,
         **pages.context("compare.page"),
     )
+
+
+def figures(comparison: Comparison) -> list[dict[str, Any]]:
+    """Plotly figures of the runs' durations and of the first tested changes after it: each
+    batch's values, one per run, as a box with every run's point, so a shift carried by a few
+    runs shows as well as one of the whole spread."""
+    changes = comparison.changes
+    tested = changes[changes["q_value"].notna() & (changes["measure"] != "run duration")]
+    shown = [("run duration", "runs", "")]
+    shown += list(tested[["measure", "subject", "who"]].itertuples(index=False, name=None))
+    values = comparison.per_run
+    drawn = []
+    for measure, subject, who in shown[:FIGURES]:
+        mine = values[
+            (values["measure"] == measure) & (values["subject"] == subject) & (values["who"] == who)
+        ]
+        if mine.empty:
+            continue
+        drawn.append(_figure(measure, subject, who, mine, comparison.names))
+    return drawn
+
+
+def _figure(
+    measure: str, subject: str, who: str, values: pd.DataFrame, names: tuple[str, str]
+) -> dict[str, Any]:
+    title = measure if measure == "run duration" else f"{measure}: {subject}"
+    if who:
+        title += f" ({who})"
+    data = []
+    for side, name in enumerate(names):
+        part = values[values["side"] == side]
+        data.append(
+            {
+                "type": "box",
+                "name": name,
+                "y": part["value"].astype(float).tolist(),
+                "text": part["run"].astype(str).tolist(),
+                "boxpoints": "all",
+                "jitter": 0.4,
+                "pointpos": 0,
+                "hovertemplate": "run %{text}: %{y}<extra></extra>",
+            }
+        )
+    unit = "seconds" if measure in TIMED or measure == "message latency" else measure
+    layout = {"title": {"text": title}, "showlegend": False, "yaxis": {"title": {"text": unit}}}
+    return {"data": data, "layout": layout, "measure": measure, "subject": subject, "who": who}
 
 
 def _rows(table: pd.DataFrame, columns: dict[str, str]) -> list[list[str]]:
