@@ -15,10 +15,12 @@ from itertools import pairwise
 from pathlib import Path
 from typing import Any
 
+import pandas as pd
 from neo4j import Driver
 
 from robotale.enhancement.mission import MissionRun, mission_run
 from robotale.errors import InputError, ModelError
+from robotale.fame_runtime.kinds import Kind
 from robotale.fame_runtime.labels import element_label
 from robotale.fame_runtime.model import Flow, Scope
 from robotale.fame_runtime.parser import parse
@@ -77,6 +79,26 @@ class ModelMap:
             found[row.robot] += [i for i in ids if i not in found[row.robot]]
         return found
 
+    def waiting(self, run: MissionRun, t: float) -> dict[str, list[str]]:
+        """``{robot: [element id, ...]}`` of the catch events each robot waits at at ``t``:
+        in a scope of its pool where nothing of it runs, those the flows lead to (through
+        gateways and elements nothing tags, an event-based gateway's every branch) from the
+        last element it ended there, or from the process' start before it did anything, when
+        the next element it starts there is one of them or nothing does. A sub-process it has
+        not started an element of yet is not read (where it waits there is not in the log)."""
+        found: dict[str, list[str]] = {}
+        for robot, scopes in self.scopes.items():
+            rows = run.instances[run.instances["robot"] == robot]
+            labels = self.labels.get(robot, {})
+            tagged = {i for label in set(rows["activity"]) for i in labels.get(label, [])}
+            for number, scope in enumerate(scopes):
+                ids = [_first_in(labels.get(a, []), scope) for a in rows["activity"]]
+                inside = rows.assign(_id=ids).dropna(subset=["_id"])
+                waits = _waiting_in(scope, inside, t, tagged, process=number == 0)
+                mine = found.setdefault(robot, [])
+                mine += [w for w in waits if w not in mine]
+        return {robot: ids for robot, ids in found.items() if ids}
+
     def flows_taken(self, run: MissionRun, t: float) -> dict[str, int]:
         """``{flow id: times}``: for each robot and each scope of its pool (the process, a
         sub-process), the flows on the shortest path (through gateways and events it does
@@ -115,6 +137,55 @@ def model_map(model: Path, robots: list[str]) -> ModelMap:
             n.scope for n in process.walk() if n.scope is not None
         ]
     return ModelMap(labels, scopes)
+
+
+def _first_in(ids: list[str], scope: Scope) -> str | None:
+    return next((i for i in ids if i in scope.nodes), None)
+
+
+def _waiting_in(
+    scope: Scope, inside: pd.DataFrame, t: float, tagged: set[str], *, process: bool
+) -> list[str]:
+    """The catch events of ``scope`` a robot whose elements there are ``inside`` (``_id``,
+    ``start``, ``end``) waits at at ``t`` (see :meth:`ModelMap.waiting`)."""
+    before = inside[inside["start"] <= t]
+    if (before["end"].isna() | (before["end"] > t)).any():
+        return []  # something of it runs in this scope
+    if before.empty:
+        if not process:
+            return []
+        sources = [i for i, node in scope.nodes.items() if node.kind == Kind.START_EVENT]
+    else:
+        sources = [str(before["_id"].iloc[-1])]
+    reachable = {c for source in sources for c in _catches_after(scope, source, tagged)}
+    later = inside.loc[inside["start"] > t, "_id"]
+    if not later.empty and later.iloc[0] not in reachable:
+        return []  # it went on through elements the log names: not waiting at a catch
+    return sorted(reachable)
+
+
+def _catches_after(scope: Scope, source: str, tagged: set[str]) -> list[str]:
+    """The intermediate catch events the flows of ``scope`` reach from ``source`` through
+    gateways and untagged elements (at most :data:`MAX_HOPS` flows)."""
+    outgoing: dict[str, list[str]] = {}
+    for flow in scope.flows.values():
+        outgoing.setdefault(flow.source, []).append(flow.target)
+    found: list[str] = []
+    frontier, seen = [source], {source}
+    for _ in range(MAX_HOPS):
+        following = []
+        for node in frontier:
+            for target in outgoing.get(node, []):
+                if target in seen:
+                    continue
+                seen.add(target)
+                element = scope.nodes.get(target)
+                if element is not None and element.kind == Kind.INTERMEDIATE_CATCH_EVENT:
+                    found.append(target)
+                elif target not in tagged:
+                    following.append(target)
+        frontier = following
+    return found
 
 
 def _path(scope: Scope, source: str, target: str, tagged: set[str]) -> list[str]:

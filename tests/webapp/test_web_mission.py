@@ -229,6 +229,76 @@ def test_flows_taken_grow_and_lie_in_the_model(client, stored_run):
     assert counts[-1].get("Drone_Flow_Again", 0) == len(explores) - 1
 
 
+def event_gateway_catches(model: Path) -> dict[str, set[str]]:
+    """``{catch event's name, normalised: the catch events waited at with it}``, read with
+    lxml: a catch event behind an event-based gateway is waited at with all of that gateway's
+    catch events, any other alone."""
+    tree = etree.parse(str(model))
+    catches = {e.get("id"): e for e in tree.iter(f"{BPMN}intermediateCatchEvent")}
+    gateways = {g.get("id") for g in tree.iter(f"{BPMN}eventBasedGateway")}
+    flows = list(tree.iter(f"{BPMN}sequenceFlow"))
+    found: dict[str, set[str]] = {}
+    for ident, catch in catches.items():
+        together = {ident}
+        for flow in flows:
+            if flow.get("targetRef") == ident and flow.get("sourceRef") in gateways:
+                together |= {
+                    f.get("targetRef")
+                    for f in flows
+                    if f.get("sourceRef") == flow.get("sourceRef") and f.get("targetRef") in catches
+                }
+        found.setdefault(normalised(catch.get("name") or ident), set()).update(together)
+    return found
+
+
+def test_a_robot_between_its_last_element_and_a_catch_waits_at_it(client, stored_run):
+    """Midway between a robot's last event and the catch event it tags next (a message or a
+    timer it waited for), the state names that catch event (with its event-based gateway's
+    others) among the elements the robot waits at (a sub-process around it may be running);
+    at any moment a robot waits only at catch events of its own pool and not at what it runs.
+    The moments and the elements come from the log with pandas and the model with lxml."""
+    events, start = run_events(stored_run)
+    catches = event_gateway_catches(stored_run.model)
+    base = f"/api/mission/{stored_run.name}/{CASE}/state"
+    checked = 0
+    for robot, mine in events.groupby("robot"):
+        seconds = (mine["time:timestamp"] - start).dt.total_seconds().to_numpy()
+        names = [normalised(a) for a in mine["concept:name"]]
+        roles = mine["msg_role"].astype("string").fillna("").tolist()
+        for position in range(1, len(names)):
+            if names[position] not in catches or roles[position] == "send":
+                continue
+            if mine["lifecycle:transition"].iloc[position - 1] != "complete":
+                continue
+            before, caught = seconds[position - 1], seconds[position]
+            if caught - before < 4 * MARGIN:
+                continue
+            t = round((before + caught) / 2, 3)
+            state = api(client, f"{base}?t={t}")
+            assert set(state["waiting"].get(robot, [])) >= catches[names[position]], (robot, t)
+            checked += 1
+    assert checked >= 3  # tractors wait for their next weed, the drone for a tractor's answer
+    # a robot waits only at catch events of its own pool, never at what it is running
+    pools = pool_catches(stored_run.model)
+    for t in cursor_times(stored_run):
+        state = api(client, f"{base}?t={t}")
+        for robot, waits in state["waiting"].items():
+            assert set(waits) <= pools[pool_of(robot)], (robot, t)
+            assert not set(waits) & set(state["elements"].get(robot, [])), (robot, t)
+
+
+def pool_catches(model: Path) -> dict[str, set[str]]:
+    """``{pool name: its intermediate catch events' ids}``, read with lxml."""
+    tree = etree.parse(str(model))
+    processes = {p.get("id"): p for p in tree.iter(f"{BPMN}process")}
+    found: dict[str, set[str]] = {}
+    for pool in tree.iter(f"{BPMN}participant"):
+        process = processes[pool.get("processRef")]
+        catches = process.iter(f"{BPMN}intermediateCatchEvent")
+        found[pool.get("name")] = {e.get("id") for e in catches}
+    return found
+
+
 def test_window_holds_what_the_log_holds_between_two_moments(client, stored_run):
     events, start = run_events(stored_run)
     seconds = (events["time:timestamp"] - start).dt.total_seconds()
@@ -387,6 +457,7 @@ def test_mission_page_shows_the_run_at_the_cursor_in_every_view(page, stored_run
     assert page.locator("#map rect.field").count() == 1
     assert page.locator("#map g.base").count() == 2
     seen = []
+    waited = 0
     for t in times:
         move_cursor(page, t)
         wait_for(page, "document.getElementById('canvas').dataset.active !== undefined")
@@ -397,6 +468,16 @@ def test_mission_page_shows_the_run_at_the_cursor_in_every_view(page, stored_run
             assert shown["positions"][robot] == pytest.approx(where), (robot, t)
         assert shown["battery"] == pytest.approx(expected["battery"]), t
         assert shown["active"] == expected["active"], t
+        # the catch events the state API says robots wait at are the ones marked waiting
+        answer = page.request.get(
+            f"{page.base_url}/api/mission/{stored_run.name}/{CASE}/state?t={t}"
+        ).json()
+        waits = sorted({i for ids in answer["waiting"].values() for i in ids})
+        marked = page.eval_on_selector_all(
+            "#canvas .djs-element.waiting", "els => els.map(e => e.dataset.elementId)"
+        )
+        assert sorted(marked) == waits, t
+        waited += bool(waits)
         at = start + pd.Timedelta(seconds=t)
         assert pd.Timestamp(shown["timeline"], tz="UTC") == pytest.approx(
             at, abs=pd.Timedelta("2ms")
@@ -407,6 +488,7 @@ def test_mission_page_shows_the_run_at_the_cursor_in_every_view(page, stored_run
     # one cursor, every view: the timeline's line moved each time, the map and the plot's
     # readings with the log (each equal to it above, and not the same at every moment)
     assert len({view["timeline"] for view in seen}) == len(times)
+    assert waited  # some robot waits at a catch event at one of the moments at least
     for key in ("positions", "battery", "active"):
         assert len({repr(view[key]) for view in seen}) > 1, key
 

@@ -60,6 +60,7 @@ def state_at(log: str, case: str):
     elements = _elements(log, case, run.robots)
     if elements is not None:
         found["elements"] = elements.active(run, t)
+        found["waiting"] = elements.waiting(run, t)
         found["flows"] = elements.flows_taken(run, t)
     return jsonify(found)
 

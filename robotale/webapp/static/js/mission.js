@@ -26,7 +26,7 @@
 
   let log = "", run = "", summary = null, whole = null, startMs = 0;
   let t = 0, playing = false, asked = 0, inFlight = false, again = false;
-  let viewer = null, marked = [], markedFlows = [];
+  let viewer = null, marked = [], markedFlows = [], markedWaits = [];
   let series = null;
 
   const colour = (robot) => COLOURS[Math.max(0, summary.robots.indexOf(robot)) % COLOURS.length];
@@ -192,12 +192,18 @@
     const registry = viewer.get("elementRegistry");
     for (const id of marked) canvas.removeMarker(id, "active");
     for (const id of markedFlows) canvas.removeMarker(id, "taken");
+    for (const id of markedWaits) canvas.removeMarker(id, "waiting");
     const active = [...new Set(Object.values(state.elements).flat())].filter((id) => registry.get(id)).sort();
     const flows = Object.keys(state.flows || {}).filter((id) => registry.get(id)).sort();
     for (const id of active) canvas.addMarker(id, "active");
     for (const id of flows) canvas.addMarker(id, "taken");
+    // catch events a robot waits at: the flows brought it there, the event has not come yet
+    const waits = [...new Set(Object.values(state.waiting || {}).flat())].filter((id) => registry.get(id)).sort();
+    for (const id of waits) canvas.addMarker(id, "waiting");
     marked = active;
     markedFlows = flows;
+    markedWaits = waits;
+    canvasBox.dataset.waiting = waits.join(" ");
     canvasBox.dataset.active = active.join(" ");
     canvasBox.dataset.taken = flows.map((id) => `${id}:${state.flows[id]}`).join(" ");
   }
