@@ -34,9 +34,14 @@ class PoolReplay:
         """Move on with ``tag``; False when the model does not allow it here. Tags other
         than starts, and labels the net does not have (untagged events, a skill's own
         messages), say nothing about the model and are allowed."""
-        if tag.lifecycle != START or tag.activity not in self.labels:
+        return tag.lifecycle != START or self.allows_start(tag.activity)
+
+    def allows_start(self, activity: str) -> bool:
+        """Move on with a start of ``activity``; False when the model does not allow it
+        here (a label the net does not have is allowed: it says nothing about the model)."""
+        if activity not in self.labels:
             return True
-        reached = self._reach(tag.activity)
+        reached = self._reach(activity)
         if reached is None:
             return False
         self.marking = reached

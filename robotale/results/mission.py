@@ -18,6 +18,7 @@ from typing import Any
 import pandas as pd
 from neo4j import Driver
 
+from robotale.discovery.online import pool_replays
 from robotale.enhancement.mission import MissionRun, mission_run
 from robotale.errors import InputError, ModelError
 from robotale.fame_runtime.kinds import Kind
@@ -79,6 +80,19 @@ class ModelMap:
             found[row.robot] += [i for i in ids if i not in found[row.robot]]
         return found
 
+    def deviated(self, deviations: list[dict[str, Any]], t: float) -> dict[str, list[str]]:
+        """``{robot: [element id, ...]}`` of the elements each robot started, by ``t``,
+        where its pool's model did not allow it (:func:`deviations`)."""
+        found: dict[str, list[str]] = {}
+        for deviation in deviations:
+            if deviation["t"] > t:
+                break  # in start order
+            robot = deviation["robot"]
+            mine = found.setdefault(robot, [])
+            ids = self.labels.get(robot, {}).get(deviation["activity"], [])
+            mine += [i for i in ids if i not in mine]
+        return {robot: ids for robot, ids in found.items() if ids}
+
     def waiting(self, run: MissionRun, t: float) -> dict[str, list[str]]:
         """``{robot: [element id, ...]}`` of the catch events each robot waits at at ``t``:
         in a scope of its pool where nothing of it runs, those the flows lead to (through
@@ -137,6 +151,22 @@ def model_map(model: Path, robots: list[str]) -> ModelMap:
             n.scope for n in process.walk() if n.scope is not None
         ]
     return ModelMap(labels, scopes)
+
+
+def deviations(model: Path, run: MissionRun, robots: list[str]) -> list[dict[str, Any]]:
+    """Each start the model did not allow where the robot was, in start order (``robot``,
+    ``activity``, ``t`` seconds): every robot's activity starts replayed on its pool's Petri
+    net as ``robotale monitor`` replays tags live (:mod:`robotale.discovery.online`)."""
+    try:
+        replays = pool_replays(model, robots)
+    except ModelError as error:
+        raise InputError(f"{error}; the run's robots are {', '.join(robots)}.") from None
+    found = []
+    for row in run.instances.itertuples(index=False):  # in start order
+        replay = replays.get(str(row.robot))
+        if replay is not None and not replay.allows_start(str(row.activity)):
+            found.append({"robot": str(row.robot), "activity": str(row.activity), "t": row.start})
+    return found
 
 
 def _first_in(ids: list[str], scope: Scope) -> str | None:

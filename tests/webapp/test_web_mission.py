@@ -362,6 +362,59 @@ def test_bad_requests_say_what_is_wrong(client, stored_run):
         assert sentence in response.get_json()["error"], (path, response.get_json())
 
 
+def throw_events(model: Path, pool: str) -> dict[str, list[str]]:
+    """``{name, normalised: [ids]}`` of a pool's intermediate throw events, read with lxml."""
+    tree = etree.parse(str(model))
+    processes = {p.get("id"): p for p in tree.iter(f"{BPMN}process")}
+    participant = next(p for p in tree.iter(f"{BPMN}participant") if p.get("name") == pool)
+    found: dict[str, list[str]] = {}
+    for element in processes[participant.get("processRef")].iter(f"{BPMN}intermediateThrowEvent"):
+        found.setdefault(normalised(element.get("name") or ""), []).append(element.get("id"))
+    return found
+
+
+def test_deviations_are_marked_where_a_robot_left_its_model(
+    app, client, stored_run, neo4j_driver, log_name
+):
+    """The engine's own run follows its model: no deviation at its end. The same run with the
+    first ``get_position`` of tractor_1 removed from the log: the tractor's next step, sending
+    its position, is a deviation from that moment on (the model sends only after getting the
+    position), and nothing before it or of another robot is."""
+    from robotale.ekg.build import build_ekg
+    from robotale.webapp.state import state as app_state
+
+    events, start = run_events(stored_run)
+    end = (events["time:timestamp"].iloc[-1] - start).total_seconds()
+    clean = api(client, f"/api/mission/{stored_run.name}/{CASE}/state?t={end}")
+    assert clean["deviations"] == {}
+
+    skipped = stored_run.log[
+        (stored_run.log["robot"] == "tractor_1")
+        & (stored_run.log["concept:name"] == "get_position")
+    ]
+    first = skipped["time:timestamp"].min()
+    dropped = skipped.index[
+        skipped["time:timestamp"]
+        <= skipped.loc[skipped["lifecycle:transition"] == "complete", "time:timestamp"].min()
+    ]
+    build_ekg(neo4j_driver, stored_run.log.drop(dropped), log_name, replace=True)
+    model = next(m for m in app_state(app).models.all() if m.name == "agri.bpmn")
+    app_state(app).models.link(log_name, model.id)
+    mine = events[(events["robot"] == "tractor_1") & (events["time:timestamp"] > first)]
+    sent = mine[
+        (mine["concept:name"] == "tractor_position!") & (mine["lifecycle:transition"] == "start")
+    ]["time:timestamp"].iloc[0]
+    at = (sent - start).total_seconds()
+    base = f"/api/mission/{log_name}/{CASE}/state"
+    assert api(client, f"{base}?t={at - 0.001}")["deviations"] == {}
+    after = api(client, f"{base}?t={at}")["deviations"]
+    assert set(after) == {"tractor_1"}
+    assert set(after["tractor_1"]) >= set(
+        throw_events(stored_run.model, "Tractor")["tractor_position"]
+    )
+    assert set(api(client, f"{base}?t={end}")["deviations"]) == {"tractor_1"}
+
+
 def test_a_log_without_positions_or_model_still_answers(client, stored_run, neo4j_driver, log_name):
     from robotale.ekg.build import build_ekg
 

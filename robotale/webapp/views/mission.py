@@ -12,7 +12,13 @@ from flask import Blueprint, jsonify, render_template, request
 from robotale.enhancement.mission import MissionRun
 from robotale.enhancement.timeline import NO_ROBOT
 from robotale.errors import InputError
-from robotale.results.mission import ModelMap, mission_site, model_map, stored_mission
+from robotale.results.mission import (
+    ModelMap,
+    deviations,
+    mission_site,
+    model_map,
+    stored_mission,
+)
 from robotale.results.site import stored_site
 from robotale.webapp import pages
 from robotale.webapp.model_store import StoredModel
@@ -61,6 +67,7 @@ def state_at(log: str, case: str):
     if elements is not None:
         found["elements"] = elements.active(run, t)
         found["waiting"] = elements.waiting(run, t)
+        found["deviations"] = elements.deviated(_deviations(log, case, run), t)
         found["flows"] = elements.flows_taken(run, t)
     return jsonify(found)
 
@@ -115,6 +122,18 @@ def _model(log: str) -> StoredModel | None:
     asked = request.args.get("model")
     models = state().models
     return models.get(asked) if asked else models.linked(log)
+
+
+def _deviations(log: str, case: str, run: MissionRun) -> list[dict[str, Any]]:
+    model = _model(log)
+    if model is None:
+        return []
+    known = [robot for robot in run.robots if robot != NO_ROBOT]
+    if is_live(log):  # a live run grows: its replay is not kept
+        return deviations(model.path, run, known)
+    return state().logs.missions.get(
+        (log, "deviations", model.id, case), lambda: deviations(model.path, run, known)
+    )
 
 
 def _elements(log: str, case: str, robots: list[str]) -> ModelMap | None:

@@ -26,7 +26,7 @@
 
   let log = "", run = "", summary = null, whole = null, startMs = 0;
   let t = 0, playing = false, asked = 0, inFlight = false, again = false;
-  let viewer = null, marked = [], markedFlows = [], markedWaits = [];
+  let viewer = null, marked = [], markedFlows = [], markedWaits = [], markedDeviations = [];
   let series = null;
 
   const colour = (robot) => COLOURS[Math.max(0, summary.robots.indexOf(robot)) % COLOURS.length];
@@ -193,6 +193,7 @@
     for (const id of marked) canvas.removeMarker(id, "active");
     for (const id of markedFlows) canvas.removeMarker(id, "taken");
     for (const id of markedWaits) canvas.removeMarker(id, "waiting");
+    for (const id of markedDeviations) canvas.removeMarker(id, "deviation");
     const active = [...new Set(Object.values(state.elements).flat())].filter((id) => registry.get(id)).sort();
     const flows = Object.keys(state.flows || {}).filter((id) => registry.get(id)).sort();
     for (const id of active) canvas.addMarker(id, "active");
@@ -204,6 +205,11 @@
     markedFlows = flows;
     markedWaits = waits;
     canvasBox.dataset.waiting = waits.join(" ");
+    // elements a robot started, by the cursor, where its pool's model did not allow it
+    const deviated = [...new Set(Object.values(state.deviations || {}).flat())].filter((id) => registry.get(id)).sort();
+    for (const id of deviated) canvas.addMarker(id, "deviation");
+    markedDeviations = deviated;
+    canvasBox.dataset.deviations = deviated.join(" ");
     canvasBox.dataset.active = active.join(" ");
     canvasBox.dataset.taken = flows.map((id) => `${id}:${state.flows[id]}`).join(" ");
   }
