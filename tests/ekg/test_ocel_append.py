@@ -118,6 +118,24 @@ def test_appending_the_later_half_gives_the_graph_of_the_whole_log(
     assert len(shared) > 0
 
 
+def test_appending_the_earlier_half_to_the_later_one(
+    tmp_path, capsys, neo4j_driver, log_name, other_name
+):
+    # New events before the stored ones: each object's chain is built again from its start.
+    whole, first, following = halves(tmp_path, "jsonocel")
+    assert ingest(capsys, whole, other_name) == (0, "")
+    assert ingest(capsys, following, log_name) == (0, "")
+    assert ingest(capsys, first, log_name, "--append") == (0, "")
+    appended, expected = graph(neo4j_driver, log_name), graph(neo4j_driver, other_name)
+    for part in expected:
+        if part != "events":  # an event's order is its position in the files as ingested
+            assert appended[part] == expected[part], part
+    without_order = [tuple(c for c in row if c[0] != "order") for row in expected["events"]]
+    assert sorted(
+        (tuple(c for c in row if c[0] != "order") for row in appended["events"]), key=repr
+    ) == sorted(without_order, key=repr)
+
+
 def test_refused_appends_leave_the_log_as_it_was(tmp_path, capsys, neo4j_driver, log_name):
     _, first, following = halves(tmp_path, "jsonocel")
     assert ingest(capsys, first, log_name) == (0, "")
