@@ -65,7 +65,8 @@ def append_objects(
 ) -> BuildSummary:
     """Append the events of the object-centric ``log`` and its ``objects`` to the stored
     log ``name``. Refused (nothing written) when there is no complete log ``name``, when an
-    object type or event column is one the log lacks, or when an event id is already in it."""
+    object type or event column is one the log lacks, when an event id is already in it, or
+    when an object id is stored with another type."""
     started = time.perf_counter()
     check_log_name(name)
     with log_write_lock(driver, name, "appending"):
@@ -77,6 +78,7 @@ def append_objects(
         check_keys(tables.events, keys)
         check_key_sizes(tables, keys)
         check_new_event_ids(driver, tables.events, name)
+        _check_same_types(driver, name, objects, types)
         classes = [class_tables(tables, key) for key in keys]
         summary: dict[str, Any] = {"events": int(info["events"]) + len(tables.events)}
         summary |= merged_values(log_values(driver, name), table_values(tables.events))
@@ -99,6 +101,30 @@ def _known_types(objects: Objects, stored: list[str], name: str) -> list[str]:
     return [kind for kind in stored if kind in given]
 
 
+def _check_same_types(driver: Driver, name: str, objects: Objects, types: list[str]) -> None:
+    table = _typed(objects, types)
+    records, _, _ = driver.execute_query(
+        cypher("ekg_ocel_other_types"),
+        ids=table.index.astype(str).tolist(),
+        types=table.tolist(),
+        entityTypes=types,
+        log=name,
+        database_=database(),
+    )
+    if records:
+        found = records[0]
+        raise InputError(
+            f"The object {found['id']!r} is of type {found['given']!r}, but the log {name!r} "
+            f"holds it as {found['stored']!r}: an object keeps its type in the whole log."
+        )
+
+
+def _typed(objects: Objects, types: list[str]) -> pd.Series:
+    """Each object's entity type, by object id, for the objects of ``types``."""
+    kinds = objects.objects.assign(type=objects.objects["type"].map(objects.column))
+    return kinds[kinds["type"].isin(types)].set_index("id")["type"]
+
+
 def _check_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> None:
     # Events of an object-centric log carry the attributes of their own type: the new events
     # may lack some of the log's columns, but may bring none it does not have.
@@ -114,8 +140,7 @@ def _check_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> None:
 def _without_stored(driver: Driver, name: str, objects: Objects, types: list[str]) -> Objects:
     """``objects`` without the object-to-object relations and attribute changes the log
     already holds (a file split off a log repeats those of the objects it shares)."""
-    kinds = objects.objects.assign(type=objects.objects["type"].map(objects.column))
-    kinds = kinds[kinds["type"].isin(types)].set_index("id")["type"]
+    kinds = _typed(objects, types)
     o2o = objects.o2o[
         objects.o2o["source"].isin(kinds.index) & objects.o2o["target"].isin(kinds.index)
     ]

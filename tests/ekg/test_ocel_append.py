@@ -154,3 +154,16 @@ def test_refused_appends_leave_the_log_as_it_was(tmp_path, capsys, neo4j_driver,
     code, err = ingest(capsys, other, log_name, "--append")
     assert code != 0 and "The object type 'parcel' is not an entity type" in err
     assert graph(neo4j_driver, log_name) == stored
+    # An object the log holds as an order, now said to be an item.
+    retyped = pm4py.read_ocel2(str(following))
+    moved = retyped.objects["ocel:type"] == "order"
+    oid = retyped.objects.loc[moved, "ocel:oid"].iloc[0]
+    for table in (retyped.objects, retyped.relations):
+        table.loc[table["ocel:oid"] == oid, "ocel:type"] = "item"
+    stored_ids = {dict(row)["id"] for row in stored["entities"]}
+    assert oid in stored_ids
+    other = tmp_path / "retyped.jsonocel"
+    pm4py.write_ocel2_json(retyped, str(other))
+    code, err = ingest(capsys, other, log_name, "--append")
+    assert code != 0 and f"The object {oid!r} is of type 'item'" in err
+    assert graph(neo4j_driver, log_name) == stored
