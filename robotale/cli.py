@@ -554,7 +554,7 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
         "--append",
         action="store_true",
         default=None,
-        help="add new runs (cases) to a log that exists, with its entities and keys",
+        help="add new runs (cases), or an object-centric log's new events, to a log that exists",
     )
     ingest.add_argument(
         "--pages",

@@ -14,6 +14,7 @@ from robotale.ekg.connection import session_driver
 from robotale.ekg.disk_space import check_space
 from robotale.ekg.keys import default_entities
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
+from robotale.ekg.ocel_append import append_objects
 from robotale.errors import InputError
 from robotale.eventlog.logkinds import RECORDINGS
 from robotale.eventlog.logsource import log_name, open_log
@@ -68,13 +69,6 @@ def ingest_command(
     if opened.reading is not None:
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
         print(format_reading(opened.reading, short=True))
-    if append and found_objects is not None:
-        raise InputError(
-            f"{path} is object-centric, and --append adds only new runs (cases), whose "
-            "directly-follows chains start afresh, while an object-centric log is one run in "
-            "which each object's chain would have to continue from its stored events; "
-            "rebuild the log with --replace instead."
-        )
     name = log or log_name(path)
     chosen = split_names(entities) if entities else None
     if chosen is None and found_objects is not None:
@@ -87,7 +81,11 @@ def ingest_command(
         if append:
             # the log's columnar copy no longer matches its build: the next analysis reads
             # the whole log back from the graph and keeps that copy instead
-            summary = append_ekg(driver, events, name, aggregate=aggregate, **names)
+            summary = (
+                append_ekg(driver, events, name, aggregate=aggregate, **names)
+                if found_objects is None
+                else append_objects(driver, events, name, found_objects, aggregate=aggregate)
+            )
         else:
             summary = build_ekg(
                 driver,

@@ -70,27 +70,33 @@ def append_ekg(
     started = time.perf_counter()
     check_log_name(name)
     with log_write_lock(driver, name, "appending"):
-        info = log_info(driver, name)
-        if info["status"] != "complete":
-            raise InputError(
-                f"The log {name!r} is {info['status']}, not complete: runs can only be "
-                "appended to a complete log."
-            )
+        info = complete_log_info(driver, name)
         _check_columns(log, info["properties"] or [], name)
         types = _same_entities(log, entities, info["entityTypes"] or [], name)
-        keys = _same_keys(aggregate, info["classTypes"] or [], name)
+        keys = same_keys(aggregate, info["classTypes"] or [], name)
         tables = graph_tables(log, types, first=int(info["events"]))
         check_keys(tables.events, keys)
         check_key_sizes(tables, keys)
         stored = log_values(driver, name)
         _check_new_cases(tables.events, stored["case"], name)
-        _check_new_event_ids(driver, tables.events, name)
+        check_new_event_ids(driver, tables.events, name)
         classes = [class_tables(tables, key) for key in keys]
         summary: dict[str, Any] = {"events": int(info["events"]) + len(tables.events)}
-        summary |= _merged_values(stored, table_values(tables.events))
+        summary |= merged_values(stored, table_values(tables.events))
         _write_or_keep(driver, name, tables, classes, summary)
     result = summarise(name, tables, classes)
     return dataclasses.replace(result, seconds=time.perf_counter() - started)
+
+
+def complete_log_info(driver: Driver, name: str) -> dict[str, Any]:
+    """What the Log node of ``name`` records; refused unless the log is complete."""
+    info = log_info(driver, name)
+    if info["status"] != "complete":
+        raise InputError(
+            f"The log {name!r} is {info['status']}, not complete: only a complete log can be "
+            "appended to."
+        )
+    return info
 
 
 def _check_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> None:
@@ -123,7 +129,7 @@ def _same_entities(
     return stored
 
 
-def _same_keys(
+def same_keys(
     aggregate: Sequence[str | Sequence[str]] | None, stored: list[str], name: str
 ) -> list[list[str]]:
     keys = [kind.split("+") for kind in stored]
@@ -148,7 +154,7 @@ def _check_new_cases(events: pd.DataFrame, stored: Sequence[Any], name: str) -> 
         )
 
 
-def _check_new_event_ids(driver: Driver, events: pd.DataFrame, name: str) -> None:
+def check_new_event_ids(driver: Driver, events: pd.DataFrame, name: str) -> None:
     records, _, _ = driver.execute_query(
         cypher("ekg_find_event_ids"), ids=events["id"].tolist(), log=name, database_=database()
     )
@@ -159,7 +165,7 @@ def _check_new_event_ids(driver: Driver, events: pd.DataFrame, name: str) -> Non
         )
 
 
-def _merged_values(stored: dict[str, Any], new: dict[str, list[str]]) -> dict[str, list[str]]:
+def merged_values(stored: dict[str, Any], new: dict[str, list[str]]) -> dict[str, list[str]]:
     return {
         key: sorted({str(v) for v in stored[column] if v is not None} | set(new[key]))
         for key, column in SUMMARY_PROPERTIES.items()
@@ -173,15 +179,18 @@ def _write_or_keep(
     classes: list[ClassTables],
     summary: dict[str, Any],
 ) -> None:
-    """Write the append in one managed transaction; on any failure Neo4j rolls it back."""
+    write_transaction(driver, name, _append, name, tables, classes, summary)
+
+
+def write_transaction(driver: Driver, name: str, work: Callable[..., None], *args: Any) -> None:
+    """Run ``work(tx, *args, between_batches)`` as one managed transaction appending to the
+    log ``name``; on any failure Neo4j rolls it back, and Ctrl-C waits for the next batch."""
     try:
         with (
             DeferredInterrupt() as interrupt,
             driver.session(database=database()) as session,
         ):
-            session.execute_write(
-                _append, name, tables, classes, summary, _checked(interrupt.check)
-            )
+            session.execute_write(work, *args, _checked(interrupt.check))
     except _Interrupted:
         raise KeyboardInterrupt from None
     except (Neo4jError, DriverError, OSError) as error:

@@ -60,30 +60,34 @@ def _write_relations(loader: Loader, o2o: pd.DataFrame, kinds: pd.Series) -> Non
     relations = o2o[o2o["source"].isin(kinds.index) & o2o["target"].isin(kinds.index)]
     if relations.empty:
         return
+    loader.run("ekg_object_relations", relation_parameters(relations, kinds))
+
+
+def relation_parameters(relations: pd.DataFrame, kinds: pd.Series) -> dict[str, list]:
+    """The query columns of object-to-object relations between objects of ``kinds``."""
     qualifiers = relations["qualifier"].astype(object)
-    loader.run(
-        "ekg_object_relations",
-        {
-            "sources": relations["source"].astype(str).tolist(),
-            "sourceTypes": relations["source"].map(kinds).tolist(),
-            "targets": relations["target"].astype(str).tolist(),
-            "targetTypes": relations["target"].map(kinds).tolist(),
-            "qualifiers": qualifiers.where(qualifiers.notna(), None).tolist(),
-        },
-    )
+    return {
+        "sources": relations["source"].astype(str).tolist(),
+        "sourceTypes": relations["source"].map(kinds).tolist(),
+        "targets": relations["target"].astype(str).tolist(),
+        "targetTypes": relations["target"].map(kinds).tolist(),
+        "qualifiers": qualifiers.where(qualifiers.notna(), None).tolist(),
+    }
 
 
 def _write_changes(loader: Loader, changes: pd.DataFrame, kinds: pd.Series) -> None:
     found = changes[changes["object"].isin(kinds.index)].reset_index(drop=True)
     if found.empty:
         return
-    loader.run(
-        "ekg_object_changes",
-        {
-            "objects": found["object"].astype(str).tolist(),
-            "types": found["object"].map(kinds).tolist(),
-            "fields": found["field"].astype(str).tolist(),
-            "values": neo4j_values(found["value"].astype(object)),
-            "times": neo4j_values(pd.to_datetime(found["time"], utc=True)),
-        },
-    )
+    loader.run("ekg_object_changes", change_parameters(found, kinds))
+
+
+def change_parameters(found: pd.DataFrame, kinds: pd.Series) -> dict[str, list]:
+    """The query columns of attribute changes of objects of ``kinds``."""
+    return {
+        "objects": found["object"].astype(str).tolist(),
+        "types": found["object"].map(kinds).tolist(),
+        "fields": found["field"].astype(str).tolist(),
+        "values": neo4j_values(found["value"].astype(object)),
+        "times": neo4j_values(pd.to_datetime(found["time"], utc=True)),
+    }

@@ -188,14 +188,3 @@ def test_attribute_changes_are_nodes_of_their_entities(tmp_path, capsys, neo4j_d
         log=log_name,
     )
     assert left == [{"n": 0}]
-
-
-def test_append_of_an_object_centric_log_is_refused(tmp_path, capsys):
-    # Refused before any connection is made: no Neo4j needed, nothing written.
-    path = tmp_path / "changes.jsonocel"
-    path.write_text(json.dumps(CHANGES))
-    code = main(["ingest", str(path), "--log", "orders", "--append"])
-    _, err = capsys.readouterr()
-    assert code != 0
-    assert f"{path} is object-centric" in err
-    assert "--replace" in err
