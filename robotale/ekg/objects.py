@@ -12,6 +12,8 @@ has a CHANGED edge to.
 
 from __future__ import annotations
 
+from typing import Any
+
 import pandas as pd
 
 from robotale.ekg.load import Loader, neo4j_values
@@ -63,7 +65,7 @@ def _write_relations(loader: Loader, o2o: pd.DataFrame, kinds: pd.Series) -> Non
     loader.run("ekg_object_relations", relation_parameters(relations, kinds))
 
 
-def relation_parameters(relations: pd.DataFrame, kinds: pd.Series) -> dict[str, list]:
+def relation_parameters(relations: pd.DataFrame, kinds: pd.Series) -> dict[str, list[Any]]:
     """The query columns of object-to-object relations between objects of ``kinds``."""
     qualifiers = relations["qualifier"].astype(object)
     return {
@@ -82,7 +84,7 @@ def _write_changes(loader: Loader, changes: pd.DataFrame, kinds: pd.Series) -> N
     loader.run("ekg_object_changes", change_parameters(found, kinds))
 
 
-def change_parameters(found: pd.DataFrame, kinds: pd.Series) -> dict[str, list]:
+def change_parameters(found: pd.DataFrame, kinds: pd.Series) -> dict[str, list[Any]]:
     """The query columns of attribute changes of objects of ``kinds``."""
     return {
         "objects": found["object"].astype(str).tolist(),

@@ -158,7 +158,7 @@ def _without_stored(driver: Driver, name: str, objects: Objects, types: list[str
 
 
 def _drop_stored(
-    driver: Driver, name: str, query: str, table: pd.DataFrame, parameters: dict[str, list]
+    driver: Driver, name: str, query: str, table: pd.DataFrame, parameters: dict[str, list[Any]]
 ) -> pd.DataFrame:
     if table.empty:
         return table
