@@ -25,7 +25,7 @@ import numpy as np
 import pandas as pd
 import plotly.graph_objects as go
 
-from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP, activity_instances
+from robotale.discovery.instances import DURATION, FINISHED, START_TIMESTAMP
 from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.followed import what_followed
 from robotale.enhancement.performance import WAIT, finished_instances, shared_steps
@@ -59,7 +59,7 @@ def battery_perspective(
     analysis = analysis_of(log)
     log = analysis.log
     levels = shared_levels(analysis)
-    lows = _low_battery_events(log, levels, threshold, low_activity)
+    lows = _low_battery_events(analysis, levels, threshold, low_activity)
     if levels.empty and lows.empty:
         return no_data("battery", f"the log has {NO_LEVELS} and no low-battery events.")
     lows = _with_what_followed(lows, analysis, following)
@@ -95,16 +95,16 @@ def low_battery_events(
     low_activity: str | None = LOW_ACTIVITY,
 ) -> pd.DataFrame:
     """When each robot's battery fell below ``threshold``, and the events of ``low_activity``."""
-    return _low_battery_events(log, _levels(log), threshold, low_activity)
+    return _low_battery_events(analysis_of(log), _levels(log), threshold, low_activity)
 
 
 def _low_battery_events(
-    log: pd.DataFrame, levels: pd.DataFrame, threshold: float, low_activity: str | None
+    analysis: LogAnalysis, levels: pd.DataFrame, threshold: float, low_activity: str | None
 ) -> pd.DataFrame:
     found = [_threshold_crossings(levels, threshold)]
     if low_activity is not None:
-        tagged = log[log[ACTIVITY].astype("string").eq(low_activity).fillna(False)]
-        found.append(_low_rows(_tagged_moments(tagged), f"activity {low_activity}"))
+        moments = _tagged_moments(analysis, low_activity)
+        found.append(_low_rows(moments, f"activity {low_activity}"))
     found = [f for f in found if not f.empty]
     if not found:
         return pd.DataFrame(columns=[CASE, ROBOT, TIMESTAMP, BATTERY, "source"])
@@ -303,11 +303,18 @@ def _low_rows(events: pd.DataFrame, source: str) -> pd.DataFrame:
     return events[columns].assign(source=source)
 
 
-def _tagged_moments(events: pd.DataFrame) -> pd.DataFrame:
-    """One row per instance of a tagged activity, at its start with the level then: a tool may
-    write such a moment as a start/complete pair, an instant event or a lone completion."""
-    carry = [BATTERY] if BATTERY in events.columns else []
-    instances = activity_instances(events, carry=carry)
+def _tagged_moments(analysis: LogAnalysis, activity: str) -> pd.DataFrame:
+    """One row per instance of the tagged ``activity``, at its start with the level then: a
+    tool may write such a moment as a start/complete pair, an instant event or a lone
+    completion."""
+    # the log's instances, shared with the consumption table, rather than the tagged rows'
+    # own: instances pair within one activity and keep the log's order, so they are the same
+    carry = [BATTERY] if BATTERY in analysis.log.columns else []
+    instances = analysis.instances(carry=carry)
+    if ACTIVITY in instances.columns:
+        instances = instances[instances[ACTIVITY].astype("string").eq(activity).fillna(False)]
+    else:
+        instances = instances.iloc[0:0]
     moments = instances.assign(**{TIMESTAMP: instances[START_TIMESTAMP]})
     if f"start_{BATTERY}" in moments.columns:  # absent when no instance was found
         moments[BATTERY] = moments[f"start_{BATTERY}"].fillna(moments[BATTERY])
