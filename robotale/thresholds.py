@@ -14,3 +14,7 @@ LOW_BATTERY_PERCENT = 20.0
 #: unless told another per message type: a message on a robot network arrives within
 #: milliseconds, or its sender retries within seconds
 MESSAGE_TIMEOUT = 5.0
+
+#: the share of an activity's earlier durations past which an instance counts as slow: the
+#: Mission page's "slow activity" moments and ``robotale monitor``'s overdue-activity alert
+SLOW_QUANTILE = 0.95

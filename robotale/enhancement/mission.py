@@ -34,14 +34,10 @@ from robotale.eventlog.schema import (
     Y,
     Z,
 )
+from robotale.thresholds import LOW_BATTERY_PERCENT, SLOW_QUANTILE
 
 #: columns that are numbers but no signal to plot: positions in a recording, ids
 NOT_SIGNALS = frozenset({"source_index", "event_id", "execution_id", "index"})
-#: a battery below this share (percent) is a low-battery moment, as the simulator warns
-LOW_BATTERY = 20.0
-#: an activity instance longer than this quantile of its activity's instances by the same
-#: robot in the whole log is a slow one
-SLOW_QUANTILE = 0.95
 #: seconds a slow instance takes at least beyond its kind's median
 SLOW_MARGIN = 1.0
 #: a move shorter than this (metres) gives no heading: a standing robot's noise
@@ -309,8 +305,9 @@ def _moments(
     start: pd.Timestamp,
 ) -> pd.DataFrame:
     """The run's moments worth a look: a lost or delayed message (where it was sent), a
-    robot's battery first falling below :data:`LOW_BATTERY` percent, an activity instance
-    slower than :data:`SLOW_QUANTILE` of its kind in the whole log (where it started)."""
+    robot's battery first falling below :data:`~robotale.thresholds.LOW_BATTERY_PERCENT`
+    percent, an activity instance slower than :data:`~robotale.thresholds.SLOW_QUANTILE` of
+    its kind in the whole log (where it started)."""
     rows: list[dict[str, Any]] = []
     for row in messages.itertuples(index=False):
         if row.lost or row.delayed:
@@ -321,9 +318,9 @@ def _moments(
             )
     if BATTERY in events.columns:
         levels = pd.to_numeric(events[BATTERY], errors="coerce")
-        low = events[levels < LOW_BATTERY]
+        low = events[levels < LOW_BATTERY_PERCENT]
         for robot, first in low.groupby(ROBOT, sort=True)["s"].min().items():
-            text = f"{robot}'s battery below {LOW_BATTERY:g}%"
+            text = f"{robot}'s battery below {LOW_BATTERY_PERCENT:g}%"
             rows.append({"s": first, "kind": "low battery", "robot": robot, "text": text})
     rows += _slow(slow, instances)
     table = pd.DataFrame(rows, columns=["s", "kind", "robot", "text"])

@@ -17,10 +17,7 @@ import pandas as pd
 from robotale.discovery.instances import activity_instances
 from robotale.errors import InputError
 from robotale.eventlog.schema import ACTIVITY
-from robotale.thresholds import MESSAGE_TIMEOUT
-
-#: the percentile of earlier durations past which an activity runs too long
-DURATION_PERCENTILE = 95
+from robotale.thresholds import MESSAGE_TIMEOUT, SLOW_QUANTILE
 
 
 @dataclass(frozen=True)
@@ -91,14 +88,14 @@ def _seconds(text: str, spec: str) -> float:
 
 
 def duration_limits(logs: Iterable[pd.DataFrame]) -> dict[str, float]:
-    """``{activity: seconds}``: the :data:`DURATION_PERCENTILE` th percentile of the
+    """``{activity: seconds}``: the :data:`~robotale.thresholds.SLOW_QUANTILE` quantile of the
     durations of each activity's finished instances in ``logs`` (earlier runs); activities
     that only happen in an instant (durations all 0) have none."""
     durations = [_finished(log) for log in logs]
     found = pd.concat(durations, ignore_index=True) if durations else pd.DataFrame()
     if found.empty:
         return {}
-    limits = found.groupby(ACTIVITY)["duration"].quantile(DURATION_PERCENTILE / 100)
+    limits = found.groupby(ACTIVITY)["duration"].quantile(SLOW_QUANTILE)
     return {str(a): float(s) for a, s in limits.items() if s > 0}
 
 

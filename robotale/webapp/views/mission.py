@@ -61,13 +61,14 @@ def state_at(log: str, case: str):
     """Every robot at ``?t=`` seconds since the run's start; with a model, the elements
     each robot is in and the flows taken so far."""
     t = _seconds("t", request.args.get("t"))
-    run = _run(log, case)
+    replay = unstored(log)
+    run = replay.run(case) if replay is not None else _stored(log, case)
     found: dict[str, Any] = run.state(t)
     elements = _elements(log, case, run.robots)
     if elements is not None:
         found["elements"] = elements.active(run, t)
         found["waiting"] = elements.waiting(run, t)
-        found["deviations"] = elements.deviated(_deviations(log, case, run), t)
+        found["deviations"] = elements.deviated(_deviations(log, run, kept=replay is None), t)
         found["flows"] = elements.flows_taken(run, t)
     return jsonify(found)
 
@@ -95,6 +96,10 @@ def _run(log: str, case: str) -> MissionRun:
     replay = unstored(log)
     if replay is not None:
         return replay.run(case)
+    return _stored(log, case)
+
+
+def _stored(log: str, case: str) -> MissionRun:
     return stored_mission(driver(), state().logs, log, case)
 
 
@@ -124,15 +129,17 @@ def _model(log: str) -> StoredModel | None:
     return models.get(asked) if asked else models.linked(log)
 
 
-def _deviations(log: str, case: str, run: MissionRun) -> list[dict[str, Any]]:
+def _deviations(log: str, run: MissionRun, *, kept: bool) -> list[dict[str, Any]]:
+    """The run's deviations from the log's model, kept for a stored log (a live run grows, a
+    replay is in memory only)."""
     model = _model(log)
     if model is None:
         return []
     known = [robot for robot in run.robots if robot != NO_ROBOT]
-    if is_live(log):  # a live run grows: its replay is not kept
+    if not kept:
         return deviations(model.path, run, known)
     return state().logs.missions.get(
-        (log, "deviations", model.id, case), lambda: deviations(model.path, run, known)
+        (log, "deviations", model.id, run.case), lambda: deviations(model.path, run, known)
     )
 
 
