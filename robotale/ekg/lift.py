@@ -48,6 +48,8 @@ class LogEdges:
             cypher("aggr_read_memberships"), log=log, database_=database()
         )
         held = members[0]
+        element_ids = dict(zip(held["ids"], held["aggregates"], strict=True))
+        holders = [element_ids[aggregate] for aggregate in held["held"]]
         ends = np.asarray(row["sources"] + row["targets"] + held["nodes"], dtype=object)
         codes, ids = pd.factorize(ends)
         count = len(row["sources"])
@@ -60,7 +62,7 @@ class LogEdges:
             holder=np.full(len(ids), FREE, dtype=np.int64),
         )
         if held["nodes"]:
-            edges.hold(codes[2 * count :], held["aggregates"])
+            edges.hold(codes[2 * count :], holders)
         return edges
 
     def hold(self, nodes: np.ndarray, aggregates: Sequence[str]) -> np.ndarray:

@@ -3,11 +3,11 @@
 Each step (:mod:`robotale.ekg.spec`) collapses the events, or the entities of one type, that
 no earlier step collapsed and that pass its ``where`` into ``Aggregate`` nodes, one per
 group: the nodes are read with their properties, grouped in pandas
-(:mod:`robotale.ekg.groups`) and the aggregates written in batches with an ``AGGREGATED_IN``
-edge from each node they replace. Then the CORR, DF and COMM edges of those nodes are lifted
-to the aggregates, counted: computed in memory from one reading of the log's edges per run
-(:mod:`robotale.ekg.lift`) and written in batches. The graph after steps 1 .. k
-is level k: its aggregates and the lifted edges between them.
+(:mod:`robotale.ekg.groups`) and the aggregates written in batches; each node they replace
+records its aggregate's id in its property ``_aggregate``. Then the CORR, DF and COMM edges
+of those nodes are lifted to the aggregates, counted: computed in memory from one reading of
+the log's edges per run (:mod:`robotale.ekg.lift`) and written in batches. The graph after
+steps 1 .. k is level k: its aggregates and the lifted edges between them.
 
 A step is kept or undone as a unit: if writing it fails, what it wrote is removed again, and
 ``undo`` removes a step and the ones stacked on it. Steps are numbered per log, so a second
@@ -287,7 +287,8 @@ def _write(
         sizes = table["count"].astype(int).tolist()
         owners = [node for node, size in zip(created, sizes, strict=True) for _ in range(size)]
         members = [str(m) for group in table["members"] for m in group]
-        loader.run("aggr_create_members", {"members": members, "aggregates": owners})
+        holders = [i for i, size in zip(table["id"], sizes, strict=True) for _ in range(size)]
+        loader.run("aggr_create_members", {"members": members, "aggregates": holders})
         lifted = edges.lift(members, owners)
         if len(lifted):
             # every lifted edge reaches one of this step's few aggregates: one batch at a time

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pandas as pd
 import pm4py
 import pytest
-from object_logs import order_log, plain
+from object_logs import logistics_csv, order_log, plain
 
 from robotale.cli import main
 from robotale.ekg.logs import delete_log, log_summary
@@ -134,6 +135,34 @@ def test_appending_the_earlier_half_to_the_later_one(
     assert sorted(
         (tuple(c for c in row if c[0] != "order") for row in appended["events"]), key=repr
     ) == sorted(without_order, key=repr)
+
+
+def test_appending_an_oced_csv_with_object_tables(
+    tmp_path, capsys, neo4j_driver, log_name, other_name
+):
+    # The OCED-style logistics CSV split by time; each part ingested with the object tables
+    # of the whole log, the second appended: the graph of one ingest of the whole file.
+    whole, objects = logistics_csv(tmp_path)
+    events = pd.read_csv(whole)
+    middle = len(events) // 2
+    first, following = tmp_path / "first.csv", tmp_path / "next.csv"
+    events.iloc[:middle].to_csv(first, index=False)
+    events.iloc[middle:].to_csv(following, index=False)
+    tables = ("--objects", str(objects))
+    assert ingest(capsys, whole, other_name, *tables) == (0, "")
+    assert ingest(capsys, first, log_name, *tables) == (0, "")
+    before = graph(neo4j_driver, log_name)
+    assert ingest(capsys, following, log_name, *tables, "--append") == (0, "")
+    appended, expected = graph(neo4j_driver, log_name), graph(neo4j_driver, other_name)
+    for part in expected:
+        assert appended[part] == expected[part], part
+    # Not vacuous: the forklifts' and trucks' chains cross the split, and the entities
+    # carry the tables' attributes.
+    first_ids = {dict(row)["id"] for row in before["events"]}
+    assert any(
+        row["a"] in first_ids and row["b"] not in first_ids for row in map(dict, expected["df"])
+    )
+    assert any(dict(dict(row)["node"]).get("axles") for row in expected["entities"])
 
 
 def test_refused_appends_leave_the_log_as_it_was(tmp_path, capsys, neo4j_driver, log_name):
