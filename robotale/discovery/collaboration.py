@@ -366,38 +366,15 @@ def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
         traces = [list(variant) for variant in dict.fromkeys(tuple(t) for t in traces)]
     if not any(traces):
         return Tau()
-    tree = _inductive_tree(traces, noise)
-    block = from_process_tree(tree)
+    # pm4py: 2 s to import and a banner: discovery only
+    from robotale.discovery.inductive import inductive_tree
+
+    block = from_process_tree(inductive_tree(traces, noise))
     if any(not trace for trace in traces):
         from robotale.discovery.layout import Operator  # the one place a run may be empty
 
         block = Operator("xor", [block, Tau()])
     return block
-
-
-def _inductive_tree(traces: list[list[str]], noise: float) -> object:
-    """pm4py's inductive miner (IMf with a noise threshold) on the traces' variants, given to
-    it as the variant counter it builds from a DataFrame, without building one: the cases in
-    the order pm4py sorts their ids (as text), so the tree is the one its DataFrame route
-    gives."""
-    # pm4py: 2 s to import and a banner: discovery only
-    from pm4py.algo.discovery.inductive.dtypes.im_ds import IMDataStructureUVCL
-    from pm4py.algo.discovery.inductive.variants.im import IMUVCL
-    from pm4py.algo.discovery.inductive.variants.imf import IMFUVCL
-    from pm4py.objects.process_tree.utils.generic import fold, tree_sort
-    from pm4py.util import constants
-
-    order = sorted((number for number, trace in enumerate(traces) if trace), key=str)
-    variants = Counter(tuple(traces[number]) for number in order)
-    parameters = {
-        "noise_threshold": noise,
-        "multiprocessing": constants.ENABLE_MULTIPROCESSING_DEFAULT,
-        "disable_fallthroughs": False,
-    }
-    miner = IMFUVCL(parameters) if noise > 0 else IMUVCL(parameters)
-    tree = fold(miner.apply(IMDataStructureUVCL(variants), parameters))
-    tree_sort(tree)
-    return tree
 
 
 def discover_collaboration(
