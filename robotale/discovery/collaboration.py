@@ -163,31 +163,39 @@ def typed_instances(log: pd.DataFrame) -> pd.DataFrame:
     if instances.empty:
         raise InputError("the selected events contain no activity of a robot.")
     robots = instances[ROBOT].astype(str)
-    # a name's type once per robot, not once per instance
-    named = robots.map({robot: robot_type(robot) for robot in robots.unique()})
-    if ROBOT_TYPE in instances.columns:
-        types = instances[ROBOT_TYPE].astype("string").fillna(named)
-    else:
-        types = named
-    instances = instances.assign(**{ROBOT: robots, ROBOT_TYPE: types.astype(str)})
+    instances = instances.assign(**{ROBOT: robots, ROBOT_TYPE: _types(instances, robots)})
     instances["_role"] = _roles(instances)
     instances["_aborted"] = interrupted(instances).to_numpy()
     ordered = instances.sort_values([CASE, ROBOT], kind="stable").reset_index(drop=True)
     return ordered
 
 
+def _types(instances: pd.DataFrame, robots: pd.Series) -> pd.Series:
+    """Each instance's robot type: the log's, else named from the robot (a name's type worked
+    out once per robot, and only when some instance lacks one)."""
+    given = instances[ROBOT_TYPE].astype("string") if ROBOT_TYPE in instances.columns else None
+    if given is not None and not given.isna().any():
+        return given.astype(str)
+    codes, names = pd.factorize(robots)
+    typed = np.array([robot_type(name) for name in names], dtype=object)
+    named = pd.Series(typed[codes], index=robots.index)
+    return (named if given is None else given.fillna(named)).astype(str)
+
+
 def _roles(instances: pd.DataFrame) -> pd.Series:
     """Each instance's message role as most instances of its activity have it: a log may
     mark a step next to a message with the message's role (the thesis' log marks one of
-    ``select_closest_tractor``'s two starts as sending ``closest_tractor``)."""
-    roles = message_roles(instances).fillna("")
-    labels = instances[ACTIVITY].astype(str)
-    majority = (
-        pd.DataFrame({"label": labels, "role": roles})
-        .groupby("label")["role"]
-        .agg(lambda values: values.mode().iloc[0])
-    )
-    return labels.map(majority).replace("", None)
+    ``select_closest_tractor``'s two starts as sending ``closest_tractor``). A tie goes to
+    the role first in name order (no role first of all), as pandas' ``mode`` has it; counted
+    from integer codes, not a group-by per activity."""
+    roles = message_roles(instances).fillna("").to_numpy(object)
+    label_codes, labels = pd.factorize(instances[ACTIVITY].astype(str).to_numpy(object))
+    role_codes, names = pd.factorize(roles, sort=True)
+    counts = np.bincount(
+        label_codes * len(names) + role_codes, minlength=len(labels) * len(names)
+    ).reshape(len(labels), len(names))
+    majority = np.asarray(names, dtype=object)[counts.argmax(axis=1)]
+    return pd.Series(majority[label_codes], index=instances.index, dtype=str).replace("", None)
 
 
 def triggers(instances: pd.DataFrame, traces: Traces, *, records_aborts: bool) -> set[str]:
@@ -225,35 +233,46 @@ def _recorded_triggers(instances: pd.DataFrame, aborted: pd.DataFrame) -> set[st
 @dataclass(slots=True)
 class Traces:
     """A type's traces (case and robot) as plain lists, built once for the trigger search
-    and the split: labels, message roles, start times and whether each instance ended
-    interrupted, position by position."""
+    and the split: labels, message roles and whether each instance ended interrupted,
+    position by position; the start and end times of all instances in one array each, trace
+    ``i`` at ``offsets[i]:offsets[i + 1]`` (only the split reads them, where a trigger is)."""
 
     labels: list[list[str]]
     roles: list[list[str | None]]
-    starts: list[np.ndarray]
-    ends: list[np.ndarray]
     aborted: list[list[bool]]
+    starts: np.ndarray
+    ends: np.ndarray
+    offsets: list[int]
+
+    def times(self, number: int) -> tuple[np.ndarray, np.ndarray]:
+        """Trace ``number``'s start and end times."""
+        part = slice(self.offsets[number], self.offsets[number + 1])
+        return self.starts[part], self.ends[part]
 
 
 def per_trace(instances: pd.DataFrame) -> Traces:
-    """The instances (in trace order) cut into traces in one pass over integer codes."""
+    """The instances (in trace order) cut into traces in one pass over integer codes, each
+    column turned into one list and sliced (not an array per trace)."""
     if instances.empty:
-        return Traces([], [], [], [], [])
+        return Traces([], [], [], np.array([]), np.array([]), [0])
     cases = pd.factorize(instances[CASE].astype(str))[0]
     robots = pd.factorize(instances[ROBOT])[0]
     bounds = np.flatnonzero((cases[1:] != cases[:-1]) | (robots[1:] != robots[:-1])) + 1
+    offsets = [0, *bounds.tolist(), len(instances)]
 
     def cut(values: np.ndarray) -> list[list]:
-        return [part.tolist() for part in np.split(values, bounds)]
+        whole = values.tolist()
+        return [whole[begin:end] for begin, end in itertools.pairwise(offsets)]
 
     # an instance that never ended runs on past everything after it
     until = instances[TIMESTAMP].where(instances[FINISHED].astype(bool))
     return Traces(
         labels=cut(instances[ACTIVITY].astype(str).to_numpy(object)),
         roles=cut(instances["_role"].to_numpy(object)),
-        starts=list(np.split(_times(instances[START_TIMESTAMP]), bounds)),
-        ends=list(np.split(_times(until), bounds)),
         aborted=cut(instances["_aborted"].to_numpy(bool)),
+        starts=_times(instances[START_TIMESTAMP]),
+        ends=_times(until),
+        offsets=offsets,
     )
 
 
@@ -266,22 +285,33 @@ def _times(times: pd.Series) -> np.ndarray:
 
 
 def _behaving_triggers(traces: Traces) -> set[str]:
-    follows: Counter[tuple[str, str]] = Counter()
-    occurs: Counter[str] = Counter()
-    candidates: dict[str, bool] = {}
-    for labels, roles in zip(traces.labels, traces.roles, strict=True):
-        counts = Counter(labels)
-        occurs.update(labels)
-        follows.update(itertools.pairwise(labels))
-        for position, (label, role) in enumerate(zip(labels, roles, strict=True)):
-            ok = counts[label] == 1 and position > 0 and role != SEND
-            candidates[label] = candidates.get(label, True) and ok
-    found = set()
-    for labels in traces.labels:
-        for before, label in itertools.pairwise(labels):
-            if candidates.get(label) and follows[(before, label)] * 2 < occurs[before]:
-                found.add(label)
-    return found
+    """The triggers of a log that records no interruption (see :func:`triggers`), counted
+    over integer codes of all traces at once."""
+    if not traces.labels:
+        return set()
+    codes, names = pd.factorize(
+        np.fromiter(itertools.chain.from_iterable(traces.labels), dtype=object)
+    )
+    kinds = len(names)
+    lengths = np.diff(traces.offsets)
+    trace = np.repeat(np.arange(len(lengths)), lengths)
+    position = np.arange(len(codes)) - np.asarray(traces.offsets)[trace]
+    sent = np.fromiter(
+        (role == SEND for role in itertools.chain.from_iterable(traces.roles)), dtype=bool
+    )
+    # a candidate comes at most once in each trace, never first, and is not sent
+    _, inverse, times = np.unique(trace * kinds + codes, return_inverse=True, return_counts=True)
+    ruled_out = (times[inverse] != 1) | (position == 0) | sent
+    candidate = np.bincount(codes[ruled_out], minlength=kinds) == 0
+    # it cuts in: some activity just before it is followed by it in less than half of its
+    # occurrences
+    occurs = np.bincount(codes, minlength=kinds)
+    within = trace[1:] == trace[:-1]
+    follows = np.bincount(
+        codes[:-1][within] * kinds + codes[1:][within], minlength=kinds * kinds
+    ).reshape(kinds, kinds)
+    cuts_in = ((follows > 0) & (follows * 2 < occurs[:, None])).any(axis=0)
+    return {str(names[code]) for code in np.flatnonzero(candidate & cuts_in)}
 
 
 @dataclass(slots=True)
@@ -303,11 +333,11 @@ def split_traces(traces: Traces, found: set[str]) -> _Split:
     own instance, where the engine tags one, is recorded apart (:func:`_own_instance`)."""
     result = _Split()
     firsts = {trace[0] for trace in traces.labels}
-    columns = zip(traces.labels, traces.starts, traces.ends, traces.aborted, strict=True)
-    for labels, starts, ends, aborted in columns:
+    for number, (labels, aborted) in enumerate(zip(traces.labels, traces.aborted, strict=True)):
         if not found.intersection(labels):  # most traces: nothing to cut
-            result.main.append(list(labels))
+            result.main.append(labels)
             continue
+        starts, ends = traces.times(number)
         main: list[str] = []
         position = 0
         while position < len(labels):
@@ -366,38 +396,15 @@ def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
         traces = [list(variant) for variant in dict.fromkeys(tuple(t) for t in traces)]
     if not any(traces):
         return Tau()
-    tree = _inductive_tree(traces, noise)
-    block = from_process_tree(tree)
+    # pm4py: 2 s to import and a banner: discovery only
+    from robotale.discovery.inductive import inductive_tree
+
+    block = from_process_tree(inductive_tree(traces, noise))
     if any(not trace for trace in traces):
         from robotale.discovery.layout import Operator  # the one place a run may be empty
 
         block = Operator("xor", [block, Tau()])
     return block
-
-
-def _inductive_tree(traces: list[list[str]], noise: float) -> object:
-    """pm4py's inductive miner (IMf with a noise threshold) on the traces' variants, given to
-    it as the variant counter it builds from a DataFrame, without building one: the cases in
-    the order pm4py sorts their ids (as text), so the tree is the one its DataFrame route
-    gives."""
-    # pm4py: 2 s to import and a banner: discovery only
-    from pm4py.algo.discovery.inductive.dtypes.im_ds import IMDataStructureUVCL
-    from pm4py.algo.discovery.inductive.variants.im import IMUVCL
-    from pm4py.algo.discovery.inductive.variants.imf import IMFUVCL
-    from pm4py.objects.process_tree.utils.generic import fold, tree_sort
-    from pm4py.util import constants
-
-    order = sorted((number for number, trace in enumerate(traces) if trace), key=str)
-    variants = Counter(tuple(traces[number]) for number in order)
-    parameters = {
-        "noise_threshold": noise,
-        "multiprocessing": constants.ENABLE_MULTIPROCESSING_DEFAULT,
-        "disable_fallthroughs": False,
-    }
-    miner = IMFUVCL(parameters) if noise > 0 else IMUVCL(parameters)
-    tree = fold(miner.apply(IMDataStructureUVCL(variants), parameters))
-    tree_sort(tree)
-    return tree
 
 
 def discover_collaboration(
