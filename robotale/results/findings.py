@@ -135,9 +135,9 @@ def prepare(
 ) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
     perspectives of the whole log, the class graph beside them, the runs and the first run's
-    timeline, what counts as a slow activity on the Mission page, the steps named in
-    ``first`` before the others (those of a page waiting for them); ``progress`` hears of
-    each step as it is done."""
+    timeline, what counts as a slow activity on the Mission page and its first run, the steps
+    named in ``first`` before the others (those of a page waiting for them); ``progress``
+    hears of each step as it is done."""
     steps: list[tuple[str, Callable[[], object]]] = [
         ("findings", lambda: stored_findings(driver, logs, name)),
         ("class graph", lambda: perspectives_graph(driver, logs, name)),
