@@ -65,6 +65,33 @@ class MissionRun:
     #: moments worth a look: s, kind, robot, text
     moments: pd.DataFrame
 
+    #: the tables of a run, by name (what :meth:`parts` and :meth:`from_parts` carry)
+    TABLES = ("events", "instances", "messages", "positions", "moments")
+
+    def parts(self) -> tuple[dict[str, Any], dict[str, pd.DataFrame]]:
+        """The run as plain values (JSON) and tables, to be kept and read back whole by
+        :meth:`from_parts`."""
+        values = {
+            "case": self.case,
+            "start": self.start.isoformat(),
+            "duration": self.duration,
+            "robots": self.robots,
+            "signals": self.signals,
+        }
+        return values, {name: getattr(self, name) for name in self.TABLES}
+
+    @classmethod
+    def from_parts(cls, values: dict[str, Any], tables: dict[str, pd.DataFrame]) -> MissionRun:
+        """The run :meth:`parts` gave ``values`` and ``tables`` of."""
+        return cls(
+            case=str(values["case"]),
+            start=pd.Timestamp(values["start"]),
+            duration=float(values["duration"]),
+            robots=[str(robot) for robot in values["robots"]],
+            signals=[str(signal) for signal in values["signals"]],
+            **{name: tables[name] for name in cls.TABLES},
+        )
+
     # -- one moment ------------------------------------------------------------------------
 
     def state(self, t: float) -> dict[str, Any]:

@@ -10,16 +10,15 @@ from collections.abc import Callable, Sequence
 from functools import partial
 from typing import Any
 
-import pandas as pd
 from neo4j import Driver
 from neo4j.exceptions import DriverError, Neo4jError
 
 from robotale.enhancement.findings import find, trusted_first
-from robotale.enhancement.mission import SLOW_COLUMNS, slow_limits
 from robotale.enhancement.registry import page_names, perspective_kind
 from robotale.enhancement.timeline import case_timeline, run_list
 from robotale.errors import InputError, RobotaleError
 from robotale.results.logdata import LogData, first_key, log_info
+from robotale.results.mission import stored_mission, stored_slow_limits
 
 
 def parse_delay(text: str | None) -> float | None:
@@ -93,28 +92,21 @@ def stored_runs(driver: Driver, logs: LogData, name: str) -> bytes:
 
 
 def stored_timeline(driver: Driver, logs: LogData, name: str, case: str) -> bytes:
-    """The timeline of the run ``case`` (the first run when empty)."""
-
-    def compute() -> dict[str, Any]:
-        frame = logs.frame(driver, name)
-        if case:
-            return case_timeline(frame, case).to_dict()
-        runs = run_list(frame)
-        return case_timeline(frame, str(runs["case"].iloc[0]) if not runs.empty else "").to_dict()
-
-    return logs.result(driver, name, ("timeline", case), compute)
-
-
-def stored_slow_limits(driver: Driver, logs: LogData, name: str) -> pd.DataFrame:
-    """What counts as a slow activity in the whole log (:func:`slow_limits`), the same for
-    each of its runs the Mission page replays: kept once per build, not computed per run."""
-    data = logs.result(
+    """The timeline of the run ``case`` (the first run when empty): kept once per run, so
+    the Timeline page's first run and the Mission page's named run share it."""
+    case = case or _first_run(driver, logs, name)
+    return logs.result(
         driver,
         name,
-        ("slow-limits",),
-        lambda: {"limits": slow_limits(logs.frame(driver, name)).to_dict(orient="records")},
+        ("timeline", case),
+        lambda: case_timeline(logs.frame(driver, name), case).to_dict(),
     )
-    return pd.DataFrame(json.loads(data)["limits"], columns=SLOW_COLUMNS)
+
+
+def _first_run(driver: Driver, logs: LogData, name: str) -> str:
+    """The log's first run (the kept run list's), "" when it has none."""
+    runs = json.loads(stored_runs(driver, logs, name))["runs"]
+    return str(runs[0]["case"]) if runs else ""
 
 
 def perspectives_graph(driver: Driver, logs: LogData, name: str) -> dict[str, Any]:
@@ -143,9 +135,9 @@ def prepare(
 ) -> None:
     """Compute what the pages show first of ``name`` (after it was stored): the findings, the
     perspectives of the whole log, the class graph beside them, the runs and the first run's
-    timeline, what counts as a slow activity on the Mission page, the steps named in
-    ``first`` before the others (those of a page waiting for them); ``progress`` hears of
-    each step as it is done."""
+    timeline, what counts as a slow activity on the Mission page and its first run, the steps
+    named in ``first`` before the others (those of a page waiting for them); ``progress``
+    hears of each step as it is done."""
     steps: list[tuple[str, Callable[[], object]]] = [
         ("findings", lambda: stored_findings(driver, logs, name)),
         ("class graph", lambda: perspectives_graph(driver, logs, name)),
@@ -157,6 +149,7 @@ def prepare(
         ("runs", lambda: stored_runs(driver, logs, name)),
         ("timeline", lambda: stored_timeline(driver, logs, name, "")),
         ("slow limits", lambda: stored_slow_limits(driver, logs, name)),
+        ("mission", lambda: stored_mission(driver, logs, name, _first_run(driver, logs, name))),
     ]
     steps.sort(key=lambda named: named[0] not in first)  # stable: the others keep their order
     for done, (what, step) in enumerate(steps, start=1):

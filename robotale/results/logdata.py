@@ -12,6 +12,7 @@ log wait for one read or one computation instead of doing it twice.
 from __future__ import annotations
 
 import hashlib
+import io
 import json
 import re
 import threading
@@ -21,6 +22,8 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
+import pyarrow as pa
+import pyarrow.parquet as pq
 from neo4j import Driver
 
 from robotale.discovery.ekg import discover_ekg
@@ -30,7 +33,7 @@ from robotale.ekg.columnar import Build, log_build, results_folder, stored_table
 from robotale.ekg.keys import DISCOVERY_KEY, built_keys
 from robotale.ekg.logs import log_info as stored_log_info
 from robotale.errors import InputError
-from robotale.files import write_file
+from robotale.files import write_file, write_files
 
 #: how many logs (and class graphs) stay in memory
 KEEP = 4
@@ -99,7 +102,9 @@ class LogData:
         #: (log, kind): what the tests count
         self.computed: Counter[tuple[str, str]] = Counter()
         self._lock = threading.Lock()
-        self._computing: dict[str, threading.Lock] = {}
+        #: one lock per log and turn; re-entrant: a computation may need another result of
+        #: its log first (a Mission run, the log's slow limits)
+        self._computing: dict[tuple[str, str], threading.RLock] = {}
 
     def frame(self, driver: Driver, name: str) -> pd.DataFrame:
         """The stored log ``name`` as a canonical event log."""
@@ -107,17 +112,22 @@ class LogData:
         return self.frames.get((name, build.key), lambda: stored_table(driver, name, MISSING_HINT))
 
     def result(
-        self, driver: Driver, name: str, what: Sequence[str], compute: Callable[[], Any]
+        self,
+        driver: Driver,
+        name: str,
+        what: Sequence[str],
+        compute: Callable[[], Any],
+        turn: str = "",
     ) -> bytes:
         """The JSON of ``compute()`` for the current build of ``name``: read from the build's
-        folder when it was computed before, else computed (one computation per log at a time,
-        so the section a page asks for first is ready first) and kept."""
+        folder when it was computed before, else computed (one computation per log and
+        ``turn`` at a time, so the section a page asks for first is ready first) and kept."""
         build = current_build(driver, name)
         if not build.complete:  # being written or failed: nothing to keep it for
             return result_json(compute())
         path = results_folder(build) / _file_name(what)
         with self._lock:
-            computing = self._computing.setdefault(name, threading.Lock())
+            computing = self._computing.setdefault((name, turn), threading.RLock())
         data = _read(path)
         if data is not None:
             return data
@@ -128,6 +138,44 @@ class LogData:
                 write_file(path, data)
                 self.computed[(name, what[0])] += 1
         return data
+
+    def tables(
+        self,
+        driver: Driver,
+        name: str,
+        what: Sequence[str],
+        compute: Callable[[], tuple[dict[str, Any], dict[str, pd.DataFrame]]],
+    ) -> tuple[dict[str, Any], dict[str, pd.DataFrame]]:
+        """Plain values and tables of the current build of ``name``, ``compute()`` once per
+        build and kept in its folder (the values as JSON, each table in Parquet), so a later
+        request, or a restarted dashboard, reads them instead. What is returned is always
+        what was read back, so the first answer is the same as every later one; tables
+        Parquet cannot hold are computed each time."""
+        build = current_build(driver, name)
+        if not build.complete:  # being written or failed: nothing to keep it for
+            return compute()
+        folder = results_folder(build)
+        values_path = folder / _file_name(what)
+        with self._lock:
+            computing = self._computing.setdefault((name, ""), threading.RLock())
+        found = _read_tables(folder, what, values_path)
+        if found is not None:
+            return found
+        with computing:
+            found = _read_tables(folder, what, values_path)
+            if found is not None:
+                return found
+            values, tables = compute()
+            try:
+                files = [(folder / _table_name(what, t), _parquet(tables[t])) for t in tables]
+            except (pa.ArrowException, ValueError, TypeError):  # a column of mixed kinds
+                return values, tables
+            # the values last: they name the tables, so a reader finds all or none
+            files.append((values_path, result_json({"values": values, "tables": list(tables)})))
+            write_files(files)
+            self.computed[(name, what[0])] += 1
+            found = _read_tables(folder, what, values_path)
+        return found if found is not None else (values, tables)
 
     def class_graph(
         self,
@@ -151,6 +199,8 @@ class LogData:
                 name,
                 what,
                 lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
+                # mostly Neo4j's work: in its own turn, beside the sections computed here
+                turn="class-graph",
             )
             graph: dict[str, Any] = json.loads(data)
             return graph
@@ -171,6 +221,35 @@ def _file_name(what: Sequence[str]) -> str:
     words = re.sub(r"[^\w.-]+", "_", "-".join(what))[:60]
     digest = hashlib.sha256("\x00".join(what).encode("utf-8")).hexdigest()[:16]
     return f"{words}-{digest}.json"
+
+
+def _table_name(what: Sequence[str], table: str) -> str:
+    return _file_name((*what, table)).removesuffix(".json") + ".parquet"
+
+
+def _parquet(table: pd.DataFrame) -> bytes:
+    sink = io.BytesIO()
+    pq.write_table(pa.Table.from_pandas(table), sink)
+    return sink.getvalue()
+
+
+def _read_tables(
+    folder: Path, what: Sequence[str], values_path: Path
+) -> tuple[dict[str, Any], dict[str, pd.DataFrame]] | None:
+    """The values and tables :meth:`LogData.tables` kept, or None when they are not all
+    there (or cannot be read: they are computed again)."""
+    data = _read(values_path)
+    if data is None:
+        return None
+    try:
+        kept = json.loads(data)
+        tables = {
+            str(t): pq.read_table(folder / _table_name(what, str(t))).to_pandas()
+            for t in kept["tables"]
+        }
+    except (OSError, ValueError, KeyError, TypeError, pa.ArrowException):
+        return None
+    return kept["values"], tables
 
 
 def result_json(value: Any) -> bytes:

@@ -9,6 +9,7 @@ found by its label among the events of the robot its pool binds, as on the Model
 
 from __future__ import annotations
 
+import json
 from collections import Counter, deque
 from dataclasses import dataclass
 from itertools import pairwise
@@ -19,14 +20,13 @@ import pandas as pd
 from neo4j import Driver
 
 from robotale.discovery.online import pool_replays
-from robotale.enhancement.mission import MissionRun, mission_run
+from robotale.enhancement.mission import SLOW_COLUMNS, MissionRun, mission_run, slow_limits
 from robotale.errors import InputError, ModelError
 from robotale.fame_runtime.kinds import Kind
 from robotale.fame_runtime.labels import element_label
 from robotale.fame_runtime.model import Flow, Scope
 from robotale.fame_runtime.parser import parse
 from robotale.fame_runtime.splitter import split
-from robotale.results.findings import stored_slow_limits
 from robotale.results.logdata import LogData, current_build
 
 #: gateways and unlabelled events a path between two tagged elements may pass through
@@ -34,18 +34,35 @@ MAX_HOPS = 8
 
 
 def stored_mission(driver: Driver, logs: LogData, name: str, case: str) -> MissionRun:
-    """The run ``case`` of the stored log ``name``, kept in memory per build."""
+    """The run ``case`` of the stored log ``name``, kept per build on disk and in memory."""
     if not case:
         raise InputError("Name the run to replay (?case=).")
     build = current_build(driver, name)
 
-    def load() -> MissionRun:
+    def compute() -> tuple[dict[str, Any], dict[str, pd.DataFrame]]:
         # the whole log's slow limits are kept with the prepared results, not computed per run
         slow = stored_slow_limits(driver, logs, name)
-        return mission_run(logs.frame(driver, name), case, slow)
+        return mission_run(logs.frame(driver, name), case, slow).parts()
+
+    def load() -> MissionRun:
+        # kept with the build: a later visit (or a restarted dashboard) reads the run's
+        # tables instead of reading the whole log and building them again
+        return MissionRun.from_parts(*logs.tables(driver, name, ("mission", str(case)), compute))
 
     run: MissionRun = logs.missions.get((name, build.key, str(case)), load)
     return run
+
+
+def stored_slow_limits(driver: Driver, logs: LogData, name: str) -> pd.DataFrame:
+    """What counts as a slow activity in the whole log (:func:`slow_limits`), the same for
+    each of its runs the Mission page replays: kept once per build, not computed per run."""
+    data = logs.result(
+        driver,
+        name,
+        ("slow-limits",),
+        lambda: {"limits": slow_limits(logs.frame(driver, name)).to_dict(orient="records")},
+    )
+    return pd.DataFrame(json.loads(data)["limits"], columns=SLOW_COLUMNS)
 
 
 def mission_site(site: dict[str, Any] | None, run: MissionRun) -> dict[str, Any]:

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import dataclasses
+import threading
 from typing import Any
 
 from flask import Flask, redirect, url_for
@@ -35,6 +36,7 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
     errors.init_app(app)
     pages.init_app(app)
     _register_blueprints(app)
+    threading.Thread(target=_warm_figures, daemon=True).start()
     app.jinja_env.globals.update(robotale_version=__version__, blueprints=app.blueprints)
     app.jinja_env.globals["menu"] = menu()
 
@@ -43,6 +45,17 @@ def create_app(settings: WebSettings | None = None, **overrides: Any) -> Flask:
         return redirect(url_for("logs.page"))
 
     return app
+
+
+def _warm_figures() -> None:
+    """Import plotly.express and read plotly's default template while the dashboard waits
+    for its first visitor: the first figure a page computes would otherwise wait for both
+    (0.6 s and more)."""
+    # function-level: 0.6 s to import, paid here in the background, not by the first figure
+    import plotly.express  # noqa: F401
+    import plotly.io as pio
+
+    pio.templates[pio.templates.default]
 
 
 def _register_blueprints(app: Flask) -> None:

@@ -1,8 +1,11 @@
 """The Perspectives page draws every section's figures with the data of the log: the points and
 bars plotly holds once the page is fully drawn, against what pandas counts in the same log.
-The figures below the fold are drawn after the page's ``robotale-perspectives-drawn`` mark."""
+The sections below the window are asked for, and the figures below the fold drawn, after the
+page's ``robotale-perspectives-drawn`` mark."""
 
 from __future__ import annotations
+
+from itertools import pairwise
 
 import mission_findings as mission
 import pytest
@@ -103,3 +106,32 @@ def test_battery_draws_every_level_of_every_robot(page, battery_log):
     assert {t["name"]: t["points"] for t in lines if t["mode"] == "lines"} == {
         str(r): int(n) + int(gaps[r]) for r, n in levels.items()
     }
+
+
+#: each section's request: its name, when it started and when it ended (ms)
+FETCHES = """() => performance.getEntriesByType('measure')
+  .filter((m) => m.name.startsWith('robotale-fetch ') && m.name !== 'robotale-fetch graph')
+  .map((m) => [m.name.slice(15), m.startTime, m.startTime + m.duration])"""
+
+
+def test_the_sections_below_the_window_load_after_the_first_view(page, thesis_log):
+    _, name = thesis_log
+    page.goto(f"{page.base_url}/perspectives?log={name}")
+    wait_for(page, ALL_DRAWN, timeout=120)
+    fetches = page.evaluate(FETCHES)
+    first_view = page.evaluate(
+        "performance.getEntriesByName('robotale-perspectives-drawn')[0].startTime"
+    )
+    # one after the other, in the page's order, each asked for once
+    order = page.evaluate(
+        "[...document.querySelectorAll('article.perspective')].map((a) => a.dataset.name)"
+    )
+    assert [n for n, _, _ in fetches] == order
+    assert all(a[2] <= b[1] for a, b in pairwise(fetches))
+    # the first section was there for the first view; the last (below the bottleneck ranking,
+    # its figure and four other sections in a 900-pixel window) came after it, and then shown
+    assert fetches[0][2] <= first_view < fetches[-1][2]
+    states = page.evaluate(
+        "[...document.querySelectorAll('article.perspective')].map((a) => a.dataset.state)"
+    )
+    assert set(states) <= {"shown", "empty"}, states

@@ -57,9 +57,9 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
         assert time.monotonic() < deadline, "the preparation did not finish"
         seen.append(client.get(f"/api/preparation?log={unprepared_log}").json)
         time.sleep(0.2)
-    # the findings, the class graph, each perspective, the runs, the first timeline and the
-    # Mission page's slow-activity limits
-    steps = 2 + len(page_names()) + 3
+    # the findings, the class graph, each perspective, the runs, the first timeline, the
+    # Mission page's slow-activity limits and its first run
+    steps = 2 + len(page_names()) + 4
     progress = json.loads((folder / PROGRESS).read_text())
     assert (progress["done"], progress["total"]) == (steps, steps)
     assert len(set(progress["steps"])) == steps

@@ -80,7 +80,7 @@
   function drawSettled() {
     const settled = [];
     for (const article of section.querySelectorAll("article.perspective")) {
-      if (article.dataset.state === "loading") break;
+      if (["waiting", "loading"].includes(article.dataset.state)) break;
       settled.push(...article.querySelectorAll(".figure"));
     }
     return Promise.all(settled.filter((box) => !box.drawing && onScreen(box)).map(draw));
@@ -136,16 +136,40 @@
     }
   }
 
-  // Every section shown, and every figure on screen once they all are.
+  // A section whose heading is in the window: the first sight of the page includes it.
+  function inView(article) {
+    return article.getBoundingClientRect().top < window.innerHeight;
+  }
+
+  // The sections one after the other, in the page's order (the dashboard computes one result
+  // of a log at a time, so asking for all at once only delays the first): those in the window
+  // first, their figures drawn; resolves then with the promise of the others, which load
+  // while the user looks (each says "loading…" until it is shown). A later call (another
+  // focus) stops the loading of the sections an earlier one had not reached.
+  let generation = 0;
   async function show(focus) {
+    const mine = ++generation;
     focusLabel.textContent = robotalePerspective.describe(focus);
     wholeLog.hidden = !focus;
     const url = new URL(window.location.href);
     url.search = robotalePerspective.query(log, focus);
     window.history.replaceState(null, "", url);
-    await Promise.all([...section.querySelectorAll("article.perspective")].map((a) => showOne(a, focus)));
+    const articles = [...section.querySelectorAll("article.perspective")];
+    for (const article of articles) {
+      article.dataset.state = "waiting";
+      article.querySelector(".summary").textContent = "loading…";
+    }
+    let next = 0;
+    while (next < articles.length && inView(articles[next])) await showOne(articles[next++], focus);
+    if (mine !== generation) return null;
     await drawVisible();
-    pending().forEach((box) => observer.observe(box));
+    const rest = (async () => {
+      while (next < articles.length && mine === generation) await showOne(articles[next++], focus);
+      if (mine !== generation) return;
+      await drawVisible();
+      pending().forEach((box) => observer.observe(box));
+    })();
+    return { rest };
   }
 
   async function start() {
@@ -154,8 +178,6 @@
       focusLabel.textContent = "no log yet: upload one on the Logs page";
       return;
     }
-    // a log nobody prepared: wait for its preparation (its requests then say what is wrong)
-    await robotale.prepared(log, "perspectives").catch(() => {});
     const info = (await robotale.logs()).find((l) => l.name === log) || { entityTypes: [] };
     const by = (info.entityTypes || []).includes("robot") ? "&by=robot" : "";
     robotalePerspective.preload();
@@ -168,20 +190,29 @@
       const started = performance.now();
       robotaleGraph.draw(graphBox, graph, { maxEdges: 150, onSelect: (node) => {
         const chosen = robotalePerspective.focusOf(node);
-        if (chosen) show(chosen).then(drawRest).catch(robotale.showError);
+        if (chosen) show(chosen).then(whole).then(drawRest).catch(robotale.showError);
       } });
       performance.measure("robotale-draw graph", { start: started });
     } catch (error) {
       robotale.showError(error);
     }
-    await figures;
-    // every section, the figures on screen and the graph drawn (what benchmarks/dashboard.py
-    // times); then the figures below the fold
+    const shown = await figures;
+    // the sections in the window, their figures and the graph drawn (what
+    // benchmarks/dashboard.py times); then the sections below it and their figures
     performance.mark("robotale-perspectives-drawn");
+    await whole(shown);
     await drawRest();
     performance.mark("robotale-perspectives-all-drawn");
+    // a log nobody prepared: its other pages' results are prepared now, in the dashboard
+    // (asked once, not awaited: this page shows all it has)
+    robotale.api(`/api/preparation?${new URLSearchParams({ log, page: "perspectives" })}`).catch(() => {});
   }
 
-  wholeLog.addEventListener("click", () => show(null).then(drawRest).catch(robotale.showError));
+  // the sections below the window too, once they are loaded
+  async function whole(shown) {
+    if (shown && shown.rest) await shown.rest;
+  }
+
+  wholeLog.addEventListener("click", () => show(null).then(whole).then(drawRest).catch(robotale.showError));
   start();
 })();
