@@ -812,6 +812,14 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
         metavar="SHARE",
         help="the inductive miner's noise threshold, 0-1 (default 0: every trace fits)",
     )
+    bpmn.add_argument(
+        "--bind",
+        dest="bind_to",
+        type=Path,
+        metavar="DRIVING.bpmn",
+        help="copy each activity's skill and inputs, script or timer, and each signal's type, "
+        "payload and data from the same-named element of this model, to run the result",
+    )
     _handled_by(bpmn, "discover.bpmn_command")
 
     ekg = actions.add_parser("ekg", help="aggregated event knowledge graph from Neo4j")
