@@ -163,7 +163,8 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         "--world",
         type=Path,
         metavar="YAML",
-        help="a simulation's world file: also list what its robots do not provide",
+        help="a simulation's world file: check call activities against its skills (unless "
+        "--skills) and list what its robots do not provide",
     )
     check.add_argument(
         "--json",

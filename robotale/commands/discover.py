@@ -17,7 +17,9 @@ from robotale.discovery.graph import ProcessGraph
 from robotale.discovery.model_diff import diff_models, marked_model
 from robotale.discovery.output import write_texts
 from robotale.discovery.render import graph_to_svg, require_dot
+from robotale.discovery.repeats import constant_repeats
 from robotale.discovery.signal_starts import started_on_signals
+from robotale.discovery.trigger_times import timed_triggers
 from robotale.errors import InputError
 from robotale.results.eventlogs import read_event_log
 
@@ -70,16 +72,19 @@ def bpmn_command(
     (a driving model) each element runs what its same-named element there runs."""
     if not 0.0 <= noise <= 1.0:
         raise InputError(f"--noise must lie between 0 and 1, not {noise:g}.")
+    if bind_to is not None and not Path(bind_to).is_file():
+        raise InputError(f"--bind {bind_to}: there is no such file")
     selection = _selection(cases, robots, robot_types, activities, since, until)
     events = read_event_log(
         log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
     )
-    if bind_to is not None and not Path(bind_to).is_file():
-        raise InputError(f"--bind {bind_to}: there is no such file")
     collaboration = discover_collaboration(events, selection, noise=noise)
     if bind_to is not None:  # to run: robots waiting for orders start an instance per order
         collaboration = started_on_signals(collaboration, events, selection, noise=noise)
     bindings = bind([pool.name for pool in collaboration.pools], bind_to)
+    if bind_to is not None:
+        bindings.timers = timed_triggers(collaboration, events, bindings, selection)
+        bindings.repeats = constant_repeats(collaboration, events, selection)
     write_texts([(out, write_bpmn(collaboration, bindings))])
     for pool in collaboration.pools:
         robots_text = ", ".join(pool.robots)

@@ -48,7 +48,15 @@ ACTIVITIES = frozenset(
     }
 )
 #: children that belong to the driving model's graph, never copied
-_GRAPH = frozenset({"incoming", "outgoing", "documentation"})
+#: ... nor a standard loop: the log has each pass as an instance of its own, so the
+#: discovered process repeats the activity itself
+_GRAPH = frozenset({"incoming", "outgoing", "documentation", "standardLoopCharacteristics"})
+#: a multi-instance marker becomes one instance per pass, for the same reason; it stays so
+#: that what the activity reads of its instance (``loopCounter``) is there
+ONE_INSTANCE = (
+    f'<bpmn:multiInstanceLoopCharacteristics xmlns:bpmn="{BPMN}">'
+    "<bpmn:loopCardinality>1</bpmn:loopCardinality></bpmn:multiInstanceLoopCharacteristics>"
+)
 _ASSOCIATIONS = frozenset({"dataInputAssociation", "dataOutputAssociation"})
 _EVENTS = frozenset(
     {"startEvent", "intermediateCatchEvent", "intermediateThrowEvent", "boundaryEvent", "endEvent"}
@@ -76,10 +84,19 @@ class Bindings:
     pools: dict[str, dict[str, Bound]] = field(default_factory=dict)
     #: per pool, message labels a skill sends or consumes itself: not events of the process
     outside: dict[str, set[str]] = field(default_factory=dict)
+    #: (pool, trigger) -> seconds after an instance began that a handler's timer fired
+    timers: dict[tuple[str, str], float] = field(default_factory=dict)
+    #: (pool, activity) -> the times in a row its robots always did it
+    repeats: dict[tuple[str, str], int] = field(default_factory=dict)
     driving: Path | None = None
 
     def of(self, pool: str, label: str) -> Bound | None:
         return self.pools.get(pool, {}).get(label)
+
+    def is_timer(self, pool: str, label: str) -> bool:
+        """Whether the driving model's element of ``label`` is a timer."""
+        bound = self.of(pool, label)
+        return bound is not None and "timerEventDefinition" in bound.body
 
     def lacking(self, pool: str, labels: Iterable[str]) -> dict[str, list[str]]:
         """The skills the activities ``labels`` of ``pool`` would call that the registry
@@ -245,7 +262,11 @@ def _activity(
         for key, value in element.attrib.items()
         if key in ("calledElement", "scriptFormat")
     )
-    body = "".join(_text(child) for child in element if _local(child) not in _GRAPH)
+    body = "".join(
+        ONE_INSTANCE if _local(child) == "multiInstanceLoopCharacteristics" else _text(child)
+        for child in element
+        if _local(child) not in _GRAPH
+    )
     return Bound(kind, attributes, body, _referenced(element, data), origin)
 
 

@@ -16,7 +16,7 @@ import itertools
 import re
 from xml.sax.saxutils import escape, quoteattr
 
-from robotale.discovery.binding import Bindings, Bound, bind, skill_name
+from robotale.discovery.binding import ONE_INSTANCE, Bindings, Bound, bind, skill_name
 from robotale.discovery.collaboration import Collaboration, Handler, Pool, signal_of
 from robotale.discovery.layout import (
     EVENT,
@@ -34,6 +34,7 @@ from robotale.discovery.layout import (
     leaves,
     simplify,
 )
+from robotale.discovery.repeats import once
 from robotale.eventlog.schema import RECEIVE, SEND
 from robotale.fame_runtime.labels import activity_label
 
@@ -76,8 +77,10 @@ class _PoolDrawing:
         self.defaults: dict[str, str] = {}
         self.event_based: set[str] = set()
         outside = self._outside()
+        repeated = {label for (name, label) in bindings.repeats if name == pool.name}
         self.main = self.framed(
-            without(pool.block, outside), self.builder.node("start", pool.starts_on or "")
+            once(without(pool.block, outside), repeated),
+            self.builder.node("start", pool.starts_on or ""),
         )
         self.handlers = [
             (
@@ -102,6 +105,18 @@ class _PoolDrawing:
             for label, stats in self.pool.stats.items()
             if stats.role in (SEND, RECEIVE) and label not in events
         }
+
+    def host(self, handler: Handler) -> str | None:
+        """The id of the activity a handler's trigger is a boundary timer of: the driving
+        model times it, and it cut short one activity only, drawn once in the main flow
+        (``None`` otherwise: the handler is an event sub-process)."""
+        if not self.bindings.is_timer(self.pool.name, handler.trigger):
+            return None
+        if len(handler.abandoned) != 1 or not handler.interrupting:
+            return None
+        (label,) = handler.abandoned
+        hosts = [s.id for s in self.main.shapes if s.kind == "task" and s.label == label]
+        return hosts[0] if len(hosts) == 1 else None
 
     def bound(self, label: str) -> Bound | None:
         return self.bindings.of(self.pool.name, label)
@@ -136,9 +151,15 @@ class _PoolDrawing:
                 # event-based gateway, not a draw that may wait for what never comes
                 self.event_based.add(split.id)
                 continue
-            redo = self._redo_share(block, split, fragment)
+            back = _back_flow(split.id, flows, outgoing)
+            if back is not None:  # a loop's split: round again with the log's share, else on
+                redo = self._redo_share(block, split, fragment)
+                share = 0.5 if redo is None else redo
+                self.conditions[back.id] = f'__import__("random").random() < {share:.3f}'
+                self.defaults[split.id] = next(f.id for f in flows if f is not back)
+                continue
             for number, flow in enumerate(flows[:-1]):
-                share = redo if redo is not None else 1 / (len(flows) - number)
+                share = 1 / (len(flows) - number)
                 self.conditions[flow.id] = f'__import__("random").random() < {share:.3f}'
             self.defaults[split.id] = flows[-1].id
 
@@ -168,6 +189,31 @@ def without(block: Block, labels: set[str]) -> Block:
         kept = simplify(Operator(block.kind, [without(c, labels) for c in block.children]))
         return kept if leaves(kept) else Tau()  # nothing left to do, not a loop of gateways
     return block
+
+
+def _back_flow(split: str, flows: list[Flow], outgoing: dict[str, list[Flow]]) -> Flow | None:
+    """The flow of ``split`` that goes round its loop again: the one from which the split is
+    reached again soonest (leaving the loop, it is reached again only through an enclosing
+    loop, which takes longer); ``None`` when no flow comes back (a choice)."""
+    best: tuple[int, int] | None = None
+    for number, flow in enumerate(flows):
+        steps = _steps_to(flow.target, split, outgoing)
+        if steps is not None and (best is None or steps < best[0]):
+            best = (steps, number)
+    return None if best is None else flows[best[1]]
+
+
+def _steps_to(start: str, goal: str, outgoing: dict[str, list[Flow]]) -> int | None:
+    seen, frontier, steps = {start}, [start], 0
+    while frontier:
+        if goal in frontier:
+            return steps
+        steps += 1
+        frontier = [
+            f.target for node in frontier for f in outgoing.get(node, []) if f.target not in seen
+        ]
+        seen.update(frontier)
+    return None
 
 
 def _loop_of(block: Block, label: str | None) -> Operator | None:
@@ -271,6 +317,10 @@ def _process(drawing: _PoolDrawing, collaboration: Collaboration) -> str:
     out += _elements(drawing, drawing.main, collaboration, None)
     out += _data_objects(drawing)
     for (handler, fragment), box in zip(drawing.handlers, drawing.boxes, strict=True):
+        host = drawing.host(handler)
+        if host is not None:  # the driving model's timer on the activity it cut short
+            out += _elements(drawing, fragment, collaboration, handler)
+            continue
         out.append(
             f'<bpmn:subProcess id="{box.id}" name={quoteattr(box.label)} triggeredByEvent="true">'
         )
@@ -327,7 +377,8 @@ def _element(
         attrs = "".join(f" {k}={quoteattr(v)}" for k, v in bound.attributes)
         name = quoteattr(display_name(shape.label))
         tag = bound.tag
-        return f'<bpmn:{tag} id="{ident}" name={name}{attrs}>{doc}{bound.body}</bpmn:{tag}>'
+        body = _repeated(bound.body, drawing.bindings.repeats.get((drawing.pool.name, shape.label)))
+        return f'<bpmn:{tag} id="{ident}" name={name}{attrs}>{doc}{body}</bpmn:{tag}>'
     if shape.kind in ("throw", "catch"):
         tag = "intermediateThrowEvent" if shape.kind == "throw" else "intermediateCatchEvent"
         name = signal_of(shape.label)
@@ -351,11 +402,24 @@ def _element(
         if handler is None or not shape.label:
             return f'<bpmn:startEvent id="{ident}" />'
         interrupting = "true" if handler.interrupting else "false"
-        definition = (
-            f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
-            if handler.kind == "signal"
-            else f'<bpmn:errorEventDefinition errorRef="{_error_id(handler.name)}" />'
-        )
+        host = drawing.host(handler)
+        if host is not None:
+            timer = drawing.bound(handler.trigger)
+            return (
+                f'<bpmn:boundaryEvent id="{ident}" name={quoteattr(display_name(handler.name))} '
+                f'attachedToRef="{host}" cancelActivity="true">'
+                f"{timer.body if timer else ''}</bpmn:boundaryEvent>"
+            )
+        after = drawing.bindings.timers.get((drawing.pool.name, handler.trigger))
+        if after is not None:  # the driving model's timer, fired when the log has it fire
+            definition = (
+                '<bpmn:timerEventDefinition><bpmn:timeDuration xsi:type="bpmn:tFormalExpression">'
+                f"PT{after:.3f}S</bpmn:timeDuration></bpmn:timerEventDefinition>"
+            )
+        elif handler.kind == "signal":
+            definition = f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
+        else:
+            definition = f'<bpmn:errorEventDefinition errorRef="{_error_id(handler.name)}" />'
         return (
             f'<bpmn:startEvent id="{ident}" name={quoteattr(handler.name)} '
             f'isInterrupting="{interrupting}">{definition}</bpmn:startEvent>'
@@ -370,6 +434,20 @@ def _element(
     default = drawing.defaults.get(ident)
     attr = f' default="{default}"' if default else ""
     return f'<bpmn:{tag} id="{ident}"{attr} />'
+
+
+def _repeated(body: str, times: int | None) -> str:
+    """``body`` with a sequential multi-instance marker of ``times`` instead of any other."""
+    if times is None:
+        return body
+    body = body.replace(ONE_INSTANCE, "")
+    marker = (
+        '<bpmn:multiInstanceLoopCharacteristics isSequential="true">'
+        f"<bpmn:loopCardinality>{times}</bpmn:loopCardinality>"
+        "</bpmn:multiInstanceLoopCharacteristics>"
+    )
+    script = body.find("<bpmn:script")
+    return body + marker if script < 0 else body[:script] + marker + body[script:]
 
 
 def _documentation(text: str) -> str:
@@ -432,8 +510,9 @@ def _diagram(drawings: list[_PoolDrawing]) -> str:
             _bounds(f"Pool_{drawing.key}", 0, drawing.y, drawing.w, drawing.h, horizontal=True)
         )
         fragments = [drawing.main] + [fragment for _, fragment in drawing.handlers]
-        for box in drawing.boxes:
-            out.append(_bounds(box.id, box.x, box.y, box.w, box.h, expanded=True))
+        for (handler, _), box in zip(drawing.handlers, drawing.boxes, strict=True):
+            if drawing.host(handler) is None:
+                out.append(_bounds(box.id, box.x, box.y, box.w, box.h, expanded=True))
         for fragment in fragments:
             for shape in fragment.shapes:
                 out.append(_bounds(shape.id, shape.x, shape.y, shape.w, shape.h))

@@ -28,6 +28,7 @@ from robotale.discovery.collaboration import (
     typed_instances,
 )
 from robotale.discovery.filters import LogFilter, filter_log
+from robotale.eventlog.prepare import robot_type
 from robotale.eventlog.schema import RECEIVE, ROBOT, ROBOT_TYPE
 
 
@@ -40,19 +41,22 @@ def started_on_signals(
 ) -> Collaboration:
     """``collaboration`` (discovered from ``log`` and ``selection``) with each pool whose
     every trace begins with one received signal started on that signal."""
-    if ROBOT in log.columns and ROBOT_TYPE not in log.columns:
-        from robotale.eventlog.prepare import robot_type  # as discovery names the types
-
-        log = log.assign(
-            **{ROBOT_TYPE: log[ROBOT].astype("string").map(robot_type, na_action="ignore")}
-        )
-    instances = typed_instances(filter_log(log, selection))
+    instances = selected_instances(log, selection)
     records_aborts = bool(instances["_aborted"].any())
     pools = []
     for pool in collaboration.pools:
         mine_ = instances[instances[ROBOT_TYPE] == pool.name]
         pools.append(_started(pool, mine_, records_aborts, noise))
     return replace(collaboration, pools=pools)
+
+
+def selected_instances(log: pd.DataFrame, selection: LogFilter | None) -> pd.DataFrame:
+    """The activity instances of the selected events, typed as discovery types them."""
+    if ROBOT in log.columns and ROBOT_TYPE not in log.columns:
+        log = log.assign(
+            **{ROBOT_TYPE: log[ROBOT].astype("string").map(robot_type, na_action="ignore")}
+        )
+    return typed_instances(filter_log(log, selection))
 
 
 def _started(pool: Pool, instances: pd.DataFrame, records_aborts: bool, noise: float) -> Pool:

@@ -4,12 +4,15 @@ the discovered model simulated in the mission's own world -> its runs against th
 The coverage measure: per robot type, the original runs' variants (a robot's activity starts
 in a run, in order, counted with pandas) that together cover at least 80 % of its cases,
 most frequent first, must each appear among the variants of the discovered model's runs.
-Where a mission cannot be closed the test says which robot type and why (:data:`UNCLOSED`),
-and checks the reason holds, rather than skipping.
+The discovered model's runs are projected onto the original's activities (the engine tags
+each event sub-process itself, where the driving model had a boundary event). Where a
+mission cannot be closed the test says which robot type and why (:data:`UNCLOSED`), and
+checks that exactly those types miss their top variants, rather than skipping.
 """
 
 from __future__ import annotations
 
+import random
 import sys
 import warnings
 from pathlib import Path
@@ -20,10 +23,13 @@ from compare import prepared
 from conftest import simulate_generated
 from lxml import etree
 
+from robotale.cli import main
 from robotale.discovery.binding import bind
 from robotale.discovery.bpmn_writer import lacking_skills, write_bpmn
 from robotale.discovery.collaboration import discover_collaboration
+from robotale.discovery.repeats import constant_repeats
 from robotale.discovery.signal_starts import started_on_signals
+from robotale.discovery.trigger_times import timed_triggers
 from robotale.fame_runtime.check import check
 from robotale.fame_runtime.labels import activity_label
 from robotale.fame_runtime.parser import parse_all
@@ -37,19 +43,38 @@ from collaboration_checks import missing_skills
 
 B = "{http://www.omg.org/spec/BPMN/20100524/MODEL}"
 SEED = 19  # a coordinator asking one worker, answers of the first seconds lost
-RUNS, AGAIN = 3, 4
-#: robot types whose top variants a discovered model cannot reproduce, and why
+RUNS, AGAIN = 3, 6
+#: missions whose discovered model reproduces the original's top variants: a scout whose
+#: exploration a timer cuts short, one or two workers, one of which gives up driving
+CLOSED = (2, 20)
+#: per mission, robot types whose top variants a discovered model cannot reproduce, and why
 UNCLOSED = {
-    "Coordinator": (
-        "its resend loop asks again on a timeout until a counter reaches 3 and moves to the "
-        "next task until a task counter reaches a bound: the log shows how often, not the "
-        "counters, so the discovered model draws each choice at random"
-    ),
-    "Worker 1": (
-        "it answers each ping of the coordinator, so its run repeats as often as the "
-        "coordinator asks, which the discovered model draws at random"
-    ),
+    19: {
+        "Coordinator": (
+            "the inductive miner puts its pings beside its waits for an answer (a loop of "
+            "ping! in parallel with the loops of no_answer, count_try and pong?, next_task): "
+            "three runs of one variant do not show that each ping waits for its answer; and "
+            "whether it asks again depends on counters (tries < 3, the task number) the log "
+            "does not record, so the discovered model draws each choice"
+        ),
+        "Worker 1": (
+            "it answers each ping of the coordinator, so its run repeats as often as the "
+            "discovered coordinator asks"
+        ),
+    },
 }
+
+
+def discovered(simulated, folder: Path) -> Path:
+    """The model ``discover bpmn --bind`` writes for the simulated mission's log."""
+    log = simulated.log
+    collaboration = started_on_signals(discover_collaboration(log), log)
+    bindings = bind([p.name for p in collaboration.pools], simulated.mission.model)
+    bindings.timers = timed_triggers(collaboration, log, bindings)
+    bindings.repeats = constant_repeats(collaboration, log)
+    out = folder / "bound.bpmn"
+    out.write_text(write_bpmn(collaboration, bindings))
+    return out
 
 
 @pytest.fixture(scope="module")
@@ -125,31 +150,90 @@ def _top(variants: pd.Series, share: float = 0.8) -> list[tuple[str, ...]]:
     return list(counts.index[: int((covered < share).sum()) + 1])
 
 
-@pytest.mark.slow
-def test_simulating_the_discovered_model_covers_the_original_top_variants(loop, tmp_path):
-    simulated, _, bound, _ = loop
+def _covered(simulated, bound: Path, folder: Path) -> dict[str, list[tuple[str, ...]]]:
+    """Per robot type, the original's top variants the discovered model's runs lack (their
+    variants projected onto the original's activities: the engine tags each event
+    sub-process itself, which a boundary event of the driving model was not)."""
     world = load_world(simulated.mission.world, bound)
+    random.seed(simulated.seed)  # the model's choices draw from Python's random
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         summary = simulate_batch(
-            plans(world, "generated", runs=AGAIN, seed=2), tmp_path / "again", workers=0
+            plans(world, "generated", runs=AGAIN, seed=simulated.seed), folder / "again", workers=0
         )
     assert summary["outcomes"].get("crashed", 0) == 0, summary
-    again = prepared(tmp_path / "again")
+    again = prepared(folder / "again")
+    known = set(simulated.log["concept:name"].astype(str))
+    again = again[again["concept:name"].astype(str).isin(known)]
     old, new = _variants(simulated.log), _variants(again)
     assert set(old.index.get_level_values(0)) == set(new.index.get_level_values(0))
+    missing = {}
     for kind in sorted(set(old.index.get_level_values(0))):
-        top = _top(old.loc[kind])
         made = set(new.loc[kind])
-        missing = [v for v in top if v not in made]
-        if kind in UNCLOSED:
-            assert missing, f"{kind} is covered now: drop it from UNCLOSED"
-            continue
-        # every activity the original's robots of this type did, the new ones did too
-        assert {a for v in old.loc[kind] for a in v} <= {a for v in made for a in v}, kind
-        assert missing == [], f"{kind}: top variants not reproduced: {missing}"
-    unclosed = sorted(UNCLOSED)
+        missing[kind] = [v for v in _top(old.loc[kind]) if v not in made]
+    return missing
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", CLOSED)
+def test_simulating_the_discovered_model_covers_the_original_top_variants(seed, tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        simulated = simulate_generated(seed, tmp_path, runs=RUNS)
+    bound = discovered(simulated, tmp_path)
+    assert check(parse_all(bound), skills=set(SKILLS)).ok
+    missing = _covered(simulated, bound, tmp_path)
+    assert missing and all(v == [] for v in missing.values()), missing
+
+
+@pytest.mark.slow
+def test_a_mission_that_cannot_be_closed_says_which_robots_and_why(loop, tmp_path):
+    simulated, _, bound, _ = loop
+    missing = _covered(simulated, bound, tmp_path)
+    reasons = UNCLOSED[simulated.seed]
+    # the robot types said to be unclosable are exactly those whose top variants are missing
+    assert {kind for kind, lacking in missing.items() if lacking} == set(reasons), missing
     pytest.xfail(
-        f"not closed for {', '.join(unclosed)}: "
-        + "; ".join(f"{k}: {UNCLOSED[k]}" for k in unclosed)
+        f"mission {simulated.seed} not closed for "
+        + "; ".join(f"{kind}: {why}" for kind, why in sorted(reasons.items()))
     )
+
+
+def test_the_command_binds_to_a_driving_model(loop, tmp_path, capsys):
+    simulated, _, bound, _ = loop
+    csv = tmp_path / "log.csv"
+    simulated.log.to_csv(csv, index=False)
+    out = tmp_path / "cli.bpmn"
+    args = ["discover", "bpmn", str(csv), "--out", str(out)]
+    assert main([*args, "--bind", str(simulated.mission.model)]) == 0
+    printed = capsys.readouterr().out
+    assert "pool Worker 1 (worker_1): event sub-processes on none; an instance per ping?" in printed
+    assert "which the simulation does not have" not in printed
+    assert check(parse_all(out), skills=set(SKILLS)).ok
+
+    # the same elements as the model the test's own route writes
+    def kinds(path):
+        root = etree.parse(str(path)).getroot()
+        return sorted(
+            (etree.QName(e).localname, e.get("name") or "")
+            for e in root.iter()
+            if e.get("name") is not None
+        )
+
+    assert kinds(out) == kinds(bound)
+    missing, fresh = tmp_path / "missing.bpmn", tmp_path / "fresh.bpmn"
+    assert main([*args[:3], "--out", str(fresh), "--bind", str(missing)]) == 1
+    assert f"--bind {missing}: there is no such file" in capsys.readouterr().err
+    assert not fresh.exists()
+
+
+def test_fame_check_with_the_world_uses_the_simulation_s_skills(loop, capsys):
+    simulated, plain, bound, sentences = loop
+    world = str(simulated.mission.world)
+    assert main(["fame", "check", str(bound), "--world", world]) == 0
+    capsys.readouterr()
+    assert main(["fame", "check", str(plain), "--world", world]) == 1
+    problems = [line for line in capsys.readouterr().out.splitlines() if "calls '" in line]
+    called = {line.split("calls '")[1].split("'")[0] for line in problems}
+    assert called == missing_skills(plain) and len(called) == len(sentences)
+    assert all("which is no skill" in line for line in problems)
