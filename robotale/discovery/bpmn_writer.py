@@ -378,6 +378,7 @@ def _element(
         name = quoteattr(display_name(shape.label))
         tag = bound.tag
         body = _repeated(bound.body, drawing.bindings.repeats.get((drawing.pool.name, shape.label)))
+        body = _own_ids(body, ident)
         return f'<bpmn:{tag} id="{ident}" name={name}{attrs}>{doc}{body}</bpmn:{tag}>'
     if shape.kind in ("throw", "catch"):
         tag = "intermediateThrowEvent" if shape.kind == "throw" else "intermediateCatchEvent"
@@ -385,7 +386,7 @@ def _element(
         signal = collaboration.signals.get(name)
         if signal is not None:
             doc = _documentation(f"{stats.text() if stats else ''}. Signal {name}: {signal.text()}")
-        body = bound.body if bound is not None else ""
+        body = _own_ids(bound.body, ident) if bound is not None else ""
         return (
             f'<bpmn:{tag} id="{ident}" name={quoteattr(name)}>{doc}{body}'
             f'<bpmn:signalEventDefinition signalRef="{_signal_id(name)}" /></bpmn:{tag}>'
@@ -396,7 +397,7 @@ def _element(
             bound = drawing.bound(shape.label)
             return (
                 f'<bpmn:startEvent id="{ident}" name={quoteattr(name)}>'
-                f"{bound.body if bound is not None else ''}"
+                f"{_own_ids(bound.body, ident) if bound is not None else ''}"
                 f'<bpmn:signalEventDefinition signalRef="{_signal_id(name)}" /></bpmn:startEvent>'
             )
         if handler is None or not shape.label:
@@ -434,6 +435,16 @@ def _element(
     default = drawing.defaults.get(ident)
     attr = f' default="{default}"' if default else ""
     return f'<bpmn:{tag} id="{ident}"{attr} />'
+
+
+def _own_ids(body: str, owner: str) -> str:
+    """``body`` copied into the element ``owner`` with the ids it defines (an input's
+    placeholder property) made its own, and the references to them: a driving element
+    copied twice must not give one id twice."""
+    for ident in re.findall(r'\bid="([^"]+)"', body):
+        body = body.replace(f'id="{ident}"', f'id="{ident}_{owner}"')
+        body = body.replace(f">{ident}<", f">{ident}_{owner}<")
+    return body
 
 
 def _repeated(body: str, times: int | None) -> str:

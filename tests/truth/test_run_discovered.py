@@ -34,7 +34,7 @@ from robotale.fame_runtime.check import check
 from robotale.fame_runtime.labels import activity_label
 from robotale.fame_runtime.parser import parse_all
 from robotale.sim.batch import simulate_batch
-from robotale.sim.plans import plans
+from robotale.sim.plans import plans, resolve_world
 from robotale.sim.skills import SKILLS
 from robotale.sim.worldspec import load_world
 
@@ -67,9 +67,12 @@ UNCLOSED = {
 
 def discovered(simulated, folder: Path) -> Path:
     """The model ``discover bpmn --bind`` writes for the simulated mission's log."""
-    log = simulated.log
+    return bound_model(simulated.log, simulated.mission.model, folder)
+
+
+def bound_model(log: pd.DataFrame, driving: Path, folder: Path) -> Path:
     collaboration = started_on_signals(discover_collaboration(log), log)
-    bindings = bind([p.name for p in collaboration.pools], simulated.mission.model)
+    bindings = bind([p.name for p in collaboration.pools], driving)
     bindings.timers = timed_triggers(collaboration, log, bindings)
     bindings.repeats = constant_repeats(collaboration, log)
     out = folder / "bound.bpmn"
@@ -237,3 +240,33 @@ def test_fame_check_with_the_world_uses_the_simulation_s_skills(loop, capsys):
     called = {line.split("calls '")[1].split("'")[0] for line in problems}
     assert called == missing_skills(plain) and len(called) == len(sentences)
     assert all("which is no skill" in line for line in problems)
+
+
+@pytest.mark.slow
+def test_the_agri_mission_runs_discovered_but_is_not_closed(tmp_path):
+    """agri: the discovered model passes ``fame check`` and runs in the agri world, but the
+    drone never hears ``weed_found``: its camera publishes it while Explore runs, which the
+    driving model catches with an event sub-process listening all along, and the discovered
+    model catches after Explore (the log puts the catch after Explore's start), when the
+    signal has gone. So no weed is reported and no tractor works."""
+    world = resolve_world("agri")[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        simulate_batch(plans(world, "agri", runs=2, seed=3), tmp_path / "runs", workers=0)
+        log = prepared(tmp_path / "runs")
+    bound = bound_model(log, world.model, tmp_path)
+    report = check(parse_all(bound), skills=set(SKILLS))
+    assert [p.sentence for _, p in report.found] == [] and report.ok, report.pairs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        summary = simulate_batch(
+            plans(load_world(world.file, bound), "agri", runs=2, seed=3),
+            tmp_path / "again",
+            workers=0,
+        )
+    assert summary["outcomes"].get("crashed", 0) == 0, summary
+    again = prepared(tmp_path / "again")
+    drone = again[again["robot"] == "drone"]["concept:name"].astype(str)
+    assert {"take_off", "explore", "weed_found!"} <= set(drone)  # it runs and sees weeds
+    assert "weed_found?" in set(log["concept:name"]) and "weed_found?" not in set(drone)
+    pytest.xfail("agri not closed: the drone's catch of weed_found comes after Explore")
