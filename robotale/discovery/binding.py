@@ -109,9 +109,7 @@ class Bindings:
 
     def skill(self, label: str) -> Bound:
         """The registry's binding: a call of the skill the label names."""
-        name = skill_name(label)
-        origin = "skill registry" if name in self.skills else "no skill of the simulation"
-        return Bound("callActivity", (("calledElement", name),), origin=origin)
+        return Bound("callActivity", (("calledElement", skill_name(label)),), origin="registry")
 
 
 def skill_name(label: str) -> str:

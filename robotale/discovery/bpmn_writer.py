@@ -16,7 +16,7 @@ import itertools
 import re
 from xml.sax.saxutils import escape, quoteattr
 
-from robotale.discovery.binding import ONE_INSTANCE, Bindings, Bound, bind, skill_name
+from robotale.discovery.binding import ONE_INSTANCE, Bindings, Bound, skill_name
 from robotale.discovery.collaboration import Collaboration, Handler, Pool, signal_of
 from robotale.discovery.layout import (
     EVENT,
@@ -232,8 +232,8 @@ def _loop_of(block: Block, label: str | None) -> Operator | None:
 def write_bpmn(collaboration: Collaboration, bindings: Bindings | None = None) -> str:
     """The collaboration as BPMN XML text with its diagram; ``bindings`` say what each
     activity runs (by default the simulator's skill of its name, see :mod:`binding`)."""
-    if bindings is None:
-        bindings = bind([pool.name for pool in collaboration.pools])
+    if bindings is None:  # every activity calls the skill of its name
+        bindings = Bindings(frozenset())
     drawings = [
         _PoolDrawing(pool, f"P{n}", bindings) for n, pool in enumerate(collaboration.pools, 1)
     ]
