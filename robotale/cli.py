@@ -163,7 +163,8 @@ def _add_fame(commands: argparse._SubParsersAction) -> None:
         "--world",
         type=Path,
         metavar="YAML",
-        help="a simulation's world file: also list what its robots do not provide",
+        help="a simulation's world file: check call activities against its skills (unless "
+        "--skills) and list what its robots do not provide",
     )
     check.add_argument(
         "--json",
@@ -811,6 +812,14 @@ def _add_discover(commands: argparse._SubParsersAction) -> None:
         type=float,
         metavar="SHARE",
         help="the inductive miner's noise threshold, 0-1 (default 0: every trace fits)",
+    )
+    bpmn.add_argument(
+        "--bind",
+        dest="bind_to",
+        type=Path,
+        metavar="DRIVING.bpmn",
+        help="copy each activity's skill and inputs, script or timer, and each signal's type, "
+        "payload and data from the same-named element of this model, to run the result",
     )
     _handled_by(bpmn, "discover.bpmn_command")
 

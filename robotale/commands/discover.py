@@ -6,7 +6,8 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
-from robotale.discovery.bpmn_writer import write_bpmn
+from robotale.discovery.binding import bind
+from robotale.discovery.bpmn_writer import lacking_skills, write_bpmn
 from robotale.discovery.collaboration import discover_collaboration
 from robotale.discovery.conformance import check_conformance
 from robotale.discovery.dfg import discover_dfg
@@ -16,6 +17,9 @@ from robotale.discovery.graph import ProcessGraph
 from robotale.discovery.model_diff import diff_models, marked_model
 from robotale.discovery.output import write_texts
 from robotale.discovery.render import graph_to_svg, require_dot
+from robotale.discovery.repeats import constant_repeats
+from robotale.discovery.signal_starts import started_on_signals
+from robotale.discovery.trigger_times import timed_triggers
 from robotale.errors import InputError
 from robotale.results.eventlogs import read_event_log
 
@@ -62,20 +66,33 @@ def bpmn_command(
     since: str | None = None,
     until: str | None = None,
     noise: float = 0.0,
+    bind_to: Path | None = None,
 ) -> int:
-    """The robots' collaboration as a BPMN file with its diagram (``out``)."""
+    """The robots' collaboration as a BPMN file with its diagram (``out``); with ``bind_to``
+    (a driving model) each element runs what its same-named element there runs."""
     if not 0.0 <= noise <= 1.0:
         raise InputError(f"--noise must lie between 0 and 1, not {noise:g}.")
+    if bind_to is not None and not Path(bind_to).is_file():
+        raise InputError(f"--bind {bind_to}: there is no such file")
     selection = _selection(cases, robots, robot_types, activities, since, until)
     events = read_event_log(
         log, log_name=log_name, mapping=mapping, case_column=case_column, case_gap=case_gap
     )
     collaboration = discover_collaboration(events, selection, noise=noise)
-    write_texts([(out, write_bpmn(collaboration))])
+    if bind_to is not None:  # to run: robots waiting for orders start an instance per order
+        collaboration = started_on_signals(collaboration, events, selection, noise=noise)
+    bindings = bind([pool.name for pool in collaboration.pools], bind_to)
+    if bind_to is not None:
+        bindings.timers = timed_triggers(collaboration, events, bindings, selection)
+        bindings.repeats = constant_repeats(collaboration, events, selection)
+    write_texts([(out, write_bpmn(collaboration, bindings))])
     for pool in collaboration.pools:
         robots_text = ", ".join(pool.robots)
         handlers = ", ".join(h.name for h in pool.handlers) or "none"
-        print(f"pool {pool.name} ({robots_text}): event sub-processes on {handlers}")
+        started = f"; an instance per {pool.starts_on}" if pool.starts_on else ""
+        print(f"pool {pool.name} ({robots_text}): event sub-processes on {handlers}{started}")
+    for sentence in lacking_skills(collaboration, bindings):
+        print(sentence)
     for signal in collaboration.signals.values():
         print(f"signal {signal.name}: {signal.text()}")
     print(f"-> {out}")

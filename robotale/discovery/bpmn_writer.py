@@ -16,6 +16,7 @@ import itertools
 import re
 from xml.sax.saxutils import escape, quoteattr
 
+from robotale.discovery.binding import ONE_INSTANCE, Bindings, Bound, skill_name
 from robotale.discovery.collaboration import Collaboration, Handler, Pool, signal_of
 from robotale.discovery.layout import (
     EVENT,
@@ -26,10 +27,14 @@ from robotale.discovery.layout import (
     Flow,
     Fragment,
     Kind,
+    Leaf,
     Operator,
     Shape,
+    Tau,
     leaves,
+    simplify,
 )
+from robotale.discovery.repeats import once
 from robotale.eventlog.schema import RECEIVE, SEND
 from robotale.fame_runtime.labels import activity_label
 
@@ -42,12 +47,7 @@ NS = (
     'xmlns:di="http://www.omg.org/spec/DD/20100524/DI" '
     'xmlns:xsi="http://www.w3.org/2001/XMLSchema-instance"'
 )
-
-
-def skill_name(label: str) -> str:
-    """The skill an activity calls: ``take_off`` -> ``TakeOff`` (the inverse of the engine's
-    tag names, :func:`activity_label`)."""
-    return "".join(part[:1].upper() + part[1:] for part in re.split(r"[^0-9a-zA-Z]+", label))
+__all__ = ["display_name", "lacking_skills", "skill_name", "write_bpmn"]
 
 
 def display_name(label: str) -> str:
@@ -68,23 +68,66 @@ class _Ids:
 class _PoolDrawing:
     """One pool's process: the shapes and flows of its main flow and of each handler."""
 
-    def __init__(self, pool: Pool, key: str) -> None:
+    def __init__(self, pool: Pool, key: str, bindings: Bindings) -> None:
         self.pool = pool
         self.key = key
+        self.bindings = bindings
         self.builder = Builder(_Ids(key), self.kind_of)
         self.conditions: dict[str, str] = {}
         self.defaults: dict[str, str] = {}
-        self.main = self.framed(pool.block, self.builder.node("start"))
+        self.event_based: set[str] = set()
+        outside = self._outside()
+        repeated = {label for (name, label) in bindings.repeats if name == pool.name}
+        self.main = self.framed(
+            once(without(pool.block, outside), repeated),
+            self.builder.node("start", pool.starts_on or ""),
+        )
         self.handlers = [
-            (handler, self.framed(handler.block, self.builder.node("start", handler.trigger)))
+            (
+                handler,
+                self.framed(
+                    without(handler.block, outside), self.builder.node("start", handler.trigger)
+                ),
+            )
             for handler in pool.handlers
         ]
         self.boxes: list[Shape] = []
         self.w = self.h = self.y = 0.0
 
+    def _outside(self) -> set[str]:
+        """The pool's messages a skill of the driving model sends or consumes itself: the
+        driving pool has no event for them (none when no driving model binds the pool)."""
+        if self.pool.name not in self.bindings.outside:
+            return set()
+        events = self.bindings.outside[self.pool.name]
+        return {
+            label
+            for label, stats in self.pool.stats.items()
+            if stats.role in (SEND, RECEIVE) and label not in events
+        }
+
+    def host(self, handler: Handler) -> str | None:
+        """The id of the activity a handler's trigger is a boundary timer of: the driving
+        model times it, and it cut short one activity only, drawn once in the main flow
+        (``None`` otherwise: the handler is an event sub-process)."""
+        if not self.bindings.is_timer(self.pool.name, handler.trigger):
+            return None
+        if len(handler.abandoned) != 1 or not handler.interrupting:
+            return None
+        (label,) = handler.abandoned
+        hosts = [s.id for s in self.main.shapes if s.kind == "task" and s.label == label]
+        return hosts[0] if len(hosts) == 1 else None
+
+    def bound(self, label: str) -> Bound | None:
+        return self.bindings.of(self.pool.name, label)
+
     def kind_of(self, label: str) -> Kind:
         role = self.pool.stats[label].role if label in self.pool.stats else None
-        return {SEND: "throw", RECEIVE: "catch"}.get(role or "", "task")
+        kind: Kind = {SEND: "throw", RECEIVE: "catch"}.get(role or "", "task")  # type: ignore[assignment]
+        bound = self.bound(label)
+        if kind == "task" and bound is not None and bound.tag == "intermediateCatchEvent":
+            return "catch"  # a timer the engine tags as an activity
+        return kind
 
     def framed(self, block: Block, start: Fragment) -> Fragment:
         body = self.builder.fragment(block)
@@ -98,13 +141,25 @@ class _PoolDrawing:
         outgoing: dict[str, list[Flow]] = {}
         for flow in fragment.flows:
             outgoing.setdefault(flow.source, []).append(flow)
+        kinds = {s.id: s.kind for s in fragment.shapes}
         for split in splits:
             flows = outgoing.get(split.id, [])
             if len(flows) < 2:
                 continue
-            redo = self._redo_share(block, split, fragment)
+            if all(kinds.get(flow.target) == "catch" for flow in flows):
+                # a choice between waits: the first signal or timer to come decides, as an
+                # event-based gateway, not a draw that may wait for what never comes
+                self.event_based.add(split.id)
+                continue
+            back = _back_flow(split.id, flows, outgoing)
+            if back is not None:  # a loop's split: round again with the log's share, else on
+                redo = self._redo_share(block, split, fragment)
+                share = 0.5 if redo is None else redo
+                self.conditions[back.id] = f'__import__("random").random() < {share:.3f}'
+                self.defaults[split.id] = next(f.id for f in flows if f is not back)
+                continue
             for number, flow in enumerate(flows[:-1]):
-                share = redo if redo is not None else 1 / (len(flows) - number)
+                share = 1 / (len(flows) - number)
                 self.conditions[flow.id] = f'__import__("random").random() < {share:.3f}'
             self.defaults[split.id] = flows[-1].id
 
@@ -124,6 +179,43 @@ class _PoolDrawing:
         return min(0.9, max(0.0, 1 - 1 / passes)) if passes > 1 else 0.1
 
 
+def without(block: Block, labels: set[str]) -> Block:
+    """``block`` with the activities ``labels`` left out."""
+    if not labels:
+        return block
+    if isinstance(block, Leaf):
+        return Tau() if block.label in labels else block
+    if isinstance(block, Operator):
+        kept = simplify(Operator(block.kind, [without(c, labels) for c in block.children]))
+        return kept if leaves(kept) else Tau()  # nothing left to do, not a loop of gateways
+    return block
+
+
+def _back_flow(split: str, flows: list[Flow], outgoing: dict[str, list[Flow]]) -> Flow | None:
+    """The flow of ``split`` that goes round its loop again: the one from which the split is
+    reached again soonest (leaving the loop, it is reached again only through an enclosing
+    loop, which takes longer); ``None`` when no flow comes back (a choice)."""
+    best: tuple[int, int] | None = None
+    for number, flow in enumerate(flows):
+        steps = _steps_to(flow.target, split, outgoing)
+        if steps is not None and (best is None or steps < best[0]):
+            best = (steps, number)
+    return None if best is None else flows[best[1]]
+
+
+def _steps_to(start: str, goal: str, outgoing: dict[str, list[Flow]]) -> int | None:
+    seen, frontier, steps = {start}, [start], 0
+    while frontier:
+        if goal in frontier:
+            return steps
+        steps += 1
+        frontier = [
+            f.target for node in frontier for f in outgoing.get(node, []) if f.target not in seen
+        ]
+        seen.update(frontier)
+    return None
+
+
 def _loop_of(block: Block, label: str | None) -> Operator | None:
     """The innermost loop whose body holds ``label`` last (the loop a split closes)."""
     if label is None or not isinstance(block, Operator):
@@ -137,9 +229,14 @@ def _loop_of(block: Block, label: str | None) -> Operator | None:
     return None
 
 
-def write_bpmn(collaboration: Collaboration) -> str:
-    """The collaboration as BPMN XML text with its diagram."""
-    drawings = [_PoolDrawing(pool, f"P{n}") for n, pool in enumerate(collaboration.pools, 1)]
+def write_bpmn(collaboration: Collaboration, bindings: Bindings | None = None) -> str:
+    """The collaboration as BPMN XML text with its diagram; ``bindings`` say what each
+    activity runs (by default the simulator's skill of its name, see :mod:`binding`)."""
+    if bindings is None:  # every activity calls the skill of its name
+        bindings = Bindings(frozenset())
+    drawings = [
+        _PoolDrawing(pool, f"P{n}", bindings) for n, pool in enumerate(collaboration.pools, 1)
+    ]
     _place(drawings)
     signals = sorted(collaboration.signals)
     errors = sorted({h.name for d in drawings for h in d.pool.handlers if h.kind == "error"})
@@ -165,6 +262,26 @@ def write_bpmn(collaboration: Collaboration) -> str:
     parts.append(_diagram(drawings))
     parts.append("</bpmn:definitions>")
     return "\n".join(parts) + "\n"
+
+
+def lacking_skills(collaboration: Collaboration, bindings: Bindings) -> list[str]:
+    """One sentence per skill the written model calls that the skill registry lacks."""
+    sentences = []
+    for pool in collaboration.pools:
+        drawing_kinds = _PoolDrawing(pool, "P", bindings)
+        labels = [
+            shape.label
+            for fragment in [drawing_kinds.main, *(f for _, f in drawing_kinds.handlers)]
+            for shape in fragment.shapes
+            if shape.kind == "task"
+        ]
+        for skill, calling in sorted(bindings.lacking(pool.name, labels).items()):
+            sentences.append(
+                f"pool {pool.name}: {', '.join(sorted(set(calling)))} calls the skill {skill}, "
+                "which the simulation does not have (give --bind a driving model that says "
+                "what it runs)"
+            )
+    return sentences
 
 
 def _summary(collaboration: Collaboration) -> str:
@@ -198,7 +315,12 @@ def _process(drawing: _PoolDrawing, collaboration: Collaboration) -> str:
         f'<bpmn:process id="Process_{drawing.key}" name={quoteattr(pool.name)} isExecutable="true">'
     ]
     out += _elements(drawing, drawing.main, collaboration, None)
+    out += _data_objects(drawing)
     for (handler, fragment), box in zip(drawing.handlers, drawing.boxes, strict=True):
+        host = drawing.host(handler)
+        if host is not None:  # the driving model's timer on the activity it cut short
+            out += _elements(drawing, fragment, collaboration, handler)
+            continue
         out.append(
             f'<bpmn:subProcess id="{box.id}" name={quoteattr(box.label)} triggeredByEvent="true">'
         )
@@ -207,6 +329,17 @@ def _process(drawing: _PoolDrawing, collaboration: Collaboration) -> str:
         out.append("</bpmn:subProcess>")
     out.append("</bpmn:process>")
     return "\n".join(out)
+
+
+def _data_objects(drawing: _PoolDrawing) -> list[str]:
+    """The driving model's data objects the bound elements read or fill, each once."""
+    labels = [s.label for _, f in [(None, drawing.main), *drawing.handlers] for s in f.shapes]
+    found: dict[str, str] = {}
+    for label in labels:
+        bound = drawing.bound(label) if label else None
+        for ident, text in bound.data if bound else ():
+            found.setdefault(ident, text)
+    return list(found.values())
 
 
 def _elements(
@@ -236,30 +369,58 @@ def _element(
     stats = drawing.pool.stats.get(shape.label)
     doc = _documentation(stats.text()) if stats and shape.kind in ("task", "throw", "catch") else ""
     ident = shape.id
-    if shape.kind == "task":
-        return (
-            f'<bpmn:callActivity id="{ident}" name={quoteattr(display_name(shape.label))} '
-            f"calledElement={quoteattr(skill_name(shape.label))}>{doc}</bpmn:callActivity>"
-        )
+    # a start event keeps its trigger: a timer the driving model attaches to an activity is
+    # no event sub-process' timer (it counts from the activity's start, not the process')
+    bound = drawing.bound(shape.label) if shape.kind in ("task", "throw", "catch") else None
+    if shape.kind == "task" or (bound is not None and bound.tag == "intermediateCatchEvent"):
+        bound = bound or drawing.bindings.skill(shape.label)
+        attrs = "".join(f" {k}={quoteattr(v)}" for k, v in bound.attributes)
+        name = quoteattr(display_name(shape.label))
+        tag = bound.tag
+        body = _repeated(bound.body, drawing.bindings.repeats.get((drawing.pool.name, shape.label)))
+        body = _own_ids(body, ident)
+        return f'<bpmn:{tag} id="{ident}" name={name}{attrs}>{doc}{body}</bpmn:{tag}>'
     if shape.kind in ("throw", "catch"):
         tag = "intermediateThrowEvent" if shape.kind == "throw" else "intermediateCatchEvent"
         name = signal_of(shape.label)
         signal = collaboration.signals.get(name)
         if signal is not None:
             doc = _documentation(f"{stats.text() if stats else ''}. Signal {name}: {signal.text()}")
+        body = _own_ids(bound.body, ident) if bound is not None else ""
         return (
-            f'<bpmn:{tag} id="{ident}" name={quoteattr(name)}>{doc}'
+            f'<bpmn:{tag} id="{ident}" name={quoteattr(name)}>{doc}{body}'
             f'<bpmn:signalEventDefinition signalRef="{_signal_id(name)}" /></bpmn:{tag}>'
         )
     if shape.kind == "start":
+        if handler is None and shape.label:  # an instance per message of this signal
+            name = signal_of(shape.label)
+            bound = drawing.bound(shape.label)
+            return (
+                f'<bpmn:startEvent id="{ident}" name={quoteattr(name)}>'
+                f"{_own_ids(bound.body, ident) if bound is not None else ''}"
+                f'<bpmn:signalEventDefinition signalRef="{_signal_id(name)}" /></bpmn:startEvent>'
+            )
         if handler is None or not shape.label:
             return f'<bpmn:startEvent id="{ident}" />'
         interrupting = "true" if handler.interrupting else "false"
-        definition = (
-            f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
-            if handler.kind == "signal"
-            else f'<bpmn:errorEventDefinition errorRef="{_error_id(handler.name)}" />'
-        )
+        host = drawing.host(handler)
+        if host is not None:
+            timer = drawing.bound(handler.trigger)
+            return (
+                f'<bpmn:boundaryEvent id="{ident}" name={quoteattr(display_name(handler.name))} '
+                f'attachedToRef="{host}" cancelActivity="true">'
+                f"{timer.body if timer else ''}</bpmn:boundaryEvent>"
+            )
+        after = drawing.bindings.timers.get((drawing.pool.name, handler.trigger))
+        if after is not None:  # the driving model's timer, fired when the log has it fire
+            definition = (
+                '<bpmn:timerEventDefinition><bpmn:timeDuration xsi:type="bpmn:tFormalExpression">'
+                f"PT{after:.3f}S</bpmn:timeDuration></bpmn:timerEventDefinition>"
+            )
+        elif handler.kind == "signal":
+            definition = f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
+        else:
+            definition = f'<bpmn:errorEventDefinition errorRef="{_error_id(handler.name)}" />'
         return (
             f'<bpmn:startEvent id="{ident}" name={quoteattr(handler.name)} '
             f'isInterrupting="{interrupting}">{definition}</bpmn:startEvent>'
@@ -269,9 +430,35 @@ def _element(
     tag = {"xor": "exclusiveGateway", "and": "parallelGateway", "or": "inclusiveGateway"}[
         shape.kind
     ]
+    if ident in drawing.event_based:
+        return f'<bpmn:eventBasedGateway id="{ident}" />'
     default = drawing.defaults.get(ident)
     attr = f' default="{default}"' if default else ""
     return f'<bpmn:{tag} id="{ident}"{attr} />'
+
+
+def _own_ids(body: str, owner: str) -> str:
+    """``body`` copied into the element ``owner`` with the ids it defines (an input's
+    placeholder property) made its own, and the references to them: a driving element
+    copied twice must not give one id twice."""
+    for ident in re.findall(r'\bid="([^"]+)"', body):
+        body = body.replace(f'id="{ident}"', f'id="{ident}_{owner}"')
+        body = body.replace(f">{ident}<", f">{ident}_{owner}<")
+    return body
+
+
+def _repeated(body: str, times: int | None) -> str:
+    """``body`` with a sequential multi-instance marker of ``times`` instead of any other."""
+    if times is None:
+        return body
+    body = body.replace(ONE_INSTANCE, "")
+    marker = (
+        '<bpmn:multiInstanceLoopCharacteristics isSequential="true">'
+        f"<bpmn:loopCardinality>{times}</bpmn:loopCardinality>"
+        "</bpmn:multiInstanceLoopCharacteristics>"
+    )
+    script = body.find("<bpmn:script")
+    return body + marker if script < 0 else body[:script] + marker + body[script:]
 
 
 def _documentation(text: str) -> str:
@@ -334,8 +521,9 @@ def _diagram(drawings: list[_PoolDrawing]) -> str:
             _bounds(f"Pool_{drawing.key}", 0, drawing.y, drawing.w, drawing.h, horizontal=True)
         )
         fragments = [drawing.main] + [fragment for _, fragment in drawing.handlers]
-        for box in drawing.boxes:
-            out.append(_bounds(box.id, box.x, box.y, box.w, box.h, expanded=True))
+        for (handler, _), box in zip(drawing.handlers, drawing.boxes, strict=True):
+            if drawing.host(handler) is None:
+                out.append(_bounds(box.id, box.x, box.y, box.w, box.h, expanded=True))
         for fragment in fragments:
             for shape in fragment.shapes:
                 out.append(_bounds(shape.id, shape.x, shape.y, shape.w, shape.h))

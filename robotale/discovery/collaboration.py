@@ -110,6 +110,8 @@ class Pool:
     handlers: list[Handler]
     stats: dict[str, ActivityStats]
     traces: int
+    #: the signal whose every receipt starts an instance (``None``: one instance per run)
+    starts_on: str | None = None
 
     @property
     def multi_instance(self) -> bool:

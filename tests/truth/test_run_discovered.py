@@ -1,0 +1,272 @@
+"""Closing the loop: a generated mission's log -> ``discover bpmn --bind`` -> ``fame check`` ->
+the discovered model simulated in the mission's own world -> its runs against the original's.
+
+The coverage measure: per robot type, the original runs' variants (a robot's activity starts
+in a run, in order, counted with pandas) that together cover at least 80 % of its cases,
+most frequent first, must each appear among the variants of the discovered model's runs.
+The discovered model's runs are projected onto the original's activities (the engine tags
+each event sub-process itself, where the driving model had a boundary event). Where a
+mission cannot be closed the test says which robot type and why (:data:`UNCLOSED`), and
+checks that exactly those types miss their top variants, rather than skipping.
+"""
+
+from __future__ import annotations
+
+import random
+import sys
+import warnings
+from pathlib import Path
+
+import pandas as pd
+import pytest
+from compare import prepared
+from conftest import simulate_generated
+from lxml import etree
+
+from robotale.cli import main
+from robotale.discovery.binding import bind
+from robotale.discovery.bpmn_writer import lacking_skills, write_bpmn
+from robotale.discovery.collaboration import discover_collaboration
+from robotale.discovery.repeats import constant_repeats
+from robotale.discovery.signal_starts import started_on_signals
+from robotale.discovery.trigger_times import timed_triggers
+from robotale.fame_runtime.check import check
+from robotale.fame_runtime.labels import activity_label
+from robotale.fame_runtime.parser import parse_all
+from robotale.sim.batch import simulate_batch
+from robotale.sim.plans import plans, resolve_world
+from robotale.sim.skills import SKILLS
+from robotale.sim.worldspec import load_world
+
+sys.path.insert(0, str(Path(__file__).parents[1] / "discovery"))
+from collaboration_checks import missing_skills
+
+B = "{http://www.omg.org/spec/BPMN/20100524/MODEL}"
+SEED = 19  # a coordinator asking one worker, answers of the first seconds lost
+RUNS, AGAIN = 3, 6
+#: missions whose discovered model reproduces the original's top variants: a scout whose
+#: exploration a timer cuts short, one or two workers, one of which gives up driving
+CLOSED = (2, 20)
+#: per mission, robot types whose top variants a discovered model cannot reproduce, and why
+UNCLOSED = {
+    19: {
+        "Coordinator": (
+            "the inductive miner puts its pings beside its waits for an answer (a loop of "
+            "ping! in parallel with the loops of no_answer, count_try and pong?, next_task): "
+            "three runs of one variant do not show that each ping waits for its answer; and "
+            "whether it asks again depends on counters (tries < 3, the task number) the log "
+            "does not record, so the discovered model draws each choice"
+        ),
+        "Worker 1": (
+            "it answers each ping of the coordinator, so its run repeats as often as the "
+            "discovered coordinator asks"
+        ),
+    },
+}
+
+
+def discovered(simulated, folder: Path) -> Path:
+    """The model ``discover bpmn --bind`` writes for the simulated mission's log."""
+    return bound_model(simulated.log, simulated.mission.model, folder)
+
+
+def bound_model(log: pd.DataFrame, driving: Path, folder: Path) -> Path:
+    collaboration = started_on_signals(discover_collaboration(log), log)
+    bindings = bind([p.name for p in collaboration.pools], driving)
+    bindings.timers = timed_triggers(collaboration, log, bindings)
+    bindings.repeats = constant_repeats(collaboration, log)
+    out = folder / "bound.bpmn"
+    out.write_text(write_bpmn(collaboration, bindings))
+    return out
+
+
+@pytest.fixture(scope="module")
+def loop(tmp_path_factory):
+    folder = tmp_path_factory.mktemp("loop")
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        simulated = simulate_generated(SEED, folder, runs=RUNS)
+    collaboration = discover_collaboration(simulated.log)
+    plain = folder / "plain.bpmn"
+    plain.write_text(write_bpmn(collaboration))
+    started = started_on_signals(collaboration, simulated.log)
+    bindings = bind([p.name for p in started.pools], simulated.mission.model)
+    bound = folder / "bound.bpmn"
+    bound.write_text(write_bpmn(started, bindings))
+    return (
+        simulated,
+        plain,
+        bound,
+        lacking_skills(collaboration, bind([p.name for p in started.pools])),
+    )
+
+
+def test_without_a_driving_model_fame_check_names_only_the_skills_the_simulation_lacks(loop):
+    simulated, plain, _, sentences = loop
+    # the truth: the driving model's elements the simulator has no skill for, which the log
+    # tags as activities (script tasks, timers), by their tag name
+    root = etree.parse(str(simulated.mission.model)).getroot()
+    tagged = set(simulated.log["concept:name"].astype(str))
+    scripted = {
+        activity_label(e.get("name"), e.get("id"))
+        for kind in ("scriptTask", "intermediateCatchEvent")
+        for e in root.iter(f"{B}{kind}")
+        if e.find(f"{B}signalEventDefinition") is None
+    } & tagged
+    expected = {"".join(w.title() for w in label.split("_")) for label in scripted}
+    assert missing_skills(plain) == expected
+    assert expected and not expected & set(SKILLS)
+    report = check(parse_all(plain), skills=set(SKILLS))
+    others = [p.sentence for _, p in report.found if "which is no skill" not in p.sentence]
+    assert others == []
+    # the command's own sentences: one per lacking skill
+    named = {s.split("calls the skill ")[1].split(",")[0] for s in sentences}
+    assert named == expected and len(sentences) == len(expected)
+
+
+def test_bound_to_the_driving_model_fame_check_accepts_it(loop):
+    _, _, bound, _ = loop
+    report = check(parse_all(bound), skills=set(SKILLS))
+    assert [p.sentence for _, p in report.found] == []
+    assert report.ok
+    root = etree.parse(str(bound)).getroot()
+    # the worker waits for orders: a process started on ping, as the driving one
+    starts = [
+        e.get("name")
+        for e in root.iter(f"{B}startEvent")
+        if e.find(f"{B}signalEventDefinition") is not None
+    ]
+    assert "ping" in starts
+
+
+def _variants(log: pd.DataFrame) -> pd.Series:
+    """(robot type, case, robot) -> the robot's activity starts in order."""
+    starts = log[log["lifecycle:transition"] == "start"]
+    starts = starts.sort_values(["case:concept:name", "robot", "time:timestamp"], kind="stable")
+    keys = ["robot_type", "case:concept:name", "robot"]
+    return starts.groupby(keys)["concept:name"].agg(lambda names: tuple(names.astype(str)))
+
+
+def _top(variants: pd.Series, share: float = 0.8) -> list[tuple[str, ...]]:
+    counts = variants.value_counts()
+    covered = counts.cumsum() / counts.sum()
+    return list(counts.index[: int((covered < share).sum()) + 1])
+
+
+def _covered(simulated, bound: Path, folder: Path) -> dict[str, list[tuple[str, ...]]]:
+    """Per robot type, the original's top variants the discovered model's runs lack (their
+    variants projected onto the original's activities: the engine tags each event
+    sub-process itself, which a boundary event of the driving model was not)."""
+    world = load_world(simulated.mission.world, bound)
+    random.seed(simulated.seed)  # the model's choices draw from Python's random
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        summary = simulate_batch(
+            plans(world, "generated", runs=AGAIN, seed=simulated.seed), folder / "again", workers=0
+        )
+    assert summary["outcomes"].get("crashed", 0) == 0, summary
+    again = prepared(folder / "again")
+    known = set(simulated.log["concept:name"].astype(str))
+    again = again[again["concept:name"].astype(str).isin(known)]
+    old, new = _variants(simulated.log), _variants(again)
+    assert set(old.index.get_level_values(0)) == set(new.index.get_level_values(0))
+    missing = {}
+    for kind in sorted(set(old.index.get_level_values(0))):
+        made = set(new.loc[kind])
+        missing[kind] = [v for v in _top(old.loc[kind]) if v not in made]
+    return missing
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("seed", CLOSED)
+def test_simulating_the_discovered_model_covers_the_original_top_variants(seed, tmp_path):
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        simulated = simulate_generated(seed, tmp_path, runs=RUNS)
+    bound = discovered(simulated, tmp_path)
+    assert check(parse_all(bound), skills=set(SKILLS)).ok
+    missing = _covered(simulated, bound, tmp_path)
+    assert missing and all(v == [] for v in missing.values()), missing
+
+
+@pytest.mark.slow
+def test_a_mission_that_cannot_be_closed_says_which_robots_and_why(loop, tmp_path):
+    simulated, _, bound, _ = loop
+    missing = _covered(simulated, bound, tmp_path)
+    reasons = UNCLOSED[simulated.seed]
+    # the robot types said to be unclosable are exactly those whose top variants are missing
+    assert {kind for kind, lacking in missing.items() if lacking} == set(reasons), missing
+    pytest.xfail(
+        f"mission {simulated.seed} not closed for "
+        + "; ".join(f"{kind}: {why}" for kind, why in sorted(reasons.items()))
+    )
+
+
+def test_the_command_binds_to_a_driving_model(loop, tmp_path, capsys):
+    simulated, _, bound, _ = loop
+    csv = tmp_path / "log.csv"
+    simulated.log.to_csv(csv, index=False)
+    out = tmp_path / "cli.bpmn"
+    args = ["discover", "bpmn", str(csv), "--out", str(out)]
+    assert main([*args, "--bind", str(simulated.mission.model)]) == 0
+    printed = capsys.readouterr().out
+    assert "pool Worker 1 (worker_1): event sub-processes on none; an instance per ping?" in printed
+    assert "which the simulation does not have" not in printed
+    assert check(parse_all(out), skills=set(SKILLS)).ok
+
+    # the same elements as the model the test's own route writes
+    def kinds(path):
+        root = etree.parse(str(path)).getroot()
+        return sorted(
+            (etree.QName(e).localname, e.get("name") or "")
+            for e in root.iter()
+            if e.get("name") is not None
+        )
+
+    assert kinds(out) == kinds(bound)
+    missing, fresh = tmp_path / "missing.bpmn", tmp_path / "fresh.bpmn"
+    assert main([*args[:3], "--out", str(fresh), "--bind", str(missing)]) == 1
+    assert f"--bind {missing}: there is no such file" in capsys.readouterr().err
+    assert not fresh.exists()
+
+
+def test_fame_check_with_the_world_uses_the_simulation_s_skills(loop, capsys):
+    simulated, plain, bound, sentences = loop
+    world = str(simulated.mission.world)
+    assert main(["fame", "check", str(bound), "--world", world]) == 0
+    capsys.readouterr()
+    assert main(["fame", "check", str(plain), "--world", world]) == 1
+    problems = [line for line in capsys.readouterr().out.splitlines() if "calls '" in line]
+    called = {line.split("calls '")[1].split("'")[0] for line in problems}
+    assert called == missing_skills(plain) and len(called) == len(sentences)
+    assert all("which is no skill" in line for line in problems)
+
+
+@pytest.mark.slow
+def test_the_agri_mission_runs_discovered_but_is_not_closed(tmp_path):
+    """agri: the discovered model passes ``fame check`` and runs in the agri world, but the
+    drone never hears ``weed_found``: its camera publishes it while Explore runs, which the
+    driving model catches with an event sub-process listening all along, and the discovered
+    model catches after Explore (the log puts the catch after Explore's start), when the
+    signal has gone. So no weed is reported and no tractor works."""
+    world = resolve_world("agri")[0]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        simulate_batch(plans(world, "agri", runs=2, seed=3), tmp_path / "runs", workers=0)
+        log = prepared(tmp_path / "runs")
+    bound = bound_model(log, world.model, tmp_path)
+    report = check(parse_all(bound), skills=set(SKILLS))
+    assert [p.sentence for _, p in report.found] == [] and report.ok, report.pairs
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        summary = simulate_batch(
+            plans(load_world(world.file, bound), "agri", runs=2, seed=3),
+            tmp_path / "again",
+            workers=0,
+        )
+    assert summary["outcomes"].get("crashed", 0) == 0, summary
+    again = prepared(tmp_path / "again")
+    drone = again[again["robot"] == "drone"]["concept:name"].astype(str)
+    assert {"take_off", "explore", "weed_found!"} <= set(drone)  # it runs and sees weeds
+    assert "weed_found?" in set(log["concept:name"]) and "weed_found?" not in set(drone)
+    pytest.xfail("agri not closed: the drone's catch of weed_found comes after Explore")
