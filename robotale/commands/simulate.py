@@ -12,6 +12,7 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any, TextIO
 
+from robotale.ekg.build import check_log_name
 from robotale.ekg.connection import session_driver
 from robotale.enhancement.monitor import alert_limits
 from robotale.enhancement.watched_run import WatchedRun
@@ -163,8 +164,13 @@ def simulate_command(
     with session_driver() as driver:
         limits = alert_limits(driver, silence, battery, message_timeout, durations_from)
 
+        def name_of(case: str) -> str:
+            return log if log and len(batch) == 1 else f"{log or scenario}_{case}"
+
+        check_log_name(name_of(batch[0].case))  # before any run, not as a crashed one
+
         def watched(case: str, robots: list[str], bus: InProcessBus) -> Callable[[], None]:
-            name = log if log and len(batch) == 1 else f"{log or scenario}_{case}"
+            name = name_of(case)
             print(f"# monitoring {', '.join(robots)} as {name}", file=err, flush=True)
             run = WatchedRun(
                 driver, name, loaded.model, robots, bus, limits, out, _announce(url, err)
