@@ -13,11 +13,11 @@ from typing import TextIO
 from robotale.discovery.online import pool_replays
 from robotale.ekg.connection import session_driver
 from robotale.ekg.live import LiveLog
-from robotale.enhancement.monitor import TICK, Monitor, alert_limits
 from robotale.fame_runtime.clock import WallClock
 from robotale.fame_runtime.dds import DdsBus
 from robotale.fame_runtime.launch import robot_list
 from robotale.fame_runtime.processes import interrupts
+from robotale.results.monitor import TICK, Monitor, alert_limits
 from robotale.thresholds import LOW_BATTERY_PERCENT
 
 

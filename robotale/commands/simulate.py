@@ -14,11 +14,11 @@ from typing import Any, TextIO
 
 from robotale.ekg.build import check_log_name
 from robotale.ekg.connection import session_driver
-from robotale.enhancement.monitor import alert_limits
-from robotale.enhancement.watched_run import WatchedRun
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import EngineCost
+from robotale.results.monitor import alert_limits
+from robotale.results.watched_run import WatchedRun
 from robotale.sim import stopping
 from robotale.sim.batch import print_summary, simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world

@@ -1,5 +1,5 @@
 """A simulated run watched as it goes (``robotale simulate --live``): the monitor of live
-robots (:class:`~robotale.enhancement.monitor.Monitor`) on the simulation's in-process bus and
+robots (:class:`~robotale.results.monitor.Monitor`) on the simulation's in-process bus and
 clock, storing the run's tags as a live log, replaying them on the robots' pools and raising
 its alerts in simulated time, as ``robotale monitor`` does for robots on DDS."""
 
@@ -8,16 +8,17 @@ from __future__ import annotations
 from collections import defaultdict
 from collections.abc import Callable
 from pathlib import Path
-from typing import Any, TextIO
+from typing import Any, TextIO, cast
 
 from neo4j import Driver
 
 from robotale.discovery.online import pool_replays
 from robotale.ekg.live import LiveLog
-from robotale.enhancement.monitor import TICK, Limits, Monitor
 from robotale.fame_runtime.bus import Envelope, InProcessBus, Subscription
+from robotale.fame_runtime.clock import RunningClock
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
 from robotale.fame_runtime.tags import tag_topic
+from robotale.results.monitor import TICK, Limits, Monitor
 
 #: called once the live log ``name`` holds its first tag (to say where to follow it)
 Announce = Callable[[str], None]
@@ -30,7 +31,9 @@ class Overheard:
     them. What the monitor publishes (its alerts) goes onto the bus like any message."""
 
     def __init__(self, bus: InProcessBus) -> None:
-        self.bus, self.clock = bus, bus.clock
+        self.bus = bus
+        # a simulation's clock runs its callbacks itself (a SimClock), as the monitor needs
+        self.clock = cast(RunningClock, bus.clock)
         self._callbacks: dict[str, list[Subscription]] = defaultdict(list)
         bus.tap(self._heard)
 

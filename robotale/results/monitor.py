@@ -8,7 +8,7 @@ from __future__ import annotations
 import functools
 import json
 from dataclasses import asdict, dataclass, field, replace
-from typing import Protocol, TextIO
+from typing import Protocol, TextIO, cast
 
 from neo4j import Driver
 
@@ -155,8 +155,7 @@ class Timing:
         elif tag.msg_id and tag.msg_role == "send" and tag.msg_id not in self.sends:
             self.sends[tag.msg_id] = tag
             if tag.msg_id not in self.received:  # a receive heard before its send
-                limit = self.limits.messages.of(tag.activity)
-                self.messages.begin(tag.msg_id, tag.stamp, limit)
+                self.messages.begin(tag.msg_id, tag.stamp, self.limits.messages.of(tag.activity))
         limit = self.limits.durations.get(tag.activity)
         if limit is None:
             return
@@ -175,7 +174,7 @@ class Timing:
             )
             alerts.append(Alert(now, "message", send.robot, text))
         for late in self.running.due(now):
-            robot, activity = late.key  # type: ignore[misc]
+            robot, activity = cast("tuple[str, str]", late.key)
             text = (
                 f"{robot}'s {activity!r} running {now - late.stamp:.1f} s, longer than "
                 f"{late.limit:.1f} s (the 95th percentile of its earlier durations)"
