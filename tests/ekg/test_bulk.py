@@ -189,7 +189,7 @@ def test_times_are_written_as_the_online_build_stores_them(neo4j_driver, zone):
     # across both daylight-saving changes of 2024, with nanoseconds; None: a fixed offset
     moments = ["2024-03-31T00:59:59.123456789Z", "2024-03-31T01:00:00Z", "2024-10-27T00:30:00Z"]
     moments += ["2024-10-27T01:30:00.5Z", "2024-12-31T23:00:00Z"]
-    utc = pd.Series(pd.to_datetime(moments, utc=True))
+    utc = pd.Series(pd.to_datetime(moments, utc=True, format="ISO8601"))
     times = utc.dt.tz_convert(zone or datetime.timezone(datetime.timedelta(hours=-3, minutes=-30)))
     texts = import_files._times(times, "timestamp").fields.tolist()
     nanos = utc.dt.as_unit("ns").astype("int64")
