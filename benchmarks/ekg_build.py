@@ -2,6 +2,7 @@
 
     python benchmarks/ekg_build.py [--sizes 100000 1000000] [--baseline-sizes 20000 100000]
     python benchmarks/ekg_build.py --whole-command --sizes 100000 1000000 10000000
+        [--build auto|online|bulk]
     python benchmarks/ekg_build.py --df-c-only --sizes 100000 1000000 [--repeat 5]
 
 ``--whole-command`` times whole ``robotale ingest`` processes against PromG's whole build
@@ -122,7 +123,10 @@ def main() -> int:
         "(benchmarks/whole_ingest.py)",
     )
     parser.add_argument(
-        "--promg-venv", type=Path, help="with --whole-command: a virtual environment with PromG"
+        "--promg-venv",
+        type=Path,
+        help="with --whole-command: a virtual environment with PromG (none: robotale's side "
+        "only; default: one is made)",
     )
     parser.add_argument(
         "--pages",
@@ -131,6 +135,12 @@ def main() -> int:
         help="with --whole-command: when the ingests prepare the dashboard's pages; "
         "background (the default) awaits that process after each ingest, visit prepares none "
         "(the command's own time is the same: it never waits for them)",
+    )
+    parser.add_argument(
+        "--build",
+        default="auto",
+        choices=("auto", "online", "bulk"),
+        help="with --whole-command: the ingests' --build (auto, the default, as a user runs it)",
     )
     parser.add_argument(
         "--df-c-only",
@@ -142,7 +152,7 @@ def main() -> int:
         from whole_ingest import main as whole_command
 
         return whole_command(
-            args.sizes, max(args.repeat, 1), args.heap, args.promg_venv, args.pages
+            args.sizes, max(args.repeat, 1), args.heap, args.promg_venv, args.pages, args.build
         )
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     if args.df_c_only:

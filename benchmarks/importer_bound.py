@@ -11,15 +11,11 @@ from __future__ import annotations
 
 import csv
 import os
-import re
 import subprocess
 import tempfile
 import time
 from dataclasses import dataclass
 from pathlib import Path
-
-# Neo4j's command-line entry point (what the ``neo4j-admin`` script starts).
-ADMIN_TOOL = "org.neo4j.cli.AdminTool"
 
 
 def write_graph(folder: Path, nodes: int, properties: int, edges: int) -> tuple[Path, Path]:
@@ -50,6 +46,12 @@ class Import:
 def importer_seconds(nodes: int, properties: int, edges: int) -> Import:
     """The importer building that graph (input files written beforehand, outside the timer);
     stops the benchmark when it imported anything else."""
+    from robotale.neo4j_server.importer import (
+        ImportFiles,
+        admin_command,
+        admin_environment,
+        parse_report,
+    )
     from robotale.neo4j_server.jars import ensure_jars
     from robotale.neo4j_server.server import DEFAULT_RELEASE, java_executable
 
@@ -61,12 +63,12 @@ def importer_seconds(nodes: int, properties: int, edges: int) -> Import:
             f"server.directories.data={home / 'data'}\nserver.directories.logs={home / 'logs'}\n"
         )
         node_file, edge_file = write_graph(home, nodes, properties, edges)
-        command = [java, "-cp", f"{lib}/*", ADMIN_TOOL, "database", "import", "full", "neo4j"]
-        command += [f"--nodes=Event={node_file}", f"--relationships={edge_file}"]
-        environment = os.environ | {"NEO4J_HOME": str(home), "NEO4J_CONF": str(home / "conf")}
+        files = ImportFiles([("Event", node_file)], [("E", edge_file)])
+        command = admin_command(java, f"{lib}/*", "neo4j", files)
+        environment = admin_environment(home)
         before = os.times()
         started = time.perf_counter()
-        result = subprocess.run(command, env=environment, capture_output=True, text=True)
+        result = subprocess.run(command, env=environment, cwd=home, capture_output=True, text=True)
         wall = time.perf_counter() - started
         after = os.times()
     if result.returncode != 0:
@@ -75,26 +77,13 @@ def importer_seconds(nodes: int, properties: int, edges: int) -> Import:
         after.children_system - before.children_system
     )
     done = parse_report(result.stdout)
+    if done is None:
+        raise SystemExit(f"the importer's report was not understood: {result.stdout[-300:]}")
     wanted = (nodes, edges, nodes * properties)
-    if done.imported != wanted:
-        raise SystemExit(f"the importer imported {done.imported}, not {wanted}")
-    return Import(wall, cpu, done.own, done.imported)
-
-
-def parse_report(stdout: str) -> Import:
-    """The importer's own time and counts from its closing report."""
-    took = re.search(r"IMPORT DONE in ((?:\d+h )?(?:\d+m )?(?:\d+s )?\d+ms)", stdout)
-    counts = [
-        re.search(rf"(\d+) {what}\b", stdout) for what in ("nodes", "relationships", "properties")
-    ]
-    if took is None or None in counts:
-        raise SystemExit(f"the importer's report was not understood: {stdout[-300:]}")
-    units = {"h": 3600.0, "m": 60.0, "s": 1.0, "ms": 0.001}
-    own = sum(
-        float(number) * units[unit] for number, unit in re.findall(r"(\d+)(h|ms|m|s)", took[1])
-    )
-    imported = tuple(int(match[1]) for match in counts if match is not None)
-    return Import(0.0, 0.0, own, (imported[0], imported[1], imported[2]))
+    imported = (done.nodes, done.relationships, done.properties)
+    if imported != wanted:
+        raise SystemExit(f"the importer imported {imported}, not {wanted}")
+    return Import(wall, cpu, done.seconds, imported)
 
 
 def print_bound(nodes: int, properties: int, edges: int, build: float) -> None:

@@ -8,16 +8,22 @@ and once as PromG's records (``peers.py``); then, interleaved (robotale, PromG, 
 PromG ...) on an emptied database of one private Neo4j with APOC (``peers.py``'s):
 
 - robotale: the process ``python -m robotale ingest LOG.csv --entities robot,msg_id
-  --aggregate activity`` from its start to its exit (reading the CSV, the build, the columnar
-  copy; the dashboard's pages are prepared afterwards by a process of their own, whose time
+  --aggregate activity --build BUILD`` from its start to its exit (reading the CSV, the build,
+  the columnar copy), run as a user runs it against robotale's own local server (the private
+  server is that server: its home is the ingest's robotale home, no ``NEO4J_URI``), so
+  ``--build auto`` (the default) takes the bulk path (Neo4j's offline importer, the server
+  stopped and started again) where the ingest would; the benchmark holds no connection to the
+  server while an ingest runs (another client keeps the bulk path from being taken); the
+  dashboard's pages are prepared afterwards by a process of their own, whose time
   until done is printed apart and awaited before the next build; with ``--pages visit`` none
   is started, which leaves the command's own work unchanged and keeps a large size's
   preparation from taking the machine between the timed runs);
 - PromG: the process ``peers_promg.py`` (PromG's import, records, events, entities, CORR, DF,
   classes, DF_A) from its start to its exit.
 
-Printed per size: each side's best wall time, its CPU time (the process and the Neo4j server,
-read from ``/proc``), PromG's time over robotale's, the peak memory of robotale's process, the
+Printed per size: each side's best wall time, its CPU time (the process with the importer it
+waits for, and the Neo4j server, read from ``/proc``, every server process the run saw),
+PromG's time over robotale's, the peak memory of robotale's process, the
 load average, and the graphs' counts side by side, checked equal where both build the same
 thing (events, entities, CORR, classes, OBSERVED).
 """
@@ -57,6 +63,7 @@ class Run:
     counts: dict[str, int] = field(default_factory=dict)
     peak_mb: float = 0.0
     pages: float | None = None
+    bulk: bool = False  # the ingest took the bulk path
 
 
 def main(
@@ -65,6 +72,7 @@ def main(
     heap: str,
     venv: Path | None = None,
     pages: str = "background",
+    build: str = "auto",
 ) -> int:
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
@@ -76,19 +84,55 @@ def main(
         os.environ["ROBOTALE_CACHE"] = str(cache_dir())
         (work / "robotale-home").mkdir()
         os.environ["ROBOTALE_HOME"] = str(work / "robotale-home")
-        if venv is not None:  # one that has PromG already
+        if venv == Path("none"):  # robotale's side only (e.g. the two build paths apart)
+            python, why_not = None, "--promg-venv none"
+        elif venv is not None:  # one that has PromG already
             python, why_not = venv / "bin" / "python", None
         else:
             python, why_not = peers.promg_environment(work / "venv")
-        with peers.private_neo4j(work, heap) as (driver, server):
+        with peers.private_neo4j(work, heap) as (shared, server):
+            shared.close()  # a connection held open would keep the ingest from the bulk path
+            driver = Reconnecting(server)
             for size in sizes:
-                measure(size, repeat, work, driver, server, python, why_not, pages)
+                measure(size, repeat, work, driver, server, python, why_not, pages, build)
+            driver.release()
     print(f"load average after: {os.getloadavg()[0]:.1f}")
     return 0
 
 
+class Reconnecting:
+    """A driver to the private server opened when first used and closed by :meth:`release`:
+    between an ingest's runs the benchmark holds no connection, and after an ingest that
+    replaced the database no bookmark of the old one."""
+
+    def __init__(self, server) -> None:
+        self.server, self.driver = server, None
+
+    def __getattr__(self, name: str):
+        if self.driver is None:
+            from robotale.ekg.connection import Settings, connect
+
+            running = self.server.running()
+            where = Settings(running.bolt_uri, "neo4j", self.server.password() or "", True)
+            self.driver = connect(where)
+        return getattr(self.driver, name)
+
+    def release(self) -> None:
+        if self.driver is not None:
+            self.driver.close()
+            self.driver = None
+
+
 def measure(
-    size: int, repeat: int, work: Path, driver, server, python, why_not, pages: str
+    size: int,
+    repeat: int,
+    work: Path,
+    driver,
+    server,
+    python,
+    why_not,
+    pages: str,
+    build: str = "auto",
 ) -> None:
     print(f"{size:,} events: load average {os.getloadavg()[0]:.1f} at the start", flush=True)
     log = synthetic_log(size)
@@ -97,12 +141,12 @@ def measure(
     ours: list[Run] = []
     theirs: list[Run] = []
     for _ in range(repeat):
-        ours.append(robotale_ingest(csv, driver, server, pages))
+        ours.append(robotale_ingest(csv, driver, server, pages, build))
         if python is not None:
             run, why_not = promg_whole(python, driver, server, log, work)
             if run is not None:
                 theirs.append(run)
-    report(size, ours, theirs, why_not, event_properties(log), pages)
+    report(size, ours, theirs, why_not, event_properties(log), pages, build)
 
 
 def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
@@ -114,8 +158,35 @@ def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
 
 def server_cpu(server) -> float:
     """CPU seconds the Neo4j server's process has used so far."""
-    running = server.running()
-    fields = Path(f"/proc/{running.pid}/stat").read_text().rsplit(")", 1)[1].split()
+    return process_cpu(server.running().pid)
+
+
+class ServerCpu:
+    """The CPU seconds the server's processes spend from now on: the last reading of each
+    process seen (one that ended keeps its last reading)."""
+
+    def __init__(self, server) -> None:
+        self.server = server
+        running = server.running()
+        self.start = {running.pid: process_cpu(running.pid)} if running else {}
+        self.last = dict(self.start)
+
+    def sample(self) -> None:
+        running = self.server.running()
+        if running is not None:
+            self.last[running.pid] = process_cpu(running.pid) or self.last.get(running.pid, 0.0)
+
+    def spent(self) -> float:
+        return sum(cpu - self.start.get(pid, 0.0) for pid, cpu in self.last.items())
+
+
+def process_cpu(pid: int) -> float:
+    """CPU seconds the process ``pid`` has used so far (0 when it is gone)."""
+    try:
+        stat = Path(f"/proc/{pid}/stat").read_text()
+    except OSError:
+        return 0.0
+    fields = stat.rsplit(")", 1)[1].split()
     return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
 
 
@@ -125,19 +196,23 @@ def children_cpu() -> float:
 
 
 def timed_process(command: list[str], server, **options) -> tuple[Run, int, str, str]:
-    """Run ``command`` to its end: its wall and CPU time, the server's CPU time meanwhile and
-    the process's peak resident memory (its high-water mark, read while it runs); its exit
+    """Run ``command`` to its end: its wall and CPU time, the server's CPU time meanwhile (of
+    every server process seen: a bulk ingest stops the server and starts a new one) and the
+    process's peak resident memory (its high-water mark, read while it runs); its exit
     status, stdout and stderr (in files: a full pipe would stop it)."""
     with tempfile.TemporaryFile("w+") as out, tempfile.TemporaryFile("w+") as err:
-        cpu, neo4j = children_cpu(), server_cpu(server)
+        cpu = children_cpu()
+        servers = ServerCpu(server)
         started = time.perf_counter()
         process = subprocess.Popen(command, stdout=out, stderr=err, text=True, **options)
         peak = 0.0
         while process.poll() is None:
             peak = max(peak, high_water_mb(process.pid))
+            servers.sample()
             time.sleep(0.05)
         wall = time.perf_counter() - started
-        run = Run(wall, children_cpu() - cpu, server_cpu(server) - neo4j, peak_mb=peak)
+        servers.sample()
+        run = Run(wall, children_cpu() - cpu, servers.spent(), peak_mb=peak)
         out.seek(0)
         err.seek(0)
         return run, process.returncode, out.read(), err.read()
@@ -153,22 +228,23 @@ def high_water_mb(pid: int) -> float:
     return int(found.group(1)) / 1024 if found else 0.0
 
 
-def robotale_ingest(csv: Path, driver, server, pages: str = "background") -> Run:
+def robotale_ingest(
+    csv: Path, driver, server, pages: str = "background", build: str = "auto"
+) -> Run:
     from robotale.results.background import done_file
 
     peers.clear(driver)
-    running = server.running()
-    environment = os.environ | {
-        "NEO4J_URI": running.bolt_uri,
-        "NEO4J_USER": "neo4j",
-        "NEO4J_PASSWORD": server.password() or "",
-        "ROBOTALE_PAGES": pages,
-    }
+    driver.release()
+    # the private server as robotale's own local server: its home is the ingest's
+    environment = {k: v for k, v in os.environ.items() if not k.startswith("NEO4J_")}
+    environment |= {"ROBOTALE_HOME": str(server.root), "ROBOTALE_PAGES": pages}
     command = [sys.executable, "-m", "robotale", "ingest", str(csv), "--log", "whole"]
     command += ["--entities", "robot,msg_id", "--aggregate", "activity", "--replace"]
+    command += ["--build", build]
     run, status, stdout, stderr = timed_process(command, server, env=environment)
     if status != 0:
         raise SystemExit(f"robotale ingest failed: {stderr.strip()}")
+    run.bulk = "neo4j-admin" in stdout
     # the graph the command built, counted before the pages' preparation adds the class
     # graph the Perspectives page shows (by activity and robot)
     run.counts = peers.counts(driver)
@@ -224,8 +300,10 @@ def report(
     why_not: str | None,
     properties: int,
     when: str = "background",
+    build: str = "auto",
 ) -> None:
     mine = best(ours)
+    path = "bulk path (neo4j-admin import)" if mine.bulk else "online path (Cypher batches)"
     if when == "visit":
         pages = "on first visit (--pages visit)"
     elif mine.pages is not None:
@@ -237,7 +315,8 @@ def report(
         f"{[round(r.wall, 1) for r in theirs]} (in turns)"
     )
     print(
-        f"\n{size:,} events, whole `robotale ingest` (CSV read to exit): {mine.wall:.1f} s wall, "
+        f"\n{size:,} events, whole `robotale ingest --build {build}` (CSV read to exit; took "
+        f"the {path}): {mine.wall:.1f} s wall, "
         f"{mine.cpu:.1f} s CPU (+ Neo4j {mine.server_cpu:.1f} s), peak memory "
         f"{mine.peak_mb:,.0f} MB; pages prepared {pages} (best of {len(ours)}; load "
         f"average {os.getloadavg()[0]:.1f})"

@@ -563,6 +563,14 @@ def _add_ingest(commands: argparse._SubParsersAction) -> None:
         help="add new runs (cases), or an object-centric log's new events, to a log that exists",
     )
     ingest.add_argument(
+        "--build",
+        metavar="HOW",
+        help="how the graph is written: online (Cypher batches, any server), bulk (Neo4j's "
+        "offline importer: only into an empty database of robotale's own local server, which "
+        "is stopped and started again meanwhile), or auto (the default: bulk for a large log "
+        "where it can be used, else online)",
+    )
+    ingest.add_argument(
         "--pages",
         metavar="WHEN",
         default=None,

@@ -3,12 +3,13 @@
 from __future__ import annotations
 
 import shlex
+import uuid
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
 
 from robotale.ekg.append import append_ekg
-from robotale.ekg.build import build_ekg
+from robotale.ekg.bulk import AUTO, BULK, build_log
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
 from robotale.ekg.disk_space import check_space
@@ -39,6 +40,7 @@ def ingest_command(
     objects: Path | None = None,
     skip_bad: bool = False,
     pages: str | None = None,
+    build: str = AUTO,
     **preparation: Any,
 ) -> int:
     """Store the log at ``path`` (CSV, XES, OCEL 2.0, Parquet, or recordings prepared as
@@ -46,9 +48,15 @@ def ingest_command(
     ``preparation`` holds the fields of :class:`~robotale.eventlog.options.PrepareOptions`
     (--tags, --actions, --auto ...). With ``append`` its runs are added to the stored log of
     that name. ``objects``: the folder of a CSV log's object tables (``<Type>.csv``). An
-    object-centric log's object types are its entity types unless ``entities`` names others."""
+    object-centric log's object types are its entity types unless ``entities`` names others.
+    ``build``: how a new log's graph is written (:func:`~robotale.ekg.bulk.build_log`)."""
     if append and replace:
         raise InputError("--append adds runs to a log and --replace rebuilds it: give one.")
+    if append and build == BULK:
+        raise InputError(
+            "--build bulk writes a new log into an empty database and --append adds runs to a "
+            "stored one: give one."
+        )
     pages = pages_when(pages)
     if log is not None and not log.strip():
         raise InputError(
@@ -75,7 +83,9 @@ def ingest_command(
         chosen = found_objects.entity_types
     names = {"entities": chosen}
     keys = aggregate or default_keys(events, chosen)
-    with session_driver() as driver:
+    # the bulk build tells this process's own connections from other clients' by it
+    agent = f"robotale-ingest/{uuid.uuid4().hex}"
+    with session_driver(user_agent=agent) as driver:
         entity_columns = chosen if chosen is not None else default_entities(events.columns)
         check_space(driver, events, name, entity_columns, len(keys))
         if append:
@@ -87,10 +97,12 @@ def ingest_command(
                 else append_objects(driver, events, name, found_objects, aggregate=aggregate)
             )
         else:
-            summary = build_ekg(
+            summary = build_log(
                 driver,
                 events,
                 name,
+                build=build,
+                user_agent=agent,
                 aggregate=keys,
                 replace=replace,
                 source=str(path),
@@ -98,6 +110,8 @@ def ingest_command(
                 **names,
             )
         print(describe(summary, appended=append))
+    # a bulk build restarted the server: new connections, with no bookmarks of the old store
+    with session_driver() as driver:
         if opened.kind is RECORDINGS:
             # the Mission page's map: the simulated runs' fields, bases and objects
             keep_sites(driver, name, run_sites(path))

@@ -92,6 +92,7 @@ def build_ekg(
     source: str = "",
     progress: bool = True,
     objects: Objects | None = None,
+    prepared: Prepared | None = None,
 ) -> BuildSummary:
     """Store ``log`` (a canonical event log) in Neo4j as the EKG named ``name``.
 
@@ -101,15 +102,11 @@ def build_ekg(
     Class nodes and DF_C edges. An existing log of that name is refused unless ``replace``.
     ``objects``: the objects of an object-centric log (their attributes, qualifiers and
     relations, :mod:`robotale.ekg.objects`), written with the log and undone with it.
+    ``prepared``: the tables :func:`prepare` computed of these arguments already.
     """
     started = time.perf_counter()
-    check_log_name(name)
-    chosen = default_entities(log.columns) if entities is None else list(entities)
-    tables = graph_tables(log, chosen)
-    keys = unique_keys(aggregate)
-    check_keys(tables.events, keys)
-    check_key_sizes(tables, keys)
-    classes = [class_tables(tables, key) for key in keys]
+    prepared = prepared or prepare(log, entities, aggregate, name)
+    chosen, tables, classes = prepared.entity_types, prepared.tables, prepared.classes
     ensure_schema(driver)
     # Checked under the lock: another ingest of this name may have finished a moment ago.
     with log_write_lock(driver, name, "ingesting") as run:
@@ -124,6 +121,31 @@ def build_ekg(
         # under the lock: no other build of this name can come between the graph and its copy
         store_copy(driver, name, log)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
+
+
+@dataclass(frozen=True)
+class Prepared:
+    """A log checked and turned into the tables of its graph, before Neo4j is touched."""
+
+    entity_types: list[str]
+    tables: GraphTables
+    classes: list[ClassTables]
+
+
+def prepare(
+    log: pd.DataFrame,
+    entities: Sequence[str] | None,
+    aggregate: Sequence[str | Sequence[str]],
+    name: str,
+) -> Prepared:
+    """Check ``log`` and its name and compute its graph's tables (bad input is refused here)."""
+    check_log_name(name)
+    chosen = default_entities(log.columns) if entities is None else list(entities)
+    tables = graph_tables(log, chosen)
+    keys = unique_keys(aggregate)
+    check_keys(tables.events, keys)
+    check_key_sizes(tables, keys)
+    return Prepared(chosen, tables, [class_tables(tables, key) for key in keys])
 
 
 def unique_keys(aggregate: Sequence[str | Sequence[str]]) -> list[list[str]]:
@@ -297,18 +319,25 @@ def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> Bu
             write_df_c(loader, classes, nodes)
         if job.objects is not None:
             write_objects(loader, job.objects, [property_name(t) for t in job.entity_types])
-    for classes in job.classes:
-        driver.execute_query(
-            cypher("ekg_log_add_class_type"), log=target, type=classes.type, database_=database()
-        )
     between_batches()
+    finish_log(driver, target, events, job.classes)
+    return summarise(target, tables, job.classes)
+
+
+def finish_log(
+    driver: Driver, log: str, events: pd.DataFrame, classes: Sequence[ClassTables]
+) -> None:
+    """Record the log's class types and summary on its Log node and mark it complete."""
+    for kind in classes:
+        driver.execute_query(
+            cypher("ekg_log_add_class_type"), log=log, type=kind.type, database_=database()
+        )
     driver.execute_query(
         cypher("ekg_log_finish"),
-        log=target,
+        log=log,
         summary={"events": len(events)} | log_values(events),
         database_=database(),
     )
-    return summarise(target, tables, job.classes)
 
 
 def summarise(log: str, tables: GraphTables, classes: Sequence[ClassTables]) -> BuildSummary:

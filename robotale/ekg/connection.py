@@ -61,12 +61,14 @@ def settings() -> Settings:
     return Settings(f"bolt://{HOST}:{port}", USER, server.password() or "", False)
 
 
-def connect(where: Settings | None = None) -> Driver:
-    """A driver for the server that answers; a :class:`ServerError` saying what to do if not."""
+def connect(where: Settings | None = None, user_agent: str | None = None) -> Driver:
+    """A driver for the server that answers; a :class:`ServerError` saying what to do if not.
+    ``user_agent`` names its connections to the server (see :func:`client_connections`)."""
     where = where or settings()
     if not where.from_env:
         _require_local_server()
-    driver = GraphDatabase.driver(where.uri, auth=where.auth, connection_timeout=5)
+    named = {"user_agent": user_agent} if user_agent else {}
+    driver = GraphDatabase.driver(where.uri, auth=where.auth, connection_timeout=5, **named)
     try:
         driver.verify_connectivity()
     except AuthError:
@@ -82,9 +84,11 @@ def connect(where: Settings | None = None) -> Driver:
 
 
 @contextmanager
-def session_driver(where: Settings | None = None) -> Iterator[Driver]:
+def session_driver(
+    where: Settings | None = None, user_agent: str | None = None
+) -> Iterator[Driver]:
     """:func:`connect` as a context manager that closes the driver."""
-    driver = connect(where)
+    driver = connect(where, user_agent)
     try:
         yield driver
     finally:
@@ -134,6 +138,11 @@ def read_rows(driver: Driver, query: str, **parameters: Any) -> list[dict[str, A
         query, parameters, database_=database(), routing_=RoutingControl.READ
     )
     return [record.data() for record in records]
+
+
+def client_connections(driver: Driver, user_agent: str) -> list[dict[str, Any]]:
+    """The server's client connections other than those named ``user_agent``."""
+    return read_rows(driver, cypher("ekg_client_connections"), agent=user_agent)
 
 
 def server_version(driver: Driver) -> dict[str, Any]:

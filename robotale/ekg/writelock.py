@@ -90,15 +90,26 @@ def log_write_lock(driver: Driver, name: str, doing: str = "writing") -> Iterato
     when the block ends, also on failure; if Neo4j is gone by then, the lock stays and is
     recognised as stale later (its writer has ended).
     """
-    run = _take(driver, name, doing)
+    run = take(driver, name, doing)
     try:
         yield run
     finally:
-        _ACTIVE.discard(run)
-        # If Neo4j is gone the lock stays; its run is no longer active, so it counts as stale.
-        with suppress(Neo4jError, DriverError, OSError), driver.session(database=database()) as s:
-            # One attempt: managed retries against a server that is gone take half a minute.
-            s.run(cypher("ekg_lock_release"), name=name, run=run).consume()
+        release(driver, name, run)
+
+
+def take(driver: Driver, name: str, doing: str = "writing") -> str:
+    """Take the write lock of ``name`` (as :func:`log_write_lock` does); returns the run's
+    id, which :func:`release` needs: for a writer whose driver changes meanwhile."""
+    return _take(driver, name, doing)
+
+
+def release(driver: Driver, name: str, run: str) -> None:
+    """Give back the lock of ``name`` that ``run`` holds, if it still does."""
+    _ACTIVE.discard(run)
+    # If Neo4j is gone the lock stays; its run is no longer active, so it counts as stale.
+    with suppress(Neo4jError, DriverError, OSError), driver.session(database=database()) as s:
+        # One attempt: managed retries against a server that is gone take half a minute.
+        s.run(cypher("ekg_lock_release"), name=name, run=run).consume()
 
 
 def _take(driver: Driver, name: str, doing: str) -> str:

@@ -67,7 +67,8 @@ DEFAULT_HTTP_PORT = 7474
 PORT_WAIT = 60.0
 #: the classes that run a server, one per release (a running server is known by its own)
 ENTRY_POINTS = frozenset(release.entry_point for release in RELEASES.values())
-_ADMIN_TOOL = "org.neo4j.cli.AdminTool"
+#: Neo4j's command-line entry point (what the ``neo4j-admin`` script starts)
+ADMIN_TOOL = "org.neo4j.cli.AdminTool"
 # The JVM options of Neo4j's own launcher (we start java directly, so we pass them ourselves).
 _JVM_OPTIONS = (
     "-XX:+UseG1GC",
@@ -156,6 +157,8 @@ class LocalServer:
         self.overlay_file = self.root / OVERLAY_NAME
         self.state_file = self.home / "server.json"
         self.ports_file = self.home / "ports.json"
+        #: the options of the last start: a restart (around an offline import) keeps them
+        self.options_file = self.home / "options.json"
         self.password_file = self.home / "password"
         #: the Neo4j version that created ``data/``: another one is not started on it
         self.version_file = self.home / "version"
@@ -206,6 +209,14 @@ class LocalServer:
             bolt_port=options.bolt_port if "ROBOTALE_NEO4J_BOLT_PORT" in env else record.bolt_port,
             http_port=options.http_port if "ROBOTALE_NEO4J_HTTP_PORT" in env else record.http_port,
         )
+
+    def running_options(self) -> ServerOptions:
+        """The options the last start used (:meth:`recorded_options` when none are kept)."""
+        if not self.options_file.is_file():
+            return self.recorded_options()
+        kept = json.loads(self.options_file.read_text())
+        plugins = kept.pop("plugins", None)
+        return ServerOptions(**kept, plugins=Path(plugins) if plugins else None)
 
     def password(self) -> str | None:
         return self.password_file.read_text().strip() if self.password_file.is_file() else None
@@ -278,6 +289,8 @@ class LocalServer:
         process = self._launch(java, classpath, options, chosen, overlay.jvm_options)
         state = RunningServer(process.pid, options.bolt_port, options.http_port)
         write_file(self.state_file, json.dumps(asdict(state)))
+        kept = asdict(options) | {"plugins": str(options.plugins) if options.plugins else None}
+        write_file(self.options_file, json.dumps(kept))
         self._record(state, stopped=False)
         try:
             self._wait_until_answering(process, state, timeout)
@@ -399,7 +412,7 @@ class LocalServer:
         env = {**os.environ, "NEO4J_HOME": str(self.home), "NEO4J_CONF": str(self.home / "conf")}
         result = subprocess.run(
             # "--": a password may begin with "-" (token_urlsafe's do, now and then).
-            [java, "-cp", f"{lib}/*", _ADMIN_TOOL, "dbms", "set-initial-password", "--", password],
+            [java, "-cp", f"{lib}/*", ADMIN_TOOL, "dbms", "set-initial-password", "--", password],
             env=env,
             capture_output=True,
             text=True,
