@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys
+from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys, sorted_distinct
 from robotale.enhancement.delays import delay_rule, delayed, slow_mode_starts
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.followed import what_followed
@@ -720,7 +720,7 @@ def _joined(deliveries: pd.DataFrame, keys: list[str], column: str) -> pd.Series
     rank = np.empty(len(names), dtype=np.int64)
     rank[np.argsort(names, kind="stable")] = np.arange(len(names))
     # each (message, value) once, messages in key order and values in text order within one
-    pairs = np.unique(message[message >= 0] * len(names) + rank[codes[message >= 0]])
+    pairs = sorted_distinct(message[message >= 0] * len(names) + rank[codes[message >= 0]])
     labels = np.sort(names)[pairs % len(names)] + ", "
     joined = pd.Series(labels, dtype=object).groupby(pairs // len(names)).sum()
     return pd.Series(joined.str.slice(stop=-2).to_numpy(object), index=grouped.size().index)
