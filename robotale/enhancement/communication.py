@@ -48,7 +48,7 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 
-from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys
+from robotale.enhancement.context import LogAnalysis, analysis_of, row_keys, sorted_distinct
 from robotale.enhancement.delays import delay_rule, delayed, slow_mode_starts
 from robotale.enhancement.effects import compare_cases
 from robotale.enhancement.followed import what_followed
@@ -496,8 +496,9 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
         if kind == ARRIVED:  # ``row`` reached ``robot``: an answer to its messages
             if isinstance(robot, str) and robot != UNKNOWN:  # most steps: one named robot
                 theirs = in_case.get(robot)
-                if theirs and robot != senders[row]:
-                    _answered(theirs, senders[row], receivers)
+                if theirs and robot != (sender := senders[row]):
+                    # :func:`_answered`, written out: the walk's most frequent step
+                    theirs[:] = [a for a in theirs if receivers[a] and sender not in receivers[a]]
             else:
                 _answer(in_case, senders[row], robot, receivers)
             continue
@@ -510,6 +511,9 @@ def _repeated(table: pd.DataFrame, deliveries: pd.DataFrame) -> tuple[pd.Series,
             mine = in_case[sender] = []
         if mine:
             mine[:] = [a for a in mine if received_at[a] > at or unheard.get(a) == receivers[a]]
+        if not mine:  # most sends: nothing of the sender's is waiting for an answer
+            mine.append(row)
+            continue
         candidates = [
             a
             for a in mine
@@ -578,10 +582,23 @@ def _possible_receivers(table: pd.DataFrame) -> list[frozenset]:
     robots that received its sender's other messages of its type (a message nobody got may
     have been meant for any of them), else none known."""
     # each distinct receiver text split once (a log has a few, on many messages)
-    codes, uniques = pd.factorize(table["receiver"].astype(object), use_na_sentinel=False)
+    codes, uniques = pd.factorize(_as_values(table["receiver"]), use_na_sentinel=False)
     sets = [_receiver_set(r) for r in uniques.tolist()]
+    if table["sender"].isna().any() or table[TYPE].isna().any():
+        # a missing sender or type is a key of its own object: worked out per message
+        return _usual_receivers(table["sender"].tolist(), table[TYPE].tolist(), sets, codes)
+    # worked out once per distinct sender, type and receiver (a log has a few, many times)
+    pair = row_keys([table["sender"], table[TYPE]], [])[0]  # no value missing: never None
+    combination = pd.factorize(pair * (len(sets) + 1) + codes)[0]
+    firsts = pd.Series(combination).drop_duplicates().index.to_numpy()
+    found = _usual_receivers(pair[firsts].tolist(), [None] * len(firsts), sets, codes[firsts])
+    return [found[c] for c in combination.tolist()]
+
+
+def _usual_receivers(senders: list, kinds: list, sets: list[frozenset], codes) -> list[frozenset]:
+    """Per message (its sender, type and receiver's code in ``sets``), its receivers, else the
+    receivers of its sender's messages of its type."""
     named = [sets[c] for c in codes.tolist()]
-    senders, kinds = table["sender"].tolist(), table[TYPE].tolist()
     usual: dict[tuple, frozenset] = {}
     for sender, kind, robots in zip(senders, kinds, named, strict=True):
         if robots:
@@ -606,6 +623,11 @@ def _naming_payloads(table: pd.DataFrame) -> list[bool]:
     frame["again"] = frame["payload"].notna() & frame.duplicated(keep=False)
     again = frame.groupby(["sender", "type"], dropna=False)["again"].transform("any")
     return again.to_numpy(bool).tolist()
+
+
+def _as_values(column: pd.Series) -> pd.Series:
+    """A text column as it is (factorised at once), another as Python objects."""
+    return column if isinstance(column.dtype, pd.StringDtype) else column.astype(object)
 
 
 def _other_payload(payloads, earlier: int, later: int, types) -> bool:
@@ -720,7 +742,7 @@ def _joined(deliveries: pd.DataFrame, keys: list[str], column: str) -> pd.Series
     rank = np.empty(len(names), dtype=np.int64)
     rank[np.argsort(names, kind="stable")] = np.arange(len(names))
     # each (message, value) once, messages in key order and values in text order within one
-    pairs = np.unique(message[message >= 0] * len(names) + rank[codes[message >= 0]])
+    pairs = sorted_distinct(message[message >= 0] * len(names) + rank[codes[message >= 0]])
     labels = np.sort(names)[pairs % len(names)] + ", "
     joined = pd.Series(labels, dtype=object).groupby(pairs // len(names)).sum()
     return pd.Series(joined.str.slice(stop=-2).to_numpy(object), index=grouped.size().index)

@@ -11,6 +11,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import START_TIMESTAMP
+from robotale.enhancement.context import sorted_distinct
 from robotale.enhancement.performance import ARROW
 from robotale.eventlog.schema import ACTIVITY, TIMESTAMP
 
@@ -28,7 +29,7 @@ def what_followed(
     times = _nanoseconds(moments[at])
     # one sorted key per instance: its block, then its start's rank among all starts, so one
     # binary search finds a moment's first instance that starts after it
-    distinct = np.unique(starts)
+    distinct = sorted_distinct(starts)
     width = len(distinct) + 1
     order = np.lexsort((np.arange(len(block)), starts, block))
     keys = block[order] * width + np.searchsorted(distinct, starts[order])

@@ -243,11 +243,17 @@ def variant_summary(variants: pd.DataFrame, seconds: str, by_robot: bool = False
 def activity_durations(instances: pd.DataFrame) -> pd.DataFrame:
     """Per activity and robot: how many instances and their mean, median, max, total duration
     (working time only)."""
-    keys = [ACTIVITY] + ([ROBOT] if ROBOT in instances.columns else [])
-    grouped = instances.groupby(keys, sort=True, dropna=False)
-    table = grouped[DURATION].agg(["count", "mean", "median", "max", "sum"])
+    keys = [instances[k] for k in [ACTIVITY] + ([ROBOT] if ROBOT in instances.columns else [])]
     # an instance that ended aborted or cancelled is counted, and said to be interrupted
-    table["interrupted"] = interrupted(instances).groupby([instances[k] for k in keys]).sum()
+    stopped = interrupted(instances)
+    # one grouping for both columns: the keys factorised once
+    both = pd.DataFrame({DURATION: instances[DURATION], "interrupted": stopped})
+    grouped = both.groupby(keys, sort=True, dropna=False)
+    table = grouped[DURATION].agg(["count", "mean", "median", "max", "sum"])
+    if any(key.isna().any() for key in keys):  # a group with a missing key has no count
+        table["interrupted"] = stopped.groupby(keys).sum()
+    else:
+        table["interrupted"] = grouped["interrupted"].sum()
     table = table.rename(columns={"sum": "total"}).reset_index()
     return table.rename(columns={ACTIVITY: "activity"})
 

@@ -99,3 +99,20 @@ def test_figures_are_drawn_once_and_only_when_read():
     assert list(figures) == ["a", "b"] and drawn == []
     assert figures["a"] == "A" and figures["a"] == "A" and drawn == ["a"]
     assert dict(figures) == {"a": "A", "b": "B"} and drawn == ["a"]
+
+
+@pytest.mark.parametrize(
+    "values",
+    [
+        np.array([], dtype=np.int64),
+        np.array([7], dtype=np.int64),
+        np.array([3, -1, 3, 2, np.iinfo(np.int64).min, 2], dtype=np.int64),
+        np.random.default_rng(5).integers(0, 50, 1_000),
+        np.random.default_rng(6).random(500),
+    ],
+)
+def test_sorted_distinct_is_numpys_unique(values):
+    found = context.sorted_distinct(values)
+    expected = np.unique(values)
+    assert found.dtype == expected.dtype
+    np.testing.assert_array_equal(found, expected)

@@ -136,3 +136,26 @@ def test_variants_per_case_and_per_robot_equal_pm4py(paths):
     durations = pm4py.get_all_case_durations(ordered)  # first to last event of each case
     assert sorted(result.tables["cases"]["duration"]) == pytest.approx(sorted(durations))
     assert result.summary["variants"] == len(expected)
+
+
+def test_activity_durations_count_interrupted_instances_by_hand():
+    """Two instances of a by r1, one interrupted (XES' ate_abort); b's robot is missing, so
+    its group has durations but no interrupted count, as a group-by that drops it gives."""
+    from robotale.enhancement.performance import activity_durations
+
+    instances = pd.DataFrame(
+        {
+            "concept:name": pd.array(["a", "b", "a", "c"], dtype="string"),
+            ROBOT: pd.array(["r1", None, "r1", "r2"], dtype="string"),
+            "duration": [1.0, 2.0, 3.0, 4.0],
+            "lifecycle:transition": pd.array(
+                ["complete", "ate_abort", "ate_abort", "Complete"], dtype="string"
+            ),
+        }
+    )
+    table = activity_durations(instances).set_index(["activity", "robot"])
+    assert table.loc[("a", "r1"), ["count", "total", "interrupted"]].tolist() == [2, 4.0, 1]
+    assert table.loc[("c", "r2"), "interrupted"] == 0
+    assert pd.isna(table.loc[("b", pd.NA), "interrupted"]) and table.loc[("b", pd.NA), "count"] == 1
+    whole = activity_durations(instances.dropna())
+    assert whole["interrupted"].dtype == "int64" and whole["interrupted"].tolist() == [1, 0]
