@@ -1,5 +1,7 @@
 """``robotale monitor``: watch live robots over DDS, storing each tag in Neo4j as it arrives
-(the live run's log grows while the run goes on) and raising alerts printed, stored and
+and, every second, the events heard since as an append to the live run's event knowledge
+graph (the log grows while the run goes on, and is complete when the watch ends); keeping the
+robots' odometry at a bounded rate for the map; and raising alerts printed, stored and
 published on ``/robotale/alerts``."""
 
 from __future__ import annotations
@@ -18,7 +20,8 @@ from neo4j import Driver
 from robotale.discovery.online import PoolReplay, pool_replays
 from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import session_driver
-from robotale.ekg.live import Alert, LiveLog
+from robotale.ekg.growing import GrowingLog
+from robotale.ekg.live import Alert, LiveLog, Pose
 from robotale.enhancement.overdue import MessageLimits, Overdue, duration_limits
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Envelope
@@ -29,16 +32,22 @@ from robotale.fame_runtime.node import KEEP_ALL
 from robotale.fame_runtime.processes import interrupts
 from robotale.fame_runtime.qos import DEFAULT_QOS
 from robotale.fame_runtime.tags import START, TAG_TYPE, Tag, tag_line, tag_topic
+from robotale.results.live import tags_events
 from robotale.thresholds import LOW_BATTERY_PERCENT
 
 #: where alerts are published, as JSON text in a std_msgs/msg/String
 ALERT_TOPIC = "/robotale/alerts"
 ALERT_TYPE = "std_msgs/msg/String"
 BATTERY_TYPE = "sensor_msgs/msg/BatteryState"
-#: what a battery reader asks for: any writer's samples, reliable or not
+ODOMETRY_TYPE = "nav_msgs/msg/Odometry"
+#: what a battery or odometry reader asks for: any writer's samples, reliable or not
 BATTERY_QOS = replace(DEFAULT_QOS, reliability="best_effort")
-#: seconds between two looks at the robots' silence
+#: seconds between two looks at the robots' silence (and two stores of odometry samples)
 TICK = 0.1
+#: seconds between two appends to the live run's event knowledge graph
+BATCH = 1.0
+#: odometry samples kept per robot and second, at most (a robot may publish far more)
+ODOMETRY_RATE = 10.0
 
 
 @dataclass(frozen=True)
@@ -62,8 +71,16 @@ class Monitor:
         replays: dict[str, PoolReplay],
         limits: Limits,
         out: TextIO,
+        graph: GrowingLog | None = None,
     ) -> None:
         self.bus, self.live, self.out = bus, live, out
+        #: the live run's event knowledge graph, appended to every BATCH seconds
+        self.graph = graph
+        self.tags: list[Tag] = []
+        self.appended, self.last_append = 0, bus.clock.now()
+        #: odometry samples not stored yet, and when each robot's next one is kept
+        self.poses: list[Pose] = []
+        self.pose_due: dict[str, float] = {}
         self.silence, self.battery, self.limits = limits.silence, limits.battery, limits
         self.timing = Timing(limits)
         self.low: set[str] = set()
@@ -80,6 +97,12 @@ class Monitor:
                 msgtype=BATTERY_TYPE,
                 qos=BATTERY_QOS,
             )
+            bus.subscribe(
+                f"/{robot}/odom",
+                functools.partial(self._odometry, robot),
+                msgtype=ODOMETRY_TYPE,
+                qos=BATTERY_QOS,
+            )
         # written now, so readers match it before the first alert; kept for late joiners
         bus.writer(ALERT_TOPIC, ALERT_TYPE, KEEP_ALL, "monitor")
 
@@ -88,6 +111,7 @@ class Monitor:
         if tag.robot not in self.heard:
             return  # a tag published on a robot's topic under another name: not this run's
         self.live.append(tag)
+        self.tags.append(tag)
         self.heard[tag.robot] = self.bus.clock.now()
         self.silent.discard(tag.robot)
         print(tag_line(tag, self.begin), file=self.out, flush=True)
@@ -109,6 +133,32 @@ class Monitor:
             self.low.add(robot)
             text = f"{robot}'s battery at {percent:.1f} %, below {self.battery:g} %"
             self.raise_alert(Alert(self.bus.clock.now(), "battery", robot, text))
+
+    def _odometry(self, robot: str, envelope: Envelope) -> None:
+        """Keep the sample if the robot's last kept one is 1/ODOMETRY_RATE s older."""
+        pose = odometry_pose(robot, envelope)
+        if pose.stamp < self.pose_due.get(robot, float("-inf")) - 1e-9:
+            return
+        self.pose_due[robot] = pose.stamp + 1.0 / ODOMETRY_RATE
+        self.poses.append(pose)
+
+    def store(self, *, final: bool = False) -> None:
+        """Store the odometry samples kept since the last store and, every BATCH seconds (or
+        at the end), append the events heard since the last append to the live graph."""
+        poses, self.poses = self.poses, []
+        self.live.poses(poses)
+        now = self.bus.clock.now()
+        due = final or now - self.last_append >= BATCH
+        if self.graph is None or not due or len(self.tags) == self.appended:
+            return
+        self.graph.update(tags_events(self.live.name, self.tags))
+        self.appended, self.last_append = len(self.tags), now
+
+    def finish(self) -> None:
+        """The watch ended: the last events appended, the live graph complete."""
+        self.store(final=True)
+        if self.graph is not None:
+            self.graph.finish()
 
     def watch(self) -> None:
         """Alert once for each robot silent longer than the limit (again after it spoke)."""
@@ -133,6 +183,23 @@ class Monitor:
     def pump(self, seconds: float) -> None:
         self.bus.clock.run(until=self.bus.clock.now() + seconds)
         self.watch()
+        self.store()
+
+
+def odometry_pose(robot: str, envelope: Envelope) -> Pose:
+    """Where a nav_msgs/msg/Odometry sample puts ``robot``, at the sample's own stamp (its
+    arrival when its header has none)."""
+    data = envelope.data
+    stamp = data.get("header", {}).get("stamp", {})
+    seconds = float(stamp.get("sec", 0)) + float(stamp.get("nanosec", 0)) / 1e9
+    at = data.get("pose", {}).get("pose", {}).get("position", {})
+    return Pose(
+        seconds or envelope.stamp,
+        robot,
+        float(at.get("x", 0.0)),
+        float(at.get("y", 0.0)),
+        float(at.get("z", 0.0)),
+    )
 
 
 class Timing:
@@ -214,9 +281,11 @@ def monitor_command(
     stopped = threading.Event()
     with session_driver() as driver:
         limits = Limits(silence, battery, messages, earlier_durations(driver, durations_from or []))
+        # refused here, before anything is stored, when --log names a log no monitor wrote
+        graph = GrowingLog(driver, log)
         bus = DdsBus(WallClock(offset=0.0), node="monitor")
         try:
-            monitor = Monitor(bus, LiveLog(driver, log), replays, limits, out)
+            monitor = Monitor(bus, LiveLog(driver, log), replays, limits, out, graph)
             # Ctrl-C or SIGTERM ends the watch between two tags, never inside a store
             with interrupts(stopped.set):
                 print(
@@ -225,10 +294,17 @@ def monitor_command(
                     flush=True,
                 )
                 while time.monotonic() < deadline and not stopped.is_set():
-                    monitor.pump(min(TICK, max(0.0, deadline - time.monotonic())))
+                    try:
+                        monitor.pump(min(TICK, max(0.0, deadline - time.monotonic())))
+                    except KeyboardInterrupt:  # during an append, which was rolled back
+                        stopped.set()
                 bus.drain()
                 monitor.pump(TICK)
+                monitor.finish()
         finally:
             bus.close()
-    print(f"# {log}: {monitor.live.count} tags stored", file=err)
+            graph.close()
+    print(
+        f"# {log}: {monitor.live.count} tags stored, {graph.events} events in its graph", file=err
+    )
     return 0
