@@ -11,6 +11,7 @@ import json
 import sys
 import threading
 import time
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import TextIO
@@ -78,6 +79,10 @@ class Monitor:
         self.graph = graph
         self.tags: list[Tag] = []
         self.appended, self.last_append = 0, bus.clock.now()
+        # appends run on a thread of their own: DDS keeps being read while one is written,
+        # and Ctrl-C reaches the watch's own handler, not the append's deferred one
+        self.appender = ThreadPoolExecutor(max_workers=1)
+        self.appending: Future[int] | None = None
         #: odometry samples not stored yet, and when each robot's next one is kept
         self.poses: list[Pose] = []
         self.pose_due: dict[str, float] = {}
@@ -147,18 +152,32 @@ class Monitor:
         at the end), append the events heard since the last append to the live graph."""
         poses, self.poses = self.poses, []
         self.live.poses(poses)
+        if self.graph is None:
+            return
+        if self.appending is not None:
+            if not (final or self.appending.done()):
+                return  # the last append is still being written
+            self.appending.result()  # a failed append's error ends the watch
+            self.appending = None
         now = self.bus.clock.now()
         due = final or now - self.last_append >= BATCH
-        if self.graph is None or not due or len(self.tags) == self.appended:
+        if not due or len(self.tags) == self.appended:
             return
-        self.graph.update(tags_events(self.live.name, self.tags))
-        self.appended, self.last_append = len(self.tags), now
+        heard, graph, name = list(self.tags), self.graph, self.live.name
+        self.appending = self.appender.submit(lambda: graph.update(tags_events(name, heard)))
+        self.appended, self.last_append = len(heard), now
+        if final:
+            self.appending.result()
+            self.appending = None
 
     def finish(self) -> None:
         """The watch ended: the last events appended, the live graph complete."""
-        self.store(final=True)
-        if self.graph is not None:
-            self.graph.finish()
+        try:
+            self.store(final=True)
+            if self.graph is not None:
+                self.graph.finish()
+        finally:
+            self.appender.shutdown()
 
     def watch(self) -> None:
         """Alert once for each robot silent longer than the limit (again after it spoke)."""
@@ -294,10 +313,7 @@ def monitor_command(
                     flush=True,
                 )
                 while time.monotonic() < deadline and not stopped.is_set():
-                    try:
-                        monitor.pump(min(TICK, max(0.0, deadline - time.monotonic())))
-                    except KeyboardInterrupt:  # during an append, which was rolled back
-                        stopped.set()
+                    monitor.pump(min(TICK, max(0.0, deadline - time.monotonic())))
                 bus.drain()
                 monitor.pump(TICK)
                 monitor.finish()

@@ -6,12 +6,10 @@ activity completes); it is listed as live while it grows and complete once finis
 
 from __future__ import annotations
 
-from collections import Counter
-
 import pytest
+from ekg_graph import graph
 
 from robotale.ekg.build import build_ekg
-from robotale.ekg.connection import database
 from robotale.ekg.growing import GrowingLog
 from robotale.ekg.keys import built_keys, default_entities
 from robotale.ekg.logs import delete_log, list_logs, log_info, stored_events
@@ -32,61 +30,6 @@ BATCHES = [
     [Tag(T0 + 3.5, "rover", "survey", "complete"), Tag(T0 + 4.0, "drone", "scan", "complete")],
     [Tag(T0 + 4.0, "rover", "dock", "start")],
 ]
-
-
-def graph(driver, name: str) -> dict:
-    """The log's graph without Neo4j's internal ids: events with their properties, and every
-    CORR, DF, COMM, OBSERVED, DF_C and BEGINS edge by the ids of its ends."""
-
-    def rows(text: str) -> list[dict]:
-        records, _, _ = driver.execute_query(text, log=name, database_=database())
-        return [r.data() for r in records]
-
-    events = rows("MATCH (e:Event {log: $log}) RETURN e.id AS id, properties(e) AS p")
-    return {
-        "events": {r["id"]: {k: v for k, v in r["p"].items() if k != "log"} for r in events},
-        "corr": Counter(
-            tuple(r.values())
-            for r in rows(
-                "MATCH (e:Event {log: $log})-[:CORR]->(n:Entity) RETURN e.id, n.type, n.id"
-            )
-        ),
-        "df": Counter(
-            tuple(r.values())
-            for r in rows(
-                "MATCH (a:Event {log: $log})-[r:DF]->(b) "
-                "RETURN a.id, b.id, r.entityType, r.entityId"
-            )
-        ),
-        "comm": Counter(
-            tuple(r.values())
-            for r in rows("MATCH (a:Event {log: $log})-[r:COMM]->(b) RETURN a.id, b.id, r.msgId")
-        ),
-        "observed": Counter(
-            tuple(r.values())
-            for r in rows(
-                "MATCH (e:Event {log: $log})-[:OBSERVED]->(c:Class) RETURN e.id, c.type, c.id"
-            )
-        ),
-        "df_c": Counter(
-            (r["a"], r["b"], r["t"], r["k"], r["n"], round(r["mean"], 9), round(r["median"], 9))
-            for r in rows(
-                "MATCH (a:Class {log: $log})-[r:DF_C]->(b) RETURN a.id AS a, b.id AS b, "
-                "a.type AS t, r.entityType AS k, r.count AS n, r.meanSeconds AS mean, "
-                "r.medianSeconds AS median"
-            )
-        ),
-        "begins": Counter(
-            tuple(r.values())
-            for r in rows(
-                "MATCH (n:Entity {log: $log})-[r:BEGINS]->(c:Class) "
-                "RETURN n.type, n.id, c.type, c.id, r.cases"
-            )
-        ),
-        "entities": Counter(
-            tuple(r.values()) for r in rows("MATCH (n:Entity {log: $log}) RETURN n.type, n.id")
-        ),
-    }
 
 
 @pytest.fixture
