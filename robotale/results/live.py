@@ -11,7 +11,6 @@ looks at how many tags and samples are stored; the run is rebuilt only when that
 from __future__ import annotations
 
 import dataclasses
-import math
 import threading
 from collections.abc import Sequence
 from dataclasses import dataclass, field
@@ -25,7 +24,8 @@ from robotale.ekg.live import Pose, live_poses, live_tags
 from robotale.enhancement.mission import MissionRun
 from robotale.eventlog import schema
 from robotale.eventlog.prepare import tags_log
-from robotale.fame_runtime.tags import Tag, tag_topic
+from robotale.eventlog.runs import robot_type
+from robotale.fame_runtime.tags import Tag, tag_nanoseconds, tag_topic
 from robotale.queries import cypher
 from robotale.results.replay import Replay
 
@@ -80,7 +80,7 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
     of its recording: one event per tag, ordered by its stamp and, at equal stamps, in the
     order they were heard (a robot's start before its own completion), its robot's tag topic
     and the tag's position there as its source; then enriched as :func:`tags_log` does."""
-    nanos = np.array([_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
+    nanos = np.array([tag_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
     robots = [t.robot for t in tags]
     frame = pd.DataFrame(
         {
@@ -89,6 +89,8 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
             schema.ACTIVITY: [t.activity for t in tags],
             schema.LIFECYCLE: [t.lifecycle for t in tags],
             schema.ROBOT: robots,
+            # a live run has no manifest: each robot's type from its name, as prepare's
+            schema.ROBOT_TYPE: [robot_type(r) for r in robots],
             schema.MSG_ID: [t.msg_id or None for t in tags],
             schema.MSG_ROLE: [t.msg_role or None for t in tags],
             schema.MSG_PAYLOAD: [t.payload or None for t in tags],
@@ -98,13 +100,6 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
     frame[schema.SOURCE_INDEX] = frame.groupby(schema.ROBOT, sort=False).cumcount()
     frame = frame.iloc[np.argsort(nanos, kind="stable")].reset_index(drop=True)
     return tags_log(frame)
-
-
-def _nanoseconds(stamp: float) -> int:
-    """``stamp`` in whole nanoseconds, its seconds and its fraction apart (their product in one
-    float would be off by hundreds of nanoseconds)."""
-    seconds = math.floor(stamp)
-    return seconds * 1_000_000_000 + round((stamp - seconds) * 1e9)
 
 
 def live_replay(driver: Driver, name: str) -> Replay | None:
