@@ -59,11 +59,8 @@ class Tag:
 
 
 def tag_nanoseconds(stamp: float) -> int:
-    """A tag's stamp in whole nanoseconds since the Unix epoch, as its message carries it: its
-    seconds and its fraction apart (their product in one float would be off by hundreds of
-    nanoseconds)."""
-    seconds = math.floor(stamp)
-    return seconds * 1_000_000_000 + round((stamp - seconds) * 1e9)
+    """A tag's stamp in whole nanoseconds since the Unix epoch, as its message carries it."""
+    return round(stamp * 1e9)
 
 
 def tag_stamp(nanoseconds: int) -> float:
