@@ -67,8 +67,12 @@ def connect(where: Settings | None = None, user_agent: str | None = None) -> Dri
     where = where or settings()
     if not where.from_env:
         _require_local_server()
-    named = {"user_agent": user_agent} if user_agent else {}
-    driver = GraphDatabase.driver(where.uri, auth=where.auth, connection_timeout=5, **named)
+    if user_agent:
+        driver = GraphDatabase.driver(
+            where.uri, auth=where.auth, connection_timeout=5, user_agent=user_agent
+        )
+    else:  # the driver's own user agent
+        driver = GraphDatabase.driver(where.uri, auth=where.auth, connection_timeout=5)
     try:
         driver.verify_connectivity()
     except AuthError:

@@ -21,7 +21,7 @@ from pathlib import Path
 
 from robotale.errors import ServerError
 from robotale.neo4j_server.jars import ensure_jars, release
-from robotale.neo4j_server.server import ADMIN_TOOL, LocalServer, java_executable
+from robotale.neo4j_server.server import ADMIN_TOOL, LocalServer, ServerOptions, java_executable
 
 #: where the database's files are moved while an import replaces them, under ``data/``
 _ASIDE = "before-import"
@@ -190,7 +190,9 @@ def _put_back(data: Path, aside: Path, database: str) -> None:
     shutil.rmtree(aside, ignore_errors=True)
 
 
-def _restart(server: LocalServer, options, progress: Callable[[str], None], when: str) -> None:
+def _restart(
+    server: LocalServer, options: ServerOptions, progress: Callable[[str], None], when: str
+) -> None:
     progress("Starting the local Neo4j again ...")
     try:
         server.start(options, progress=progress)
