@@ -118,9 +118,11 @@ def test_storing_prepares_everything_the_pages_show_first(app, neo4j_driver, the
     prepare(neo4j_driver, state(app).logs, name)
     prepared = computed(app, name)
     files = kept(neo4j_driver, name)
-    # findings, five perspectives, the class graph, the runs, the first run's timeline, and
-    # the Mission page's slow-activity limits
-    assert len(files) == 10
+    # findings, five perspectives, the class graph, the runs, the first run's timeline, the
+    # Mission page's slow-activity limits, and its first run: its values and five tables
+    mission = [f for f in files if f.startswith("mission-1-")]
+    assert len(files) - len(mission) == 10
+    assert len(mission) == 6 and sum(f.endswith(".parquet") for f in mission) == 5
     assert sum(f.startswith("slow-limits-") for f in files) == 1
     client = app.test_client()
     for url in [*PAGES[:6], *PAGES[7:], "/api/discover/ekg?log={}&by=robot"]:
