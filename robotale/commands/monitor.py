@@ -1,7 +1,5 @@
 """``robotale monitor``: watch live robots over DDS, storing each tag in Neo4j as it arrives
-and, every second, the events heard since as an append to the live run's event knowledge
-graph (the log grows while the run goes on, and is complete when the watch ends); keeping the
-robots' odometry at a bounded rate for the map; and raising alerts printed, stored and
+(the live run's log grows while the run goes on) and raising alerts printed, stored and
 published on ``/robotale/alerts``."""
 
 from __future__ import annotations
@@ -14,7 +12,6 @@ from typing import TextIO
 
 from robotale.discovery.online import pool_replays
 from robotale.ekg.connection import session_driver
-from robotale.ekg.growing import GrowingLog
 from robotale.ekg.live import LiveLog
 from robotale.fame_runtime.clock import WallClock
 from robotale.fame_runtime.dds import DdsBus
@@ -48,11 +45,9 @@ def monitor_command(
     stopped = threading.Event()
     with session_driver() as driver:
         limits = alert_limits(driver, silence, battery, message_timeout, durations_from)
-        # refused here, before anything is stored, when --log names a log no monitor wrote
-        graph = GrowingLog(driver, log)
         bus = DdsBus(WallClock(offset=0.0), node="monitor")
         try:
-            monitor = Monitor(bus, LiveLog(driver, log), replays, limits, out, graph)
+            monitor = Monitor(bus, LiveLog(driver, log), replays, limits, out)
             # Ctrl-C or SIGTERM ends the watch between two tags, never inside a store
             with interrupts(stopped.set):
                 print(
@@ -64,11 +59,7 @@ def monitor_command(
                     monitor.pump(min(TICK, max(0.0, deadline - time.monotonic())))
                 bus.drain()
                 monitor.pump(TICK)
-                monitor.finish()
         finally:
             bus.close()
-            graph.close()
-    print(
-        f"# {log}: {monitor.live.count} tags stored, {graph.events} events in its graph", file=err
-    )
+    print(f"# {log}: {monitor.live.count} tags stored", file=err)
     return 0

@@ -7,7 +7,6 @@ from __future__ import annotations
 
 import functools
 import json
-from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
 from typing import Protocol, TextIO, cast
 
@@ -15,8 +14,7 @@ from neo4j import Driver
 
 from robotale.discovery.online import PoolReplay
 from robotale.ekg.columnar import stored_table
-from robotale.ekg.growing import GrowingLog
-from robotale.ekg.live import Alert, LiveLog, Pose
+from robotale.ekg.live import Alert, LiveLog
 from robotale.enhancement.overdue import MessageLimits, Overdue, duration_limits
 from robotale.errors import InputError
 from robotale.fame_runtime.bus import Bus, Envelope
@@ -24,22 +22,16 @@ from robotale.fame_runtime.clock import RunningClock
 from robotale.fame_runtime.node import KEEP_ALL
 from robotale.fame_runtime.qos import DEFAULT_QOS
 from robotale.fame_runtime.tags import START, TAG_TYPE, Tag, tag_line, tag_topic
-from robotale.results.live import tags_events
 from robotale.thresholds import LOW_BATTERY_PERCENT
 
 #: where alerts are published, as JSON text in a std_msgs/msg/String
 ALERT_TOPIC = "/robotale/alerts"
 ALERT_TYPE = "std_msgs/msg/String"
 BATTERY_TYPE = "sensor_msgs/msg/BatteryState"
-ODOMETRY_TYPE = "nav_msgs/msg/Odometry"
-#: what a battery or odometry reader asks for: any writer's samples, reliable or not
+#: what a battery reader asks for: any writer's samples, reliable or not
 BATTERY_QOS = replace(DEFAULT_QOS, reliability="best_effort")
-#: seconds between two looks at the robots' silence (and two stores of odometry samples)
+#: seconds between two looks at the robots' silence
 TICK = 0.1
-#: seconds between two appends to the live run's event knowledge graph
-BATCH = 1.0
-#: odometry samples kept per robot and second, at most (a robot may publish far more)
-ODOMETRY_RATE = 10.0
 
 
 @dataclass(frozen=True)
@@ -69,20 +61,8 @@ class Monitor:
         replays: dict[str, PoolReplay],
         limits: Limits,
         out: TextIO,
-        graph: GrowingLog | None = None,
     ) -> None:
         self.bus, self.live, self.out = bus, live, out
-        #: the live run's event knowledge graph, appended to every BATCH seconds
-        self.graph = graph
-        self.tags: list[Tag] = []
-        self.appended, self.last_append = 0, bus.clock.now()
-        # appends run on a thread of their own: DDS keeps being read while one is written,
-        # and Ctrl-C reaches the watch's own handler, not the append's deferred one
-        self.appender = ThreadPoolExecutor(max_workers=1)
-        self.appending: Future[int] | None = None
-        #: odometry samples not stored yet, and when each robot's next one is kept
-        self.poses: list[Pose] = []
-        self.pose_due: dict[str, float] = {}
         self.silence, self.battery, self.limits = limits.silence, limits.battery, limits
         self.timing = Timing(limits)
         self.low: set[str] = set()
@@ -99,12 +79,6 @@ class Monitor:
                 msgtype=BATTERY_TYPE,
                 qos=BATTERY_QOS,
             )
-            bus.subscribe(
-                f"/{robot}/odom",
-                functools.partial(self._odometry, robot),
-                msgtype=ODOMETRY_TYPE,
-                qos=BATTERY_QOS,
-            )
         # a DDS writer is made now, so readers match it before the first alert, and kept for
         # late joiners; an in-process bus needs none
         declare = getattr(bus, "writer", None)
@@ -116,7 +90,6 @@ class Monitor:
         if tag.robot not in self.heard:
             return  # a tag published on a robot's topic under another name: not this run's
         self.live.append(tag)
-        self.tags.append(tag)
         self.heard[tag.robot] = self.bus.clock.now()
         self.silent.discard(tag.robot)
         print(tag_line(tag, self.begin), file=self.out, flush=True)
@@ -138,46 +111,6 @@ class Monitor:
             self.low.add(robot)
             text = f"{robot}'s battery at {percent:.1f} %, below {self.battery:g} %"
             self.raise_alert(Alert(self.bus.clock.now(), "battery", robot, text))
-
-    def _odometry(self, robot: str, envelope: Envelope) -> None:
-        """Keep the sample if the robot's last kept one is 1/ODOMETRY_RATE s older."""
-        pose = odometry_pose(robot, envelope)
-        if pose.stamp < self.pose_due.get(robot, float("-inf")) - 1e-9:
-            return
-        self.pose_due[robot] = pose.stamp + 1.0 / ODOMETRY_RATE
-        self.poses.append(pose)
-
-    def store(self, *, final: bool = False) -> None:
-        """Store the odometry samples kept since the last store and, every BATCH seconds (or
-        at the end), append the events heard since the last append to the live graph."""
-        poses, self.poses = self.poses, []
-        self.live.poses(poses)
-        if self.graph is None:
-            return
-        if self.appending is not None:
-            if not (final or self.appending.done()):
-                return  # the last append is still being written
-            self.appending.result()  # a failed append's error ends the watch
-            self.appending = None
-        now = self.bus.clock.now()
-        due = final or now - self.last_append >= BATCH
-        if not due or len(self.tags) == self.appended:
-            return
-        heard, graph, name = list(self.tags), self.graph, self.live.name
-        self.appending = self.appender.submit(lambda: graph.update(tags_events(name, heard)))
-        self.appended, self.last_append = len(heard), now
-        if final:
-            self.appending.result()
-            self.appending = None
-
-    def finish(self) -> None:
-        """The watch ended: the last events appended, the live graph complete."""
-        try:
-            self.store(final=True)
-            if self.graph is not None:
-                self.graph.finish()
-        finally:
-            self.appender.shutdown()
 
     def watch(self) -> None:
         """Alert once for each robot silent longer than the limit (again after it spoke)."""
@@ -202,23 +135,6 @@ class Monitor:
     def pump(self, seconds: float) -> None:
         self.bus.clock.run(until=self.bus.clock.now() + seconds)
         self.watch()
-        self.store()
-
-
-def odometry_pose(robot: str, envelope: Envelope) -> Pose:
-    """Where a nav_msgs/msg/Odometry sample puts ``robot``, at the sample's own stamp (its
-    arrival when its header has none)."""
-    data = envelope.data
-    stamp = data.get("header", {}).get("stamp", {})
-    seconds = float(stamp.get("sec", 0)) + float(stamp.get("nanosec", 0)) / 1e9
-    at = data.get("pose", {}).get("pose", {}).get("position", {})
-    return Pose(
-        seconds or envelope.stamp,
-        robot,
-        float(at.get("x", 0.0)),
-        float(at.get("y", 0.0)),
-        float(at.get("z", 0.0)),
-    )
 
 
 class Timing:
