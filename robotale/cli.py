@@ -319,34 +319,39 @@ def _add_monitor(commands: argparse._SubParsersAction) -> None:
     monitor.add_argument("model", type=Path, metavar="MISSION.bpmn")
     monitor.add_argument("--robots", help="the robots' namespaces, e.g. drone,tractor_1")
     monitor.add_argument("--log", required=True, help="the name the live run is stored under")
-    monitor.add_argument(
+    _add_alert_limits(monitor)
+    monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
+    _handled_by(monitor, "monitor.monitor_command", extra="dds")
+
+
+def _add_alert_limits(parser: argparse.ArgumentParser) -> None:
+    """When the monitor of a live run (``monitor``, ``simulate --live``) raises alerts."""
+    parser.add_argument(
         "--silence",
         type=float,
         metavar="SECONDS",
         help="alert when a robot says nothing this long (default 10)",
     )
-    monitor.add_argument(
+    parser.add_argument(
         "--battery",
         type=float,
         metavar="PERCENT",
         help=f"alert below this charge (default {LOW_BATTERY_PERCENT:g})",
     )
-    monitor.add_argument(
+    parser.add_argument(
         "--message-timeout",
         action="append",
         metavar="[TYPE=]SECONDS",
         help="alert when a message (of the type: its send's label) is not received within "
         f"this long (default {MESSAGE_TIMEOUT:g}); repeatable",
     )
-    monitor.add_argument(
+    parser.add_argument(
         "--durations-from",
         action="append",
         metavar="LOG",
         help="alert when an activity runs longer than the 95th percentile of its durations "
         "in this stored log (earlier runs of the mission); repeatable",
     )
-    monitor.add_argument("--duration", type=float, metavar="SECONDS", help="stop after this long")
-    _handled_by(monitor, "monitor.monitor_command", extra="dds")
 
 
 def _add_prepare(commands: argparse._SubParsersAction) -> None:
@@ -719,6 +724,25 @@ def _add_simulate(commands: argparse._SubParsersAction) -> None:
         "--overwrite", action="store_true", default=None, help="replace runs already in --out"
     )
     simulate.add_argument("--quiet", action="store_true", default=None, help="no progress bar")
+    simulate.add_argument(
+        "--live",
+        action="store_true",
+        default=None,
+        help="watch each run as it goes, as robotale monitor watches robots: tags printed and "
+        "stored in Neo4j, alerts, the Mission page following it (--pace, default 1)",
+    )
+    simulate.add_argument(
+        "--log",
+        metavar="NAME",
+        help="--live: the live log's name (several runs: NAME_run_0001 ...; default "
+        "SCENARIO_run_0001 ...)",
+    )
+    _add_alert_limits(simulate)
+    simulate.add_argument(
+        "--dashboard",
+        metavar="URL",
+        help="--live: the dashboard whose Mission page follows the run (http://127.0.0.1:5000)",
+    )
     _handled_by(simulate, "simulate.simulate_command")
 
 

@@ -7,19 +7,26 @@ import os
 import shutil
 import sqlite3
 import sys
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any, TextIO
 
+from robotale.ekg.build import check_log_name
+from robotale.ekg.connection import session_driver
 from robotale.errors import InputError
+from robotale.fame_runtime.bus import InProcessBus
 from robotale.fame_runtime.clock import EngineCost
+from robotale.results.monitor import alert_limits
+from robotale.results.watched_run import WatchedRun
 from robotale.sim import stopping
 from robotale.sim.batch import print_summary, simulate_batch
 from robotale.sim.plans import adjust, check, plans, resolve_world
-from robotale.sim.run import CRASHED, RunPlan
+from robotale.sim.run import CRASHED, RunPlan, Watch
 from robotale.sim.worldspec import World
 from robotale.storage import local_path
+from robotale.thresholds import LOW_BATTERY_PERCENT
+from robotale.webapp.live_address import dashboard_url, live_page, serves_live
 
 
 def simulate_command(
@@ -49,15 +56,28 @@ def simulate_command(
     pace: float | None = None,
     overwrite: bool = False,
     quiet: bool = False,
+    live: bool = False,
+    log: str | None = None,
+    silence: float = 10.0,
+    battery: float = LOW_BATTERY_PERCENT,
+    message_timeout: list[str] | None = None,
+    durations_from: list[str] | None = None,
+    dashboard: str | None = None,
     out: TextIO | None = None,
+    err: TextIO | None = None,
 ) -> int:
     """A batch of ``runs`` runs recorded under ``out_dir`` (``runs/<scenario>``; a folder or an
     fsspec URL); with ``gui``
     one run in pybullet's window at ``pace`` simulated seconds per wall second. ``executor``
     (``local[:N]``, ``dask://HOST:PORT``) says where the runs go; ``thesis`` takes the
     scenario's world calibrated to the thesis. The ``stop`` scenario runs the stop-distance
-    experiment (``runs`` per variant and speed, 10) and prints its table."""
-    out = out or sys.stdout
+    experiment (``runs`` per variant and speed, 10) and prints its table. With ``live`` the
+    monitor watches each run as it goes (at ``pace``, default 1: as fast as the wall clock):
+    its tags are printed and stored as the live log ``log`` (a batch: ``log_run_0001`` ...;
+    default the scenario's name and the run's), and alerts raised as ``robotale monitor``
+    raises them (``silence``, ``battery``, ``message_timeout``, ``durations_from``); the live
+    run's Mission page is on the dashboard at ``dashboard``."""
+    out, err = out or sys.stdout, err or sys.stderr
     if runs is not None and runs < 1:
         raise InputError(f"--runs {runs}: give the number of runs to simulate, 1 or more.")
     preset = "thesis" if thesis else None
@@ -104,9 +124,18 @@ def simulate_command(
         )
 
     target = out_dir or Path("runs") / scenario
+    if not live and (log or dashboard or message_timeout or durations_from):
+        raise InputError(
+            "--log, --dashboard, --message-timeout and --durations-from go with --live"
+        )
+    if live and experiment:
+        raise InputError("--live watches a mission's runs; the stop experiment is no mission run")
+    if live:  # a person watches the live run as it goes, as in pybullet's window
+        pace = pace or 1.0
     if gui and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
         raise InputError("--gui needs a display (DISPLAY is not set); run without --gui")
     watching = gui or bool(pace)
+    watch: Watch | None = None  # the monitor, with --live
 
     def simulate(batch: list[RunPlan], folder: Path) -> dict[str, Any]:
         return simulate_batch(
@@ -118,6 +147,7 @@ def simulate_command(
             progress=not (quiet or watching),
             gui=gui,
             pace=(pace or 1.0) if watching else None,
+            watch=watch,
         )
 
     if experiment:
@@ -128,6 +158,31 @@ def simulate_command(
             )
         return stop_experiment(loaded, plans_for, simulate, folder, out)
     batch = plans_for(loaded)
+    if not live:
+        return _simulated(simulate, batch, target, out)
+    url = dashboard_url(dashboard)
+    with session_driver() as driver:
+        limits = alert_limits(driver, silence, battery, message_timeout, durations_from)
+
+        def name_of(case: str) -> str:
+            return log if log and len(batch) == 1 else f"{log or scenario}_{case}"
+
+        check_log_name(name_of(batch[0].case))  # before any run, not as a crashed one
+
+        def watched(case: str, robots: list[str], bus: InProcessBus) -> Callable[[], None]:
+            name = name_of(case)
+            print(f"# monitoring {', '.join(robots)} as {name}", file=err, flush=True)
+            run = WatchedRun(
+                driver, name, loaded.model, robots, bus, limits, out, _announce(url, err)
+            )
+            return lambda: print(f"# {name}: {run.end()} tags stored", file=err, flush=True)
+
+        watch = watched
+        return _simulated(simulate, batch, target, out)
+
+
+def _simulated(simulate, batch: list[RunPlan], target: str | Path, out: TextIO) -> int:
+    """Simulate ``batch`` into ``target``, print its summary; the exit status."""
     try:
         summary = simulate(batch, target)
     except (OSError, sqlite3.OperationalError) as error:
@@ -136,6 +191,24 @@ def simulate_command(
         raise InputError(_no_space(folder, batch)) from None
     print_summary(summary, target, out)
     return _crash_status(summary)
+
+
+def _announce(url: str, err: TextIO) -> Callable[[str], None]:
+    """Says where the live run ``name`` is followed, once its first tag is stored."""
+
+    def announce(name: str) -> None:
+        page = live_page(url, name)
+        if serves_live(url, name):
+            print(f"# Mission page: {page}", file=err, flush=True)
+        else:
+            print(
+                f"# no dashboard answers at {url}: start `robotale serve` (same Neo4j) and "
+                f"open {page}",
+                file=err,
+                flush=True,
+            )
+
+    return announce
 
 
 def _disk_full(error: Exception) -> bool:

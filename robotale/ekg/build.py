@@ -400,7 +400,7 @@ def write_graph(
             },
         )
     for kind, nodes in zip(classes, class_nodes, strict=True):
-        _write_begins(loader, kind.entries, entity_nodes, nodes, new_log)
+        write_begins(loader, kind.entries, entity_nodes, nodes, new_log)
     return class_nodes
 
 
@@ -445,7 +445,7 @@ def _write_classes(loader: Loader, classes: ClassTables) -> np.ndarray:
     return np.asarray(created, dtype=object)
 
 
-def _write_begins(
+def write_begins(
     loader: Loader,
     entries: pd.DataFrame,
     entity_nodes: np.ndarray,

@@ -24,6 +24,17 @@ class Alert:
     text: str
 
 
+@dataclass(frozen=True, slots=True)
+class Pose:
+    """Where ``robot`` was at ``stamp`` (seconds since the Unix epoch), by its odometry."""
+
+    stamp: float
+    robot: str
+    x: float
+    y: float
+    z: float
+
+
 class LiveLog:
     """The growing log ``name``: tags appended one transaction each, numbered as heard."""
 
@@ -45,6 +56,18 @@ class LiveLog:
             text=alert.text,
         )
 
+    def poses(self, poses: list[Pose]) -> None:
+        """Store odometry samples, all in one transaction."""
+        if poses:
+            self._run(
+                "live_append_poses",
+                stamps=[p.stamp for p in poses],
+                robots=[p.robot for p in poses],
+                xs=[p.x for p in poses],
+                ys=[p.y for p in poses],
+                zs=[p.z for p in poses],
+            )
+
     def _run(self, query: str, **parameters: Any) -> None:
         self.driver.execute_query(
             cypher(query), {"log": self.name, **parameters}, database_=database()
@@ -52,7 +75,7 @@ class LiveLog:
 
 
 def delete_live(driver: Driver, name: str) -> None:
-    """Forget the live run ``name``: its tags and alerts."""
+    """Forget the live run ``name``: its tags, odometry samples and alerts."""
     driver.execute_query(cypher("live_delete"), {"log": name}, database_=database())
 
 
@@ -71,6 +94,12 @@ def live_tags(driver: Driver, name: str) -> list[Tag]:
         )
         for r in records
     ]
+
+
+def live_poses(driver: Driver, name: str) -> list[Pose]:
+    """The odometry samples stored so far for the live run ``name``, oldest first."""
+    records, _, _ = driver.execute_query(cypher("live_poses"), {"log": name}, database_=database())
+    return [Pose(r["stamp"], r["robot"], r["x"], r["y"], r["z"]) for r in records]
 
 
 def live_alerts(driver: Driver, name: str) -> list[Alert]:

@@ -19,6 +19,9 @@ from robotale.queries import cypher, statements
 
 # The status of a log whose ingest ended before it was complete.
 FAILED = "failed"
+# A live log (robotale.ekg.growing) while its monitor grows it, and once that monitor ended
+# without completing it (killed): what it holds is consistent, but the run went on unheard.
+LIVE, INTERRUPTED = "live", "interrupted"
 
 
 def list_logs(driver: Driver) -> list[dict[str, Any]]:
@@ -42,12 +45,15 @@ def _with_truth(driver: Driver, row: dict[str, Any], locks: dict[str, Holder]) -
     number of events stored so far rather than the count a finished build records."""
     row = dict(row)
     run = row.pop("run", None)
-    if row["status"] != "building":
+    if row["status"] not in ("building", LIVE):
         return row
     # A rebuild writes under a temporary name while the lock guards the log's own name:
     # the writer is the lock of the same run.
     writer = next((lock for lock in locks.values() if lock.run == run), None)
-    status = "building" if writer is not None and writer.alive() else FAILED
+    alive = writer is not None and writer.alive()
+    if row["status"] == LIVE:
+        return row | {"status": LIVE if alive else INTERRUPTED}
+    status = "building" if alive else FAILED
     return row | {"status": status, "events": stored_events(driver, row["name"])}
 
 

@@ -22,7 +22,14 @@ from cyclonedds.idl import types as idl_types
 from rosbags.typesys import Stores, get_types_from_msg, get_typestore
 
 from robotale.errors import ModelError
-from robotale.fame_runtime.tags import TAG_TYPE, Tag, register_tag_type, text_fields
+from robotale.fame_runtime.tags import (
+    TAG_TYPE,
+    Tag,
+    register_tag_type,
+    tag_nanoseconds,
+    tag_stamp,
+    text_fields,
+)
 
 #: cyclonedds' IDL types, made by subscripting (``array[int8, 3]``), which its annotations
 #: do not express
@@ -177,7 +184,7 @@ def to_data(sample: Any, msgtype: str) -> Any:
     if msgtype == TAG_TYPE:
         stamp = data["stamp"]
         return Tag(
-            stamp["sec"] + stamp["nanosec"] / 1e9,
+            tag_stamp(stamp["sec"] * 1_000_000_000 + stamp["nanosec"]),
             data["robot"],
             data["activity"],
             data["lifecycle"],
@@ -199,7 +206,7 @@ def _plain(value: Any) -> Any:
 
 def tag_fields(tag: Tag) -> dict[str, Any]:
     """A Tag as ``robotale_msgs/msg/Tag`` fields."""
-    nanoseconds = round(tag.stamp * 1e9)
+    nanoseconds = tag_nanoseconds(tag.stamp)
     return {
         "stamp": {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000},
         **text_fields(tag),

@@ -9,6 +9,7 @@ adds it to a rosbags type store so bags can be written and read without a ROS in
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Callable
 from dataclasses import dataclass, fields
 from enum import StrEnum
@@ -55,6 +56,26 @@ class Tag:
     msg_id: str = ""
     msg_role: str = ""
     payload: str = ""
+
+
+def tag_nanoseconds(stamp: float) -> int:
+    """A tag's stamp in whole nanoseconds since the Unix epoch, as its message carries it."""
+    return round(stamp * 1e9)
+
+
+def tag_stamp(nanoseconds: int) -> float:
+    """The stamp whose :func:`tag_nanoseconds` are ``nanoseconds``: a float holds a stamp of
+    today only to about 240 ns, and the nearest one to ``nanoseconds`` may give others, so
+    its neighbours are tried too. A tag received keeps its stamp to the nanosecond when sent
+    on (a recorder's bag), and a live run's events have the times of its recording's."""
+    nearest = nanoseconds / 1_000_000_000  # int / int: correctly rounded
+    candidate = below = above = nearest
+    for _ in range(4):
+        for candidate in (below, above):
+            if tag_nanoseconds(candidate) == nanoseconds:
+                return candidate
+        below, above = math.nextafter(below, -math.inf), math.nextafter(above, math.inf)
+    return nearest  # a writer that is not robotale's chose nanoseconds no float gives
 
 
 #: the tag's fields besides its stamp, in its order: the message's ``string`` fields, the columns

@@ -3,45 +3,84 @@ the canonical event log ``prepare`` makes of a recording (the same columns, orde
 ids), and served as a :class:`~robotale.results.replay.Replay` so the Mission and Timeline
 pages answer on it as on a stored log while it grows.
 
-The run's case is the live log's name. Each request looks at how many tags are stored; the
-events are rebuilt only when that number grew.
+The run's case is the live log's name. The robots' positions (the map's trails and the state
+API's pose) are the odometry samples the monitor kept, not columns of the events. Each request
+looks at how many tags and samples are stored; the run is rebuilt only when that grew.
 """
 
 from __future__ import annotations
 
-import math
+import dataclasses
 import threading
+from collections.abc import Sequence
+from dataclasses import dataclass, field
 
 import numpy as np
 import pandas as pd
 from neo4j import Driver
 
 from robotale.ekg.connection import database
-from robotale.ekg.live import live_tags
+from robotale.ekg.live import Pose, live_poses, live_tags
+from robotale.enhancement.mission import MissionRun
 from robotale.eventlog import schema
 from robotale.eventlog.prepare import tags_log
-from robotale.fame_runtime.tags import tag_topic
+from robotale.eventlog.runs import robot_type
+from robotale.fame_runtime.tags import Tag, tag_nanoseconds, tag_topic
 from robotale.queries import cypher
 from robotale.results.replay import Replay
 
 _lock = threading.Lock()
-#: live log name -> (tags it held, its replay): the last copy built of each
-_built: dict[str, tuple[int, Replay]] = {}
+#: live log name -> ((tags, samples) it held, its replay): the last copy built of each
+_built: dict[str, tuple[tuple[int, int], Replay]] = {}
+
+
+@dataclass
+class LiveReplay(Replay):
+    """A live run: its events, and its robots' positions from their odometry."""
+
+    poses: list[Pose] = field(default_factory=list)
+
+    def run(self, case: str) -> MissionRun:
+        if case in self.runs or not self.poses:
+            return super().run(case)
+        run = super().run(case)
+        start = run.start.timestamp()
+        positions = pd.DataFrame(
+            {
+                "robot": [p.robot for p in self.poses],
+                "s": [p.stamp - start for p in self.poses],
+                "x": [p.x for p in self.poses],
+                "y": [p.y for p in self.poses],
+                "z": [p.z for p in self.poses],
+            }
+        )
+        self.runs[case] = dataclasses.replace(run, positions=positions)
+        return self.runs[case]
 
 
 def live_count(driver: Driver, name: str) -> int:
     """How many tags the live run ``name`` holds (0 when there is none)."""
+    return live_counts(driver, name)[0]
+
+
+def live_counts(driver: Driver, name: str) -> tuple[int, int]:
+    """How many tags and odometry samples the live run ``name`` holds."""
     records, _, _ = driver.execute_query(cypher("live_count"), {"log": name}, database_=database())
-    return int(records[0]["tags"])
+    return int(records[0]["tags"]), int(records[0]["poses"])
 
 
 def live_events(driver: Driver, name: str) -> pd.DataFrame:
-    """The live run ``name`` as the canonical event log ``prepare`` makes of its recording:
-    one event per tag, ordered by its stamp and, at equal stamps, in the order the monitor
-    heard them (a robot's start before its own completion), its robot's tag topic and the
-    tag's position there as its source; then enriched as :func:`tags_log` does."""
-    tags = live_tags(driver, name)
-    nanos = np.array([_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
+    """The live run ``name`` as the canonical event log ``prepare`` makes of its recording
+    (:func:`tags_events` of the tags stored for it)."""
+    return tags_events(name, live_tags(driver, name))
+
+
+def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
+    """The tags heard of the live run ``name`` as the canonical event log ``prepare`` makes
+    of its recording: one event per tag, ordered by its stamp and, at equal stamps, in the
+    order they were heard (a robot's start before its own completion), its robot's tag topic
+    and the tag's position there as its source; then enriched as :func:`tags_log` does."""
+    nanos = np.array([tag_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
     robots = [t.robot for t in tags]
     frame = pd.DataFrame(
         {
@@ -50,6 +89,8 @@ def live_events(driver: Driver, name: str) -> pd.DataFrame:
             schema.ACTIVITY: [t.activity for t in tags],
             schema.LIFECYCLE: [t.lifecycle for t in tags],
             schema.ROBOT: robots,
+            # a live run has no manifest: each robot's type from its name, as prepare's
+            schema.ROBOT_TYPE: [robot_type(r) for r in robots],
             schema.MSG_ID: [t.msg_id or None for t in tags],
             schema.MSG_ROLE: [t.msg_role or None for t in tags],
             schema.MSG_PAYLOAD: [t.payload or None for t in tags],
@@ -61,23 +102,16 @@ def live_events(driver: Driver, name: str) -> pd.DataFrame:
     return tags_log(frame)
 
 
-def _nanoseconds(stamp: float) -> int:
-    """``stamp`` in whole nanoseconds, its seconds and its fraction apart (their product in one
-    float would be off by hundreds of nanoseconds)."""
-    seconds = math.floor(stamp)
-    return seconds * 1_000_000_000 + round((stamp - seconds) * 1e9)
-
-
 def live_replay(driver: Driver, name: str) -> Replay | None:
     """The live run ``name`` as it stands now, or None when no monitor stored one."""
-    count = live_count(driver, name)
-    if not count:
+    count = live_counts(driver, name)
+    if not count[0]:
         return None
     with _lock:
         held = _built.get(name)
     if held is not None and held[0] == count:
         return held[1]
-    replay = Replay(name, live_events(driver, name), {})
+    replay = LiveReplay(name, live_events(driver, name), {}, poses=live_poses(driver, name))
     with _lock:
         _built[name] = (count, replay)
     return replay

@@ -44,7 +44,7 @@ from robotale.fame_runtime.manifest import (
 )
 from robotale.files import write_file
 from robotale.sim import scenarios
-from robotale.sim.run import CRASHED, RunPlan, simulate_run
+from robotale.sim.run import CRASHED, RunPlan, Watch, simulate_run
 from robotale.storage import Place, local_path, place, upload_folder, writing
 
 SUMMARY = "robotale-batch.json"
@@ -60,14 +60,15 @@ def simulate_batch(
     gui: bool = False,
     pace: float | None = None,
     executor: str | ExecutorSpec | None = None,
+    watch: Watch | None = None,
 ) -> dict[str, Any]:
     """Simulate every run of ``plans`` into ``out``; returns the batch summary.
 
     ``workers`` processes run them (default: one per CPU, at most one per run; 0 runs them in
     this process); ``executor`` (``local:N``, ``dask://HOST:PORT``) names where else they go.
     ``overwrite`` replaces the runs of an earlier batch in ``out``. With ``gui`` (pybullet's
-    window) or ``pace`` (simulated seconds per wall second) the runs go one after the other in
-    this process, for a person to watch.
+    window), ``pace`` (simulated seconds per wall second) or ``watch`` (the monitor, watching
+    each run as it goes) the runs go one after the other in this process.
     """
     spec = executor if isinstance(executor, ExecutorSpec) else parse_executor(executor, workers)
     local = local_path(out)
@@ -75,7 +76,13 @@ def simulate_batch(
     where: Path | Place = place(out) if local is None else local.resolve() if spec.remote else local
     _prepare_destination(where, overwrite)
     began = time.perf_counter()
-    here = gui or pace or spec.workers == 0 or (len(plans) == 1 and not spec.remote)
+    here = (
+        gui
+        or pace
+        or watch is not None
+        or spec.workers == 0
+        or (len(plans) == 1 and not spec.remote)
+    )
     workers = 0
     manifests: dict[str, RunManifest] = {}
     with tqdm(
@@ -90,7 +97,7 @@ def simulate_batch(
         try:
             if here:
                 for plan in plans:
-                    finished(_run(plan, where, gui=gui, pace=pace))
+                    finished(_run(plan, where, gui=gui, pace=pace, watch=watch))
             else:
                 workers = _in_pool(plans, where, spec, finished)
         except BaseException:
@@ -108,16 +115,26 @@ def simulate_batch(
 
 
 def _run(
-    plan: RunPlan, where: Path | Place, *, gui: bool = False, pace: float | None = None
+    plan: RunPlan,
+    where: Path | Place,
+    *,
+    gui: bool = False,
+    pace: float | None = None,
+    watch: Watch | None = None,
 ) -> RunManifest:
     """One run recorded into a local folder, or recorded here and uploaded to a place."""
     if isinstance(where, Place):
-        return run_uploaded(plan, where, gui=gui, pace=pace)
-    return run_into(plan, where, gui=gui, pace=pace)
+        return run_uploaded(plan, where, gui=gui, pace=pace, watch=watch)
+    return run_into(plan, where, gui=gui, pace=pace, watch=watch)
 
 
 def run_uploaded(
-    plan: RunPlan, target: Place, *, gui: bool = False, pace: float | None = None
+    plan: RunPlan,
+    target: Place,
+    *,
+    gui: bool = False,
+    pace: float | None = None,
+    watch: Watch | None = None,
 ) -> RunManifest:
     """One run recorded in a local temporary folder (rosbag2 writes local files only), then
     uploaded as ``target/<case>`` through a hidden folder moved into place."""
@@ -125,7 +142,7 @@ def run_uploaded(
     if (done := _remote_manifest(final)) is not None:  # a late second attempt, as in run_into
         return done
     with tempfile.TemporaryDirectory(prefix="robotale-run-") as folder:
-        manifest = run_into(plan, Path(folder), gui=gui, pace=pace)
+        manifest = run_into(plan, Path(folder), gui=gui, pace=pace, watch=watch)
         try:
             upload_folder(Path(folder) / plan.case, final)
         except Exception:  # ftplib's refusals are no OSError
@@ -142,7 +159,12 @@ def _remote_manifest(run: Place) -> RunManifest | None:
 
 
 def run_into(
-    plan: RunPlan, out: Path, *, gui: bool = False, pace: float | None = None
+    plan: RunPlan,
+    out: Path,
+    *,
+    gui: bool = False,
+    pace: float | None = None,
+    watch: Watch | None = None,
 ) -> RunManifest:
     """One run recorded into ``out/<case>`` (through a hidden partial folder)."""
     # rosbag2 names its storage files after the bag's folder, so the bag is written under its
@@ -156,7 +178,7 @@ def run_into(
     shutil.rmtree(partial, ignore_errors=True)
     partial.mkdir(parents=True)
     try:
-        manifest = simulate_run(plan, partial / plan.case, gui=gui, pace=pace)
+        manifest = simulate_run(plan, partial / plan.case, gui=gui, pace=pace, watch=watch)
         try:
             (partial / plan.case).rename(final)
         except OSError:

@@ -15,7 +15,7 @@ import datetime as dt
 import math
 import time
 import traceback
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -43,6 +43,10 @@ from robotale.sim.world import SimWorld, WindowClosed
 from robotale.sim.worldspec import World
 
 ENDED, TIME_LIMIT, CRASHED = "ended", "time limit", "crashed"
+
+#: something watching a run as it goes (``simulate --live``): given the run's case, its robots
+#: and its bus before the mission starts; what it gives back is called when the run has ended
+Watch = Callable[[str, list[str], InProcessBus], Callable[[], None]]
 
 
 @dataclass(frozen=True)
@@ -84,9 +88,15 @@ def skills_of(world: World) -> dict[str, Skill]:
 
 
 def simulate_run(
-    plan: RunPlan, folder: Path, *, gui: bool = False, pace: float | None = None
+    plan: RunPlan,
+    folder: Path,
+    *,
+    gui: bool = False,
+    pace: float | None = None,
+    watch: Watch | None = None,
 ) -> RunManifest:
-    """Simulate and record one run into ``folder`` (created); returns its manifest."""
+    """Simulate and record one run into ``folder`` (created), ``watch`` watching it; returns
+    its manifest."""
     began = time.perf_counter()
     world, start = plan.world, plan.start
     setup = draw(world, plan.seed)
@@ -102,7 +112,7 @@ def simulate_run(
     )
     truth = Truth(clock, plan.case, [r.name for r in setup.robots])
     truth.watch_bus(bus)
-    recorder = sim = mission = None
+    recorder = sim = mission = watching = None
     status, reason, detail = CRASHED, "", ""
     try:
         definitions = parse(world.model)
@@ -119,6 +129,8 @@ def simulate_run(
             distro=plan.distro,
         )
         bus.tap(recorder.tap)
+        if watch is not None:  # after the recorder: a tag is in the bag before it is judged
+            watching = watch(plan.case, [r.name for r in setup.robots], bus)
         sim = SimWorld(
             world, setup, clock=clock, bus=bus, gui=gui, silent=skill_signals(definitions)
         )
@@ -139,6 +151,8 @@ def simulate_run(
         if sim is not None and truth.sampled_at != clock.now():
             _samples(truth, sim)  # the last moments too: the run rarely ends on a tick
         truth.ended(status)
+        if watching is not None:
+            watching()
         if recorder is not None:
             recorder.close()
         if sim is not None:

@@ -149,3 +149,66 @@ def test_a_missing_message_is_told_apart(runs, against):
     fewer = runs[runs[MSG_ID].ne(first).fillna(True)].reset_index(drop=True)
     verdict = against.compared(ours, against.comparable(find(fewer)))
     assert verdict.startswith("DIFFERENT") and "sent" in verdict
+
+
+@pytest.fixture(scope="module")
+def live():
+    return benchmark("live")
+
+
+def test_the_live_benchmark_checks_every_tag_stored_once_as_published(live):
+    """Tags read back as the monitor stores them (the stamp through a DDS sample's seconds and
+    nanoseconds, then a float) match those published; one lost, one stored twice and one never
+    published are each named."""
+    from robotale.fame_runtime.rostypes import tag_fields
+    from robotale.fame_runtime.tags import Tag
+
+    published, stored = [], []
+    for robot in live.robots_of(3):
+        stamp = 1_800_000_000.0
+        for _, (gap, activity, lifecycle) in zip(range(7), live.tag_steps(robot, 1), strict=False):
+            stamp += gap
+            published.append(live.key(robot, activity, lifecycle, stamp))
+            wire = tag_fields(Tag(stamp, robot, activity, lifecycle))["stamp"]
+            heard = wire["sec"] + wire["nanosec"] / 1e9
+            stored.append(live.key(robot, activity, lifecycle, heard))
+    assert len(set(published)) == 21
+    assert live.same_tags(published, stored[::-1]) == ([], [])
+    lost, twice, foreign = stored[4], stored[9], ("rover_9", "survey", "start", 1)
+    changed = [t for t in stored if t != lost] + [twice, foreign]
+    missing, extra = live.same_tags(published, changed)
+    assert missing == [published[4]]
+    assert sorted(extra) == sorted([twice, foreign])
+
+
+def test_the_live_benchmark_robots_tag_what_their_pool_allows(live, tmp_path):
+    """The synthetic robots start their activities in an order the benchmark's model allows
+    (replayed as the monitor replays them), so the monitor raises no deviation."""
+    from robotale.discovery.online import pool_replays
+    from robotale.fame_runtime.tags import Tag
+
+    model = tmp_path / "rover.bpmn"
+    model.write_text(live.MODEL)
+    robots = live.robots_of(2)
+    replays = pool_replays(model, robots)
+    for robot in robots:
+        steps = zip(range(40), live.tag_steps(robot, 3), strict=False)
+        tags = [Tag(float(i), robot, a, lc) for i, (_, (_, a, lc)) in enumerate(steps)]
+        assert {t.activity for t in tags} == set(live.ACTIVITIES)
+        assert all(replays[robot].allows(t) for t in tags)
+    # a robot that skips measure deviates: the replay can tell
+    skipping = [("survey", "start"), ("survey", "complete"), ("report", "start")]
+    fresh = pool_replays(model, ["rover_1"])["rover_1"]
+    allowed = [fresh.allows(Tag(0.0, "rover_1", a, lc)) for a, lc in skipping]
+    assert allowed == [True, True, False]
+
+
+def test_the_live_benchmark_times_a_tag_from_the_first_answer_within_two_microseconds(live):
+    published = [
+        ("rover_1", "survey", "start", 10_000_000),
+        ("rover_1", "survey", "complete", 12_000_000),
+    ]
+    seen = {10_000_002: 10.5, 10_000_000: 11.0, 12_000_003: 13.0}
+    assert live.shown(published, seen) == {published[0]: 10.5}
+    stamps = {k: k[3] / 1e6 for k in published}
+    assert live.lags(stamps, live.shown(published, seen)) == [(10.0, 0.5)]

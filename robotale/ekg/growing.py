@@ -1,0 +1,435 @@
+"""A log that grows while its run goes on: :class:`GrowingLog`.
+
+A live run is one case whose events keep coming. Each :meth:`GrowingLog.update` is given the
+whole log as it stands now (what ``prepare`` would make of everything heard so far) and writes,
+in one transaction of the append machinery (:func:`~robotale.ekg.append.write_transaction`,
+under the log's write lock, held for the whole run), only what changed since the last update:
+the new events with their CORR and OBSERVED edges, the DF and COMM edges that appeared or
+vanished, and each event's id and position where an event heard late moved it. The stored log
+therefore always equals the graph ``robotale ingest`` builds of that log, and Cypher, the
+console and Discover read it while it grows.
+
+Usually a batch only extends each entity's DF chain from its last stored event; an event
+placed before stored ones (an in-progress sample, known once its activity completes, or a
+message's receive heard before its send) splices into the chain instead. DF_C and BEGINS are
+written again for the classes each time: they are few, and an exact median needs every
+duration.
+
+Events are told apart across updates by a hash of their values (every property but the id,
+which is a position), the n-th of equal rows matched to the n-th.
+"""
+
+from __future__ import annotations
+
+import shlex
+from contextlib import ExitStack
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+import pandas as pd
+from neo4j import Driver, ManagedTransaction
+
+from robotale.ekg.append import write_transaction
+from robotale.ekg.build import (
+    check_key_sizes,
+    check_keys,
+    check_log_name,
+    ensure_schema,
+    write_begins,
+    write_df_c,
+)
+from robotale.ekg.columnar import delete_copies, store_copy
+from robotale.ekg.connection import database
+from robotale.ekg.keys import built_keys, default_entities
+from robotale.ekg.load import Loader, neo4j_values
+from robotale.ekg.logs import LIVE, delete_log, log_exists, log_info
+from robotale.ekg.tables import (
+    ClassTables,
+    GraphTables,
+    class_tables,
+    graph_tables,
+    log_values,
+)
+from robotale.ekg.writelock import log_write_lock
+from robotale.errors import InputError, LogNotFound
+from robotale.queries import cypher, statements
+
+#: what a live log's Log node records as its source: a new run of that name replaces it
+LIVE_SOURCE = "robotale monitor"
+
+
+@dataclass
+class _Stored:
+    """What the graph holds of the log, by event key (see :func:`event_keys`)."""
+
+    nodes: dict[str, str] = field(default_factory=dict)  # event key -> element id
+    placed: dict[str, tuple[str, int]] = field(default_factory=dict)  # key -> (id, order)
+    entities: dict[tuple[str, str], str] = field(default_factory=dict)  # (type, id) -> element
+    classes: dict[tuple[str, str], str] = field(default_factory=dict)  # (type, id) -> element
+    df: set[tuple[str, str, str, str]] = field(default_factory=set)  # keys, type, entity id
+    comm: set[tuple[str, str, str]] = field(default_factory=set)  # send, receive keys, msg id
+
+
+@dataclass
+class _Change:
+    """One update: the log's tables now, their event keys, and the store before it."""
+
+    tables: GraphTables
+    classes: list[ClassTables]
+    keys: np.ndarray
+    before: _Stored
+    after: _Stored = field(default_factory=_Stored)
+
+    @property
+    def new(self) -> np.ndarray:
+        """Positions of the events the graph does not hold yet."""
+        return np.flatnonzero([key not in self.before.nodes for key in self.keys])
+
+
+class GrowingLog:
+    """The live log ``name``: refused when a log of that name is stored that no monitor
+    wrote; an earlier live log of that name is replaced. Holds the log's write lock from
+    here until :meth:`close`."""
+
+    def __init__(self, driver: Driver, name: str) -> None:
+        check_log_name(name)
+        self.driver, self.name = driver, name
+        ensure_schema(driver)
+        self._stack = ExitStack()
+        self.run = self._stack.enter_context(log_write_lock(driver, name, "monitoring"))
+        try:
+            self._clear_earlier()
+        except BaseException:
+            self._stack.close()
+            raise
+        self.stored = _Stored()
+        self.log: pd.DataFrame | None = None
+        self.begun = False  # the Log node is written
+        self.summary: dict[str, Any] = {}
+        self.types: list[str] = []
+        self.keys: list[list[str]] = []
+
+    @property
+    def events(self) -> int:
+        """How many events the graph holds."""
+        return len(self.stored.nodes)
+
+    def _clear_earlier(self) -> None:
+        if not log_exists(self.driver, self.name):
+            return
+        try:
+            source = log_info(self.driver, self.name)["source"]
+        except LogNotFound:  # events without a Log node: a failed ingest's
+            source = None
+        if source != LIVE_SOURCE:
+            raise InputError(
+                f"A log named {self.name!r} is stored in Neo4j and is not a live run's: "
+                "give the monitor another --log, or remove that log with "
+                f"`robotale logs delete {shlex.quote(self.name)}`."
+            )
+        delete_log(self.driver, self.name)
+        delete_copies(self.name)
+
+    def update(self, log: pd.DataFrame) -> int:
+        """Make the stored log the graph of ``log`` (a canonical event log: the whole run so
+        far); returns how many events were new. Nothing is written when nothing changed."""
+        if log.empty:
+            return 0
+        if not self.types:
+            self.types = default_entities(log.columns)
+            self.keys = [key.split(",") for key in built_keys(self.types)]
+        tables = graph_tables(log, self.types)
+        check_keys(tables.events, self.keys)
+        check_key_sizes(tables, self.keys)
+        classes = [class_tables(tables, key) for key in self.keys]
+        change = _Change(tables, classes, event_keys(tables.events), self.stored)
+        new = len(change.new)
+        if not new and len(change.keys) == len(self.stored.nodes):
+            return 0  # the same events: their edges are the same too
+        if not self.begun:
+            self._begin(tables, classes)
+            self.begun = True
+        summary = {"events": len(tables.events)} | log_values(tables.events)
+        write_transaction(self.driver, self.name, _write, self.name, change, summary)
+        self.stored, self.log, self.summary = change.after, log, summary
+        return new
+
+    def _begin(self, tables: GraphTables, classes: list[ClassTables]) -> None:
+        self.driver.execute_query(
+            cypher("ekg_live_begin"),
+            log=self.name,
+            run=self.run,
+            source=LIVE_SOURCE,
+            status=LIVE,
+            properties=list(tables.events.columns),
+            entityTypes=list(self.types),
+            classTypes=[kind.type for kind in classes],
+            database_=database(),
+        )
+
+    def finish(self) -> None:
+        """The run ended: the log is complete (and gets its columnar copy, as an ingest's)."""
+        if self.log is not None:
+            self.driver.execute_query(
+                cypher("ekg_log_finish"),
+                log=self.name,
+                summary=self.summary,
+                database_=database(),
+            )
+            store_copy(self.driver, self.name, self.log)
+        self.close()
+
+    def close(self) -> None:
+        """Give the write lock back (a log left ``live`` shows as interrupted)."""
+        self._stack.close()
+
+
+def event_keys(events: pd.DataFrame) -> np.ndarray:
+    """One text per event that stays the same while the log grows: a 64-bit hash of its
+    values but the id (a position), and how many equal events come before it. Texts of the
+    values themselves cost ten times more; two different events share a hash with a chance
+    of about n²/2⁶⁵ (1 in 4·10⁹ for 100,000 events)."""
+    hashes = pd.util.hash_pandas_object(events.drop(columns="id"), index=False)
+    seen = hashes.groupby(hashes, sort=False).cumcount().to_numpy()
+    keys: np.ndarray = np.array(
+        [f"{h:016x}#{n}" for h, n in zip(hashes.to_numpy().tolist(), seen.tolist(), strict=True)],
+        dtype=object,
+    )
+    return keys
+
+
+def _write(
+    tx: ManagedTransaction,
+    name: str,
+    change: _Change,
+    summary: dict[str, Any],
+    between_batches: Any,
+) -> None:
+    """The transaction of one update; fills ``change.after`` with what the graph then holds."""
+    loader = Loader(None, name, None, between_batches, tx=tx)
+    tables, keys, before = change.tables, change.keys, change.before
+    after = _Stored(entities=dict(before.entities), classes=dict(before.classes))
+    gone = sorted(set(before.nodes) - set(keys))
+    if gone:
+        deleted = [before.nodes[key] for key in gone]
+        for statement in statements("ekg_live_delete_events"):
+            tx.run(statement, log=name, nodes=deleted).consume()
+        after.entities, after.classes = {}, {}  # an entity may have gone with its events
+        entity_nodes = _merged(loader, tables.entities, {})
+        class_nodes = [_merged_classes(loader, kind, {}) for kind in change.classes]
+    else:
+        entity_nodes = _merged(loader, tables.entities, after.entities)
+        class_nodes = [_merged_classes(loader, kind, after.classes) for kind in change.classes]
+    for (kind, entity), node in zip(
+        tables.entities.itertuples(index=False), entity_nodes, strict=True
+    ):
+        after.entities[(str(kind), str(entity))] = node
+    for kind, nodes in zip(change.classes, class_nodes, strict=True):
+        ids = kind.classes["id"].astype(str).tolist()
+        after.classes |= {(kind.type, c): n for c, n in zip(ids, nodes, strict=True)}
+    event_nodes = _events(loader, change, entity_nodes, class_nodes)
+    after.nodes = dict(zip(keys.tolist(), event_nodes.tolist(), strict=True))
+    after.placed = _renumber(tx, name, tables.events, keys, before, event_nodes)
+    after.df = _edges(loader, tx, name, tables, keys, event_nodes, before.df)
+    after.comm = _comm(loader, tables, keys, event_nodes, before.comm)
+    for kind, nodes in zip(change.classes, class_nodes, strict=True):
+        between_batches()
+        tx.run(cypher("ekg_ocel_delete_df_c"), log=name, type=kind.type).consume()
+        write_df_c(loader, kind, nodes)
+        tx.run(cypher("ekg_live_delete_begins"), log=name, type=kind.type).consume()
+        write_begins(loader, kind.entries, entity_nodes, nodes, new_log=True)
+    tx.run(cypher("ekg_log_summary"), log=name, summary=summary).consume()
+    change.after = after
+
+
+def _merged(
+    loader: Loader, entities: pd.DataFrame, known: dict[tuple[str, str], str]
+) -> np.ndarray:
+    """The element ids of ``entities`` (rows: type, id), those not ``known`` merged now."""
+    nodes = np.array(
+        [known.get((str(t), str(i))) for t, i in entities.itertuples(index=False)], dtype=object
+    )
+    missing = entities[pd.isna(nodes)]
+    for entity_type, part in missing.groupby("type", sort=False):
+        created = loader.run("ekg_merge_entities", {"ids": part["id"].tolist()}, type=entity_type)
+        nodes[entities.index.get_indexer(part.index)] = created
+    return nodes
+
+
+def _merged_classes(
+    loader: Loader, kind: ClassTables, known: dict[tuple[str, str], str]
+) -> np.ndarray:
+    """The element ids of the classes of ``kind``, those not ``known`` merged now."""
+    table = kind.classes
+    nodes = np.array([known.get((kind.type, str(c))) for c in table["id"]], dtype=object)
+    missing = table[pd.isna(nodes)]
+    if len(missing):
+        created = loader.run(
+            "ekg_create_classes",
+            {"ids": missing["id"].tolist()},
+            {"properties": {k: neo4j_values(missing[k]) for k in kind.key}},
+            type=kind.type,
+            key=kind.key,
+        )
+        nodes[np.flatnonzero(pd.isna(nodes))] = created
+    return nodes
+
+
+def _events(
+    loader: Loader,
+    change: _Change,
+    entity_nodes: np.ndarray,
+    class_nodes: list[np.ndarray],
+) -> np.ndarray:
+    """The element ids of every event of the log, the new ones created now with their CORR
+    and OBSERVED edges, under ids of their own until :func:`_renumber` places them."""
+    tables, keys, before = change.tables, change.keys, change.before
+    nodes = np.array([before.nodes.get(key) for key in keys.tolist()], dtype=object)
+    new = change.new
+    if not len(new):
+        return nodes
+    corr = tables.corr[np.isin(tables.corr["event"].to_numpy(), new)]
+    per_event: dict[int, list[str]] = {int(i): [] for i in new}
+    for event, entity in corr.itertuples(index=False):
+        per_event[int(event)].append(entity_nodes[int(entity)])
+    observed = [
+        [
+            nodes_of[kind.observed[i]]
+            for kind, nodes_of in zip(change.classes, class_nodes, strict=True)
+        ]
+        for i in new.tolist()
+    ]
+    fresh = tables.events.iloc[new].assign(id=[f"{_PLACING}{key}" for key in keys[new]])
+    empty = pd.DataFrame(
+        {"source": [], "target": [], "entityType": [], "entityId": [], "msgId": []}
+    )
+    created = loader.events(
+        fresh.reset_index(drop=True),
+        [per_event[int(i)] for i in new],
+        observed,
+        empty.astype({"source": np.int64, "target": np.int64}),
+        empty.astype({"source": np.int64, "target": np.int64}),
+    )
+    nodes[new] = created
+    return nodes
+
+
+#: the prefix of the id an event has while an update places it (no log's id starts so)
+_PLACING = "\x00placing "
+
+
+def _renumber(
+    tx: ManagedTransaction,
+    name: str,
+    events: pd.DataFrame,
+    keys: np.ndarray,
+    before: _Stored,
+    nodes: np.ndarray,
+) -> dict[str, tuple[str, int]]:
+    """Give every event whose id or position changed (and every new one) its own; moved
+    events first get ids of their own, so no two events share an id on the way."""
+    ids = events["id"].astype(str).tolist()
+    placed = {key: (ids[order], order) for order, key in enumerate(keys.tolist())}
+    moved = [k for k, (key, place) in enumerate(placed.items()) if before.placed.get(key) != place]
+    if not moved:
+        return placed
+    stored = [k for k in moved if keys[k] in before.placed]
+    query = cypher("ekg_live_renumber")
+    if stored:
+        tx.run(
+            query,
+            log=name,
+            nodes=nodes[stored].tolist(),
+            ids=[f"{_PLACING}{keys[k]}" for k in stored],
+            orders=stored,
+        ).consume()
+    tx.run(
+        query,
+        log=name,
+        nodes=nodes[moved].tolist(),
+        ids=[placed[keys[k]][0] for k in moved],
+        orders=moved,
+    ).consume()
+    return placed
+
+
+def _edges(
+    loader: Loader,
+    tx: ManagedTransaction,
+    name: str,
+    tables: GraphTables,
+    keys: np.ndarray,
+    nodes: np.ndarray,
+    before: set[tuple[str, str, str, str]],
+) -> set[tuple[str, str, str, str]]:
+    """The DF edges of the log now: those that vanished deleted, the new ones created."""
+    df = tables.df
+    now = set(
+        zip(
+            keys[df["source"].to_numpy()].tolist(),
+            keys[df["target"].to_numpy()].tolist(),
+            df["entityType"].astype(str).tolist(),
+            df["entityId"].astype(str).tolist(),
+            strict=True,
+        )
+    )
+    known = set(keys.tolist())  # the edges of deleted events went with them
+    stale = [edge for edge in before - now if edge[0] in known and edge[1] in known]
+    at = {key: k for k, key in enumerate(keys.tolist())}
+    if stale:
+        tx.run(
+            cypher("ekg_live_delete_df"),
+            log=name,
+            sources=[nodes[at[e[0]]] for e in stale],
+            targets=[nodes[at[e[1]]] for e in stale],
+            entityTypes=[e[2] for e in stale],
+            entityIds=[e[3] for e in stale],
+        ).consume()
+    added = sorted(now - before)
+    for entity_type in sorted({e[2] for e in added}):
+        part = [e for e in added if e[2] == entity_type]
+        loader.run(
+            "ekg_create_df",
+            {
+                "sources": [nodes[at[e[0]]] for e in part],
+                "targets": [nodes[at[e[1]]] for e in part],
+                "entityIds": [e[3] for e in part],
+            },
+            entityType=entity_type,
+        )
+    return now
+
+
+def _comm(
+    loader: Loader,
+    tables: GraphTables,
+    keys: np.ndarray,
+    nodes: np.ndarray,
+    before: set[tuple[str, str, str]],
+) -> set[tuple[str, str, str]]:
+    """The COMM edges of the log now, the new ones created (a COMM edge vanishes only with
+    one of its events)."""
+    comm = tables.comm
+    sources = comm["source"].to_numpy(dtype=np.int64)
+    targets = comm["target"].to_numpy(dtype=np.int64)
+    now = set(
+        zip(
+            keys[sources].tolist(),
+            keys[targets].tolist(),
+            comm["msgId"].astype(str).tolist(),
+            strict=True,
+        )
+    )
+    added = sorted(now - before)
+    if added:
+        at = {key: k for k, key in enumerate(keys.tolist())}
+        loader.run(
+            "ekg_create_comm",
+            {
+                "sources": [nodes[at[e[0]]] for e in added],
+                "targets": [nodes[at[e[1]]] for e in added],
+                "msgIds": [e[2] for e in added],
+            },
+        )
+    return now
