@@ -25,15 +25,17 @@ Printed per robot count:
 - the monitor process' CPU (user + system) per robot, in % of one core;
 - the check: the tags stored are the tags published (robot, activity, lifecycle, stamp).
 
-The monitor stores tags only (odometry is published and carried by DDS, but the monitor does
-not subscribe to it), so the odometry load is on DDS and the publishers, not on the store.
+The monitor subscribes to the odometry too and stores it at most 10 samples a second per
+robot (as ``LivePose`` nodes, batched with the tags every tenth of a second), so the API's
+looks read the positions as they grow as well.
 
 Then the Mission page's first paint (its ``robotale-mission-shown`` mark, in headless Chromium
 as the browser tests drive it, best of ``--repeat``) for one live run of ``--paint-events``
-tags (20 robots' tags appended one transaction each, as the monitor appends them: the single
-writer's append rate is printed too), against the same events stored as an ordinary log
-(``build_ekg``), the baseline. Targets: lag p95 under 1 s at 20 robots for 10 minutes with no
-growth; first paint under 1 s at 10,000 events. The load average is printed before and after.
+tags (20 robots' tags; the first ones appended one transaction each, as a monitor hearing a
+tag at a time appends them, and that rate printed), against the same events stored as an
+ordinary log (``build_ekg``), the baseline. Targets: lag p95 under 1 s at 20 robots for 10
+minutes with no growth; first paint under 1 s at 10,000 events. The load average is printed
+before and after.
 """
 
 from __future__ import annotations
@@ -460,7 +462,7 @@ def paint(driver, events: int, repeat: int, folder: Path) -> None:
     spent = time.perf_counter() - began
     print(f"the monitor's store: {len(timed)} tags appended one transaction each in {spent:.1f} s:"
           f" {len(timed) / spent:.0f} tags/s (load average {os.getloadavg()[0]:.1f})")  # fmt: skip
-    _append_rest(driver, name, tags, len(timed))
+    _append_rest(live, tags, len(timed))
     log = live_events(driver, name)
     log["case:concept:name"] = stored
     store(driver, stored, log)
@@ -493,27 +495,11 @@ def paint(driver, events: int, repeat: int, folder: Path) -> None:
           f"{verdict})")  # fmt: skip
 
 
-def _append_rest(driver, name: str, tags: list, done: int) -> None:
+def _append_rest(live, tags: list, done: int) -> None:
     """The tags after the first ``done`` stored as the monitor stores them (its query, the
     same numbering), a thousand to a transaction: the run to paint, built faster."""
-    from robotale.ekg.connection import database
-    from robotale.fame_runtime.tags import text_fields
-    from robotale.queries import cypher
-
-    query = cypher("live_append_tag")
-
-    def write(tx, chunk: list[tuple[int, object]]) -> None:
-        for seq, tag in chunk:
-            fields = text_fields(tag)
-            tx.run(query, log=name, seq=seq, stamp=tag.stamp, robot=fields["robot"],
-                   activity=fields["activity"], lifecycle=fields["lifecycle"],
-                   msgId=fields["msg_id"], msgRole=fields["msg_role"],
-                   payload=fields["payload"])  # fmt: skip
-
-    numbered = list(enumerate(tags, start=1))[done:]
-    with driver.session(database=database()) as session:
-        for first in range(0, len(numbered), 1000):
-            session.execute_write(write, numbered[first : first + 1000])
+    for first in range(done, len(tags), 1000):
+        live.append_tags(tags[first : first + 1000])
 
 
 # -- the whole benchmark -----------------------------------------------------------------------

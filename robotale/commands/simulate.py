@@ -2,12 +2,13 @@
 
 from __future__ import annotations
 
+import contextlib
 import errno
 import os
 import shutil
 import sqlite3
 import sys
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import replace
 from pathlib import Path
 from typing import Any, TextIO
@@ -15,8 +16,9 @@ from typing import Any, TextIO
 from robotale.ekg.build import check_log_name
 from robotale.ekg.connection import session_driver
 from robotale.errors import InputError
-from robotale.fame_runtime.bus import InProcessBus
-from robotale.fame_runtime.clock import EngineCost
+from robotale.extras import require
+from robotale.fame_runtime.bus import Bus, InProcessBus
+from robotale.fame_runtime.clock import EngineCost, WallClock
 from robotale.results.monitor import alert_limits
 from robotale.results.watched_run import WatchedRun
 from robotale.sim import stopping
@@ -161,7 +163,7 @@ def simulate_command(
     if not live:
         return _simulated(simulate, batch, target, out)
     url = dashboard_url(dashboard)
-    with session_driver() as driver:
+    with session_driver() as driver, _alert_relay() as relay:
         limits = alert_limits(driver, silence, battery, message_timeout, durations_from)
 
         def name_of(case: str) -> str:
@@ -173,7 +175,7 @@ def simulate_command(
             name = name_of(case)
             print(f"# monitoring {', '.join(robots)} as {name}", file=err, flush=True)
             run = WatchedRun(
-                driver, name, loaded.model, robots, bus, limits, out, _announce(url, err)
+                driver, name, loaded.model, robots, bus, limits, out, _announce(url, err), relay
             )
             return lambda: print(f"# {name}: {run.end()} tags stored", file=err, flush=True)
 
@@ -191,6 +193,25 @@ def _simulated(simulate, batch: list[RunPlan], target: str | Path, out: TextIO) 
         raise InputError(_no_space(folder, batch)) from None
     print_summary(summary, target, out)
     return _crash_status(summary)
+
+
+@contextlib.contextmanager
+def _alert_relay() -> Iterator[Bus | None]:
+    """A bus on the DDS domain (``ROS_DOMAIN_ID``) the live runs' alerts are published on too,
+    for robots and operators there, when Cyclone DDS is installed; else None."""
+    try:
+        require("dds")
+    except InputError:
+        yield None
+        return
+    # Cyclone DDS is an optional extra (robotale[dds]) and 0.9 s to import: --live only
+    from robotale.fame_runtime.dds import DdsBus
+
+    relay = DdsBus(WallClock(), node="monitor")
+    try:
+        yield relay
+    finally:
+        relay.close()
 
 
 def _announce(url: str, err: TextIO) -> Callable[[str], None]:

@@ -1,8 +1,10 @@
-"""A live run's log in Neo4j: each tag stored the moment it is heard, in a transaction of
-its own, so the run is queryable while it goes on; and the alerts raised about it."""
+"""A live run's log in Neo4j: the tags stored as they are heard, a few at a time, each batch a
+transaction of its own, so the run is queryable while it goes on; and the alerts raised about
+it."""
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Any
 
@@ -36,37 +38,57 @@ class Pose:
 
 
 class LiveLog:
-    """The growing log ``name``: tags appended one transaction each, numbered as heard."""
+    """The growing log ``name``: tags appended a few at a time, each batch a transaction,
+    numbered as heard."""
 
     def __init__(self, driver: Driver, name: str) -> None:
         check_log_name(name)
-        self.driver, self.name, self.count = driver, name, 0
+        self.driver, self.name, self.count, self.pose_count = driver, name, 0, 0
         delete_live(driver, name)  # a new run of that name starts empty
 
     def append(self, tag: Tag) -> None:
-        self.count += 1
-        self._run("live_append_tag", seq=self.count, stamp=tag.stamp, **_names(text_fields(tag)))
+        self.append_tags([tag])
+
+    def append_tags(self, tags: Sequence[Tag]) -> None:
+        """Store ``tags`` (in the order they were heard), all in one transaction."""
+        if not tags:
+            return
+        fields = [text_fields(tag) for tag in tags]
+        self._run(
+            "live_append_tags",
+            seqs=list(range(self.count + 1, self.count + len(tags) + 1)),
+            stamps=[tag.stamp for tag in tags],
+            **{name: [f[key] for f in fields] for key, name in _NAMES.items()},
+        )
+        self.count += len(tags)
 
     def alert(self, alert: Alert) -> None:
-        self._run(
-            "live_append_alert",
-            stamp=alert.stamp,
-            kind=alert.kind,
-            robot=alert.robot,
-            text=alert.text,
-        )
+        self.alerts([alert])
+
+    def alerts(self, alerts: Sequence[Alert]) -> None:
+        """Store ``alerts``, all in one transaction."""
+        if alerts:
+            self._run(
+                "live_append_alerts",
+                stamps=[a.stamp for a in alerts],
+                kinds=[a.kind for a in alerts],
+                robots=[a.robot for a in alerts],
+                texts=[a.text for a in alerts],
+            )
 
     def poses(self, poses: list[Pose]) -> None:
         """Store odometry samples, all in one transaction."""
         if poses:
             self._run(
                 "live_append_poses",
+                seqs=list(range(self.pose_count + 1, self.pose_count + len(poses) + 1)),
                 stamps=[p.stamp for p in poses],
                 robots=[p.robot for p in poses],
                 xs=[p.x for p in poses],
                 ys=[p.y for p in poses],
                 zs=[p.z for p in poses],
             )
+            self.pose_count += len(poses)
 
     def _run(self, query: str, **parameters: Any) -> None:
         self.driver.execute_query(
@@ -79,9 +101,12 @@ def delete_live(driver: Driver, name: str) -> None:
     driver.execute_query(cypher("live_delete"), {"log": name}, database_=database())
 
 
-def live_tags(driver: Driver, name: str) -> list[Tag]:
-    """The tags stored for the live run ``name``, in the order they were heard."""
-    records, _, _ = driver.execute_query(cypher("live_tags"), {"log": name}, database_=database())
+def live_tags(driver: Driver, name: str, after: int = 0) -> list[Tag]:
+    """The tags stored for the live run ``name``, in the order they were heard (those after
+    the first ``after``)."""
+    records, _, _ = driver.execute_query(
+        cypher("live_tags"), {"log": name, "after": after}, database_=database()
+    )
     return [
         Tag(
             r["stamp"],
@@ -96,9 +121,12 @@ def live_tags(driver: Driver, name: str) -> list[Tag]:
     ]
 
 
-def live_poses(driver: Driver, name: str) -> list[Pose]:
-    """The odometry samples stored so far for the live run ``name``, oldest first."""
-    records, _, _ = driver.execute_query(cypher("live_poses"), {"log": name}, database_=database())
+def live_poses(driver: Driver, name: str, after: int = 0) -> list[Pose]:
+    """The odometry samples stored so far for the live run ``name`` (those after the first
+    ``after``), in the order they were stored."""
+    records, _, _ = driver.execute_query(
+        cypher("live_poses"), {"log": name, "after": after}, database_=database()
+    )
     return [Pose(r["stamp"], r["robot"], r["x"], r["y"], r["z"]) for r in records]
 
 
@@ -108,13 +136,12 @@ def live_alerts(driver: Driver, name: str) -> list[Alert]:
     return [Alert(r["stamp"], r["kind"], r["robot"], r["text"]) for r in records]
 
 
-def _names(fields: dict[str, str]) -> dict[str, str]:
-    """A tag's text fields under their Cypher parameter names (camel case)."""
-    return {
-        "robot": fields["robot"],
-        "activity": fields["activity"],
-        "lifecycle": fields["lifecycle"],
-        "msgId": fields["msg_id"],
-        "msgRole": fields["msg_role"],
-        "payload": fields["payload"],
-    }
+#: a tag's text fields under the Cypher parameter names of their lists
+_NAMES = {
+    "robot": "robots",
+    "activity": "activities",
+    "lifecycle": "lifecycles",
+    "msg_id": "msgIds",
+    "msg_role": "msgRoles",
+    "payload": "payloads",
+}

@@ -31,7 +31,7 @@ from collections.abc import Callable
 from typing import Any
 
 from cyclonedds.builtin import BuiltinDataReader, BuiltinTopicDcpsParticipant
-from cyclonedds.core import Listener, Policy, Qos
+from cyclonedds.core import DDSException, Entity, Listener, Policy, Qos
 from cyclonedds.domain import DomainParticipant
 from cyclonedds.pub import DataWriter
 from cyclonedds.sub import DataReader
@@ -361,7 +361,32 @@ class DdsBus:
         if self.recorder:  # robots must not wait for it any more, even while this process lives
             with contextlib.suppress(Exception):
                 self.participant.set_qos(Qos(Policy.Userdata(b"")))
-        self.participant = None
+        participant, self.participant = self.participant, None
+        self._writers.clear()
+        self._topics.clear()
+        if participant is not None:
+            leave(participant)
+
+
+def leave(participant: DomainParticipant) -> None:
+    """Delete ``participant`` and every reader, writer and topic in it now. Dropping the last
+    reference would do it too, but only once the garbage collector finds the cycles around a
+    bus (or never, while a caller or a traceback holds a writer): until then it stays on the
+    domain, and its transient-local writers hand their old samples to every new reader."""
+    # the binding deletes an entity in its finaliser and nowhere else, once: each of ours is
+    # finalised now (so no finaliser deletes its handle later, when Cyclone may have given the
+    # number to another entity), and deleting the participant deletes the rest with it
+    for entity in list(Entity._entities.values()):
+        if entity is not participant and _participant_of(entity) is participant:
+            entity.__del__()
+    participant.__del__()
+
+
+def _participant_of(entity: Entity) -> Any:
+    try:
+        return entity.get_participant()
+    except DDSException:  # a domain, or an entity Cyclone deleted already
+        return None
 
 
 class Recorders:

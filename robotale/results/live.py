@@ -5,7 +5,8 @@ pages answer on it as on a stored log while it grows.
 
 The run's case is the live log's name. The robots' positions (the map's trails and the state
 API's pose) are the odometry samples the monitor kept, not columns of the events. Each request
-looks at how many tags and samples are stored; the run is rebuilt only when that grew.
+looks at how many tags and samples are stored and reads only the new ones; the events are made
+again only when tags came.
 """
 
 from __future__ import annotations
@@ -30,8 +31,8 @@ from robotale.queries import cypher
 from robotale.results.replay import Replay
 
 _lock = threading.Lock()
-#: live log name -> ((tags, samples) it held, its replay): the last copy built of each
-_built: dict[str, tuple[tuple[int, int], Replay]] = {}
+#: live log name -> what a reader holds of it: its tags and samples, and the replay built
+_kept: dict[str, _Kept] = {}
 
 
 @dataclass
@@ -39,23 +40,45 @@ class LiveReplay(Replay):
     """A live run: its events, and its robots' positions from their odometry."""
 
     poses: list[Pose] = field(default_factory=list)
+    #: the runs as their events make them, kept while only the positions grow
+    bare: dict[str, MissionRun] = field(default_factory=dict)
 
     def run(self, case: str) -> MissionRun:
-        if case in self.runs or not self.poses:
-            return super().run(case)
-        run = super().run(case)
-        start = run.start.timestamp()
-        positions = pd.DataFrame(
-            {
-                "robot": [p.robot for p in self.poses],
-                "s": [p.stamp - start for p in self.poses],
-                "x": [p.x for p in self.poses],
-                "y": [p.y for p in self.poses],
-                "z": [p.z for p in self.poses],
-            }
-        )
-        self.runs[case] = dataclasses.replace(run, positions=positions)
-        return self.runs[case]
+        if case in self.runs:
+            return self.runs[case]
+        if case not in self.bare:
+            self.bare[case] = super().run(case)
+        run = self.bare[case]
+        if self.poses:
+            run = dataclasses.replace(run, positions=_positions(self.poses, run.start))
+        self.runs[case] = run
+        return run
+
+
+def _positions(poses: list[Pose], start: pd.Timestamp) -> pd.DataFrame:
+    """Where each robot was, by its odometry: robot, s (seconds since ``start``), x, y, z, in
+    time order (by robot where two share a time)."""
+    at = start.timestamp()
+    table = pd.DataFrame(
+        {
+            "robot": [p.robot for p in poses],
+            "s": [p.stamp - at for p in poses],
+            "x": [p.x for p in poses],
+            "y": [p.y for p in poses],
+            "z": [p.z for p in poses],
+        }
+    )
+    return table.sort_values(["s", "robot"], kind="stable").reset_index(drop=True)
+
+
+@dataclass
+class _Kept:
+    """What a reader holds of a live run: every tag and sample read so far, and the replay
+    built of them."""
+
+    tags: list[Tag] = field(default_factory=list)
+    poses: list[Pose] = field(default_factory=list)
+    replay: LiveReplay | None = None
 
 
 def live_count(driver: Driver, name: str) -> int:
@@ -103,15 +126,24 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
 
 
 def live_replay(driver: Driver, name: str) -> Replay | None:
-    """The live run ``name`` as it stands now, or None when no monitor stored one."""
-    count = live_counts(driver, name)
-    if not count[0]:
+    """The live run ``name`` as it stands now, or None when no monitor stored one. Only what
+    was stored since the last look is read: the tags and samples kept are extended; the
+    events are made again when tags came, the positions alone when only samples came."""
+    tags, poses = live_counts(driver, name)
+    if not tags:
         return None
     with _lock:
-        held = _built.get(name)
-    if held is not None and held[0] == count:
-        return held[1]
-    replay = LiveReplay(name, live_events(driver, name), {}, poses=live_poses(driver, name))
-    with _lock:
-        _built[name] = (count, replay)
-    return replay
+        kept = _kept.get(name)
+        if kept is None or tags < len(kept.tags) or poses < len(kept.poses):
+            kept = _kept[name] = _Kept()  # new, or a new run of that name
+        old = kept.replay
+        if old is not None and (tags, poses) == (len(kept.tags), len(kept.poses)):
+            return old
+        new_tags = live_tags(driver, name, after=len(kept.tags))
+        kept.tags += new_tags
+        kept.poses += live_poses(driver, name, after=len(kept.poses))
+        if old is None or new_tags:
+            kept.replay = LiveReplay(name, tags_events(name, kept.tags), {}, poses=kept.poses)
+        else:  # the same events: the runs they make are kept, their positions made again
+            kept.replay = LiveReplay(name, old.events, {}, poses=kept.poses, bare=old.bare)
+        return kept.replay

@@ -7,9 +7,10 @@ from __future__ import annotations
 
 import functools
 import json
+from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
-from typing import Protocol, TextIO, cast
+from typing import Any, Protocol, TextIO, cast
 
 from neo4j import Driver
 
@@ -60,7 +61,9 @@ class WatchedBus(Bus, Protocol):
 
 
 class Monitor:
-    """The robots' tags as they are heard: stored, printed, and their silences watched."""
+    """The robots' tags as they are heard: replayed, printed, their silences watched and
+    alerts raised at once from what is held in memory; stored in Neo4j behind that, on
+    threads of their own, so a slow store never holds an alert or the reading of DDS back."""
 
     def __init__(
         self,
@@ -70,16 +73,24 @@ class Monitor:
         limits: Limits,
         out: TextIO,
         graph: GrowingLog | None = None,
+        stored: Callable[[int], None] | None = None,
+        relay: Bus | None = None,
     ) -> None:
         self.bus, self.live, self.out = bus, live, out
+        #: the buses the alerts are published on: the watched one, and ``relay`` (a DDS
+        #: domain's, where robots and operators hear a simulated run's alerts)
+        self.alert_buses = [bus] if relay is None else [bus, relay]
         #: the live run's event knowledge graph, appended to every BATCH seconds
         self.graph = graph
         self.tags: list[Tag] = []
+        self.store_live = Writer(self._write_live)
+        self.store_graph = Writer(self._write_graph)
+        #: what was heard or raised and is not stored yet
+        self.unstored: list[Tag] = []
+        self.alerts: list[Alert] = []
         self.appended, self.last_append = 0, bus.clock.now()
-        # appends run on a thread of their own: DDS keeps being read while one is written,
-        # and Ctrl-C reaches the watch's own handler, not the append's deferred one
-        self.appender = ThreadPoolExecutor(max_workers=1)
-        self.appending: Future[int] | None = None
+        #: called with how many tags are stored, after each store of tags
+        self.stored = stored or (lambda count: None)
         #: odometry samples not stored yet, and when each robot's next one is kept
         self.poses: list[Pose] = []
         self.pose_due: dict[str, float] = {}
@@ -107,16 +118,17 @@ class Monitor:
             )
         # a DDS writer is made now, so readers match it before the first alert, and kept for
         # late joiners; an in-process bus needs none
-        declare = getattr(bus, "writer", None)
-        if declare is not None:
-            declare(ALERT_TOPIC, ALERT_TYPE, KEEP_ALL, "monitor")
+        for alerts in self.alert_buses:
+            declare = getattr(alerts, "writer", None)
+            if declare is not None:
+                declare(ALERT_TOPIC, ALERT_TYPE, KEEP_ALL, "monitor")
 
     def _tag(self, envelope: Envelope) -> None:
         tag: Tag = envelope.data
         if tag.robot not in self.heard:
             return  # a tag published on a robot's topic under another name: not this run's
-        self.live.append(tag)
         self.tags.append(tag)
+        self.unstored.append(tag)
         self.heard[tag.robot] = self.bus.clock.now()
         self.silent.discard(tag.robot)
         print(tag_line(tag, self.begin), file=self.out, flush=True)
@@ -148,36 +160,41 @@ class Monitor:
         self.poses.append(pose)
 
     def store(self, *, final: bool = False) -> None:
-        """Store the odometry samples kept since the last store and, every BATCH seconds (or
-        at the end), append the events heard since the last append to the live graph."""
-        poses, self.poses = self.poses, []
-        self.live.poses(poses)
-        if self.graph is None:
+        """Hand what was heard since the last store to the live log's writer (tags, alerts,
+        odometry samples) and, every BATCH seconds (or at the end), the events heard so far
+        to the graph's; each writer takes the next batch once it has written the last."""
+        if self.store_live.free(final) and (self.unstored or self.alerts or self.poses):
+            batch = (self.unstored, self.alerts, self.poses)
+            self.unstored, self.alerts, self.poses = [], [], []
+            self.store_live.start(batch, final)
+        if self.graph is None or not self.store_graph.free(final):
             return
-        if self.appending is not None:
-            if not (final or self.appending.done()):
-                return  # the last append is still being written
-            self.appending.result()  # a failed append's error ends the watch
-            self.appending = None
         now = self.bus.clock.now()
-        due = final or now - self.last_append >= BATCH
-        if not due or len(self.tags) == self.appended:
-            return
-        heard, graph, name = list(self.tags), self.graph, self.live.name
-        self.appending = self.appender.submit(lambda: graph.update(tags_events(name, heard)))
-        self.appended, self.last_append = len(heard), now
-        if final:
-            self.appending.result()
-            self.appending = None
+        if (final or now - self.last_append >= BATCH) and len(self.tags) > self.appended:
+            self.appended, self.last_append = len(self.tags), now
+            self.store_graph.start(list(self.tags), final)
+
+    def _write_live(self, batch: tuple[list[Tag], list[Alert], list[Pose]]) -> None:
+        tags, alerts, poses = batch
+        self.live.append_tags(tags)
+        self.live.alerts(alerts)
+        self.live.poses(poses)
+        if tags:
+            self.stored(self.live.count)
+
+    def _write_graph(self, heard: list[Tag]) -> None:
+        assert self.graph is not None  # only started with a graph
+        self.graph.update(tags_events(self.live.name, heard))
 
     def finish(self) -> None:
-        """The watch ended: the last events appended, the live graph complete."""
+        """The watch ended: the last tags, alerts and events stored, the live graph complete."""
         try:
             self.store(final=True)
             if self.graph is not None:
                 self.graph.finish()
         finally:
-            self.appender.shutdown()
+            self.store_live.close()
+            self.store_graph.close()
 
     def watch(self) -> None:
         """Alert once for each robot silent longer than the limit (again after it spoke)."""
@@ -192,17 +209,49 @@ class Monitor:
             self.raise_alert(alert)
 
     def raise_alert(self, alert: Alert) -> None:
+        """Printed and published now; stored with the next batch."""
         print(f"# alert {alert.kind} {alert.robot}: {alert.text}", file=self.out, flush=True)
-        self.live.alert(alert)
         text = json.dumps(asdict(alert), separators=(",", ":"))
-        self.bus.publish(
-            ALERT_TOPIC, {"data": text}, msgtype=ALERT_TYPE, sender="monitor", qos=KEEP_ALL
-        )
+        for alerts in self.alert_buses:
+            alerts.publish(
+                ALERT_TOPIC, {"data": text}, msgtype=ALERT_TYPE, sender="monitor", qos=KEEP_ALL
+            )
+        self.alerts.append(alert)
 
     def pump(self, seconds: float) -> None:
         self.bus.clock.run(until=self.bus.clock.now() + seconds)
         self.watch()
         self.store()
+
+
+class Writer:
+    """One batch at a time written on a thread of its own: what is heard meanwhile waits for
+    the next batch, so the batches grow while the store is slow and nothing queues up behind
+    it. A failed write's error ends the watch at the next look."""
+
+    def __init__(self, write: Callable[[Any], None]) -> None:
+        self.write = write
+        # Ctrl-C reaches the watch's own handler, not the write's deferred one
+        self.thread = ThreadPoolExecutor(max_workers=1)
+        self.writing: Future[None] | None = None
+
+    def free(self, final: bool = False) -> bool:
+        """Whether the last batch is written (waiting for it when ``final``)."""
+        if self.writing is None:
+            return True
+        if not (final or self.writing.done()):
+            return False
+        writing, self.writing = self.writing, None
+        writing.result()  # its error, if it failed
+        return True
+
+    def start(self, batch: Any, final: bool = False) -> None:
+        self.writing = self.thread.submit(self.write, batch)
+        if final:
+            self.free(final=True)
+
+    def close(self) -> None:
+        self.thread.shutdown()
 
 
 def odometry_pose(robot: str, envelope: Envelope) -> Pose:

@@ -13,11 +13,11 @@ from typing import Any, TextIO, cast
 from neo4j import Driver
 
 from robotale.discovery.online import pool_replays
+from robotale.ekg.growing import GrowingLog
 from robotale.ekg.live import LiveLog
-from robotale.fame_runtime.bus import Envelope, InProcessBus, Subscription
+from robotale.fame_runtime.bus import Bus, Envelope, InProcessBus, Subscription
 from robotale.fame_runtime.clock import RunningClock
 from robotale.fame_runtime.qos import DEFAULT_QOS, QoS
-from robotale.fame_runtime.tags import tag_topic
 from robotale.results.monitor import TICK, Limits, Monitor
 
 #: called once the live log ``name`` holds its first tag (to say where to follow it)
@@ -64,7 +64,9 @@ class Overheard:
 
 
 class WatchedRun:
-    """One simulated run under the monitor: made before its mission starts, ended after."""
+    """One simulated run under the monitor: made before its mission starts, ended after. Its
+    tags are stored as the live log ``name`` and as a growing event knowledge graph, as
+    ``robotale monitor`` stores a run on DDS."""
 
     def __init__(
         self,
@@ -76,32 +78,49 @@ class WatchedRun:
         limits: Limits,
         out: TextIO,
         announce: Announce | None = None,
+        relay: Bus | None = None,
     ) -> None:
-        self.name, self.announce = name, announce
-        heard = Overheard(bus)
-        self.monitor = Monitor(
-            heard, LiveLog(driver, name), pool_replays(model, robots), limits, out
-        )
-        # after the monitor's own subscription: the tag is stored when it is announced
-        for robot in robots:
-            heard.subscribe(tag_topic(robot), self._first)
+        """``relay``: another bus the alerts are published on (see :class:`Monitor`)."""
+        self.name, self.announce, self.announced = name, announce, False
+        replays = pool_replays(model, robots)
+        # refused here, before the run starts, when a log no monitor wrote has that name
+        graph = GrowingLog(driver, name)
+        try:
+            self.monitor = Monitor(
+                Overheard(bus),
+                LiveLog(driver, name),
+                replays,
+                limits,
+                out,
+                graph,
+                self._stored,
+                relay,
+            )
+        except BaseException:
+            graph.close()
+            raise
         self._tick(bus)
 
     def _tick(self, bus: InProcessBus) -> None:
-        """The monitor looks at the robots' silences and the time things take every
-        :data:`TICK` simulated seconds, as it does every :data:`TICK` wall seconds on DDS."""
+        """The monitor looks at the robots' silences and the time things take, and hands what
+        it heard to its writers, every :data:`TICK` simulated seconds, as it does every
+        :data:`TICK` wall seconds on DDS."""
 
         def look() -> None:
             self.monitor.watch()
+            self.monitor.store()
             bus.clock.call_later(TICK, look)
 
         bus.clock.call_later(TICK, look)
 
-    def _first(self, _envelope: Envelope) -> None:
-        if self.announce is not None and self.monitor.live.count == 1:
+    def _stored(self, count: int) -> None:
+        """The live log holds ``count`` tags (on the monitor's writer thread)."""
+        if self.announce is not None and count and not self.announced:
+            self.announced = True
             self.announce(self.name)
 
     def end(self) -> int:
-        """A last look at the run as it ended; how many tags were stored."""
+        """A last look at the run as it ended, everything stored; how many tags were."""
         self.monitor.watch()
+        self.monitor.finish()
         return self.monitor.live.count

@@ -1,8 +1,9 @@
 """``robotale simulate --live``: a real agri run in pybullet watched by the monitor on the
-simulation's bus, its tags stored as a live run the dashboard serves while it goes on. Set
-against the run's own recording: the live run's events are, row by row, those ``prepare`` makes
-of the bag, and the battery alerts are the bag's battery samples crossing the threshold, read
-back with rosbags."""
+simulation's bus, its tags stored as a live run (and its event knowledge graph) the dashboard
+serves while it goes on. Set against the run's own recording: the live run's events are, row
+by row, those ``prepare`` makes of the bag, and the battery alerts are the bag's battery
+samples crossing the threshold, read back with rosbags; a plain cyclonedds reader on the DDS
+domain gets the same alerts."""
 
 from __future__ import annotations
 
@@ -38,9 +39,18 @@ def battery_crossings(bag, robots) -> list[tuple[str, float, float]]:
 
 
 def test_simulate_live_stores_the_run_as_recorded_and_prints_the_battery_alert(
-    tmp_path, capsys, neo4j_driver, dashboard
+    tmp_path, tmp_path_factory, monkeypatch, capsys, neo4j_driver, dashboard
 ):
+    import json
+
+    cyclonedds = pytest.importorskip("cyclonedds.domain")
+    from cyclonedds.core import Policy, Qos
+    from cyclonedds.sub import DataReader
+    from cyclonedds.topic import Topic
+    from dds_domain import loopback
+
     from robotale.ekg.live import delete_live, live_alerts, live_tags
+    from robotale.ekg.logs import delete_log, log_info, stored_events
     from robotale.eventlog.preparing import prepare_recordings
     from robotale.results.live import live_events
 
@@ -50,16 +60,33 @@ def test_simulate_live_stores_the_run_as_recorded_and_prints_the_battery_alert(
     args = ["simulate", "agri", "--runs", "1", "--out", str(out), "--live", "--log", name]
     args += ["--pace", "1000", "--silence", "600", "--dashboard", dashboard.url]
     args += ["--fault", "battery:tractor_1@20,rate=0.06,for=14"]
+    # a plain cyclonedds reader of the alerts the run publishes on the DDS domain too
+    from robotale.fame_runtime.dds import leave
+    from robotale.fame_runtime.rostypes import idl_type
+
+    participant = cyclonedds.DomainParticipant(loopback(tmp_path_factory, monkeypatch))
+    kept = Qos(
+        Policy.Reliability.Reliable(10**9), Policy.Durability.TransientLocal, Policy.History.KeepAll
+    )
+    topic = Topic(participant, "rt/robotale/alerts", idl_type("std_msgs/msg/String"))
+    reader = DataReader(participant, topic, qos=kept)
     try:
         assert main(args) == 0
         said = capsys.readouterr()
+        published = [json.loads(s.data) for s in reader.take(N=100) if s.sample_info.valid_data]
         events = live_events(neo4j_driver, name)
         tags = live_tags(neo4j_driver, name)
         stored = live_alerts(neo4j_driver, name)
+        graphed, status = stored_events(neo4j_driver, name), log_info(neo4j_driver, name)["status"]
     finally:
+        leave(participant)
         delete_live(neo4j_driver, name)
+        delete_log(neo4j_driver, name)  # the live run's event knowledge graph
     bag = out / "run_0001"
-    assert_prepared(events, prepare_recordings(bag))
+    prepared = prepare_recordings(bag)
+    assert_prepared(events, prepared)
+    # its event knowledge graph grew with it and holds every event, complete once it ended
+    assert (graphed, status) == (len(prepared), "complete")
 
     # the dashboard answered on the live run once its first tag was stored
     page = f"{dashboard.url}/mission?log={name}&case={name}"
@@ -77,3 +104,7 @@ def test_simulate_live_stores_the_run_as_recorded_and_prints_the_battery_alert(
         assert f"{robot}'s battery at {percent:.1f} %" in text
         assert f"# alert battery {robot}: {text}" in said.out
     assert {a.kind for a in stored} == {"battery"}, stored
+    # and published on the DDS domain as stored
+    assert sorted((a["stamp"], a["kind"], a["robot"], a["text"]) for a in published) == sorted(
+        (a.stamp, a.kind, a.robot, a.text) for a in stored
+    )
