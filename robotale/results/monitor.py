@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import functools
 import json
+import time
 from collections.abc import Callable
 from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import asdict, dataclass, field, replace
@@ -37,7 +38,9 @@ ODOMETRY_TYPE = "nav_msgs/msg/Odometry"
 BATTERY_QOS = replace(DEFAULT_QOS, reliability="best_effort")
 #: seconds between two looks at the robots' silence (and two stores of odometry samples)
 TICK = 0.1
-#: seconds between two appends to the live run's event knowledge graph
+#: wall seconds between two appends to the live run's event knowledge graph (wall, not the
+#: bus's clock: a simulation running a thousand times faster than the wall would otherwise
+#: have its graph rebuilt back to back, each update costing more as the run grows)
 BATCH = 1.0
 #: odometry samples kept per robot and second, at most (a robot may publish far more)
 ODOMETRY_RATE = 10.0
@@ -73,7 +76,6 @@ class Monitor:
         limits: Limits,
         out: TextIO,
         graph: GrowingLog | None = None,
-        stored: Callable[[int], None] | None = None,
         relay: Bus | None = None,
     ) -> None:
         self.bus, self.live, self.out = bus, live, out
@@ -88,9 +90,7 @@ class Monitor:
         #: what was heard or raised and is not stored yet
         self.unstored: list[Tag] = []
         self.alerts: list[Alert] = []
-        self.appended, self.last_append = 0, bus.clock.now()
-        #: called with how many tags are stored, after each store of tags
-        self.stored = stored or (lambda count: None)
+        self.appended, self.last_append = 0, time.monotonic()
         #: odometry samples not stored yet, and when each robot's next one is kept
         self.poses: list[Pose] = []
         self.pose_due: dict[str, float] = {}
@@ -169,18 +169,18 @@ class Monitor:
             self.store_live.start(batch, final)
         if self.graph is None or not self.store_graph.free(final):
             return
-        now = self.bus.clock.now()
-        if (final or now - self.last_append >= BATCH) and len(self.tags) > self.appended:
-            self.appended, self.last_append = len(self.tags), now
-            self.store_graph.start(list(self.tags), final)
+        # the graph gets the tags the live log holds already: a reader that finds the graph
+        # finds its tags too (and never takes a run being stored for an ingested log)
+        stored, now = self.live.count, time.monotonic()
+        if (final or now - self.last_append >= BATCH) and stored > self.appended:
+            self.appended, self.last_append = stored, now
+            self.store_graph.start(self.tags[:stored], final)
 
     def _write_live(self, batch: tuple[list[Tag], list[Alert], list[Pose]]) -> None:
         tags, alerts, poses = batch
         self.live.append_tags(tags)
         self.live.alerts(alerts)
         self.live.poses(poses)
-        if tags:
-            self.stored(self.live.count)
 
     def _write_graph(self, heard: list[Tag]) -> None:
         assert self.graph is not None  # only started with a graph

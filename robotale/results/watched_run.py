@@ -84,21 +84,19 @@ class WatchedRun:
         self.name, self.announce, self.announced = name, announce, False
         replays = pool_replays(model, robots)
         # refused here, before the run starts, when a log no monitor wrote has that name
-        graph = GrowingLog(driver, name)
+        self.graph = GrowingLog(driver, name)
         try:
+            # the graph is handed to the monitor once the run is announced: the dashboard's
+            # first answer does not wait behind the graph's first append (which has Neo4j plan
+            # each of its queries)
             self.monitor = Monitor(
-                Overheard(bus),
-                LiveLog(driver, name),
-                replays,
-                limits,
-                out,
-                graph,
-                self._stored,
-                relay,
+                Overheard(bus), LiveLog(driver, name), replays, limits, out, relay=relay
             )
         except BaseException:
-            graph.close()
+            self.graph.close()
             raise
+        if announce is None:
+            self.monitor.graph = self.graph
         self._tick(bus)
 
     def _tick(self, bus: InProcessBus) -> None:
@@ -109,18 +107,22 @@ class WatchedRun:
         def look() -> None:
             self.monitor.watch()
             self.monitor.store()
+            self._announce()
             bus.clock.call_later(TICK, look)
 
         bus.clock.call_later(TICK, look)
 
-    def _stored(self, count: int) -> None:
-        """The live log holds ``count`` tags (on the monitor's writer thread)."""
-        if self.announce is not None and count and not self.announced:
+    def _announce(self) -> None:
+        """Say where the run is followed, once the live log holds a tag. On the simulation's
+        thread, which waits meanwhile: a dashboard in this process answers sooner so."""
+        if self.announce is not None and self.monitor.live.count and not self.announced:
             self.announced = True
             self.announce(self.name)
+            self.monitor.graph = self.graph
 
     def end(self) -> int:
         """A last look at the run as it ended, everything stored; how many tags were."""
         self.monitor.watch()
+        self.monitor.graph = self.graph  # also when nothing was announced
         self.monitor.finish()
         return self.monitor.live.count
