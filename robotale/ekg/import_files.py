@@ -3,8 +3,9 @@
 The files hold exactly the nodes, relationships and properties (with their Neo4j types) that
 the online build writes through Cypher (:mod:`robotale.ekg.build`): events, entities and
 classes, the log's ``Log`` node and its ``LogLock``, CORR, OBSERVED, DF, COMM, BEGINS and
-DF_C. Each file has its header on its first line; nodes get integer ids in one id space
-(events, then entities, classes, the Log node and the lock), which the importer does not store.
+DF_C. Each file has its header on its first line; nodes get the ids 0, 1, 2 ... in one id space
+(events, then entities, classes, the Log node and the lock), which the importer takes as the
+nodes' own ids (none is stored as a property).
 
 Values are written as the importer reads them: strings always quoted (an unquoted empty field
 is a missing value, as ``None`` is online), floats in a form that reads back exactly, times with
@@ -112,7 +113,8 @@ def write_import_files(
     edge_count = len(corr) + len(tables.df) + len(tables.comm)
     edge_count += sum(len(events) + len(c.entries) + len(c.df_c) for c in classes)
     multiline = _has_line_breaks(tables, classes)
-    return ImportFiles(nodes, relationships, multiline, (node_count, edge_count))
+    expected = (node_count, edge_count)
+    return ImportFiles(nodes, relationships, multiline, expected, dense_ids=True)
 
 
 # -- the columns of each file ----------------------------------------------------------------
