@@ -85,7 +85,7 @@ def build_log(
     if build not in BUILDS:
         raise InputError(f"--build {build!r} is not one of {', '.join(BUILDS)}.")
     prepared = prepare(log, entities, aggregate, name)
-    reason = None if build == ONLINE else refusal(driver, prepared, objects, user_agent)
+    reason = "--build online" if build == ONLINE else refusal(driver, prepared, objects, user_agent)
     if build == AUTO and reason is None and len(log) < BULK_FROM:
         reason = f"fewer than {BULK_FROM:,} events"
     if build == BULK and reason is not None:
