@@ -56,9 +56,9 @@ from robotale.queries import cypher
 
 ONLINE, BULK, AUTO = "online", "bulk", "auto"
 BUILDS = (AUTO, ONLINE, BULK)
-#: from this many events on ``auto`` takes the bulk path: below it, stopping and starting the
-#: server takes longer than writing online (docs/benchmarks.md, "Bulk import")
-BULK_FROM = 400_000
+#: from this many events on ``auto`` takes the bulk path: at this size it already took less
+#: wall and CPU time than writing online, restart included (docs/benchmarks.md, "Bulk import")
+BULK_FROM = 100_000
 #: how long the indexes and constraints may take to come online after an import
 INDEX_WAIT = 3600
 
@@ -85,7 +85,7 @@ def build_log(
     if build not in BUILDS:
         raise InputError(f"--build {build!r} is not one of {', '.join(BUILDS)}.")
     prepared = prepare(log, entities, aggregate, name)
-    reason = None if build == ONLINE else refusal(driver, prepared, objects, user_agent)
+    reason = "--build online" if build == ONLINE else refusal(driver, prepared, objects, user_agent)
     if build == AUTO and reason is None and len(log) < BULK_FROM:
         reason = f"fewer than {BULK_FROM:,} events"
     if build == BULK and reason is not None:

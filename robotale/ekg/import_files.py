@@ -3,28 +3,32 @@
 The files hold exactly the nodes, relationships and properties (with their Neo4j types) that
 the online build writes through Cypher (:mod:`robotale.ekg.build`): events, entities and
 classes, the log's ``Log`` node and its ``LogLock``, CORR, OBSERVED, DF, COMM, BEGINS and
-DF_C. Each file has its header on its first line; nodes get integer ids in one id space
-(events, then entities, classes, the Log node and the lock), which the importer does not store.
+DF_C. Each file has its header on its first line; nodes get the ids 0, 1, 2 ... in one id space
+(events, then entities, classes, the Log node and the lock), which the importer takes as the
+nodes' own ids (none is stored as a property).
 
 Values are written as the importer reads them: strings always quoted (an unquoted empty field
-is a missing value, as ``None`` is online), floats in their shortest exact form, times with
+is a missing value, as ``None`` is online), floats in a form that reads back exactly, times with
 nanoseconds, their offset and, where the log has one, their zone's name.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.compute as pc
+from pyarrow import csv
 
 from robotale.ekg.load import timezone_name
 from robotale.ekg.tables import ClassTables, GraphTables
 from robotale.neo4j_server.importer import ImportFiles
 
-#: rows formatted and written at a time: bounds the memory the text of a file takes
+#: rows the writer formats at a time: bounds the memory the text of a file takes
 _CHUNK = 200_000
 #: the separator of array values in a field (the importer's default)
 ARRAY_DELIMITER = ";"
@@ -32,10 +36,11 @@ ARRAY_DELIMITER = ";"
 
 @dataclass(frozen=True)
 class Column:
-    """One property of a file: its header (``name:type``) and its fields as text."""
+    """One property of a file: its header (``name:type``) and its values, which the writer
+    formats (texts quoted, a missing value as an empty field)."""
 
     header: str
-    fields: pd.Series
+    fields: pa.Array
 
 
 def unsupported(tables: GraphTables, classes: Sequence[ClassTables]) -> str | None:
@@ -108,7 +113,8 @@ def write_import_files(
     edge_count = len(corr) + len(tables.df) + len(tables.comm)
     edge_count += sum(len(events) + len(c.entries) + len(c.df_c) for c in classes)
     multiline = _has_line_breaks(tables, classes)
-    return ImportFiles(nodes, relationships, multiline, (node_count, edge_count))
+    expected = (node_count, edge_count)
+    return ImportFiles(nodes, relationships, multiline, expected, dense_ids=True)
 
 
 # -- the columns of each file ----------------------------------------------------------------
@@ -117,10 +123,10 @@ def write_import_files(
 def _event_columns(events: pd.DataFrame, log: str) -> list[Column]:
     size = len(events)
     columns = [
-        _ids(pd.Series(np.arange(size))),
+        _ids(np.arange(size)),
         _constant("log", log, size),
         _typed(events["id"], "id"),
-        Column("order:long", pd.Series(np.arange(size)).astype(str)),
+        Column("order:long", pa.array(np.arange(size, dtype=np.int64))),
         _times(events["timestamp"], "timestamp"),
     ]
     others = [name for name in events.columns if name not in ("id", "timestamp")]
@@ -129,7 +135,7 @@ def _event_columns(events: pd.DataFrame, log: str) -> list[Column]:
 
 def _entity_columns(entities: pd.DataFrame, log: str, base: int) -> list[Column]:
     return [
-        _ids(pd.Series(np.arange(len(entities)) + base)),
+        _ids(np.arange(len(entities)) + base),
         _constant("log", log, len(entities)),
         _typed(entities["type"], "type"),
         _typed(entities["id"], "id"),
@@ -140,11 +146,11 @@ def _class_columns(kind: ClassTables, log: str, base: int) -> list[Column]:
     table = kind.classes
     size = len(table)
     columns = [
-        _ids(pd.Series(np.arange(size) + base)),
+        _ids(np.arange(size) + base),
         _constant("log", log, size),
         _constant("type", kind.type, size),
         _typed(table["id"], "id"),
-        Column("key:string[]", pd.Series([_quote_array(kind.key)] * size, dtype=object)),
+        _constant("key", ARRAY_DELIMITER.join(kind.key), size, "string[]"),
     ]
     return columns + [_typed(table[name], name) for name in kind.key]
 
@@ -152,16 +158,17 @@ def _class_columns(kind: ClassTables, log: str, base: int) -> list[Column]:
 def _single(node: int, properties: dict[str, object]) -> list[Column]:
     """The columns of a file of one node with ``properties`` (texts, integers, lists of
     texts, or :class:`Instant`)."""
-    columns = [_ids(pd.Series([node]))]
+    columns = [_ids(np.array([node]))]
     for name, value in properties.items():
         if isinstance(value, Instant):
-            columns.append(Column(f"{name}:datetime", pd.Series([value.text])))
+            columns.append(_constant(name, value.text, 1, "datetime"))
         elif isinstance(value, bool | int):
-            columns.append(Column(f"{name}:long", pd.Series([str(int(value))])))
+            columns.append(Column(f"{name}:long", pa.array([int(value)], pa.int64())))
         elif isinstance(value, list | tuple):
-            columns.append(Column(f"{name}:string[]", pd.Series([_quote_array(value)])))
+            text = ARRAY_DELIMITER.join(str(v) for v in value)
+            columns.append(_constant(name, text, 1, "string[]"))
         else:
-            columns.append(Column(f"{name}:string", pd.Series([_quote(str(value))])))
+            columns.append(_constant(name, str(value), 1))
     return columns
 
 
@@ -185,6 +192,8 @@ _KINDS = (
     (pd.api.types.is_integer_dtype, "long"),
     (pd.api.types.is_float_dtype, "double"),
 )
+#: the Arrow type each kind is written from (the writer quotes texts, not numbers)
+_ARROW = {"boolean": pa.bool_(), "long": pa.int64(), "string": pa.large_string()}
 
 
 def _kind(column: pd.Series) -> str | None:
@@ -205,26 +214,27 @@ def _typed(column: pd.Series, name: str) -> Column:
     kind = _kind(column)
     if kind == "double":
         return _double(column, name, keep_nan=False)
-    if kind == "boolean":
-        text = column.map({True: "true", False: "false"})
-        return Column(f"{name}:boolean", text.astype(object).where(column.notna(), ""))
-    if kind == "long":
-        present = column.notna()
-        text = column.astype(object).where(present, 0).astype("int64").astype(str)
-        return Column(f"{name}:long", text.where(present, ""))
-    values = column.astype(object)
-    present = values.notna()
-    text = '"' + values.where(present, "").astype(str).str.replace('"', '""', regex=False) + '"'
-    return Column(f"{name}:string", text.where(present, ""))
+    assert kind is not None, "unsupported() refused the column"
+    return Column(f"{name}:{kind}", _arrow(column, _ARROW[kind]))
+
+
+def _arrow(column: pd.Series, kind: pa.DataType) -> pa.Array | pa.ChunkedArray:
+    """``column`` as Arrow values of ``kind``, a missing value (None, NaN, NA) as null."""
+    return pa.array(column, from_pandas=True).cast(kind)
 
 
 def _double(column: pd.Series, name: str, keep_nan: bool) -> Column:
     values = column.to_numpy(float)
+    infinite = np.isinf(values)
+    if not infinite.any() and not (keep_nan and np.isnan(values).any()):
+        # online, a missing float is no property: NaN becomes an empty field
+        return Column(f"{name}:double", pa.array(values, from_pandas=True))
+    # the writer spells these "inf" and "nan"; the importer reads Java's spelling
     text = pd.Series(values.astype(str)).str.replace("inf", "Infinity", regex=False)
     text = text.str.replace("nan", "NaN", regex=False)
-    if not keep_nan:  # online, a missing float is no property
-        text = text.where(~np.isnan(values), "")
-    return Column(f"{name}:double", text)
+    if not keep_nan:
+        text = text.where(~np.isnan(values), None)
+    return Column(f"{name}:double", pa.array(text, pa.large_string(), from_pandas=True))
 
 
 def _times(times: pd.Series, name: str) -> Column:
@@ -234,12 +244,16 @@ def _times(times: pd.Series, name: str) -> Column:
     shown = times.dt.tz_convert(zone) if named else times
     local = shown.dt.tz_localize(None)
     utc = times.dt.tz_convert("UTC").dt.tz_localize(None)
-    offsets = ((local - utc) // pd.Timedelta(minutes=1)).astype("int64")
-    suffixes = offsets.map({m: _offset(m) for m in offsets.unique().tolist()})
-    if named:
-        suffixes = suffixes + f"[{zone}]"
-    text = pd.Series(np.datetime_as_string(local.to_numpy("datetime64[ns]"), unit="ns"))
-    return Column(f"{name}:datetime", text + suffixes.to_numpy())
+    offsets = ((local - utc) // pd.Timedelta(minutes=1)).to_numpy("int64")
+    # few offsets (a zone's standard and summer time): each suffix written once
+    unique, at = np.unique(offsets, return_inverse=True)
+    suffixes = [_offset(int(m)) + (f"[{zone}]" if named else "") for m in unique]
+    suffix = pa.array(suffixes, pa.large_string()).take(pa.array(at.astype(np.int64)))
+    text = pa.array(np.datetime_as_string(local.to_numpy("datetime64[ns]"), unit="ns"))
+    joined = pc.binary_join_element_wise(
+        text.cast(pa.large_string()), suffix, pa.scalar("", pa.large_string())
+    )
+    return Column(f"{name}:datetime", joined)
 
 
 def _offset(minutes: int) -> str:
@@ -252,20 +266,12 @@ def instant(moment: pd.Timestamp) -> Instant:
     return Instant(moment.isoformat())
 
 
-def _ids(values: pd.Series) -> Column:
-    return Column(":ID", values.astype(str))
+def _ids(values: np.ndarray) -> Column:
+    return Column(":ID", pa.array(np.asarray(values, dtype=np.int64)))
 
 
-def _constant(name: str, value: str, size: int) -> Column:
-    return Column(f"{name}:string", pd.Series([_quote(value)] * size, dtype=object))
-
-
-def _quote(text: str) -> str:
-    return '"' + text.replace('"', '""') + '"'
-
-
-def _quote_array(values: Iterable[object]) -> str:
-    return _quote(ARRAY_DELIMITER.join(str(v) for v in values))
+def _constant(name: str, value: str, size: int, kind: str = "string") -> Column:
+    return Column(f"{name}:{kind}", pa.repeat(pa.scalar(value, pa.large_string()), size))
 
 
 def _has_line_breaks(tables: GraphTables, classes: Sequence[ClassTables]) -> bool:
@@ -276,7 +282,9 @@ def _has_line_breaks(tables: GraphTables, classes: Sequence[ClassTables]) -> boo
             column = table[name]
             if (
                 _kind(column) == "string"
-                and column.astype("string").str.contains(r"[\r\n]", regex=True, na=False).any()
+                and pc.any(
+                    pc.match_substring_regex(_arrow(column, pa.large_string()), r"[\r\n]")
+                ).as_py()
             ):
                 return True
     return False
@@ -289,23 +297,20 @@ def _edges(
     path: Path, sources: pd.Series, targets: pd.Series, properties: Sequence[Column] = ()
 ) -> Path:
     columns = [
-        Column(":START_ID", pd.Series(np.asarray(sources)).astype(str)),
-        Column(":END_ID", pd.Series(np.asarray(targets)).astype(str)),
+        Column(":START_ID", pa.array(np.asarray(sources, dtype=np.int64))),
+        Column(":END_ID", pa.array(np.asarray(targets, dtype=np.int64))),
         *properties,
     ]
     return _write(path, columns)
 
 
 def _write(path: Path, columns: Sequence[Column]) -> Path:
-    size = len(columns[0].fields)
-    with path.open("w", encoding="utf-8", newline="") as out:
-        out.write(",".join(column.header for column in columns) + "\n")
-        for start in range(0, size, _CHUNK):
-            parts = [
-                pd.Series(column.fields.to_numpy()[start : start + _CHUNK], dtype=object)
-                for column in columns
-            ]
-            lines = parts[0].str.cat(parts[1:], sep=",") if len(parts) > 1 else parts[0]
-            out.write("\n".join(lines.tolist()))
-            out.write("\n")
+    """The header line, then Arrow's CSV writer: texts always quoted (an empty text is ``""``,
+    a missing value an empty field, as the importer reads them), numbers as they are."""
+    names = [f"c{k}" for k in range(len(columns))]
+    table = pa.table([column.fields for column in columns], names=names)
+    options = csv.WriteOptions(include_header=False, quoting_style="needed", batch_size=_CHUNK)
+    with path.open("wb") as out:
+        out.write((",".join(column.header for column in columns) + "\n").encode())
+        csv.write_csv(table, out, options)
     return path

@@ -44,6 +44,8 @@ class ImportFiles:
     #: the node and relationship counts the files hold, checked against the importer's report
     expected: tuple[int, int] | None = None
     options: Sequence[str] = field(default_factory=tuple)
+    #: the nodes' ids are 0, 1, 2 ... across all node files, each once
+    dense_ids: bool = False
 
 
 @dataclass(frozen=True)
@@ -59,7 +61,9 @@ class ImportReport:
 def admin_command(java: str, classpath: str, database: str, files: ImportFiles) -> list[str]:
     """The ``neo4j-admin database import full`` command line for ``files``."""
     command = [java, "-cp", classpath, ADMIN_TOOL, "database", "import", "full", database]
-    command += ["--overwrite-destination=true", "--id-type=integer", "--bad-tolerance=0"]
+    # dense ids are the node ids themselves: the importer then builds no map from ids to nodes
+    id_type = "actual" if files.dense_ids else "integer"
+    command += ["--overwrite-destination=true", f"--id-type={id_type}", "--bad-tolerance=0"]
     command += [f"--nodes={label}={path}" for label, path in files.nodes]
     command += [f"--relationships={kind}={path}" for kind, path in files.relationships]
     if files.multiline:
@@ -195,7 +199,8 @@ def _restart(
 ) -> None:
     progress("Starting the local Neo4j again ...")
     try:
-        server.start(options, progress=progress)
+        # the build goes on with queries: the Browser may finish starting meanwhile
+        server.start(options, progress=progress, bolt_only=True)
     except ServerError as error:
         raise RestartFailed(
             f"The local Neo4j did not start again {when}: {error} Start it with "

@@ -256,8 +256,13 @@ class LocalServer:
         options: ServerOptions | None = None,
         timeout: float = 180,
         progress: Callable[[str], None] = lambda line: None,
+        bolt_only: bool = False,
     ) -> RunningServer:
         """Start the server in the background and wait until Bolt answers.
+
+        ``bolt_only``: return once Bolt answers, while the web server (Browser, HTTP) may still
+        be starting (Neo4j opens Bolt after its databases are up and HTTP after Bolt, which
+        takes seconds more): for a caller that only queries.
 
         Returns the already running server if there is one. Ports the last server of this home
         held (it crashed, or was stopped a moment ago) are waited for, with ``progress`` lines;
@@ -293,7 +298,7 @@ class LocalServer:
         write_file(self.options_file, json.dumps(kept))
         self._record(state, stopped=False)
         try:
-            self._wait_until_answering(process, state, timeout)
+            self._wait_until_answering(process, state, timeout, bolt_only)
         except BaseException:
             _terminate(process.pid, grace=30)
             self.state_file.unlink(missing_ok=True)
@@ -454,14 +459,19 @@ class LocalServer:
             )
 
     def _wait_until_answering(
-        self, process: subprocess.Popen[bytes], state: RunningServer, timeout: float
+        self,
+        process: subprocess.Popen[bytes],
+        state: RunningServer,
+        timeout: float,
+        bolt_only: bool = False,
     ) -> None:
         deadline = time.monotonic() + timeout
         while time.monotonic() < deadline:
             if process.poll() is not None:
                 self._fail(f"Neo4j exited with status {process.returncode} while starting", state)
             # HTTP comes up last: once it answers, Bolt, Browser and the databases are ready.
-            if _http_answers(state) and bolt_answers(state.bolt_uri, (USER, self.password() or "")):
+            http = bolt_only or _http_answers(state)
+            if http and bolt_answers(state.bolt_uri, (USER, self.password() or "")):
                 return
             time.sleep(0.5)
         self._fail(f"Neo4j did not answer on {state.bolt_uri} within {timeout:.0f} s", state)

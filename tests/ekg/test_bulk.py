@@ -20,7 +20,7 @@ from neo4j import Driver
 
 from robotale.ekg import import_files
 from robotale.ekg.build import build_ekg
-from robotale.ekg.bulk import BULK, build_log
+from robotale.ekg.bulk import BULK, ONLINE, build_log
 from robotale.ekg.connection import connect
 from robotale.ekg.load import timezone_name
 from robotale.ekg.logs import delete_log_locked, list_logs, log_summary
@@ -180,7 +180,10 @@ def test_the_bulk_build_equals_the_online_build(managed, neo4j_driver, thesis_lo
         assert "the database is as it was before" in str(failed.value)
     with connect() as after:
         assert after.execute_query("MATCH (n) RETURN count(n) AS n").records[0]["n"] == 0
-        build_log(after, thesis_log, name, aggregate=["activity"], progress=False)
+        # --build online into the empty database of robotale's server: written online, no restart
+        running = managed.running()
+        build_log(after, thesis_log, name, build=ONLINE, aggregate=["activity"], progress=False)
+        assert managed.running() == running
         assert answers(after, name)[1]["events"] == len(thesis_log)
 
 
