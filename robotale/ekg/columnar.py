@@ -134,10 +134,11 @@ def widened_schema(columns: pa.Schema, added: pd.DataFrame) -> bytes:
     """The column types ``columns`` of a log with the columns of ``added`` after them, as the
     Log node records them: appended runs that bring a column the log did not have."""
     more = _arrow_table(added).schema
-    described = json.loads(columns.metadata[b"pandas"]) if columns.metadata else None
+    recorded = (columns.metadata or {}).get(b"pandas")
     fields = [*columns, *more]
-    if described is None:  # no pandas description to extend: Arrow's own types restore it
+    if recorded is None:  # no pandas description to extend: Arrow's own types restore it
         return pa.schema(fields).serialize().to_pybytes()
+    described = json.loads(recorded)
     described["columns"] += json.loads(more.metadata[b"pandas"])["columns"]
     return _recorded(pa.schema(fields, metadata={b"pandas": json.dumps(described).encode()}))
 
