@@ -30,6 +30,7 @@ from robotale.ekg.build import (
     why,
     write_graph,
 )
+from robotale.ekg.columnar import log_build, widened_schema
 from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.load import Loader
@@ -64,14 +65,17 @@ def append_ekg(
     """Append the runs of ``log`` (a canonical event log) to the stored log ``name``.
 
     ``entities`` and ``aggregate`` default to the stored log's; given, they must be the
-    same. Refused (nothing written) when there is no complete log ``name``, when the runs
-    have other columns, or when one of their cases or event ids is already in the log.
+    same. A column the log does not have yet becomes a new event property: the new events
+    carry it, the Log node lists it and its columnar copy gains the column (empty for the
+    events stored before). Refused (nothing written) when there is no complete log ``name``,
+    when the runs lack a column the log has, or when one of their cases or event ids is
+    already in the log.
     """
     started = time.perf_counter()
     check_log_name(name)
     with log_write_lock(driver, name, "appending"):
         info = complete_log_info(driver, name)
-        _check_columns(log, info["properties"] or [], name)
+        added = _new_columns(log, info["properties"] or [], name)
         types = _same_entities(log, entities, info["entityTypes"] or [], name)
         keys = same_keys(aggregate, info["classTypes"] or [], name)
         tables = graph_tables(log, types, first=int(info["events"]))
@@ -83,6 +87,8 @@ def append_ekg(
         classes = [class_tables(tables, key) for key in keys]
         summary: dict[str, Any] = {"events": int(info["events"]) + len(tables.events)}
         summary |= merged_values(stored, table_values(tables.events))
+        if added:
+            summary |= _widened(driver, name, log, info["properties"] or [], added)
         _write_or_keep(driver, name, tables, classes, summary)
     result = summarise(name, tables, classes)
     return dataclasses.replace(result, seconds=time.perf_counter() - started)
@@ -99,20 +105,30 @@ def complete_log_info(driver: Driver, name: str) -> dict[str, Any]:
     return info
 
 
-def _check_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> None:
+def _new_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> list[str]:
+    """The columns of ``log`` (as given) that the stored log does not have yet; refused if
+    ``log`` lacks one it has."""
     # Every event gets an id and a msg_role, whether the log has such columns or not.
     given = {property_name(c) for c in log.columns} | {"id", schema.MSG_ROLE}
-    extra = sorted(given - set(stored))
     missing = sorted(set(stored) - given)
-    if extra or missing:
-        difference = (
-            f"the column {extra[0]!r}, which the log {name!r} does not have"
-            if extra
-            else f"no column {missing[0]!r}, which the log {name!r} has"
-        )
+    if missing:
         raise InputError(
-            f"The runs to append have {difference}: appended runs need the same columns as the log."
+            f"The runs to append have no column {missing[0]!r}, which the log {name!r} has: "
+            "appended runs need every column of the log."
         )
+    return [c for c in log.columns if property_name(c) not in set(stored)]
+
+
+def _widened(
+    driver: Driver, name: str, log: pd.DataFrame, stored: Sequence[str], added: list[str]
+) -> dict[str, Any]:
+    """What the Log node records of its event properties once ``added`` (columns of
+    ``log``) join them: the list, and the columnar copy's column types if it has them."""
+    summary: dict[str, Any] = {"properties": [*stored, *map(property_name, added)]}
+    types = log_build(driver, name).columns
+    if types is not None:
+        summary["columns"] = widened_schema(types, log[added])
+    return summary
 
 
 def _same_entities(

@@ -21,6 +21,7 @@ from __future__ import annotations
 import contextlib
 import datetime as dt
 import hashlib
+import json
 import logging
 import shutil
 from dataclasses import dataclass
@@ -120,16 +121,36 @@ def store_copy(driver: Driver, name: str, log: pd.DataFrame) -> Path | None:
             cypher("ekg_log_set_columns"),
             log=name,
             run=build.run,
-            columns=table.schema.remove_metadata()
-            .with_metadata({b"pandas": table.schema.metadata[b"pandas"]})
-            .serialize()
-            .to_pybytes(),
+            columns=_recorded(table.schema),
             database_=database(),
         )
         return _save(build, table)
     except (OSError, RobotaleError, pa.ArrowException) as error:
         _log.warning("The columnar copy of %r was not kept (%s).", name, error)
         return None
+
+
+def widened_schema(columns: pa.Schema, added: pd.DataFrame) -> bytes:
+    """The column types ``columns`` of a log with the columns of ``added`` after them, as the
+    Log node records them: appended runs that bring a column the log did not have."""
+    more = _arrow_table(added).schema
+    recorded = (columns.metadata or {}).get(b"pandas")
+    fields = [*columns, *more]
+    if recorded is None:  # no pandas description to extend: Arrow's own types restore it
+        return pa.schema(fields).serialize().to_pybytes()
+    described = json.loads(recorded)
+    described["columns"] += json.loads(more.metadata[b"pandas"])["columns"]
+    return _recorded(pa.schema(fields, metadata={b"pandas": json.dumps(described).encode()}))
+
+
+def _recorded(columns: pa.Schema) -> bytes:
+    """``columns`` as the Log node records them: the fields and pandas' description only."""
+    return (
+        columns.remove_metadata()
+        .with_metadata({b"pandas": columns.metadata[b"pandas"]})
+        .serialize()
+        .to_pybytes()
+    )
 
 
 def stored_table(driver: Driver, name: str, hint: str | None = None) -> pd.DataFrame:

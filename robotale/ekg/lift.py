@@ -42,12 +42,16 @@ class LogEdges:
     holder: np.ndarray  # per node code: the code of the aggregate holding it, or FREE
 
     @classmethod
-    def read(cls, driver: Driver, log: str) -> LogEdges:
+    def read(cls, driver: Driver, log: str, stacked: bool = True) -> LogEdges:
+        """``stacked``: whether earlier steps collapsed nodes of the log (if not, no node
+        has an aggregate and none is looked for)."""
         row = _read_edges(driver, log)
-        members, _, _ = driver.execute_query(
-            cypher("aggr_read_memberships"), log=log, database_=database()
-        )
-        held = members[0]
+        held: dict[str, list[str]] = {k: [] for k in ("ids", "aggregates", "nodes", "held")}
+        if stacked:
+            members, _, _ = driver.execute_query(
+                cypher("aggr_read_memberships"), log=log, database_=database()
+            )
+            held = members[0].data()
         element_ids = dict(zip(held["ids"], held["aggregates"], strict=True))
         holders = [element_ids[aggregate] for aggregate in held["held"]]
         ends = np.asarray(row["sources"] + row["targets"] + held["nodes"], dtype=object)

@@ -77,7 +77,7 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
         plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
         events, entities = _unaggregated(driver, log)
-        edges = LogEdges.read(driver, log)
+        edges = LogEdges.read(driver, log, stacked=first > 1)
         for plan in plans:
             result = _run_or_undo(driver, log, plan, (events, entities), edges)
             events, entities = result.final_events, result.final_entities
