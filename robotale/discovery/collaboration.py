@@ -273,7 +273,7 @@ def per_trace(instances: pd.DataFrame) -> Traces:
     column turned into one list and sliced (not an array per trace)."""
     if instances.empty:
         return Traces([], [], [], np.array([]), np.array([]), [0])
-    cases = pd.factorize(instances[CASE].astype(str))[0]
+    cases = pd.factorize(instances[CASE])[0]
     robots = pd.factorize(instances[ROBOT])[0]
     bounds = np.flatnonzero((cases[1:] != cases[:-1]) | (robots[1:] != robots[:-1])) + 1
     offsets = [0, *bounds.tolist(), len(instances)]
@@ -601,17 +601,18 @@ def _stats(instances: pd.DataFrame) -> dict[str, ActivityStats]:
     durations = instances[DURATION].to_numpy(float)
     finished = instances[FINISHED].to_numpy(bool)
     roles = instances["_role"].to_numpy(object)
+    has_role = instances["_role"].notna().to_numpy(bool)
     stats = {}
     for code, at in _positions(codes, len(labels)):
         done = durations[at][finished[at]]
         done = done[~np.isnan(done)]
-        known = [role for role in roles[at] if not pd.isna(role)]
+        known = at[has_role[at]]
         stats[str(labels[code])] = ActivityStats(
             count=len(at),
             robots=sorted(set(robots[at])),
             mean=float(np.mean(done)) if len(done) else None,
             median=float(np.median(done)) if len(done) else None,
-            role=str(known[0]) if known else None,
+            role=str(roles[known[0]]) if len(known) else None,
         )
     return stats
 
