@@ -339,8 +339,10 @@ def understood(kinds: pd.Series) -> pd.Series:
 def _in_progress(log: pd.DataFrame) -> pd.Series:
     if schema.STATE not in log.columns:
         return pd.Series(False, index=log.index).to_numpy(bool)
-    states = log[schema.STATE].astype("string").map(normalised, na_action="ignore")
-    return (states == INPROGRESS_STATE).fillna(False).to_numpy(bool)
+    # each distinct state normalised once: a log repeats a handful of them
+    codes, states = pd.factorize(log[schema.STATE].astype("string"))
+    meant = np.array([normalised(state) == INPROGRESS_STATE for state in states], dtype=bool)
+    return np.append(meant, False)[codes]
 
 
 def lifecycle_columns(log: pd.DataFrame, kinds: pd.Series) -> list[str]:
