@@ -74,12 +74,16 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     # and ordered
     lifecycle = _lifecycle(log)
     keep = _control_flow(log, lifecycle)
-    events, lifecycle = log[keep], lifecycle[keep]
+    # the rows are chosen and ordered on the few columns that order and pair them; the
+    # log's other columns are taken once, for the instances
+    reading = [c for c in (CASE, ROBOT, ACTIVITY, TIMESTAMP, *INSTANCE_KEYS) if c in log.columns]
+    at = np.flatnonzero(keep)
+    events, lifecycle = log[reading].iloc[at], lifecycle.iloc[at]
     if events.empty:
         return _empty_instances(log)
     order = _tie_positions(events, lifecycle)
     if order is not None:
-        events, lifecycle = events.iloc[order], lifecycle.iloc[order]
+        events, lifecycle, at = events.iloc[order], lifecycle.iloc[order], at[order]
     starts = (lifecycle == START).to_numpy()
     completes = (lifecycle == COMPLETE).to_numpy()
     begun = _paired_rows(_group_codes(events), starts, completes)
@@ -95,8 +99,9 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     ranked = np.lexsort((opened, when, cases))
     rows, opened, finished = rows[ranked], opened[ranked], finished[ranked]
 
-    instances = events.iloc[rows].reset_index(drop=True)
-    at_start = events.iloc[opened].set_axis(instances.index)
+    instances = log.iloc[at[rows]].reset_index(drop=True)
+    read_at_start = list(dict.fromkeys([TIMESTAMP, *carry]))
+    at_start = log[read_at_start].iloc[at[opened]].set_axis(instances.index)
     instances[START_TIMESTAMP] = at_start[TIMESTAMP]
     for column in carry:
         instances[f"start_{column}"] = at_start[column]
