@@ -265,46 +265,6 @@ def _pairing_keys(events: pd.DataFrame) -> list[str]:
     return keys
 
 
-def _matched_completes(group: np.ndarray, starts: np.ndarray, completes: np.ndarray) -> np.ndarray:
-    """Which completes find an open start of their group (events in time order).
-
-    The number of open starts follows q_i = max(q_(i-1) + d_i, 0) with d = +1 for a start and
-    -1 for a complete; its closed form S_i - min(0, min_(k<=i) S_k) over the running sum S
-    keeps the pairing vectorised. A complete is matched when a start was open before it.
-    """
-    step = pd.Series(starts.astype(int) - completes.astype(int))
-    by_group = step.groupby(group)
-    running = by_group.cumsum()
-    open_now = running - running.groupby(group).cummin().clip(upper=0)
-    open_before = open_now.groupby(group).shift(1, fill_value=0)
-    return completes & (open_before.to_numpy() > 0)
-
-
-def _paired_starts(
-    events: pd.DataFrame,
-    group: np.ndarray,
-    starts: np.ndarray,
-    matched: np.ndarray,
-    columns: list[str],
-) -> pd.DataFrame:
-    """The start events' ``columns`` for the matched completes: first in, first out within
-    each group, so the k-th matched complete of a group pairs with the group's k-th start."""
-    start_rank = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
-    match_rank = pd.Series(group[matched]).groupby(group[matched]).cumcount().to_numpy()
-    start_table = events.loc[starts, columns].reset_index(drop=True)
-    start_table = start_table.assign(_g=group[starts], _k=start_rank)
-    wanted = pd.DataFrame({"_g": group[matched], "_k": match_rank})
-    return wanted.merge(start_table, on=["_g", "_k"], how="left")
-
-
-def _consumed_starts(group: np.ndarray, starts: np.ndarray, matched: np.ndarray) -> np.ndarray:
-    """Which starts were paired: the first n starts of a group with n matched completes."""
-    n_matched = pd.Series(matched).groupby(group).transform("sum").to_numpy()
-    rank = np.zeros(len(group), dtype=int)
-    rank[starts] = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
-    return starts & (rank < n_matched)
-
-
 def _empty_instances(log: pd.DataFrame) -> pd.DataFrame:
     empty = log.iloc[0:0].copy()
     empty[START_TIMESTAMP] = pd.Series(dtype=log[TIMESTAMP].dtype)
