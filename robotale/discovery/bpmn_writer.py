@@ -81,12 +81,15 @@ class _PoolDrawing:
         self.main = self.framed(
             once(without(pool.block, outside), repeated),
             self.builder.node("start", pool.starts_on or ""),
+            pool.traces,
         )
         self.handlers = [
             (
                 handler,
                 self.framed(
-                    without(handler.block, outside), self.builder.node("start", handler.trigger)
+                    without(handler.block, outside),
+                    self.builder.node("start", handler.trigger),
+                    handler.count,
                 ),
             )
             for handler in pool.handlers
@@ -129,13 +132,15 @@ class _PoolDrawing:
             return "catch"  # a timer the engine tags as an activity
         return kind
 
-    def framed(self, block: Block, start: Fragment) -> Fragment:
+    def framed(self, block: Block, start: Fragment, traces: int) -> Fragment:
+        """``block`` drawn from ``start`` to an end; ``traces``: how many runs of it the log
+        has (the process' traces, or how often a handler ran)."""
         body = self.builder.fragment(block)
         fragment = self.builder.sequence([start, body, self.builder.node("end")])
-        self._choose(block, fragment)
+        self._choose(block, fragment, traces)
         return fragment
 
-    def _choose(self, block: Block, fragment: Fragment) -> None:
+    def _choose(self, block: Block, fragment: Fragment, traces: int) -> None:
         """Conditions for the exclusive splits of ``fragment`` (built from ``block``)."""
         splits = [s for s in fragment.shapes if s.kind == "xor"]
         outgoing: dict[str, list[Flow]] = {}
@@ -153,7 +158,7 @@ class _PoolDrawing:
                 continue
             back = _back_flow(split.id, flows, outgoing)
             if back is not None:  # a loop's split: round again with the log's share, else on
-                redo = self._redo_share(block, split, fragment)
+                redo = self._redo_share(block, split, fragment, traces)
                 share = 0.5 if redo is None else redo
                 self.conditions[back.id] = f'__import__("random").random() < {share:.3f}'
                 self.defaults[split.id] = next(f.id for f in flows if f is not back)
@@ -163,19 +168,22 @@ class _PoolDrawing:
                 self.conditions[flow.id] = f'__import__("random").random() < {share:.3f}'
             self.defaults[split.id] = flows[-1].id
 
-    def _redo_share(self, block: Block, split: Shape, fragment: Fragment) -> float | None:
+    def _redo_share(
+        self, block: Block, split: Shape, fragment: Fragment, traces: int
+    ) -> float | None:
         """For a loop's split: the share of passes that went round again, from the counts of
-        the first activity of the body against the traces (capped so a run ends)."""
+        the first activity of the body against the fragment's ``traces`` (capped so a run
+        ends)."""
         ids = [s.id for s in fragment.shapes]
         position = ids.index(split.id)
         before = [s for s in fragment.shapes[:position] if s.kind in ("task", "throw", "catch")]
         loop = _loop_of(block, before[-1].label if before else None)
-        if loop is None or not self.pool.traces:
+        if loop is None or not traces:
             return None
         first = leaves(loop.children[0]) or leaves(loop.children[1])
         if not first or first[0] not in self.pool.stats:
             return None
-        passes = self.pool.stats[first[0]].count / self.pool.traces
+        passes = self.pool.stats[first[0]].count / traces
         return min(0.9, max(0.0, 1 - 1 / passes)) if passes > 1 else 0.1
 
 
@@ -418,7 +426,11 @@ def _element(
                 f"PT{after:.3f}S</bpmn:timeDuration></bpmn:timerEventDefinition>"
             )
         elif handler.kind == "signal":
-            definition = f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
+            # the driving model's catch of the signal: the data its message fills
+            caught = drawing.bound(handler.trigger)
+            definition = (_own_ids(caught.body, ident) if caught is not None else "") + (
+                f'<bpmn:signalEventDefinition signalRef="{_signal_id(handler.name)}" />'
+            )
         else:
             definition = f'<bpmn:errorEventDefinition errorRef="{_error_id(handler.name)}" />'
         return (

@@ -32,9 +32,11 @@ from robotale.discovery.filters import LogFilter, filter_log
 from robotale.discovery.instances import (
     DURATION,
     FINISHED,
+    INSTANCE_KEYS,
     START_TIMESTAMP,
     activity_instances,
     interrupted,
+    sort_codes,
 )
 from robotale.discovery.layout import Block, Tau, from_process_tree
 from robotale.errors import InputError
@@ -42,11 +44,14 @@ from robotale.eventlog.prepare import robot_type
 from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
+    LIFECYCLE,
+    MSG_ROLE,
     RECEIVE,
     REQUIRED,
     ROBOT,
     ROBOT_TYPE,
     SEND,
+    STATE,
     TIMESTAMP,
     message_roles,
 )
@@ -168,8 +173,9 @@ def typed_instances(log: pd.DataFrame) -> pd.DataFrame:
     instances = instances.assign(**{ROBOT: robots, ROBOT_TYPE: _types(instances, robots)})
     instances["_role"] = _roles(instances)
     instances["_aborted"] = interrupted(instances).to_numpy()
-    ordered = instances.sort_values([CASE, ROBOT], kind="stable").reset_index(drop=True)
-    return ordered
+    # by case and robot, as a stable sort of the two columns orders them
+    order = np.lexsort((sort_codes(instances[ROBOT]), sort_codes(instances[CASE])))
+    return instances.take(order).reset_index(drop=True)
 
 
 def _types(instances: pd.DataFrame, robots: pd.Series) -> pd.Series:
@@ -189,14 +195,24 @@ def _roles(instances: pd.DataFrame) -> pd.Series:
     mark a step next to a message with the message's role (the thesis' log marks one of
     ``select_closest_tractor``'s two starts as sending ``closest_tractor``). A tie goes to
     the role first in name order (no role first of all), as pandas' ``mode`` has it; counted
-    from integer codes, not a group-by per activity."""
-    roles = message_roles(instances).fillna("").to_numpy(object)
-    label_codes, labels = pd.factorize(instances[ACTIVITY].astype(str).to_numpy(object))
-    role_codes, names = pd.factorize(roles, sort=True)
+    from integer codes, not a group-by per activity, and each distinct activity's name read
+    once."""
+    label_codes, labels = pd.factorize(instances[ACTIVITY], use_na_sentinel=False)
+    names = np.array(sorted(["", SEND, RECEIVE]), dtype=object)
+    code_of = {name: code for code, name in enumerate(names)}
+    named = message_roles(pd.DataFrame({ACTIVITY: labels}))
+    role_codes = np.array([code_of[role or ""] for role in named], dtype=np.int64)[label_codes]
+    if MSG_ROLE in instances.columns:
+        # a role the log sets wins over the name's (as :func:`message_roles` has it)
+        given_codes, given = pd.factorize(instances[MSG_ROLE].astype("string").fillna(""))
+        for role in (SEND, RECEIVE):
+            role_codes[np.isin(given_codes, np.flatnonzero(np.asarray(given) == role))] = code_of[
+                role
+            ]
     counts = np.bincount(
         label_codes * len(names) + role_codes, minlength=len(labels) * len(names)
     ).reshape(len(labels), len(names))
-    majority = np.asarray(names, dtype=object)[counts.argmax(axis=1)]
+    majority = names[counts.argmax(axis=1)]
     return pd.Series(majority[label_codes], index=instances.index, dtype=str).replace("", None)
 
 
@@ -257,7 +273,7 @@ def per_trace(instances: pd.DataFrame) -> Traces:
     column turned into one list and sliced (not an array per trace)."""
     if instances.empty:
         return Traces([], [], [], np.array([]), np.array([]), [0])
-    cases = pd.factorize(instances[CASE].astype(str))[0]
+    cases = pd.factorize(instances[CASE])[0]
     robots = pd.factorize(instances[ROBOT])[0]
     bounds = np.flatnonzero((cases[1:] != cases[:-1]) | (robots[1:] != robots[:-1])) + 1
     offsets = [0, *bounds.tolist(), len(instances)]
@@ -327,16 +343,87 @@ class _Split:
     abandoned: dict[str, Counter] = field(default_factory=lambda: defaultdict(Counter))
 
 
-def split_traces(traces: Traces, found: set[str]) -> _Split:
+@dataclass(slots=True)
+class Heard:
+    """Signals a robot type heard while busy (:func:`heard_while_busy`): their labels, and
+    for every instance of the type's traces (flat, in trace order) the end, in ticks, of the
+    latest-ending activity that was running when it started."""
+
+    labels: set[str]
+    busy_until: np.ndarray
+
+
+def heard_while_busy(traces: Traces) -> Heard:
+    """The received signals a robot always heard while it was busy with something else.
+
+    A receipt is heard while busy when an activity of the same robot (no message, ended
+    normally, not cut short) started before it and ended after it began: the robot took the
+    signal without stopping, so something listened all along, as an event sub-process that
+    does not interrupt (FAME's non-interrupting handler, G2.2). A signal is such a trigger
+    when every receipt of it in the type's traces was heard so; a receipt that sometimes
+    came while the robot waited for it is a catch in its process. Worked out over all
+    traces at once: the running maximum of the activities' ends, read just before the
+    first instance that starts at the receipt's moment."""
+    if not traces.labels:
+        return Heard(set(), np.array([], dtype=np.int64))
+    roles = np.fromiter(itertools.chain.from_iterable(traces.roles), dtype=object)
+    received = roles == RECEIVE
+    if not received.any():
+        return Heard(set(), np.array([], dtype=np.int64))
+    starts, ends = _as_ticks(traces.starts), _as_ticks(traces.ends)
+    aborted = np.fromiter(itertools.chain.from_iterable(traces.aborted), dtype=bool)
+    working = pd.isna(roles) & ~aborted & (ends != _NEVER)
+    lengths = np.diff(traces.offsets)
+    trace = np.repeat(np.arange(len(lengths)), lengths)
+    latest = pd.Series(np.where(working, ends, _NEVER)).groupby(trace).cummax().to_numpy()
+    # the first instance of each (trace, moment): what started before it, started earlier
+    first = np.ones(len(starts), dtype=bool)
+    first[1:] = (trace[1:] != trace[:-1]) | (starts[1:] != starts[:-1])
+    tie = np.maximum.accumulate(np.where(first, np.arange(len(starts)), 0))
+    before = tie - 1
+    own = (before >= 0) & (trace[np.maximum(before, 0)] == trace)
+    busy_until = np.where(own, latest[np.maximum(before, 0)], _NEVER)
+    heard = received & (busy_until > starts)
+    labels = np.fromiter(itertools.chain.from_iterable(traces.labels), dtype=object)
+    codes, names = pd.factorize(labels[received])
+    always = np.bincount(codes[~heard[received]], minlength=len(names)) == 0
+    return Heard({str(name) for name in names[always]}, busy_until)
+
+
+#: the tick of an instance that never ended
+_NEVER = np.iinfo(np.int64).min
+
+
+def _as_ticks(times: np.ndarray) -> np.ndarray:
+    """Times as integer nanoseconds (:data:`_NEVER` where missing)."""
+    if times.dtype.kind != "M":  # times of several offsets, kept as objects
+        times = pd.to_datetime(pd.Series(times), utc=True).dt.tz_localize(None).to_numpy()
+    return times.astype("datetime64[ns]").astype(np.int64)
+
+
+def handled_parts(instances: pd.DataFrame, *, records_aborts: bool) -> _Split:
+    """A type's traces cut at its triggers (:func:`triggers`) and at the signals it heard
+    while busy (:func:`heard_while_busy`)."""
+    traces = per_trace(instances)
+    found = triggers(instances, traces, records_aborts=records_aborts)
+    return split_traces(traces, found, heard_while_busy(traces))
+
+
+def split_traces(traces: Traces, found: set[str], heard: Heard | None = None) -> _Split:
     """Each trace's instances outside the handlers (the process), and each handler's own.
 
     A handler runs from its trigger to the end of the trace, or to the first activity that
-    begins a trace of its type (the robot took up its process again). The event sub-process'
-    own instance, where the engine tags one, is recorded apart (:func:`_own_instance`)."""
+    begins a trace of its type (the robot took up its process again); the handler of a
+    signal heard while busy (``heard``) holds what the robot began while the activity the
+    signal came in was still running, and the robot went on after it. The event
+    sub-process' own instance, where the engine tags one, is recorded apart
+    (:func:`_own_instance`)."""
     result = _Split()
+    listened = heard.labels - found if heard is not None else set()
+    cutting = found | listened
     firsts = {trace[0] for trace in traces.labels}
     for number, (labels, aborted) in enumerate(zip(traces.labels, traces.aborted, strict=True)):
-        if not found.intersection(labels):  # most traces: nothing to cut
+        if not cutting.intersection(labels):  # most traces: nothing to cut
             result.main.append(labels)
             continue
         starts, ends = traces.times(number)
@@ -344,6 +431,13 @@ def split_traces(traces: Traces, found: set[str]) -> _Split:
         position = 0
         while position < len(labels):
             label = labels[position]
+            if label in listened and heard is not None:
+                end = _busy_end(traces, heard, number, position)
+                result.tags[label].append(_own_instance(labels, starts, ends, position, end))
+                result.handled[label].append(labels[position + 1 : end])
+                result.went_on[label] = True
+                position = end
+                continue
             if label not in found:
                 main.append(label)
                 position += 1
@@ -361,6 +455,18 @@ def split_traces(traces: Traces, found: set[str]) -> _Split:
             position = end
         result.main.append(main)
     return result
+
+
+def _busy_end(traces: Traces, heard: Heard, number: int, trigger: int) -> int:
+    """Where the handler of a signal heard while busy ends in trace ``number``: at the
+    first instance that began once the activity the signal came in had ended."""
+    begin = traces.offsets[number]
+    until = heard.busy_until[begin + trigger]
+    starts = _as_ticks(traces.times(number)[0])
+    end = trigger + 1
+    while end < len(starts) and starts[end] < until:
+        end += 1
+    return end
 
 
 def _own_instance(
@@ -409,6 +515,11 @@ def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
     return block
 
 
+#: the columns discovery reads: the rest of a log (positions, batteries ...) is not carried
+#: through the pairing and the split into pools
+_READ = {*REQUIRED, ROBOT, ROBOT_TYPE, LIFECYCLE, STATE, MSG_ROLE, *INSTANCE_KEYS}
+
+
 def discover_collaboration(
     log: pd.DataFrame, selection: LogFilter | None = None, *, noise: float = 0.0
 ) -> Collaboration:
@@ -418,7 +529,7 @@ def discover_collaboration(
             **{ROBOT_TYPE: log[ROBOT].astype("string").map(robot_type, na_action="ignore")}
         )
     events = filter_log(log, selection)
-    instances = typed_instances(events)
+    instances = typed_instances(events[[c for c in events.columns if c in _READ]])
     pools = []
     for name, mine_ in instances.groupby(ROBOT_TYPE, sort=False):
         pools.append(_pool(str(name), mine_, noise, bool(instances["_aborted"].any())))
@@ -435,11 +546,11 @@ def discover_collaboration(
 
 
 def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool) -> Pool:
-    traces = per_trace(instances)
-    found = triggers(instances, traces, records_aborts=records_aborts)
-    parts = split_traces(traces, found)
+    parts = handled_parts(instances, records_aborts=records_aborts)
     handlers = [
-        _handler(label, instances, parts, noise) for label in sorted(found) if parts.handled[label]
+        _handler(label, instances, parts, noise)
+        for label in sorted(parts.handled)
+        if parts.handled[label]
     ]
     return Pool(
         name=name,
@@ -483,18 +594,38 @@ def _role(instances: pd.DataFrame, label: str) -> str | None:
 
 
 def _stats(instances: pd.DataFrame) -> dict[str, ActivityStats]:
+    """Each activity's statistics, its instances found by integer codes (a slice of arrays
+    per activity, not a DataFrame group): numpy's mean and median are what pandas' give."""
+    codes, labels = pd.factorize(instances[ACTIVITY], sort=True)
+    robots = instances[ROBOT].to_numpy(object)
+    durations = instances[DURATION].to_numpy(float)
+    finished = instances[FINISHED].to_numpy(bool)
+    roles = instances["_role"].to_numpy(object)
+    has_role = instances["_role"].notna().to_numpy(bool)
     stats = {}
-    for label, group in instances.groupby(ACTIVITY, sort=True):
-        done = group.loc[group[FINISHED], DURATION].dropna()
-        roles = group["_role"].dropna()
-        stats[str(label)] = ActivityStats(
-            count=len(group),
-            robots=sorted(group[ROBOT].unique()),
-            mean=float(done.mean()) if len(done) else None,
-            median=float(done.median()) if len(done) else None,
-            role=str(roles.iloc[0]) if len(roles) else None,
+    for code, at in _positions(codes, len(labels)):
+        done = durations[at][finished[at]]
+        done = done[~np.isnan(done)]
+        known = at[has_role[at]]
+        stats[str(labels[code])] = ActivityStats(
+            count=len(at),
+            robots=sorted(set(robots[at])),
+            mean=float(np.mean(done)) if len(done) else None,
+            median=float(np.median(done)) if len(done) else None,
+            role=str(roles[known[0]]) if len(known) else None,
         )
     return stats
+
+
+def _positions(codes: np.ndarray, kinds: int) -> list[tuple[int, np.ndarray]]:
+    """For each code that occurs (-1, missing, left out), its positions in order."""
+    order = np.argsort(codes, kind="stable")
+    bounds = np.searchsorted(codes[order], np.arange(kinds + 1))
+    return [
+        (code, order[bounds[code] : bounds[code + 1]])
+        for code in range(kinds)
+        if bounds[code + 1] > bounds[code]
+    ]
 
 
 def signal_of(label: str) -> str:
@@ -503,16 +634,26 @@ def signal_of(label: str) -> str:
 
 
 def _signals(instances: pd.DataFrame) -> dict[str, Signal]:
-    messages = instances[instances["_role"].isin([SEND, RECEIVE])]
+    roles = instances["_role"].to_numpy(object)
+    sent, got = roles == SEND, roles == RECEIVE
+    messages = np.flatnonzero(sent | got)
+    codes, labels = pd.factorize(
+        instances[ACTIVITY].to_numpy(object)[messages], use_na_sentinel=False
+    )
+    named, names = pd.factorize(
+        np.array([signal_of(str(label)) for label in labels], dtype=object), sort=True
+    )
+    signal = named[codes] if len(codes) else codes
+    kinds = instances[ROBOT_TYPE].to_numpy(object)[messages]
+    sent, got = sent[messages], got[messages]
     signals = {}
-    for name, group in messages.groupby(messages[ACTIVITY].astype(str).map(signal_of), sort=True):
-        sent = group[group["_role"] == SEND]
-        got = group[group["_role"] == RECEIVE]
-        signals[str(name)] = Signal(
-            name=str(name),
-            sent=len(sent),
-            received=len(got),
-            senders=sorted(sent[ROBOT_TYPE].unique()),
-            receivers=sorted(got[ROBOT_TYPE].unique()),
+    for code, at in _positions(signal, len(names)):
+        name = str(names[code])
+        signals[name] = Signal(
+            name=name,
+            sent=int(sent[at].sum()),
+            received=int(got[at].sum()),
+            senders=sorted(set(kinds[at][sent[at]])),
+            receivers=sorted(set(kinds[at][got[at]])),
         )
     return signals

@@ -74,42 +74,108 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     # and ordered
     lifecycle = _lifecycle(log)
     keep = _control_flow(log, lifecycle)
-    events, lifecycle = log[keep], lifecycle[keep]
+    # the rows are chosen and ordered on the few columns that order and pair them; the
+    # log's other columns are taken once, for the instances
+    reading = [c for c in (CASE, ROBOT, ACTIVITY, TIMESTAMP, *INSTANCE_KEYS) if c in log.columns]
+    at = np.flatnonzero(keep)
+    events, lifecycle = log[reading].iloc[at], lifecycle.iloc[at]
     if events.empty:
         return _empty_instances(log)
     order = _tie_positions(events, lifecycle)
     if order is not None:
-        events, lifecycle = events.iloc[order], lifecycle.iloc[order]
-    events = events.assign(_order=np.arange(len(events)))
-    group = events.groupby(_pairing_keys(events), dropna=False, sort=False).ngroup()
+        events, lifecycle, at = events.iloc[order], lifecycle.iloc[order], at[order]
     starts = (lifecycle == START).to_numpy()
     completes = (lifecycle == COMPLETE).to_numpy()
-    matched = _matched_completes(group.to_numpy(), starts, completes)
-    # the start event's position breaks ties between instances that start at the same time
-    from_start = {TIMESTAMP: START_TIMESTAMP, "_order": "_start_order"}
-    from_start |= {c: f"start_{c}" for c in carry}
-    paired_starts = _paired_starts(events, group.to_numpy(), starts, matched, list(from_start))
+    begun = _paired_rows(_group_codes(events), starts, completes)
+    # one row per instance: each completion or instant event, and each start nothing paired;
+    # ``begun`` holds the row it started at (its own where the start is not in the log)
+    rows = np.flatnonzero(~starts | (begun == -1))
+    opened = np.where(starts[rows] | (begun[rows] == -1), rows, begun[rows])
+    finished = ~starts[rows]
+    # in case and start order, instances that start at once by the start event's position
+    cases = sort_codes(events[CASE].iloc[rows]) if CASE in events.columns else 0
+    when = _ticks(events[TIMESTAMP].iloc[opened]).copy()
+    when[events[TIMESTAMP].iloc[opened].isna().to_numpy()] = np.iinfo(np.int64).max
+    ranked = np.lexsort((opened, when, cases))
+    rows, opened, finished = rows[ranked], opened[ranked], finished[ranked]
 
-    anchors = ~starts  # completes and instant events
-    finished = events[anchors].copy()
-    paired = matched[anchors]
-    for column, renamed in from_start.items():
-        finished[renamed] = finished[column]
-        values = paired_starts[column].set_axis(finished.index[paired])
-        finished.loc[paired, renamed] = values
-    finished[FINISHED] = True
-    finished[START_KNOWN] = paired | (lifecycle[anchors] == "none").to_numpy()
-    unfinished = events[starts & ~_consumed_starts(group.to_numpy(), starts, matched)].copy()
-    for column, renamed in from_start.items():
-        unfinished[renamed] = unfinished[column]
-    unfinished[TIMESTAMP] = pd.Series(pd.NaT, index=unfinished.index, dtype=events[TIMESTAMP].dtype)
-    unfinished[FINISHED] = False
-    unfinished[START_KNOWN] = True
+    instances = log.iloc[at[rows]].reset_index(drop=True)
+    read_at_start = list(dict.fromkeys([TIMESTAMP, *carry]))
+    at_start = log[read_at_start].iloc[at[opened]].set_axis(instances.index)
+    instances[START_TIMESTAMP] = at_start[TIMESTAMP]
+    for column in carry:
+        instances[f"start_{column}"] = at_start[column]
+    ended = instances[TIMESTAMP].where(finished, pd.NaT)
+    instances[TIMESTAMP] = ended
+    instances[FINISHED] = finished
+    instant = (lifecycle.iloc[rows] == "none").to_numpy()
+    instances[START_KNOWN] = ~finished | (opened != rows) | instant
+    instances[DURATION] = (ended - instances[START_TIMESTAMP]).dt.total_seconds()
+    return instances
 
-    instances = pd.concat([finished, unfinished])
-    instances[DURATION] = (instances[TIMESTAMP] - instances[START_TIMESTAMP]).dt.total_seconds()
-    instances = instances.sort_values([CASE, START_TIMESTAMP, "_start_order"], kind="stable")
-    return instances.drop(columns=["_order", "_start_order"]).reset_index(drop=True)
+
+def _group_codes(events: pd.DataFrame) -> np.ndarray:
+    """One integer per event naming its pairing group (:func:`_pairing_keys`; a missing
+    value a value of its own), from each key column's codes."""
+    codes = np.zeros(len(events), dtype=np.int64)
+    for column in _pairing_keys(events):
+        column_codes, uniques = pd.factorize(events[column], use_na_sentinel=True)
+        codes = codes * (len(uniques) + 1) + (column_codes + 1)
+        codes = pd.factorize(codes)[0].astype(np.int64)  # kept small: no overflow
+    return codes
+
+
+def _paired_rows(group: np.ndarray, starts: np.ndarray, completes: np.ndarray) -> np.ndarray:
+    """For each completion, the row of the start it pairs with (-1: none); for each start,
+    the row of its completion (-1: it never completed); -1 for other events.
+
+    Within a group (events in time order) first in, first out: the number of open starts
+    follows q_i = max(q_(i-1) + d_i, 0) with d = +1 for a start and -1 for a completion, in
+    the closed form S_i - min(0, min_(k<=i) S_k) over the running sum S. A completion is
+    matched when a start was open before it, and the k-th matched completion of a group
+    pairs with the group's k-th start."""
+    paired = np.full(len(group), -1, dtype=np.int64)
+    by_group = np.argsort(group, kind="stable")  # each group's events, in time order
+    g = group[by_group]
+    step = starts[by_group].astype(np.int64) - completes[by_group].astype(np.int64)
+    first = np.ones(len(g), dtype=bool)
+    first[1:] = g[1:] != g[:-1]
+    begin = np.maximum.accumulate(np.where(first, np.arange(len(g)), 0))
+    total = np.cumsum(step)
+    running = total - np.where(begin > 0, total[begin - 1], 0)  # S within the group
+    lowest = _group_cummin(running, first)
+    open_now = running - np.minimum(lowest, 0)
+    open_before = np.where(first, 0, np.roll(open_now, 1))
+    matched = completes[by_group] & (open_before > 0)
+    is_start = starts[by_group]
+    # the k-th matched completion of each group and the group's k-th start
+    match_rank = _rank_in_group(matched, begin)
+    start_at = np.flatnonzero(is_start)
+    # where each group's starts begin in ``start_at``
+    starts_before = np.cumsum(is_start) - is_start
+    offset = starts_before[begin]
+    pairs = np.flatnonzero(matched)
+    opened = start_at[offset[pairs] + match_rank[pairs]]
+    paired[by_group[pairs]] = by_group[opened]
+    paired[by_group[opened]] = by_group[pairs]
+    return paired
+
+
+def _group_cummin(values: np.ndarray, first: np.ndarray) -> np.ndarray:
+    """The running minimum of ``values`` restarting where ``first`` is set."""
+    return pd.Series(values).groupby(np.cumsum(first)).cummin().to_numpy()
+
+
+def _rank_in_group(flags: np.ndarray, begin: np.ndarray) -> np.ndarray:
+    """For each set flag, how many flags of its group come before it."""
+    count = np.cumsum(flags)
+    return count - flags - np.where(begin > 0, count[begin - 1], 0)
+
+
+def sort_codes(values: pd.Series) -> np.ndarray:
+    """Integers that order as pandas sorts ``values`` (a missing value last)."""
+    codes, uniques = pd.factorize(values, sort=True)
+    return np.where(codes == -1, len(uniques), codes)
 
 
 def in_tie_order(events: pd.DataFrame) -> pd.DataFrame:
@@ -197,46 +263,6 @@ def _pairing_keys(events: pd.DataFrame) -> list[str]:
         if instance_key in events.columns:
             return [*keys, instance_key]
     return keys
-
-
-def _matched_completes(group: np.ndarray, starts: np.ndarray, completes: np.ndarray) -> np.ndarray:
-    """Which completes find an open start of their group (events in time order).
-
-    The number of open starts follows q_i = max(q_(i-1) + d_i, 0) with d = +1 for a start and
-    -1 for a complete; its closed form S_i - min(0, min_(k<=i) S_k) over the running sum S
-    keeps the pairing vectorised. A complete is matched when a start was open before it.
-    """
-    step = pd.Series(starts.astype(int) - completes.astype(int))
-    by_group = step.groupby(group)
-    running = by_group.cumsum()
-    open_now = running - running.groupby(group).cummin().clip(upper=0)
-    open_before = open_now.groupby(group).shift(1, fill_value=0)
-    return completes & (open_before.to_numpy() > 0)
-
-
-def _paired_starts(
-    events: pd.DataFrame,
-    group: np.ndarray,
-    starts: np.ndarray,
-    matched: np.ndarray,
-    columns: list[str],
-) -> pd.DataFrame:
-    """The start events' ``columns`` for the matched completes: first in, first out within
-    each group, so the k-th matched complete of a group pairs with the group's k-th start."""
-    start_rank = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
-    match_rank = pd.Series(group[matched]).groupby(group[matched]).cumcount().to_numpy()
-    start_table = events.loc[starts, columns].reset_index(drop=True)
-    start_table = start_table.assign(_g=group[starts], _k=start_rank)
-    wanted = pd.DataFrame({"_g": group[matched], "_k": match_rank})
-    return wanted.merge(start_table, on=["_g", "_k"], how="left")
-
-
-def _consumed_starts(group: np.ndarray, starts: np.ndarray, matched: np.ndarray) -> np.ndarray:
-    """Which starts were paired: the first n starts of a group with n matched completes."""
-    n_matched = pd.Series(matched).groupby(group).transform("sum").to_numpy()
-    rank = np.zeros(len(group), dtype=int)
-    rank[starts] = pd.Series(group[starts]).groupby(group[starts]).cumcount().to_numpy()
-    return starts & (rank < n_matched)
 
 
 def _empty_instances(log: pd.DataFrame) -> pd.DataFrame:

@@ -21,10 +21,8 @@ import pandas as pd
 from robotale.discovery.collaboration import (
     Collaboration,
     Pool,
+    handled_parts,
     mine,
-    per_trace,
-    split_traces,
-    triggers,
     typed_instances,
 )
 from robotale.discovery.filters import LogFilter, filter_log
@@ -60,9 +58,7 @@ def selected_instances(log: pd.DataFrame, selection: LogFilter | None) -> pd.Dat
 
 
 def _started(pool: Pool, instances: pd.DataFrame, records_aborts: bool, noise: float) -> Pool:
-    traces = per_trace(instances)
-    found = triggers(instances, traces, records_aborts=records_aborts)
-    parts = split_traces(traces, found)
+    parts = handled_parts(instances, records_aborts=records_aborts)
     first = _common_first(parts.main, pool)
     if first is None:
         return pool

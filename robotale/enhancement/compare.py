@@ -204,7 +204,9 @@ def _per_run(
 
 def _frequencies(instances: pd.DataFrame, who: Callable, runs: pd.Index) -> pd.DataFrame:
     """How often each run does each activity (per robot type), 0 in the runs without it."""
-    counted = _per_run(instances.assign(_one=1.0), who, ACTIVITY, "_one", "sum")
+    # only the columns counted: the instances' others are not copied
+    read = [c for c in (ROBOT, ACTIVITY, CASE) if c in instances.columns]
+    counted = _per_run(instances[read].assign(_one=1.0), who, ACTIVITY, "_one", "sum")
     if counted.empty:
         return counted
     wide = counted.pivot_table(

@@ -462,6 +462,8 @@ def canonical_log(
 def _require_text(path: Path, log: pd.DataFrame, column: str, lines: pd.Series) -> None:
     """Refuse a typed value (an XES ``<boolean>`` or ``<int>``) in a column that holds words."""
     values = log[column]
+    if isinstance(values.dtype, pd.StringDtype):  # a text column holds nothing else
+        return
     typed = values.notna() & ~values.map(lambda value: isinstance(value, str))
     if typed.any():
         first = typed.idxmax()

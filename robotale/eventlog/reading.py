@@ -246,12 +246,25 @@ def has_padded_markers(text: str) -> bool:
     """Whether a CSV text may hold a marker (or nothing) with blanks around it, which only
     :func:`mark_missing` recognises; one regular expression over the text, so files without
     any (nearly all) are read at the speed of pandas' own parser."""
-    # a blank next to a delimiter or a line's end is rare, and plain substring tests are fast
-    blanks = (", ", ",\t", " ,", "\t,", "\n ", "\n\t", " \n", "\t\n", " \r", "\t\r")
+    # a blank next to a delimiter or a line's end is rare: looked for in one pass over the
+    # bytes (a character of more than one byte has none of these in it)
     edges = text[:1] + text.rstrip("\r\n")[-1:]
-    if not any(blank in text for blank in blanks) and not edges.isspace():
+    if not _blank_beside_an_edge(text) and not edges.isspace():
         return False
     return _PADDED.search(text) is not None
+
+
+def _blank_beside_an_edge(text: str) -> bool:
+    """Whether a blank (space or tab) follows a comma or a line break, or comes before a
+    comma or a line's end, anywhere in ``text``."""
+    data = np.frombuffer(text.encode("utf-8", "surrogatepass"), dtype=np.uint8)
+    blanks = np.flatnonzero((data == ord(" ")) | (data == ord("\t")))
+    before = data[blanks[blanks > 0] - 1]
+    after = data[blanks[blanks < len(data) - 1] + 1]
+    return bool(
+        np.isin(before, [ord(","), ord("\n")]).any()
+        or np.isin(after, [ord(","), ord("\n"), ord("\r")]).any()
+    )
 
 
 def mark_missing(table: pd.DataFrame) -> dict[str, int]:
@@ -339,8 +352,10 @@ def understood(kinds: pd.Series) -> pd.Series:
 def _in_progress(log: pd.DataFrame) -> pd.Series:
     if schema.STATE not in log.columns:
         return pd.Series(False, index=log.index).to_numpy(bool)
-    states = log[schema.STATE].astype("string").map(normalised, na_action="ignore")
-    return (states == INPROGRESS_STATE).fillna(False).to_numpy(bool)
+    # each distinct state normalised once: a log repeats a handful of them
+    codes, states = pd.factorize(log[schema.STATE].astype("string"))
+    meant = np.array([normalised(state) == INPROGRESS_STATE for state in states], dtype=bool)
+    return np.append(meant, False)[codes]
 
 
 def lifecycle_columns(log: pd.DataFrame, kinds: pd.Series) -> list[str]:
