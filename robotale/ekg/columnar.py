@@ -137,7 +137,8 @@ def widened_schema(columns: pa.Schema, added: pd.DataFrame) -> bytes:
     recorded = (columns.metadata or {}).get(b"pandas")
     fields = [*columns, *more]
     if recorded is None:  # no pandas description to extend: Arrow's own types restore it
-        return pa.schema(fields).serialize().to_pybytes()
+        serialized: bytes = pa.schema(fields).serialize().to_pybytes()
+        return serialized
     described = json.loads(recorded)
     described["columns"] += json.loads(more.metadata[b"pandas"])["columns"]
     return _recorded(pa.schema(fields, metadata={b"pandas": json.dumps(described).encode()}))
@@ -145,12 +146,13 @@ def widened_schema(columns: pa.Schema, added: pd.DataFrame) -> bytes:
 
 def _recorded(columns: pa.Schema) -> bytes:
     """``columns`` as the Log node records them: the fields and pandas' description only."""
-    return (
+    serialized: bytes = (
         columns.remove_metadata()
         .with_metadata({b"pandas": columns.metadata[b"pandas"]})
         .serialize()
         .to_pybytes()
     )
+    return serialized
 
 
 def stored_table(driver: Driver, name: str, hint: str | None = None) -> pd.DataFrame:
