@@ -27,8 +27,9 @@ def _larger_than_the_disk(path, events: int) -> None:
             "activity": [f"step_{n % 37}" for n in numbers],
             "timestamp": pd.Timestamp("2024-01-01", tz="UTC") + pd.to_timedelta(numbers, "s"),
             "robot": [f"robot_{n % 5}" for n in numbers],
-            # a long value per event: the property store grows past the disk quickly
-            "note": [f"note {n:08d} " * 40 for n in numbers],
+            # a long value per event: the property store grows past the disk quickly, with
+            # few events for robotale to prepare twice
+            "note": [f"note {n:08d} " * 120 for n in numbers],
         }
     ).to_csv(path, index=False)
 
@@ -49,7 +50,7 @@ def test_a_full_disk_under_neo4j_is_one_sentence_naming_it(
     _start(server)
     try:
         log = tmp_path / "big.csv"
-        _larger_than_the_disk(log, 60_000)
+        _larger_than_the_disk(log, 20_000)
         assert log.stat().st_size > 48 * 1024**2 / 3
 
         # the check before the write: one sentence, and nothing of the log in Neo4j
@@ -57,7 +58,7 @@ def test_a_full_disk_under_neo4j_is_one_sentence_naming_it(
         assert main(["ingest", str(log), "--log", "big"]) == 1
         refused = capsys.readouterr().err.strip().splitlines()[-1]
         assert refused.startswith("robotale: Neo4j's data folder "), refused
-        assert "'big' (60,000 events) needs about " in refused
+        assert "'big' (20,000 events) needs about " in refused
         data = refused.split("Neo4j's data folder ", 1)[1].split(" has ", 1)[0]
         assert Path(data).resolve() == disk.resolve()
         said_free = float(refused.split(" has ", 1)[1].split(" MB free", 1)[0])
