@@ -2,8 +2,8 @@
 of them (also when they bring a column the log lacks), and a refused or interrupted append
 leaves the log as it was.
 
-The runs are the thesis authors' five recorded runs, each repeated four times as a run of
-its own (new case and event ids, a day later each time): twenty real multi-robot runs that
+The runs are the thesis authors' five recorded runs, each repeated twice as a run of
+its own (new case and event ids, a day later each time): ten real multi-robot runs that
 number their messages from ``m_1`` again, as simulated runs do.
 """
 
@@ -34,7 +34,7 @@ KEYS = ("activity", "activity,robot")
 
 @pytest.fixture(scope="module")
 def runs(thesis_csv) -> pd.DataFrame:
-    """Twenty runs in the thesis log's own CSV columns, numbered run_01 ... run_20."""
+    """Ten runs in the thesis log's own CSV columns, numbered run_01 ... run_10."""
     raw = pd.read_csv(thesis_csv, dtype=str)
     times = pd.to_datetime(raw["time"], format="ISO8601")
     # The recorded runs lie a day or so apart; within a run no pause lasts an hour.
@@ -42,7 +42,7 @@ def runs(thesis_csv) -> pd.DataFrame:
     cases = sorted(raw["case"].unique(), key=int)
     assert len(cases) == 5
     parts = []
-    for run in range(1, 21):
+    for run in range(1, 11):
         part = raw[raw["case"] == cases[(run - 1) % 5]].copy()
         part["case"] = f"run_{run:02d}"
         part["event_id"] = f"r{run}_" + part["event_id"]
@@ -113,7 +113,7 @@ def other_name(neo4j_driver, log_name):
 def test_appending_runs_gives_the_graph_of_one_ingest(
     tmp_path, capsys, neo4j_driver, runs, log_name, other_name
 ):
-    first = runs["case"] <= "run_10"
+    first = runs["case"] <= "run_05"
     # The later runs bring an attribute the first ones lack: the append adds the property.
     runs = runs.assign(charge=np.where(first, np.nan, np.linspace(99.5, 20.25, len(runs))))
     runs.to_csv(tmp_path / "all.csv", index=False)
@@ -127,9 +127,9 @@ def test_appending_runs_gives_the_graph_of_one_ingest(
     whole = content(neo4j_driver, other_name)
     appended = content(neo4j_driver, log_name)
     assert_same(appended, whole)
-    # The append did change what the first ten runs had: the comparison is not vacuous.
+    # The append did change what the first five runs had: the comparison is not vacuous.
     assert appended["counts"]["events"] == len(runs) == 2 * before["counts"]["events"]
-    assert appended["counts"]["cases"] == 20 and appended["values"]["case"][-1] == "run_20"
+    assert appended["counts"]["cases"] == 10 and appended["values"]["case"][-1] == "run_10"
     changed = [p for p, v in before["df_c"].items() if appended["df_c"][p] != v]
     assert changed, "the DF_C edges of the first runs were updated"
     assert all(appended["begins"][k] == 2 * v for k, v in before["begins"].items())
@@ -137,7 +137,7 @@ def test_appending_runs_gives_the_graph_of_one_ingest(
     assert appended["counts"]["entities:robot"] == 3
     assert log_info(neo4j_driver, log_name)["events"] == len(runs)
 
-    # The columnar copy kept at the first ingest holds ten runs: analyses read all twenty.
+    # The columnar copy kept at the first ingest holds five runs: analyses read all ten.
     def table(name: str) -> pd.DataFrame:
         events = stored_table(neo4j_driver, name)
         return events.sort_values(EVENT_ID, kind="stable").reset_index(drop=True)
