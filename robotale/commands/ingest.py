@@ -9,6 +9,7 @@ from pathlib import Path
 from typing import Any
 
 from robotale.ekg.append import append_ekg
+from robotale.ekg.build import refuse_existing
 from robotale.ekg.bulk import AUTO, BULK, build_log
 from robotale.ekg.columnar import delete_copies
 from robotale.ekg.connection import session_driver
@@ -63,6 +64,14 @@ def ingest_command(
             f"--log {log!r} names no log: give it a name, or leave --log out to use "
             f"{log_name(path)!r}."
         )
+    name = log or log_name(path)
+    # the bulk build tells this process's own connections from other clients' by it
+    agent = f"robotale-ingest/{uuid.uuid4().hex}"
+    if not (append or replace):
+        # before the log is read: a name in use is refused at once, whatever the log's size
+        # (the build asks again under the write lock)
+        with session_driver(user_agent=agent) as driver:
+            refuse_existing(driver, name)
     skipped: list[Path] | None = [] if skip_bad else None
     opened = open_log(
         path,
@@ -77,14 +86,11 @@ def ingest_command(
     if opened.reading is not None:
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
         print(format_reading(opened.reading, short=True))
-    name = log or log_name(path)
     chosen = split_names(entities) if entities else None
     if chosen is None and found_objects is not None:
         chosen = found_objects.entity_types
     names = {"entities": chosen}
     keys = aggregate or default_keys(events, chosen)
-    # the bulk build tells this process's own connections from other clients' by it
-    agent = f"robotale-ingest/{uuid.uuid4().hex}"
     with session_driver(user_agent=agent) as driver:
         entity_columns = chosen if chosen is not None else default_entities(events.columns)
         check_space(driver, events, name, entity_columns, len(keys))

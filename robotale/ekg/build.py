@@ -82,6 +82,13 @@ def _exists_message(driver: Driver, name: str) -> str:
     )
 
 
+def refuse_existing(driver: Driver, name: str) -> None:
+    """Refuse a new log of a name Neo4j already holds, in the sentence that says how to clear
+    it: asked before a log is read, so a refused ingest answers at once whatever its size."""
+    if log_exists(driver, name):
+        raise InputError(_exists_message(driver, name))
+
+
 def build_ekg(
     driver: Driver,
     log: pd.DataFrame,
@@ -110,9 +117,9 @@ def build_ekg(
     ensure_schema(driver)
     # Checked under the lock: another ingest of this name may have finished a moment ago.
     with log_write_lock(driver, name, "ingesting") as run:
-        existing = log_exists(driver, name)
-        if existing and not replace:
-            raise InputError(_exists_message(driver, name))
+        if not replace:
+            refuse_existing(driver, name)
+        existing = replace and log_exists(driver, name)
         target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
         job = _Job(tables, classes, target, source, progress, run, objects, chosen)
         summary = _write_or_undo(driver, job)

@@ -106,6 +106,15 @@ def test_existing_log_name(tmp_path, capsys, graph_counts, log_name):
     assert code == 1 and one_sentence(message), message
     assert f"A log named '{log_name}' already exists in Neo4j; use --replace" in message
     assert graph_counts() == before
+    # The name is refused before the file is read: a file that could not be read at all
+    # gets the same answer, and nothing of a reading is reported.
+    unreadable = tmp_path / "unreadable.csv"
+    unreadable.write_text("time,activity,robot\nnot a time,takeoff,drone\n")
+    code = main(["ingest", str(unreadable), "--log", log_name])
+    captured = capsys.readouterr()
+    assert code == 1 and captured.out == "", captured.out
+    assert f"A log named '{log_name}' already exists in Neo4j" in captured.err
+    assert graph_counts() == before
 
 
 def test_digits_beyond_64_bits_are_stored_as_text(tmp_path, capsys, neo4j_driver, log_name):
