@@ -22,7 +22,7 @@ import csv
 import dataclasses
 import io
 import warnings
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from contextlib import suppress
 from pathlib import Path
 from typing import TypeAlias
@@ -154,7 +154,8 @@ def _read_csv(
         text_columns.append(case)
     kinds = {reading.normalised(kind) for kind in objects}
     text_columns += [name for name in header if reading.normalised(name) in kinds]
-    table, missing = _csv_table(path, text, text_columns)
+    times = next((src for src, canonical in renames.items() if canonical == schema.TIMESTAMP), None)
+    table, missing = _csv_table(path, text, text_columns, times)
     lines = pd.Series(range(2, len(table) + 2), index=table.index)  # line 1 is the header
     return canonical_log(path, table, renames, lines, case, case_gap, missing)
 
@@ -168,7 +169,7 @@ def _csv_header(path: Path, text: str) -> list[str]:
             ".jsonocel or .json."
         )
     try:
-        names = next(csv.reader(io.StringIO(text), strict=True), [])
+        names = next(csv.reader(_lines(text), strict=True), [])
     except csv.Error as error:
         raise InputError(f"{path} line 1: the header is not readable CSV ({error}).") from None
     if not any(name.strip() for name in names):
@@ -183,15 +184,31 @@ def _csv_header(path: Path, text: str) -> list[str]:
     return names
 
 
+def _lines(text: str) -> Iterator[str]:
+    """The lines of ``text`` one by one, each cut when it is asked for (the header alone
+    reads one line, not a copy of the whole file)."""
+    begin = 0
+    while begin < len(text):
+        end = text.find("\n", begin)
+        end = len(text) if end == -1 else end + 1
+        yield text[begin:end]
+        begin = end
+
+
 def _csv_table(
-    path: Path, text: str, text_columns: list[str]
+    path: Path, text: str, text_columns: list[str], times: str | None = None
 ) -> tuple[pd.DataFrame, dict[str, int]]:
     """The CSV's cells with the missing markers cleared, and how many per column.
 
     The markers are ours to decide, not pandas' (its own list takes "NA" for missing and
-    leaves "-" as a value). Markers as whole cells are cleared by pandas' parser itself;
-    only a file with blanks around a marker is read as text and cleared cell by cell.
+    leaves "-" as a value). Markers as whole cells are cleared by the parser itself;
+    only a file with blanks around a marker is read as text and cleared cell by cell. Most
+    files are read by pyarrow's reader (:func:`.reading.arrow_csv`); one it may read
+    otherwise than pandas, and one it cannot read, by pandas' parser, whose reading and
+    error sentences are the rule.
     """
+    if (table := reading.arrow_csv(text, text_columns, times)) is not None:
+        return table, _missing_counts(table)
     try:
         # index_col=False: a first row with more cells than the header would otherwise turn
         # the first column into the index; pandas warns instead, and the warning is an error.
@@ -211,13 +228,17 @@ def _csv_table(
                 index_col=False,
             )
             if huge := [c for c in reading.huge_integer_columns(table) if c not in text_columns]:
-                return _csv_table(path, text, [*text_columns, *huge])
+                return _csv_table(path, text, [*text_columns, *huge], times)
     except pd.errors.ParserWarning:
         raise InputError(_long_row(path, text)) from None
     except (pd.errors.ParserError, pd.errors.EmptyDataError, ValueError, csv.Error) as error:
         raise InputError(f"{path} is not a readable CSV file: {_one_line(error)}") from None
+    return table, _missing_counts(table)
+
+
+def _missing_counts(table: pd.DataFrame) -> dict[str, int]:
     counts = table.isna().sum()  # every NaN is a marker: no other value reads as one
-    return table, {str(column): int(n) for column, n in counts.items() if n}
+    return {str(column): int(n) for column, n in counts.items() if n}
 
 
 def _long_row(path: Path, text: str) -> str:
@@ -419,7 +440,11 @@ def canonical_log(
     kinds = reading.event_kinds(log)
     dropped = reading.dropped_rows(kinds, lines)
     keep = reading.understood(kinds).to_numpy(bool)
-    copies, copied = reading.exact_copies(table, lines, keep, schema.EVENT_ID in log.columns)
+    ids = next(
+        (src for src, canonical in renames.items() if canonical == schema.EVENT_ID),
+        schema.EVENT_ID if schema.EVENT_ID in table.columns else None,
+    )
+    copies, copied = reading.exact_copies(table, lines, keep, ids)
     dropped |= copied
     keep = keep & ~copies
     if not keep.any():
@@ -531,10 +556,12 @@ def parse_timestamps(path: Path, values: pd.Series, lines: pd.Series) -> pd.Seri
 
 
 def _to_datetime(text: pd.Series) -> pd.Series:
+    # no cache of distinct values: a log's times are nearly all distinct, and building it
+    # costs more than it saves
     try:
-        return pd.to_datetime(text, format="ISO8601", errors="coerce")
+        return pd.to_datetime(text, format="ISO8601", errors="coerce", cache=False)
     except ValueError:  # mixed offsets, or offsets mixed with naive times
-        return pd.to_datetime(text, format="ISO8601", errors="coerce", utc=True)
+        return pd.to_datetime(text, format="ISO8601", errors="coerce", utc=True, cache=False)
 
 
 def _check_columns(path: Path, log: pd.DataFrame) -> None:
@@ -614,5 +641,6 @@ def _read_text(path: Path) -> str:
 
 def _event_counts(kinds: pd.Series) -> dict[str, int]:
     """Events by kind; aborted and cancelled ends only where the log has them."""
-    counts = {kind: int((kinds == kind).sum()) for kind in (*reading.KINDS, *reading.OUTCOMES)}
+    found = kinds.value_counts()  # one pass, not a comparison per kind
+    counts = {kind: int(found.get(kind, 0)) for kind in (*reading.KINDS, *reading.OUTCOMES)}
     return {k: n for k, n in counts.items() if n or k in reading.KINDS}

@@ -9,7 +9,6 @@ from pathlib import Path
 
 import pandas as pd
 
-from robotale.discovery.ekg import read_stored_log
 from robotale.errors import InputError
 from robotale.eventlog.readers import parse_mapping, read_log_with_reading
 from robotale.eventlog.reading import Reading, format_reading
@@ -27,6 +26,9 @@ def read_event_log(
     ``case_gap``; how it was read goes to stderr) or, with ``log_name``, a log stored in
     Neo4j."""
     if log_name:
+        # the graph database's driver takes a second to import: only a stored log needs it
+        from robotale.discovery.ekg import read_stored_log
+
         return read_stored_log(log_name)
     if not log:
         raise InputError("name an event log: a CSV or XES file, or --log NAME for a stored one.")
