@@ -326,25 +326,32 @@ def _beyond_int64(column: pd.Series) -> bool:
 def event_kinds(log: pd.DataFrame) -> pd.Series:
     """Each row's kind: start, complete, instant, sample, or ``?<value>`` for a lifecycle value
     that is none of these (such rows are dropped)."""
-    if schema.LIFECYCLE in log.columns:
-        raw = log[schema.LIFECYCLE].astype("string").str.strip()
-        meaning = raw.str.lower().map(LIFECYCLE_VALUES)
-    else:
-        raw = pd.Series(pd.NA, index=log.index, dtype="string")
-        meaning = pd.Series(None, index=log.index, dtype=object)
     in_progress = _in_progress(log)
-    absent = raw.isna().to_numpy(bool)
-    kinds = pd.Series("instant", index=log.index, dtype=object)
-    kinds[(meaning == schema.START).to_numpy(bool)] = "start"
-    kinds[(meaning == schema.COMPLETE).to_numpy(bool)] = "complete"
-    for outcome in OUTCOMES:
-        kinds[(meaning == outcome).to_numpy(bool)] = outcome
-    no_transition = absent | (meaning == schema.NONE).to_numpy(bool)
-    kinds[absent & ~in_progress] = "complete"  # pm4py's default: a recorded completion
-    kinds[no_transition & in_progress] = "sample"
-    unknown = (~absent) & meaning.isna().to_numpy(bool)
-    kinds[unknown] = "?" + raw[unknown]
-    return kinds
+    if schema.LIFECYCLE not in log.columns:
+        kinds = np.where(in_progress, "sample", "complete").astype(object)
+        return pd.Series(kinds, index=log.index, dtype=object)
+    # each distinct lifecycle value read once (a log repeats a handful), its rows by code;
+    # a missing value is the last code
+    codes, values = pd.factorize(log[schema.LIFECYCLE].astype("string"))
+    raw = pd.Series(values, dtype="string").str.strip()
+    meaning = raw.str.lower().map(LIFECYCLE_VALUES).to_numpy(object)
+    kind_of = np.array([*map(_kind, raw.to_numpy(object), meaning), "complete"], dtype=object)
+    # no transition (missing, or none) and a state in progress: a sample
+    silent = np.append(meaning == schema.NONE, True)[codes]
+    kinds = kind_of[codes]
+    kinds[silent & in_progress] = "sample"
+    return pd.Series(kinds, index=log.index, dtype=object)
+
+
+def _kind(raw: object, meaning: object) -> str:
+    """The kind of a row whose lifecycle value is ``raw`` (stripped), meaning ``meaning``."""
+    if pd.isna(raw):  # no lifecycle: a recorded completion, as pm4py reads it
+        return "complete"
+    if meaning in (schema.START, schema.COMPLETE, *OUTCOMES):
+        return str(meaning)
+    if meaning == schema.NONE:
+        return "instant"
+    return f"?{raw}"
 
 
 def understood(kinds: pd.Series) -> pd.Series:
@@ -379,7 +386,10 @@ def lifecycle_columns(log: pd.DataFrame, kinds: pd.Series) -> list[str]:
         log.loc[samples, schema.STATE] = schema.INPROGRESS
     transitions = {"start": schema.START, "complete": schema.COMPLETE}
     transitions |= {outcome: outcome for outcome in OUTCOMES}
-    log[schema.LIFECYCLE] = kinds.map(transitions).fillna(schema.NONE).astype("string")
+    # a handful of kinds: each turned into its lifecycle once, the rows by code
+    codes, found = pd.factorize(kinds)
+    lifecycle = np.array([transitions.get(kind, schema.NONE) for kind in found], dtype=object)
+    log[schema.LIFECYCLE] = pd.Series(lifecycle[codes], index=log.index, dtype="string")
     return notes
 
 

@@ -248,9 +248,11 @@ def test_the_agri_mission_runs_discovered_and_the_drone_hears_the_weeds(tmp_path
     model catches with an event sub-process listening all along. The log has every receipt
     inside an Explore, so the discovered model catches it with a non-interrupting event
     sub-process too; run in the agri world, the drone hears the weeds and reports them, the
-    tractors answer with their positions and the closest one moves to the weed. (Whether it
-    then cuts is a draw of the discovered tractor's choices: the log does not say why a
-    tractor stops.)"""
+    tractors answer with their positions and the closest one moves to the weed. (Whether a
+    tractor moves and cuts is a draw of the discovered tractor's choices. The log holds the
+    reason, which discovery does not mine yet: the payload of the ``closest_tractor`` a
+    tractor caught names the tractor that is to go, and it moves exactly when that is
+    itself.)"""
     world = resolve_world("agri")[0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
