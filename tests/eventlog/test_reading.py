@@ -7,6 +7,8 @@ reader itself.
 
 from __future__ import annotations
 
+import io
+
 import pandas as pd
 import pm4py
 import pytest
@@ -22,8 +24,8 @@ from pm4py.objects.log.util import interval_lifecycle
 
 from robotale.discovery.instances import activity_instances, control_flow_events
 from robotale.errors import InputError
-from robotale.eventlog import schema
-from robotale.eventlog.readers import read_log, read_log_with_reading
+from robotale.eventlog import reading, schema
+from robotale.eventlog.readers import _csv_table, read_log, read_log_with_reading
 
 WRITERS = {
     "robotale.csv": write_robotale_csv,
@@ -380,3 +382,53 @@ def test_pairs_that_all_last_nothing_are_warned_of(tmp_path):
     rows[-1] = rows[-1].replace("10:00:05", "10:00:07")
     _, reading = read_log_with_reading(write(tmp_path, "lasting.csv", "\n".join(rows) + "\n"))
     assert reading.warnings == []
+
+
+_HEADER = "case,activity,timestamp,lifecycle,robot,extra\n"
+_ROWS = "1,a,2024-01-01T00:00:00Z,start,r1,{}\n1,a,2024-01-01T00:00:01Z,complete,r1,{}\n"
+#: the ``extra`` column's two cells, and whether pyarrow's reader takes the file (else it goes
+#: to pandas' parser; ``None``: either may)
+_CELLS = {
+    "integers": ("1", "2", True),
+    "a float and a missing cell": ("1.5", "", True),
+    "markers": ("null", "-", True),
+    "text that is not a marker": ("NA", "n.a.", True),
+    "quoted text with a quote": ('"x ""y"""', '""', True),
+    "numbers with exponents": ("1e3", "1E-2", True),
+    "leading zeros in text": ("007", "x", True),
+    "truth values": ("True", "False", False),
+    "dates": ("2024-01-02", "2024-01-03", False),
+    "clock times": ("10:00:00", "11:00:00", False),
+    "blanks beside a number": (" 1", "2 ", False),
+    "quoted text with a comma and a blank": ('"x, y"', "z", False),
+    "a line break in a cell": ('"two\nlines"', "z", None),
+}
+
+
+@pytest.mark.parametrize("cells", _CELLS.values(), ids=_CELLS.keys())
+def test_a_csv_reads_as_pandas_parser_reads_it(tmp_path, cells):
+    """Whichever reader a file goes to, its cells are pandas' parser's with robotale's
+    options (markers missing, the text columns and the time column as text)."""
+    first, second, fast = cells
+    text = _HEADER + _ROWS.format(first, second)
+    names = ["case", "activity", "lifecycle", "robot"]
+    if fast is not None:
+        assert (reading.arrow_csv(text, names, "timestamp") is not None) == fast
+    table, missing = _csv_table(tmp_path / "log.csv", text, names, "timestamp")
+    pandas = pd.read_csv(
+        io.StringIO(text),
+        dtype=dict.fromkeys([*names, "timestamp"], str),
+        keep_default_na=False,
+        na_values=sorted(reading.MISSING_MARKERS),
+        index_col=False,
+    )
+    pd.testing.assert_frame_equal(table, pandas)
+    assert missing == {c: int(n) for c, n in pandas.isna().sum().items() if n}
+
+
+def test_a_long_integer_keeps_every_digit(tmp_path):
+    """pyarrow's reader would take 12345678901234567890 for a float (12345678901234567168):
+    such a file is read by pandas' parser, which keeps the integer."""
+    path = tmp_path / "log.csv"
+    path.write_text(_HEADER + _ROWS.format("12345678901234567890", "1"))
+    assert read_log(path)["extra"].tolist() == [12345678901234567890, 1]
