@@ -193,6 +193,8 @@ def _read_json(path: Path) -> ObjectLog:
 
 def _entries(path: Path, document: Mapping[str, Any], key: str) -> list[dict[str, Any]]:
     items = document.get(key) or []
+    if not isinstance(items, list):
+        raise InputError(f"{path}: the {key} are not a list of JSON objects.")
     for number, item in enumerate(items, start=1):
         if not isinstance(item, dict):
             raise InputError(f"{path}: {key[:-1]} {number} is not a JSON object.")

@@ -137,6 +137,8 @@ def test_xes(folder, content):
 
 @FUZZ
 @given(document=st.dictionaries(OCEL_KEYS, JSON, max_size=4) | JSON)
+# Found by fuzzing once: a list of objects given as a plain value.
+@example(document={"objects": True})
 def test_ocel_json_where_a_log_is_expected(folder, document):
     for name in ("log.jsonocel", "log.csv"):
         read_or_refuse(folder, name, json.dumps(document).encode())
