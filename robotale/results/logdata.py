@@ -27,6 +27,7 @@ import pyarrow.parquet as pq
 from neo4j import Driver
 
 from robotale.discovery.ekg import discover_ekg
+from robotale.discovery.ekg_table import computable, table_class_graph
 from robotale.discovery.graph import json_ready
 from robotale.ekg.aggregate import aggregation_key
 from robotale.ekg.columnar import Build, log_build, results_folder, stored_table
@@ -198,7 +199,7 @@ class LogData:
                 driver,
                 name,
                 what,
-                lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
+                lambda: self._class_graph(driver, name, info, key, entity_types),
                 # mostly Neo4j's work: in its own turn, beside the sections computed here
                 turn="class-graph",
             )
@@ -207,6 +208,25 @@ class LogData:
 
         found: dict[str, Any] = self.graphs.get((name, version, tuple(key), shown), compute)
         return found
+
+    def _class_graph(
+        self,
+        driver: Driver,
+        name: str,
+        info: dict[str, Any],
+        key: Sequence[str],
+        entity_types: Sequence[str] | None,
+    ) -> dict[str, Any]:
+        """The class graph computed from the log's event table (the copy the pages read
+        anyway) when it holds the key and the entity types, else read from Neo4j (which
+        also says what a request names wrongly)."""
+        known = list(info.get("entityTypes") or [])
+        types = known if entity_types is None else list(entity_types)
+        properties = aggregation_key(list(key))
+        frame = self.frame(driver, name)
+        if set(types) <= set(known) and computable(frame, properties, types):
+            return table_class_graph(name, frame, properties, types).to_dict()
+        return discover_ekg(name, list(key), entity_types, driver=driver).to_dict()
 
     def forget(self, name: str) -> None:
         """Drop what is kept in memory of ``name`` (it was deleted or rebuilt)."""
