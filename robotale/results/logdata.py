@@ -33,6 +33,7 @@ from robotale.ekg.aggregate import aggregation_key
 from robotale.ekg.columnar import Build, log_build, results_folder, stored_table
 from robotale.ekg.keys import DISCOVERY_KEY, built_keys
 from robotale.ekg.logs import log_info as stored_log_info
+from robotale.enhancement.context import LogAnalysis
 from robotale.errors import InputError
 from robotale.files import write_file, write_files
 
@@ -96,6 +97,10 @@ class LogData:
 
     def __init__(self, keep: int = KEEP) -> None:
         self.frames = Cache(keep)
+        #: the tables the perspectives and findings share (activity instances, steps, message
+        #: tables), of the last log analysed: its sections and findings computed one after
+        #: the other build them once; one log only, as they outweigh the log itself
+        self.analyses = Cache(1)
         self.graphs = Cache(4 * keep)
         #: the runs the Mission page replays, and the models' elements they map to
         self.missions = Cache(4 * keep)
@@ -111,6 +116,12 @@ class LogData:
         """The stored log ``name`` as a canonical event log."""
         build = current_build(driver, name)
         return self.frames.get((name, build.key), lambda: stored_table(driver, name, MISSING_HINT))
+
+    def analysis(self, driver: Driver, name: str) -> LogAnalysis:
+        """The stored log ``name`` as an analysis whose shared tables later computations of
+        the same build reuse."""
+        build = current_build(driver, name)
+        return self.analyses.get((name, build.key), lambda: LogAnalysis(self.frame(driver, name)))
 
     def result(
         self,
@@ -231,6 +242,7 @@ class LogData:
     def forget(self, name: str) -> None:
         """Drop what is kept in memory of ``name`` (it was deleted or rebuilt)."""
         self.frames.forget(name)
+        self.analyses.forget(name)
         self.graphs.forget(name)
         self.missions.forget(name)
 
