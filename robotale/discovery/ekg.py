@@ -64,12 +64,12 @@ def discover_ekg(
     graph = ProcessGraph(
         kind="ekg", info={"log": log, "aggregate": key, "class_type": kind, "entities": types}
     )
-    graph.nodes = _class_nodes(_run(driver, "discover_classes", log=log, type=kind), key)
-    graph.edges = _df_c_edges(_run(driver, "discover_df_c", log=log, type=kind, entityTypes=types))
-    graph.edges += _comm_edges(_run(driver, "discover_comm_c", log=log, type=kind))
+    graph.nodes = class_nodes(_run(driver, "discover_classes", log=log, type=kind), key)
+    graph.edges = df_c_edges(_run(driver, "discover_df_c", log=log, type=kind, entityTypes=types))
+    graph.edges += comm_edges(_run(driver, "discover_comm_c", log=log, type=kind))
     for entity_type in types:
         rows = _run(driver, "discover_entry_nodes", log=log, type=kind, entityType=entity_type)
-        nodes, edges = _entry(entity_type, rows)
+        nodes, edges = entry_graph(entity_type, rows)
         graph.nodes += nodes
         graph.edges += edges
     return graph
@@ -101,7 +101,7 @@ def _entity_types(info: dict[str, Any], chosen: Sequence[str] | None, log: str) 
     return list(chosen)
 
 
-def _class_nodes(rows: list[dict[str, Any]], key: list[str]) -> list[Node]:
+def class_nodes(rows: list[dict[str, Any]], key: list[str]) -> list[Node]:
     nodes = []
     for row in rows:
         values = {name: row["properties"].get(name) for name in key}
@@ -132,11 +132,11 @@ def _class_label(values: dict[str, Any]) -> str:
     return f"{head} ({', '.join(rest)})" if rest else head
 
 
-def _df_c_edges(rows: list[dict[str, Any]]) -> list[Edge]:
+def df_c_edges(rows: list[dict[str, Any]]) -> list[Edge]:
     return [_edge(row, row["entityType"]) for row in rows]
 
 
-def _comm_edges(rows: list[dict[str, Any]]) -> list[Edge]:
+def comm_edges(rows: list[dict[str, Any]]) -> list[Edge]:
     return [_edge(row, COMM) for row in rows]
 
 
@@ -151,7 +151,7 @@ def _edge(row: dict[str, Any], entity_type: str) -> Edge:
     )
 
 
-def _entry(entity_type: str, rows: list[dict[str, Any]]) -> tuple[list[Node], list[Edge]]:
+def entry_graph(entity_type: str, rows: list[dict[str, Any]]) -> tuple[list[Node], list[Edge]]:
     """Entry nodes of one entity type: one per entity, or one for all when there are many.
 
     An entity begins once per case it appears in (directly-follows never crosses a case), so

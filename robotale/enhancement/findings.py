@@ -25,7 +25,7 @@ from robotale.discovery.graph import json_ready
 from robotale.enhancement.battery import battery_perspective
 from robotale.enhancement.bottlenecks import ALPHA, find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
-from robotale.enhancement.context import LogAnalysis
+from robotale.enhancement.context import LogAnalysis, analysis_of
 from robotale.enhancement.encounters import (
     METRES,
     SECONDS,
@@ -87,7 +87,7 @@ class Findings:
 
 
 def find(
-    log: pd.DataFrame,
+    log: pd.DataFrame | LogAnalysis,
     *,
     threshold: float = LOW_BATTERY_PERCENT,
     delay_threshold: float | None = None,
@@ -99,7 +99,7 @@ def find(
     # one analysis for all: the activity instances, steps, case durations and the message
     # table are built once; the messages come first so the bottlenecks' queueing reuses them.
     # The spatial perspective is not needed: the areas are two numbers per robot.
-    analysis = LogAnalysis(log)
+    analysis = analysis_of(log)
     communication = communication_perspective(analysis, delay_threshold=delay_threshold)
     perspectives = {
         "performance": performance_perspective(analysis),
@@ -112,7 +112,7 @@ def find(
     answers = [
         sequence_answer(performance),
         delay_answer(perspectives["bottlenecks"], performance, runs),
-        robot_answer(log, performance),
+        robot_answer(analysis.log, performance),
         battery_answer(perspectives["battery"], runs),
         message_answer(perspectives["communication"]),
     ]

@@ -135,6 +135,14 @@ class Preparations:
                 running.start()
         return _progress(folder / PROGRESS, PAGE_STEPS.get(page))
 
+    def wait(self) -> None:
+        """Return once the preparations this dashboard runs are done: what a measurement of
+        one page waits for before the next, so neither pays for the other's preparation."""
+        with self._lock:
+            running = list(self._running.values())
+        for thread in running:
+            thread.join()
+
     def _prepare(
         self, key: tuple[str, str], driver: Driver, logs: LogData, first: Sequence[str]
     ) -> None:

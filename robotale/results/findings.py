@@ -44,7 +44,7 @@ def stored_findings(driver: Driver, logs: LogData, name: str, delay: float | Non
     is delayed above ``delay`` seconds (else by the default rule)."""
 
     def compute() -> dict[str, Any]:
-        result = find(logs.frame(driver, name), delay_threshold=delay)
+        result = find(logs.analysis(driver, name), delay_threshold=delay)
         runs = result.runs.reindex(columns=["case", "start", "duration"])
         return {**result.to_dict(), "runs": runs.to_dict(orient="records")}
 
@@ -66,8 +66,8 @@ def stored_perspective(
     options = kind.taken({"delay_threshold": delay})
 
     def compute() -> dict[str, Any]:
-        frame = logs.frame(driver, name)
-        result = kind.compute(frame, activity=activity, robot=robot, **options)
+        analysis = logs.analysis(driver, name)
+        result = kind.compute(analysis, activity=activity, robot=robot, **options)
         if which == "bottlenecks" and result.has_data:
             # the same order as the Findings page: effects that may be chance come last
             result.tables["bottlenecks"] = trusted_first(result.tables["bottlenecks"])

@@ -11,6 +11,7 @@ log wait for one read or one computation instead of doing it twice.
 
 from __future__ import annotations
 
+import contextlib
 import hashlib
 import io
 import json
@@ -27,11 +28,13 @@ import pyarrow.parquet as pq
 from neo4j import Driver
 
 from robotale.discovery.ekg import discover_ekg
+from robotale.discovery.ekg_table import computable, table_class_graph
 from robotale.discovery.graph import json_ready
 from robotale.ekg.aggregate import aggregation_key
 from robotale.ekg.columnar import Build, log_build, results_folder, stored_table
 from robotale.ekg.keys import DISCOVERY_KEY, built_keys
 from robotale.ekg.logs import log_info as stored_log_info
+from robotale.enhancement.context import LogAnalysis
 from robotale.errors import InputError
 from robotale.files import write_file, write_files
 
@@ -95,6 +98,10 @@ class LogData:
 
     def __init__(self, keep: int = KEEP) -> None:
         self.frames = Cache(keep)
+        #: the tables the perspectives and findings share (activity instances, steps, message
+        #: tables), of the last log analysed: its sections and findings computed one after
+        #: the other build them once; one log only, as they outweigh the log itself
+        self.analyses = Cache(1)
         self.graphs = Cache(4 * keep)
         #: the runs the Mission page replays, and the models' elements they map to
         self.missions = Cache(4 * keep)
@@ -110,6 +117,12 @@ class LogData:
         """The stored log ``name`` as a canonical event log."""
         build = current_build(driver, name)
         return self.frames.get((name, build.key), lambda: stored_table(driver, name, MISSING_HINT))
+
+    def analysis(self, driver: Driver, name: str) -> LogAnalysis:
+        """The stored log ``name`` as an analysis whose shared tables later computations of
+        the same build reuse."""
+        build = current_build(driver, name)
+        return self.analyses.get((name, build.key), lambda: LogAnalysis(self.frame(driver, name)))
 
     def result(
         self,
@@ -198,7 +211,7 @@ class LogData:
                 driver,
                 name,
                 what,
-                lambda: discover_ekg(name, list(key), entity_types, driver=driver).to_dict(),
+                lambda: self._class_graph(driver, name, info, key, entity_types),
                 # mostly Neo4j's work: in its own turn, beside the sections computed here
                 turn="class-graph",
             )
@@ -208,9 +221,32 @@ class LogData:
         found: dict[str, Any] = self.graphs.get((name, version, tuple(key), shown), compute)
         return found
 
+    def _class_graph(
+        self,
+        driver: Driver,
+        name: str,
+        info: dict[str, Any],
+        key: Sequence[str],
+        entity_types: Sequence[str] | None,
+    ) -> dict[str, Any]:
+        """The class graph computed from the log's event table (the copy the pages read
+        anyway) when it holds the key and the entity types, else read from Neo4j (which
+        also says what a request names wrongly)."""
+        known = list(info.get("entityTypes") or [])
+        types = known if entity_types is None else list(entity_types)
+        properties = aggregation_key(list(key))
+        frame = self.frame(driver, name)
+        if set(types) <= set(known) and computable(frame, properties, types):
+            # refused when no event names an entity of the chosen types: the stored graph
+            # answers that, as it always did (no edges of those types)
+            with contextlib.suppress(InputError):
+                return table_class_graph(name, frame, properties, types).to_dict()
+        return discover_ekg(name, list(key), entity_types, driver=driver).to_dict()
+
     def forget(self, name: str) -> None:
         """Drop what is kept in memory of ``name`` (it was deleted or rebuilt)."""
         self.frames.forget(name)
+        self.analyses.forget(name)
         self.graphs.forget(name)
         self.missions.forget(name)
 

@@ -12,6 +12,7 @@ from instance_frames import instance_frame
 from robotale.cli import main
 from robotale.discovery import discover_ekg
 from robotale.discovery.ekg import COMM, read_stored_log
+from robotale.discovery.ekg_table import table_class_graph
 from robotale.ekg import build_ekg
 from robotale.ekg.logs import delete_log
 from robotale.errors import InputError
@@ -34,6 +35,32 @@ def stored(neo4j_driver, thesis_log):
 def by_robot(stored, neo4j_driver):
     """activity+robot classes: built on demand, the log was stored with activity only."""
     return discover_ekg(stored, "activity,robot", driver=neo4j_driver)
+
+
+def same_graph(computed: dict, stored: dict) -> None:
+    """The class graph computed from the event table is the stored graph's: the same nodes
+    and edges in the same order, the seconds equal to rounding (Neo4j adds them up in
+    another order)."""
+    assert computed["info"] == stored["info"]
+    for part in ("nodes", "edges"):
+        assert len(computed[part]) == len(stored[part])
+        for mine, theirs in zip(computed[part], stored[part], strict=True):
+            assert mine["durations"] == pytest.approx(theirs["durations"], rel=1e-9, abs=1e-9)
+            assert {**mine, "durations": None} == {**theirs, "durations": None}
+
+
+def test_the_table_computes_the_graph_neo4j_holds(by_robot, stored, neo4j_driver, thesis_log):
+    """The class graph from the event table against the one read from Neo4j: classes built
+    on demand by Cypher (activity+robot) and with the log (activity), one entity type or
+    both."""
+    same_graph(
+        table_class_graph(stored, thesis_log, ["activity", "robot"], ["robot", "msg_id"]).to_dict(),
+        by_robot.to_dict(),
+    )
+    by_activity = discover_ekg(stored, "activity", ["msg_id"], driver=neo4j_driver)
+    computed = table_class_graph(stored, thesis_log, ["activity"], ["msg_id"])
+    same_graph(computed.to_dict(), by_activity.to_dict())
+    assert any(e.entity_type == COMM for e in computed.edges)
 
 
 def test_per_robot_df_counts_equal_pm4py(by_robot, thesis_log):
@@ -184,6 +211,10 @@ def test_samples_are_no_instances(neo4j_driver, tmp_path):
         graph = discover_ekg(name, "activity", driver=neo4j_driver)
         explore = graph.node("explore")
         assert explore.count == 3
+        same_graph(
+            table_class_graph(name, read_log(path), ["activity"], ["robot"]).to_dict(),
+            graph.to_dict(),
+        )
         assert (explore.properties["samples"], explore.properties["events"]) == (5, 11)
         assert graph.node("land").count == 1
     finally:
