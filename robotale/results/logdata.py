@@ -122,7 +122,10 @@ class LogData:
         """The stored log ``name`` as an analysis whose shared tables later computations of
         the same build reuse."""
         build = current_build(driver, name)
-        return self.analyses.get((name, build.key), lambda: LogAnalysis(self.frame(driver, name)))
+        analysis: LogAnalysis = self.analyses.get(
+            (name, build.key), lambda: LogAnalysis(self.frame(driver, name))
+        )
+        return analysis
 
     def result(
         self,
