@@ -21,6 +21,7 @@ import shlex
 import tempfile
 import time
 from collections.abc import Callable, Sequence
+from concurrent.futures import ThreadPoolExecutor, wait
 from pathlib import Path
 
 import pandas as pd
@@ -30,13 +31,13 @@ from robotale.ekg.build import (
     BuildSummary,
     Prepared,
     build_ekg,
-    ensure_schema,
+    ensure_schema_together,
     finish_log,
     prepare,
     summarise,
     undo_after_failure,
 )
-from robotale.ekg.columnar import store_copy
+from robotale.ekg.columnar import delete_copies, store_copy
 from robotale.ekg.connection import (
     client_connections,
     database,
@@ -153,7 +154,7 @@ def build_bulk(
     started = time.perf_counter()
     server = LocalServer()
     tables, classes = prepared.tables, prepared.classes
-    ensure_schema(driver)
+    ensure_schema_together(driver)
     run = take(driver, name, "ingesting")
     try:
         if why := _occupied(driver, run, user_agent):
@@ -229,21 +230,28 @@ def _finish(
     prepared: Prepared,
     progress: Callable[[str], None],
 ) -> None:
-    """After the import: the indexes and constraints, online, the Log node completed, the
-    columnar copy kept; what was imported is removed again when that fails."""
-    try:
-        progress("Creating the indexes and constraints ...")
-        ensure_schema(driver)
-        driver.execute_query(cypher("ekg_await_indexes"), seconds=INDEX_WAIT, database_=database())
-        finish_log(driver, name, prepared.tables.events, prepared.classes)
-    except BaseException as error:
-        undo_after_failure(
-            error,
-            lambda: delete_log(driver, name),
-            f"Finishing the imported log {name!r} failed",
-            f"`robotale logs delete {shlex.quote(name)}`",
-        )
-    store_copy(driver, name, log)
+    """After the import: the indexes and constraints, created together, and meanwhile the
+    columnar copy kept (it needs no index); then the Log node completed. What was imported is
+    removed again when that fails."""
+    progress("Creating the indexes and constraints ...")
+    with ThreadPoolExecutor(max_workers=1) as beside:
+        copying = beside.submit(store_copy, driver, name, log)
+        try:
+            ensure_schema_together(driver)
+            driver.execute_query(
+                cypher("ekg_await_indexes"), seconds=INDEX_WAIT, database_=database()
+            )
+            finish_log(driver, name, prepared.tables.events, prepared.classes)
+        except BaseException as error:
+            wait([copying])
+            delete_copies(name)  # the copy of a log that is not kept
+            undo_after_failure(
+                error,
+                lambda: delete_log(driver, name),
+                f"Finishing the imported log {name!r} failed",
+                f"`robotale logs delete {shlex.quote(name)}`",
+            )
+    copying.result()
 
 
 def _say(line: str) -> None:

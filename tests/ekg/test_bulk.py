@@ -21,6 +21,7 @@ from neo4j import Driver
 from robotale.ekg import import_files
 from robotale.ekg.build import build_ekg
 from robotale.ekg.bulk import BULK, ONLINE, build_log
+from robotale.ekg.columnar import EVENTS, build_folder, log_build
 from robotale.ekg.connection import connect
 from robotale.ekg.load import timezone_name
 from robotale.ekg.logs import delete_log_locked, list_logs, log_summary
@@ -155,6 +156,9 @@ def test_the_bulk_build_equals_the_online_build(managed, neo4j_driver, thesis_lo
         assert {row[-1] for row in built} == {"ONLINE"}
         assert built == {row for row in schema(neo4j_driver) if row[0] in declared}
         assert bulk.execute_query("MATCH (k:LogLock) RETURN count(k) AS n").records[0]["n"] == 0
+        # the columnar copy, kept while the indexes filled, belongs to the imported build
+        copy = pd.read_parquet(build_folder(log_build(bulk, name)) / EVENTS)
+        pd.testing.assert_frame_equal(copy, log.reset_index(drop=True))
 
         # a second log goes online into the database that now holds a graph: no restart
         second = f"{name}-second"
