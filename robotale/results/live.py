@@ -12,8 +12,9 @@ again only when tags came.
 from __future__ import annotations
 
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -164,24 +165,40 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
 
 def live_replay(driver: Driver, name: str) -> Replay | None:
     """The live run ``name`` as it stands now, or None when no monitor stored one. Only what
-    was stored since the last look is read: the tags and samples kept are extended; the
-    events are made again when tags came, the positions alone when only samples came."""
-    tags, poses = live_counts(driver, name)
-    if not tags:
-        return None
+    was stored since the last look is read (an index seek by number, whatever the run's
+    length): the tags and samples kept are extended; the events are made again when tags
+    came, the positions grown when only samples came."""
     with _lock:
-        kept = _kept.get(name)
-        if kept is None or tags < len(kept.tags) or poses < kept.positions.count:
-            kept = _kept[name] = _Kept()  # new, or a new run of that name
+        kept = _kept.get(name) or _Kept()
+        new_tags = _since(live_tags, driver, name, kept.tags)
+        new_poses = _since(live_poses, driver, name, kept.positions.poses)
+        if new_tags is None or new_poses is None:  # a new run of that name began
+            kept = _Kept()
+            new_tags, new_poses = live_tags(driver, name), live_poses(driver, name)
+        if not kept.tags and not new_tags:
+            _kept.pop(name, None)
+            return None
+        _kept[name] = kept
         old = kept.replay
-        if old is not None and (tags, poses) == (len(kept.tags), kept.positions.count):
+        if old is not None and not new_tags and not new_poses:
             return old
-        new_tags = live_tags(driver, name, after=len(kept.tags))
         kept.tags += new_tags
-        kept.positions.add(live_poses(driver, name, after=kept.positions.count))
+        kept.positions.add(new_poses)
         if old is None or new_tags:
             events = tags_events(name, kept.tags)
             kept.replay = LiveReplay(name, events, {}, positions=kept.positions)
         else:  # the same events: the runs they make are kept, their positions grown
             kept.replay = LiveReplay(name, old.events, {}, positions=kept.positions, bare=old.bare)
         return kept.replay
+
+
+def _since(read: Callable[..., list[Any]], driver: Driver, name: str, held: list[Any]):
+    """What ``read`` finds stored after the ``held`` ones (numbered 1, 2, ... as stored), or
+    None when the one held last is no longer stored under its number: a new run of that name
+    began. The last one held is read again to tell."""
+    if not held:
+        return read(driver, name)
+    found = read(driver, name, after=len(held) - 1)
+    if not found or found[0] != held[-1]:
+        return None
+    return found[1:]

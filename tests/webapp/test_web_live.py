@@ -51,6 +51,20 @@ def test_the_mission_api_answers_on_what_the_monitor_stored_so_far(client, live)
     assert [r["case"] for r in runs] == [live.name]
 
 
+def test_a_new_run_of_the_same_name_replaces_the_one_read(client, live, neo4j_driver):
+    """A reader that kept a longer run of that name reads the new one from its start."""
+    from robotale.ekg.live import LiveLog
+
+    api = f"/api/mission/{live.name}/{live.name}"
+    tags(live, [(0, "rover", "survey", "start"), (1, "rover", "survey", "complete")])
+    tags(live, [(2, "rover", "dock", "start")])
+    assert client.get(api).json["duration"] == pytest.approx(2.0, abs=1e-6)
+    again = LiveLog(neo4j_driver, live.name)  # the monitor started again: a new run
+    tags(again, [(10, "drone", "scan", "start"), (13, "drone", "scan", "complete")])
+    grown = client.get(api).json
+    assert grown["robots"] == ["drone"] and grown["duration"] == pytest.approx(3.0, abs=1e-6)
+
+
 def test_the_state_follows_odometry_stored_in_batches_late_ones_too(client, live):
     """Poses come in batches beside the tags, a later batch holding a sample older than one
     already read: at moments between the samples, each robot's pose and heading are its
