@@ -20,7 +20,9 @@ Printed per robot count:
 - the lag from a tag's stamp to the first answer of the API that shows it (its time among the
   summary's ``event_times``): p50 and p95, over the whole run and over its first and last
   thirds (by stamp), to show whether it grows; beside it, the baseline measured in the same
-  run on the same tags: the lag to a plain ``cyclonedds`` reader in this process;
+  run on the same tags: the lag to a plain ``cyclonedds`` reader in this process; then the
+  lag per minute of stamps beside the load average and the machine's CPU (``/proc/stat``) in
+  that minute, so growth over a long run shows, and this process' CPU;
 - the store's append rate: tags stored in Neo4j per second, against tags published per second;
 - the monitor process' CPU (user + system) per robot, in % of one core;
 - the check: the tags stored are the tags published (robot, activity, lifecycle, stamp).
@@ -29,7 +31,8 @@ The monitor subscribes to the odometry too and stores it at most 10 samples a se
 robot (as ``LivePose`` nodes, batched with the tags every tenth of a second), so the API's
 looks read the positions as they grow as well.
 
-Then the Mission page's first paint (its ``robotale-mission-shown`` mark, in headless Chromium
+Then the Mission page's first paint (its ``robotale-mission-shown`` mark: the first state drawn,
+the map's robots and their table, before the timeline, model and plot, in headless Chromium
 as the browser tests drive it, best of ``--repeat``) for one live run of ``--paint-events``
 tags (20 robots' tags; the first ones appended one transaction each, as a monitor hearing a
 tag at a time appends them, and that rate printed), against the same events stored as an
