@@ -20,7 +20,9 @@ Printed per robot count:
 - the lag from a tag's stamp to the first answer of the API that shows it (its time among the
   summary's ``event_times``): p50 and p95, over the whole run and over its first and last
   thirds (by stamp), to show whether it grows; beside it, the baseline measured in the same
-  run on the same tags: the lag to a plain ``cyclonedds`` reader in this process;
+  run on the same tags: the lag to a plain ``cyclonedds`` reader in this process; then the
+  lag per minute of stamps beside the load average and the machine's CPU (``/proc/stat``) in
+  that minute, so growth over a long run shows, and this process' CPU;
 - the store's append rate: tags stored in Neo4j per second, against tags published per second;
 - the monitor process' CPU (user + system) per robot, in % of one core;
 - the check: the tags stored are the tags published (robot, activity, lifecycle, stamp).
@@ -29,7 +31,8 @@ The monitor subscribes to the odometry too and stores it at most 10 samples a se
 robot (as ``LivePose`` nodes, batched with the tags every tenth of a second), so the API's
 looks read the positions as they grow as well.
 
-Then the Mission page's first paint (its ``robotale-mission-shown`` mark, in headless Chromium
+Then the Mission page's first paint (its ``robotale-mission-shown`` mark: the first state drawn,
+the map's robots and their table, before the timeline, model and plot, in headless Chromium
 as the browser tests drive it, best of ``--repeat``) for one live run of ``--paint-events``
 tags (20 robots' tags; the first ones appended one transaction each, as a monitor hearing a
 tag at a time appends them, and that rate printed), against the same events stored as an
@@ -323,7 +326,8 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
         )
         for group, out in zip(groups, outs, strict=True)
     ]
-    cpu_before = _cpu(monitor.pid)
+    cpu_before, own_before = _cpu(monitor.pid), time.process_time()
+    machine = Machine()
     began = time.time()
     seen: dict[Key, float] = {}
     looks: list[float] = []  # seconds each look (summary, then state) took
@@ -344,6 +348,8 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
         for s in summary["event_times"]:
             seen.setdefault(round((start + s) * 1e6), now)
     ended = time.time()
+    own = time.process_time() - own_before
+    machine.close()
     sent = [tuple(t) for out in outs for t in json.loads(out.read_text())]
     caught_up = _catch_up(driver, name, len(sent), ended)
     cpu, cpu_wall = _cpu(monitor.pid) - cpu_before, time.time() - began
@@ -364,6 +370,12 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
           f"{quantiles(looks)[0]:.2f} s each), load average "
           f"{os.getloadavg()[0]:.1f}")  # fmt: skip
     _print_lags("stamp -> Mission state API", api_lags, dds_lags)
+    _print_minutes(api_lags, machine)
+    busy, load = machine.busy(began, ended), machine.load(began, ended)
+    share = 100 * own / (ended - began)
+    print(f"  this process (the API's looks and the plain reader): {share:.0f} % of a core "
+          f"while publishing; the machine: {busy:.0f} % of its {os.cpu_count()} cores busy, "
+          f"load average {load:.1f}")  # fmt: skip
     print(f"  store: {_rate(counts):.1f} tags/s appended while publishing; all "
           f"{len(stored)} of {len(published)} stored "
           f"{_caught(caught_up)} after the last was published")  # fmt: skip
@@ -387,6 +399,64 @@ def _print_lags(what: str, measured: list[tuple[float, float]], baseline) -> Non
           f"{f95:.3f} s, last third p50 {l50:.3f} / p95 {l95:.3f} s")  # fmt: skip
     print(f"  baseline, stamp -> plain cyclonedds reader: p50 {b50:.4f} s, p95 {b95:.4f} s "
           f"(the API's p95 is {p95 / b95:.0f}x)")  # fmt: skip
+
+
+class Machine:
+    """The load average and the machine's CPU (``/proc/stat``) sampled every few seconds, to
+    print beside the lags of the same minutes."""
+
+    EVERY = 2.0
+
+    def __init__(self) -> None:
+        self.samples: list[tuple[float, float, int, int]] = []  # time, load, busy, total ticks
+        self.stop = threading.Event()
+        self.thread = threading.Thread(target=self._sample, daemon=True)
+        self.thread.start()
+
+    def _sample(self) -> None:
+        while True:
+            fields = [int(v) for v in Path("/proc/stat").read_text().split("\n")[0].split()[1:]]
+            idle = fields[3] + fields[4]  # idle and waiting for I/O
+            self.samples.append((time.time(), os.getloadavg()[0], sum(fields) - idle, sum(fields)))
+            if self.stop.wait(self.EVERY):
+                return
+
+    def close(self) -> None:
+        self.stop.set()
+        self.thread.join()
+
+    def _between(self, start: float, end: float) -> list[tuple[float, float, int, int]]:
+        return [s for s in self.samples if start <= s[0] <= end]
+
+    def busy(self, start: float, end: float) -> float:
+        """% of all cores busy from ``start`` to ``end`` (nan with fewer than two samples)."""
+        inside = self._between(start, end)
+        if len(inside) < 2:
+            return float("nan")
+        (_, _, b0, t0), (_, _, b1, t1) = inside[0], inside[-1]
+        return 100 * (b1 - b0) / max(t1 - t0, 1)
+
+    def load(self, start: float, end: float) -> float:
+        """The mean 1-minute load average sampled from ``start`` to ``end``."""
+        inside = self._between(start, end)
+        return sum(s[1] for s in inside) / len(inside) if inside else float("nan")
+
+
+def _print_minutes(measured: list[tuple[float, float]], machine: Machine) -> None:
+    """The lag per minute of stamps, beside the machine's load and CPU in that minute: a lag
+    that grows with the run shows here."""
+    if not measured:
+        return
+    first = measured[0][0]
+    minutes: dict[int, list[float]] = {}
+    for stamp, lag in measured:
+        minutes.setdefault(int((stamp - first) // 60), []).append(lag)
+    for minute, values in sorted(minutes.items()):
+        p50, p95 = quantiles(values)
+        start, end = first + 60 * minute, first + 60 * (minute + 1)
+        print(f"    minute {minute + 1:2d}: lag p50 {p50:.3f} s, p95 {p95:.3f} s "
+              f"({len(values)} tags); load average {machine.load(start, end):.1f}, CPU "
+              f"{machine.busy(start, end):.0f} % busy")  # fmt: skip
 
 
 def _catch_up(driver, name: str, published: int, since: float) -> float | None:

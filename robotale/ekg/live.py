@@ -10,7 +10,7 @@ from typing import Any
 
 from neo4j import Driver
 
-from robotale.ekg.build import check_log_name
+from robotale.ekg.build import check_log_name, ensure_schema
 from robotale.ekg.connection import database
 from robotale.fame_runtime.tags import Tag, text_fields
 from robotale.queries import cypher
@@ -44,6 +44,7 @@ class LiveLog:
     def __init__(self, driver: Driver, name: str) -> None:
         check_log_name(name)
         self.driver, self.name, self.count, self.pose_count = driver, name, 0, 0
+        ensure_schema(driver)  # the (log, seq) indexes a following reader looks up by
         delete_live(driver, name)  # a new run of that name starts empty
 
     def append(self, tag: Tag) -> None:

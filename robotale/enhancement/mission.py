@@ -11,15 +11,18 @@ received by ``t``.
 
 from __future__ import annotations
 
+import dataclasses
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
+from functools import cached_property
 from typing import Any
 
 import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
-from robotale.enhancement.timeline import NO_ROBOT, case_timeline
+from robotale.enhancement.mission_state import Facts, Tracks
+from robotale.enhancement.timeline import NO_ROBOT, case_messages
 from robotale.errors import InputError
 from robotale.eventlog.schema import (
     ACTIVITY,
@@ -40,8 +43,6 @@ from robotale.thresholds import LOW_BATTERY_PERCENT, SLOW_QUANTILE
 NOT_SIGNALS = frozenset({"source_index", "event_id", "execution_id", "index"})
 #: seconds a slow instance takes at least beyond its kind's median
 SLOW_MARGIN = 1.0
-#: a move shorter than this (metres) gives no heading: a standing robot's noise
-MIN_MOVE = 1e-3
 
 
 @dataclass(frozen=True)
@@ -64,6 +65,9 @@ class MissionRun:
     signals: list[str]
     #: moments worth a look: s, kind, robot, text
     moments: pd.DataFrame
+    #: each robot's positions as kept while they grew (a live run's); None: read from
+    #: :attr:`positions` when first asked
+    tracks: Tracks | None = field(default=None, compare=False, repr=False)
 
     #: the tables of a run, by name (what :meth:`parts` and :meth:`from_parts` carry)
     TABLES = ("events", "instances", "messages", "positions", "moments")
@@ -106,69 +110,33 @@ class MissionRun:
         }
 
     def _robot_state(self, robot: str, t: float) -> dict[str, Any]:
+        track = self.position_tracks.get(robot)
         return {
-            "pose": self._pose(robot, t),
-            "heading": self._heading(robot, t),
-            "battery": self._last_value(robot, BATTERY, t),
-            "activities": self.active(robot, t),
-            "last_message": self._last_message(robot, t),
+            "pose": track.pose(t),
+            "heading": track.heading(t),
+            "battery": self.facts.battery_at(robot, t),
+            "activities": self.facts.active(robot, t),
+            "last_message": self.facts.last_message(robot, t),
         }
+
+    @cached_property
+    def position_tracks(self) -> Tracks:
+        """Each robot's positions in time arrays: the ones kept as they grew (a live run's),
+        else read once from :attr:`positions`."""
+        return self.tracks if self.tracks is not None else Tracks.of(self.positions)
+
+    @cached_property
+    def facts(self) -> Facts:
+        """Each robot's battery, activities and messages in time arrays, read once."""
+        return Facts.of(self.events, self.instances, self.messages)
 
     def active(self, robot: str, t: float) -> list[str]:
         """The activities of ``robot`` running at ``t``, in start order."""
-        mine = self.instances[self.instances["robot"] == robot]
-        end = mine["end"].fillna(math.inf)
-        running = mine[(mine["start"] <= t) & (t < end)]
-        return running["activity"].tolist()
+        return self.facts.active(robot, t)
 
     def active_instances(self, t: float) -> pd.DataFrame:
         end = self.instances["end"].fillna(math.inf)
         return self.instances[(self.instances["start"] <= t) & (t < end)]
-
-    def _pose(self, robot: str, t: float) -> dict[str, float] | None:
-        mine = self.positions[(self.positions["robot"] == robot) & (self.positions["s"] <= t)]
-        if mine.empty:
-            return None
-        last = mine.iloc[-1]
-        return {axis: _number(last[axis]) for axis in ("x", "y", "z")}
-
-    def _heading(self, robot: str, t: float) -> float | None:
-        """Radians, counter-clockwise from +x, of the robot's last move by ``t``."""
-        mine = self.positions[(self.positions["robot"] == robot) & (self.positions["s"] <= t)]
-        xy = mine[["x", "y"]].to_numpy(float)
-        if len(xy) < 2:
-            return None
-        steps = np.diff(xy, axis=0)
-        moved = np.flatnonzero(np.hypot(steps[:, 0], steps[:, 1]) > MIN_MOVE)
-        if not len(moved):
-            return None
-        dx, dy = steps[moved[-1]]
-        return float(math.atan2(dy, dx))
-
-    def _last_value(self, robot: str, column: str, t: float) -> float | None:
-        if column not in self.events.columns:
-            return None
-        mine = self.events[(self.events[ROBOT] == robot) & (self.events["s"] <= t)]
-        values = pd.to_numeric(mine[column], errors="coerce").dropna()
-        return _number(values.iloc[-1]) if not values.empty else None
-
-    def _last_message(self, robot: str, t: float) -> dict[str, Any] | None:
-        messages = self.messages
-        sent = messages[(messages["sender"] == robot) & (messages["sent"] <= t)]
-        received = messages[(messages["receiver"] == robot) & (messages["received"] <= t)]
-        candidates = [(row.sent, "sent", row) for row in sent.itertuples(index=False)]
-        candidates += [(row.received, "received", row) for row in received.itertuples()]
-        if not candidates:
-            return None
-        at, role, row = max(candidates, key=lambda item: item[0])
-        other = row.receiver if role == "sent" else row.sender
-        return {
-            "msg_id": str(row.msg_id),
-            "role": role,
-            "with": None if pd.isna(other) else str(other),
-            "s": float(at),
-            "lost": bool(row.lost),
-        }
 
     # -- between two moments ---------------------------------------------------------------
 
@@ -220,7 +188,11 @@ class MissionRun:
 
     def summary(self) -> dict[str, Any]:
         """What the page needs before it asks about a moment."""
-        control = self.events[self.events[LIFECYCLE].astype("string").fillna("") != NONE]
+        return {**self.head(), **self._made_of_events}
+
+    def head(self) -> dict[str, Any]:
+        """The little the page draws a first moment with: the run's start, length, robots,
+        fields and whether it has positions."""
         return {
             "case": self.case,
             "start": _iso(self.start),
@@ -228,16 +200,34 @@ class MissionRun:
             "robots": self.robots,
             "signals": self.signals,
             "has_positions": not self.positions.empty,
+        }
+
+    @cached_property
+    def _made_of_events(self) -> dict[str, Any]:
+        control = self.events[self.events[LIFECYCLE].astype("string").fillna("") != NONE]
+        return {
             "event_times": sorted(set(control["s"].round(6).tolist())),
             "instances": _records(self.instances),
             "moments": _records(self.moments),
         }
 
+    def with_positions(self, positions: pd.DataFrame, tracks: Tracks) -> MissionRun:
+        """The same run with other positions (``tracks`` holding them per robot): what is
+        read of its events once is kept, not read again."""
+        moved = dataclasses.replace(self, positions=positions, tracks=tracks)
+        # cached_property keeps its values in the instance's dict: the ones that do not
+        # depend on the positions are handed on
+        for name in ("facts", "_made_of_events"):
+            if name in self.__dict__:
+                moved.__dict__[name] = self.__dict__[name]
+        return moved
+
 
 def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) -> MissionRun:
     """The run ``case`` of ``log`` (an :class:`InputError` naming some runs when it has none);
     ``slow`` is :func:`slow_limits` of ``log`` when it was kept, else it is computed here."""
-    timeline = case_timeline(log, case)  # also checks the run exists
+    # also checks the run exists; a robot with a bar on the timeline has an instance here
+    run_messages, lanes = case_messages(log, case)
     cases = log[CASE].astype("string")
     events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
     events = events.sort_values(TIMESTAMP, kind="stable")
@@ -248,12 +238,17 @@ def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) 
     )
     events = events.assign(**{ROBOT: robots_column.astype(str)})
     start = events[TIMESTAMP].iloc[0]
+    found = activity_instances(events)
+    if slow is None:
+        # a log of this run alone, in time order (a live run's): its instances are the log's
+        alone = len(events) == len(log) and events.index.equals(log.index)
+        slow = _slow_limits_of(found) if alone else slow_limits(log)
     events = events.assign(s=_seconds(events[TIMESTAMP], start))
-    instances = _instances(events, start)
-    messages = _messages(timeline.messages, start)
+    instances = _instances(found, start)
+    messages = _messages(run_messages, start)
     positions = _positions(events)
     # a robot whose only activity is still running (a live run's) has no bar yet, but a lane
-    robots = sorted(set(timeline.robots) | set(positions["robot"]) | set(instances["robot"]))
+    robots = sorted(lanes | set(positions["robot"]) | set(instances["robot"]))
     return MissionRun(
         case=str(case),
         start=start,
@@ -264,9 +259,7 @@ def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) 
         messages=messages,
         positions=positions,
         signals=_signals(events),
-        moments=_moments(
-            slow_limits(log) if slow is None else slow, events, instances, messages, start
-        ),
+        moments=_moments(slow, events, instances, messages, start),
     )
 
 
@@ -274,8 +267,8 @@ def _seconds(times: pd.Series, start: pd.Timestamp) -> pd.Series:
     return (times - start).dt.total_seconds()
 
 
-def _instances(events: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
-    found = activity_instances(events)
+def _instances(found: pd.DataFrame, start: pd.Timestamp) -> pd.DataFrame:
+    """The run's activity instances (``found`` by :func:`activity_instances`) in seconds."""
     if found.empty:
         return pd.DataFrame(columns=["robot", "activity", "start", "end"])
     ends = _seconds(found[TIMESTAMP], start).where(found[FINISHED].astype(bool))
@@ -362,7 +355,11 @@ def slow_limits(log: pd.DataFrame) -> pd.DataFrame:
     """What counts as slow for each robot and activity of the whole ``log``: the
     :data:`SLOW_QUANTILE` (``limit``), the ``median`` and the ``count`` of the seconds its
     finished instances took. The same for every run of the log, so it can be kept."""
-    every = activity_instances(log)
+    return _slow_limits_of(activity_instances(log))
+
+
+def _slow_limits_of(every: pd.DataFrame) -> pd.DataFrame:
+    """:func:`slow_limits` of a log whose activity instances are ``every``."""
     every = every[every[FINISHED].astype(bool)]
     if every.empty or ROBOT not in every.columns:
         return pd.DataFrame(columns=SLOW_COLUMNS)

@@ -89,17 +89,31 @@ def run_list(log: pd.DataFrame) -> pd.DataFrame:
 def case_timeline(log: pd.DataFrame, case: str) -> Timeline:
     """The timeline of run ``case`` of ``log`` (an :class:`InputError` naming the runs there
     are when it has no such run)."""
-    cases = log[CASE].astype("string")
-    events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
-    if events.empty:
-        known = ", ".join(sorted(cases.dropna().unique())[:5])
-        raise InputError(f"the log has no run {case!r}; its runs include {known}.")
-    events = events.assign(**{ROBOT: _robots(events)})
+    events = _case_events(log, case)
     bars = _bars(events)
     messages = _messages(events)
     battery = _battery(events)
     robots = sorted(set(bars["robot"]) | set(battery["robot"]) | _message_robots(messages))
     return Timeline(str(case), robots, bars, messages, battery, log_colours(log))
+
+
+def case_messages(log: pd.DataFrame, case: str) -> tuple[pd.DataFrame, set[str]]:
+    """The messages of :func:`case_timeline` and the robots they and the battery readings
+    give a lane, without its bars (a run replayed needs its messages, not their drawing)."""
+    events = _case_events(log, case)
+    messages = _messages(events)
+    return messages, set(_battery(events)["robot"]) | _message_robots(messages)
+
+
+def _case_events(log: pd.DataFrame, case: str) -> pd.DataFrame:
+    """The events of run ``case``, each with its robot (an :class:`InputError` naming the
+    runs there are when it has no such run)."""
+    cases = log[CASE].astype("string")
+    events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
+    if events.empty:
+        known = ", ".join(sorted(cases.dropna().unique())[:5])
+        raise InputError(f"the log has no run {case!r}; its runs include {known}.")
+    return events.assign(**{ROBOT: _robots(events)})
 
 
 def _robots(events: pd.DataFrame) -> pd.Series:

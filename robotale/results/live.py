@@ -11,10 +11,10 @@ again only when tags came.
 
 from __future__ import annotations
 
-import dataclasses
 import threading
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
+from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -23,6 +23,7 @@ from neo4j import Driver
 from robotale.ekg.connection import database
 from robotale.ekg.live import Pose, live_poses, live_tags
 from robotale.enhancement.mission import MissionRun
+from robotale.enhancement.mission_state import Tracks
 from robotale.eventlog import schema
 from robotale.eventlog.prepare import tags_log
 from robotale.eventlog.runs import robot_type
@@ -39,7 +40,7 @@ _kept: dict[str, _Kept] = {}
 class LiveReplay(Replay):
     """A live run: its events, and its robots' positions from their odometry."""
 
-    poses: list[Pose] = field(default_factory=list)
+    positions: Positions | None = None
     #: the runs as their events make them, kept while only the positions grow
     bare: dict[str, MissionRun] = field(default_factory=dict)
 
@@ -49,23 +50,59 @@ class LiveReplay(Replay):
         if case not in self.bare:
             self.bare[case] = super().run(case)
         run = self.bare[case]
-        if self.poses:
-            run = dataclasses.replace(run, positions=_positions(self.poses, run.start))
+        if self.positions is not None and self.positions.count:
+            table, tracks = self.positions.since(run.start)
+            run = run.with_positions(table, tracks)
         self.runs[case] = run
         return run
 
 
-def _positions(poses: list[Pose], start: pd.Timestamp) -> pd.DataFrame:
-    """Where each robot was, by its odometry: robot, s (seconds since ``start``), x, y, z, in
+class Positions:
+    """A live run's odometry samples as they come: the positions table (robot, s, x, y, z in
+    time order, by robot where two share a time) and each robot's track, grown in place while
+    the samples come in time order, made again whole when one comes late or the run's start
+    moves."""
+
+    def __init__(self) -> None:
+        self.poses: list[Pose] = []
+        self.at: float | None = None
+        self.table = _positions([], 0.0)
+        self.tracks = Tracks()
+
+    @property
+    def count(self) -> int:
+        return len(self.poses)
+
+    def add(self, poses: list[Pose]) -> None:
+        self.poses += poses
+        if self.at is None or not poses:
+            return
+        chunk = _positions(poses, self.at)
+        ahead = self.table.empty or chunk["s"].min() > self.table["s"].iloc[-1]
+        if ahead and self.tracks.extended(chunk):
+            self.table = pd.concat([self.table, chunk], ignore_index=True)
+        else:
+            self.at = None  # made again whole when next asked
+
+    def since(self, start: pd.Timestamp) -> tuple[pd.DataFrame, Tracks]:
+        """The positions in seconds since ``start``, and their tracks."""
+        at = start.timestamp()
+        if at != self.at:
+            self.at, self.table = at, _positions(self.poses, at)
+            self.tracks = Tracks.of(self.table)
+        return self.table, self.tracks
+
+
+def _positions(poses: list[Pose], at: float) -> pd.DataFrame:
+    """Where each robot was, by its odometry: robot, s (seconds since ``at``), x, y, z, in
     time order (by robot where two share a time)."""
-    at = start.timestamp()
     table = pd.DataFrame(
         {
             "robot": [p.robot for p in poses],
-            "s": [p.stamp - at for p in poses],
-            "x": [p.x for p in poses],
-            "y": [p.y for p in poses],
-            "z": [p.z for p in poses],
+            "s": np.array([p.stamp for p in poses], dtype=float) - at,
+            "x": np.array([p.x for p in poses], dtype=float),
+            "y": np.array([p.y for p in poses], dtype=float),
+            "z": np.array([p.z for p in poses], dtype=float),
         }
     )
     return table.sort_values(["s", "robot"], kind="stable").reset_index(drop=True)
@@ -77,7 +114,7 @@ class _Kept:
     built of them."""
 
     tags: list[Tag] = field(default_factory=list)
-    poses: list[Pose] = field(default_factory=list)
+    positions: Positions = field(default_factory=Positions)
     replay: LiveReplay | None = None
 
 
@@ -105,6 +142,7 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
     and the tag's position there as its source; then enriched as :func:`tags_log` does."""
     nanos = np.array([tag_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
     robots = [t.robot for t in tags]
+    types = {robot: robot_type(robot) for robot in set(robots)}  # a few robots, many tags
     frame = pd.DataFrame(
         {
             schema.CASE: name,
@@ -113,7 +151,7 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
             schema.LIFECYCLE: [t.lifecycle for t in tags],
             schema.ROBOT: robots,
             # a live run has no manifest: each robot's type from its name, as prepare's
-            schema.ROBOT_TYPE: [robot_type(r) for r in robots],
+            schema.ROBOT_TYPE: [types[r] for r in robots],
             schema.MSG_ID: [t.msg_id or None for t in tags],
             schema.MSG_ROLE: [t.msg_role or None for t in tags],
             schema.MSG_PAYLOAD: [t.payload or None for t in tags],
@@ -127,23 +165,40 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
 
 def live_replay(driver: Driver, name: str) -> Replay | None:
     """The live run ``name`` as it stands now, or None when no monitor stored one. Only what
-    was stored since the last look is read: the tags and samples kept are extended; the
-    events are made again when tags came, the positions alone when only samples came."""
-    tags, poses = live_counts(driver, name)
-    if not tags:
-        return None
+    was stored since the last look is read (an index seek by number, whatever the run's
+    length): the tags and samples kept are extended; the events are made again when tags
+    came, the positions grown when only samples came."""
     with _lock:
-        kept = _kept.get(name)
-        if kept is None or tags < len(kept.tags) or poses < len(kept.poses):
-            kept = _kept[name] = _Kept()  # new, or a new run of that name
+        kept = _kept.get(name) or _Kept()
+        new_tags = _since(live_tags, driver, name, kept.tags)
+        new_poses = _since(live_poses, driver, name, kept.positions.poses)
+        if new_tags is None or new_poses is None:  # a new run of that name began
+            kept = _Kept()
+            new_tags, new_poses = live_tags(driver, name), live_poses(driver, name)
+        if not kept.tags and not new_tags:
+            _kept.pop(name, None)
+            return None
+        _kept[name] = kept
         old = kept.replay
-        if old is not None and (tags, poses) == (len(kept.tags), len(kept.poses)):
+        if old is not None and not new_tags and not new_poses:
             return old
-        new_tags = live_tags(driver, name, after=len(kept.tags))
         kept.tags += new_tags
-        kept.poses += live_poses(driver, name, after=len(kept.poses))
+        kept.positions.add(new_poses)
         if old is None or new_tags:
-            kept.replay = LiveReplay(name, tags_events(name, kept.tags), {}, poses=kept.poses)
-        else:  # the same events: the runs they make are kept, their positions made again
-            kept.replay = LiveReplay(name, old.events, {}, poses=kept.poses, bare=old.bare)
+            events = tags_events(name, kept.tags)
+            kept.replay = LiveReplay(name, events, {}, positions=kept.positions)
+        else:  # the same events: the runs they make are kept, their positions grown
+            kept.replay = LiveReplay(name, old.events, {}, positions=kept.positions, bare=old.bare)
         return kept.replay
+
+
+def _since(read: Callable[..., list[Any]], driver: Driver, name: str, held: list[Any]):
+    """What ``read`` finds stored after the ``held`` ones (numbered 1, 2, ... as stored), or
+    None when the one held last is no longer stored under its number: a new run of that name
+    began. The last one held is read again to tell."""
+    if not held:
+        return read(driver, name)
+    found = read(driver, name, after=len(held) - 1)
+    if not found or found[0] != held[-1]:
+        return None
+    return found[1:]

@@ -15,8 +15,3 @@ def unstored(name: str) -> Replay | None:
     if replay is not None or not name:
         return replay
     return live_replay(driver(), name)
-
-
-def is_live(name: str) -> bool:
-    """True when ``name`` is a live run (so the Mission page follows it as it grows)."""
-    return name not in state().replays and live_replay(driver(), name) is not None

@@ -51,6 +51,65 @@ def test_the_mission_api_answers_on_what_the_monitor_stored_so_far(client, live)
     assert [r["case"] for r in runs] == [live.name]
 
 
+def test_a_new_run_of_the_same_name_replaces_the_one_read(client, live, neo4j_driver):
+    """A reader that kept a longer run of that name reads the new one from its start."""
+    from robotale.ekg.live import LiveLog
+
+    api = f"/api/mission/{live.name}/{live.name}"
+    tags(live, [(0, "rover", "survey", "start"), (1, "rover", "survey", "complete")])
+    tags(live, [(2, "rover", "dock", "start")])
+    assert client.get(api).json["duration"] == pytest.approx(2.0, abs=1e-6)
+    again = LiveLog(neo4j_driver, live.name)  # the monitor started again: a new run
+    tags(again, [(10, "drone", "scan", "start"), (13, "drone", "scan", "complete")])
+    grown = client.get(api).json
+    assert grown["robots"] == ["drone"] and grown["duration"] == pytest.approx(3.0, abs=1e-6)
+
+
+def test_the_state_follows_odometry_stored_in_batches_late_ones_too(client, live):
+    """Poses come in batches beside the tags, a later batch holding a sample older than one
+    already read: at moments between the samples, each robot's pose and heading are its
+    last sample's and last move's among all the samples written, read here with pandas."""
+    import math
+
+    import pandas as pd
+
+    from robotale.ekg.live import Pose
+
+    api = f"/api/mission/{live.name}/{live.name}"
+    tags(live, [(0, "rover", "survey", "start"), (0, "drone", "scan", "start")])
+    written: list[Pose] = []
+    batches = [
+        [Pose(T0 + s / 10, r, s * 0.1 * (1 if r == "rover" else -1), s * 0.05, 0.0)
+         for s in range(1, 20) for r in ("rover", "drone")],
+        [Pose(T0 + s / 10, "rover", 2.0, 1.0 + s * 0.2, 0.0) for s in range(20, 40)],
+        # a late drone sample (older than its last one read) and a standing rover
+        [Pose(T0 + 0.55, "drone", 9.0, 9.0, 1.0), Pose(T0 + 4.5, "rover", 2.0, 8.8, 0.0)],
+    ]  # fmt: skip
+    for batch in batches:
+        live.poses(batch)
+        written += batch
+        table = pd.DataFrame(written).sort_values("stamp", kind="stable")
+        table["s"] = table["stamp"] - T0
+        assert client.get(api).status_code == 200
+        for t in (0.05, 0.57, 1.23, 3.01, 4.7):
+            state = client.get(f"{api}/state?t={t}").json
+            for robot in ("rover", "drone"):
+                mine = table[(table["robot"] == robot) & (table["s"] <= t)]
+                facts = state["robots"][robot]
+                if mine.empty:
+                    assert facts["pose"] is None, (robot, t)
+                    continue
+                last = mine.iloc[-1]
+                assert facts["pose"] == {"x": last["x"], "y": last["y"], "z": last["z"]}
+                steps = mine[["x", "y"]].diff().dropna()
+                steps = steps[(steps["x"] ** 2 + steps["y"] ** 2) ** 0.5 > 1e-3]
+                if steps.empty:
+                    assert facts["heading"] is None, (robot, t)
+                else:
+                    dy, dx = steps.iloc[-1]["y"], steps.iloc[-1]["x"]
+                    assert facts["heading"] == pytest.approx(math.atan2(dy, dx)), (robot, t)
+
+
 @pytest.mark.browser
 def test_the_mission_page_follows_a_live_run_until_moved_back(page, live):
     from browser import wait_for

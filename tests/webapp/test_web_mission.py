@@ -207,6 +207,90 @@ def test_heading_is_the_direction_of_the_last_move(client, stored_run):
             assert facts["heading"] == pytest.approx(math.atan2(dy, dx))
 
 
+def scratch_activities(events: pd.DataFrame, seconds: pd.Series) -> pd.DataFrame:
+    """robot, activity, start, end (inf: never ended) of every activity instance, paired here
+    first in first out per robot, activity and instance key, from the log's starts and
+    completes (``inprogress`` samples left out)."""
+    key = next((k for k in ("execution_id", "concept:instance", "msg_id") if k in events), None)
+    rows = events.assign(_s=seconds)
+    rows = rows[rows["lifecycle:transition"].isin(["start", "complete"])]
+    if "lifecycle:state" in rows:
+        rows = rows[rows["lifecycle:state"].astype("string").fillna("").ne("inprogress")]
+    keys = ["robot", "concept:name"] + ([key] if key else [])
+    found = []
+    for group, mine in rows.groupby(keys, sort=False, dropna=False):
+        waiting: list[float] = []
+        for lifecycle, at in zip(mine["lifecycle:transition"], mine["_s"], strict=True):
+            if lifecycle == "start":
+                waiting.append(at)
+            elif waiting:
+                found.append((group[0], group[1], waiting.pop(0), at))
+        found += [(group[0], group[1], begun, math.inf) for begun in waiting]
+    return pd.DataFrame(found, columns=["robot", "activity", "start", "end"])
+
+
+def scratch_last_message(messages: pd.DataFrame, robot: str, t: float) -> tuple[float, set]:
+    """The time of ``robot``'s last message by ``t`` and the (msg_id, role) of those then."""
+    sent = messages[(messages["sender"] == robot) & (messages["sent"] <= t)]
+    received = messages[(messages["receiver"] == robot) & (messages["received"] <= t)]
+    times = pd.concat([sent["sent"], received["received"]])
+    if times.empty:
+        return math.nan, set()
+    last = times.max()
+    return last, {(str(m), "sent") for m in sent.loc[sent["sent"] == last, "msg_id"]} | {
+        (str(m), "received") for m in received.loc[received["received"] == last, "msg_id"]
+    }
+
+
+def test_state_from_time_arrays_equals_the_log_read_from_scratch(client, stored_run):
+    """The state API answers from per-robot time arrays read once: at moments all over the
+    run, on event times exactly (where at-or-before and before-the-end tell), each robot's
+    pose, heading, battery, activities and last message equal what pandas reads from the
+    stored log at that moment."""
+    from robotale.enhancement.communication import message_table
+
+    events, start = run_events(stored_run)
+    seconds = (events["time:timestamp"] - start).dt.total_seconds()
+    instances = scratch_activities(events, seconds)
+    messages = message_table(events)
+    for column, at in (("sent", "sent_at"), ("received", "received_at")):
+        messages[column] = (messages[at] - start).dt.total_seconds()
+    exact = sorted(set(instances["start"]) | set(instances["end"]) - {math.inf})
+    moments = [0.0, *exact[:: max(1, len(exact) // 12)], float(seconds.max()), 1e9]
+    checked = 0
+    for t in moments:
+        state = api(client, f"/api/mission/{stored_run.name}/{CASE}/state?t={t!r}")
+        for robot, facts in state["robots"].items():
+            mine = events[(events["robot"] == robot) & (seconds <= t)]
+            placed = mine.dropna(subset=["x", "y"])
+            if placed.empty:
+                assert facts["pose"] is None and facts["heading"] is None
+            else:
+                last = placed.iloc[-1]
+                assert facts["pose"] == {axis: float(last[axis]) for axis in ("x", "y", "z")}
+                steps = placed[["x", "y"]].diff().dropna()
+                steps = steps[(steps["x"] ** 2 + steps["y"] ** 2) ** 0.5 > 1e-3]
+                if steps.empty:
+                    assert facts["heading"] is None
+                else:
+                    dx, dy = steps.iloc[-1]["x"], steps.iloc[-1]["y"]
+                    assert facts["heading"] == pytest.approx(math.atan2(dy, dx))
+            levels = mine["battery"].dropna()
+            assert facts["battery"] == (None if levels.empty else float(levels.iloc[-1]))
+            running = instances[
+                (instances["robot"] == robot) & (instances["start"] <= t) & (t < instances["end"])
+            ]
+            assert sorted(facts["activities"]) == sorted(running["activity"]), (robot, t)
+            last_at, candidates = scratch_last_message(messages, robot, t)
+            if not candidates:
+                assert facts["last_message"] is None
+            else:
+                told = facts["last_message"]
+                assert told["s"] == last_at and (told["msg_id"], told["role"]) in candidates
+            checked += bool(facts["activities"]) + bool(facts["last_message"])
+    assert checked >= 20  # the moments hold work and messages, not only empty answers
+
+
 def test_flows_taken_grow_and_lie_in_the_model(client, stored_run):
     tree = etree.parse(str(stored_run.model))
     flows = {f.get("id") for f in tree.iter(f"{BPMN}sequenceFlow")}

@@ -19,11 +19,12 @@ from robotale.results.mission import (
     model_map,
     stored_mission,
 )
+from robotale.results.replay import Replay
 from robotale.results.site import stored_site
 from robotale.webapp import pages
 from robotale.webapp.model_store import StoredModel
 from robotale.webapp.state import driver, state
-from robotale.webapp.unstored import is_live, unstored
+from robotale.webapp.unstored import unstored
 
 blueprint = Blueprint("mission", __name__)
 
@@ -44,16 +45,27 @@ def page():
 @blueprint.get("/api/mission/<log>/<case>")
 def summary(log: str, case: str):
     """The run's length, robots, fields, activity instances, moments and site."""
-    run = _run(log, case)
+    replay = unstored(log)
+    run = _run(log, case, replay)
+    return jsonify({**run.summary(), **_about(log, run, replay)})
+
+
+@blueprint.get("/api/mission/<log>/<case>/head")
+def head(log: str, case: str):
+    """The little the page draws its first moment with (the summary without the run's
+    event times, instances and moments, which grow with the run)."""
+    replay = unstored(log)
+    run = _run(log, case, replay)
+    return jsonify({**run.head(), **_about(log, run, replay)})
+
+
+def _about(log: str, run: MissionRun, replay: Replay | None) -> dict[str, Any]:
     model = _model(log)
-    return jsonify(
-        {
-            **run.summary(),
-            "site": mission_site(_site(log, run), run),
-            "model": model.id if model else None,
-            "live": is_live(log),
-        }
-    )
+    return {
+        "site": mission_site(_site(log, run, replay), run),
+        "model": model.id if model else None,
+        "live": replay is not None and log not in state().replays,
+    }
 
 
 @blueprint.get("/api/mission/<log>/<case>/state")
@@ -62,7 +74,7 @@ def state_at(log: str, case: str):
     each robot is in and the flows taken so far."""
     t = _seconds("t", request.args.get("t"))
     replay = unstored(log)
-    run = replay.run(case) if replay is not None else _stored(log, case)
+    run = _run(log, case, replay)
     found: dict[str, Any] = run.state(t)
     elements = _elements(log, case, run.robots)
     if elements is not None:
@@ -90,10 +102,15 @@ def series(log: str, case: str):
     return jsonify({"field": field, "robots": run.series(field)})
 
 
-def _run(log: str, case: str) -> MissionRun:
+_UNASKED = object()
+
+
+def _run(log: str, case: str, replay: Any = _UNASKED) -> MissionRun:
     """The run from the replay named ``log`` this dashboard serves (a replay hides a stored
-    log of the same name) or the live run of that name, else from the stored log."""
-    replay = unstored(log)
+    log of the same name) or the live run of that name (``replay``, when the caller already
+    looked for it), else from the stored log."""
+    if replay is _UNASKED:
+        replay = unstored(log)
     if replay is not None:
         return replay.run(case)
     return _stored(log, case)
@@ -103,8 +120,7 @@ def _stored(log: str, case: str) -> MissionRun:
     return stored_mission(driver(), state().logs, log, case)
 
 
-def _site(log: str, run: MissionRun) -> dict[str, Any] | None:
-    replay = unstored(log)
+def _site(log: str, run: MissionRun, replay: Replay | None) -> dict[str, Any] | None:
     if replay is not None:
         return replay.sites.get(run.case)
     return stored_site(driver(), log, run.case)

@@ -57,6 +57,8 @@
     const xs = [], ys = [];
     if (site.field) { xs.push(0, site.field[0]); ys.push(0, site.field[1]); }
     for (const b of site.bases || []) { xs.push(b.x - b.radius, b.x + b.radius); ys.push(b.y - b.radius, b.y + b.radius); }
+    // the positions' extent the server sent, until the positions themselves come
+    if (site.source === "positions" && site.extent) { xs.push(site.extent[0], site.extent[2]); ys.push(site.extent[1], site.extent[3]); }
     for (const rows of Object.values(whole.positions)) for (const [, x, y] of rows) { xs.push(x); ys.push(y); }
     if (!xs.length) return null;
     const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
@@ -309,10 +311,12 @@
         drawRobots(state);
         paintModel(state);
         listRobots(state);
-        root.dataset.shown = String(at);
-        root.dataset.state = "shown";
         if (!performance.getEntriesByName("robotale-mission-shown").length) {
-          performance.mark("robotale-mission-shown"); // the first state drawn (benchmarks/dashboard.py)
+          performance.mark("robotale-mission-shown"); // the first state drawn (benchmarks/live.py)
+        }
+        if (root.dataset.loaded) { // every view is there: the page is shown at `at`
+          root.dataset.shown = String(at);
+          root.dataset.state = "shown";
         }
       }
     } catch (error) {
@@ -407,7 +411,7 @@
   async function followLive() {
     const stay = !following();
     const fresh = await robotale.api(base());
-    whole = await robotale.api(`${base()}/window?from=0&to=${fresh.duration}`);
+    await growWhole(Math.max(0, summary.duration - OVERLAP), fresh.duration);
     summary = fresh;
     slider.max = String(summary.duration);
     root.dataset.duration = String(summary.duration);
@@ -417,22 +421,41 @@
     if (looks % TIMELINE_EVERY === 0) await loadTimeline();
   }
 
+  // seconds before the last look's end the next look asks again from: samples stored a little
+  // after the tags of their time (odometry is stored beside the tags) are not missed
+  const OVERLAP = 5;
+  // the run's positions and messages from `from` to `to` seconds merged into what the page
+  // holds, instead of the whole run again at every look
+  async function growWhole(from, to) {
+    const fresh = await robotale.api(`${base()}/window?from=${from}&to=${to}`);
+    for (const [robot, rows] of Object.entries(fresh.positions)) {
+      whole.positions[robot] = (whole.positions[robot] || []).filter((r) => r[0] < from).concat(rows);
+    }
+    const ids = new Set(fresh.messages.map((m) => m.msg_id));
+    whole.messages = whole.messages.filter((m) => !ids.has(m.msg_id)).concat(fresh.messages);
+  }
+
   function watchLive() {
     root.dataset.live = "1";
     const look = () => followLive().catch(robotale.showError).finally(() => setTimeout(look, LIVE_POLL * 1000));
     setTimeout(look, LIVE_POLL * 1000);
   }
 
+  // the first moment is drawn from a small answer (the run's head and its state at the cursor);
+  // the run's event times, findings, positions, timeline, model and plot come after it
   async function start() {
     log = await robotale.currentLog().catch(() => "");
     if (!log) { say("No log yet: upload one on the Logs page."); root.dataset.state = "empty"; return; }
     try {
-      const { runs } = await robotale.api(`/api/timeline/runs?log=${encodeURIComponent(log)}`);
-      runPicker.replaceChildren(...runs.map((r) => robotale.el("option", { value: String(r.case), text: String(r.case) })));
-      run = root.dataset.case || (runs.length ? String(runs[0].case) : "");
-      runPicker.value = run;
-      summary = await robotale.api(base());
-      whole = await robotale.api(`${base()}/window?from=0&to=${summary.duration}`);
+      const runsAsked = robotale.api(`/api/timeline/runs?log=${encodeURIComponent(log)}`);
+      run = root.dataset.case || "";
+      if (!run) { const { runs } = await runsAsked; run = runs.length ? String(runs[0].case) : ""; }
+      const listed = runsAsked.then(({ runs }) => {
+        runPicker.replaceChildren(...runs.map((r) => robotale.el("option", { value: String(r.case), text: String(r.case) })));
+        runPicker.value = run;
+      });
+      summary = { ...(await robotale.api(`${base()}/head`)), event_times: [], moments: [] };
+      whole = { positions: {}, messages: [] };
       startMs = Date.parse(summary.start);
       slider.max = String(summary.duration);
       const notes = [];
@@ -447,7 +470,13 @@
       wire();
       const asked = root.dataset.t === "" ? (summary.live ? summary.duration : 0) : Number(root.dataset.t);
       setCursor(asked || 0);
-      await Promise.all([loadModel(summary.model), loadTimeline(), loadSeries(fieldPicker.value)]);
+      const [full, positions] = await Promise.all([robotale.api(base()), robotale.api(`${base()}/window?from=0&to=${summary.duration}`)]);
+      summary = full;
+      whole = positions;
+      drawSite(summary.site);
+      setCursor(t);
+      await Promise.all([listed, loadModel(summary.model), loadTimeline(), loadSeries(fieldPicker.value)]);
+      root.dataset.loaded = "1";
       setCursor(t);
       if (summary.live) watchLive();
     } catch (error) {
