@@ -192,7 +192,9 @@ def live_replay(driver: Driver, name: str) -> Replay | None:
         return kept.replay
 
 
-def _since(read: Callable[..., list[Any]], driver: Driver, name: str, held: list[Any]):
+def _since(
+    read: Callable[..., list[Any]], driver: Driver, name: str, held: list[Any]
+) -> list[Any] | None:
     """What ``read`` finds stored after the ``held`` ones (numbered 1, 2, ... as stored), or
     None when the one held last is no longer stored under its number: a new run of that name
     began. The last one held is read again to tell."""
