@@ -288,31 +288,36 @@ def promg_environment(folder: Path) -> tuple[Path | None, str | None]:
 
 
 class private_neo4j:
-    """A Neo4j for this benchmark only, with APOC core and extended as plugins."""
+    """A Neo4j for this benchmark only, with APOC core and extended as plugins (PromG needs
+    them); with ``apoc=False`` a server as robotale sets one up for a user: no plugins, on
+    free ports (so it runs beside the one with APOC)."""
 
-    def __init__(self, work: Path, heap: str) -> None:
-        self.work, self.heap = work, heap
+    def __init__(self, work: Path, heap: str, apoc: bool = True) -> None:
+        self.work, self.heap, self.apoc = work, heap, apoc
 
     def __enter__(self):
         from robotale.ekg.connection import Settings, connect
         from robotale.neo4j_server.jars import apoc_with_file_access
         from robotale.neo4j_server.server import LocalServer, ServerOptions, free_port
 
-        plugins = self.work / "plugins"
-        plugins.mkdir()
-        for jar in apoc_with_file_access():
-            (plugins / jar.name).symlink_to(jar)
+        self.work.mkdir(parents=True, exist_ok=True)
         home = self.work / "home"
         home.mkdir()
-        (home / "neo4j.conf").write_text(OVERLAY)
-        (home / "apoc.conf").write_text(APOC_CONF)
+        plugins = None
+        if self.apoc:
+            plugins = self.work / "plugins"
+            plugins.mkdir()
+            for jar in apoc_with_file_access():
+                (plugins / jar.name).symlink_to(jar)
+            (home / "neo4j.conf").write_text(OVERLAY)
+            (home / "apoc.conf").write_text(APOC_CONF)
         self.server = LocalServer(home)
         # the ports of the configuration (ROBOTALE_NEO4J_BOLT_PORT / _HTTP_PORT) when set, so
         # the benchmark runs beside a server on the default ports; else free ones
         configured = ServerOptions.from_env()
         bolt, http = (
             (configured.bolt_port, configured.http_port)
-            if "ROBOTALE_NEO4J_BOLT_PORT" in os.environ
+            if "ROBOTALE_NEO4J_BOLT_PORT" in os.environ and self.apoc
             else (free_port(), free_port())
         )
         options = ServerOptions(bolt, http, heap=self.heap, pagecache="1g", plugins=plugins)

@@ -5,7 +5,10 @@
 
 For each size, ``ekg_build.py``'s synthetic log is written once as a CSV (robotale's input)
 and once as PromG's records (``peers.py``); then, interleaved (robotale, PromG, robotale,
-PromG ...) on an emptied database of one private Neo4j with APOC (``peers.py``'s):
+PromG ...) on emptied databases of two private servers: one with APOC for PromG
+(``peers.py``'s), and one without plugins for robotale, as robotale sets a server up for a
+user (plugins cost a restart the time to load their classes: about 27 s for APOC core and
+extended at 1M events and load 15, a cost robotale's user does not pay):
 
 - robotale: the process ``python -m robotale ingest LOG.csv --entities robot,msg_id
   --aggregate activity --build BUILD`` from its start to its exit (reading the CSV, the build,
@@ -38,6 +41,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from contextlib import ExitStack
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -90,12 +94,19 @@ def main(
             python, why_not = venv / "bin" / "python", None
         else:
             python, why_not = peers.promg_environment(work / "venv")
-        with peers.private_neo4j(work, heap) as (shared, server):
+        with peers.private_neo4j(work / "robotale", heap, apoc=False) as (shared, server):
             shared.close()  # a connection held open would keep the ingest from the bulk path
-            driver = Reconnecting(server)
-            for size in sizes:
-                measure(size, repeat, work, driver, server, python, why_not, pages, build)
-            driver.release()
+            ours = Reconnecting(server)
+            with ExitStack() as stack:
+                theirs = None
+                if python is not None:
+                    peer, peer_server = stack.enter_context(peers.private_neo4j(work, heap))
+                    theirs = (peer, peer_server)
+                for size in sizes:
+                    measure(
+                        size, repeat, work, (ours, server), theirs, python, why_not, pages, build
+                    )
+            ours.release()
     print(f"load average after: {os.getloadavg()[0]:.1f}")
     return 0
 
@@ -127,26 +138,27 @@ def measure(
     size: int,
     repeat: int,
     work: Path,
-    driver,
-    server,
+    ours,
+    theirs,
     python,
     why_not,
     pages: str,
     build: str = "auto",
 ) -> None:
+    """``ours`` and ``theirs``: (driver, server) of robotale's and PromG's servers."""
     print(f"{size:,} events: load average {os.getloadavg()[0]:.1f} at the start", flush=True)
     log = synthetic_log(size)
     csv = work / f"log{size}.csv"
     canonical_csv(log).to_csv(csv, index=False)
-    ours: list[Run] = []
-    theirs: list[Run] = []
+    robotale_runs: list[Run] = []
+    promg_runs: list[Run] = []
     for _ in range(repeat):
-        ours.append(robotale_ingest(csv, driver, server, pages, build))
-        if python is not None:
-            run, why_not = promg_whole(python, driver, server, log, work)
+        robotale_runs.append(robotale_ingest(csv, *ours, pages, build))
+        if python is not None and theirs is not None:
+            run, why_not = promg_whole(python, *theirs, log, work)
             if run is not None:
-                theirs.append(run)
-    report(size, ours, theirs, why_not, event_properties(log), pages, build)
+                promg_runs.append(run)
+    report(size, robotale_runs, promg_runs, why_not, event_properties(log), pages, build)
 
 
 def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
