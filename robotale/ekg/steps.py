@@ -2,12 +2,14 @@
 
 Each step (:mod:`robotale.ekg.spec`) collapses the events, or the entities of one type, that
 no earlier step collapsed and that pass its ``where`` into ``Aggregate`` nodes, one per
-group: the nodes are read with their properties, grouped in pandas
-(:mod:`robotale.ekg.groups`) and the aggregates written in batches; each node they replace
-records its aggregate's id in its property ``_aggregate``. Then the CORR, DF and COMM edges
-of those nodes are lifted to the aggregates, counted: computed in memory from one reading of
-the log's edges per run (:mod:`robotale.ekg.lift`) and written in batches. The graph after
-steps 1 .. k is level k: its aggregates and the lifted edges between them.
+group: the nodes are taken with their properties (events from the log's columnar copy, their
+``where`` evaluated in pandas by :mod:`robotale.ekg.where_table`; entities read from Neo4j),
+grouped in pandas (:mod:`robotale.ekg.groups`) and the aggregates written in batches; each
+node they replace records its aggregate's id in its property ``_aggregate``. Then the CORR,
+DF and COMM edges of those nodes are lifted to the aggregates, counted: computed in memory
+from the log's event table (:mod:`robotale.ekg.lift`), nothing read back from the graph, and
+written in batches. The graph after steps 1 .. k is level k: its aggregates and the lifted
+edges between them.
 
 A step is kept or undone as a unit: if writing it fails, what it wrote is removed again, and
 ``undo`` removes a step and the ones stacked on it. Steps are numbered per log, so a second
@@ -22,6 +24,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
+import numpy as np
 import pandas as pd
 from neo4j import Driver
 from neo4j.time import DateTime
@@ -35,14 +38,13 @@ from robotale.ekg.load import Loader, neo4j_values
 from robotale.ekg.logs import log_info
 from robotale.ekg.spec import AggrStep
 from robotale.ekg.where import Condition, parse_where
+from robotale.ekg.where_table import matching
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError
 from robotale.queries import cypher, statements
 
 #: the properties every aggregate has; a group-by key of one of these names is only in ``name``
 OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")
-#: how many events tell which properties hold times
-KEY_SAMPLE = 10_000
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
 
@@ -73,11 +75,13 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
     ensure_schema(driver)
     with log_write_lock(driver, log, "aggregating"):
         first = _last_step(driver, log) + 1
-        keys: dict[str | None, tuple[set[str], list[str]]] = {}
+        edges = LogEdges.of_log(driver, log, info.get("entityTypes") or [])
+        keys: dict[str | None, tuple[set[str], list[str]]] = {None: _event_keys(edges.events)}
         plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
         events, entities = _unaggregated(driver, log)
-        edges = LogEdges.read(driver, log, stacked=first > 1)
+        if first > 1:
+            edges.read_memberships(driver, log)
         for plan in plans:
             result = _run_or_undo(driver, log, plan, (events, entities), edges)
             events, entities = result.final_events, result.final_entities
@@ -130,7 +134,10 @@ def _run_or_undo(
 ) -> StepResult:
     step, number = plan.step, plan.number
     started = time.perf_counter()
-    nodes = _read_nodes(driver, log, plan)
+    if step.origin == "Event":
+        nodes = _event_nodes(edges, plan)
+    else:
+        nodes = _read_nodes(driver, log, plan, edges)
     table = aggregate_table(step, number, nodes, set(plan.times) & set(plan.reads))
     try:
         with DeferredInterrupt() as interrupt:
@@ -215,11 +222,17 @@ def _plan(
     return _Plan(step, number, reads, resolved, condition, times)
 
 
+def _event_keys(events: pd.DataFrame) -> tuple[set[str], list[str]]:
+    """The events' property keys and those that hold zoned times, from the event table."""
+    keys = {str(c) for c in events.columns if events[c].notna().any()} | {"order"}
+    times = [str(c) for c in events.columns if isinstance(events[c].dtype, pd.DatetimeTZDtype)]
+    return keys, times
+
+
 def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[str], list[str]]:
-    # Events: a sample tells the types (their keys are on the Log node); entities: all.
-    limit = KEY_SAMPLE if entity_type is None else 2**62
+    # an entity type's keys are read from all its entities
     records, _, _ = driver.execute_query(
-        cypher("aggr_node_keys"), log=log, type=entity_type, limit=limit, database_=database()
+        cypher("aggr_node_keys"), log=log, type=entity_type, limit=2**62, database_=database()
     )
     row = records[0] if records else None
     if row is None:
@@ -227,17 +240,58 @@ def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[s
     return set(row["keys"]) - {"log"}, list(row["times"])
 
 
-def _read_nodes(driver: Driver, log: str, plan: _Plan) -> pd.DataFrame:
-    """One row per node the step collapses: ``node`` and a column per property read (for
-    an entity type a group-by names: what the event is correlated to, joined by ``,``)."""
-    step, reads, resolved, condition = plan.step, plan.reads, plan.resolved, plan.condition
-    query = "aggr_read_events" if step.origin == "Event" else "aggr_read_entities"
-    text = cypher(query).replace(_WHERE_MARKER, condition.cypher)
+def _event_nodes(edges: LogEdges, plan: _Plan) -> pd.DataFrame:
+    """One row per event the step collapses, from the log's event table: ``node`` (its
+    code) and a column per property read, the values as Neo4j holds them (times as Unix
+    nanoseconds); for an entity type a group-by names, what the event is correlated to
+    there (the id of the aggregate holding the entity, else the entity's id; joined by ``,``)."""
+    free = edges.free_events()
+    table = edges.events.iloc[free].reset_index(drop=True).assign(order=free)
+    chosen = free[matching(plan.condition, table[[n for n in plan.condition.names if n in table]])]
+    rows = edges.events.iloc[chosen].reset_index(drop=True).assign(order=chosen)
+    frame = pd.DataFrame({"node": chosen})
+    for name in plan.reads:
+        column = rows[name] if name in rows else pd.Series([None] * len(rows), dtype=object)
+        frame[name] = _as_stored(column, name in plan.times)
+    for name in plan.resolved:
+        frame[name] = _correlated(edges, chosen, name)
+    return frame
+
+
+def _as_stored(column: pd.Series, is_time: bool) -> pd.Series:
+    """A column of the event table as Neo4j returns it (times: Unix nanoseconds)."""
+    if is_time:
+        ticks = column.dt.tz_convert("UTC").dt.as_unit("ns")
+        return pd.Series(ticks.array.asi8, dtype="Int64").where(ticks.notna().to_numpy(), None)
+    return pd.Series(neo4j_values(column), dtype=object)
+
+
+def _correlated(edges: LogEdges, events: np.ndarray, kind: str) -> list[str | None]:
+    """For each of ``events`` (positions): what stands for its entities of type ``kind``,
+    distinct, sorted and joined by ``,`` (None when it has none)."""
+    corr = edges.corr
+    corr = corr[edges.types[corr["entity"].to_numpy()] == kind]
+    wanted = np.zeros(len(edges.events), dtype=bool)
+    wanted[events] = True
+    corr = corr[wanted[corr["event"].to_numpy()]]
+    pairs = pd.DataFrame(
+        {"event": corr["event"].to_numpy(), "value": edges.standing(corr["entity"].to_numpy())}
+    )
+    pairs["value"] = pairs["value"].astype(str)
+    pairs = pairs.drop_duplicates().sort_values(["event", "value"], kind="stable")
+    joined = pairs.groupby("event", sort=False)["value"].agg(",".join)
+    return [None if pd.isna(v) else v for v in joined.reindex(events).tolist()]
+
+
+def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.DataFrame:
+    """One row per entity the step collapses: ``node`` (its code) and a column per property
+    read; read from Neo4j, whose element ids are kept for the writes."""
+    step, reads, condition = plan.step, plan.reads, plan.condition
+    text = cypher("aggr_read_entities").replace(_WHERE_MARKER, condition.cypher)
     parameters: dict[str, Any] = {
         "log": log,
         "properties": reads,
         "times": [t for t in plan.times if t in reads],
-        "entityTypes": resolved,
         "type": step.ent_type,
     }
     records, _, _ = driver.execute_query(
@@ -246,12 +300,9 @@ def _read_nodes(driver: Driver, log: str, plan: _Plan) -> pd.DataFrame:
     row = records[0]
     values = row["values"]
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
-    if resolved:
-        found = row["entities"]
-        for position, name in enumerate(resolved):
-            frame[name] = [",".join(sorted(set(map(str, e[position])))) or None for e in found]
-    nodes = row["nodes"]
-    frame.insert(0, "node", nodes)
+    codes = edges.entity_codes(str(step.ent_type), [str(i) for i in row["ids"]])
+    edges.know(codes, row["nodes"])
+    frame.insert(0, "node", codes)
     return frame
 
 
@@ -284,20 +335,23 @@ def _write(
             type=step.ent_type,
             key=[key.name for key in step.group_by],
         )
-        sizes = table["count"].astype(int).tolist()
-        owners = [node for node, size in zip(created, sizes, strict=True) for _ in range(size)]
-        members = [str(m) for group in table["members"] for m in group]
-        holders = [i for i, size in zip(table["id"], sizes, strict=True) for _ in range(size)]
-        loader.run("aggr_create_members", {"members": members, "aggregates": holders})
-        lifted = edges.lift(members, owners)
+        sizes = table["count"].astype(int).to_numpy()
+        members = np.concatenate([np.asarray(group, dtype=np.int64) for group in table["members"]])
+        holders = np.repeat(table["id"].to_numpy(dtype=object), sizes).tolist()
+        owners = np.repeat(np.asarray(created, dtype=object), sizes).tolist()
+        member_ids = edges.resolve(loader, members)
+        loader.run("aggr_create_members", {"members": member_ids.tolist(), "aggregates": holders})
+        lifted = edges.lift(edges.hold(members, holders, owners))
         if len(lifted):
+            sources = edges.resolve(loader, lifted["source"].to_numpy())
+            targets = edges.resolve(loader, lifted["target"].to_numpy())
             # every lifted edge reaches one of this step's few aggregates: one batch at a time
             Loader(driver, log, None, between_batches, workers=1).run(
                 "aggr_create_lifted",
                 {
                     "kinds": lifted["kind"].tolist(),
-                    "sources": lifted["source"].tolist(),
-                    "targets": lifted["target"].tolist(),
+                    "sources": sources.tolist(),
+                    "targets": targets.tolist(),
                     "entityTypes": lifted["entityType"].tolist(),
                     "counts": lifted["count"].astype(int).tolist(),
                 },

@@ -10,7 +10,6 @@ import json
 import pytest
 
 from robotale.cli import main
-from robotale.ekg import lift
 from robotale.ekg.build import build_ekg
 from robotale.ekg.connection import database
 from robotale.ekg.spec import parse_spec
@@ -129,12 +128,7 @@ def test_event_step_with_every_function(neo4j_driver, small):
     assert (result.aggregates, result.members) == (2, 5)
 
 
-# the log's edges read in one query, and two events per query (three queries for five events)
-@pytest.mark.parametrize("page", [lift.EDGE_PAGE, 2])
-def test_entity_step_then_event_step_by_the_aggregated_entities(
-    neo4j_driver, small, page, monkeypatch
-):
-    monkeypatch.setattr(lift, "EDGE_PAGE", page)
+def test_entity_step_then_event_step_by_the_aggregated_entities(neo4j_driver, small):
     spec = steps(
         {"aggr_type": "ENTITIES", "ent_type": "robot", "group_by": ["type"],
          "attr_aggrs": [{"name": "id", "function": "MULTISET"}]},
