@@ -20,7 +20,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Any
 
 import numpy as np
 import pandas as pd
@@ -208,21 +207,19 @@ class LogEdges:
 
     # -- earlier steps -------------------------------------------------------------------
 
+    def held_entities(self) -> int:
+        """How many entities an aggregate holds."""
+        return int(((self.holder >= 0) & ~pd.isna(self.types)).sum())
+
     def read_memberships(self, driver: Driver, log: str) -> None:
         """Record which aggregate of earlier steps holds each node they collapsed."""
         records, _, _ = driver.execute_query(
             cypher("aggr_read_memberships"), log=log, database_=database()
         )
-        row: dict[str, Any] = records[0].data()
-        aggregates = dict(zip(row["ids"], row["aggregates"], strict=True))
-        types = np.asarray(row["types"], dtype=object)
-        keys = np.asarray(row["keys"], dtype=object)
-        held = np.asarray(row["held"], dtype=object)
-        codes = np.zeros(len(keys), dtype=np.int64)
-        events = pd.isna(types)
-        codes[events] = self.event_codes(keys[events].tolist())
-        for kind in pd.unique(types[~events]):
-            mine = types == kind
-            codes[mine] = self.entity_codes(kind, keys[mine].tolist())
-        if len(codes):
-            self.hold(codes, held.tolist(), [aggregates[h] for h in held])
+        for row in records:
+            members = [str(m) for m in row["members"]]
+            if row["type"] is None:
+                codes = self.event_codes(members)
+            else:
+                codes = self.entity_codes(str(row["type"]), members)
+            self.hold(codes, [row["id"]] * len(codes), [row["aggregate"]] * len(codes))

@@ -4,8 +4,9 @@ Each step (:mod:`robotale.ekg.spec`) collapses the events, or the entities of on
 no earlier step collapsed and that pass its ``where`` into ``Aggregate`` nodes, one per
 group: the nodes are taken with their properties (events from the log's columnar copy, their
 ``where`` evaluated in pandas by :mod:`robotale.ekg.where_table`; entities read from Neo4j),
-grouped in pandas (:mod:`robotale.ekg.groups`) and the aggregates written in batches; each
-node they replace records its aggregate's id in its property ``_aggregate``. Then the CORR,
+grouped in pandas (:mod:`robotale.ekg.groups`) and the aggregates written in batches, with
+the ids of the nodes each replaces as lists (``AggregateMembers`` nodes, a few writes per
+aggregate rather than one per member). Then the CORR,
 DF and COMM edges of those nodes are lifted to the aggregates, counted: computed in memory
 from the log's event table (:mod:`robotale.ekg.lift`), nothing read back from the graph, and
 written in batches. The graph after steps 1 .. k is level k: its aggregates and the lifted
@@ -33,7 +34,7 @@ from robotale.ekg.build import ensure_schema, undo_after_failure
 from robotale.ekg.connection import database
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
-from robotale.ekg.lift import LogEdges
+from robotale.ekg.lift import FREE, LogEdges
 from robotale.ekg.load import Loader, neo4j_values
 from robotale.ekg.logs import log_info
 from robotale.ekg.spec import AggrStep
@@ -45,6 +46,8 @@ from robotale.queries import cypher, statements
 
 #: the properties every aggregate has; a group-by key of one of these names is only in ``name``
 OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")
+#: the most member ids one AggregateMembers node lists
+MEMBERS_PART = 100_000
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
 
@@ -79,9 +82,9 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
         keys: dict[str | None, tuple[set[str], list[str]]] = {None: _event_keys(edges.events)}
         plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
-        events, entities = _unaggregated(driver, log)
         if first > 1:
             edges.read_memberships(driver, log)
+        events, entities = _unaggregated(driver, log, edges)
         for plan in plans:
             result = _run_or_undo(driver, log, plan, (events, entities), edges)
             events, entities = result.final_events, result.final_entities
@@ -230,9 +233,8 @@ def _event_keys(events: pd.DataFrame) -> tuple[set[str], list[str]]:
 
 
 def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[str], list[str]]:
-    # an entity type's keys are read from all its entities
     records, _, _ = driver.execute_query(
-        cypher("aggr_node_keys"), log=log, type=entity_type, limit=2**62, database_=database()
+        cypher("aggr_node_keys"), log=log, type=entity_type, database_=database()
     )
     row = records[0] if records else None
     if row is None:
@@ -303,7 +305,7 @@ def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.Da
     codes = edges.entity_codes(str(step.ent_type), [str(i) for i in row["ids"]])
     edges.know(codes, row["nodes"])
     frame.insert(0, "node", codes)
-    return frame
+    return frame[edges.holder[codes] == FREE].reset_index(drop=True)
 
 
 def _write(
@@ -339,8 +341,7 @@ def _write(
         members = np.concatenate([np.asarray(group, dtype=np.int64) for group in table["members"]])
         holders = np.repeat(table["id"].to_numpy(dtype=object), sizes).tolist()
         owners = np.repeat(np.asarray(created, dtype=object), sizes).tolist()
-        member_ids = edges.resolve(loader, members)
-        loader.run("aggr_create_members", {"members": member_ids.tolist(), "aggregates": holders})
+        _write_members(driver, log, number, table, edges, between_batches)
         lifted = edges.lift(edges.hold(members, holders, owners))
         if len(lifted):
             sources = edges.resolve(loader, lifted["source"].to_numpy())
@@ -366,6 +367,38 @@ def _write(
     )
 
 
+def _write_members(
+    driver: Driver,
+    log: str,
+    number: int,
+    table: pd.DataFrame,
+    edges: LogEdges,
+    between_batches: Callable[[], None],
+) -> None:
+    """The ids of each aggregate's members, in parts of at most :data:`MEMBERS_PART`, a few
+    parts per transaction."""
+    parts: list[tuple[str, int, list[str]]] = []
+    for aggregate, group in zip(table["id"], table["members"], strict=True):
+        keys = edges.keys[np.asarray(group, dtype=np.int64)]
+        for part, start in enumerate(range(0, len(keys), MEMBERS_PART)):
+            parts.append((aggregate, part, [str(k) for k in keys[start : start + MEMBERS_PART]]))
+    batch: list[tuple[str, int, list[str]]] = []
+    for index, item in enumerate(parts):
+        batch.append(item)
+        if sum(len(b[2]) for b in batch) >= MEMBERS_PART or index == len(parts) - 1:
+            between_batches()
+            driver.execute_query(
+                cypher("aggr_create_members"),
+                log=log,
+                step=number,
+                aggregates=[b[0] for b in batch],
+                parts=[b[1] for b in batch],
+                members=[b[2] for b in batch],
+                database_=database(),
+            )
+            batch = []
+
+
 def _storable(column: pd.Series) -> list[Any]:
     """An aggregate column as values Neo4j stores; times stay Neo4j times (nanoseconds)."""
     if any(isinstance(v, DateTime) for v in column):
@@ -378,9 +411,10 @@ def _last_step(driver: Driver, log: str) -> int:
     return int(steps[-1]["step"]) if steps else 0
 
 
-def _unaggregated(driver: Driver, log: str) -> tuple[int, int]:
+def _unaggregated(driver: Driver, log: str, edges: LogEdges) -> tuple[int, int]:
+    """How many events and entities no aggregate holds."""
     records, _, _ = driver.execute_query(cypher("aggr_unaggregated"), log=log, database_=database())
-    return int(records[0]["events"]), int(records[0]["entities"])
+    return len(edges.free_events()), int(records[0]["entities"]) - edges.held_entities()
 
 
 def _delete_steps(driver: Driver, log: str, step: int) -> None:

@@ -65,9 +65,12 @@ def lifted(driver, log: str, kind: str) -> dict[tuple[str, str, str | None], int
 
 def members(driver, log: str) -> dict[str, set[str]]:
     records, _, _ = driver.execute_query(
-        "MATCH (n) WHERE n.log = $log AND n._aggregate IS NOT NULL "
-        "MATCH (a:Aggregate {log: $log, id: n._aggregate}) "
-        "RETURN a.name AS a, collect(n.id) AS ids",
+        "MATCH (m:AggregateMembers {log: $log}) UNWIND m.members AS member "
+        "MATCH (a:Aggregate {log: $log, id: m.id}) "
+        "OPTIONAL MATCH (e:Event {log: $log, id: member}) "
+        "OPTIONAL MATCH (n:Entity {log: $log, type: a.type, id: member}) "
+        "WITH a, coalesce(e, n) AS node WHERE node IS NOT NULL "
+        "RETURN a.name AS a, collect(node.id) AS ids",
         log=log,
         database_=database(),
     )
