@@ -7,9 +7,9 @@ integer codes: the events by their position in the log, then the entities by the
 the entity table (an entity no event names gets a code when a step meets it), then the
 aggregates. Which aggregate holds each node is kept per code. A step's edges are found with
 numpy, their ends mapped to what stands for them at this level (the aggregate holding the
-node, else the node), counted per pair, kind and entity type with pandas. Only then are
-element ids needed: those of the step's members and of the other ends of its edges are
-looked up by key (an event's id; an entity's type and id), each node once per run.
+node, else the node), counted per pair, kind and entity type with pandas. The aggregates'
+element ids are known from their creation; an edge's other end that no aggregate holds is
+found by its key (an event's id; an entity's type and id) when the edge is written.
 
 The rules are those of a step lifted in Cypher: an edge from a member becomes an edge from
 its aggregate; an edge into a member from a node no aggregate of the same step holds becomes
@@ -27,7 +27,6 @@ from neo4j import Driver
 
 from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import database
-from robotale.ekg.load import Loader
 from robotale.ekg.tables import GraphTables, graph_tables
 from robotale.errors import RobotaleError
 from robotale.queries import cypher
@@ -43,7 +42,7 @@ class LogEdges:
     events: pd.DataFrame  # the event table (Event property names); row = position = code
     types: np.ndarray  # per code: an entity's type; None for events and aggregates
     keys: np.ndarray  # per code: the node's id (events, entities) or the aggregate's id
-    element_ids: np.ndarray  # per code: the element id, None until it is needed
+    element_ids: np.ndarray  # per code: an aggregate's element id; None for the others
     kinds: np.ndarray  # 'CORR', 'DF', 'COMM' per edge
     sources: np.ndarray  # codes
     targets: np.ndarray
@@ -127,35 +126,6 @@ class LogEdges:
             found[new] = codes[positions]
         return found
 
-    def know(self, codes: np.ndarray, element_ids: Sequence[str]) -> None:
-        """Record element ids already read (a step's entities come with theirs)."""
-        self.element_ids[codes] = np.asarray(list(element_ids), dtype=object)
-
-    def resolve(self, loader: Loader, codes: np.ndarray) -> np.ndarray:
-        """The element ids of ``codes``, looking up by key those not known yet."""
-        unknown = np.unique(codes[pd.isna(self.element_ids[codes])])
-        events = unknown[pd.isna(self.types[unknown])]
-        if len(events):
-            found = loader.run("aggr_event_ids", {"ids": self.keys[events].tolist()})
-            self._found(events, found, "events")
-        entities = unknown[~pd.isna(self.types[unknown])]
-        if len(entities):
-            found = loader.run(
-                "aggr_entity_ids",
-                {"types": self.types[entities].tolist(), "ids": self.keys[entities].tolist()},
-            )
-            self._found(entities, found, "entities")
-        found_ids: np.ndarray = self.element_ids[codes]
-        return found_ids
-
-    def _found(self, codes: np.ndarray, found: list[str], what: str) -> None:
-        if len(found) != len(codes):
-            raise RobotaleError(
-                f"{len(codes) - len(found)} of the {what} of the log's event table are not in "
-                "the graph; rebuild the log's columnar copy (robotale logs) and run the step again."
-            )
-        self.element_ids[codes] = np.asarray(found, dtype=object)
-
     # -- aggregates ------------------------------------------------------------------------
 
     def hold(
@@ -171,6 +141,11 @@ class LogEdges:
         codes = self._append(np.full(len(names), None, object), names, elements)
         self.holder[nodes] = codes[positions]
         return codes[positions]
+
+    def aggregates(self, codes: np.ndarray) -> np.ndarray:
+        """Which of ``codes`` are aggregates (the others are events or entities)."""
+        found: np.ndarray = ~pd.isna(self.element_ids[codes])
+        return found
 
     def standing(self, codes: np.ndarray) -> np.ndarray:
         """What stands for each code at this level: the id of the aggregate holding it, else

@@ -287,7 +287,7 @@ def _correlated(edges: LogEdges, events: np.ndarray, kind: str) -> list[str | No
 
 def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.DataFrame:
     """One row per entity the step collapses: ``node`` (its code) and a column per property
-    read; read from Neo4j, whose element ids are kept for the writes."""
+    read; read from Neo4j (an entity's attributes may be set after the log was built)."""
     step, reads, condition = plan.step, plan.reads, plan.condition
     text = cypher("aggr_read_entities").replace(_WHERE_MARKER, condition.cypher)
     parameters: dict[str, Any] = {
@@ -303,7 +303,6 @@ def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.Da
     values = row["values"]
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
     codes = edges.entity_codes(str(step.ent_type), [str(i) for i in row["ids"]])
-    edges.know(codes, row["nodes"])
     frame.insert(0, "node", codes)
     return frame[edges.holder[codes] == FREE].reset_index(drop=True)
 
@@ -343,21 +342,7 @@ def _write(
         owners = np.repeat(np.asarray(created, dtype=object), sizes).tolist()
         _write_members(driver, log, number, table, edges, between_batches)
         lifted = edges.lift(edges.hold(members, holders, owners))
-        if len(lifted):
-            sources = edges.resolve(loader, lifted["source"].to_numpy())
-            targets = edges.resolve(loader, lifted["target"].to_numpy())
-            # every lifted edge reaches one of this step's few aggregates: one batch at a time
-            Loader(driver, log, None, between_batches, workers=1).run(
-                "aggr_create_lifted",
-                {
-                    "kinds": lifted["kind"].tolist(),
-                    "sources": sources.tolist(),
-                    "targets": targets.tolist(),
-                    "entityTypes": lifted["entityType"].tolist(),
-                    "counts": lifted["count"].astype(int).tolist(),
-                },
-                step=number,
-            )
+        _write_lifted(driver, log, number, lifted, edges, between_batches)
     driver.execute_query(
         cypher("aggr_step_finish"),
         log=log,
@@ -365,6 +350,55 @@ def _write(
         counts={"aggregates": len(table), "members": int(table["count"].sum())},
         database_=database(),
     )
+
+
+def _write_lifted(
+    driver: Driver,
+    log: str,
+    number: int,
+    lifted: pd.DataFrame,
+    edges: LogEdges,
+    between_batches: Callable[[], None],
+) -> None:
+    """The lifted edges of step ``number``: those between two aggregates by their element
+    ids, the others with the end no aggregate holds found by its key. Every one of them
+    reaches one of the step's few aggregates, so batches side by side would only wait on
+    each other's locks: one at a time."""
+    source, target = lifted["source"].to_numpy(), lifted["target"].to_numpy()
+    from_aggregate, to_aggregate = edges.aggregates(source), edges.aggregates(target)
+    loader = Loader(driver, log, None, between_batches, workers=1)
+    common = {
+        "kinds": lifted["kind"].to_numpy(dtype=object),
+        "entityTypes": lifted["entityType"].to_numpy(dtype=object),
+        "counts": lifted["count"].astype(int).to_numpy(),
+    }
+    both = from_aggregate & to_aggregate
+    if both.any():
+        loader.run(
+            "aggr_create_lifted",
+            {name: values[both].tolist() for name, values in common.items()}
+            | {
+                "sources": edges.element_ids[source[both]].tolist(),
+                "targets": edges.element_ids[target[both]].tolist(),
+            },
+            step=number,
+        )
+    one = ~both
+    if one.any():
+        outgoing = from_aggregate[one]
+        aggregate = np.where(outgoing, source[one], target[one])
+        node = np.where(outgoing, target[one], source[one])
+        loader.run(
+            "aggr_create_lifted_free",
+            {name: values[one].tolist() for name, values in common.items()}
+            | {
+                "aggregates": edges.element_ids[aggregate].tolist(),
+                "nodes": edges.keys[node].tolist(),
+                "types": edges.types[node].tolist(),
+                "outgoing": outgoing.tolist(),
+            },
+            step=number,
+        )
 
 
 def _write_members(
