@@ -384,21 +384,26 @@ def _write_lifted(
             step=number,
         )
     one = ~both
-    if one.any():
-        outgoing = from_aggregate[one]
-        aggregate = np.where(outgoing, source[one], target[one])
-        node = np.where(outgoing, target[one], source[one])
-        loader.run(
-            "aggr_create_lifted_free",
-            {name: values[one].tolist() for name, values in common.items()}
-            | {
-                "aggregates": edges.element_ids[aggregate].tolist(),
-                "nodes": edges.keys[node].tolist(),
-                "types": edges.types[node].tolist(),
-                "outgoing": outgoing.tolist(),
-            },
-            step=number,
-        )
+    outgoing = from_aggregate[one]
+    aggregate = np.where(outgoing, source[one], target[one])
+    node = np.where(outgoing, target[one], source[one])
+    entity = ~pd.isna(edges.types[node])
+    for query, chosen in (
+        ("aggr_create_lifted_event", ~entity),
+        ("aggr_create_lifted_entity", entity),
+    ):
+        if chosen.any():
+            loader.run(
+                query,
+                {name: values[one][chosen].tolist() for name, values in common.items()}
+                | {
+                    "aggregates": edges.element_ids[aggregate[chosen]].tolist(),
+                    "nodes": edges.keys[node[chosen]].tolist(),
+                    "types": edges.types[node[chosen]].tolist(),
+                    "outgoing": outgoing[chosen].tolist(),
+                },
+                step=number,
+            )
 
 
 def _write_members(
