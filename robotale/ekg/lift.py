@@ -28,7 +28,7 @@ from neo4j import Driver
 from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import database
 from robotale.ekg.tables import GraphTables, graph_tables
-from robotale.errors import RobotaleError
+from robotale.errors import InputError
 from robotale.queries import cypher
 
 #: a node no aggregate holds
@@ -103,9 +103,10 @@ class LogEdges:
         )
         if (found < 0).any():
             missing = np.asarray(ids, dtype=object)[found < 0][0]
-            raise RobotaleError(
-                f"The event {missing!r} is in the graph but not in the log's event table; "
-                "rebuild the log's columnar copy (robotale logs) and run the step again."
+            raise InputError(
+                f"An aggregation step of this log holds the event {missing!r}, which the log "
+                "no longer has: undo its steps (robotale aggregate LOG --undo 1) and run them "
+                "again."
             )
         return found
 
