@@ -11,6 +11,8 @@ MATCH (c:Class) WHERE c.log = $log AND c.type IS NOT NULL AND c.id IS NOT NULL
 CALL (c) { DETACH DELETE c } IN TRANSACTIONS OF 10000 ROWS;
 MATCH (a:Aggregate) WHERE a.log = $log AND a.step IS NOT NULL AND a.id IS NOT NULL
 CALL (a) { DETACH DELETE a } IN TRANSACTIONS OF 1000 ROWS;
+MATCH (m:AggregateMembers) WHERE m.log = $log
+CALL (m) { DELETE m } IN TRANSACTIONS OF 100 ROWS;
 MATCH (s:AggregationStep) WHERE s.log = $log AND s.step IS NOT NULL
 DELETE s;
 MATCH (l:Log {name: $log})

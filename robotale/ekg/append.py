@@ -88,7 +88,7 @@ def append_ekg(
         summary: dict[str, Any] = {"events": int(info["events"]) + len(tables.events)}
         summary |= merged_values(stored, table_values(tables.events))
         if added:
-            summary |= _widened(driver, name, log, info["properties"] or [], added)
+            summary |= widened_properties(driver, name, log, info["properties"] or [], added)
         _write_or_keep(driver, name, tables, classes, summary)
     result = summarise(name, tables, classes)
     return dataclasses.replace(result, seconds=time.perf_counter() - started)
@@ -119,7 +119,7 @@ def _new_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> list[st
     return [c for c in log.columns if property_name(c) not in set(stored)]
 
 
-def _widened(
+def widened_properties(
     driver: Driver, name: str, log: pd.DataFrame, stored: Sequence[str], added: list[str]
 ) -> dict[str, Any]:
     """What the Log node records of its event properties once ``added`` (columns of

@@ -1,15 +1,19 @@
-"""The edges an aggregation step lifts, computed in memory from one reading of the log.
+"""The edges an aggregation step lifts, computed in memory from the log's columnar copy.
 
-The CORR, DF and COMM edges the build wrote are read once per run (element ids, as columns,
-a range of events per query) and kept as integer codes; so is which aggregate holds each
-node already collapsed. A step then needs no reading at all: the edges that touch its
-members are found with numpy, their other ends mapped to what stands for them at this level
-(the aggregate holding the node, else the node), counted per pair, kind and entity type with
-pandas, and written in batches
-(``cypher/aggr_create_lifted.cypher``). The rules are those of a step lifted in Cypher: an
-edge from a member becomes an edge from its aggregate; an edge into a member from a node no
-aggregate of the same step holds becomes an edge into its aggregate (so an edge between two
-aggregates of one step is written once).
+The CORR, DF and COMM edges of a log are derived from its event table (the columnar copy,
+:func:`robotale.ekg.columnar.stored_table`) as the build derived them
+(:func:`robotale.ekg.tables.graph_tables`), instead of being read back from Neo4j. Nodes are
+integer codes: the events by their position in the log, then the entities by their row in
+the entity table (an entity no event names gets a code when a step meets it), then the
+aggregates. Which aggregate holds each node is kept per code. A step's edges are found with
+numpy, their ends mapped to what stands for them at this level (the aggregate holding the
+node, else the node), counted per pair, kind and entity type with pandas. The aggregates'
+element ids are known from their creation; an edge's other end that no aggregate holds is
+found by its key (an event's id; an entity's type and id) when the edge is written.
+
+The rules are those of a step lifted in Cypher: an edge from a member becomes an edge from
+its aggregate; an edge into a member from a node no aggregate of the same step holds becomes
+an edge into its aggregate (so an edge between two aggregates of one step is written once).
 """
 
 from __future__ import annotations
@@ -21,88 +25,146 @@ import numpy as np
 import pandas as pd
 from neo4j import Driver
 
+from robotale.ekg.columnar import stored_table
 from robotale.ekg.connection import database
+from robotale.ekg.tables import GraphTables, graph_tables
+from robotale.errors import InputError
 from robotale.queries import cypher
 
 #: a node no aggregate holds
 FREE = -1
-#: events whose edges are read in one query
-EDGE_PAGE = 100_000
 
 
 @dataclass
 class LogEdges:
-    """The log's liftable edges and who holds each node, by integer codes of element ids."""
+    """The log's liftable edges and who holds each node, by integer codes."""
 
-    ids: pd.Index  # element id of each node code, then of each aggregate code appended
+    events: pd.DataFrame  # the event table (Event property names); row = position = code
+    types: np.ndarray  # per code: an entity's type; None for events and aggregates
+    keys: np.ndarray  # per code: the node's id (events, entities) or the aggregate's id
+    element_ids: np.ndarray  # per code: an aggregate's element id; None for the others
     kinds: np.ndarray  # 'CORR', 'DF', 'COMM' per edge
-    sources: np.ndarray  # node codes
+    sources: np.ndarray  # codes
     targets: np.ndarray
     entity_types: np.ndarray  # a DF edge's entity type, '' for the others
-    holder: np.ndarray  # per node code: the code of the aggregate holding it, or FREE
+    holder: np.ndarray  # per code: the code of the aggregate holding it, or FREE
+    corr: pd.DataFrame  # ``event``, ``entity`` (codes): what each event is correlated to
 
     @classmethod
-    def read(cls, driver: Driver, log: str, stacked: bool = True) -> LogEdges:
-        """``stacked``: whether earlier steps collapsed nodes of the log (if not, no node
-        has an aggregate and none is looked for)."""
-        row = _read_edges(driver, log)
-        held: dict[str, list[str]] = {k: [] for k in ("ids", "aggregates", "nodes", "held")}
-        if stacked:
-            members, _, _ = driver.execute_query(
-                cypher("aggr_read_memberships"), log=log, database_=database()
-            )
-            held = members[0].data()
-        element_ids = dict(zip(held["ids"], held["aggregates"], strict=True))
-        holders = [element_ids[aggregate] for aggregate in held["held"]]
-        ends = np.asarray(row["sources"] + row["targets"] + held["nodes"], dtype=object)
-        codes, ids = pd.factorize(ends)
-        count = len(row["sources"])
-        edges = cls(
-            ids=pd.Index(ids, dtype=object),
-            kinds=np.asarray(row["kinds"], dtype=object),
-            sources=codes[:count],
-            targets=codes[count : 2 * count],
-            entity_types=np.asarray(row["entityTypes"], dtype=object),
-            holder=np.full(len(ids), FREE, dtype=np.int64),
+    def of_log(cls, driver: Driver, log: str, entity_types: Sequence[str]) -> LogEdges:
+        """The edges of the stored log ``log`` built with ``entity_types``."""
+        return cls.of_tables(graph_tables(stored_table(driver, log), list(entity_types)))
+
+    @classmethod
+    def of_tables(cls, tables: GraphTables) -> LogEdges:
+        events, entities = tables.events, tables.entities
+        count = len(events)
+        corr = tables.corr["entity"].to_numpy() + count
+        df, comm = tables.df, tables.comm
+        frames = [
+            ("CORR", tables.corr["event"].to_numpy(), corr, np.full(len(corr), "", object)),
+            ("DF", df["source"].to_numpy(), df["target"].to_numpy(),
+             df["entityType"].astype(object).to_numpy()),
+            ("COMM", comm["source"].to_numpy(), comm["target"].to_numpy(),
+             np.full(len(comm), "", object)),
+        ]  # fmt: skip
+        codes = count + len(entities)
+        return cls(
+            events=events,
+            types=np.concatenate(
+                [np.full(count, None, object), entities["type"].astype(object).to_numpy()]
+            ),
+            keys=np.concatenate(
+                [events["id"].astype(object).to_numpy(), entities["id"].astype(object).to_numpy()]
+            ),
+            element_ids=np.full(codes, None, dtype=object),
+            kinds=np.concatenate([np.full(len(f[1]), f[0], object) for f in frames]),
+            sources=np.concatenate([np.asarray(f[1], np.int64) for f in frames]),
+            targets=np.concatenate([np.asarray(f[2], np.int64) for f in frames]),
+            entity_types=np.concatenate([f[3] for f in frames]),
+            holder=np.full(codes, FREE, dtype=np.int64),
+            corr=pd.DataFrame({"event": tables.corr["event"].to_numpy(), "entity": corr}),
         )
-        if held["nodes"]:
-            edges.hold(codes[2 * count :], holders)
-        return edges
 
-    def hold(self, nodes: np.ndarray, aggregates: Sequence[str]) -> np.ndarray:
-        """Record that each of ``nodes`` (codes) is held by the aggregate of the same
-        position (element ids); returns the aggregates' codes."""
-        names, positions = np.unique(np.asarray(aggregates, dtype=object), return_inverse=True)
-        first = len(self.ids)
-        self.ids = self.ids.append(pd.Index(names, dtype=object))
-        self.holder = np.concatenate([self.holder, np.full(len(names), FREE, dtype=np.int64)])
-        codes = first + positions
-        self.holder[nodes] = codes
-        return codes
+    # -- codes ---------------------------------------------------------------------------
 
-    def codes(self, element_ids: Sequence[str]) -> np.ndarray:
-        """The codes of nodes by element id (nodes with no liftable edge get new codes)."""
-        found: np.ndarray = self.ids.get_indexer(pd.Index(element_ids, dtype=object))
-        new = found < 0
-        if new.any():
-            first = len(self.ids)
-            self.ids = self.ids.append(pd.Index(np.asarray(element_ids, dtype=object)[new]))
-            self.holder = np.concatenate(
-                [self.holder, np.full(int(new.sum()), FREE, dtype=np.int64)]
+    def _append(self, types: np.ndarray, keys: np.ndarray, element_ids: np.ndarray) -> np.ndarray:
+        first = len(self.keys)
+        self.types = np.concatenate([self.types, types])
+        self.keys = np.concatenate([self.keys, keys])
+        self.element_ids = np.concatenate([self.element_ids, element_ids])
+        self.holder = np.concatenate([self.holder, np.full(len(keys), FREE, dtype=np.int64)])
+        return np.arange(first, first + len(keys))
+
+    def event_codes(self, ids: Sequence[str]) -> np.ndarray:
+        """The codes of events by id (the positions of the events with those ids)."""
+        found: np.ndarray = pd.Index(self.events["id"].astype(object)).get_indexer(
+            pd.Index(list(ids), dtype=object)
+        )
+        if (found < 0).any():
+            missing = np.asarray(ids, dtype=object)[found < 0][0]
+            raise InputError(
+                f"An aggregation step of this log holds the event {missing!r}, which the log "
+                "no longer has: undo its steps (robotale aggregate LOG --undo 1) and run them "
+                "again."
             )
-            found[new] = np.arange(first, first + int(new.sum()))
         return found
 
-    def lift(self, members: Sequence[str], aggregates: Sequence[str]) -> pd.DataFrame:
-        """Collapse ``members`` into ``aggregates`` (element ids, one per member) and return
-        the lifted edges of that step: ``kind``, ``source``, ``target`` (element ids),
-        ``entityType`` (None but for DF) and ``count``."""
-        step = np.zeros(0, dtype=np.int64)
-        if len(members):
-            step = self.hold(self.codes(members), aggregates)
-        in_step = np.zeros(len(self.ids), dtype=bool)
-        in_step[np.unique(step)] = True
-        standing = np.where(self.holder >= 0, self.holder, np.arange(len(self.ids)))
+    def entity_codes(self, kind: str, ids: Sequence[str]) -> np.ndarray:
+        """The codes of the entities of type ``kind`` by id (new codes for entities that no
+        event names)."""
+        ids = np.asarray(list(ids), dtype=object)
+        mine = np.flatnonzero(self.types == kind)
+        index = pd.Index(self.keys[mine], dtype=object)
+        at = index.get_indexer(pd.Index(ids, dtype=object)) if len(index) else np.full(len(ids), -1)
+        found = np.where(at >= 0, mine[np.maximum(at, 0)], -1)
+        new = found < 0
+        if new.any():
+            unique, positions = np.unique(ids[new], return_inverse=True)
+            codes = self._append(
+                np.full(len(unique), kind, object), unique, np.full(len(unique), None, object)
+            )
+            found[new] = codes[positions]
+        return found
+
+    # -- aggregates ------------------------------------------------------------------------
+
+    def hold(
+        self, nodes: np.ndarray, aggregates: Sequence[str], element_ids: Sequence[str | None]
+    ) -> np.ndarray:
+        """Record that each of ``nodes`` (codes) is held by the aggregate of the same
+        position (``aggregates``: their ids, ``element_ids`` theirs); returns the
+        aggregates' codes."""
+        names, first, positions = np.unique(
+            np.asarray(list(aggregates), dtype=object), return_index=True, return_inverse=True
+        )
+        elements = np.asarray(list(element_ids), dtype=object)[first]
+        codes = self._append(np.full(len(names), None, object), names, elements)
+        self.holder[nodes] = codes[positions]
+        return codes[positions]
+
+    def aggregates(self, codes: np.ndarray) -> np.ndarray:
+        """Which of ``codes`` are aggregates (the others are events or entities)."""
+        found: np.ndarray = ~pd.isna(self.element_ids[codes])
+        return found
+
+    def standing(self, codes: np.ndarray) -> np.ndarray:
+        """What stands for each code at this level: the id of the aggregate holding it, else
+        its own id."""
+        held = self.holder[codes]
+        found: np.ndarray = np.where(held >= 0, self.keys[np.maximum(held, 0)], self.keys[codes])
+        return found
+
+    def free_events(self) -> np.ndarray:
+        """The positions of the events no aggregate holds."""
+        return np.flatnonzero(self.holder[: len(self.events)] == FREE)
+
+    def lift(self, step: np.ndarray) -> pd.DataFrame:
+        """The lifted edges of the step whose aggregates are the codes ``step``: ``kind``,
+        ``source``, ``target`` (codes), ``entityType`` (None but for DF) and ``count``."""
+        in_step = np.zeros(len(self.keys), dtype=bool)
+        in_step[step] = True
+        standing = np.where(self.holder >= 0, self.holder, np.arange(len(self.keys)))
         source, target = standing[self.sources], standing[self.targets]
         # out of a member; or into one from a node that no aggregate of this step holds
         chosen = in_step[source] | (in_step[target] & ~in_step[source])
@@ -116,26 +178,24 @@ class LogEdges:
         )
         lifted = frame.groupby(["kind", "source", "target", "entityType"], sort=False).size()
         lifted = lifted.rename("count").reset_index()
-        lifted["source"] = self.ids[lifted["source"].to_numpy()].to_numpy()
-        lifted["target"] = self.ids[lifted["target"].to_numpy()].to_numpy()
         lifted["entityType"] = lifted["entityType"].where(lifted["entityType"] != "", None)
         return lifted
 
+    # -- earlier steps -------------------------------------------------------------------
 
-def _read_edges(driver: Driver, log: str) -> dict[str, list[str]]:
-    """The log's liftable edges as columns, read :data:`EDGE_PAGE` events at a time."""
-    records, _, _ = driver.execute_query(
-        cypher("aggr_event_positions"), log=log, database_=database()
-    )
-    columns: dict[str, list[str]] = {"kinds": [], "sources": [], "targets": [], "entityTypes": []}
-    for first in range(0, int(records[0]["end"]), EDGE_PAGE):
-        page, _, _ = driver.execute_query(
-            cypher("aggr_read_edges"),
-            log=log,
-            first=first,
-            last=first + EDGE_PAGE,
-            database_=database(),
+    def held_entities(self) -> int:
+        """How many entities an aggregate holds."""
+        return int(((self.holder >= 0) & ~pd.isna(self.types)).sum())
+
+    def read_memberships(self, driver: Driver, log: str) -> None:
+        """Record which aggregate of earlier steps holds each node they collapsed."""
+        records, _, _ = driver.execute_query(
+            cypher("aggr_read_memberships"), log=log, database_=database()
         )
-        for name, values in columns.items():
-            values.extend(page[0][name])
-    return columns
+        for row in records:
+            members = [str(m) for m in row["members"]]
+            if row["type"] is None:
+                codes = self.event_codes(members)
+            else:
+                codes = self.entity_codes(str(row["type"]), members)
+            self.hold(codes, [row["id"]] * len(codes), [row["aggregate"]] * len(codes))

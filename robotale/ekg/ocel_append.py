@@ -27,6 +27,7 @@ from robotale.ekg.append import (
     complete_log_info,
     merged_values,
     same_keys,
+    widened_properties,
     write_transaction,
 )
 from robotale.ekg.build import (
@@ -65,14 +66,14 @@ def append_objects(
 ) -> BuildSummary:
     """Append the events of the object-centric ``log`` and its ``objects`` to the stored
     log ``name``. Refused (nothing written) when there is no complete log ``name``, when an
-    object type or event column is one the log lacks, when an event id is already in it, or
-    when an object id is stored with another type."""
+    object type is one the log lacks, when an event id is already in it, or when an object id
+    is stored with another type. An event attribute the log lacks joins its attributes."""
     started = time.perf_counter()
     check_log_name(name)
     with log_write_lock(driver, name, "appending"):
         info = complete_log_info(driver, name)
         types = _known_types(objects, info["entityTypes"] or [], name)
-        _check_columns(log, info["properties"] or [], name)
+        added = _new_attributes(log, info["properties"] or [])
         keys = same_keys(aggregate, info["classTypes"] or [], name)
         tables = graph_tables(log, types, first=int(info["events"]))
         check_keys(tables.events, keys)
@@ -82,6 +83,8 @@ def append_objects(
         classes = [class_tables(tables, key) for key in keys]
         summary: dict[str, Any] = {"events": int(info["events"]) + len(tables.events)}
         summary |= merged_values(log_values(driver, name), table_values(tables.events))
+        if added:  # the stored events lack it, as they lack the attributes of other types
+            summary |= widened_properties(driver, name, log, info["properties"] or [], added)
         new = _without_stored(driver, name, objects, types)
         write_transaction(driver, name, _append, name, tables, classes, new, types, summary)
     result = summarise(name, tables, classes)
@@ -125,16 +128,12 @@ def _typed(objects: Objects, types: list[str]) -> pd.Series:
     return kinds[kinds["type"].isin(types)].set_index("id")["type"]
 
 
-def _check_columns(log: pd.DataFrame, stored: Sequence[str], name: str) -> None:
-    # Events of an object-centric log carry the attributes of their own type: the new events
-    # may lack some of the log's columns, but may bring none it does not have.
-    given = {property_name(c) for c in log.columns} | {"id", schema.MSG_ROLE}
-    extra = sorted(given - set(stored))
-    if extra:
-        raise InputError(
-            f"The events to append have the attribute {extra[0]!r}, which the log {name!r} "
-            "does not have: rebuild the log from both files with --replace."
-        )
+def _new_attributes(log: pd.DataFrame, stored: Sequence[str]) -> list[str]:
+    """The columns of ``log`` (as given) whose event attribute the stored log lacks. Events of
+    an object-centric log carry the attributes of their own type: the new events may lack
+    some of the log's attributes and bring others, as one ingest of both files would."""
+    own = {"id", schema.MSG_ROLE}  # every event gets these, whatever the file holds
+    return [c for c in log.columns if property_name(c) not in {*stored, *own}]
 
 
 def _without_stored(driver: Driver, name: str, objects: Objects, types: list[str]) -> Objects:

@@ -2,12 +2,15 @@
 
 Each step (:mod:`robotale.ekg.spec`) collapses the events, or the entities of one type, that
 no earlier step collapsed and that pass its ``where`` into ``Aggregate`` nodes, one per
-group: the nodes are read with their properties, grouped in pandas
-(:mod:`robotale.ekg.groups`) and the aggregates written in batches; each node they replace
-records its aggregate's id in its property ``_aggregate``. Then the CORR, DF and COMM edges
-of those nodes are lifted to the aggregates, counted: computed in memory from one reading of
-the log's edges per run (:mod:`robotale.ekg.lift`) and written in batches. The graph after
-steps 1 .. k is level k: its aggregates and the lifted edges between them.
+group: the nodes are taken with their properties (events from the log's columnar copy, their
+``where`` evaluated in pandas by :mod:`robotale.ekg.where_table`; entities read from Neo4j),
+grouped in pandas (:mod:`robotale.ekg.groups`) and the aggregates written in batches, with
+the ids of the nodes each replaces as lists (``AggregateMembers`` nodes, a few writes per
+aggregate rather than one per member). Then the CORR,
+DF and COMM edges of those nodes are lifted to the aggregates, counted: computed in memory
+from the log's event table (:mod:`robotale.ekg.lift`), nothing read back from the graph, and
+written in batches. The graph after steps 1 .. k is level k: its aggregates and the lifted
+edges between them.
 
 A step is kept or undone as a unit: if writing it fails, what it wrote is removed again, and
 ``undo`` removes a step and the ones stacked on it. Steps are numbered per log, so a second
@@ -22,6 +25,7 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from typing import Any
 
+import numpy as np
 import pandas as pd
 from neo4j import Driver
 from neo4j.time import DateTime
@@ -30,19 +34,20 @@ from robotale.ekg.build import ensure_schema, undo_after_failure
 from robotale.ekg.connection import database
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
-from robotale.ekg.lift import LogEdges
+from robotale.ekg.lift import FREE, LogEdges
 from robotale.ekg.load import Loader, neo4j_values
 from robotale.ekg.logs import log_info
 from robotale.ekg.spec import AggrStep
 from robotale.ekg.where import Condition, parse_where
+from robotale.ekg.where_table import matching
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError
 from robotale.queries import cypher, statements
 
 #: the properties every aggregate has; a group-by key of one of these names is only in ``name``
 OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")
-#: how many events tell which properties hold times
-KEY_SAMPLE = 10_000
+#: the most member ids one AggregateMembers node lists
+MEMBERS_PART = 100_000
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
 
@@ -73,11 +78,13 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
     ensure_schema(driver)
     with log_write_lock(driver, log, "aggregating"):
         first = _last_step(driver, log) + 1
-        keys: dict[str | None, tuple[set[str], list[str]]] = {}
+        edges = LogEdges.of_log(driver, log, info.get("entityTypes") or [])
+        keys: dict[str | None, tuple[set[str], list[str]]] = {None: _event_keys(edges.events)}
         plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
-        events, entities = _unaggregated(driver, log)
-        edges = LogEdges.read(driver, log, stacked=first > 1)
+        if first > 1:
+            edges.read_memberships(driver, log)
+        events, entities = _unaggregated(driver, log, edges)
         for plan in plans:
             result = _run_or_undo(driver, log, plan, (events, entities), edges)
             events, entities = result.final_events, result.final_entities
@@ -130,7 +137,10 @@ def _run_or_undo(
 ) -> StepResult:
     step, number = plan.step, plan.number
     started = time.perf_counter()
-    nodes = _read_nodes(driver, log, plan)
+    if step.origin == "Event":
+        nodes = _event_nodes(edges, plan)
+    else:
+        nodes = _read_nodes(driver, log, plan, edges)
     table = aggregate_table(step, number, nodes, set(plan.times) & set(plan.reads))
     try:
         with DeferredInterrupt() as interrupt:
@@ -215,11 +225,16 @@ def _plan(
     return _Plan(step, number, reads, resolved, condition, times)
 
 
+def _event_keys(events: pd.DataFrame) -> tuple[set[str], list[str]]:
+    """The events' property keys and those that hold zoned times, from the event table."""
+    keys = {str(c) for c in events.columns if events[c].notna().any()} | {"order"}
+    times = [str(c) for c in events.columns if isinstance(events[c].dtype, pd.DatetimeTZDtype)]
+    return keys, times
+
+
 def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[str], list[str]]:
-    # Events: a sample tells the types (their keys are on the Log node); entities: all.
-    limit = KEY_SAMPLE if entity_type is None else 2**62
     records, _, _ = driver.execute_query(
-        cypher("aggr_node_keys"), log=log, type=entity_type, limit=limit, database_=database()
+        cypher("aggr_node_keys"), log=log, type=entity_type, database_=database()
     )
     row = records[0] if records else None
     if row is None:
@@ -227,17 +242,58 @@ def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[s
     return set(row["keys"]) - {"log"}, list(row["times"])
 
 
-def _read_nodes(driver: Driver, log: str, plan: _Plan) -> pd.DataFrame:
-    """One row per node the step collapses: ``node`` and a column per property read (for
-    an entity type a group-by names: what the event is correlated to, joined by ``,``)."""
-    step, reads, resolved, condition = plan.step, plan.reads, plan.resolved, plan.condition
-    query = "aggr_read_events" if step.origin == "Event" else "aggr_read_entities"
-    text = cypher(query).replace(_WHERE_MARKER, condition.cypher)
+def _event_nodes(edges: LogEdges, plan: _Plan) -> pd.DataFrame:
+    """One row per event the step collapses, from the log's event table: ``node`` (its
+    code) and a column per property read, the values as Neo4j holds them (times as Unix
+    nanoseconds); for an entity type a group-by names, what the event is correlated to
+    there (the id of the aggregate holding the entity, else the entity's id; joined by ``,``)."""
+    free = edges.free_events()
+    table = edges.events.iloc[free].reset_index(drop=True).assign(order=free)
+    chosen = free[matching(plan.condition, table[[n for n in plan.condition.names if n in table]])]
+    rows = edges.events.iloc[chosen].reset_index(drop=True).assign(order=chosen)
+    frame = pd.DataFrame({"node": chosen})
+    for name in plan.reads:
+        column = rows[name] if name in rows else pd.Series([None] * len(rows), dtype=object)
+        frame[name] = _as_stored(column, name in plan.times)
+    for name in plan.resolved:
+        frame[name] = _correlated(edges, chosen, name)
+    return frame
+
+
+def _as_stored(column: pd.Series, is_time: bool) -> pd.Series:
+    """A column of the event table as Neo4j returns it (times: Unix nanoseconds)."""
+    if is_time:
+        ticks = column.dt.tz_convert("UTC").dt.as_unit("ns")
+        return pd.Series(ticks.array.asi8, dtype="Int64").where(ticks.notna().to_numpy(), None)
+    return pd.Series(neo4j_values(column), dtype=object)
+
+
+def _correlated(edges: LogEdges, events: np.ndarray, kind: str) -> list[str | None]:
+    """For each of ``events`` (positions): what stands for its entities of type ``kind``,
+    distinct, sorted and joined by ``,`` (None when it has none)."""
+    corr = edges.corr
+    corr = corr[edges.types[corr["entity"].to_numpy()] == kind]
+    wanted = np.zeros(len(edges.events), dtype=bool)
+    wanted[events] = True
+    corr = corr[wanted[corr["event"].to_numpy()]]
+    pairs = pd.DataFrame(
+        {"event": corr["event"].to_numpy(), "value": edges.standing(corr["entity"].to_numpy())}
+    )
+    pairs["value"] = pairs["value"].astype(str)
+    pairs = pairs.drop_duplicates().sort_values(["event", "value"], kind="stable")
+    joined = pairs.groupby("event", sort=False)["value"].agg(",".join)
+    return [None if pd.isna(v) else v for v in joined.reindex(events).tolist()]
+
+
+def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.DataFrame:
+    """One row per entity the step collapses: ``node`` (its code) and a column per property
+    read; read from Neo4j (an entity's attributes may be set after the log was built)."""
+    step, reads, condition = plan.step, plan.reads, plan.condition
+    text = cypher("aggr_read_entities").replace(_WHERE_MARKER, condition.cypher)
     parameters: dict[str, Any] = {
         "log": log,
         "properties": reads,
         "times": [t for t in plan.times if t in reads],
-        "entityTypes": resolved,
         "type": step.ent_type,
     }
     records, _, _ = driver.execute_query(
@@ -246,13 +302,9 @@ def _read_nodes(driver: Driver, log: str, plan: _Plan) -> pd.DataFrame:
     row = records[0]
     values = row["values"]
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
-    if resolved:
-        found = row["entities"]
-        for position, name in enumerate(resolved):
-            frame[name] = [",".join(sorted(set(map(str, e[position])))) or None for e in found]
-    nodes = row["nodes"]
-    frame.insert(0, "node", nodes)
-    return frame
+    codes = edges.entity_codes(str(step.ent_type), [str(i) for i in row["ids"]])
+    frame.insert(0, "node", codes)
+    return frame[edges.holder[codes] == FREE].reset_index(drop=True)
 
 
 def _write(
@@ -284,25 +336,13 @@ def _write(
             type=step.ent_type,
             key=[key.name for key in step.group_by],
         )
-        sizes = table["count"].astype(int).tolist()
-        owners = [node for node, size in zip(created, sizes, strict=True) for _ in range(size)]
-        members = [str(m) for group in table["members"] for m in group]
-        holders = [i for i, size in zip(table["id"], sizes, strict=True) for _ in range(size)]
-        loader.run("aggr_create_members", {"members": members, "aggregates": holders})
-        lifted = edges.lift(members, owners)
-        if len(lifted):
-            # every lifted edge reaches one of this step's few aggregates: one batch at a time
-            Loader(driver, log, None, between_batches, workers=1).run(
-                "aggr_create_lifted",
-                {
-                    "kinds": lifted["kind"].tolist(),
-                    "sources": lifted["source"].tolist(),
-                    "targets": lifted["target"].tolist(),
-                    "entityTypes": lifted["entityType"].tolist(),
-                    "counts": lifted["count"].astype(int).tolist(),
-                },
-                step=number,
-            )
+        sizes = table["count"].astype(int).to_numpy()
+        members = np.concatenate([np.asarray(group, dtype=np.int64) for group in table["members"]])
+        holders = np.repeat(table["id"].to_numpy(dtype=object), sizes).tolist()
+        owners = np.repeat(np.asarray(created, dtype=object), sizes).tolist()
+        _write_members(driver, log, number, table, edges, between_batches)
+        lifted = edges.lift(edges.hold(members, holders, owners))
+        _write_lifted(driver, log, number, lifted, edges, between_batches)
     driver.execute_query(
         cypher("aggr_step_finish"),
         log=log,
@@ -310,6 +350,92 @@ def _write(
         counts={"aggregates": len(table), "members": int(table["count"].sum())},
         database_=database(),
     )
+
+
+def _write_lifted(
+    driver: Driver,
+    log: str,
+    number: int,
+    lifted: pd.DataFrame,
+    edges: LogEdges,
+    between_batches: Callable[[], None],
+) -> None:
+    """The lifted edges of step ``number``: those between two aggregates by their element
+    ids, the others with the end no aggregate holds found by its key. Every one of them
+    reaches one of the step's few aggregates, so batches side by side would only wait on
+    each other's locks: one at a time."""
+    source, target = lifted["source"].to_numpy(), lifted["target"].to_numpy()
+    from_aggregate, to_aggregate = edges.aggregates(source), edges.aggregates(target)
+    loader = Loader(driver, log, None, between_batches, workers=1)
+    common = {
+        "kinds": lifted["kind"].to_numpy(dtype=object),
+        "entityTypes": lifted["entityType"].to_numpy(dtype=object),
+        "counts": lifted["count"].astype(int).to_numpy(),
+    }
+    both = from_aggregate & to_aggregate
+    if both.any():
+        loader.run(
+            "aggr_create_lifted",
+            {name: values[both].tolist() for name, values in common.items()}
+            | {
+                "sources": edges.element_ids[source[both]].tolist(),
+                "targets": edges.element_ids[target[both]].tolist(),
+            },
+            step=number,
+        )
+    one = ~both
+    outgoing = from_aggregate[one]
+    aggregate = np.where(outgoing, source[one], target[one])
+    node = np.where(outgoing, target[one], source[one])
+    entity = ~pd.isna(edges.types[node])
+    for query, chosen in (
+        ("aggr_create_lifted_event", ~entity),
+        ("aggr_create_lifted_entity", entity),
+    ):
+        if chosen.any():
+            loader.run(
+                query,
+                {name: values[one][chosen].tolist() for name, values in common.items()}
+                | {
+                    "aggregates": edges.element_ids[aggregate[chosen]].tolist(),
+                    "nodes": edges.keys[node[chosen]].tolist(),
+                    "types": edges.types[node[chosen]].tolist(),
+                    "outgoing": outgoing[chosen].tolist(),
+                },
+                step=number,
+            )
+
+
+def _write_members(
+    driver: Driver,
+    log: str,
+    number: int,
+    table: pd.DataFrame,
+    edges: LogEdges,
+    between_batches: Callable[[], None],
+) -> None:
+    """The ids of each aggregate's members, in parts of at most :data:`MEMBERS_PART`, a few
+    parts per transaction."""
+    parts: list[tuple[str, int, list[str]]] = []
+    for aggregate, group in zip(table["id"], table["members"], strict=True):
+        keys = edges.keys[np.asarray(group, dtype=np.int64)]
+        for part, start in enumerate(range(0, len(keys), MEMBERS_PART)):
+            parts.append((aggregate, part, [str(k) for k in keys[start : start + MEMBERS_PART]]))
+    batch: list[tuple[str, int, list[str]]] = []
+    for index, item in enumerate(parts):
+        batch.append(item)
+        if sum(len(b[2]) for b in batch) >= MEMBERS_PART or index == len(parts) - 1:
+            between_batches()
+            driver.execute_query(
+                cypher("aggr_create_members"),
+                log=log,
+                step=number,
+                aggregates=[b[0] for b in batch],
+                parts=[b[1] for b in batch],
+                members=[b[2] for b in batch],
+                database_=database(),
+            )
+            batch = []
 
 
 def _storable(column: pd.Series) -> list[Any]:
@@ -324,9 +450,10 @@ def _last_step(driver: Driver, log: str) -> int:
     return int(steps[-1]["step"]) if steps else 0
 
 
-def _unaggregated(driver: Driver, log: str) -> tuple[int, int]:
+def _unaggregated(driver: Driver, log: str, edges: LogEdges) -> tuple[int, int]:
+    """How many events and entities no aggregate holds."""
     records, _, _ = driver.execute_query(cypher("aggr_unaggregated"), log=log, database_=database())
-    return int(records[0]["events"]), int(records[0]["entities"])
+    return len(edges.free_events()), int(records[0]["entities"]) - edges.held_entities()
 
 
 def _delete_steps(driver: Driver, log: str, step: int) -> None:

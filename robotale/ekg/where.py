@@ -1,5 +1,6 @@
 """The ``where`` filter of an aggregation step: a small expression language, parsed and checked
-here and run by Neo4j as a parameterised condition.
+here and run by Neo4j as a parameterised condition, or on a table of the nodes in pandas
+(:mod:`robotale.ekg.where_table`) with Cypher's meaning.
 
 Grammar (keywords in any case)::
 
@@ -21,7 +22,7 @@ from __future__ import annotations
 import datetime as dt
 import re
 from collections.abc import Collection
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any, NoReturn
 
 from robotale.errors import InputError
@@ -49,6 +50,10 @@ class Condition:
     cypher: str
     parameters: dict[str, Any]
     names: frozenset[str]  # the properties it reads
+    #: the same condition as a tree, for evaluating it on a table: ("or"|"and", [parts]),
+    #: ("not", part), ("in", name, [values]), ("null"|"not null", name), (op, name, value);
+    #: None: always true
+    tree: Any = field(default=None, compare=False)
 
 
 @dataclass(frozen=True)
@@ -62,7 +67,7 @@ def parse_where(text: str, node: str, known: Collection[str], what: str) -> Cond
     """Parse ``text`` into a condition on the variable ``node``; every property it names must
     be one of ``known``. ``what`` names the filter in messages ("the where of step 2")."""
     parser = _Parser(_tokens(text, what), text, node, what)
-    cypher = parser.expression()
+    cypher, tree = parser.expression()
     if not parser.done():
         parser.fail("expected and, or or the end")
     unknown = sorted(parser.names - set(known))
@@ -71,7 +76,7 @@ def parse_where(text: str, node: str, known: Collection[str], what: str) -> Cond
             f"{what.capitalize()} names {unknown[0]!r}, which these nodes do not have; "
             f"they have {', '.join(sorted(known)) or 'no properties'}."
         )
-    return Condition(cypher, parser.parameters, frozenset(parser.names))
+    return Condition(cypher, parser.parameters, frozenset(parser.names), tree)
 
 
 def _tokens(text: str, what: str) -> list[_Token]:
@@ -100,44 +105,48 @@ class _Parser:
         self.parameters: dict[str, Any] = {}
         self.names: set[str] = set()
 
-    # -- the grammar, one method per rule
-    def expression(self) -> str:
+    # -- the grammar, one method per rule: each returns the Cypher text and the tree
+    def expression(self) -> tuple[str, Any]:
         parts = [self.conjunction()]
         while self.keyword("or"):
             parts.append(self.conjunction())
-        return parts[0] if len(parts) == 1 else "(" + " OR ".join(parts) + ")"
+        return _joined(parts, "OR")
 
-    def conjunction(self) -> str:
+    def conjunction(self) -> tuple[str, Any]:
         parts = [self.negation()]
         while self.keyword("and"):
             parts.append(self.negation())
-        return parts[0] if len(parts) == 1 else "(" + " AND ".join(parts) + ")"
+        return _joined(parts, "AND")
 
-    def negation(self) -> str:
+    def negation(self) -> tuple[str, Any]:
         if self.keyword("not"):
-            return f"(NOT {self.negation()})"
+            text, tree = self.negation()
+            return f"(NOT {text})", ("not", tree)
         if self.punct("("):
-            inner = self.expression()
+            text, tree = self.expression()
             if not self.punct(")"):
                 self.fail("expected )")
-            return f"({inner})"
+            return f"({text})", tree
         return self.test()
 
-    def test(self) -> str:
-        name = self.name()
+    def test(self) -> tuple[str, Any]:
+        name, prop = self.name()
         if self.keyword("in"):
-            return f"{name} IN {self.parameter(self.values())}"
+            values = self.values()
+            return f"{name} IN {self.parameter(values)}", ("in", prop, values)
         if self.keyword("is"):
             negated = self.keyword("not")
             if not self.keyword("null"):
                 self.fail("expected null")
-            return f"{name} IS {'NOT ' if negated else ''}NULL"
+            tree = ("not null" if negated else "null", prop)
+            return f"{name} IS {'NOT ' if negated else ''}NULL", tree
         token = self.next()
         if token is None or token.kind != "op":
             self.fail("expected a comparison (=, <>, <, <=, >, >=), in or is", token)
-        return f"{name} {_OPERATORS[token.text]} {self.parameter(self.value())}"
+        op, value = _OPERATORS[token.text], self.value()
+        return f"{name} {op} {self.parameter(value)}", (op, prop, value)
 
-    def name(self) -> str:
+    def name(self) -> tuple[str, str]:
         token = self.next()
         if token is None or token.kind not in ("word", "quoted"):
             self.fail("expected a property name", token)
@@ -148,7 +157,7 @@ class _Parser:
             self.fail(f"{name!r} is not a property name", token)
         self.names.add(name)
         # Safe to quote: a property name holds no backtick (schema.is_property_name).
-        return f"{self.node}.`{name}`"
+        return f"{self.node}.`{name}`", name
 
     def values(self) -> list[Any]:
         if not self.punct("["):
@@ -210,6 +219,13 @@ class _Parser:
             token = self.tokens[self.position]
         where = f"at character {token.at + 1} ({token.text!r})" if token else "at its end"
         raise InputError(f"{self.what.capitalize()} cannot be read {where}: {expected}.")
+
+
+def _joined(parts: list[tuple[str, Any]], word: str) -> tuple[str, Any]:
+    if len(parts) == 1:
+        return parts[0]
+    text = "(" + f" {word} ".join(p[0] for p in parts) + ")"
+    return text, (word.lower(), [p[1] for p in parts])
 
 
 def _unquote(text: str) -> str:

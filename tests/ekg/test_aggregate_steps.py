@@ -10,7 +10,6 @@ import json
 import pytest
 
 from robotale.cli import main
-from robotale.ekg import lift
 from robotale.ekg.build import build_ekg
 from robotale.ekg.connection import database
 from robotale.ekg.spec import parse_spec
@@ -66,9 +65,12 @@ def lifted(driver, log: str, kind: str) -> dict[tuple[str, str, str | None], int
 
 def members(driver, log: str) -> dict[str, set[str]]:
     records, _, _ = driver.execute_query(
-        "MATCH (n) WHERE n.log = $log AND n._aggregate IS NOT NULL "
-        "MATCH (a:Aggregate {log: $log, id: n._aggregate}) "
-        "RETURN a.name AS a, collect(n.id) AS ids",
+        "MATCH (m:AggregateMembers {log: $log}) UNWIND m.members AS member "
+        "MATCH (a:Aggregate {log: $log, id: m.id}) "
+        "OPTIONAL MATCH (e:Event {log: $log, id: member}) "
+        "OPTIONAL MATCH (n:Entity {log: $log, type: a.type, id: member}) "
+        "WITH a, coalesce(e, n) AS node WHERE node IS NOT NULL "
+        "RETURN a.name AS a, collect(node.id) AS ids",
         log=log,
         database_=database(),
     )
@@ -129,12 +131,7 @@ def test_event_step_with_every_function(neo4j_driver, small):
     assert (result.aggregates, result.members) == (2, 5)
 
 
-# the log's edges read in one query, and two events per query (three queries for five events)
-@pytest.mark.parametrize("page", [lift.EDGE_PAGE, 2])
-def test_entity_step_then_event_step_by_the_aggregated_entities(
-    neo4j_driver, small, page, monkeypatch
-):
-    monkeypatch.setattr(lift, "EDGE_PAGE", page)
+def test_entity_step_then_event_step_by_the_aggregated_entities(neo4j_driver, small):
     spec = steps(
         {"aggr_type": "ENTITIES", "ent_type": "robot", "group_by": ["type"],
          "attr_aggrs": [{"name": "id", "function": "MULTISET"}]},

@@ -11,9 +11,11 @@ import pandas as pd
 import pm4py
 import pytest
 from object_logs import logistics_csv, order_log, plain
+from pandas.testing import assert_frame_equal
 
 from robotale.cli import main
-from robotale.ekg.logs import delete_log, log_summary
+from robotale.ekg.columnar import stored_table
+from robotale.ekg.logs import delete_log, log_info, log_summary
 
 pytestmark = pytest.mark.filterwarnings("ignore::UserWarning", "ignore::FutureWarning")
 
@@ -25,7 +27,8 @@ WRITERS = {
 
 QUERIES = {
     "events": "MATCH (e:Event {log: $log}) RETURN e.id AS id, e.activity AS activity,"
-    " e.timestamp AS time, e.order AS order, e.price AS price, e.clerk AS clerk",
+    " e.timestamp AS time, e.order AS order, e.price AS price, e.clerk AS clerk,"
+    " e.courier AS courier",
     "entities": "MATCH (n:Entity {log: $log}) RETURN n.type AS type, n.id AS id,"
     " properties(n) AS node",
     "corr": "MATCH (e:Event {log: $log})-[c:CORR]->(n:Entity) RETURN e.id AS e, n.type AS t,"
@@ -62,20 +65,36 @@ def _plain(value: object) -> object:
     return plain(value)
 
 
+def _by_id(table: pd.DataFrame) -> pd.DataFrame:
+    """An event table in one order of rows and columns, with missing values as None."""
+    table = table.sort_values("ocel:eid" if "ocel:eid" in table else table.columns[0])
+    table = table[sorted(table.columns)].reset_index(drop=True).astype(object)
+    return table.where(table.notna(), None)
+
+
 def ingest(capsys, path: Path, log: str, *options: str) -> tuple[int, str]:
     code = main(["ingest", str(path), "--log", log, *options])
     return code, capsys.readouterr().err
 
 
 def halves(tmp_path: Path, suffix: str) -> tuple[Path, Path, Path]:
-    """The order log as one file and as two, split by time, all written by pm4py."""
+    """The order log as one file and as two, split by time, all written by pm4py. The later
+    half's deliveries name a courier, an attribute the earlier half's events lack."""
     whole = order_log()
     events = whole.events.sort_values("ocel:timestamp")["ocel:eid"].tolist()
     middle = len(events) // 2
+    later = whole.events["ocel:eid"].isin(events[middle:])
+    deliveries = later & (whole.events["ocel:activity"] == "deliver")
+    whole.events["courier"] = None
+    whole.events.loc[deliveries, "courier"] = ["dhl", "ups"] * int(deliveries.sum() // 2) + (
+        ["dhl"] if deliveries.sum() % 2 else []
+    )
+    first = pm4py.filter_ocel_events(whole, events[:middle])
+    first.events = first.events.drop(columns=["courier"])
     paths = []
     for name, ocel in (
         ("whole", whole),
-        ("first", pm4py.filter_ocel_events(whole, events[:middle])),
+        ("first", first),
         ("next", pm4py.filter_ocel_events(whole, events[middle:])),
     ):
         path = tmp_path / f"{name}.{suffix}"
@@ -113,6 +132,16 @@ def test_appending_the_later_half_gives_the_graph_of_the_whole_log(
     ]
     assert crossing, "some object's events lie on both sides of the split"
     assert len(expected["events"]) == 2 * len(before["events"])
+    # The later half brought an attribute the stored log lacked: recorded as one ingest of the
+    # whole records it, and in the columnar copy, empty for the events stored before.
+    assert not any(dict(row)["courier"] for row in before["events"])
+    assert {dict(row)["courier"] for row in expected["events"]} == {None, "dhl", "ups"}
+    assert "courier" in log_info(neo4j_driver, log_name)["properties"]
+    assert_frame_equal(
+        _by_id(stored_table(neo4j_driver, log_name)),
+        _by_id(stored_table(neo4j_driver, other_name)),
+        check_dtype=False,
+    )
     shared = pm4py.read_ocel2(str(first)).objects.merge(
         pm4py.read_ocel2(str(following)).objects, on="ocel:oid"
     )
