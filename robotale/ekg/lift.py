@@ -113,14 +113,18 @@ class LogEdges:
     def entity_codes(self, kind: str, ids: Sequence[str]) -> np.ndarray:
         """The codes of the entities of type ``kind`` by id (new codes for entities that no
         event names)."""
-        ids = np.asarray(list(ids), dtype=object)
+        wanted: np.ndarray = np.asarray(list(ids), dtype=object)
         mine = np.flatnonzero(self.types == kind)
         index = pd.Index(self.keys[mine], dtype=object)
-        at = index.get_indexer(pd.Index(ids, dtype=object)) if len(index) else np.full(len(ids), -1)
+        at = (
+            index.get_indexer(pd.Index(wanted, dtype=object))
+            if len(index)
+            else np.full(len(wanted), -1)
+        )
         found = np.where(at >= 0, mine[np.maximum(at, 0)], -1)
         new = found < 0
         if new.any():
-            unique, positions = np.unique(ids[new], return_inverse=True)
+            unique, positions = np.unique(wanted[new], return_inverse=True)
             codes = self._append(
                 np.full(len(unique), kind, object), unique, np.full(len(unique), None, object)
             )
