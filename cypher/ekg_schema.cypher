@@ -18,7 +18,7 @@ CREATE INDEX ekg_attribute_change_log IF NOT EXISTS
 FOR (c:AttributeChange) ON (c.log);;
 // a live run's tags and odometry samples, read by a following page as they grow: the new ones
 // after a number, and the highest number (how many there are) without counting them all
-CREATE RANGE INDEX live_tag_seq IF NOT EXISTS
+CREATE INDEX live_tag_seq IF NOT EXISTS
 FOR (t:LiveTag) ON (t.log, t.seq);
-CREATE RANGE INDEX live_pose_seq IF NOT EXISTS
+CREATE INDEX live_pose_seq IF NOT EXISTS
 FOR (p:LivePose) ON (p.log, p.seq)
