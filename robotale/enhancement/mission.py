@@ -207,9 +207,25 @@ class MissionRun:
         control = self.events[self.events[LIFECYCLE].astype("string").fillna("") != NONE]
         return {
             "event_times": sorted(set(control["s"].round(6).tolist())),
-            "instances": _records(self.instances),
+            "instances": self.instance_records,
             "moments": _records(self.moments),
         }
+
+    @cached_property
+    def instance_records(self) -> list[dict[str, Any]]:
+        """:attr:`instances` as JSON records, row by row."""
+        return _records(self.instances)
+
+    def grown_from(self, earlier: MissionRun, kept: int) -> None:
+        """Take over what ``earlier``, this run before events came after its first ``kept``
+        activity instances, read of those instances (they are the same rows at the same
+        seconds), so only the later ones are read again."""
+        records = earlier.__dict__.get("instance_records")
+        if records is None or earlier.start != self.start or len(records) < kept:
+            return
+        later = _records(self.instances.iloc[kept:])
+        # cached_property keeps its value in the instance's dict
+        self.__dict__["instance_records"] = records[:kept] + later
 
     def with_positions(self, positions: pd.DataFrame, tracks: Tracks) -> MissionRun:
         """The same run with other positions (``tracks`` holding them per robot): what is
@@ -217,7 +233,7 @@ class MissionRun:
         moved = dataclasses.replace(self, positions=positions, tracks=tracks)
         # cached_property keeps its values in the instance's dict: the ones that do not
         # depend on the positions are handed on
-        for name in ("facts", "_made_of_events"):
+        for name in ("facts", "_made_of_events", "instance_records"):
             if name in self.__dict__:
                 moved.__dict__[name] = self.__dict__[name]
         return moved
@@ -228,6 +244,17 @@ def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) 
     ``slow`` is :func:`slow_limits` of ``log`` when it was kept, else it is computed here."""
     # also checks the run exists; a robot with a bar on the timeline has an instance here
     run_messages, lanes = case_messages(log, case)
+    events = run_events(log, case)
+    found = activity_instances(events)
+    if slow is None:
+        # a log of this run alone, in time order (a live run's): its instances are the log's
+        alone = len(events) == len(log) and events.index.equals(log.index)
+        slow = _slow_limits_of(found) if alone else slow_limits(log)
+    return _assembled(str(case), events, found, run_messages, lanes, slow)
+
+
+def run_events(log: pd.DataFrame, case: str) -> pd.DataFrame:
+    """The events of run ``case`` of ``log`` in time order, each with its robot's name."""
     cases = log[CASE].astype("string")
     events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
     events = events.sort_values(TIMESTAMP, kind="stable")
@@ -236,13 +263,42 @@ def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) 
         if ROBOT in events.columns
         else pd.Series(NO_ROBOT, index=events.index)
     )
-    events = events.assign(**{ROBOT: robots_column.astype(str)})
+    return events.assign(**{ROBOT: robots_column.astype(str)})
+
+
+def lone_run(events: pd.DataFrame, case: str, found: pd.DataFrame) -> MissionRun:
+    """The run ``case`` of a log holding only it (a live run's), its :func:`run_events` being
+    ``events`` and their :func:`activity_instances` ``found``: what :func:`mission_run`
+    makes of that log, without pairing the activities again."""
+    # the messages and lanes are read of the events that carry a message or a battery level
+    # (a message's delay is judged among all of them); the first event names the run
+    carrying = events[MSG_ID].notna() if MSG_ID in events.columns else events[ROBOT].isna()
+    if BATTERY in events.columns:
+        carrying |= pd.to_numeric(events[BATTERY], errors="coerce").notna()
+    carrying.iloc[0] = True
+    run_messages, lanes = case_messages(events[carrying.to_numpy(bool)], case)
+    return _assembled(str(case), events, found, run_messages, lanes, _slow_limits_of(found))
+
+
+def open_from(found: pd.DataFrame, last: pd.Timestamp) -> pd.Timestamp:
+    """The start of the earliest activity instance still open among ``found`` (of a run whose
+    events end at ``last``), else ``last``: a later event can change no instance that started
+    earlier, since all of those ended."""
+    still_open = ~found[FINISHED].astype(bool)
+    return min(found[START_TIMESTAMP][still_open].min(), last) if still_open.any() else last
+
+
+def _assembled(
+    case: str,
+    events: pd.DataFrame,
+    found: pd.DataFrame,
+    run_messages: pd.DataFrame,
+    lanes: set[str],
+    slow: pd.DataFrame,
+) -> MissionRun:
+    """The run of its :func:`run_events`, their instances ``found``, its messages and lanes
+    as :func:`case_messages` reads them, and the ``slow`` limits."""
     start = events[TIMESTAMP].iloc[0]
-    found = activity_instances(events)
-    if slow is None:
-        # a log of this run alone, in time order (a live run's): its instances are the log's
-        alone = len(events) == len(log) and events.index.equals(log.index)
-        slow = _slow_limits_of(found) if alone else slow_limits(log)
     events = events.assign(s=_seconds(events[TIMESTAMP], start))
     instances = _instances(found, start)
     messages = _messages(run_messages, start)
@@ -250,7 +306,7 @@ def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) 
     # a robot whose only activity is still running (a live run's) has no bar yet, but a lane
     robots = sorted(lanes | set(positions["robot"]) | set(instances["robot"]))
     return MissionRun(
-        case=str(case),
+        case=case,
         start=start,
         duration=float(events["s"].iloc[-1]),
         robots=robots,

@@ -20,17 +20,21 @@ import numpy as np
 import pandas as pd
 from neo4j import Driver
 
+from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
 from robotale.ekg.connection import database
 from robotale.ekg.live import Pose, live_poses, live_tags
-from robotale.enhancement.mission import MissionRun
+from robotale.enhancement.mission import MissionRun, lone_run, open_from, run_events
 from robotale.enhancement.mission_state import Tracks
 from robotale.eventlog import schema
+from robotale.eventlog.enrich import pair_activities
 from robotale.eventlog.prepare import tags_log
 from robotale.eventlog.runs import robot_type
 from robotale.fame_runtime.tags import Tag, tag_nanoseconds, tag_topic
 from robotale.queries import cypher
 from robotale.results.replay import Replay
 
+#: a stamp no end has: the start is still open
+NEVER = np.iinfo(np.int64).max
 _lock = threading.Lock()
 #: live log name -> what a reader holds of it: its tags and samples, and the replay built
 _kept: dict[str, _Kept] = {}
@@ -110,12 +114,149 @@ def _positions(poses: list[Pose], at: float) -> pd.DataFrame:
 
 @dataclass
 class _Kept:
-    """What a reader holds of a live run: every tag and sample read so far, and the replay
-    built of them."""
+    """What a reader holds of a live run: every tag and sample read so far, the events and
+    activity instances made of the tags, and the replay built of them."""
 
     tags: list[Tag] = field(default_factory=list)
+    heard: Heard = field(default_factory=lambda: Heard())
     positions: Positions = field(default_factory=Positions)
+    events: pd.DataFrame | None = None
+    #: :func:`activity_instances` of the run's events
+    found: pd.DataFrame | None = None
     replay: LiveReplay | None = None
+
+    def grow(self, name: str, tags: list[Tag]) -> tuple[pd.DataFrame, MissionRun]:
+        """Take the newly read ``tags`` in; the events and the run they make with the ones
+        held. Only the tail is made again, from the earliest activity still open at the last
+        look on, with the starts of the activities that straddle that moment (so their ends
+        pair as in the whole run): the events and instances before it are kept. The whole
+        run is made again when a new tag is older than that moment, or when the enrichment
+        and the activity instances would not pair the same starts across it."""
+        self.tags += tags
+        self.heard.add(tags)
+        fresh = self.heard.nanos[len(self.tags) - len(tags) :]
+        # made again whole when the tail will not do
+        made = self._made(name, self._tail(fresh)) or self._made(name, None)
+        assert made is not None  # the whole run is always made
+        events, found, unchanged = made
+        run = lone_run(run_events(events, name), name, found)
+        before = self.replay.runs.get(name) if self.replay is not None else None
+        if unchanged and before is not None:
+            run.grown_from(before, unchanged)
+        self.events, self.found = events, found
+        return events, run
+
+    def _made(
+        self, name: str, tail: tuple[int, np.ndarray] | None
+    ) -> tuple[pd.DataFrame, pd.DataFrame, int] | None:
+        """The run's events and activity instances made again from the ``tail`` (from when,
+        and of which tags) or whole (None), and how many of the first instances stay as they
+        were; None when an instance kept and one made again start at once (the order of the
+        two is not told without their start events)."""
+        cut, chosen = (
+            tail if tail is not None else (np.iinfo(np.int64).min, np.arange(len(self.tags)))
+        )
+        frame, rows = _tag_frame(name, self.tags, self.heard, chosen)
+        made = tags_log(frame)
+        found = activity_instances(run_events(made, name))
+        if tail is None or self.events is None or self.found is None:
+            self.heard.pair(frame, rows)
+            return made, found, 0
+        # the instances over by the cut are kept; the straddling ones are made again
+        ended = _nanos(self.found[schema.TIMESTAMP]) < cut
+        earlier = self.found[ended & self.found[FINISHED].to_numpy(bool)]
+        begun = np.concatenate([_nanos(earlier[START_TIMESTAMP]), _nanos(found[START_TIMESTAMP])])
+        if _same_starts(earlier, found):
+            return None
+        self.heard.pair(frame, rows)
+        first = begun[len(earlier) :].min() if len(found) else NEVER
+        order = np.argsort(begun, kind="stable")
+        found = pd.concat([earlier, found], ignore_index=True).iloc[order]
+        # the instances kept that start before any made again lead the run's table as they
+        # led it at the last look
+        unchanged = int((begun[: len(earlier)] < first).sum())
+        kept = int(np.searchsorted(_nanos(self.events[schema.TIMESTAMP]), cut))
+        # the straddling starts and their inprogress events before the cut are kept already;
+        # the rest numbered as in the whole run, after the events kept
+        made = made[_nanos(made[schema.TIMESTAMP]) >= cut].reset_index(drop=True)
+        position = pd.Series(np.arange(kept, kept + len(made)), index=made.index)
+        made[schema.EVENT_ID] = made[schema.CASE].astype(str) + ":" + position.astype(str)
+        events = _joined(self.events.iloc[:kept], made)
+        return events, found.reset_index(drop=True), unchanged
+
+    def _tail(self, fresh: np.ndarray) -> tuple[int, np.ndarray] | None:
+        """From when (nanoseconds) the run is made again, and the tags (heard positions)
+        that make it: every one from then on and the starts of the activities straddling
+        then. None when the whole run is made again."""
+        if self.events is None or self.found is None or not len(self.events):
+            return None
+        found, heard = self.found, self.heard
+        cut = open_from(found, self.events[schema.TIMESTAMP].iloc[-1]).value
+        starting = heard.starting
+        never = starting & (heard.ended == NEVER)
+        if never.any():  # a start the enrichment left open, its instance ended
+            cut = min(cut, int(heard.nanos[never].min()))
+        if len(fresh) and fresh.min() < cut:
+            return None
+        straddling = np.flatnonzero(starting & (heard.nanos < cut) & (heard.ended >= cut))
+        starts, ends = _nanos(found[START_TIMESTAMP]), _nanos(found[schema.TIMESTAMP])
+        over = found[(starts < cut) & (ends >= cut) & found[FINISHED].to_numpy(bool)]
+        begun = self._starts(over)
+        if begun is None or not np.array_equal(np.sort(begun), straddling):
+            return None  # the two pairings differ across the cut
+        return cut, np.union1d(straddling, np.flatnonzero(heard.nanos >= cut))
+
+    def _starts(self, instances: pd.DataFrame) -> np.ndarray | None:
+        """The positions of the start tags of ``instances``, or None when they are not
+        each told apart by robot, activity and stamp."""
+        at = dict.fromkeys(
+            zip(
+                instances[schema.ROBOT].astype(str),
+                instances[schema.ACTIVITY].astype(str),
+                _nanos(instances[START_TIMESTAMP]).tolist(),
+                strict=True,
+            ),
+            -1,
+        )
+        if len(at) < len(instances):
+            return None
+        for index in np.flatnonzero(np.isin(self.heard.nanos, [key[2] for key in at])):
+            tag = self.tags[index]
+            key = (tag.robot, tag.activity, int(self.heard.nanos[index]))
+            if key in at and tag.lifecycle == schema.START:
+                if at[key] != -1:
+                    return None  # two starts alike: which one began it is not told
+                at[key] = int(index)
+        begun = np.array(list(at.values()), dtype=np.int64)
+        return None if (begun == -1).any() else begun
+
+
+def _joined(kept: pd.DataFrame, made: pd.DataFrame) -> pd.DataFrame:
+    """The events ``kept`` followed by those ``made`` again, each column of the type the
+    whole run's values give it (a column of no message ids yet is of objects, one with some
+    of strings)."""
+    events = pd.concat([kept, made], ignore_index=True)
+    for column in made.columns:
+        if column in kept.columns and kept[column].dtype != made[column].dtype:
+            events[column] = pd.Series(events[column].tolist(), name=column)
+    return events
+
+
+def _same_starts(kept: pd.DataFrame, made: pd.DataFrame) -> bool:
+    """Whether an instance ``kept`` and one ``made`` again are a robot's at the same moment."""
+
+    def starts(found: pd.DataFrame) -> pd.MultiIndex:
+        return pd.MultiIndex.from_arrays(
+            [found[schema.ROBOT].astype(str), _nanos(found[START_TIMESTAMP])]
+        )
+
+    return bool(starts(made).isin(starts(kept)).any())
+
+
+def _nanos(times: pd.Series) -> np.ndarray:
+    """Nanoseconds since the Unix epoch of ``times`` (UTC)."""
+    nanos: np.ndarray = pd.DatetimeIndex(times).asi8
+    return nanos
 
 
 def live_count(driver: Driver, name: str) -> int:
@@ -140,27 +281,72 @@ def tags_events(name: str, tags: Sequence[Tag]) -> pd.DataFrame:
     of its recording: one event per tag, ordered by its stamp and, at equal stamps, in the
     order they were heard (a robot's start before its own completion), its robot's tag topic
     and the tag's position there as its source; then enriched as :func:`tags_log` does."""
-    nanos = np.array([tag_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
-    robots = [t.robot for t in tags]
+    heard = Heard()
+    heard.add(tags)
+    return tags_log(_tag_frame(name, tags, heard, np.arange(len(tags)))[0])
+
+
+class Heard:
+    """What orders and places the tags of a live run: each one's stamp (nanoseconds) and its
+    position among its robot's tags (its source index), in the order they were heard."""
+
+    def __init__(self) -> None:
+        self.nanos = np.empty(0, dtype=np.int64)
+        self.sources = np.empty(0, dtype=np.int64)
+        #: for each start, the stamp of the end the enrichment pairs it with (:data:`NEVER`
+        #: while none does); for other tags unread
+        self.ended = np.empty(0, dtype=np.int64)
+        #: whether each tag starts an activity
+        self.starting = np.empty(0, dtype=bool)
+        self.counts: dict[str, int] = {}
+
+    def add(self, tags: Sequence[Tag]) -> None:
+        sources = []
+        for tag in tags:
+            sources.append(self.counts.get(tag.robot, 0))
+            self.counts[tag.robot] = sources[-1] + 1
+        nanos = np.array([tag_nanoseconds(t.stamp) for t in tags], dtype=np.int64)
+        self.nanos = np.concatenate([self.nanos, nanos])
+        self.sources = np.concatenate([self.sources, np.array(sources, dtype=np.int64)])
+        self.ended = np.concatenate([self.ended, np.full(len(tags), NEVER, dtype=np.int64)])
+        starting = np.array([tag.lifecycle == schema.START for tag in tags], dtype=bool)
+        self.starting = np.concatenate([self.starting, starting])
+
+    def pair(self, frame: pd.DataFrame, rows: np.ndarray) -> None:
+        """Note which end closes each start among the tags of ``frame`` (as
+        :func:`_tag_frame` made it, ``rows`` their heard positions), as the enrichment
+        pairs them."""
+        starts, ends, _ = pair_activities(frame)
+        self.ended[rows] = NEVER
+        self.ended[rows[starts]] = self.nanos[rows[ends]]
+
+
+def _tag_frame(
+    name: str, tags: Sequence[Tag], heard: Heard, chosen: np.ndarray
+) -> tuple[pd.DataFrame, np.ndarray]:
+    """The ``chosen`` tags as the rows :func:`tags_log` enriches, ordered by stamp and, at
+    equal stamps, as heard; and each row's position in heard order."""
+    nanos = heard.nanos[chosen]
+    robots = [tags[i].robot for i in chosen]
     types = {robot: robot_type(robot) for robot in set(robots)}  # a few robots, many tags
     frame = pd.DataFrame(
         {
             schema.CASE: name,
             schema.TIMESTAMP: pd.to_datetime(nanos, unit="ns", utc=True),
-            schema.ACTIVITY: [t.activity for t in tags],
-            schema.LIFECYCLE: [t.lifecycle for t in tags],
+            schema.ACTIVITY: [tags[i].activity for i in chosen],
+            schema.LIFECYCLE: [tags[i].lifecycle for i in chosen],
             schema.ROBOT: robots,
             # a live run has no manifest: each robot's type from its name, as prepare's
             schema.ROBOT_TYPE: [types[r] for r in robots],
-            schema.MSG_ID: [t.msg_id or None for t in tags],
-            schema.MSG_ROLE: [t.msg_role or None for t in tags],
-            schema.MSG_PAYLOAD: [t.payload or None for t in tags],
+            schema.MSG_ID: [tags[i].msg_id or None for i in chosen],
+            schema.MSG_ROLE: [tags[i].msg_role or None for i in chosen],
+            schema.MSG_PAYLOAD: [tags[i].payload or None for i in chosen],
             schema.SOURCE_TOPIC: [tag_topic(r) for r in robots],
+            schema.SOURCE_INDEX: heard.sources[chosen],
         }
     )
-    frame[schema.SOURCE_INDEX] = frame.groupby(schema.ROBOT, sort=False).cumcount()
-    frame = frame.iloc[np.argsort(nanos, kind="stable")].reset_index(drop=True)
-    return tags_log(frame)
+    order = np.argsort(nanos, kind="stable")
+    return frame.iloc[order].reset_index(drop=True), np.asarray(chosen)[order]
 
 
 def live_replay(driver: Driver, name: str) -> Replay | None:
@@ -182,11 +368,10 @@ def live_replay(driver: Driver, name: str) -> Replay | None:
         old = kept.replay
         if old is not None and not new_tags and not new_poses:
             return old
-        kept.tags += new_tags
         kept.positions.add(new_poses)
         if old is None or new_tags:
-            events = tags_events(name, kept.tags)
-            kept.replay = LiveReplay(name, events, {}, positions=kept.positions)
+            events, run = kept.grow(name, new_tags)
+            kept.replay = LiveReplay(name, events, {}, positions=kept.positions, bare={name: run})
         else:  # the same events: the runs they make are kept, their positions grown
             kept.replay = LiveReplay(name, old.events, {}, positions=kept.positions, bare=old.bare)
         return kept.replay

@@ -135,3 +135,54 @@ def test_the_mission_page_follows_a_live_run_until_moved_back(page, live):
     page.keyboard.press("End")
     tags(live, [(12.0, "rover", "survey", "start")])
     wait_for(page, f"Number({root}.dataset.t) === 12")
+
+
+def test_a_run_grown_in_batches_equals_the_run_made_of_all_its_tags(
+    live, neo4j_driver, monkeypatch
+):
+    """Tags stored in batches, one closing an activity opened in an earlier one, a message
+    sent in one and received in a later one, another older than the last look's open
+    activities: after each look, the run the reader grew equals the one made afresh of every
+    tag written (events, instances, messages, moments, the state at moments in between),
+    and some look made only the tail again."""
+    import pandas as pd
+
+    from robotale.enhancement.mission import mission_run
+    from robotale.results import live as reading
+
+    remade: list[tuple[int, int]] = []  # (tags made again, tags held) at each making
+    tag_frame = reading._tag_frame
+
+    def counted(name, held, heard, chosen):
+        remade.append((len(chosen), len(held)))
+        return tag_frame(name, held, heard, chosen)
+
+    monkeypatch.setattr(reading, "_tag_frame", counted)
+    batches = [
+        [(0, "rover", "survey", "start", ""), (1.5, "drone", "scan", "start", ""),
+         (2, "rover", "survey", "complete", ""), (2.5, "rover", "call", "start", "send")],
+        [(2.5, "rover", "call", "complete", "send"), (3, "rover", "dock", "start", ""),
+         (4, "drone", "scan", "complete", "")],
+        [(4.5, "drone", "hear", "start", "receive"), (4.5, "drone", "hear", "complete", "receive"),
+         (6, "rover", "dock", "complete", ""), (6, "drone", "scan", "start", "")],
+        [(7, "rover", "survey", "start", ""), (8, "drone", "scan", "complete", ""),
+         (9, "rover", "survey", "complete", "")],
+        [(8.5, "drone", "land", "start", ""), (9.5, "drone", "land", "complete", "")],
+        [(1, "drone", "late", "start", ""), (1.2, "drone", "late", "complete", "")],
+    ]  # fmt: skip
+    written: list[Tag] = []
+    for batch in batches:
+        for s, robot, activity, lifecycle, role in batch:
+            tag = Tag(T0 + s, robot, activity, lifecycle, "m1" if role else "", role)
+            live.append(tag)
+            written.append(tag)
+        run = reading.live_replay(neo4j_driver, live.name).run(live.name)
+        whole = mission_run(reading.tags_events(live.name, written), live.name)
+        for table in ("events", "instances", "messages", "moments"):
+            pd.testing.assert_frame_equal(getattr(run, table), getattr(whole, table), obj=table)
+        assert (run.robots, run.duration) == (whole.robots, whole.duration)
+        assert run.summary() == whole.summary()  # its records partly kept from the last look
+        for t in (0.5, 2.5, 4.5, 6.0, 8.7, 9.5):
+            assert run.state(t) == whole.state(t), t
+    assert len(whole.messages) == 1 and whole.messages["receiver"].iloc[0] == "drone"
+    assert any(chosen < held for chosen, held in remade)
