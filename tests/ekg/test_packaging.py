@@ -23,8 +23,9 @@ def test_queries_load_from_the_checkout():
 
 def test_statements_split_on_semicolons_and_drop_comments():
     parts = statements("ekg_delete_log")
-    # events, attribute changes, entities, classes, aggregates, steps, the Log node
-    assert len(parts) == 7
+    # events, attribute changes, entities, classes, aggregates, the aggregates' member lists,
+    # steps, the Log node
+    assert len(parts) == 8
     assert all(not part.startswith("//") and not part.endswith(";") for part in parts)
     assert parts[-1].startswith("MATCH (l:Log {name: $log})")
 
