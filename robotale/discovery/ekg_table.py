@@ -25,11 +25,11 @@ from robotale.ekg.load import neo4j_values
 from robotale.ekg.tables import (
     ClassTables,
     GraphTables,
-    _utc_ticks,
     class_tables,
     graph_tables,
     instance_ends,
     property_name,
+    utc_ticks,
 )
 from robotale.eventlog import schema
 
@@ -146,7 +146,7 @@ def _comm_rows(tables: GraphTables, classes: ClassTables) -> list[dict[str, Any]
         return []
     source = comm["source"].to_numpy(dtype=np.int64)
     target = comm["target"].to_numpy(dtype=np.int64)
-    ticks = _utc_ticks(tables.events)
+    ticks = utc_ticks(tables.events)
     messages = pd.DataFrame(
         {
             "a": classes.observed[source],

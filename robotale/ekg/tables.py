@@ -243,7 +243,7 @@ def _directly_follows(
     chain = entity * (len(names) + 1) + case
     chain[case < 0] = -1 - np.arange(int((case < 0).sum()))  # each a chain of its own
     # sorting by event position last makes the log order break ties between equal times
-    order = np.lexsort((event, _utc_ticks(events)[event], chain))
+    order = np.lexsort((event, utc_ticks(events)[event], chain))
     ordered_event, ordered_entity, ordered_chain = event[order], entity[order], chain[order]
     same = ordered_chain[1:] == ordered_chain[:-1]
     # each entity's type and id taken from the entity table's own arrays: an array of
@@ -303,7 +303,7 @@ def instance_ends(events: pd.DataFrame) -> np.ndarray:
     return ends
 
 
-def _utc_ticks(events: pd.DataFrame) -> np.ndarray:
+def utc_ticks(events: pd.DataFrame) -> np.ndarray:
     """The events' times as nanoseconds since the epoch (UTC), compared as integers."""
     times = events["timestamp"].dt.tz_convert("UTC").dt.as_unit("ns")
     ticks: np.ndarray = (
@@ -421,7 +421,7 @@ def _neo4j_text(values: pd.Series) -> pd.Series:
 
 
 def _seconds_between(events: pd.DataFrame, source: np.ndarray, target: np.ndarray) -> np.ndarray:
-    seconds, part = np.divmod(_utc_ticks(events), 1_000_000_000)
+    seconds, part = np.divmod(utc_ticks(events), 1_000_000_000)
     between: np.ndarray = (seconds[target] - seconds[source]) + (part[target] - part[source]) / 1e9
     return between
 
