@@ -13,6 +13,7 @@ says how often, not why.
 from __future__ import annotations
 
 import itertools
+import keyword
 import re
 from xml.sax.saxutils import escape, quoteattr
 
@@ -34,6 +35,7 @@ from robotale.discovery.layout import (
     leaves,
     simplify,
 )
+from robotale.discovery.payload_choices import separating
 from robotale.discovery.repeats import once
 from robotale.eventlog.schema import RECEIVE, SEND
 from robotale.fame_runtime.labels import activity_label
@@ -156,6 +158,8 @@ class _PoolDrawing:
                 # event-based gateway, not a draw that may wait for what never comes
                 self.event_based.add(split.id)
                 continue
+            if self._payload_choice(split, flows, fragment, outgoing):
+                continue
             back = _back_flow(split.id, flows, outgoing)
             if back is not None:  # a loop's split: round again with the log's share, else on
                 redo = self._redo_share(block, split, fragment, traces)
@@ -167,6 +171,29 @@ class _PoolDrawing:
                 share = 1 / (len(flows) - number)
                 self.conditions[flow.id] = f'__import__("random").random() < {share:.3f}'
             self.defaults[split.id] = flows[-1].id
+
+    def _payload_choice(
+        self, split: Shape, flows: list[Flow], fragment: Fragment, outgoing: dict[str, list[Flow]]
+    ) -> bool:
+        """Conditions on a two-way choice made after a catch, when a test of the caught
+        payload separates the branches in every catch of the log (:mod:`payload_choices`);
+        False when there is no such test."""
+        if len(flows) != 2 or not self.pool.caught or split.id not in self.builder.joins:
+            return False  # a loop's split is no choice
+        catch = _nearest_catch(split, fragment, outgoing, set(self.pool.caught))
+        variable = signal_of(catch.label).replace("/", "_") if catch else ""
+        if catch is None or not variable.isidentifier() or keyword.iskeyword(variable):
+            return False
+        join = self.builder.joins.get(split.id)
+        labels = {s.id: s.label for s in fragment.shapes if s.kind in ("task", "throw", "catch")}
+        branches = [frozenset(_inside(flow.target, join, outgoing, labels)) for flow in flows]
+        found = separating(self.pool.caught[catch.label], branches)
+        if found is None:
+            return False
+        test, chosen = found
+        for number, flow in enumerate(flows):
+            self.conditions[flow.id] = test.expression(variable, holds=number == chosen)
+        return True
 
     def _redo_share(
         self, block: Block, split: Shape, fragment: Fragment, traces: int
@@ -209,6 +236,66 @@ def _back_flow(split: str, flows: list[Flow], outgoing: dict[str, list[Flow]]) -
         if steps is not None and (best is None or steps < best[0]):
             best = (steps, number)
     return None if best is None else flows[best[1]]
+
+
+def _nearest_catch(
+    split: Shape, fragment: Fragment, outgoing: dict[str, list[Flow]], labels: set[str]
+) -> Shape | None:
+    """The catch of one of ``labels`` nearest before ``split`` that every path from the
+    fragment's entry to the split passes (so the message was caught when the choice is
+    made); ``None`` when there is none."""
+    best: tuple[int, Shape] | None = None
+    for shape in fragment.shapes:
+        if shape.kind != "catch" or shape.label not in labels or fragment.entry is None:
+            continue
+        if _reaches(fragment, split.id, avoiding=shape.id):
+            continue  # a way round the catch
+        steps = _steps_to(shape.id, split.id, outgoing)
+        if steps is not None and (best is None or steps < best[0]):
+            best = (steps, shape)
+    return None if best is None else best[1]
+
+
+def _reaches(fragment: Fragment, goal: str, *, avoiding: str) -> bool:
+    """Whether a token can reach ``goal`` from the fragment's entry without passing
+    ``avoiding``: a parallel join goes on only once all its incoming flows are reached."""
+    kinds = {shape.id: shape.kind for shape in fragment.shapes}
+    incoming: dict[str, set[str]] = {}
+    for flow in fragment.flows:
+        incoming.setdefault(flow.target, set()).add(flow.source)
+    reached = {fragment.entry}
+    grew = True
+    while grew:
+        grew = False
+        for flow in fragment.flows:
+            node = flow.target
+            if node in reached or node == avoiding or flow.source not in reached:
+                continue
+            if kinds.get(node) == "and" and not incoming[node] <= reached:
+                continue
+            reached.add(node)
+            grew = True
+    return goal in reached
+
+
+def _inside(
+    start: str, join: str | None, outgoing: dict[str, list[Flow]], labels: dict[str, str]
+) -> set[str]:
+    """The activities and events of a branch: what is reached from its first element before
+    the gateway joining the branches."""
+    found: set[str] = set()
+    seen, frontier = {start}, [start]
+    while frontier:
+        node = frontier.pop()
+        if node == join:
+            continue
+        if node in labels:
+            found.add(labels[node])
+        for flow in outgoing.get(node, []):
+            if flow.target not in seen:
+                seen.add(flow.target)
+                frontier.append(flow.target)
+    return found
 
 
 def _steps_to(start: str, goal: str, outgoing: dict[str, list[Flow]]) -> int | None:

@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import itertools
 from collections import Counter, defaultdict
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
@@ -39,12 +40,14 @@ from robotale.discovery.instances import (
     sort_codes,
 )
 from robotale.discovery.layout import Block, Tau, from_process_tree
+from robotale.discovery.payload_choices import Caught, payload_fields, windows
 from robotale.errors import InputError
 from robotale.eventlog.prepare import robot_type
 from robotale.eventlog.schema import (
     ACTIVITY,
     CASE,
     LIFECYCLE,
+    MSG_PAYLOAD,
     MSG_ROLE,
     RECEIVE,
     REQUIRED,
@@ -117,6 +120,8 @@ class Pool:
     traces: int
     #: the signal whose every receipt starts an instance (``None``: one instance per run)
     starts_on: str | None = None
+    #: each message the process catches with a payload: every catch, what came after it
+    caught: dict[str, list[Caught]] = field(default_factory=dict)
 
     @property
     def multi_instance(self) -> bool:
@@ -261,6 +266,10 @@ class Traces:
     starts: np.ndarray
     ends: np.ndarray
     offsets: list[int]
+    #: each received instance's payload fields (:func:`payload_fields`), position by
+    #: position; ``None`` when the log has no payload of a received message
+    payloads: list[list[tuple[tuple[str, str], ...]]] | None = None
+    robots: list[str] = field(default_factory=list)  # each trace's robot
 
     def times(self, number: int) -> tuple[np.ndarray, np.ndarray]:
         """Trace ``number``'s start and end times."""
@@ -284,6 +293,7 @@ def per_trace(instances: pd.DataFrame) -> Traces:
 
     # an instance that never ended runs on past everything after it
     until = instances[TIMESTAMP].where(instances[FINISHED].astype(bool))
+    fields = _received_payloads(instances)
     return Traces(
         labels=cut(instances[ACTIVITY].astype(str).to_numpy(object)),
         roles=cut(instances["_role"].to_numpy(object)),
@@ -291,7 +301,28 @@ def per_trace(instances: pd.DataFrame) -> Traces:
         starts=_times(instances[START_TIMESTAMP]),
         ends=_times(until),
         offsets=offsets,
+        payloads=None if fields is None else cut(fields),
+        robots=instances[ROBOT].to_numpy(object)[offsets[:-1]].tolist(),
     )
+
+
+def _received_payloads(instances: pd.DataFrame) -> np.ndarray | None:
+    """Each instance's payload fields where it received a message with one (each distinct
+    payload text read once); ``None`` when no received message has a payload."""
+    if MSG_PAYLOAD not in instances.columns:
+        return None
+    received = (instances["_role"] == RECEIVE).to_numpy(bool) & instances[
+        MSG_PAYLOAD
+    ].notna().to_numpy(bool)
+    if not received.any():
+        return None
+    codes, texts = pd.factorize(instances[MSG_PAYLOAD].to_numpy(object)[received])
+    parsed = np.empty(len(texts), dtype=object)
+    parsed[:] = [payload_fields(text) for text in texts]
+    fields = np.empty(len(instances), dtype=object)
+    fields[:] = [()] * len(instances)
+    fields[received] = parsed[codes]
+    return fields
 
 
 def _times(times: pd.Series) -> np.ndarray:
@@ -341,6 +372,7 @@ class _Split:
     tags: dict[str, list[tuple[str, ...]]] = field(default_factory=lambda: defaultdict(list))
     went_on: dict[str, bool] = field(default_factory=lambda: defaultdict(bool))
     abandoned: dict[str, Counter] = field(default_factory=lambda: defaultdict(Counter))
+    caught: dict[str, list[Caught]] = field(default_factory=lambda: defaultdict(list))
 
 
 @dataclass(slots=True)
@@ -425,9 +457,11 @@ def split_traces(traces: Traces, found: set[str], heard: Heard | None = None) ->
     for number, (labels, aborted) in enumerate(zip(traces.labels, traces.aborted, strict=True)):
         if not cutting.intersection(labels):  # most traces: nothing to cut
             result.main.append(labels)
+            _catches(result, traces, number, range(len(labels)))
             continue
         starts, ends = traces.times(number)
         main: list[str] = []
+        kept: list[int] = []
         position = 0
         while position < len(labels):
             label = labels[position]
@@ -440,6 +474,7 @@ def split_traces(traces: Traces, found: set[str], heard: Heard | None = None) ->
                 continue
             if label not in found:
                 main.append(label)
+                kept.append(position)
                 position += 1
                 continue
             for before in range(position - 1, -1, -1):
@@ -454,7 +489,25 @@ def split_traces(traces: Traces, found: set[str], heard: Heard | None = None) ->
             result.went_on[label] |= end < len(labels)
             position = end
         result.main.append(main)
+        _catches(result, traces, number, kept)
     return result
+
+
+def _catches(result: _Split, traces: Traces, number: int, kept: Sequence[int]) -> None:
+    """The catches with a payload among trace ``number``'s instances ``kept`` in the
+    process, each with the activities of the process after it (:func:`windows`)."""
+    if traces.payloads is None:
+        return
+    fields = traces.payloads[number]
+    if not any(fields[position] for position in kept):
+        return
+    labels, roles = traces.labels[number], traces.roles[number]
+    caught = {labels[position] for position in kept if roles[position] == RECEIVE}
+    robot = traces.robots[number]
+    main = [labels[position] for position in kept]
+    for label, found in windows(main, [fields[p] for p in kept], caught).items():
+        for at, after in found:
+            result.caught[label].append(Caught(fields[kept[at]], robot, after))
 
 
 def _busy_end(traces: Traces, heard: Heard, number: int, trigger: int) -> int:
@@ -517,7 +570,7 @@ def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
 
 #: the columns discovery reads: the rest of a log (positions, batteries ...) is not carried
 #: through the pairing and the split into pools
-_READ = {*REQUIRED, ROBOT, ROBOT_TYPE, LIFECYCLE, STATE, MSG_ROLE, *INSTANCE_KEYS}
+_READ = {*REQUIRED, ROBOT, ROBOT_TYPE, LIFECYCLE, STATE, MSG_ROLE, MSG_PAYLOAD, *INSTANCE_KEYS}
 
 
 def discover_collaboration(
@@ -559,6 +612,7 @@ def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool
         handlers=handlers,
         stats=_stats(instances),
         traces=len(parts.main),
+        caught=dict(parts.caught),
     )
 
 

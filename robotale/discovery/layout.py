@@ -185,6 +185,8 @@ class Builder:
     def __init__(self, ids: Callable[[str], str], kind_of: Callable[[str], Kind]) -> None:
         self.ids = ids
         self.kind_of = kind_of
+        #: each split gateway of :meth:`branches` and the gateway joining its branches
+        self.joins: dict[str, str] = {}
 
     def fragment(self, block: Block) -> Fragment:
         if isinstance(block, Tau):
@@ -235,6 +237,7 @@ class Builder:
         mid = y + first_mid
         result = Fragment(mid=mid)
         s, j = split.shapes[0], join.shapes[0]
+        self.joins[s.id] = j.id
         s.x, s.y = 0, mid - GATEWAY / 2
         j.x, j.y = GATEWAY + 2 * GAP_X + inner_w, mid - GATEWAY / 2
         result.shapes += [s, j]

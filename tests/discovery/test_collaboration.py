@@ -116,3 +116,24 @@ def test_conformance_reports_precision_one_only_where_the_model_allows_nothing_m
     # the thesis' tractors' model allows any interleaving of their loops: far from exact
     loose = check_conformance(thesis_days, discovered).robots
     assert (loose["precision"] < 0.9).all() and (loose["precision"] > 0).all()
+
+
+def test_the_tractors_cut_grass_when_closest_tractor_names_them(thesis_days):
+    """The payload rule of FAME's tractor (``tractor === namespace``), found in the log: the
+    test of the caught ``name`` against the tractor's own name separates cutting grass from
+    not, in every catch (the thesis' duplicate deliveries read once). The miner draws the
+    catch beside the tractors' work rather than before a choice, so the written model has
+    no choice to put it on."""
+    from robotale.discovery.payload_choices import Test, separating
+
+    tractor = discover_collaboration(thesis_days).pool("Tractor")
+    caught = tractor.caught["closest_tractor?"]
+    assert separating(caught, [frozenset(), frozenset({"cut_grass"})]) == (Test("name", None), 1)
+    # with pandas: each tractor cut grass once per closest_tractor naming it
+    starts = thesis_days[thesis_days["lifecycle:transition"] == "start"]
+    names = starts["concept:name"].astype(str)
+    got = starts[(names == "closest_tractor?") & starts["robot"].str.startswith("tractor")]
+    mine = got[[robot in str(p) for p, robot in zip(got["msg_payload"], got["robot"], strict=True)]]
+    cut = starts[names == "cut_grass"]
+    assert mine.groupby("robot").size().to_dict() == cut.groupby("robot").size().to_dict()
+    assert sum(Test("name", None).holds(one) for one in caught) == len(cut)

@@ -120,6 +120,23 @@ def test_the_marked_model_draws_what_was_never_used(tmp_path, capsys):
     named = _named_without_signal(etree.parse(str(model)))
     assert {named[pool][key] for pool, key in expected} <= red
     assert red == {i for row in found["unused_elements"] for i in row["ids"]}
+    # the tractors cut grass exactly after a closest_tractor naming them (counted with
+    # pandas), as the driving model's condition has it: the discovered choice reads so too
+    starts = log[log["lifecycle:transition"] == "start"]
+    names = starts["concept:name"]
+    got = starts[(names == "closest_tractor?") & (starts["robot_type"] == "Tractor")]
+    mine = got[
+        [json.loads(p)["data"] == r for p, r in zip(got["msg_payload"], got["robot"], strict=True)]
+    ]
+    cut = starts[names == "cut_grass"]
+    assert mine.groupby("robot").size().to_dict() == cut.groupby("robot").size().to_dict()
+    flows = {
+        f.findtext(f"{BPMN}conditionExpression"): f.get("targetRef")
+        for f in etree.parse(str(discovered)).iter(f"{BPMN}sequenceFlow")
+    }
+    target = flows["closest_tractor.get('data') == robot.name"]
+    assert "closest_tractor.get('data') != robot.name" in flows
+    assert etree.parse(str(discovered)).find(f".//*[@id='{target}']").get("name") == "Cut Grass"
 
 
 def test_diff_names_signals_thrown_but_never_caught(mission):

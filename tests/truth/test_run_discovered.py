@@ -12,6 +12,7 @@ checks that exactly those types miss their top variants, rather than skipping.
 
 from __future__ import annotations
 
+import json
 import random
 import sys
 import warnings
@@ -248,11 +249,9 @@ def test_the_agri_mission_runs_discovered_and_the_drone_hears_the_weeds(tmp_path
     model catches with an event sub-process listening all along. The log has every receipt
     inside an Explore, so the discovered model catches it with a non-interrupting event
     sub-process too; run in the agri world, the drone hears the weeds and reports them, the
-    tractors answer with their positions and the closest one moves to the weed. (Whether a
-    tractor moves and cuts is a draw of the discovered tractor's choices. The log holds the
-    reason, which discovery does not mine yet: the payload of the ``closest_tractor`` a
-    tractor caught names the tractor that is to go, and it moves exactly when that is
-    itself.)"""
+    tractors answer with their positions and the closest one moves to the weed. Whether a
+    tractor cuts is no draw: the log holds the reason, the payload of the ``closest_tractor``
+    a tractor caught names the tractor that is to go, and the discovered choice reads it."""
     world = resolve_world("agri")[0]
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
@@ -286,3 +285,14 @@ def test_the_agri_mission_runs_discovered_and_the_drone_hears_the_weeds(tmp_path
     assert {"weed_found?", "weed_position!", "closest_tractor!"} <= drone
     tractors = set(again.loc[again["robot"] != "drone", "concept:name"].astype(str))
     assert {"weed_position?", "tractor_position!", "closest_tractor?", "move"} <= tractors
+    # each tractor cut grass once per closest_tractor naming it, in the discovered model's
+    # runs as in the driving model's (counted with pandas)
+    assert "closest_tractor.get('data') == robot.name" in bound.read_text(encoding="utf-8")
+    for runs in (log, again):
+        starts = runs[runs["lifecycle:transition"] == "start"]
+        names = starts["concept:name"].astype(str)
+        got = starts[(names == "closest_tractor?") & (starts["robot"] != "drone")]
+        payloads = zip(got["msg_payload"], got["robot"], strict=True)
+        mine = got[[json.loads(text)["data"] == robot for text, robot in payloads]]
+        cut = starts[names == "cut_grass"]
+        assert mine.groupby("robot").size().to_dict() == cut.groupby("robot").size().to_dict()
