@@ -17,7 +17,9 @@ interleaved (compare, findings, compare, findings ...), best of ``--runs``:
 
 - *the whole command*: ``robotale compare A.csv B.csv`` as the user runs it, a process of its
   own (start, imports, reading both files, the comparison, the printed text), the batches
-  written to CSV beforehand; its wall time and the CPU time of the process.
+  written to CSV beforehand; its wall time and the CPU time of the process, and how often it
+  waited (voluntary context switches) or was preempted (involuntary ones): a wall time far
+  above the CPU time with few waits is time queued behind other work, not waiting.
 
 The runs' mean duration the comparison reports is checked equal to the findings' for each
 batch, and the command's first sentence equal to the function's. Target: compare under 5 s
@@ -116,18 +118,27 @@ def _both(function, first, second):
 
 
 class Command:
-    """``robotale compare A B`` run as a process; the CPU time of the last run kept."""
+    """``robotale compare A B`` run as a process; its least CPU time kept, and how often the
+    process of that turn gave up the processor to wait (voluntary context switches: reading
+    a file, a lock, a socket) and how often the scheduler took it away (involuntary: other
+    work on a busy machine), which tell a wall time spent waiting from one spent queued."""
 
     def __init__(self, first: Path, second: Path) -> None:
         self.arguments = [sys.executable, "-m", "robotale", "compare", str(first), str(second)]
         self.cpu = float("inf")
+        self.switches = (0, 0)  # (voluntary, involuntary) of the turn with the least CPU
 
     def __call__(self) -> str:
         before = resource.getrusage(resource.RUSAGE_CHILDREN)
         done = subprocess.run(self.arguments, capture_output=True, text=True, check=True)
         after = resource.getrusage(resource.RUSAGE_CHILDREN)
         spent = (after.ru_utime - before.ru_utime) + (after.ru_stime - before.ru_stime)
-        self.cpu = min(self.cpu, spent)
+        if spent < self.cpu:
+            self.cpu = spent
+            self.switches = (
+                after.ru_nvcsw - before.ru_nvcsw,
+                after.ru_nivcsw - before.ru_nivcsw,
+            )
         return done.stdout
 
 
@@ -182,6 +193,8 @@ def measure(template: pd.DataFrame, size: int, runs: int, scratch: Path) -> None
           f"{command.cpu:.2f} s; target < {TARGET_SECONDS:g} s: "
           f"{'met' if whole < TARGET_SECONDS else 'MISSED'} in wall time, "
           f"{'met' if command.cpu < TARGET_SECONDS else 'MISSED'} in CPU time)")  # fmt: skip
+    waited, queued = command.switches
+    print(f"  {'':40} the command waited {waited} times, was preempted {queued} times")
     assert comparison.sentences[0] in printed, "the command says another first sentence"
     print(f"  {'findings of A and of B':40} {theirs:7.2f} s  (CPU {CPU[1]:.2f} s)")
     print(f"  {'compare / findings':40} {ours / theirs:7.2f} x")
