@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
-from robotale.enhancement.mission_state import Facts, Tracks
+from robotale.enhancement.mission_state import Facts, Tracks, rows_by_robot
 from robotale.enhancement.timeline import NO_ROBOT, case_messages
 from robotale.errors import InputError
 from robotale.eventlog.schema import (
@@ -149,7 +149,9 @@ class MissionRun:
         messages = self.messages
         sent_in = messages["sent"].between(start, end)
         received_in = messages["received"].between(start, end)
-        positions = self.positions[self.positions["s"].between(start, end)]
+        seconds = self.positions["s"].to_numpy(float)
+        positions = self.positions[(seconds >= start) & (seconds <= end)]
+        xyzs = positions[["s", "x", "y", "z"]].to_numpy(float)
         moments = self.moments[self.moments["s"].between(start, end)]
         return {
             "case": self.case,
@@ -167,8 +169,8 @@ class MissionRun:
             ],
             "messages": _records(messages[sent_in | received_in]),
             "positions": {
-                str(robot): rows[["s", "x", "y", "z"]].to_numpy(float).tolist()
-                for robot, rows in positions.groupby("robot", sort=True)
+                robot: xyzs[rows].tolist()
+                for robot, rows in sorted(rows_by_robot(positions["robot"]).items())
             },
             "moments": _records(moments),
         }

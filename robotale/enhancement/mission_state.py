@@ -101,7 +101,7 @@ class Tracks:
         positions = positions.dropna(subset=["s"])  # a sample of no time is never at one
         if positions.empty:
             return True
-        groups = _by_robot(positions["robot"])
+        groups = rows_by_robot(positions["robot"])
         s = positions["s"].to_numpy(float)
         for robot, rows in groups.items():
             track = self.robots.get(robot)
@@ -179,11 +179,11 @@ def _activities(
             table["end"].astype(float).fillna(math.inf).to_numpy(float)[rows],
             names[rows].tolist(),
         )
-        for robot, rows in _by_robot(table["robot"]).items()
+        for robot, rows in rows_by_robot(table["robot"]).items()
     }
 
 
-def _by_robot(robots: pd.Series) -> dict[str, np.ndarray]:
+def rows_by_robot(robots: pd.Series) -> dict[str, np.ndarray]:
     """The positions of each robot's rows, in their order: what a group-by gives, in arrays
     (a live run's tables are grouped again at every look)."""
     codes, names = pd.factorize(robots, sort=False)
