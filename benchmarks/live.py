@@ -337,12 +337,13 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
     began = time.time()
     seen: dict[Key, float] = {}
     looks: list[float] = []  # CPU seconds of this thread each look that found tags took
+    waits: list[float] = []  # of which in the summary's request (its checks while waiting)
     counts: list[tuple[float, int]] = []  # (wall time, tags stored then)
     held: dict | None = None  # what the page holds: the run's length and number of events
     while any(p.poll() is None for p in publishers):
         counts.append((time.time(), live_count(driver, name)))
         cpu = time.thread_time()
-        summary = _look(client, name, held)
+        summary, waited = _look(client, name, held)
         if summary is None:  # no tag stored yet
             time.sleep(0.1)
             continue
@@ -350,6 +351,7 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
             continue  # the wait ran out: nothing new
         now = time.time()
         looks.append(time.thread_time() - cpu)
+        waits.append(waited)
         held = summary
         start = _epoch(summary["start"])
         for s in summary["event_times"]:
@@ -375,7 +377,8 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
           f"({len(published) / span:.1f}/s) and {count * ODOM_RATE * span:.0f} odometry "
           f"samples; {len(looks)} API looks that found tags (summary, window, state: "
           f"median {1000 * quantiles(looks)[0]:.0f} ms CPU each, p95 "
-          f"{1000 * quantiles(looks)[1]:.0f} ms), load average "
+          f"{1000 * quantiles(looks)[1]:.0f} ms; the summary with its wait's checks median "
+          f"{1000 * quantiles(waits)[0]:.0f} ms), load average "
           f"{os.getloadavg()[0]:.1f}")  # fmt: skip
     _print_lags("stamp -> Mission state API", api_lags, dds_lags)
     s50, s95 = quantiles(_stored_lags(published, stored, counts))
@@ -397,26 +400,28 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
           f"({len(missing)} missing, {len(extra)} extra)")  # fmt: skip
 
 
-def _look(client, name: str, held: dict | None) -> dict | None:
+def _look(client, name: str, held: dict | None) -> tuple[dict | None, float]:
     """One look of a page following the live run, as the Mission page makes it: the run's
     summary from a little before the end it holds (waiting on the server, up to a second
     here, until the run holds other events than it does), then the positions and messages
-    of that stretch and the state at the new end. The summary, or None when no tag is
-    stored yet."""
+    of that stretch and the state at the new end. The summary (None when no tag is stored
+    yet) and the CPU seconds of this thread its request took."""
     api = f"/api/mission/{name}/{name}"
+    cpu = time.thread_time()
     if held is None:
         answer = client.get(api)
         since = 0.0
     else:
         since = max(0.0, held["duration"] - PAGE_OVERLAP)
         answer = client.get(f"{api}?since={since}&known={held['events']}&wait=1")
+    waited = time.thread_time() - cpu
     if answer.status_code != 200:
-        return None
+        return None, waited
     summary = answer.json
     if held is None or summary["events"] != held["events"]:
         client.get(f"{api}/window?from={since}&to={summary['duration']}")
         client.get(f"{api}/state?t={summary['duration']}")
-    return summary
+    return summary, waited
 
 
 def _print_lags(what: str, measured: list[tuple[float, float]], baseline) -> None:

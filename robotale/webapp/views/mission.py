@@ -61,8 +61,9 @@ def summary(log: str, case: str):
     return jsonify({**run.summary(since), **_about(log, run, replay)})
 
 
-#: seconds a look at a live run waits for it to grow at most; between two checks
-LONGEST_WAIT, CHECK_EVERY = 30.0, 0.05
+#: seconds a look at a live run waits for it to grow at most; between two checks (the
+#: monitor stores what it heard every tenth of a second: a check more often finds nothing)
+LONGEST_WAIT, CHECK_EVERY = 30.0, 0.1
 
 
 def _grown(
