@@ -12,15 +12,19 @@ robotale's message types) publish, for every robot, a tag every 1 to 2 s (starts
 completes of its activities, in the model's order, stamped with the wall clock) and odometry
 (``nav_msgs/msg/Odometry`` on ``/<robot>/odom``) 10 times a second, for ``--duration``
 seconds. Meanwhile this process asks the Mission page's data API, through Flask's test client
-on the same Neo4j, what a following page asks (the run's summary, then its state at the end)
-again and again.
+on the same Neo4j, what a following page asks, as the page asks it: the run's summary from a
+little before the end it holds, waiting on the server until the run holds other events (a long
+poll), then the positions and messages of that stretch and the state at the new end; again and
+again.
 
 Printed per robot count:
 
 - the lag from a tag's stamp to the first answer of the API that shows it (its time among the
   summary's ``event_times``): p50 and p95, over the whole run and over its first and last
   thirds (by stamp), to show whether it grows; beside it, the baseline measured in the same
-  run on the same tags: the lag to a plain ``cyclonedds`` reader in this process; then the
+  run on the same tags: the lag to a plain ``cyclonedds`` reader in this process; the part of
+  the lag before the monitor stored the tag (to the resolution of the counts taken before each
+  look); the CPU time of this thread per look that found tags; then the
   lag per minute of stamps beside the load average and the machine's CPU (``/proc/stat``) in
   that minute, so growth over a long run shows, and this process' CPU;
 - the store's append rate: tags stored in Neo4j per second, against tags published per second;
@@ -104,6 +108,8 @@ LAG_TARGET, PAINT_TARGET, PAINT_ROBOTS = 1.0, 1.0, 20
 TIMED_APPENDS = 500
 #: seconds the monitor may go on storing after the last tag was published
 CATCH_UP = 120.0
+#: seconds before the end it holds a following page asks again from (the page's OVERLAP)
+PAGE_OVERLAP = 5.0
 
 #: a tag as published and as stored: robot, activity, lifecycle, stamp in microseconds
 Key = tuple[str, str, str, int]
@@ -330,20 +336,23 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
     machine = Machine()
     began = time.time()
     seen: dict[Key, float] = {}
-    looks: list[float] = []  # seconds each look (summary, then state) took
+    looks: list[float] = []  # CPU seconds of this thread each look that found tags took
+    waits: list[float] = []  # of which in the summary's request (its checks while waiting)
     counts: list[tuple[float, int]] = []  # (wall time, tags stored then)
-    api = f"/api/mission/{name}/{name}"
+    held: dict | None = None  # what the page holds: the run's length and number of events
     while any(p.poll() is None for p in publishers):
         counts.append((time.time(), live_count(driver, name)))
-        asked = time.time()
-        answer = client.get(api)
-        if answer.status_code != 200:  # no tag stored yet
+        cpu = time.thread_time()
+        summary, waited = _look(client, name, held)
+        if summary is None:  # no tag stored yet
             time.sleep(0.1)
             continue
-        summary = answer.json
-        client.get(f"{api}/state?t={summary['duration']}")
+        if held is not None and summary["events"] == held["events"]:
+            continue  # the wait ran out: nothing new
         now = time.time()
-        looks.append(now - asked)
+        looks.append(time.thread_time() - cpu)
+        waits.append(waited)
+        held = summary
         start = _epoch(summary["start"])
         for s in summary["event_times"]:
             seen.setdefault(round((start + s) * 1e6), now)
@@ -366,10 +375,15 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
     span = max(stamps.values()) - min(stamps.values())
     print(f"{count} robots, {span:.0f} s of tags, {len(published)} tags published "
           f"({len(published) / span:.1f}/s) and {count * ODOM_RATE * span:.0f} odometry "
-          f"samples; {len(looks)} API looks (summary + state, median "
-          f"{quantiles(looks)[0]:.2f} s each), load average "
+          f"samples; {len(looks)} API looks that found tags (summary, window, state: "
+          f"median {1000 * quantiles(looks)[0]:.0f} ms CPU each, p95 "
+          f"{1000 * quantiles(looks)[1]:.0f} ms; the summary with its wait's checks median "
+          f"{1000 * quantiles(waits)[0]:.0f} ms), load average "
           f"{os.getloadavg()[0]:.1f}")  # fmt: skip
     _print_lags("stamp -> Mission state API", api_lags, dds_lags)
+    s50, s95 = quantiles(_stored_lags(published, stored, counts))
+    print(f"  of which stamp -> stored by the monitor (seen by this process' count before "
+          f"each look): p50 {s50:.3f} s, p95 {s95:.3f} s")  # fmt: skip
     _print_minutes(api_lags, machine)
     busy, load = machine.busy(began, ended), machine.load(began, ended)
     share = 100 * own / (ended - began)
@@ -384,6 +398,30 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
     ok = not missing and not extra
     print(f"  check: tags stored == tags published: {'yes' if ok else 'NO'} "
           f"({len(missing)} missing, {len(extra)} extra)")  # fmt: skip
+
+
+def _look(client, name: str, held: dict | None) -> tuple[dict | None, float]:
+    """One look of a page following the live run, as the Mission page makes it: the run's
+    summary from a little before the end it holds (waiting on the server, up to a second
+    here, until the run holds other events than it does), then the positions and messages
+    of that stretch and the state at the new end. The summary (None when no tag is stored
+    yet) and the CPU seconds of this thread its request took."""
+    api = f"/api/mission/{name}/{name}"
+    cpu = time.thread_time()
+    if held is None:
+        answer = client.get(api)
+        since = 0.0
+    else:
+        since = max(0.0, held["duration"] - PAGE_OVERLAP)
+        answer = client.get(f"{api}?since={since}&known={held['events']}&wait=1")
+    waited = time.thread_time() - cpu
+    if answer.status_code != 200:
+        return None, waited
+    summary = answer.json
+    if held is None or summary["events"] != held["events"]:
+        client.get(f"{api}/window?from={since}&to={summary['duration']}")
+        client.get(f"{api}/state?t={summary['duration']}")
+    return summary, waited
 
 
 def _print_lags(what: str, measured: list[tuple[float, float]], baseline) -> None:
@@ -457,6 +495,23 @@ def _print_minutes(measured: list[tuple[float, float]], machine: Machine) -> Non
         print(f"    minute {minute + 1:2d}: lag p50 {p50:.3f} s, p95 {p95:.3f} s "
               f"({len(values)} tags); load average {machine.load(start, end):.1f}, CPU "
               f"{machine.busy(start, end):.0f} % busy")  # fmt: skip
+
+
+def _stored_lags(published: list[Key], stored: list[Key], counts: list[tuple[float, int]]):
+    """Seconds from each stored tag's stamp to the first count that held it (the tags are
+    numbered as stored), for the tags published: how late the monitor stores a tag, to the
+    resolution of the counts."""
+    import numpy as np
+
+    times = np.array([t for t, _ in counts])
+    held = np.maximum.accumulate(np.array([n for _, n in counts], dtype=np.int64))
+    sent = {k[3] for k in published}
+    firsts = np.searchsorted(held, np.arange(1, len(stored) + 1))
+    return [
+        times[first] - tag[3] / 1e6
+        for tag, first in zip(stored, firsts, strict=True)
+        if tag[3] in sent and first < len(times)
+    ]
 
 
 def _catch_up(driver, name: str, published: int, since: float) -> float | None:

@@ -131,6 +131,18 @@ def live_poses(driver: Driver, name: str, after: int = 0) -> list[Pose]:
     return [Pose(r["stamp"], r["robot"], r["x"], r["y"], r["z"]) for r in records]
 
 
+def live_since(driver: Driver, name: str, tags: int, poses: int) -> tuple[list[Tag], list[Pose]]:
+    """The tags and the odometry samples stored for the live run ``name`` after the first
+    ``tags`` and the first ``poses``, each in the order stored: both in one round trip."""
+    records, _, _ = driver.execute_query(
+        cypher("live_since"),
+        {"log": name, "tags": tags, "poses": poses},
+        database_=database(),
+    )
+    found = records[0]
+    return [Tag(*row) for row in found["tags"]], [Pose(*row) for row in found["poses"]]
+
+
 def live_alerts(driver: Driver, name: str) -> list[Alert]:
     """The alerts raised so far about the live run ``name``, oldest first."""
     records, _, _ = driver.execute_query(cypher("live_alerts"), {"log": name}, database_=database())

@@ -21,7 +21,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
-from robotale.enhancement.mission_state import Facts, Tracks
+from robotale.enhancement.mission_state import Facts, Tracks, rows_by_robot
 from robotale.enhancement.timeline import NO_ROBOT, case_messages
 from robotale.errors import InputError
 from robotale.eventlog.schema import (
@@ -149,7 +149,9 @@ class MissionRun:
         messages = self.messages
         sent_in = messages["sent"].between(start, end)
         received_in = messages["received"].between(start, end)
-        positions = self.positions[self.positions["s"].between(start, end)]
+        seconds = self.positions["s"].to_numpy(float)
+        positions = self.positions[(seconds >= start) & (seconds <= end)]
+        xyzs = positions[["s", "x", "y", "z"]].to_numpy(float)
         moments = self.moments[self.moments["s"].between(start, end)]
         return {
             "case": self.case,
@@ -167,8 +169,8 @@ class MissionRun:
             ],
             "messages": _records(messages[sent_in | received_in]),
             "positions": {
-                str(robot): rows[["s", "x", "y", "z"]].to_numpy(float).tolist()
-                for robot, rows in positions.groupby("robot", sort=True)
+                robot: xyzs[rows].tolist()
+                for robot, rows in sorted(rows_by_robot(positions["robot"]).items())
             },
             "moments": _records(moments),
         }
@@ -186,17 +188,44 @@ class MissionRun:
             for robot, rows in table.groupby("robot", sort=True)
         }
 
-    def summary(self) -> dict[str, Any]:
-        """What the page needs before it asks about a moment."""
-        return {**self.head(), **self._made_of_events}
+    def summary(self, since: float | None = None) -> dict[str, Any]:
+        """What the page needs before it asks about a moment; from ``since`` seconds on only
+        (a page following a live run holds the rest): the event times from then, the
+        instances running or begun from then (those over before it are as they were), and
+        all the moments (few, and a slow one is judged against every instance so far)."""
+        if since is None:
+            return {**self.head(), **self._made_of_events}
+        return {
+            **self.head(),
+            "since": since,
+            # a page holding other than these many earlier times missed a late tag: it asks
+            # for the whole summary again
+            "times_before": self._times_before(since),
+            "event_times": self._event_times(since),
+            "instances": _records(self.instances[_changed_since(self.instances, since)]),
+            "moments": self._made_of_events["moments"],
+        }
+
+    def _times_before(self, since: float) -> int:
+        """How many distinct :meth:`summary` event times are before ``since``."""
+        control = self.events[LIFECYCLE].astype("string").fillna("").to_numpy() != NONE
+        times = self.events["s"].to_numpy(float)[control].round(6)
+        return int(np.unique(times[times < since]).size)
+
+    def _event_times(self, since: float) -> list[float]:
+        """The distinct times (to the microsecond) of the control events at or after
+        ``since``, sorted: only the events from shortly before it are read."""
+        first = int(np.searchsorted(self.events["s"].to_numpy(float), since - 1e-6))
+        return [s for s in _event_times(self.events.iloc[first:]) if s >= since]
 
     def head(self) -> dict[str, Any]:
-        """The little the page draws a first moment with: the run's start, length, robots,
-        fields and whether it has positions."""
+        """The little the page draws a first moment with: the run's start, length, number
+        of events (a live run grown), robots, fields and whether it has positions."""
         return {
             "case": self.case,
             "start": _iso(self.start),
             "duration": self.duration,
+            "events": len(self.events),
             "robots": self.robots,
             "signals": self.signals,
             "has_positions": not self.positions.empty,
@@ -204,9 +233,8 @@ class MissionRun:
 
     @cached_property
     def _made_of_events(self) -> dict[str, Any]:
-        control = self.events[self.events[LIFECYCLE].astype("string").fillna("") != NONE]
         return {
-            "event_times": sorted(set(control["s"].round(6).tolist())),
+            "event_times": _event_times(self.events),
             "instances": self.instance_records,
             "moments": _records(self.moments),
         }
@@ -436,26 +464,48 @@ def _slow_limits_of(every: pd.DataFrame) -> pd.DataFrame:
 
 
 def _slow(slow: pd.DataFrame, instances: pd.DataFrame) -> list[dict[str, Any]]:
-    """The run's instances slower than ``slow`` (:func:`slow_limits`) says of their kind."""
-    kinds = {
-        (str(robot), str(activity)): (float(limit), float(median), int(count))
-        for robot, activity, limit, median, count in zip(
-            *(slow[column] for column in SLOW_COLUMNS), strict=True
-        )
-    }
-    found = []
-    for row in instances.dropna(subset=["end"]).itertuples(index=False):
-        limit, median, count = kinds.get((row.robot, row.activity), (math.nan, math.nan, 0))
-        if count < 3:  # too few to say what is slow
-            continue
-        took = row.end - row.start
-        # a second past the typical one, not a rounding of an instant one
-        if took > limit + 1e-9 and took - median >= SLOW_MARGIN:
-            text = f"{row.activity} by {row.robot} took {took:.1f} s"
-            found.append(
-                {"s": row.start, "kind": "slow activity", "robot": row.robot, "text": text}
-            )
-    return found
+    """The run's instances slower than ``slow`` (:func:`slow_limits`) says of their kind, in
+    the order of ``instances``: judged in arrays, as a live run's every instance is again at
+    each look."""
+    done = instances.dropna(subset=["end"])
+    if done.empty or slow.empty:
+        return []
+    kinds = pd.MultiIndex.from_arrays([slow["robot"].astype(str), slow["activity"].astype(str)])
+    robots, activities = done["robot"].astype(str), done["activity"].astype(str)
+    at = kinds.get_indexer(pd.MultiIndex.from_arrays([robots, activities]))
+    known = at >= 0
+    limit = np.where(known, slow["limit"].to_numpy(float)[at], np.nan)
+    median = np.where(known, slow["median"].to_numpy(float)[at], np.nan)
+    count = np.where(known, slow["count"].to_numpy(np.int64)[at], 0)
+    starts = done["start"].to_numpy(float)
+    took = done["end"].to_numpy(float) - starts
+    # too few to say what is slow under 3; a second past the typical one, not a rounding of
+    # an instant one
+    with np.errstate(invalid="ignore"):
+        slower = (count >= 3) & (took > limit + 1e-9) & (took - median >= SLOW_MARGIN)
+    return [
+        {
+            "s": float(starts[i]),
+            "kind": "slow activity",
+            "robot": robots.iloc[i],
+            "text": f"{activities.iloc[i]} by {robots.iloc[i]} took {took[i]:.1f} s",
+        }
+        for i in np.flatnonzero(slower)
+    ]
+
+
+def _event_times(events: pd.DataFrame) -> list[float]:
+    """The distinct times (seconds, to the microsecond) of ``events`` that are no message
+    or reading alone (a step of the page's cursor), sorted."""
+    control = events[events[LIFECYCLE].astype("string").fillna("") != NONE]
+    return sorted(set(control["s"].round(6).tolist()))
+
+
+def _changed_since(instances: pd.DataFrame, since: float) -> pd.Series:
+    """Which of ``instances`` may differ from what a look at ``since`` seconds saw: those
+    begun from then on, still running, or ended from then on."""
+    end = instances["end"].astype(float)
+    return (instances["start"].astype(float) >= since) | end.isna() | (end >= since)
 
 
 def _event_rows(events: pd.DataFrame):

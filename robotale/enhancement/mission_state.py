@@ -101,15 +101,15 @@ class Tracks:
         positions = positions.dropna(subset=["s"])  # a sample of no time is never at one
         if positions.empty:
             return True
-        groups = positions.groupby("robot", sort=False)
-        firsts = groups["s"].min()
-        for robot, first in firsts.items():
-            track = self.robots.get(str(robot))
-            if track is not None and track.size and first < track.s[track.size - 1]:
+        groups = rows_by_robot(positions["robot"])
+        s = positions["s"].to_numpy(float)
+        for robot, rows in groups.items():
+            track = self.robots.get(robot)
+            if track is not None and track.size and s[rows].min() < track.s[track.size - 1]:
                 return False
-        for robot, rows in groups:
-            track = self.robots.setdefault(str(robot), Track())
-            track.append(rows["s"].to_numpy(float), rows[["x", "y", "z"]].to_numpy(float))
+        xyz = positions[["x", "y", "z"]].to_numpy(float)
+        for robot, rows in groups.items():
+            self.robots.setdefault(robot, Track()).append(s[rows], xyz[rows])
         return True
 
     def get(self, robot: str) -> Track:
@@ -172,13 +172,27 @@ def _activities(
     instances: pd.DataFrame,
 ) -> dict[str, tuple[np.ndarray, np.ndarray, list[str]]]:
     table = instances.dropna(subset=["start"])
+    names = table["activity"].astype(str).to_numpy()
     return {
-        str(robot): (
-            rows["start"].to_numpy(float),
-            rows["end"].astype(float).fillna(math.inf).to_numpy(float),
-            rows["activity"].astype(str).tolist(),
+        robot: (
+            table["start"].to_numpy(float)[rows],
+            table["end"].astype(float).fillna(math.inf).to_numpy(float)[rows],
+            names[rows].tolist(),
         )
-        for robot, rows in table.groupby("robot", sort=False)
+        for robot, rows in rows_by_robot(table["robot"]).items()
+    }
+
+
+def rows_by_robot(robots: pd.Series) -> dict[str, np.ndarray]:
+    """The positions of each robot's rows, in their order: what a group-by gives, in arrays
+    (a live run's tables are grouped again at every look)."""
+    codes, names = pd.factorize(robots, sort=False)
+    order = np.argsort(codes, kind="stable")
+    bounds = np.searchsorted(codes[order], np.arange(len(names) + 1))
+    return {
+        str(name): order[bounds[i] : bounds[i + 1]]
+        for i, name in enumerate(names)
+        if bounds[i] < bounds[i + 1]
     }
 
 

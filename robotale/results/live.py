@@ -12,7 +12,7 @@ again only when tags came.
 from __future__ import annotations
 
 import threading
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -22,7 +22,7 @@ from neo4j import Driver
 
 from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
 from robotale.ekg.connection import database
-from robotale.ekg.live import Pose, live_poses, live_tags
+from robotale.ekg.live import Pose, live_since, live_tags
 from robotale.enhancement.mission import MissionRun, lone_run, open_from, run_events
 from robotale.enhancement.mission_state import Tracks
 from robotale.eventlog import schema
@@ -356,11 +356,10 @@ def live_replay(driver: Driver, name: str) -> Replay | None:
     came, the positions grown when only samples came."""
     with _lock:
         kept = _kept.get(name) or _Kept()
-        new_tags = _since(live_tags, driver, name, kept.tags)
-        new_poses = _since(live_poses, driver, name, kept.positions.poses)
+        new_tags, new_poses = _since(driver, name, kept.tags, kept.positions.poses)
         if new_tags is None or new_poses is None:  # a new run of that name began
             kept = _Kept()
-            new_tags, new_poses = live_tags(driver, name), live_poses(driver, name)
+            new_tags, new_poses = live_since(driver, name, 0, 0)
         if not kept.tags and not new_tags:
             _kept.pop(name, None)
             return None
@@ -378,14 +377,21 @@ def live_replay(driver: Driver, name: str) -> Replay | None:
 
 
 def _since(
-    read: Callable[..., list[Any]], driver: Driver, name: str, held: list[Any]
-) -> list[Any] | None:
-    """What ``read`` finds stored after the ``held`` ones (numbered 1, 2, ... as stored), or
-    None when the one held last is no longer stored under its number: a new run of that name
-    began. The last one held is read again to tell."""
+    driver: Driver, name: str, tags: list[Tag], poses: list[Pose]
+) -> tuple[list[Tag] | None, list[Pose] | None]:
+    """The tags and samples stored after the ``tags`` and ``poses`` held (numbered 1, 2, ...
+    as stored), in one round trip; either None when the one held last is no longer stored
+    under its number: a new run of that name began. The last one held is read again to
+    tell."""
+    found = live_since(driver, name, max(len(tags) - 1, 0), max(len(poses) - 1, 0))
+    return _after(tags, found[0]), _after(poses, found[1])
+
+
+def _after(held: list[Any], found: list[Any]) -> list[Any] | None:
+    """What ``found`` (read from the last one ``held`` on) adds, or None when it does not
+    begin with that one."""
     if not held:
-        return read(driver, name)
-    found = read(driver, name, after=len(held) - 1)
+        return found
     if not found or found[0] != held[-1]:
         return None
     return found[1:]

@@ -5,6 +5,7 @@ Chromium unless the user moved the cursor back."""
 
 from __future__ import annotations
 
+import time
 import uuid
 
 import pytest
@@ -49,6 +50,29 @@ def test_the_mission_api_answers_on_what_the_monitor_stored_so_far(client, live)
     assert state["robots"]["rover"]["activities"] == ["dock"]
     runs = client.get(f"/api/timeline/runs?log={live.name}").json["runs"]
     assert [r["case"] for r in runs] == [live.name]
+
+
+def test_a_look_waiting_for_the_run_to_grow_answers_with_the_tag_stored_meanwhile(client, live):
+    """A page following the run asks with the number of events it holds: the answer comes
+    once a tag is stored (here from another thread, half a second later), not at the wait's
+    end, and holds what is new from ``since`` on."""
+    import threading
+
+    api = f"/api/mission/{live.name}/{live.name}"
+    tags(live, [(0, "rover", "survey", "start")])
+    held = client.get(api).json
+    later = threading.Timer(0.5, tags, (live, [(2.5, "rover", "survey", "complete")]))
+    later.start()
+    began = time.monotonic()
+    fresh = client.get(f"{api}?since=1&known={held['events']}&wait=30").json
+    later.join()
+    whole = client.get(api).json  # the whole summary of the run grown
+    assert fresh["events"] == whole["events"] > held["events"]
+    assert fresh["duration"] == pytest.approx(2.5, abs=1e-6)
+    assert fresh["event_times"] == [s for s in whole["event_times"] if s >= 1] != []
+    assert fresh["times_before"] == len([s for s in whole["event_times"] if s < 1])
+    assert fresh["instances"] == whole["instances"]  # the one instance, ended after 1 s
+    assert time.monotonic() - began < 30  # told before the wait ran out
 
 
 def test_a_new_run_of_the_same_name_replaces_the_one_read(client, live, neo4j_driver):
@@ -171,6 +195,8 @@ def test_a_run_grown_in_batches_equals_the_run_made_of_all_its_tags(
         [(1, "drone", "late", "start", ""), (1.2, "drone", "late", "complete", "")],
     ]  # fmt: skip
     written: list[Tag] = []
+    held: dict | None = None  # the summary as a following page holds it, grown look by look
+    wholes = 0  # looks that told the page to ask for the whole summary again
     for batch in batches:
         for s, robot, activity, lifecycle, role in batch:
             tag = Tag(T0 + s, robot, activity, lifecycle, "m1" if role else "", role)
@@ -182,7 +208,30 @@ def test_a_run_grown_in_batches_equals_the_run_made_of_all_its_tags(
             pd.testing.assert_frame_equal(getattr(run, table), getattr(whole, table), obj=table)
         assert (run.robots, run.duration) == (whole.robots, whole.duration)
         assert run.summary() == whole.summary()  # its records partly kept from the last look
+        # the page asks for what may have changed since a little before the end it held
+        since = 0.0 if held is None else max(0.0, held["duration"] - 3.0)
+        grown = followed(held, run.summary(since))
+        wholes += grown is None
+        held = grown if grown is not None else run.summary()
+        assert held == whole.summary(), since
         for t in (0.5, 2.5, 4.5, 6.0, 8.7, 9.5):
             assert run.state(t) == whole.state(t), t
+    assert wholes == 1  # the late tags (older than the end held less 3 s) were told
     assert len(whole.messages) == 1 and whole.messages["receiver"].iloc[0] == "drone"
     assert any(chosen < held for chosen, held in remade)
+
+
+def followed(held: dict | None, fresh: dict) -> dict | None:
+    """The summary a page held grown by ``fresh`` (one asked for ``since`` some time), as the
+    Mission page grows it: the event times and the instances over before then kept; None
+    when the page must ask for the whole summary (it holds other earlier times)."""
+    since, before = fresh.pop("since"), fresh.pop("times_before")
+    if held is None:
+        return fresh
+    kept = [s for s in held["event_times"] if s < since]
+    if len(kept) != before:
+        return None
+    times = kept + fresh["event_times"]
+    over = [i for i in held["instances"] if i["end"] is not None and i["end"] < since]
+    instances = sorted(over + fresh["instances"], key=lambda i: (i["start"], i["robot"]))
+    return {**fresh, "event_times": times, "instances": instances}

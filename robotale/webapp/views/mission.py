@@ -5,6 +5,7 @@ data API it (and anyone) reads: a run's state at a moment and what happened in a
 from __future__ import annotations
 
 import math
+import time
 from typing import Any
 
 from flask import Blueprint, jsonify, render_template, request
@@ -44,10 +45,53 @@ def page():
 
 @blueprint.get("/api/mission/<log>/<case>")
 def summary(log: str, case: str):
-    """The run's length, robots, fields, activity instances, moments and site."""
+    """The run's length, robots, fields, activity instances, moments and site; with
+    ``?since=`` seconds, only what may have changed from then on (see
+    :meth:`MissionRun.summary`). With ``?known=`` a number of events, a live run holding that
+    many is answered once it holds others, or after ``?wait=`` seconds (at most
+    :data:`LONGEST_WAIT`): a page following the run hears of a tag as soon as it is stored,
+    not at its next look."""
+    since = _optional_seconds("since")
+    known = request.args.get("known")
     replay = unstored(log)
     run = _run(log, case, replay)
-    return jsonify({**run.summary(), **_about(log, run, replay)})
+    if known is not None and _live(log, replay):
+        wait = min(max(_optional_seconds("wait", "to wait") or 0.0, 0.0), LONGEST_WAIT)
+        replay, run = _grown(log, case, (replay, run), _count(known), time.monotonic() + wait)
+    return jsonify({**run.summary(since), **_about(log, run, replay)})
+
+
+#: seconds a look at a live run waits for it to grow at most; between two checks (the
+#: monitor stores what it heard every tenth of a second: a check more often finds nothing)
+LONGEST_WAIT, CHECK_EVERY = 30.0, 0.1
+
+
+def _grown(
+    log: str, case: str, now: tuple[Replay | None, MissionRun], known: int, until: float
+) -> tuple[Replay | None, MissionRun]:
+    """The live run (``now`` with its replay) once it holds other than ``known`` events, or
+    as it is at ``until`` (monotonic): each check reads only what was stored since the
+    last."""
+    replay, run = now
+    while len(run.events) == known and time.monotonic() < until:
+        time.sleep(CHECK_EVERY)
+        replay = unstored(log)
+        if replay is None:  # the run was deleted meanwhile
+            break
+        run = _run(log, case, replay)
+    return replay, run
+
+
+def _count(text: str) -> int:
+    try:
+        return int(text)
+    except ValueError:
+        raise InputError(f"?known= must be a whole number of events, not {text!r}.") from None
+
+
+def _live(log: str, replay: Replay | None) -> bool:
+    """Whether ``log`` is a live run (a replayed recording hides one of that name)."""
+    return replay is not None and log not in state().replays
 
 
 @blueprint.get("/api/mission/<log>/<case>/head")
@@ -64,7 +108,7 @@ def _about(log: str, run: MissionRun, replay: Replay | None) -> dict[str, Any]:
     return {
         "site": mission_site(_site(log, run, replay), run),
         "model": model.id if model else None,
-        "live": replay is not None and log not in state().replays,
+        "live": _live(log, replay),
     }
 
 
@@ -126,15 +170,19 @@ def _site(log: str, run: MissionRun, replay: Replay | None) -> dict[str, Any] | 
     return stored_site(driver(), log, run.case)
 
 
-def _seconds(name: str, text: str | None) -> float:
+def _optional_seconds(name: str, what: str = "since the run's start") -> float | None:
+    """The seconds ``?name=`` gives, or None when it is not given."""
+    text = request.args.get(name)
+    return None if text is None else _seconds(name, text, what)
+
+
+def _seconds(name: str, text: str | None, what: str = "since the run's start") -> float:
     try:
         value = float(text) if text is not None else math.nan
     except ValueError:
         value = math.nan
     if not math.isfinite(value):
-        raise InputError(
-            f"?{name}= must be a number of seconds since the run's start, not {text!r}."
-        )
+        raise InputError(f"?{name}= must be a number of seconds {what}, not {text!r}.")
     return value
 
 

@@ -402,23 +402,40 @@
 
   // ---- a live run: the page follows now -----------------------------------------------------
 
-  // seconds between two looks at a live run; the timeline is redrawn every TIMELINE_EVERY looks
-  const LIVE_POLL = 1, TIMELINE_EVERY = 5;
-  let looks = 0;
+  // a look at a live run waits on the server until the run grows (at most LIVE_WAIT seconds), so
+  // a tag shows as soon as it is stored rather than at the next of looks a fixed time apart; the
+  // timeline is redrawn at most every TIMELINE_EVERY seconds, after an error the next look waits
+  const LIVE_WAIT = 10, TIMELINE_EVERY = 5, AFTER_ERROR = 1;
+  let timelineDrawn = 0;
   // the cursor follows the run's end while it is there; moved back, it stays where it was put
   const following = () => summary.duration - t < 1e-6;
 
   async function followLive() {
+    const since = Math.max(0, summary.duration - OVERLAP);
+    let fresh = await robotale.api(`${base()}?since=${since}&known=${summary.events}&wait=${LIVE_WAIT}`);
+    // only what may have changed from `since` on came: the rest is what the page holds, unless
+    // a late tag changed it (then the whole summary is asked again)
+    const kept = summary.event_times.filter((s) => s < since);
+    if (kept.length !== fresh.times_before) fresh = await robotale.api(base());
+    else {
+      fresh.event_times = kept.concat(fresh.event_times);
+      fresh.instances = summary.instances
+        .filter((i) => i.end !== null && i.end < since)
+        .concat(fresh.instances)
+        .sort((a, b) => a.start - b.start || (a.robot < b.robot ? -1 : a.robot > b.robot ? 1 : 0));
+    }
+    if (fresh.events === summary.events) return;
     const stay = !following();
-    const fresh = await robotale.api(base());
-    await growWhole(Math.max(0, summary.duration - OVERLAP), fresh.duration);
+    await growWhole(since, fresh.duration);
     summary = fresh;
     slider.max = String(summary.duration);
     root.dataset.duration = String(summary.duration);
     root.dataset.following = stay ? "0" : "1";
     if (!playing) setCursor(stay ? t : summary.duration);
-    looks += 1;
-    if (looks % TIMELINE_EVERY === 0) await loadTimeline();
+    if (performance.now() - timelineDrawn > TIMELINE_EVERY * 1000) {
+      timelineDrawn = performance.now();
+      await loadTimeline();
+    }
   }
 
   // seconds before the last look's end the next look asks again from: samples stored a little
@@ -437,8 +454,12 @@
 
   function watchLive() {
     root.dataset.live = "1";
-    const look = () => followLive().catch(robotale.showError).finally(() => setTimeout(look, LIVE_POLL * 1000));
-    setTimeout(look, LIVE_POLL * 1000);
+    const look = () => followLive().then(look, (error) => {
+      robotale.showError(error);
+      setTimeout(look, AFTER_ERROR * 1000);
+    });
+    timelineDrawn = performance.now();
+    look();
   }
 
   // the first moment is drawn from a small answer (the run's head and its state at the cursor);
