@@ -2,12 +2,16 @@
 ask before they ask for anything else. A log whose pages nobody prepared (stored with
 ``--pages visit``, or its preparation died) gets its preparation started by the first such
 question, in the dashboard; the page shows "preparing … N of M" until the results it shows
-are ready, then shows them."""
+are ready, then shows them. Its later questions wait (``?wait=``) until the preparation goes
+on, so the page hears of its results as soon as they are kept."""
 
 from __future__ import annotations
 
+import math
+
 from flask import Blueprint, jsonify, request
 
+from robotale.errors import InputError
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("preparation", __name__)
@@ -17,5 +21,19 @@ blueprint = Blueprint("preparation", __name__)
 def preparation():
     known = state()
     name, page = request.args.get("log", ""), request.args.get("page", "")
-    found = known.preparations.status(driver(), known.logs, name, page)
+    wait = _seconds(request.args.get("wait"))
+    found = known.preparations.status(driver(), known.logs, name, page, wait)
     return jsonify(found.to_dict())
+
+
+def _seconds(text: str | None) -> float:
+    """``?wait=``: how long an answer that is not ready may wait (missing: not at all)."""
+    if text is None or not text.strip():
+        return 0.0
+    try:
+        seconds = float(text)
+    except ValueError:
+        seconds = math.nan
+    if not math.isfinite(seconds) or seconds < 0:
+        raise InputError(f"?wait= must be a number of seconds of 0 or more, not {text!r}.")
+    return seconds
