@@ -73,7 +73,7 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
     # a wait that is no number of seconds: one sentence, nothing started
     refused = client.get(f"{asked}&wait=soon")
     assert refused.status_code == 400
-    assert refused.json["error"] == "?wait= must be a number of seconds of 0 or more, not 'soon'."
+    assert refused.json["error"] == "the wait 'soon' is not a number of seconds of 0 or more."
     # one preparation, however often it was asked: each result computed once, then kept
     computed = state(app).logs.computed
     assert computed[(unprepared_log, "findings")] == 1

@@ -7,11 +7,9 @@ on, so the page hears of its results as soon as they are kept."""
 
 from __future__ import annotations
 
-import math
-
 from flask import Blueprint, jsonify, request
 
-from robotale.errors import InputError
+from robotale.results.findings import parse_seconds
 from robotale.webapp.state import driver, state
 
 blueprint = Blueprint("preparation", __name__)
@@ -21,19 +19,7 @@ blueprint = Blueprint("preparation", __name__)
 def preparation():
     known = state()
     name, page = request.args.get("log", ""), request.args.get("page", "")
-    wait = _seconds(request.args.get("wait"))
+    # how long an answer that is not ready may wait (missing: not at all)
+    wait = parse_seconds(request.args.get("wait"), "the wait") or 0.0
     found = known.preparations.status(driver(), known.logs, name, page, wait)
     return jsonify(found.to_dict())
-
-
-def _seconds(text: str | None) -> float:
-    """``?wait=``: how long an answer that is not ready may wait (missing: not at all)."""
-    if text is None or not text.strip():
-        return 0.0
-    try:
-        seconds = float(text)
-    except ValueError:
-        seconds = math.nan
-    if not math.isfinite(seconds) or seconds < 0:
-        raise InputError(f"?wait= must be a number of seconds of 0 or more, not {text!r}.")
-    return seconds
