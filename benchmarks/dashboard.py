@@ -321,6 +321,19 @@ class _Client:
         except urllib.error.HTTPError as error:
             return error.code
 
+    def get_json(self, path: str) -> tuple[int, object]:
+        """The status and, for a JSON answer, its value (else None)."""
+        import json
+        import urllib.error
+
+        try:
+            with self.opener.open(f"{self.url}{path}", timeout=600) as response:
+                data = response.read()
+                kind = response.headers.get("Content-Type", "")
+                return response.status, json.loads(data) if "json" in kind else None
+        except urllib.error.HTTPError as error:
+            return error.code, None
+
     def post_json(self, path: str, body: dict) -> tuple[int, dict]:
         import json
         import urllib.error
@@ -416,7 +429,9 @@ def measure_pages(
 
 #: the dashboard's answers the first view of each page waits for, after its HTML (``{log}``:
 #: the log's name): Discover's class graph by activity and robot with every flow, the
-#: Perspectives page's first section and the class graph beside it, the Findings
+#: Perspectives page's first section and the class graph beside it, the Findings, the Mission
+#: page's run list, then its first run's head and its state at the start (``{case}``: the first
+#: run the run list names)
 FIRST_VIEW = {
     "discover": ("/discover", "/api/aggregation/steps", "/api/discover/ekg?by=robot"),
     "perspectives": (
@@ -425,6 +440,12 @@ FIRST_VIEW = {
         "/api/discover/ekg?by=robot",
     ),
     "findings": ("/findings", "/api/findings"),
+    "mission": (
+        "/mission",
+        "/api/timeline/runs",
+        "/api/mission/{log}/{case}/head",
+        "/api/mission/{log}/{case}/state?t=0",
+    ),
 }
 
 
@@ -440,10 +461,17 @@ def server_seconds(dashboard, which: str, log: str, repeat: int, cold: bool) -> 
     for _ in range(repeat):
         empty(dashboard, log, cold)
         cpu, started = time.process_time(), time.perf_counter()
-        for path in FIRST_VIEW[which]:
-            status = client.get(path + ("&" if "?" in path else "?") + f"log={quote(log)}")
+        case = ""
+        for asked in FIRST_VIEW[which]:
+            if "{" in asked:  # named in the path: the log and its first run
+                path = asked.format(log=quote(log, safe=""), case=quote(case, safe=""))
+            else:
+                path = asked + ("&" if "?" in asked else "?") + f"log={quote(log)}"
+            status, answer = client.get_json(path)
             if status != 200:
                 raise SystemExit(f"{path} of {log} answered {status}")
+            if asked == "/api/timeline/runs":
+                case = str(answer["runs"][0]["case"])
         timings.append(time.perf_counter() - started)
         spent.append(time.process_time() - cpu)
     return statistics.median(timings), statistics.median(spent)

@@ -8,7 +8,9 @@ lets each caller say where logs come from: the command line, the dashboard's Log
 
 from __future__ import annotations
 
-from typing import Any
+from collections.abc import Callable
+from contextvars import ContextVar, Token
+from typing import Any, TypeVar
 
 from neo4j import READ_ACCESS, Driver
 
@@ -23,6 +25,35 @@ FAILED = "failed"
 # without completing it (killed): what it holds is consistent, but the run went on unheard.
 LIVE, INTERRUPTED = "live", "interrupted"
 
+#: within a look (:func:`start_look`): what each Log node said, by what was asked and log name
+_LOOK: ContextVar[dict[tuple[str, str], Any] | None] = ContextVar("log_look", default=None)
+_Read = TypeVar("_Read")
+
+
+def start_look() -> Token[dict[tuple[str, str], Any] | None]:
+    """From now until :func:`end_look`, in this context, each log's Log node is read once (its
+    build and its description): one answer of the dashboard asks for them a dozen times, and
+    each is a round trip to Neo4j. For what only reads and shows one state of a log."""
+    return _LOOK.set({})
+
+
+def end_look(token: Token[dict[tuple[str, str], Any] | None]) -> None:
+    try:
+        _LOOK.reset(token)
+    except ValueError:  # ended in another context than it started in: nothing kept here
+        _LOOK.set(None)
+
+
+def _looked(what: str, name: str, read: Callable[[], _Read]) -> _Read:
+    """``read()``, once per look."""
+    seen = _LOOK.get()
+    if seen is None:
+        return read()
+    if (what, name) not in seen:
+        seen[(what, name)] = read()
+    found: _Read = seen[(what, name)]
+    return found
+
 
 def list_logs(driver: Driver) -> list[dict[str, Any]]:
     """Every stored log as its Log node describes it, by name (see :func:`_with_truth`)."""
@@ -33,10 +64,15 @@ def list_logs(driver: Driver) -> list[dict[str, Any]]:
 def log_info(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
     """What the Log node of ``name`` records: ``status``, ``events``, ``source``,
     ``entityTypes``, ``classTypes``, ``created`` (text) and the event ``properties``."""
-    rows = _rows(driver, "ekg_log_info", log=name)
-    if not rows:
+    found = _looked("info", name, lambda: _info(driver, name))
+    if found is None:
         raise LogNotFound(name, hint)
-    return _with_truth(driver, rows[0], holders(driver))
+    return dict(found)
+
+
+def _info(driver: Driver, name: str) -> dict[str, Any] | None:
+    rows = _rows(driver, "ekg_log_info", log=name)
+    return _with_truth(driver, rows[0], holders(driver)) if rows else None
 
 
 def _with_truth(driver: Driver, row: dict[str, Any], locks: dict[str, Holder]) -> dict[str, Any]:
@@ -66,10 +102,10 @@ def log_run(driver: Driver, name: str) -> str | None:
 def log_build_row(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
     """What the Log node of ``name`` records of its current build (``status``, ``created``,
     ``run``, ``appended``, ``properties``, ``columns``), for its columnar copy."""
-    rows = _rows(driver, "ekg_log_build", log=name)
+    rows = _looked("build", name, lambda: _rows(driver, "ekg_log_build", log=name))
     if not rows:
         raise LogNotFound(name, hint)
-    return rows[0]
+    return dict(rows[0])
 
 
 def log_summary(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:

@@ -45,6 +45,10 @@ PROGRESS = "prepared.progress"
 STALE_SECONDS = 120.0
 #: how much lower the preparing process runs than the command that started it
 NICENESS = 10
+#: the longest a question about a preparation waits for it to go on (seconds)
+LONGEST_WAIT = 5.0
+#: how often a waiting question looks at the preparation's progress (seconds)
+LOOK_EVERY = 0.05
 
 
 def start(name: str) -> subprocess.Popen[bytes]:
@@ -108,11 +112,25 @@ class Preparations:
         self._lock = threading.Lock()
         self._running: dict[tuple[str, str], threading.Thread] = {}
 
-    def status(self, driver: Driver, logs: LogData, name: str, page: str = "") -> Preparation:
+    def status(
+        self, driver: Driver, logs: LogData, name: str, page: str = "", wait: float = 0.0
+    ) -> Preparation:
         """How far the preparation of ``name``'s pages is, ready when the steps the page
         ``page`` shows are done (a page not named: all of them); starts a preparation when
         none is done or under way (here or in another process, such as ``robotale
-        ingest``'s)."""
+        ingest``'s). With ``wait`` (seconds, at most :data:`LONGEST_WAIT`), an answer that is
+        not ready waits until it is, or until a step is done, or that long: a page waiting
+        for its results hears of them at once instead of at its next question."""
+        found = self._status(driver, logs, name, page)
+        deadline = time.monotonic() + min(max(wait, 0.0), LONGEST_WAIT)
+        while not found.ready and time.monotonic() < deadline:
+            time.sleep(LOOK_EVERY)
+            later = self._status(driver, logs, name, page)
+            if later != found:
+                return later
+        return found
+
+    def _status(self, driver: Driver, logs: LogData, name: str, page: str) -> Preparation:
         build = current_build(driver, name)
         if not build.complete:  # being written: its pages compute what they show
             return Preparation(ready=True)

@@ -24,6 +24,11 @@ from robotale.results.mission import stored_mission, stored_slow_limits
 def parse_delay(text: str | None) -> float | None:
     """The ``delay`` argument of a request: seconds above which a message is delayed (missing
     or empty: the default rule)."""
+    return parse_seconds(text, "the delay")
+
+
+def parse_seconds(text: str | None, what: str) -> float | None:
+    """A request's argument ``what`` of seconds, 0 or more (None when missing or empty)."""
     if text is None or not text.strip():
         return None
     try:
@@ -31,7 +36,7 @@ def parse_delay(text: str | None) -> float | None:
     except ValueError:
         seconds = math.nan
     if not math.isfinite(seconds) or seconds < 0:
-        raise InputError(f"the delay {text!r} is not a number of seconds of 0 or more.")
+        raise InputError(f"{what} {text!r} is not a number of seconds of 0 or more.")
     return seconds
 
 

@@ -11,9 +11,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from flask import Flask, current_app
+from flask import Flask, current_app, g, request
 from neo4j import Driver
 
+from robotale.ekg.logs import end_look, start_look
 from robotale.results.background import Preparations
 from robotale.results.logdata import Cache, LogData
 from robotale.results.replay import Replay
@@ -52,6 +53,20 @@ def init_app(app: Flask, settings: WebSettings) -> AppState:
     """Give ``app`` its objects."""
     workers = Pool(settings.console_workers, settings.console_memory_mb)
     app.extensions[_KEY] = made = AppState(settings, ModelStore(settings.model_dir), workers)
+
+    @app.before_request
+    def _look() -> None:
+        # a page's answer reads a log's Log node for every result it touches: once is enough
+        # for what only reads (GET); what changes logs reads it afresh
+        if request.method == "GET":
+            g.robotale_look = start_look()
+
+    @app.teardown_request
+    def _end_look(_error: BaseException | None) -> None:
+        token = g.pop("robotale_look", None)
+        if token is not None:
+            end_look(token)
+
     return made
 
 

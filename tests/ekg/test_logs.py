@@ -7,11 +7,15 @@ import pytest
 
 from robotale.ekg import build_ekg
 from robotale.ekg.logs import (
+    delete_log,
+    end_look,
+    log_build_row,
     log_info,
     log_robots,
     log_summary,
     log_values,
     require_log,
+    start_look,
     stored_events,
 )
 from robotale.errors import InputError, LogNotFound
@@ -44,6 +48,24 @@ def test_a_logs_description_and_values_are_those_of_its_file(neo4j_driver, store
     assert stored_events(neo4j_driver, name) == len(raw)
     assert log_summary(neo4j_driver, name)["counts"]["events"] == len(raw)
     require_log(neo4j_driver, name)  # there: nothing raised
+
+
+def test_within_a_look_the_log_node_is_read_once(neo4j_driver, stored):
+    name, _ = stored
+    outside = log_info(neo4j_driver, name), log_build_row(neo4j_driver, name)
+    look = start_look()
+    try:
+        seen = log_info(neo4j_driver, name), log_build_row(neo4j_driver, name)
+        delete_log(neo4j_driver, name)
+        # the same answers as outside a look, and read once: the deletion is not seen
+        assert seen == outside
+        assert (log_info(neo4j_driver, name), log_build_row(neo4j_driver, name)) == outside
+    finally:
+        end_look(look)
+    with pytest.raises(LogNotFound):
+        log_info(neo4j_driver, name)
+    with pytest.raises(LogNotFound):
+        log_build_row(neo4j_driver, name)
 
 
 def test_a_missing_log_is_one_sentence_with_the_callers_hint(neo4j_driver, log_name):

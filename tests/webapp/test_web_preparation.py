@@ -55,8 +55,8 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
     deadline = time.monotonic() + 600
     while not (folder / DONE).exists():
         assert time.monotonic() < deadline, "the preparation did not finish"
-        seen.append(client.get(f"/api/preparation?log={unprepared_log}").json)
-        time.sleep(0.2)
+        # as the pages ask: an answer that is not ready waits for the preparation to go on
+        seen.append(client.get(f"/api/preparation?log={unprepared_log}&wait=1").json)
     # the findings, the class graph, each perspective, the runs, the first timeline, the
     # Mission page's slow-activity limits and its first run
     steps = 2 + len(page_names()) + 4
@@ -70,6 +70,10 @@ def test_the_first_question_starts_the_preparation_and_says_how_far_it_is(
     counted = [(s["done"], s["total"]) for s in seen if s["total"]]
     assert counted == sorted(counted) and all(done <= total for done, total in counted)
     assert client.get(asked).json["ready"] is True
+    # a wait that is no number of seconds: one sentence, nothing started
+    refused = client.get(f"{asked}&wait=soon")
+    assert refused.status_code == 400
+    assert refused.json["error"] == "the wait 'soon' is not a number of seconds of 0 or more."
     # one preparation, however often it was asked: each result computed once, then kept
     computed = state(app).logs.computed
     assert computed[(unprepared_log, "findings")] == 1

@@ -105,23 +105,20 @@ const robotale = (() => {
 
   // Resolves once what the page `page` shows of `log` is prepared. A log nobody prepared
   // yet gets its preparation started by the first question; until the page's results are
-  // ready it says how far the preparation is ("preparing … N of M"), asking again every
-  // 0.1 s for two seconds, then every 0.5 s, and then the page goes on to show them.
+  // ready it says how far the preparation is ("preparing … N of M"), asking again at once:
+  // the dashboard answers when the preparation goes on (a step done, or the page's results
+  // ready) or after two seconds, and then the page goes on to show them.
   async function prepared(log, page) {
     const asked = `/api/preparation?${new URLSearchParams({ log, page })}`;
     let status = await api(asked);
     if (status.ready) return;
     const box = document.getElementById("preparing");
-    const since = performance.now();
     box.hidden = false;
     while (!status.ready) {
       const steps = status.total ? ` ${status.done} of ${status.total}` : "";
       const last = status.step ? ` (${status.step} done)` : "";
       box.textContent = `preparing the pages of ${log} …${steps}${last}`;
-      // often at first (a page's own results are often ready within a second), then less
-      const waited = performance.now() - since;
-      await new Promise((resolve) => setTimeout(resolve, waited < 2000 ? 100 : 500));
-      status = await api(asked);
+      status = await api(`${asked}&wait=2`);
     }
     box.hidden = true;
     performance.mark("robotale-prepared");
