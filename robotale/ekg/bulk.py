@@ -58,11 +58,12 @@ from robotale.timings import stage
 
 ONLINE, BULK, AUTO = "online", "bulk", "auto"
 BUILDS = (AUTO, ONLINE, BULK)
-#: from this many events on ``auto`` takes the bulk path. At 100,000 events it costs about
-#: 1.8x the CPU of writing online to a server that has run a build before (the restart, the
-#: importer's JVM and the indexes filled on a cold server are fixed costs), and it leaves the
-#: server cold for the next command (docs/benchmarks.md, "Where the whole ingest's time goes")
-BULK_FROM = 200_000
+#: from this many events on ``auto`` takes the bulk path. It cost 1.8x the CPU of writing
+#: online to a server that has run a build before at 100,000 events and 1.2x at 200,000 (the
+#: restart, the importer's JVM and the indexes filled on a cold server are fixed costs; the
+#: restart also leaves the server cold for the next command): the two cross at about 300,000
+#: (docs/benchmarks.md, "Where the whole ingest's time goes")
+BULK_FROM = 300_000
 #: how long the indexes and constraints may take to come online after an import
 INDEX_WAIT = 3600
 
