@@ -37,6 +37,7 @@ import json
 import os
 import re
 import resource
+import signal
 import subprocess
 import sys
 import tempfile
@@ -78,6 +79,10 @@ def main(
     pages: str = "background",
     build: str = "auto",
 ) -> int:
+    # each line as it is printed: a run stopped from outside (a time limit, the kernel's
+    # out-of-memory killer) leaves what was measured until then, not an empty output
+    sys.stdout.reconfigure(line_buffering=True)  # type: ignore[union-attr]
+    signal.signal(signal.SIGTERM, stopped)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
         work = Path(folder)
@@ -152,13 +157,27 @@ def measure(
     canonical_csv(log).to_csv(csv, index=False)
     robotale_runs: list[Run] = []
     promg_runs: list[Run] = []
-    for _ in range(repeat):
-        robotale_runs.append(robotale_ingest(csv, *ours, pages, build))
+    for turn in range(1, repeat + 1):
+        mine = robotale_ingest(csv, *ours, pages, build)
+        robotale_runs.append(mine)
+        print(f"  turn {turn}: {said(mine, 'robotale')}")
         if python is not None and theirs is not None:
+            print(f"  turn {turn}: PromG started (load average {os.getloadavg()[0]:.1f})")
             run, why_not = promg_whole(python, *theirs, log, work)
             if run is not None:
                 promg_runs.append(run)
+                print(f"  turn {turn}: {said(run, 'PromG')}")
+            else:
+                print(f"  turn {turn}: PromG did not finish: {why_not}")
     report(size, robotale_runs, promg_runs, why_not, event_properties(log), pages, build)
+
+
+def said(run: Run, who: str) -> str:
+    """One run's figures on one line, printed as it ends."""
+    return (
+        f"{who} {run.wall:.1f} s wall, {run.cpu:.1f} s CPU (+ Neo4j {run.server_cpu:.1f} s); "
+        f"load average {os.getloadavg()[0]:.1f}"
+    )
 
 
 def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
@@ -255,7 +274,7 @@ def robotale_ingest(
     command += ["--build", build]
     run, status, stdout, stderr = timed_process(command, server, env=environment)
     if status != 0:
-        raise SystemExit(f"robotale ingest failed: {stderr.strip()}")
+        raise SystemExit(failure("robotale ingest", status, stderr, run, server))
     run.bulk = "neo4j-admin" in stdout
     # the graph the command built, counted before the pages' preparation adds the class
     # graph the Perspectives page shows (by activity and robot)
@@ -267,6 +286,34 @@ def robotale_ingest(
         time.sleep(0.2)
     run.pages = json.loads(done.read_text())["seconds"] if done.exists() else None
     return run
+
+
+def failure(who: str, status: int, stderr: str, run: Run, server) -> str:
+    """Why a timed process failed, in one sentence: its exit status or the signal that ended
+    it (SIGKILL with a high peak memory: the kernel's out-of-memory killer, as its log says),
+    its last line on stderr, and whether the server it used still runs."""
+    if status < 0:
+        how = f"was ended by {signal.Signals(-status).name}"
+        if -status == signal.SIGKILL:
+            how += " (the kernel's out-of-memory killer sends it: see `dmesg`)"
+    else:
+        how = f"exited with status {status}"
+    lines = [line for line in stderr.strip().splitlines() if line.strip()]
+    said = f", saying: {lines[-1].strip()}" if lines else ", saying nothing on stderr"
+    up = "still runs" if server.running() is not None else "no longer runs"
+    return (
+        f"{who} {how} after {run.wall:.1f} s (peak memory {run.peak_mb:,.0f} MB){said}; "
+        f"its Neo4j server {up}; load average {os.getloadavg()[0]:.1f}"
+    )
+
+
+def stopped(number: int, frame) -> None:
+    """A SIGTERM (a time limit, ``kill``) ends the benchmark as an error that says so: the
+    servers are stopped and what was printed stays."""
+    raise SystemExit(
+        f"the benchmark was stopped by {signal.Signals(number).name} (load average "
+        f"{os.getloadavg()[0]:.1f})"
+    )
 
 
 def alive(pid: int) -> bool:

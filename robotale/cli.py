@@ -20,6 +20,7 @@ from robotale import __version__
 from robotale.errors import RobotaleError
 from robotale.extras import require
 from robotale.thresholds import LOW_BATTERY_PERCENT, MESSAGE_TIMEOUT
+from robotale.timings import stage
 
 #: the namespace key holding the handler's dotted name; subparser keys begin with "_" too
 _HANDLER = "_handler"
@@ -84,9 +85,11 @@ def run_handler(args: argparse.Namespace) -> int:
     module, _, name = getattr(args, _HANDLER).rpartition(".")
     if getattr(args, _EXTRA, ""):
         require(getattr(args, _EXTRA))
-    handler = getattr(importlib.import_module(module), name)
+    with stage("import the command's modules"):
+        handler = getattr(importlib.import_module(module), name)
     given = {k: v for k, v in vars(args).items() if not k.startswith("_") and v is not None}
-    return int(handler(**given) or 0)
+    with stage(f"the command {name}"):
+        return int(handler(**given) or 0)
 
 
 def _add_neo4j(commands: argparse._SubParsersAction) -> None:

@@ -12,7 +12,7 @@ from robotale.ekg.append import append_ekg
 from robotale.ekg.build import refuse_existing
 from robotale.ekg.bulk import AUTO, BULK, build_log
 from robotale.ekg.columnar import delete_copies
-from robotale.ekg.connection import session_driver
+from robotale.ekg.connection import session_driver, settings
 from robotale.ekg.disk_space import check_space
 from robotale.ekg.keys import default_entities
 from robotale.ekg.logs import FAILED, delete_log_locked, list_logs, log_summary, require_log
@@ -23,8 +23,10 @@ from robotale.eventlog.logsource import log_name, open_log
 from robotale.eventlog.options import PrepareOptions
 from robotale.eventlog.preparing import kept_runs
 from robotale.eventlog.reading import format_reading
+from robotale.neo4j_server.server import LocalServer
 from robotale.results.site import keep_sites, run_sites
 from robotale.results.storing import default_keys, describe, pages_when, prepare_pages
+from robotale.timings import stage, watch_server
 
 
 def ingest_command(
@@ -59,6 +61,8 @@ def ingest_command(
             "stored one: give one."
         )
     pages = pages_when(pages)
+    if not settings().from_env:  # robotale's own local server: its CPU time counts in timings
+        watch_server(_local_server_pid)
     if log is not None and not log.strip():
         raise InputError(
             f"--log {log!r} names no log: give it a name, or leave --log out to use "
@@ -70,18 +74,22 @@ def ingest_command(
     if not (append or replace):
         # before the log is read: a name in use is refused at once, whatever the log's size
         # (the build asks again under the write lock)
-        with session_driver(user_agent=agent) as driver:
+        with (
+            stage("connect, and check the name is free"),
+            session_driver(user_agent=agent) as driver,
+        ):
             refuse_existing(driver, name)
     skipped: list[Path] | None = [] if skip_bad else None
-    opened = open_log(
-        path,
-        mapping=mapping,
-        case=case,
-        case_gap=case_gap,
-        objects=objects,
-        preparation=PrepareOptions.given(preparation),
-        skipped=skipped,
-    )
+    with stage("read the log"):
+        opened = open_log(
+            path,
+            mapping=mapping,
+            case=case,
+            case_gap=case_gap,
+            objects=objects,
+            preparation=PrepareOptions.given(preparation),
+            skipped=skipped,
+        )
     events, found_objects = opened.events, opened.objects
     if opened.reading is not None:
         # on stdout, as part of ingest's report: its stderr holds only a failure's sentence
@@ -93,7 +101,8 @@ def ingest_command(
     keys = aggregate or default_keys(events, chosen)
     with session_driver(user_agent=agent) as driver:
         entity_columns = chosen if chosen is not None else default_entities(events.columns)
-        check_space(driver, events, name, entity_columns, len(keys))
+        with stage("check the disk space"):
+            check_space(driver, events, name, entity_columns, len(keys))
         if append:
             # the log's columnar copy no longer matches its build: the next analysis reads
             # the whole log back from the graph and keeps that copy instead
@@ -121,10 +130,16 @@ def ingest_command(
         if opened.kind is RECORDINGS:
             # the Mission page's map: the simulated runs' fields, bases and objects
             keep_sites(driver, name, run_sites(path))
-        prepare_pages(driver, name, pages)
+        with stage("the dashboard's pages"):
+            prepare_pages(driver, name, pages)
     if skipped is not None and opened.kind is RECORDINGS:
         print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
+
+
+def _local_server_pid() -> int | None:
+    running = LocalServer().running()
+    return running.pid if running is not None else None
 
 
 def logs_list() -> int:

@@ -47,6 +47,7 @@ from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, LogNotFound, ServerError
 from robotale.eventlog.objects import Objects
 from robotale.queries import cypher, statements
+from robotale.timings import stage
 
 
 @dataclass(frozen=True)
@@ -113,9 +114,11 @@ def build_ekg(
     ``prepared``: the tables :func:`prepare` computed of these arguments already.
     """
     started = time.perf_counter()
-    prepared = prepared or prepare(log, entities, aggregate, name)
+    with stage("compute the graph's tables"):
+        prepared = prepared or prepare(log, entities, aggregate, name)
     chosen, tables, classes = prepared.entity_types, prepared.tables, prepared.classes
-    ensure_schema(driver)
+    with stage("the indexes and constraints"):
+        ensure_schema(driver)
     # Checked under the lock: another ingest of this name may have finished a moment ago.
     with log_write_lock(driver, name, "ingesting") as run:
         if not replace:
@@ -123,11 +126,13 @@ def build_ekg(
         existing = replace and log_exists(driver, name)
         target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
         job = _Job(tables, classes, target, source, progress, run, objects, chosen)
-        summary = _write_or_undo(driver, job)
+        with stage("write the graph"):
+            summary = _write_or_undo(driver, job)
         if existing:
             _swap(driver, target, name)
         # under the lock: no other build of this name can come between the graph and its copy
-        store_copy(driver, name, log)
+        with stage("the columnar copy"):
+            store_copy(driver, name, log)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
 
 

@@ -54,12 +54,16 @@ from robotale.eventlog.objects import Objects
 from robotale.neo4j_server.importer import RestartFailed, import_offline
 from robotale.neo4j_server.server import LocalServer
 from robotale.queries import cypher
+from robotale.timings import stage
 
 ONLINE, BULK, AUTO = "online", "bulk", "auto"
 BUILDS = (AUTO, ONLINE, BULK)
-#: from this many events on ``auto`` takes the bulk path: at this size it already took less
-#: wall and CPU time than writing online, restart included (docs/benchmarks.md, "Bulk import")
-BULK_FROM = 100_000
+#: from this many events on ``auto`` takes the bulk path. It cost 1.8x the CPU of writing
+#: online to a server that has run a build before at 100,000 events and 1.2x at 200,000 (the
+#: restart, the importer's JVM and the indexes filled on a cold server are fixed costs; the
+#: restart also leaves the server cold for the next command): the two cross at about 300,000
+#: (docs/benchmarks.md, "Where the whole ingest's time goes")
+BULK_FROM = 300_000
 #: how long the indexes and constraints may take to come online after an import
 INDEX_WAIT = 3600
 
@@ -85,8 +89,12 @@ def build_log(
     """
     if build not in BUILDS:
         raise InputError(f"--build {build!r} is not one of {', '.join(BUILDS)}.")
-    prepared = prepare(log, entities, aggregate, name)
-    reason = "--build online" if build == ONLINE else refusal(driver, prepared, objects, user_agent)
+    with stage("compute the graph's tables"):
+        prepared = prepare(log, entities, aggregate, name)
+    with stage("choose the build"):
+        reason = (
+            "--build online" if build == ONLINE else refusal(driver, prepared, objects, user_agent)
+        )
     if build == AUTO and reason is None and len(log) < BULK_FROM:
         reason = f"fewer than {BULK_FROM:,} events"
     if build == BULK and reason is not None:
@@ -154,7 +162,8 @@ def build_bulk(
     started = time.perf_counter()
     server = LocalServer()
     tables, classes = prepared.tables, prepared.classes
-    ensure_schema_together(driver)
+    with stage("the indexes and constraints before the import"):
+        ensure_schema_together(driver)
     run = take(driver, name, "ingesting")
     try:
         if why := _occupied(driver, run, user_agent):
@@ -168,7 +177,8 @@ def build_bulk(
     with tempfile.TemporaryDirectory(dir=server.home, prefix="import-") as folder:
         progress(f"Writing the import files of {len(tables.events):,} events ...")
         try:
-            files = write_import_files(Path(folder), tables, classes, node, lock)
+            with stage("write the import files"):
+                files = write_import_files(Path(folder), tables, classes, node, lock)
         except BaseException:  # e.g. a full disk: the server still runs
             release(driver, name, run)
             raise
@@ -237,11 +247,14 @@ def _finish(
     with ThreadPoolExecutor(max_workers=1) as beside:
         copying = beside.submit(store_copy, driver, name, log)
         try:
-            ensure_schema_together(driver)
-            driver.execute_query(
-                cypher("ekg_await_indexes"), seconds=INDEX_WAIT, database_=database()
-            )
-            finish_log(driver, name, prepared.tables.events, prepared.classes)
+            with stage("create the indexes and constraints"):
+                ensure_schema_together(driver)
+            with stage("wait for the indexes"):
+                driver.execute_query(
+                    cypher("ekg_await_indexes"), seconds=INDEX_WAIT, database_=database()
+                )
+            with stage("complete the Log node"):
+                finish_log(driver, name, prepared.tables.events, prepared.classes)
         except BaseException as error:
             wait([copying])
             delete_copies(name)  # the copy of a log that is not kept
@@ -251,7 +264,8 @@ def _finish(
                 f"Finishing the imported log {name!r} failed",
                 f"`robotale logs delete {shlex.quote(name)}`",
             )
-    copying.result()
+    with stage("wait for the columnar copy"):
+        copying.result()
 
 
 def _say(line: str) -> None:

@@ -22,6 +22,7 @@ from pathlib import Path
 from robotale.errors import ServerError
 from robotale.neo4j_server.jars import ensure_jars, release
 from robotale.neo4j_server.server import ADMIN_TOOL, LocalServer, ServerOptions, java_executable
+from robotale.timings import stage
 
 #: where the database's files are moved while an import replaces them, under ``data/``
 _ASIDE = "before-import"
@@ -109,16 +110,19 @@ def import_offline(
     data = server.home / "data"
     aside = data / f"{_ASIDE}-{uuid.uuid4().hex[:8]}"
     progress("Stopping the local Neo4j for the import ...")
-    server.stop()
+    with stage("stop the server"):
+        server.stop()
     _move_aside(data, aside, database)
     try:
-        report = _run_importer(server, options.version, database, files, progress)
+        with stage("the offline importer"):
+            report = _run_importer(server, options.version, database, files, progress)
     except BaseException as error:
         _put_back(data, aside, database)
         _restart(server, options, progress, f"after the failed import ({error})")
         raise
     shutil.rmtree(aside, ignore_errors=True)
-    _restart(server, options, progress, "after the import")
+    with stage("start the server again"):
+        _restart(server, options, progress, "after the import")
     return report
 
 

@@ -4,6 +4,7 @@ input, once where both sides compute the same and once where one computes someth
 from __future__ import annotations
 
 import importlib.util
+import signal
 import sys
 from pathlib import Path
 
@@ -82,6 +83,20 @@ def test_the_whole_ingests_graphs_are_checked_equal_where_both_build_the_same(
     assert whole.same_counts(ours, fewer) == [
         f"CORR: robotale {ours['relationship:CORR']:,}, PromG {fewer['relationship:CORR']:,}"
     ]
+
+
+def test_an_ingest_ended_by_a_signal_is_told_in_one_sentence(tmp_path):
+    whole = benchmark("whole_ingest")
+    from robotale.neo4j_server.server import LocalServer
+
+    server = LocalServer(tmp_path)  # an empty home: no server runs there
+    killed = "import os, signal, sys; print('reading', file=sys.stderr, flush=True); "
+    killed += "os.kill(os.getpid(), signal.SIGKILL)"
+    run, status, _, stderr = whole.timed_process([sys.executable, "-c", killed], server)
+    said = whole.failure("robotale ingest", status, stderr, run, server)
+    assert status == -signal.SIGKILL
+    assert said.startswith("robotale ingest was ended by SIGKILL")
+    assert "saying: reading; its Neo4j server no longer runs" in said
 
 
 def test_the_importers_bound_checks_what_it_imported():

@@ -131,7 +131,7 @@ def test_bulk_is_refused_where_the_server_is_not_robotales(neo4j_driver, thesis_
 @pytest.mark.timeout(2400)  # two imports, each stopping and starting a server
 def test_the_bulk_build_equals_the_online_build(managed, neo4j_driver, thesis_log, monkeypatch):
     log = typed_log(thesis_log)
-    # what follows the comparison needs no size (bulk is never chosen by size below 100,000
+    # what follows the comparison needs no size (bulk is never chosen by size below BULK_FROM
     # events): a part of the typed log, written faster
     small = log.head(SMALL)
     name = f"bulk-{uuid.uuid4().hex[:6]}"
