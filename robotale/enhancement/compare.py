@@ -52,7 +52,6 @@ from robotale.enhancement.performance import (
     shared_cases,
     shared_steps,
 )
-from robotale.enhancement.student import lower_tail
 from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, ROBOT_TYPE
 
 #: the measures, in the order of the tables; each compares one value per run
@@ -387,6 +386,10 @@ def welch(long: pd.DataFrame) -> pd.Series:
     ranks); the t-test on the same per-run values sees it. Welch's form, because a change
     usually changes the spread too, and with a dozen runs or more per side the mean is near
     normal enough for the t distribution."""
+    # scipy.special alone: Student's t distribution function without the second that
+    # importing scipy.stats costs (only comparisons need it)
+    from scipy.special import stdtr
+
     keys = ["measure", "subject", "who"]
     long = long.dropna(subset=["value"])
     stats = long.groupby([*keys, "side"], sort=False)["value"].agg(["size", "mean", "var"])
@@ -398,7 +401,7 @@ def welch(long: pd.DataFrame) -> pd.Series:
     t = (b["mean"] - a["mean"]) / np.sqrt(spread.where(known))
     df = spread**2 / (spread_a**2 / (a["size"] - 1) + spread_b**2 / (b["size"] - 1))
     # the upper tail beyond |t| is the distribution function below -|t|
-    p = 2 * lower_tail(df.where(known).to_numpy(float), t.to_numpy(float))
+    p = 2 * stdtr(df.where(known).to_numpy(float), -np.abs(t.to_numpy(float)))
     return pd.Series(p, index=a.index)
 
 
