@@ -369,6 +369,11 @@ def _write_lifted(
     entities' read once per run, :meth:`LogEdges.ends`), :data:`LIFT_WORKERS` batches in
     flight."""
     source, target = lifted["source"].to_numpy(), lifted["target"].to_numpy()
+    # grouped by the aggregate they reach: two batches in flight touch different aggregates
+    # rather than both waiting on each of the step's few
+    reached = np.where(pd.isna(edges.element_ids[source]), target, source)
+    order = np.argsort(reached, kind="stable")
+    lifted, source, target = lifted.iloc[order], source[order], target[order]
     loader = Loader(driver, log, None, between_batches, workers=LIFT_WORKERS)
     loader.run(
         "aggr_create_lifted",
