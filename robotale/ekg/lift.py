@@ -168,6 +168,12 @@ class LogEdges:
         ends: np.ndarray = np.where(
             pd.isna(self.element_ids[codes]), self.stored[codes], self.element_ids[codes]
         )
+        if pd.isna(ends).any():  # an edge to it would be dropped without a word
+            missing = self.keys[codes[pd.isna(ends)][0]]
+            raise InputError(
+                f"The log {log!r} in Neo4j has no node {missing!r}, which its columnar copy "
+                "names: ingest the log again (robotale ingest ... --replace)."
+            )
         return ends
 
     @staticmethod
