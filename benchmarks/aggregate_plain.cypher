@@ -111,15 +111,37 @@ WITH a, coalesce(g, o) AS other, count(*) AS count
 CREATE (other)-[:COMM {step: $step, count: count}]->(a);
 
 // output: every aggregate of log $log
-MATCH (a:Aggregate {log: $log}) RETURN properties(a) AS a;
+MATCH (a:Aggregate {log: $log}) RETURN properties(a) AS a, elementId(a) AS element;
 
-// output: every lifted edge that touches an aggregate of log $log
+// output: every lifted edge out of the aggregate with element id $aggregate (read one
+// aggregate at a time: at a million events all of them at once pass the server's limit on a
+// transaction's memory)
 MATCH (a)-[r:CORR|DF|COMM]->(b)
-WHERE r.step IS NOT NULL AND (a:Aggregate AND a.log = $log OR b:Aggregate AND b.log = $log)
+WHERE elementId(a) = $aggregate AND r.step IS NOT NULL
 RETURN a.id AS source, b.id AS target, type(r) AS type, r.entityType AS entityType,
+       r.count AS count, r.step AS step;
+
+// output: every lifted edge into the aggregate with element id $aggregate from a node that is
+// no aggregate of log $log (those are read as edges out of their aggregate)
+MATCH (b)-[r:CORR|DF|COMM]->(a)
+WHERE elementId(a) = $aggregate AND r.step IS NOT NULL AND NOT (b:Aggregate AND b.log = $log)
+RETURN b.id AS source, a.id AS target, type(r) AS type, r.entityType AS entityType,
        r.count AS count, r.step AS step;
 
 // attributes: the rows $rows (id and attributes) set on the entities of type $type
 UNWIND $rows AS row
 MATCH (n:Entity {log: $log, type: $type, id: row.id})
 SET n += row;
+
+// ends: the element ids of the ends of every lifted edge out of the aggregate with element id
+// $aggregate, and of those into it from a node that is no aggregate of log $log
+CALL () {
+  MATCH (a)-[r:CORR|DF|COMM]->(b)
+  WHERE elementId(a) = $aggregate AND r.step IS NOT NULL
+  RETURN a, b
+  UNION ALL
+  MATCH (b)-[r:CORR|DF|COMM]->(a)
+  WHERE elementId(a) = $aggregate AND r.step IS NOT NULL AND NOT (b:Aggregate AND b.log = $log)
+  RETURN b AS a, a AS b
+}
+RETURN elementId(a) AS source, elementId(b) AS target;

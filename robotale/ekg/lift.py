@@ -8,8 +8,9 @@ the entity table (an entity no event names gets a code when a step meets it), th
 aggregates. Which aggregate holds each node is kept per code. A step's edges are found with
 numpy, their ends mapped to what stands for them at this level (the aggregate holding the
 node, else the node), counted per pair, kind and entity type with pandas. The aggregates'
-element ids are known from their creation; an edge's other end that no aggregate holds is
-found by its key (an event's id; an entity's type and id) when the edge is written.
+element ids are known from their creation; those of the events and entities a lifted edge
+reaches are read once per run, the events' or an entity type's all together (looking each
+up by its key as an edge is written costs Neo4j more than the edge itself).
 
 The rules are those of a step lifted in Cypher: an edge from a member becomes an edge from
 its aggregate; an edge into a member from a node no aggregate of the same step holds becomes
@@ -43,6 +44,7 @@ class LogEdges:
     types: np.ndarray  # per code: an entity's type; None for events and aggregates
     keys: np.ndarray  # per code: the node's id (events, entities) or the aggregate's id
     element_ids: np.ndarray  # per code: an aggregate's element id; None for the others
+    stored: np.ndarray  # per code: an event's or entity's element id once read; else None
     kinds: np.ndarray  # 'CORR', 'DF', 'COMM' per edge
     sources: np.ndarray  # codes
     targets: np.ndarray
@@ -78,6 +80,7 @@ class LogEdges:
                 [events["id"].astype(object).to_numpy(), entities["id"].astype(object).to_numpy()]
             ),
             element_ids=np.full(codes, None, dtype=object),
+            stored=np.full(codes, None, dtype=object),
             kinds=np.concatenate([np.full(len(f[1]), f[0], object) for f in frames]),
             sources=np.concatenate([np.asarray(f[1], np.int64) for f in frames]),
             targets=np.concatenate([np.asarray(f[2], np.int64) for f in frames]),
@@ -93,6 +96,7 @@ class LogEdges:
         self.types = np.concatenate([self.types, types])
         self.keys = np.concatenate([self.keys, keys])
         self.element_ids = np.concatenate([self.element_ids, element_ids])
+        self.stored = np.concatenate([self.stored, np.full(len(keys), None, dtype=object)])
         self.holder = np.concatenate([self.holder, np.full(len(keys), FREE, dtype=np.int64)])
         return np.arange(first, first + len(keys))
 
@@ -147,10 +151,36 @@ class LogEdges:
         self.holder[nodes] = codes[positions]
         return codes[positions]
 
-    def aggregates(self, codes: np.ndarray) -> np.ndarray:
-        """Which of ``codes`` are aggregates (the others are events or entities)."""
-        found: np.ndarray = ~pd.isna(self.element_ids[codes])
-        return found
+    def ends(self, driver: Driver, log: str, codes: np.ndarray) -> np.ndarray:
+        """The element ids of ``codes``: an aggregate's as created; the events' and each
+        entity type's read from Neo4j the first time one of them is asked for."""
+        nodes = codes[pd.isna(self.element_ids[codes]) & pd.isna(self.stored[codes])]
+        if nodes.size and (nodes < len(self.events)).any():
+            ids, elements = self._read(driver, cypher("aggr_event_element_ids"), log=log)
+            at = pd.Index(self.events["id"].astype(object)).get_indexer(pd.Index(ids, dtype=object))
+            self.stored[at[at >= 0]] = elements[at >= 0]
+        for kind in pd.unique(self.types[nodes[nodes >= len(self.events)]]):
+            ids, elements = self._read(
+                driver, cypher("aggr_entity_element_ids"), log=log, type=kind
+            )
+            found = self.entity_codes(str(kind), ids.tolist())  # may grow the arrays: first
+            self.stored[found] = elements
+        ends: np.ndarray = np.where(
+            pd.isna(self.element_ids[codes]), self.stored[codes], self.element_ids[codes]
+        )
+        if pd.isna(ends).any():  # an edge to it would be dropped without a word
+            missing = self.keys[codes[pd.isna(ends)][0]]
+            raise InputError(
+                f"The log {log!r} in Neo4j has no node {missing!r}, which its columnar copy "
+                "names: ingest the log again (robotale ingest ... --replace)."
+            )
+        return ends
+
+    @staticmethod
+    def _read(driver: Driver, query: str, **parameters: object) -> tuple[np.ndarray, np.ndarray]:
+        records, _, _ = driver.execute_query(query, parameters, database_=database())
+        row = records[0]
+        return np.asarray(row["ids"], dtype=object), np.asarray(row["elements"], dtype=object)
 
     def standing(self, codes: np.ndarray) -> np.ndarray:
         """What stands for each code at this level: the id of the aggregate holding it, else

@@ -48,6 +48,10 @@ from robotale.queries import cypher, statements
 OWN_PROPERTIES = ("log", "step", "id", "name", "count", "origin", "key", "type")
 #: the most member ids one AggregateMembers node lists
 MEMBERS_PART = 100_000
+#: lifted-edge batches in flight: every edge reaches one of the step's few aggregates, yet
+#: Neo4j creates edges on one node from two transactions without waiting (measured on a
+#: busy 2-core machine: no slower than one at a time; on a quiet one the second core helps)
+LIFT_WORKERS = 2
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
 
@@ -77,6 +81,7 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
     info = log_info(driver, log)
     ensure_schema(driver)
     with log_write_lock(driver, log, "aggregating"):
+        _refuse_legacy(driver, log)
         first = _last_step(driver, log) + 1
         edges = LogEdges.of_log(driver, log, info.get("entityTypes") or [])
         keys: dict[str | None, tuple[set[str], list[str]]] = {None: _event_keys(edges.events)}
@@ -360,50 +365,27 @@ def _write_lifted(
     edges: LogEdges,
     between_batches: Callable[[], None],
 ) -> None:
-    """The lifted edges of step ``number``: those between two aggregates by their element
-    ids, the others with the end no aggregate holds found by its key. Every one of them
-    reaches one of the step's few aggregates, so batches side by side would only wait on
-    each other's locks: one at a time."""
+    """The lifted edges of step ``number``, both ends by element id (the events' and
+    entities' read once per run, :meth:`LogEdges.ends`), :data:`LIFT_WORKERS` batches in
+    flight."""
     source, target = lifted["source"].to_numpy(), lifted["target"].to_numpy()
-    from_aggregate, to_aggregate = edges.aggregates(source), edges.aggregates(target)
-    loader = Loader(driver, log, None, between_batches, workers=1)
-    common = {
-        "kinds": lifted["kind"].to_numpy(dtype=object),
-        "entityTypes": lifted["entityType"].to_numpy(dtype=object),
-        "counts": lifted["count"].astype(int).to_numpy(),
-    }
-    both = from_aggregate & to_aggregate
-    if both.any():
-        loader.run(
-            "aggr_create_lifted",
-            {name: values[both].tolist() for name, values in common.items()}
-            | {
-                "sources": edges.element_ids[source[both]].tolist(),
-                "targets": edges.element_ids[target[both]].tolist(),
-            },
-            step=number,
-        )
-    one = ~both
-    outgoing = from_aggregate[one]
-    aggregate = np.where(outgoing, source[one], target[one])
-    node = np.where(outgoing, target[one], source[one])
-    entity = ~pd.isna(edges.types[node])
-    for query, chosen in (
-        ("aggr_create_lifted_event", ~entity),
-        ("aggr_create_lifted_entity", entity),
-    ):
-        if chosen.any():
-            loader.run(
-                query,
-                {name: values[one][chosen].tolist() for name, values in common.items()}
-                | {
-                    "aggregates": edges.element_ids[aggregate[chosen]].tolist(),
-                    "nodes": edges.keys[node[chosen]].tolist(),
-                    "types": edges.types[node[chosen]].tolist(),
-                    "outgoing": outgoing[chosen].tolist(),
-                },
-                step=number,
-            )
+    # grouped by the aggregate they reach: two batches in flight touch different aggregates
+    # rather than both waiting on each of the step's few
+    reached = np.where(pd.isna(edges.element_ids[source]), target, source)
+    order = np.argsort(reached, kind="stable")
+    lifted, source, target = lifted.iloc[order], source[order], target[order]
+    loader = Loader(driver, log, None, between_batches, workers=LIFT_WORKERS)
+    loader.run(
+        "aggr_create_lifted",
+        {
+            "kinds": lifted["kind"].tolist(),
+            "entityTypes": lifted["entityType"].tolist(),
+            "counts": lifted["count"].astype(int).tolist(),
+            "sources": edges.ends(driver, log, source).tolist(),
+            "targets": edges.ends(driver, log, target).tolist(),
+        },
+        step=number,
+    )
 
 
 def _write_members(
@@ -456,7 +438,33 @@ def _unaggregated(driver: Driver, log: str, edges: LogEdges) -> tuple[int, int]:
     return len(edges.free_events()), int(records[0]["entities"]) - edges.held_entities()
 
 
+def _legacy_steps(driver: Driver, log: str, step: int = 1) -> list[int]:
+    """The steps from ``step`` on that earlier versions of robotale wrote: their members are
+    marked on the nodes themselves, not listed."""
+    records, _, _ = driver.execute_query(
+        cypher("aggr_legacy_steps"), log=log, step=step, database_=database()
+    )
+    return [int(n) for n in records[0]["steps"]]
+
+
+def _refuse_legacy(driver: Driver, log: str) -> None:
+    """A step stacked on steps whose members are not listed would collapse those members
+    again: refuse, saying how to redo them."""
+    legacy = _legacy_steps(driver, log)
+    if legacy:
+        listed = ", ".join(map(str, legacy))
+        raise InputError(
+            f"The aggregation step(s) {listed} of log {log!r} were written by an earlier version "
+            "of robotale, which kept their members in another form: undo them with "
+            f"`robotale aggregate {shlex.quote(log)} --undo {legacy[0]}` and run them again."
+        )
+
+
 def _delete_steps(driver: Driver, log: str, step: int) -> None:
+    legacy = _legacy_steps(driver, log, step)
     with driver.session(database=database()) as session:
+        if legacy:  # their members carry marks, which go with them
+            for statement in statements("aggr_undo_marks"):
+                session.run(statement, log=log, step=step).consume()
         for statement in statements("aggr_undo"):
             session.run(statement, log=log, step=step).consume()

@@ -213,6 +213,34 @@ def test_stacked_steps_undo_as_units(neo4j_driver, small, graph_counts):
     assert undo(neo4j_driver, small) == []
 
 
+def test_steps_of_an_earlier_version_are_undone_with_their_marks(neo4j_driver, small, graph_counts):
+    before = graph_counts()
+    run_spec(neo4j_driver, small, steps(
+        {"aggr_type": "ENTITIES", "ent_type": "parcel", "group_by": ["type"]},
+    ))  # fmt: skip
+    # the form an earlier version left: no member list, each member marked with its aggregate
+    neo4j_driver.execute_query(
+        "MATCH (m:AggregateMembers {log: $log}) DELETE m "
+        "WITH count(*) AS done MATCH (n:Entity {log: $log, type: 'parcel'}) "
+        "SET n._aggregate = '1:parcel'",
+        log=small,
+        database_=database(),
+    )
+    again = steps({"aggr_type": "EVENTS", "group_by": ["activity"]})
+    with pytest.raises(InputError, match=r"step\(s\) 1 of log .* earlier version.*--undo 1"):
+        run_spec(neo4j_driver, small, again)
+    assert undo(neo4j_driver, small) == [1]
+    assert graph_counts() == before
+    marked, _, _ = neo4j_driver.execute_query(
+        "MATCH (n {log: $log}) WHERE n._aggregate IS NOT NULL RETURN count(n) AS n",
+        log=small,
+        database_=database(),
+    )
+    assert marked[0]["n"] == 0
+    run_spec(neo4j_driver, small, again)  # the log aggregates as it did before
+    assert set(aggregates(neo4j_driver, small)) == {"move", "spray"}
+
+
 def test_bad_steps_are_refused_before_anything_is_written(neo4j_driver, small, graph_counts):
     before = graph_counts()
     cases = [
