@@ -153,7 +153,7 @@ def _row(record: Record) -> dict[str, Any]:
     """``record.data()``, with the values that need no conversion taken as they are."""
     return {
         key: value if isinstance(value, _AS_THEY_ARE) else record.data(key)[key]
-        for key, value in record.items()
+        for key, value in zip(record.keys(), record, strict=True)
     }
 
 
