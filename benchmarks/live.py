@@ -63,6 +63,8 @@ from collections import Counter
 from collections.abc import Iterator
 from pathlib import Path
 
+from robotale.timings import process_seconds
+
 BENCHMARKS = Path(__file__).resolve().parent
 sys.path.insert(0, str(BENCHMARKS))
 
@@ -540,9 +542,8 @@ def _rate(counts: list[tuple[float, int]]) -> float:
 
 
 def _cpu(pid: int) -> float:
-    """User + system CPU seconds of process ``pid`` so far (Linux's ``/proc``)."""
-    fields = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    """User + system CPU seconds of process ``pid`` so far (0 when it is gone)."""
+    return process_seconds(pid) or 0.0
 
 
 def _epoch(iso: str) -> float:

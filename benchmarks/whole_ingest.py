@@ -48,6 +48,8 @@ from pathlib import Path
 
 import pandas as pd
 
+from robotale.timings import process_seconds
+
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 
@@ -213,12 +215,7 @@ class ServerCpu:
 
 def process_cpu(pid: int) -> float:
     """CPU seconds the process ``pid`` has used so far (0 when it is gone)."""
-    try:
-        stat = Path(f"/proc/{pid}/stat").read_text()
-    except OSError:
-        return 0.0
-    fields = stat.rsplit(")", 1)[1].split()
-    return (int(fields[11]) + int(fields[12])) / os.sysconf("SC_CLK_TCK")
+    return process_seconds(pid) or 0.0
 
 
 def children_cpu() -> float:
