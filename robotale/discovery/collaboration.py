@@ -22,13 +22,14 @@ from __future__ import annotations
 
 import itertools
 from collections import Counter, defaultdict
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, field
 from typing import Any, Literal
 
 import numpy as np
 import pandas as pd
 
+from robotale.discovery.answers import answered, as_units, expanded
 from robotale.discovery.filters import LogFilter, filter_log
 from robotale.discovery.instances import (
     DURATION,
@@ -548,9 +549,16 @@ def _no_later(until: Any, bound: Any) -> bool:
 # -- mining ------------------------------------------------------------------------------------
 
 
-def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
+def mine(
+    traces: list[list[str]], noise: float = 0.0, roles: Mapping[str, str | None] | None = None
+) -> Block:
     """The inductive miner's process tree of ``traces`` as blocks (an empty trace is a run
-    that does nothing, which the tree allows by a skip)."""
+    that does nothing, which the tree allows by a skip). With the activities' message
+    ``roles``, a throw and the wait that always follows it are mined as one step
+    (:mod:`robotale.discovery.answers`), so the robot waits for each answer."""
+    pairs = answered(traces, roles) if roles else {}
+    if pairs:
+        traces = as_units(traces, pairs)
     if not noise:
         # without a noise threshold the miner's cuts depend on which steps follow which, not
         # on how often: each variant once gives the same tree, faster
@@ -560,7 +568,7 @@ def mine(traces: list[list[str]], noise: float = 0.0) -> Block:
     # pm4py: 2 s to import and a banner: discovery only
     from robotale.discovery.inductive import inductive_tree
 
-    block = from_process_tree(inductive_tree(traces, noise))
+    block = expanded(from_process_tree(inductive_tree(traces, noise)))
     if any(not trace for trace in traces):
         from robotale.discovery.layout import Operator  # the one place a run may be empty
 
@@ -600,23 +608,31 @@ def discover_collaboration(
 
 def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool) -> Pool:
     parts = handled_parts(instances, records_aborts=records_aborts)
+    stats = _stats(instances)
+    roles = {label: activity.role for label, activity in stats.items()}
     handlers = [
-        _handler(label, instances, parts, noise)
+        _handler(label, instances, parts, noise, roles)
         for label in sorted(parts.handled)
         if parts.handled[label]
     ]
     return Pool(
         name=name,
         robots=sorted(instances[ROBOT].unique()),
-        block=mine(parts.main, noise),
+        block=mine(parts.main, noise, roles),
         handlers=handlers,
-        stats=_stats(instances),
+        stats=stats,
         traces=len(parts.main),
         caught=dict(parts.caught),
     )
 
 
-def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -> Handler:
+def _handler(
+    label: str,
+    instances: pd.DataFrame,
+    parts: _Split,
+    noise: float,
+    roles: Mapping[str, str | None],
+) -> Handler:
     tag = _tag(parts.tags[label])
     traces = parts.handled[label]
     if tag is not None:  # the sub-process itself, not a step inside it
@@ -626,7 +642,7 @@ def _handler(label: str, instances: pd.DataFrame, parts: _Split, noise: float) -
         trigger=label,
         kind="signal" if received else "error",
         interrupting=not parts.went_on[label],
-        block=mine(traces, noise),
+        block=mine(traces, noise, roles),
         count=len(traces),
         abandoned=dict(parts.abandoned[label]),
         tag=tag,

@@ -63,9 +63,9 @@ def _started(pool: Pool, instances: pd.DataFrame, records_aborts: bool, noise: f
     if first is None:
         return pool
     cut = [piece for trace in parts.main for piece in _cut(trace, first)]
-    return replace(
-        pool, block=mine([piece[1:] for piece in cut], noise), traces=len(cut), starts_on=first
-    )
+    roles = {label: activity.role for label, activity in pool.stats.items()}
+    block = mine([piece[1:] for piece in cut], noise, roles)
+    return replace(pool, block=block, traces=len(cut), starts_on=first)
 
 
 def _common_first(traces: list[list[str]], pool: Pool) -> str | None:
