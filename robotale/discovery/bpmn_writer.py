@@ -36,7 +36,7 @@ from robotale.discovery.layout import (
     simplify,
 )
 from robotale.discovery.payload_choices import separating
-from robotale.discovery.repeats import once
+from robotale.discovery.repeats import once, unrolled
 from robotale.eventlog.schema import RECEIVE, SEND
 from robotale.fame_runtime.labels import activity_label
 
@@ -79,9 +79,9 @@ class _PoolDrawing:
         self.defaults: dict[str, str] = {}
         self.event_based: set[str] = set()
         outside = self._outside()
-        repeated = {label for (name, label) in bindings.repeats if name == pool.name}
+        repeats = {label: n for (name, label), n in bindings.repeats.items() if name == pool.name}
         self.main = self.framed(
-            once(without(pool.block, outside), repeated),
+            once(without(unrolled(pool.block, repeats), outside), set(repeats)),
             self.builder.node("start", pool.starts_on or ""),
             pool.traces,
         )
