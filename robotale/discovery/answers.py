@@ -29,14 +29,19 @@ _JOIN = "\x1f"
 def answered(traces: Sequence[Sequence[str]], roles: Mapping[str, str | None]) -> dict[str, str]:
     """Follower -> throw, for every throw that is always directly followed by one of steps
     that each come only directly after it, one of which is a received message."""
+    # the distinct pairs of steps in a row, None at each trace's start and end, found by
+    # pairwise and a set over all traces laid end to end (no Python loop per step)
+    flat: list[str | None] = [None]
+    for trace in traces:
+        flat += trace
+        flat.append(None)
     after: dict[str, set[str | None]] = {}  # each throw's followers (None: the trace ends)
     before: dict[str, set[str | None]] = {}  # each step's predecessors (None: trace start)
-    for trace in traces:
-        for first, second in itertools.pairwise([None, *trace, None]):
-            if first is not None and roles.get(first) == SEND:
-                after.setdefault(first, set()).add(second)
-            if second is not None:
-                before.setdefault(second, set()).add(first)
+    for first, second in set(itertools.pairwise(flat)):
+        if first is not None and roles.get(first) == SEND:
+            after.setdefault(first, set()).add(second)
+        if second is not None:
+            before.setdefault(second, set()).add(first)
     found: dict[str, str] = {}
     for throw, followers in sorted(after.items()):
         if None in followers or throw in followers:
