@@ -6,9 +6,10 @@ then gets an answer for each of two tasks)."""
 from __future__ import annotations
 
 from robotale.discovery.answers import answered
-from robotale.discovery.collaboration import mine
+from robotale.discovery.collaboration import discover_collaboration, mine
 from robotale.discovery.layout import Leaf, Operator, Tau, leaves
 from robotale.discovery.repeats import _rounds, loop_key, steps_loops, unrolled
+from robotale.discovery.signal_starts import started_on_signals
 
 ASKING = ["ping!", "no_answer", "count_try"]
 ANSWERED = ["next_task", "ping!", "pong?"]
@@ -56,3 +57,18 @@ def test_a_loop_that_always_went_round_three_times_is_written_out():
     assert unrolled(loop, {loop_key(loop): 3}) == Operator("seq", [Leaf(x) for x in "ababab"])
     redo = Operator("loop", [Leaf("a"), Leaf("b")])
     assert unrolled(redo, {loop_key(redo): 2}) == Operator("seq", [Leaf(x) for x in "aba"])
+
+
+def test_the_thesis_tractors_answer_does_not_always_follow_their_throw(thesis_log):
+    """The thesis' tractors: ``move`` is logged between ``tractor_position!`` and the
+    ``closest_tractor?`` that decides it in some instances (counted with pandas), so the
+    catch is no pair of the throw and stays beside the work, as the miner alone draws it."""
+    starts = thesis_log[
+        thesis_log["robot"].astype(str).str.startswith("tractor")
+        & (thesis_log["lifecycle:transition"] == "start")
+    ].sort_values(["robot", "time:timestamp"], kind="stable")
+    names = starts["concept:name"].astype(str)
+    after = names.groupby(starts["robot"]).shift(-1)[names == "tractor_position!"]
+    assert set(after) == {"closest_tractor?", "move"}
+    tractor = started_on_signals(discover_collaboration(thesis_log), thesis_log).pool("Tractor")
+    assert "and" in _kinds(tractor.block)
