@@ -497,7 +497,11 @@ def empty(dashboard, log: str, cold: bool) -> None:
     current.preparations.wait()
     current.logs.forget(log)
     if cold:
-        shutil.rmtree(results_folder(log_build(driver, log)))
+        # a request of the last load the browser left (a section below the fold) may still
+        # be computing in the dashboard and write its result while the folder is removed
+        folder = results_folder(log_build(driver, log))
+        while folder.exists():
+            shutil.rmtree(folder, ignore_errors=True)
     else:
         prepare(driver, current.logs, log)
         current.logs.forget(log)
