@@ -138,6 +138,9 @@ def test_the_mission_page_draws_a_replayed_bag(page, app, recorded):
     try:
         page.goto(f"{page.base_url}{mission_path(replay)}&t=20")
         wait_for(page, "Number(document.getElementById('mission').dataset.shown) === 20")
+        # each drawn once it is scrolled into the window
+        page.locator("#plot").scroll_into_view_if_needed()
+        page.locator("#mission-timeline").scroll_into_view_if_needed()
         expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
         expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
         assert page.locator("#map rect.field").count() == 1

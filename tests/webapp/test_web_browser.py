@@ -162,6 +162,8 @@ def test_upload_ingest_discover_and_drill_down(page, screenshot, thesis_csv, sce
         expect(page.locator(f"article[data-name={name}]")).to_have_attribute(
             "data-state", re.compile("shown|empty")
         )
+    # the 3D figure is drawn once it is in the window
+    page.locator("article[data-name=spatial] .figure").scroll_into_view_if_needed()
     expect(page.locator("article[data-name=spatial] .figure[data-plotted]")).to_have_count(1)
     screenshot(page, "perspectives")
     page.click("#whole-log")

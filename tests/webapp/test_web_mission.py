@@ -530,6 +530,18 @@ def wait_for_shown(page, t: float) -> None:
     wait_for(page, f"Number({SHOWN}) === {t}")
 
 
+def scroll_to_plots(page) -> None:
+    """Bring the timeline and the plot into the window (the page draws each once a quarter
+    of it is there) and wait until both are drawn."""
+    from playwright.sync_api import expect
+
+    for box in ("#mission-timeline", "#plot"):
+        page.locator(box).scroll_into_view_if_needed()
+    page.locator("#mission-timeline").scroll_into_view_if_needed()
+    expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
+    expect(page.locator("#plot")).to_have_attribute("data-field", re.compile("."))
+
+
 def expected_view(run: StoredRun, t: float) -> dict:
     """What the page must show at ``t``, from the stored log with pandas and the model file
     with lxml (and the truth for the running activities)."""
@@ -588,6 +600,7 @@ def test_mission_page_shows_the_run_at_the_cursor_in_every_view(page, stored_run
     page.goto(f"{page.base_url}/mission?log={stored_run.name}&case={CASE}&t={times[0]}")
     wait_for_shown(page, times[0])
     expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")
+    scroll_to_plots(page)
     expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
     expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
     expect(page.locator("#mission-missing")).to_be_hidden()
@@ -643,6 +656,7 @@ def test_clicking_a_bar_a_finding_or_a_key_moves_the_cursor(page, stored_run):
     page.click("#mission-link")
     wait_for_shown(page, 0)
     assert f"case={CASE}" in page.url and f"log={stored_run.name}" in page.url
+    page.locator("#mission-timeline").scroll_into_view_if_needed()
     wait_for(page, "document.getElementById('mission-timeline').dataset.drawn")
 
     # the longest bar of the timeline: the cursor goes to its start, an activity's true start
@@ -694,6 +708,42 @@ def test_clicking_a_bar_a_finding_or_a_key_moves_the_cursor(page, stored_run):
 
 
 @pytest.mark.browser
+def test_the_timeline_and_the_plot_are_drawn_when_scrolled_to(page, stored_run):
+    """Below the first view the timeline and the plot say they are drawn when scrolled to
+    (plotly takes the page's only thread for them) while the rest of the page is shown; in
+    the window, each is drawn: the cursor's line where the cursor is, a line per robot with
+    battery levels in the log."""
+    from playwright.sync_api import expect
+
+    events, start = run_events(stored_run)
+    page.set_viewport_size({"width": 1400, "height": 700})
+    page.goto(f"{page.base_url}/mission?log={stored_run.name}&case={CASE}&t=30")
+    wait_for_shown(page, 30)
+    expect(page.locator("#canvas")).to_have_attribute("data-rendered", "1")
+    for box in ("#mission-timeline", "#plot"):
+        expect(page.locator(f"{box} > .placeholder")).to_have_text("drawn when scrolled into view")
+    assert page.evaluate("document.getElementById('mission-timeline').dataset.drawn") is None
+    assert page.evaluate("document.getElementById('plot').dataset.field") is None
+    # the readings at the cursor need no drawing
+    robots = set(events.dropna(subset=["battery"])["robot"].astype(str))
+    rows = page.eval_on_selector_all("#plot-values tr[data-robot]", "els => els.length")
+    assert rows == len(robots)
+
+    page.locator("#mission-timeline").scroll_into_view_if_needed()
+    expect(page.locator("#mission-timeline")).to_have_attribute("data-drawn", "1")
+    expect(page.locator("#mission-timeline > .placeholder")).to_have_count(0)
+    line = page.evaluate("document.getElementById('mission-timeline').layout.shapes[0].x0")
+    at = start + pd.Timedelta(seconds=30)
+    assert pd.Timestamp(line, tz="UTC") == pytest.approx(at, abs=pd.Timedelta("2ms"))
+
+    page.locator("#plot").scroll_into_view_if_needed()
+    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
+    expect(page.locator("#plot > .placeholder")).to_have_count(0)
+    lines = page.evaluate("document.getElementById('plot')._fullData.map((t) => t.name)")
+    assert set(lines) == robots
+
+
+@pytest.mark.browser
 def test_the_page_says_what_a_run_without_positions_or_model_lacks(
     page, stored_run, neo4j_driver, log_name
 ):
@@ -709,6 +759,7 @@ def test_the_page_says_what_a_run_without_positions_or_model_lacks(
     expect(page.locator("#mission-missing")).to_contain_text("No model is linked")
     expect(page.locator("#map")).to_contain_text("no positions in this run")
     assert page.locator("#map g.robot").count() == 0
-    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
     wait_for(page, "document.querySelectorAll('#plot-values tr[data-robot]').length === 3")
+    scroll_to_plots(page)
+    expect(page.locator("#plot")).to_have_attribute("data-field", "battery")
     assert page.locator("#robots table tbody tr").count() == 3

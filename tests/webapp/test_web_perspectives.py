@@ -1,15 +1,18 @@
 """The Perspectives page draws every section's figures with the data of the log: the points and
 bars plotly holds once the page is fully drawn, against what pandas counts in the same log.
 The sections below the window are asked for, and the figures below the fold drawn, after the
-page's ``robotale-perspectives-drawn`` mark."""
+page's ``robotale-perspectives-drawn`` mark; a 3D figure (WebGL) once it is scrolled into the
+window."""
 
 from __future__ import annotations
 
+import re
 from itertools import pairwise
 
 import mission_findings as mission
 import pytest
 from browser import wait_for
+from playwright.sync_api import expect
 from test_web_findings import _store  # stored as the Findings tests store theirs
 
 from robotale.eventlog import schema
@@ -55,9 +58,14 @@ def battery_log(neo4j_driver, tmp_path_factory):
 
 
 def drawn(page, log: str) -> list[dict]:
-    """Open the page of ``log``, wait until every figure is drawn; what plotly drew."""
+    """Open the page of ``log``, wait until every figure is drawn (those drawn only in the
+    window scrolled to); what plotly drew."""
     page.goto(f"{page.base_url}/perspectives?log={log}")
     wait_for(page, ALL_DRAWN, timeout=120)
+    waiting = page.locator("article.perspective .figure:has(> .placeholder)")
+    while left := waiting.count():
+        waiting.first.scroll_into_view_if_needed()
+        wait_for(page, f"document.querySelectorAll('.figure > .placeholder').length < {left}", 120)
     return page.evaluate(DRAWN_FIGURES)
 
 
@@ -83,6 +91,32 @@ def test_spatial_draws_every_placed_event_by_activity(page, thesis_log):
     placed = log.dropna(subset=["x", "y"]).groupby(schema.ACTIVITY).size()
     figures = drawn(page, name)
     points = {t["name"]: t["points"] for t in traces(figures, "spatial", "scatter3d")}
+    assert points == {str(a): int(n) for a, n in placed.items()}
+
+
+def test_the_3d_figure_is_drawn_when_scrolled_into_view(page, thesis_log):
+    """Every other figure is drawn without being looked at; the spatial section's 3D scatter
+    says it is drawn when scrolled to, and is, with every placed event, once in the window."""
+    log, name = thesis_log
+    page.goto(f"{page.base_url}/perspectives?log={name}")
+    wait_for(page, ALL_DRAWN, timeout=120)
+    spatial = page.locator("article[data-name=spatial] .figure")
+    expect(spatial).to_have_count(1)
+    expect(spatial.locator("> .placeholder")).to_have_text(
+        "3D figure: drawn when scrolled into view"
+    )
+    figures = page.evaluate(DRAWN_FIGURES)
+    waiting = [f for f in figures if not f["plotted"]]
+    assert [f["section"] for f in waiting] == ["spatial"] and not waiting[0]["traces"]
+    assert all(f["plotted"] == str(len(f["traces"])) for f in figures if f["plotted"])
+
+    spatial.scroll_into_view_if_needed()
+    expect(spatial.locator("> .placeholder")).to_have_count(0)
+    expect(spatial).to_have_attribute("data-plotted", re.compile("[1-9]"))
+    points = {
+        t["name"]: t["points"] for t in traces(page.evaluate(DRAWN_FIGURES), "spatial", "scatter3d")
+    }
+    placed = log.dropna(subset=["x", "y"]).groupby(schema.ACTIVITY).size()
     assert points == {str(a): int(n) for a, n in placed.items()}
 
 

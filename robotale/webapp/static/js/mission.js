@@ -222,33 +222,46 @@
     return { type: "line", xref: "x", yref: "paper", x0: x, x1: x, y0: 0, y1: 1, line: { color: "#111", width: 2 } };
   }
 
+  // The timeline and the plot are drawn once a quarter of each is in the window (at once if it
+  // is): plotly draws a run's thousands of bars and message arrows in one go of the page's only
+  // thread (about a second), during which the page would answer nothing; below the first view
+  // they wait until scrolled to. Their data is there before: the values at the cursor, the
+  // page's `loaded`. Resolves when the answer is there (the drawing is `timelineBox.drawing`).
+  const SHOWN_SHARE = 0.25;
   async function loadTimeline() {
     const data = await robotale.api(`/api/timeline?${new URLSearchParams({ log, case: run })}`);
-    const first = !timelineBox.dataset.drawn;
-    await robotalePerspective.plot(timelineBox, data.figure);
-    timelineBox.dataset.drawn = "1";
-    if (first) timelineBox.on("plotly_click", (event) => {
-      const point = event.points[0];
-      if (!point) return;
-      const at = point.base !== undefined ? point.base : point.x;
-      setCursor(fromPlotDate(at));
-    });
+    timelineBox.drawing = robotalePerspective.whenShown(timelineBox, async () => {
+      const first = !timelineBox.dataset.drawn;
+      await robotalePerspective.plot(timelineBox, data.figure);
+      timelineBox.dataset.drawn = "1";
+      if (first) timelineBox.on("plotly_click", (event) => {
+        const point = event.points[0];
+        if (!point) return;
+        const at = point.base !== undefined ? point.base : point.x;
+        setCursor(fromPlotDate(at));
+      });
+      moveLines(); // the cursor may have moved since the answer came
+    }, SHOWN_SHARE);
+    timelineBox.drawing.catch(robotale.showError);
   }
 
   async function loadSeries(field) {
     if (!field) return;
     const data = await robotale.api(`${base()}/series?${new URLSearchParams({ field })}`);
     series = data;
-    const traces = Object.entries(data.robots).map(([robot, rows]) => ({
-      type: "scatter", mode: "lines", name: robot, x: rows.map((r) => r[0]), y: rows.map((r) => r[1]),
-      line: { color: colour(robot), shape: "hv" },
-    }));
-    const layout = { xaxis: { title: "seconds" }, yaxis: { title: field }, shapes: [cursorShape(t)], height: 320,
-      legend: { orientation: "h" } };
-    await robotalePerspective.plot(plotBox, { data: traces, layout });
-    plotBox.dataset.field = field;
-    plotBox.on("plotly_click", (event) => event.points[0] && setCursor(event.points[0].x));
     showValues();
+    plotBox.drawing = robotalePerspective.whenShown(plotBox, async () => {
+      const traces = Object.entries(data.robots).map(([robot, rows]) => ({
+        type: "scatter", mode: "lines", name: robot, x: rows.map((r) => r[0]), y: rows.map((r) => r[1]),
+        line: { color: colour(robot), shape: "hv" },
+      }));
+      const layout = { xaxis: { title: "seconds" }, yaxis: { title: field }, shapes: [cursorShape(t)], height: 320,
+        legend: { orientation: "h" } };
+      await robotalePerspective.plot(plotBox, { data: traces, layout });
+      plotBox.dataset.field = field;
+      plotBox.on("plotly_click", (event) => event.points[0] && setCursor(event.points[0].x));
+    }, SHOWN_SHARE);
+    plotBox.drawing.catch(robotale.showError);
   }
 
   // each robot's plotted value at the cursor: its last sample at or before it

@@ -90,6 +90,46 @@ const robotalePerspective = (() => {
     box.dataset.plotted = String(figure.data.length);
   }
 
+  // A figure drawn with WebGL (plotly's gl3d bundle: a 3D scatter): 1-2 s of the page's only
+  // thread and of the compositor with software rendering, during which the page answers
+  // nothing, not even a click on a link; such a figure is drawn only once it is in the window.
+  function isHeavy(figure) {
+    return bundleOf(figure) === "gl3d";
+  }
+
+  // Calls `draw` once at least `share` of `box` is in the window (at once if it is; of a box
+  // taller than the window, `share` of the window), saying in an empty box meanwhile that it
+  // is drawn when scrolled to; a later call for the same box replaces a draw not yet begun
+  // (the newer data) and begins after one under way. Resolves with what `draw` resolves with.
+  const waiting = new WeakMap();
+  const underWay = new WeakMap();
+  const STEPS = Array.from({ length: 21 }, (_, i) => i / 20);
+  function whenShown(box, draw, share = 0) {
+    const earlier = waiting.get(box);
+    if (earlier) earlier.disconnect();
+    return new Promise((resolve, reject) => {
+      let note = box.querySelector(":scope > .placeholder");
+      if (!note && !box.robotalePlotly) {
+        note = robotale.el("p", { class: "placeholder hint", text: "drawn when scrolled into view" });
+        box.prepend(note);
+      }
+      const enough = (entry) => entry.isIntersecting && entry.intersectionRect.height
+        >= share * Math.min(entry.boundingClientRect.height, window.innerHeight);
+      const observer = new IntersectionObserver((entries) => {
+        if (!entries.some(enough)) return;
+        observer.disconnect();
+        waiting.delete(box);
+        if (note) note.textContent = "drawing…";
+        // the note goes once the figure is there (or could not be drawn)
+        const done = (underWay.get(box) || Promise.resolve()).catch(() => {}).then(draw);
+        underWay.set(box, done);
+        done.then(resolve, reject).finally(() => note && note.remove());
+      }, { threshold: STEPS });
+      waiting.set(box, observer);
+      observer.observe(box);
+    });
+  }
+
   function summaryText(summary) {
     return Object.entries(summary || {})
       .filter(([, value]) => value === null || typeof value !== "object")
@@ -97,5 +137,5 @@ const robotalePerspective = (() => {
       .join(" · ");
   }
 
-  return { focusOf, describe, query, load, preload, plot, summaryText };
+  return { focusOf, describe, query, load, preload, plot, isHeavy, whenShown, summaryText };
 })();

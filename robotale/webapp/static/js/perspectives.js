@@ -46,8 +46,9 @@
 
   // A figure is drawn when its box is on screen; the others when they scroll into view or,
   // once everything on screen is drawn, one by one while the browser is idle: plotly draws on
-  // the page's only thread, and the figures below the fold (a 3D scatter among them) would
-  // otherwise hold up the first sight of the page.
+  // the page's only thread, and the figures below the fold would otherwise hold up the first
+  // sight of the page. A 3D figure (WebGL) is drawn only when it is in the window, after the
+  // first view: it takes the page's thread for seconds (robotalePerspective.isHeavy).
   const observer = new IntersectionObserver((entries) => {
     for (const entry of entries) if (entry.isIntersecting) draw(entry.target).catch(robotale.showError);
   });
@@ -67,8 +68,18 @@
     return bottom > 0 && top < window.innerHeight && right > 0 && left < window.innerWidth;
   }
 
+  // the figures not drawn yet, but those drawn only in the window
   function pending() {
-    return [...section.querySelectorAll(".figure")].filter((box) => !box.drawing);
+    return [...section.querySelectorAll(".figure")].filter((box) => !box.drawing && !box.heavy);
+  }
+
+  function drawWhenShown(box) {
+    box.drawing = robotalePerspective.whenShown(box, () => {
+      const started = performance.now();
+      return robotalePerspective.plot(box, box.figure).then(() =>
+        performance.measure(`robotale-plot ${box.dataset.section}`, { start: started }));
+    });
+    box.drawing.catch(robotale.showError);
   }
 
   function drawVisible() {
@@ -83,7 +94,7 @@
       if (["waiting", "loading"].includes(article.dataset.state)) break;
       settled.push(...article.querySelectorAll(".figure"));
     }
-    return Promise.all(settled.filter((box) => !box.drawing && onScreen(box)).map(draw));
+    return Promise.all(settled.filter((box) => !box.drawing && !box.heavy && onScreen(box)).map(draw));
   }
 
   function idle() {
@@ -117,6 +128,8 @@
       const boxes = Object.values(result.figures).filter(hasPoints).map((figure) => {
         const box = robotale.el("div", { class: "figure", "data-section": name });
         box.figure = figure;
+        box.heavy = robotalePerspective.isHeavy(figure);
+        if (box.heavy) box.append(robotale.el("p", { class: "placeholder hint", text: "3D figure: drawn when scrolled into view" }));
         return box;
       });
       figures.append(...boxes);
@@ -168,6 +181,7 @@
       if (mine !== generation) return;
       await drawVisible();
       pending().forEach((box) => observer.observe(box));
+      section.querySelectorAll(".figure").forEach((box) => box.heavy && !box.drawing && drawWhenShown(box));
     })();
     return { rest };
   }
@@ -198,7 +212,8 @@
     }
     const shown = await figures;
     // the sections in the window, their figures and the graph drawn (what
-    // benchmarks/dashboard.py times); then the sections below it and their figures
+    // benchmarks/dashboard.py times); then the sections below it and their figures (a 3D
+    // figure when it is scrolled into view)
     performance.mark("robotale-perspectives-drawn");
     await whole(shown);
     await drawRest();
