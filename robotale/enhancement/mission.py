@@ -322,18 +322,32 @@ def run_events(log: pd.DataFrame, case: str) -> pd.DataFrame:
     return events.assign(**{ROBOT: robots_column.astype(str)})
 
 
-def lone_run(events: pd.DataFrame, case: str, found: pd.DataFrame) -> MissionRun:
+def lone_run(
+    events: pd.DataFrame,
+    case: str,
+    found: pd.DataFrame,
+    told: tuple[pd.DataFrame, set[str]] | None = None,
+) -> MissionRun:
     """The run ``case`` of a log holding only it (a live run's), its :func:`run_events` being
     ``events`` and their :func:`activity_instances` ``found``: what :func:`mission_run`
-    makes of that log, without pairing the activities again."""
-    # the messages and lanes are read of the events that carry a message or a battery level
-    # (a message's delay is judged among all of them); the first event names the run
-    carrying = events[MSG_ID].notna() if MSG_ID in events.columns else events[ROBOT].isna()
-    if BATTERY in events.columns:
-        carrying |= pd.to_numeric(events[BATTERY], errors="coerce").notna()
-    carrying.iloc[0] = True
-    run_messages, lanes = case_messages(events[carrying.to_numpy(bool)], case)
+    makes of that log, without pairing the activities again. ``told``: the
+    :func:`case_messages` of its :func:`carrying` events, when the caller kept them."""
+    if told is None:
+        told = case_messages(events[carrying(events)], case)
+    run_messages, lanes = told
     return _assembled(str(case), events, found, run_messages, lanes, _slow_limits_of(found))
+
+
+def carrying(events: pd.DataFrame, *, first: bool = True) -> np.ndarray:
+    """Which ``events`` the messages and lanes of a lone run are read of: those that carry
+    a message or a battery level (a message's delay is judged among all of them), and the
+    first, which names the run (unless ``first`` is False: ``events`` are a later part)."""
+    found = events[MSG_ID].notna() if MSG_ID in events.columns else events[ROBOT].isna()
+    if BATTERY in events.columns:
+        found |= pd.to_numeric(events[BATTERY], errors="coerce").notna()
+    rows: np.ndarray = found.to_numpy(bool).copy()
+    rows[:1] |= first
+    return rows
 
 
 def open_from(found: pd.DataFrame, last: pd.Timestamp) -> pd.Timestamp:
