@@ -144,14 +144,16 @@ class MissionRun:
         """The events, messages, positions and moments between ``start`` and ``end`` s."""
         if end < start:
             raise InputError(f"the window ends ({end} s) before it starts ({start} s).")
-        events = self.events[(self.events["s"] >= start) & (self.events["s"] <= end)]
+        # the events are in time order: the window's are found by bisection, not by a pass
+        # over the whole run (a live run's grows at every look)
+        seconds = self.events["s"].to_numpy(float)
+        first = int(np.searchsorted(seconds, start, side="left"))
+        last = int(np.searchsorted(seconds, end, side="right"))
+        events = self.events.iloc[first:last]
         control = events[events[LIFECYCLE].astype("string").fillna("") != NONE]
         messages = self.messages
         sent_in = messages["sent"].between(start, end)
         received_in = messages["received"].between(start, end)
-        seconds = self.positions["s"].to_numpy(float)
-        positions = self.positions[(seconds >= start) & (seconds <= end)]
-        xyzs = positions[["s", "x", "y", "z"]].to_numpy(float)
         moments = self.moments[self.moments["s"].between(start, end)]
         return {
             "case": self.case,
@@ -168,11 +170,22 @@ class MissionRun:
                 for row in _event_rows(control)
             ],
             "messages": _records(messages[sent_in | received_in]),
-            "positions": {
-                robot: xyzs[rows].tolist()
-                for robot, rows in sorted(rows_by_robot(positions["robot"]).items())
-            },
+            "positions": self._positions_between(start, end),
             "moments": _records(moments),
+        }
+
+    def _positions_between(self, start: float, end: float) -> dict[str, list[list[float]]]:
+        """``{robot: [[s, x, y, z], ...]}`` from ``start`` to ``end`` seconds, in time order:
+        a live run's read from its robots' tracks by bisection, so the window costs what it
+        holds, not the whole run's samples."""
+        if self.tracks is not None:
+            return self.tracks.between(start, end)
+        seconds = self.positions["s"].to_numpy(float)
+        positions = self.positions[(seconds >= start) & (seconds <= end)]
+        xyzs = positions[["s", "x", "y", "z"]].to_numpy(float)
+        return {
+            robot: xyzs[rows].tolist()
+            for robot, rows in sorted(rows_by_robot(positions["robot"]).items())
         }
 
     def series(self, column: str) -> dict[str, list[list[float]]]:
@@ -202,15 +215,25 @@ class MissionRun:
             # for the whole summary again
             "times_before": self._times_before(since),
             "event_times": self._event_times(since),
-            "instances": _records(self.instances[_changed_since(self.instances, since)]),
-            "moments": self._made_of_events["moments"],
+            # the records of the instances kept from the last look are not made again
+            "instances": [
+                self.instance_records[i]
+                for i in np.flatnonzero(_changed_since(self.instances, since).to_numpy(bool))
+            ],
+            "moments": self.moment_records,
         }
 
     def _times_before(self, since: float) -> int:
         """How many distinct :meth:`summary` event times are before ``since``."""
+        times = self._control_times
+        return int(np.unique(times[: np.searchsorted(times, since, side="left")]).size)
+
+    @cached_property
+    def _control_times(self) -> np.ndarray:
+        """The times (to the microsecond) of the control events, sorted."""
         control = self.events[LIFECYCLE].astype("string").fillna("").to_numpy() != NONE
-        times = self.events["s"].to_numpy(float)[control].round(6)
-        return int(np.unique(times[times < since]).size)
+        times: np.ndarray = np.sort(self.events["s"].to_numpy(float)[control].round(6))
+        return times
 
     def _event_times(self, since: float) -> list[float]:
         """The distinct times (to the microsecond) of the control events at or after
@@ -236,8 +259,13 @@ class MissionRun:
         return {
             "event_times": _event_times(self.events),
             "instances": self.instance_records,
-            "moments": _records(self.moments),
+            "moments": self.moment_records,
         }
+
+    @cached_property
+    def moment_records(self) -> list[dict[str, Any]]:
+        """:attr:`moments` as JSON records (all of them in every summary: they are few)."""
+        return _records(self.moments)
 
     @cached_property
     def instance_records(self) -> list[dict[str, Any]]:
@@ -294,18 +322,32 @@ def run_events(log: pd.DataFrame, case: str) -> pd.DataFrame:
     return events.assign(**{ROBOT: robots_column.astype(str)})
 
 
-def lone_run(events: pd.DataFrame, case: str, found: pd.DataFrame) -> MissionRun:
+def lone_run(
+    events: pd.DataFrame,
+    case: str,
+    found: pd.DataFrame,
+    told: tuple[pd.DataFrame, set[str]] | None = None,
+) -> MissionRun:
     """The run ``case`` of a log holding only it (a live run's), its :func:`run_events` being
     ``events`` and their :func:`activity_instances` ``found``: what :func:`mission_run`
-    makes of that log, without pairing the activities again."""
-    # the messages and lanes are read of the events that carry a message or a battery level
-    # (a message's delay is judged among all of them); the first event names the run
-    carrying = events[MSG_ID].notna() if MSG_ID in events.columns else events[ROBOT].isna()
-    if BATTERY in events.columns:
-        carrying |= pd.to_numeric(events[BATTERY], errors="coerce").notna()
-    carrying.iloc[0] = True
-    run_messages, lanes = case_messages(events[carrying.to_numpy(bool)], case)
+    makes of that log, without pairing the activities again. ``told``: the
+    :func:`case_messages` of its :func:`carrying` events, when the caller kept them."""
+    if told is None:
+        told = case_messages(events[carrying(events)], case)
+    run_messages, lanes = told
     return _assembled(str(case), events, found, run_messages, lanes, _slow_limits_of(found))
+
+
+def carrying(events: pd.DataFrame, *, first: bool = True) -> np.ndarray:
+    """Which ``events`` the messages and lanes of a lone run are read of: those that carry
+    a message or a battery level (a message's delay is judged among all of them), and the
+    first, which names the run (unless ``first`` is False: ``events`` are a later part)."""
+    found = events[MSG_ID].notna() if MSG_ID in events.columns else events[ROBOT].isna()
+    if BATTERY in events.columns:
+        found |= pd.to_numeric(events[BATTERY], errors="coerce").notna()
+    rows: np.ndarray = found.to_numpy(bool).copy()
+    rows[:1] |= first
+    return rows
 
 
 def open_from(found: pd.DataFrame, last: pd.Timestamp) -> pd.Timestamp:

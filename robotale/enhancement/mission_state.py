@@ -112,6 +112,20 @@ class Tracks:
             self.robots.setdefault(robot, Track()).append(s[rows], xyz[rows])
         return True
 
+    def between(self, start: float, end: float) -> dict[str, list[list[float]]]:
+        """``{robot: [[s, x, y, z], ...]}`` of the samples from ``start`` to ``end`` seconds
+        (both included), robots in name order, those with none left out."""
+        found = {}
+        for robot in sorted(self.robots):
+            track = self.robots[robot]
+            times = track.s[: track.size]
+            first = int(np.searchsorted(times, start, side="left"))
+            last = int(np.searchsorted(times, end, side="right"))
+            if first < last:
+                rows = np.column_stack([times[first:last], track.xyz[first:last]])
+                found[robot] = rows.tolist()
+        return found
+
     def get(self, robot: str) -> Track:
         return self.robots.get(robot) or Track()
 
@@ -173,12 +187,11 @@ def _activities(
 ) -> dict[str, tuple[np.ndarray, np.ndarray, list[str]]]:
     table = instances.dropna(subset=["start"])
     names = table["activity"].astype(str).to_numpy()
+    # each column read once, then cut per robot (not read again for every robot)
+    starts = table["start"].to_numpy(float)
+    ends = table["end"].astype(float).fillna(math.inf).to_numpy(float)
     return {
-        robot: (
-            table["start"].to_numpy(float)[rows],
-            table["end"].astype(float).fillna(math.inf).to_numpy(float)[rows],
-            names[rows].tolist(),
-        )
+        robot: (starts[rows], ends[rows], names[rows].tolist())
         for robot, rows in rows_by_robot(table["robot"]).items()
     }
 

@@ -23,8 +23,9 @@ from neo4j import Driver
 from robotale.discovery.instances import FINISHED, START_TIMESTAMP, activity_instances
 from robotale.ekg.connection import database
 from robotale.ekg.live import Pose, live_since, live_tags
-from robotale.enhancement.mission import MissionRun, lone_run, open_from, run_events
+from robotale.enhancement.mission import MissionRun, carrying, lone_run, open_from, run_events
 from robotale.enhancement.mission_state import Tracks
+from robotale.enhancement.timeline import NO_ROBOT, case_messages
 from robotale.eventlog import schema
 from robotale.eventlog.enrich import pair_activities
 from robotale.eventlog.prepare import tags_log
@@ -124,6 +125,10 @@ class _Kept:
     #: :func:`activity_instances` of the run's events
     found: pd.DataFrame | None = None
     replay: LiveReplay | None = None
+    #: which of :attr:`events` the run's messages were read of (:func:`carrying`), and what
+    #: :func:`case_messages` read of them
+    carried: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=bool))
+    told: tuple[pd.DataFrame, set[str]] | None = None
 
     def grow(self, name: str, tags: list[Tag]) -> tuple[pd.DataFrame, MissionRun]:
         """Take the newly read ``tags`` in; the events and the run they make with the ones
@@ -138,21 +143,35 @@ class _Kept:
         # made again whole when the tail will not do
         made = self._made(name, self._tail(fresh)) or self._made(name, None)
         assert made is not None  # the whole run is always made
-        events, found, unchanged = made
-        run = lone_run(run_events(events, name), name, found)
+        events, found, unchanged, kept = made
+        events_of_run = _run_events(events, name)
+        run = lone_run(events_of_run, name, found, self._told(name, events_of_run, kept))
         before = self.replay.runs.get(name) if self.replay is not None else None
         if unchanged and before is not None:
             run.grown_from(before, unchanged)
         self.events, self.found = events, found
         return events, run
 
+    def _told(self, name: str, events: pd.DataFrame, kept: int) -> tuple[pd.DataFrame, set[str]]:
+        """:func:`case_messages` of the run's :func:`carrying` ``events``, the first ``kept``
+        of them as at the last look: read again only when the events carrying a message or a
+        battery level are others than then, or among those made again."""
+        rows = np.concatenate([self.carried[:kept], carrying(events.iloc[kept:], first=False)])
+        rows[:1] = True
+        at = np.flatnonzero(rows)
+        same = np.array_equal(at, np.flatnonzero(self.carried)) and bool((at < kept).all())
+        if self.told is None or not same:
+            self.told = case_messages(events[rows], name)
+        self.carried = rows
+        return self.told
+
     def _made(
         self, name: str, tail: tuple[int, np.ndarray] | None
-    ) -> tuple[pd.DataFrame, pd.DataFrame, int] | None:
+    ) -> tuple[pd.DataFrame, pd.DataFrame, int, int] | None:
         """The run's events and activity instances made again from the ``tail`` (from when,
-        and of which tags) or whole (None), and how many of the first instances stay as they
-        were; None when an instance kept and one made again start at once (the order of the
-        two is not told without their start events)."""
+        and of which tags) or whole (None), how many of the first instances stay as they
+        were and how many of the first events; None when an instance kept and one made again
+        start at once (the order of the two is not told without their start events)."""
         cut, chosen = (
             tail if tail is not None else (np.iinfo(np.int64).min, np.arange(len(self.tags)))
         )
@@ -161,7 +180,7 @@ class _Kept:
         found = activity_instances(run_events(made, name))
         if tail is None or self.events is None or self.found is None:
             self.heard.pair(frame, rows)
-            return made, found, 0
+            return made, found, 0, 0
         # the instances over by the cut are kept; the straddling ones are made again
         ended = _nanos(self.found[schema.TIMESTAMP]) < cut
         earlier = self.found[ended & self.found[FINISHED].to_numpy(bool)]
@@ -182,7 +201,7 @@ class _Kept:
         position = pd.Series(np.arange(kept, kept + len(made)), index=made.index)
         made[schema.EVENT_ID] = made[schema.CASE].astype(str) + ":" + position.astype(str)
         events = _joined(self.events.iloc[:kept], made)
-        return events, found.reset_index(drop=True), unchanged
+        return events, found.reset_index(drop=True), unchanged, kept
 
     def _tail(self, fresh: np.ndarray) -> tuple[int, np.ndarray] | None:
         """From when (nanoseconds) the run is made again, and the tags (heard positions)
@@ -229,6 +248,16 @@ class _Kept:
                 at[key] = int(index)
         begun = np.array(list(at.values()), dtype=np.int64)
         return None if (begun == -1).any() else begun
+
+
+def _run_events(events: pd.DataFrame, name: str) -> pd.DataFrame:
+    """:func:`run_events` of a live run's ``events``: they are its one case's and, but for a
+    late tag, in time order already, so only the robots' column is made as there (not the
+    whole run filtered and sorted again at every look)."""
+    if schema.ROBOT not in events.columns or (np.diff(_nanos(events[schema.TIMESTAMP])) < 0).any():
+        return run_events(events, name)
+    robots = events[schema.ROBOT].astype("string").fillna(NO_ROBOT).astype(str)
+    return events.assign(**{schema.ROBOT: robots})
 
 
 def _joined(kept: pd.DataFrame, made: pd.DataFrame) -> pd.DataFrame:

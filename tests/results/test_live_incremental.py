@@ -1,0 +1,90 @@
+"""A live run read look by look equals the run made afresh of every tag heard so far, however
+the tags were split into the batches the looks found: the reader keeps the run's tables and
+makes again only what the new tags touch, and that must change no answer."""
+
+from __future__ import annotations
+
+import random
+import uuid
+from pathlib import Path
+
+import pandas as pd
+import pytest
+
+from robotale.enhancement.mission import mission_run
+from robotale.fame_runtime.tags import Tag
+from robotale.results import live as reading
+
+#: a recorded run: the thesis' agricultural mission (drone and tractors, their messages)
+RECORDING = Path(__file__).resolve().parents[2] / "examples" / "thesis" / "robotic_data.csv"
+#: the first tags of it, heard one by one (enough for messages, repeats and late tags)
+HEARD = 90
+
+
+def recorded_tags(count: int, seed: int) -> list[Tag]:
+    """The first ``count`` tags of the recording in the order a monitor might hear them:
+    the recording's order, with some neighbours of different robots swapped (a robot's tag
+    heard after a later one of another robot: a late tag)."""
+    rows = pd.read_csv(RECORDING, nrows=count, dtype=str, keep_default_na=False)
+    times = pd.to_datetime(rows["time"], utc=True, format="ISO8601")
+    stamps = (times - pd.Timestamp(0, tz="UTC")).dt.total_seconds()
+    tags = [
+        Tag(float(stamp), row.resource, row.activity, row.lifecycle, row.msg_id, row.msg_role,
+            row.msg_payload)
+        for stamp, row in zip(stamps, rows.itertuples(index=False), strict=True)
+    ]  # fmt: skip
+    draw = random.Random(seed)
+    for i in draw.sample(range(count - 1), count // 10):
+        if tags[i].robot != tags[i + 1].robot:
+            tags[i], tags[i + 1] = tags[i + 1], tags[i]
+    return tags
+
+
+def batches(tags: list[Tag], seed: int) -> list[list[Tag]]:
+    """``tags`` cut at random places into batches of 1 to 25."""
+    draw, cut, first = random.Random(seed), [], 0
+    while first < len(tags):
+        size = draw.randint(1, 25)
+        cut.append(tags[first : first + size])
+        first += size
+    return cut
+
+
+@pytest.mark.parametrize("seed", [1, 2, 3])
+def test_the_run_grown_look_by_look_equals_the_run_made_of_all_tags_heard(monkeypatch, seed):
+    """Over random splits of a recorded run: after each batch, the run the reader grew equals
+    :func:`mission_run` of every tag heard (its tables, robots, length, summary whole and
+    since a moment, windows and the state at moments throughout), and some looks made only
+    the tail again."""
+    name = f"live_{uuid.uuid4().hex[:8]}"
+    stored: list[Tag] = []
+    monkeypatch.setattr(
+        reading, "live_since", lambda _driver, _log, tags, _poses: (stored[tags:], [])
+    )
+    remade: list[tuple[int, int]] = []  # (tags made again, tags held) at each making
+    tag_frame = reading._tag_frame
+
+    def counted(log, held, heard, chosen):
+        remade.append((len(chosen), len(held)))
+        return tag_frame(log, held, heard, chosen)
+
+    monkeypatch.setattr(reading, "_tag_frame", counted)
+    try:
+        for batch in batches(recorded_tags(HEARD, seed), seed):
+            stored += batch
+            replay = reading.live_replay(None, name)  # type: ignore[arg-type]
+            assert replay is not None
+            run = replay.run(name)
+            whole = mission_run(reading.tags_events(name, stored), name)
+            for table in ("events", "instances", "messages", "moments"):
+                pd.testing.assert_frame_equal(getattr(run, table), getattr(whole, table), obj=table)
+            assert (run.robots, run.duration) == (whole.robots, whole.duration)
+            assert run.summary() == whole.summary()
+            for fraction in (0.0, 0.5, 0.9, 1.0):
+                t = min(round(whole.duration * fraction, 3), whole.duration)
+                assert run.summary(t) == whole.summary(t), t
+                assert run.state(t) == whole.state(t), t
+                assert run.window(t, whole.duration) == whole.window(t, whole.duration), t
+    finally:
+        reading._kept.pop(name, None)
+    assert any(chosen < held for chosen, held in remade)
