@@ -27,7 +27,7 @@ from tqdm import tqdm
 
 from robotale.ekg import disk_full
 from robotale.ekg.aggregate import aggregation_key
-from robotale.ekg.columnar import store_copy
+from robotale.ekg.columnar import delete_copies, store_copy
 from robotale.ekg.connection import database
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.keys import DEFAULT_AGGREGATE, default_entities
@@ -125,14 +125,16 @@ def build_ekg(
             refuse_existing(driver, name)
         existing = replace and log_exists(driver, name)
         target = f"{name} (rebuilding {uuid.uuid4().hex[:8]})" if existing else name
-        job = _Job(tables, classes, target, source, progress, run, objects, chosen)
+        # under the lock: no other build of this name can come between the graph and its
+        # copy. A new log's copy needs only its Log node: it is written beside the graph.
+        copy = None if existing else _copying(driver, name, log)
+        job = _Job(tables, classes, target, source, progress, run, objects, chosen, copy)
         with stage("write the graph"):
             summary = _write_or_undo(driver, job)
         if existing:
             _swap(driver, target, name)
-        # under the lock: no other build of this name can come between the graph and its copy
-        with stage("the columnar copy"):
-            store_copy(driver, name, log)
+            with stage("the columnar copy"):
+                store_copy(driver, name, log)
     return dataclasses.replace(summary, log=name, seconds=time.perf_counter() - started)
 
 
@@ -241,6 +243,15 @@ class _Job:
     run: str  # the id of this run's write lock, recorded on the Log node
     objects: Objects | None = None
     entity_types: Sequence[str] = ()
+    copy: Callable[[], object] | None = None  # the columnar copy, kept beside the graph
+
+
+def _copying(driver: Driver, name: str, log: pd.DataFrame) -> Callable[[], object]:
+    def copy() -> object:
+        with stage("the columnar copy (beside the graph)"):
+            return store_copy(driver, name, log)
+
+    return copy
 
 
 def _write_or_undo(driver: Driver, job: _Job) -> BuildSummary:
@@ -343,15 +354,23 @@ def _write(driver: Driver, job: _Job, between_batches: Callable[[], None]) -> Bu
         entityTypes=entities["type"].unique().tolist(),
         database_=database(),
     )
-    with _progress(tables, job.classes, target, job.progress) as bar:
-        loader = Loader(driver, target, bar, between_batches)
-        class_nodes = write_graph(loader, tables, job.classes, new_log=True)
-        for classes, nodes in zip(job.classes, class_nodes, strict=True):
-            write_df_c(loader, classes, nodes)
-        if job.objects is not None:
-            write_objects(loader, job.objects, [property_name(t) for t in job.entity_types])
-    between_batches()
-    finish_log(driver, target, events, job.classes)
+    with ThreadPoolExecutor(max_workers=1) as beside:
+        copying = beside.submit(job.copy) if job.copy is not None else None
+        try:
+            with _progress(tables, job.classes, target, job.progress) as bar:
+                loader = Loader(driver, target, bar, between_batches)
+                write_graph(loader, tables, job.classes, new_log=True, df_c=True)
+                if job.objects is not None:
+                    write_objects(loader, job.objects, [property_name(t) for t in job.entity_types])
+            between_batches()
+            finish_log(driver, target, events, job.classes)
+            if copying is not None:
+                copying.result()
+        except BaseException:
+            if copying is not None:  # the copy of a log that is not kept
+                wait([copying])
+                delete_copies(target)
+            raise
     return summarise(target, tables, job.classes)
 
 
@@ -395,12 +414,18 @@ def _progress(
 
 
 def write_graph(
-    loader: Loader, tables: GraphTables, classes: Sequence[ClassTables], *, new_log: bool
+    loader: Loader,
+    tables: GraphTables,
+    classes: Sequence[ClassTables],
+    *,
+    new_log: bool,
+    df_c: bool = False,
 ) -> list[np.ndarray]:
     """Entities and classes, then events with their CORR, OBSERVED, DF and COMM edges, then
-    the DF and COMM edges between batches, and BEGINS edges. ``new_log``: nothing of the
-    log is stored yet (an append finds the entities and BEGINS edges the log has). Returns
-    the element ids of each key's classes, by class row."""
+    the DF and COMM edges between batches, and BEGINS edges (and with ``df_c`` the DF_C
+    edges :func:`class_tables` computed). ``new_log``: nothing of the log is stored yet (an
+    append finds the entities and BEGINS edges the log has). Returns the element ids of each
+    key's classes, by class row."""
     entity_nodes = _write_entities(loader, tables.entities, new_log)
     class_nodes = [_write_classes(loader, c) for c in classes]
     per_event = _per_event(tables.corr, entity_nodes, len(tables.events))
@@ -410,7 +435,27 @@ def write_graph(
     event_nodes = loader.events(
         tables.events, per_event, observed, df[df_within], comm[comm_within], tables.first
     )
-    for entity_type, part in df[~df_within].groupby("entityType", sort=True):
+
+    def between_events() -> None:
+        _write_between(loader, df[~df_within], comm[~comm_within], event_nodes)
+
+    def at_classes() -> None:
+        for kind, nodes in zip(classes, class_nodes, strict=True):
+            write_begins(loader, kind.entries, entity_nodes, nodes, new_log)
+            if df_c:
+                write_df_c(loader, kind, nodes)
+
+    # the edges between events and those at entities and classes end at no node in common:
+    # neither waits for the other's locks
+    loader.together(between_events, at_classes)
+    return class_nodes
+
+
+def _write_between(
+    loader: Loader, df: pd.DataFrame, comm: pd.DataFrame, event_nodes: np.ndarray
+) -> None:
+    """The DF and COMM edges whose two events lie in different batches."""
+    for entity_type, part in df.groupby("entityType", sort=True):
         loader.run(
             "ekg_create_df",
             {
@@ -420,19 +465,15 @@ def write_graph(
             },
             entityType=entity_type,
         )
-    between = comm[~comm_within]
-    if len(between):
+    if len(comm):
         loader.run(
             "ekg_create_comm",
             {
-                "sources": event_nodes[between["source"]].tolist(),
-                "targets": event_nodes[between["target"]].tolist(),
-                "msgIds": between["msgId"].tolist(),
+                "sources": event_nodes[comm["source"]].tolist(),
+                "targets": event_nodes[comm["target"]].tolist(),
+                "msgIds": comm["msgId"].tolist(),
             },
         )
-    for kind, nodes in zip(classes, class_nodes, strict=True):
-        write_begins(loader, kind.entries, entity_nodes, nodes, new_log)
-    return class_nodes
 
 
 def write_df_c(loader: Loader, classes: ClassTables, nodes: np.ndarray) -> None:

@@ -13,9 +13,10 @@ from __future__ import annotations
 import datetime as dt
 import itertools
 import math
+import os
 from collections import deque
 from collections.abc import Callable, Mapping, Sequence
-from concurrent.futures import Future, ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor, wait
 from typing import Any
 
 import numpy as np
@@ -24,10 +25,30 @@ from neo4j import Driver, ManagedTransaction
 from tqdm import tqdm
 
 from robotale.ekg.connection import database
+from robotale.errors import InputError
 from robotale.queries import cypher
 
-BATCH = 5_000
-WORKERS = 2
+#: rows per transaction: 2,000 events cost the server less CPU than 5,000 or 10,000, most of
+#: it in its garbage collector (a smaller transaction's state dies young; docs/ekg.md)
+BATCH = 2_000
+#: transactions in flight when ``ROBOTALE_BUILD_WORKERS`` does not say: one per core, at least
+#: two (Neo4j runs each transaction on one core) and at most four (more only wait on each
+#: other's commits and hold more transaction state in the server's heap)
+WORKERS = min(4, max(2, os.cpu_count() or 2))
+WORKERS_ENV = "ROBOTALE_BUILD_WORKERS"
+
+
+def build_workers() -> int:
+    """How many batches a build keeps in flight: ``ROBOTALE_BUILD_WORKERS`` (1 writes one
+    batch after the other), else :data:`WORKERS`."""
+    given = os.environ.get(WORKERS_ENV, "").strip()
+    if not given:
+        return WORKERS
+    if not given.isdigit() or int(given) < 1:
+        raise InputError(
+            f"{WORKERS_ENV}={given!r} is not a number of transactions: give 1 or more."
+        )
+    return int(given)
 
 
 class Loader:
@@ -40,7 +61,7 @@ class Loader:
         progress: tqdm | None = None,
         between_batches: Callable[[], None] = lambda: None,
         tx: ManagedTransaction | None = None,
-        workers: int = WORKERS,
+        workers: int | None = None,
     ) -> None:
         self.driver = driver
         self.log = log
@@ -50,7 +71,7 @@ class Loader:
         # kept or undone as a whole.
         self.tx = tx
         # batches that all reach the same few nodes only wait on each other's locks: one
-        self.workers = workers
+        self.workers = build_workers() if workers is None else workers
 
     def run(
         self,
@@ -86,6 +107,21 @@ class Loader:
         if self.tx is not None:
             return [node for start in range(0, size, BATCH) for node in write(start)]
         return _in_flight(write, range(0, size, BATCH), self.workers)
+
+    def together(self, *parts: Callable[[], None]) -> None:
+        """Run ``parts``, writes of which no two touch the same node, at the same time, each in
+        transactions of its own, so that Neo4j works on them with as many cores; one after
+        the other in the caller's transaction (an append) or with one worker. The first
+        failure is raised once every part has ended."""
+        if self.tx is not None or self.workers < 2 or len(parts) < 2:
+            for part in parts:
+                part()
+            return
+        with ThreadPoolExecutor(max_workers=len(parts)) as pool:
+            running = [pool.submit(part) for part in parts]
+            wait(running)
+        for done in running:
+            done.result()
 
     def _execute(self, text: str, parameters: dict[str, Any]) -> list[Any]:
         if self.tx is not None:
