@@ -9,7 +9,9 @@ graph tables derived as the build derives them, and the five steps of OCEAN's lo
 specification replayed on :class:`robotale.ekg.lift.LogEdges` (the members of each step
 chosen in pandas as the steps' group-bys and wheres say; the totals are the benchmark's
 lifted-edge counts, checked by it against the plain queries). It tells how much of the edge
-writing is spent on edges whose other end a later step of the same specification replaces.
+writing per step was spent on edges whose other end a later step of the same specification
+replaces, and prints how many edges the level the five steps end at has (robotale writes
+those, each by the later step of its two ends).
 """
 
 from __future__ import annotations
@@ -51,8 +53,8 @@ def count(size: int) -> None:
     lifted = []
     for step in range(1, 6):
         nodes, names = members(edges, log, step)
-        held = edges.hold(nodes, [f"{step}:{name}" for name in names], ["-"] * len(nodes))
-        lifted.append(edges.lift(np.unique(held)))
+        held = edges.hold(nodes, [f"{step}:{name}" for name in names], ["-"] * len(nodes), step)
+        lifted.append(edges.lift(np.unique(held)))  # each step's edges at its own level
     aggregate = ~pd.isna(edges.element_ids)  # as the step's aggregates were held
     totals = np.zeros(3, dtype=np.int64)
     print(f"{size:,} events:")
@@ -68,6 +70,8 @@ def count(size: int) -> None:
               "step collapses")  # fmt: skip
     print(f"  all steps: {totals.sum():,}: {totals[0]:,} between aggregates, {totals[1]:,} to "
           f"a node a later step collapses, {totals[2]:,} to a node no step collapses")  # fmt: skip
+    final = sum(len(edges.lift(edges.aggregates_of(step), upto=step)) for step in range(1, 6))
+    print(f"  at the level the five steps end at (what robotale writes): {final:,}")
 
 
 def members(edges: LogEdges, log: ObjectLog, step: int) -> tuple[np.ndarray, np.ndarray]:

@@ -1,7 +1,12 @@
 // One batch of the aggregates of step $step of log $log: $ids, $names, $counts (how many
 // nodes each replaces), $origin ('Event' or 'Entity'), $type (the entity type, or null),
 // $key (the group-by names) and $properties {key: [values]} (group-by values and attribute
-// aggregations; null values are not stored). Returns [row, element id] pairs.
+// aggregations; null values are not stored). Returns [row, element id] pairs. The step's
+// record (as aggr_step_begin writes it: $spec, $run) comes with its first batch, in the same
+// transaction: one write fewer per step.
+MERGE (s:AggregationStep {log: $log, step: $step})
+ON CREATE SET s.spec = $spec, s.status = 'writing', s.created = datetime(), s.run = $run
+WITH s
 UNWIND range(0, size($ids) - 1) AS i
 CREATE (a:Aggregate {log: $log, step: $step, id: $ids[i], name: $names[i], count: $counts[i],
                      origin: $origin, key: $key})

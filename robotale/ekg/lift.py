@@ -15,6 +15,9 @@ up by its key as an edge is written costs Neo4j more than the edge itself).
 The rules are those of a step lifted in Cypher: an edge from a member becomes an edge from
 its aggregate; an edge into a member from a node no aggregate of the same step holds becomes
 an edge into its aggregate (so an edge between two aggregates of one step is written once).
+Each lifted edge belongs to the later step of its two ends (a node no step holds counts as
+step 0), so :meth:`LogEdges.lift` takes, for a step, only the edges whose other end stands
+at a step no later than it.
 """
 
 from __future__ import annotations
@@ -50,6 +53,7 @@ class LogEdges:
     targets: np.ndarray
     entity_types: np.ndarray  # a DF edge's entity type, '' for the others
     holder: np.ndarray  # per code: the code of the aggregate holding it, or FREE
+    levels: np.ndarray  # per code: an aggregate's step; 0 for events and entities
     corr: pd.DataFrame  # ``event``, ``entity`` (codes): what each event is correlated to
 
     @classmethod
@@ -86,18 +90,22 @@ class LogEdges:
             targets=np.concatenate([np.asarray(f[2], np.int64) for f in frames]),
             entity_types=np.concatenate([f[3] for f in frames]),
             holder=np.full(codes, FREE, dtype=np.int64),
+            levels=np.zeros(codes, dtype=np.int64),
             corr=pd.DataFrame({"event": tables.corr["event"].to_numpy(), "entity": corr}),
         )
 
     # -- codes ---------------------------------------------------------------------------
 
-    def _append(self, types: np.ndarray, keys: np.ndarray, element_ids: np.ndarray) -> np.ndarray:
+    def _append(
+        self, types: np.ndarray, keys: np.ndarray, element_ids: np.ndarray, level: int = 0
+    ) -> np.ndarray:
         first = len(self.keys)
         self.types = np.concatenate([self.types, types])
         self.keys = np.concatenate([self.keys, keys])
         self.element_ids = np.concatenate([self.element_ids, element_ids])
         self.stored = np.concatenate([self.stored, np.full(len(keys), None, dtype=object)])
         self.holder = np.concatenate([self.holder, np.full(len(keys), FREE, dtype=np.int64)])
+        self.levels = np.concatenate([self.levels, np.full(len(keys), level, dtype=np.int64)])
         return np.arange(first, first + len(keys))
 
     def event_codes(self, ids: Sequence[str]) -> np.ndarray:
@@ -138,18 +146,40 @@ class LogEdges:
     # -- aggregates ------------------------------------------------------------------------
 
     def hold(
-        self, nodes: np.ndarray, aggregates: Sequence[str], element_ids: Sequence[str | None]
+        self,
+        nodes: np.ndarray,
+        aggregates: Sequence[str],
+        element_ids: Sequence[str | None],
+        step: int,
     ) -> np.ndarray:
-        """Record that each of ``nodes`` (codes) is held by the aggregate of the same
-        position (``aggregates``: their ids, ``element_ids`` theirs); returns the
-        aggregates' codes."""
+        """Record that each of ``nodes`` (codes) is held by the aggregate of step ``step`` of
+        the same position (``aggregates``: their ids, ``element_ids`` theirs, None while it is
+        not written yet); returns the aggregates' codes."""
         names, first, positions = np.unique(
             np.asarray(list(aggregates), dtype=object), return_index=True, return_inverse=True
         )
         elements = np.asarray(list(element_ids), dtype=object)[first]
-        codes = self._append(np.full(len(names), None, object), names, elements)
+        codes = self._append(np.full(len(names), None, object), names, elements, step)
         self.holder[nodes] = codes[positions]
         return codes[positions]
+
+    def aggregates_of(self, step: int) -> np.ndarray:
+        """The codes of the aggregates of step ``step``."""
+        return np.flatnonzero(self.levels == step)
+
+    def written(self, ids: Sequence[str], element_ids: Sequence[str], step: int) -> None:
+        """The aggregates of step ``step`` with ``ids`` were created with ``element_ids``."""
+        mine = self.aggregates_of(step)
+        at = pd.Index(self.keys[mine], dtype=object).get_indexer(pd.Index(list(ids), dtype=object))
+        self.element_ids[mine[at]] = np.asarray(list(element_ids), dtype=object)
+
+    def release(self, step: int) -> np.ndarray:
+        """Forget the aggregates of steps ``step`` and later (undone, or never written): their
+        members are free again; returns those members' codes."""
+        held = self.holder >= 0
+        freed = np.flatnonzero(held & (self.levels[np.maximum(self.holder, 0)] >= step))
+        self.holder[freed] = FREE
+        return freed
 
     def ends(self, driver: Driver, log: str, codes: np.ndarray) -> np.ndarray:
         """The element ids of ``codes``: an aggregate's as created; the events' and each
@@ -193,15 +223,29 @@ class LogEdges:
         """The positions of the events no aggregate holds."""
         return np.flatnonzero(self.holder[: len(self.events)] == FREE)
 
-    def lift(self, step: np.ndarray) -> pd.DataFrame:
+    def lift(
+        self, step: np.ndarray, upto: int | None = None, others: np.ndarray | None = None
+    ) -> pd.DataFrame:
         """The lifted edges of the step whose aggregates are the codes ``step``: ``kind``,
-        ``source``, ``target`` (codes), ``entityType`` (None but for DF) and ``count``."""
+        ``source``, ``target`` (codes), ``entityType`` (None but for DF) and ``count``. Ends
+        stand for what holds them now; with ``upto``, only the edges whose other end stands
+        at step ``upto`` or earlier (a free node: 0), the later step's edges being its own;
+        with ``others`` (codes), only those whose other end is one of them."""
         in_step = np.zeros(len(self.keys), dtype=bool)
         in_step[step] = True
         standing = np.where(self.holder >= 0, self.holder, np.arange(len(self.keys)))
         source, target = standing[self.sources], standing[self.targets]
+        other = np.ones(len(self.keys), dtype=bool)
+        if upto is not None:
+            other &= self.levels <= upto
+        if others is not None:
+            wanted = np.zeros(len(self.keys), dtype=bool)
+            wanted[others] = True
+            other &= wanted
         # out of a member; or into one from a node that no aggregate of this step holds
-        chosen = in_step[source] | (in_step[target] & ~in_step[source])
+        chosen = (in_step[source] & other[target]) | (
+            in_step[target] & ~in_step[source] & other[source]
+        )
         frame = pd.DataFrame(
             {
                 "kind": self.kinds[chosen],
@@ -232,4 +276,5 @@ class LogEdges:
                 codes = self.event_codes(members)
             else:
                 codes = self.entity_codes(str(row["type"]), members)
-            self.hold(codes, [row["id"]] * len(codes), [row["aggregate"]] * len(codes))
+            aggregate, step = [row["id"]] * len(codes), int(row["step"])
+            self.hold(codes, aggregate, [row["aggregate"]] * len(codes), step)

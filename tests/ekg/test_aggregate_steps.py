@@ -343,3 +343,44 @@ def test_band_grid_and_region_keys(neo4j_driver, small):
     assert members(neo4j_driver, small) == {
         "75.0|0,0": {"e1", "e5"}, "75.0|1,0": {"e2"}, "left": {"e3"}, "right": {"e4"},
     }  # fmt: skip
+
+
+ROBOTS = {"aggr_type": "ENTITIES", "ent_type": "robot", "group_by": ["type"]}
+ACTIVITIES = {"aggr_type": "EVENTS", "group_by": ["activity"]}
+# step 1 alone: every event's CORR edge to its robot goes to the robots' aggregate
+ROBOTS_ALONE = {(e, "robot", None): 1 for e in ("e1", "e2", "e3", "e4", "e5")}
+
+
+def test_steps_run_together_write_the_edges_of_the_level_they_end_at(
+    neo4j_driver, small, graph_counts
+):
+    run_spec(neo4j_driver, small, steps(ROBOTS))
+    alone = {kind: lifted(neo4j_driver, small, kind) for kind in ("CORR", "DF", "COMM")}
+    assert alone["CORR"] == ROBOTS_ALONE
+    counts = graph_counts()
+    undo(neo4j_driver, small)
+    run_spec(neo4j_driver, small, steps(ROBOTS, ACTIVITIES))
+    # together: no edge from an event to the robots, since step 2 holds every event; move
+    # e1 e3 e5 -> robots 3 times, o1 (e1, e3) twice; spray e2 e4 -> robots twice, o2 (e4) once
+    assert lifted(neo4j_driver, small, "CORR") == {
+        ("move", "robot", None): 3,
+        ("move", "o1", None): 2,
+        ("spray", "robot", None): 2,
+        ("spray", "o2", None): 1,
+    }
+    # undoing step 2 gives step 1 the edges it has when run alone
+    assert undo(neo4j_driver, small) == [2]
+    assert {kind: lifted(neo4j_driver, small, kind) for kind in alone} == alone
+    assert graph_counts() == counts
+
+
+def test_a_later_step_that_fails_leaves_the_earlier_ones_as_if_run_alone(neo4j_driver, small):
+    from robotale.errors import ServerError
+
+    neo4j_driver.execute_query(
+        "CREATE (:Aggregate {log: $log, step: 2, id: '2:spray'})", log=small, database_=database()
+    )
+    with pytest.raises(ServerError, match=r"Aggregation step 2 of .* failed"):
+        run_spec(neo4j_driver, small, steps(ROBOTS, ACTIVITIES))
+    assert [s["step"] for s in list_steps(neo4j_driver, small)] == [1]
+    assert lifted(neo4j_driver, small, "CORR") == ROBOTS_ALONE
