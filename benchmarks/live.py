@@ -302,9 +302,11 @@ class Baseline:
         self.thread.join()
 
 
-def measure(count: int, seconds: float, per_process: int, folder: Path, client, driver) -> None:
+def measure(
+    count: int, seconds: float, per_process: int, folder: Path, client, driver, held_run: bool
+) -> None:
     from robotale.ekg.live import delete_live, live_tags
-    from robotale.results.live import live_count
+    from robotale.results.live import live_builds, live_count
 
     robots = robots_of(count)
     name = f"bench_live_{count}"
@@ -345,7 +347,7 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
     while any(p.poll() is None for p in publishers):
         counts.append((time.time(), live_count(driver, name)))
         cpu = time.thread_time()
-        summary, waited = _look(client, name, held)
+        summary, waited = _look(client, name, held, held_run)
         if summary is None:  # no tag stored yet
             time.sleep(0.1)
             continue
@@ -359,6 +361,7 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
         for s in summary["event_times"]:
             seen.setdefault(round((start + s) * 1e6), now)
     ended = time.time()
+    builds = live_builds(name)
     own = time.process_time() - own_before
     machine.close()
     sent = [tuple(t) for out in outs for t in json.loads(out.read_text())]
@@ -375,6 +378,9 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
     api_lags = lags(stamps, shown(published, seen))
     dds_lags = lags(stamps, baseline.seen)
     span = max(stamps.values()) - min(stamps.values())
+    asked = "of the run the summary showed" if held_run else "of the run as stored then"
+    print(f"window and state asked {asked}: the run made {builds} times in "
+          f"{len(looks)} looks that found tags")  # fmt: skip
     print(f"{count} robots, {span:.0f} s of tags, {len(published)} tags published "
           f"({len(published) / span:.1f}/s) and {count * ODOM_RATE * span:.0f} odometry "
           f"samples; {len(looks)} API looks that found tags (summary, window, state: "
@@ -402,12 +408,13 @@ def measure(count: int, seconds: float, per_process: int, folder: Path, client, 
           f"({len(missing)} missing, {len(extra)} extra)")  # fmt: skip
 
 
-def _look(client, name: str, held: dict | None) -> tuple[dict | None, float]:
+def _look(client, name: str, held: dict | None, held_run: bool) -> tuple[dict | None, float]:
     """One look of a page following the live run, as the Mission page makes it: the run's
     summary from a little before the end it holds (waiting on the server, up to a second
     here, until the run holds other events than it does), then the positions and messages
     of that stretch and the state at the new end. The summary (None when no tag is stored
-    yet) and the CPU seconds of this thread its request took."""
+    yet) and the CPU seconds of this thread its request took. With ``held_run``, the window
+    and the state are asked of the run the summary showed (``?events=``), as the page asks."""
     api = f"/api/mission/{name}/{name}"
     cpu = time.thread_time()
     if held is None:
@@ -421,8 +428,9 @@ def _look(client, name: str, held: dict | None) -> tuple[dict | None, float]:
         return None, waited
     summary = answer.json
     if held is None or summary["events"] != held["events"]:
-        client.get(f"{api}/window?from={since}&to={summary['duration']}")
-        client.get(f"{api}/state?t={summary['duration']}")
+        events = f"&events={summary['events']}" if held_run else ""
+        client.get(f"{api}/window?from={since}&to={summary['duration']}{events}")
+        client.get(f"{api}/state?t={summary['duration']}{events}")
     return summary, waited
 
 
@@ -639,6 +647,13 @@ def main() -> int:
     parser.add_argument("--paint-events", type=int, default=10_000)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--heap", default="1g")
+    parser.add_argument(
+        "--ask",
+        choices=["held", "unheld", "both"],
+        default="held",
+        help="the window and state asked of the run the summary showed (held, as the page "
+        "does), of the run as stored then (unheld, as the page did before), or both in turn",
+    )
     parser.add_argument("--domain", type=int, default=150 + os.getpid() % 80)
     parser.add_argument("--publish", help=argparse.SUPPRESS)
     parser.add_argument("--out", type=Path, help=argparse.SUPPRESS)
@@ -660,8 +675,10 @@ def main() -> int:
 
         app = create_app(upload_dir=folder / "uploads", model_dir=folder / "models")
         client = app.test_client()
+        asks = [False, True] if args.ask == "both" else [args.ask == "held"]
         for count in args.robots:
-            measure(count, args.duration, args.per_process, folder, client, driver)
+            for held in asks:
+                measure(count, args.duration, args.per_process, folder, client, driver, held)
         if args.paint_events:
             paint(driver, args.paint_events, args.repeat, folder)
     print(f"load average after: {os.getloadavg()[0]:.1f}")

@@ -129,6 +129,9 @@ class _Kept:
     #: :func:`case_messages` read of them
     carried: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=bool))
     told: tuple[pd.DataFrame, set[str]] | None = None
+    #: how many times the run's events were made (the first look's and each one that
+    #: found tags), for :func:`live_builds`
+    builds: int = 0
 
     def grow(self, name: str, tags: list[Tag]) -> tuple[pd.DataFrame, MissionRun]:
         """Take the newly read ``tags`` in; the events and the run they make with the ones
@@ -378,13 +381,22 @@ def _tag_frame(
     return frame.iloc[order].reset_index(drop=True), np.asarray(chosen)[order]
 
 
-def live_replay(driver: Driver, name: str) -> Replay | None:
+def live_replay(driver: Driver, name: str, holding: int | None = None) -> Replay | None:
     """The live run ``name`` as it stands now, or None when no monitor stored one. Only what
     was stored since the last look is read (an index seek by number, whatever the run's
     length): the tags and samples kept are extended; the events are made again when tags
-    came, the positions grown when only samples came."""
+    came, the positions grown when only samples came. Looks wait for each other (one lock):
+    of looks asking at once after the store changed, the first makes the run again and the
+    others find nothing new.
+
+    With ``holding``, a number of events: the run kept, unread, when it holds that many (a
+    page asking the window and the state of the run its summary showed: they answer on that
+    run rather than each make it again of the tags stored since, which at 20 robots came
+    between any two requests)."""
     with _lock:
         kept = _kept.get(name) or _Kept()
+        if holding is not None and kept.replay is not None and len(kept.replay.events) == holding:
+            return kept.replay
         new_tags, new_poses = _since(driver, name, kept.tags, kept.positions.poses)
         if new_tags is None or new_poses is None:  # a new run of that name began
             kept = _Kept()
@@ -399,10 +411,19 @@ def live_replay(driver: Driver, name: str) -> Replay | None:
         kept.positions.add(new_poses)
         if old is None or new_tags:
             events, run = kept.grow(name, new_tags)
+            kept.builds += 1
             kept.replay = LiveReplay(name, events, {}, positions=kept.positions, bare={name: run})
         else:  # the same events: the runs they make are kept, their positions grown
             kept.replay = LiveReplay(name, old.events, {}, positions=kept.positions, bare=old.bare)
         return kept.replay
+
+
+def live_builds(name: str) -> int:
+    """How many times this process made the events of the live run ``name`` (since it last
+    began anew), for benchmarks and tests."""
+    with _lock:
+        kept = _kept.get(name)
+        return kept.builds if kept is not None else 0
 
 
 def _since(

@@ -9,9 +9,11 @@ from robotale.results.replay import Replay
 from robotale.webapp.state import driver, state
 
 
-def unstored(name: str) -> Replay | None:
-    """The replayed recording or the live run named ``name``, or None (a stored log)."""
+def unstored(name: str, holding: int | None = None) -> Replay | None:
+    """The replayed recording or the live run named ``name``, or None (a stored log); with
+    ``holding``, the live run as it was kept if it holds that many events (see
+    :func:`live_replay`)."""
     replay = state().replays.get(name)
     if replay is not None or not name:
         return replay
-    return live_replay(driver(), name)
+    return live_replay(driver(), name, holding)

@@ -5,6 +5,7 @@ makes again only what the new tags touch, and that must change no answer."""
 from __future__ import annotations
 
 import random
+import threading
 import uuid
 from pathlib import Path
 
@@ -88,3 +89,46 @@ def test_the_run_grown_look_by_look_equals_the_run_made_of_all_tags_heard(monkey
     finally:
         reading._kept.pop(name, None)
     assert any(chosen < held for chosen, held in remade)
+
+
+def test_looks_asking_at_once_after_the_store_changed_make_the_run_once(monkeypatch):
+    """Eight looks asking at once after tags were stored make the run once between them (the
+    reader's own count of makings), and all answer on that run; a look holding the events a
+    summary showed answers on the run kept, unread, after more tags were stored, and a look
+    without makes the run again of them."""
+    name = f"live_{uuid.uuid4().hex[:8]}"
+    tags = recorded_tags(40, seed=1)
+    stored: list[Tag] = tags[:20]
+    monkeypatch.setattr(
+        reading, "live_since", lambda _driver, _log, held, _poses: (stored[held:], [])
+    )
+    try:
+        first = reading.live_replay(None, name)  # type: ignore[arg-type]
+        assert first is not None and reading.live_builds(name) == 1
+        stored += tags[20:30]
+        start = threading.Barrier(8)
+        answers: list[object] = []
+
+        def look() -> None:
+            start.wait()
+            answers.append(reading.live_replay(None, name))  # type: ignore[arg-type]
+
+        looks = [threading.Thread(target=look) for _ in range(8)]
+        for thread in looks:
+            thread.start()
+        for thread in looks:
+            thread.join()
+        assert reading.live_builds(name) == 2
+        assert len(answers) == 8 and all(answer is answers[0] for answer in answers)
+        shown = answers[0]
+        assert isinstance(shown, reading.LiveReplay)
+        assert len(shown.events) == len(reading.tags_events(name, stored))
+        stored += tags[30:]
+        assert reading.live_replay(None, name, len(shown.events)) is shown  # type: ignore[arg-type]
+        assert reading.live_builds(name) == 2
+        grown = reading.live_replay(None, name)  # type: ignore[arg-type]
+        assert grown is not None and reading.live_builds(name) == 3
+        whole = mission_run(reading.tags_events(name, stored), name)
+        pd.testing.assert_frame_equal(grown.run(name).events, whole.events)
+    finally:
+        reading._kept.pop(name, None)

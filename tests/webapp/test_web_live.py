@@ -75,6 +75,26 @@ def test_a_look_waiting_for_the_run_to_grow_answers_with_the_tag_stored_meanwhil
     assert time.monotonic() - began < 30  # told before the wait ran out
 
 
+def test_the_window_and_state_asked_with_the_summarys_events_answer_on_that_run(client, live):
+    """A look's window and state asked with the events its summary showed answer on the run
+    that summary was made of, though a tag was stored since (the next look reads it); asked
+    without, on the run as stored; a number of events that is not one is refused."""
+    api = f"/api/mission/{live.name}/{live.name}"
+    tags(live, [(0, "rover", "survey", "start"), (2, "drone", "scan", "start")])
+    shown = client.get(api).json
+    tags(live, [(3, "rover", "survey", "complete")])
+    held = f"&events={shown['events']}"
+    state = client.get(f"{api}/state?t=3{held}").json
+    assert state["robots"]["rover"]["activities"] == ["survey"]  # as the summary's run had it
+    window = client.get(f"{api}/window?from=0&to=3{held}").json
+    assert window == client.get(f"{api}/window?from=0&to=3{held}").json
+    state = client.get(f"{api}/state?t=3").json
+    assert state["robots"]["rover"]["activities"] == []  # the run as stored: survey over
+    grown = client.get(f"{api}/window?from=0&to=3").json
+    assert len(grown["events"]) == len(window["events"]) + 1
+    assert client.get(f"{api}/state?t=3&events=some").status_code == 400
+
+
 def test_a_new_run_of_the_same_name_replaces_the_one_read(client, live, neo4j_driver):
     """A reader that kept a longer run of that name reads the new one from its start."""
     from robotale.ekg.live import LiveLog

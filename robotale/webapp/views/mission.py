@@ -82,11 +82,11 @@ def _grown(
     return replay, run
 
 
-def _count(text: str) -> int:
+def _count(text: str, name: str = "?known=") -> int:
     try:
         return int(text)
     except ValueError:
-        raise InputError(f"?known= must be a whole number of events, not {text!r}.") from None
+        raise InputError(f"{name} must be a whole number of events, not {text!r}.") from None
 
 
 def _live(log: str, replay: Replay | None) -> bool:
@@ -115,9 +115,10 @@ def _about(log: str, run: MissionRun, replay: Replay | None) -> dict[str, Any]:
 @blueprint.get("/api/mission/<log>/<case>/state")
 def state_at(log: str, case: str):
     """Every robot at ``?t=`` seconds since the run's start; with a model, the elements
-    each robot is in and the flows taken so far."""
+    each robot is in and the flows taken so far. With ``?events=``, of a live run as it was
+    kept when it holds that many events (see :func:`_holding`)."""
     t = _seconds("t", request.args.get("t"))
-    replay = unstored(log)
+    replay = unstored(log, _holding())
     run = _run(log, case, replay)
     found: dict[str, Any] = run.state(t)
     elements = _elements(log, case, run.robots)
@@ -131,11 +132,23 @@ def state_at(log: str, case: str):
 
 @blueprint.get("/api/mission/<log>/<case>/window")
 def window(log: str, case: str):
-    """The events, messages, positions and moments from ``?from=`` to ``?to=`` seconds."""
+    """The events, messages, positions and moments from ``?from=`` to ``?to=`` seconds. With
+    ``?events=``, of a live run as it was kept when it holds that many events (see
+    :func:`_holding`)."""
     start = _seconds("from", request.args.get("from"))
     end = _seconds("to", request.args.get("to"))
-    run = _run(log, case)
+    run = _run(log, case, unstored(log, _holding()))
     return jsonify(run.window(start, end))
+
+
+def _holding() -> int | None:
+    """The number of events ``?events=`` gives, or None. A page following a live run sends
+    the number its summary showed with the window and the state it asks next: they answer
+    on the run that summary was made of, kept, rather than each make the run again of the
+    tags stored in the meantime (at 20 robots some came between any two requests); the
+    next look reads them."""
+    text = request.args.get("events")
+    return None if text is None else _count(text, "?events=")
 
 
 @blueprint.get("/api/mission/<log>/<case>/series")

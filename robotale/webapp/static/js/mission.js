@@ -319,7 +319,7 @@
     inFlight = true;
     const at = t;
     try {
-      const state = await robotale.api(`${base()}/state?t=${encodeURIComponent(at)}`);
+      const state = await robotale.api(`${base()}/state?t=${encodeURIComponent(at)}${held()}`);
       if (at === t || !again) {
         drawRobots(state);
         paintModel(state);
@@ -422,6 +422,8 @@
   let timelineDrawn = 0;
   // the cursor follows the run's end while it is there; moved back, it stays where it was put
   const following = () => summary.duration - t < 1e-6;
+  // a live run's state asked of the run the page's summary was made of, kept on the server
+  const held = () => (root.dataset.live === "1" && summary && Number.isInteger(summary.events) ? `&events=${summary.events}` : "");
 
   async function followLive() {
     const since = Math.max(0, summary.duration - OVERLAP);
@@ -439,7 +441,7 @@
     }
     if (fresh.events === summary.events) return;
     const stay = !following();
-    await growWhole(since, fresh.duration);
+    await growWhole(since, fresh.duration, fresh.events);
     summary = fresh;
     slider.max = String(summary.duration);
     root.dataset.duration = String(summary.duration);
@@ -456,8 +458,10 @@
   const OVERLAP = 5;
   // the run's positions and messages from `from` to `to` seconds merged into what the page
   // holds, instead of the whole run again at every look
-  async function growWhole(from, to) {
-    const fresh = await robotale.api(`${base()}/window?from=${from}&to=${to}`);
+  // holding `events`: the run the summary showing them was made of, kept on the server (not
+  // made again of the tags stored since: the next look reads them)
+  async function growWhole(from, to, events) {
+    const fresh = await robotale.api(`${base()}/window?from=${from}&to=${to}&events=${events}`);
     for (const [robot, rows] of Object.entries(fresh.positions)) {
       whole.positions[robot] = (whole.positions[robot] || []).filter((r) => r[0] < from).concat(rows);
     }
