@@ -44,7 +44,7 @@ from robotale.ekg.connection import database
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.lift import FREE, LogEdges
-from robotale.ekg.load import Loader, neo4j_values
+from robotale.ekg.load import BATCH, Loader, neo4j_values
 from robotale.ekg.logs import log_info
 from robotale.ekg.spec import AggrStep
 from robotale.ekg.where import Condition, parse_where
@@ -93,7 +93,8 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
         _refuse_legacy(driver, log)
         first = _last_step(driver, log) + 1
         edges = LogEdges.of_log(driver, log, info.get("entityTypes") or [])
-        keys: dict[str | None, tuple[set[str], list[str]]] = {None: _event_keys(edges.events)}
+        keys = _node_keys(driver, log, [s.ent_type for s in steps if s.ent_type is not None])
+        keys[None] = _event_keys(edges.events)
         plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
         if first > 1:
@@ -247,7 +248,7 @@ def _plan(
     known: dict[str | None, tuple[set[str], list[str]]],
 ) -> _Plan:
     """Check every name ``step`` uses against the log; what it will read. ``known``: the
-    node keys already read in this run, by entity type (None: events)."""
+    node keys of this run (read once, all types together), by entity type (None: events)."""
     what = f"step {number}"
     entity_types = list(info.get("entityTypes") or [])
     if step.origin == "Entity" and step.ent_type not in entity_types:
@@ -255,9 +256,7 @@ def _plan(
             f"The log {log!r} has no entities of type {step.ent_type!r} for {what}; it has "
             f"{', '.join(entity_types) or 'none'}."
         )
-    if step.ent_type not in known:  # the entities' keys are read from all of them: once
-        known[step.ent_type] = _node_keys(driver, log, step.ent_type)
-    found, times = known[step.ent_type]
+    found, times = known.get(step.ent_type, (set(), []))
     keys = set(found)
     resolved: list[str] = []
     if step.origin == "Event":  # a property the sampled events lack may be on later ones
@@ -290,14 +289,16 @@ def _event_keys(events: pd.DataFrame) -> tuple[set[str], list[str]]:
     return keys, times
 
 
-def _node_keys(driver: Driver, log: str, entity_type: str | None) -> tuple[set[str], list[str]]:
+def _node_keys(
+    driver: Driver, log: str, entity_types: Sequence[str]
+) -> dict[str | None, tuple[set[str], list[str]]]:
+    """The property keys of the entities of each of ``entity_types`` (read from all of them,
+    every type in one query) and those that hold zoned times; a type without entities is
+    left out."""
     records, _, _ = driver.execute_query(
-        cypher("aggr_node_keys"), log=log, type=entity_type, database_=database()
+        cypher("aggr_node_keys"), log=log, types=sorted(set(entity_types)), database_=database()
     )
-    row = records[0] if records else None
-    if row is None:
-        return set(), []
-    return set(row["keys"]) - {"log"}, list(row["times"])
+    return {str(row["type"]): (set(row["keys"]) - {"log"}, list(row["times"])) for row in records}
 
 
 def _event_nodes(edges: LogEdges, plan: _Plan) -> pd.DataFrame:
@@ -394,6 +395,7 @@ def _write(
     if len(table):
         own = [c for c in table.columns if c not in ("id", "name", "count", "members")]
         stored = [c for c in own if c not in OWN_PROPERTIES]
+        together, apart = _members_with_batches(_member_parts(table, edges))
         created = loader.run(
             "aggr_create_aggregates",
             {
@@ -402,13 +404,18 @@ def _write(
                 "counts": table["count"].astype(int).tolist(),
             },
             {"properties": {c: _storable(table[c]) for c in stored}},
+            {
+                "memberOf": [[p[0] for p in batch] for batch in together],
+                "parts": [[p[1] for p in batch] for batch in together],
+                "members": [[p[2] for p in batch] for batch in together],
+            },
             **record,
             origin=step.origin,
             type=step.ent_type,
             key=[key.name for key in step.group_by],
         )
         edges.written(table["id"].tolist(), created, number)
-        _write_members(driver, log, number, table, edges, between_batches)
+        _write_members(driver, log, number, apart, between_batches)
         lifted = edges.lift(edges.aggregates_of(number), upto=number)
         _write_lifted(driver, log, number, lifted, edges, between_batches)
     driver.execute_query(
@@ -464,22 +471,52 @@ def _relink(driver: Driver, log: str, edges: LogEdges, steps: range, freed: np.n
             _write_lifted(driver, log, number, lifted, edges, lambda: None)
 
 
+#: one member list part: the aggregate's id, the part's number, the members' ids
+_Part = tuple[str, int, list[str]]
+
+
+def _member_parts(table: pd.DataFrame, edges: LogEdges) -> list[list[_Part]]:
+    """Per aggregate (row of ``table``), its member lists: the ids of its members in parts
+    of at most :data:`MEMBERS_PART`."""
+    parts: list[list[_Part]] = []
+    for aggregate, group in zip(table["id"], table["members"], strict=True):
+        keys = edges.keys[np.asarray(group, dtype=np.int64)]
+        parts.append(
+            [
+                (aggregate, part, [str(k) for k in keys[start : start + MEMBERS_PART]])
+                for part, start in enumerate(range(0, len(keys), MEMBERS_PART))
+            ]
+        )
+    return parts
+
+
+def _members_with_batches(parts: list[list[_Part]]) -> tuple[list[list[_Part]], list[_Part]]:
+    """The member lists that go with the aggregates' batches (per batch of :data:`BATCH`
+    aggregates: all of theirs when they list at most :data:`MEMBERS_PART` ids together, else
+    none) and those written apart. A small step's lists then cost no round trip of their
+    own; a large step's stay in transactions of their own size."""
+    together: list[list[_Part]] = []
+    apart: list[_Part] = []
+    for start in range(0, len(parts), BATCH):
+        batch = [part for row in parts[start : start + BATCH] for part in row]
+        if sum(len(part[2]) for part in batch) <= MEMBERS_PART:
+            together.append(batch)
+        else:
+            together.append([])
+            apart.extend(batch)
+    return together, apart
+
+
 def _write_members(
     driver: Driver,
     log: str,
     number: int,
-    table: pd.DataFrame,
-    edges: LogEdges,
+    parts: list[_Part],
     between_batches: Callable[[], None],
 ) -> None:
-    """The ids of each aggregate's members, in parts of at most :data:`MEMBERS_PART`, a few
-    parts per transaction."""
-    parts: list[tuple[str, int, list[str]]] = []
-    for aggregate, group in zip(table["id"], table["members"], strict=True):
-        keys = edges.keys[np.asarray(group, dtype=np.int64)]
-        for part, start in enumerate(range(0, len(keys), MEMBERS_PART)):
-            parts.append((aggregate, part, [str(k) for k in keys[start : start + MEMBERS_PART]]))
-    batch: list[tuple[str, int, list[str]]] = []
+    """The member lists ``parts`` of step ``number``'s aggregates, a few parts per
+    transaction (at most about :data:`MEMBERS_PART` ids)."""
+    batch: list[_Part] = []
     for index, item in enumerate(parts):
         batch.append(item)
         if sum(len(b[2]) for b in batch) >= MEMBERS_PART or index == len(parts) - 1:
