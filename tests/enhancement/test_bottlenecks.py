@@ -265,3 +265,37 @@ def test_the_outcome_is_held_fixed(escort_and_aborted_runs):
         "Runs are compared with runs of the same outcome: the completed runs against each "
         "other, leaving out 2 runs that did not complete."
     )
+
+
+def test_the_figure_is_plotly_express_bar_chart(known_bottleneck):
+    """The bars are built from graph objects; the JSON is the same text as plotly express'
+    bar chart of the same candidates (what the figure was drawn by before)."""
+    import plotly.express as px
+
+    from robotale.enhancement.bottlenecks import _figure, _short
+
+    result = find_bottlenecks(known_bottleneck)
+    # a robot left out and a second kind, so that the legend and the "-" robot are compared
+    ranking = result.table.copy()
+    ranking.loc[ranking.index[-1], ["robot", "kind"]] = [None, "queueing"]
+    shown = ranking.head(15).assign(
+        candidate=lambda t: (
+            t["kind"]
+            + ": "
+            + t["activity"].astype(str).map(lambda a: _short(a, 40))
+            + " ("
+            + t["robot"].fillna("-").astype(str)
+            + ")"
+        )
+    )
+    expected = px.bar(
+        shown,
+        x="delay_per_case",
+        y="candidate",
+        color="kind",
+        orientation="h",
+        hover_data=["explanation"],
+        title="Bottlenecks: seconds they add per case",
+    ).update_yaxes(autorange="reversed")
+    assert len(expected.data) == 2  # one trace per kind
+    assert _figure(ranking).to_json() == expected.to_json()
