@@ -586,6 +586,7 @@ def _figure(ranking: pd.DataFrame):
     ``px.bar(shown, x="delay_per_case", y="candidate", color="kind", orientation="h",
     hover_data=["explanation"])`` draws, built from graph objects (plotly express spent
     about 0.03 s of a cold Perspectives page's first answer working out what to draw)."""
+    # plotly takes about half a second to import: only a figure needs it
     import plotly.graph_objects as go
     import plotly.io as pio
 
@@ -624,7 +625,7 @@ def _figure(ranking: pd.DataFrame):
 
 def _kind_bars(kind: str, rows: pd.DataFrame, colour: str):
     """One kind's bars, with the hover text and legend entry plotly express gives them."""
-    import plotly.graph_objects as go
+    import plotly.graph_objects as go  # imported by the figure first (plotly's start-up cost)
 
     return go.Bar(
         customdata=rows[["explanation"]].to_numpy(object),
