@@ -581,16 +581,9 @@ def _short(text: str, limit: int = 80) -> str:
     return text if len(text) <= limit else text[: limit - 3] + "..."
 
 
-def _figure(ranking: pd.DataFrame):
-    """The first 15 candidates as horizontal bars, one trace per kind: the figure
-    ``px.bar(shown, x="delay_per_case", y="candidate", color="kind", orientation="h",
-    hover_data=["explanation"])`` draws, built from graph objects (plotly express spent
-    about 0.03 s of a cold Perspectives page's first answer working out what to draw)."""
-    # plotly takes about half a second to import: only a figure needs it
-    import plotly.graph_objects as go
-    import plotly.io as pio
-
-    shown = ranking.head(15).assign(
+def _shown(ranking: pd.DataFrame) -> pd.DataFrame:
+    """The first 15 candidates, each with its bar's label: kind, activity and robot."""
+    return ranking.head(15).assign(
         candidate=lambda t: (
             t["kind"]
             + ": "
@@ -600,6 +593,18 @@ def _figure(ranking: pd.DataFrame):
             + ")"
         )
     )
+
+
+def _figure(ranking: pd.DataFrame):
+    """The first 15 candidates as horizontal bars, one trace per kind: the figure
+    ``px.bar(shown, x="delay_per_case", y="candidate", color="kind", orientation="h",
+    hover_data=["explanation"])`` draws, built from graph objects (plotly express spent
+    about 0.03 s of a cold Perspectives page's first answer working out what to draw)."""
+    # plotly takes about half a second to import: only a figure needs it
+    import plotly.graph_objects as go
+    import plotly.io as pio
+
+    shown = _shown(ranking)
     template = pio.templates[pio.templates.default]
     colours = template.layout.colorway
     bars = [

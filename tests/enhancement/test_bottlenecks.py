@@ -272,22 +272,13 @@ def test_the_figure_is_plotly_express_bar_chart(known_bottleneck):
     bar chart of the same candidates (what the figure was drawn by before)."""
     import plotly.express as px
 
-    from robotale.enhancement.bottlenecks import _figure, _short
+    from robotale.enhancement.bottlenecks import _figure, _shown
 
     result = find_bottlenecks(known_bottleneck)
     # a robot left out and a second kind, so that the legend and the "-" robot are compared
     ranking = result.table.copy()
     ranking.loc[ranking.index[-1], ["robot", "kind"]] = [None, "queueing"]
-    shown = ranking.head(15).assign(
-        candidate=lambda t: (
-            t["kind"]
-            + ": "
-            + t["activity"].astype(str).map(lambda a: _short(a, 40))
-            + " ("
-            + t["robot"].fillna("-").astype(str)
-            + ")"
-        )
-    )
+    shown = _shown(ranking)
     expected = px.bar(
         shown,
         x="delay_per_case",
