@@ -311,9 +311,12 @@ def mission_run(log: pd.DataFrame, case: str, slow: pd.DataFrame | None = None) 
 
 def run_events(log: pd.DataFrame, case: str) -> pd.DataFrame:
     """The events of run ``case`` of ``log`` in time order, each with its robot's name."""
-    cases = log[CASE].astype("string")
-    events = log[cases.eq(str(case)).fillna(False).to_numpy(bool)]
-    events = events.sort_values(TIMESTAMP, kind="stable")
+    chosen = log[CASE].astype("string").eq(str(case)).fillna(False).to_numpy(bool)
+    # a live run's log is its one run, in time order but for a late tag: it is asked at every
+    # look, so neither a copy of every row nor a sort is made when none is needed
+    events = log if chosen.all() else log[chosen]
+    if not events[TIMESTAMP].is_monotonic_increasing:
+        events = events.sort_values(TIMESTAMP, kind="stable")
     robots_column = (
         events[ROBOT].astype("string").fillna(NO_ROBOT)
         if ROBOT in events.columns

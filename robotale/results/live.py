@@ -25,7 +25,7 @@ from robotale.ekg.connection import database
 from robotale.ekg.live import Pose, live_since, live_tags
 from robotale.enhancement.mission import MissionRun, carrying, lone_run, open_from, run_events
 from robotale.enhancement.mission_state import Tracks
-from robotale.enhancement.timeline import NO_ROBOT, case_messages
+from robotale.enhancement.timeline import case_messages
 from robotale.eventlog import schema
 from robotale.eventlog.enrich import pair_activities
 from robotale.eventlog.prepare import tags_log
@@ -147,7 +147,7 @@ class _Kept:
         made = self._made(name, self._tail(fresh)) or self._made(name, None)
         assert made is not None  # the whole run is always made
         events, found, unchanged, kept = made
-        events_of_run = _run_events(events, name)
+        events_of_run = run_events(events, name)
         run = lone_run(events_of_run, name, found, self._told(name, events_of_run, kept))
         before = self.replay.runs.get(name) if self.replay is not None else None
         if unchanged and before is not None:
@@ -251,16 +251,6 @@ class _Kept:
                 at[key] = int(index)
         begun = np.array(list(at.values()), dtype=np.int64)
         return None if (begun == -1).any() else begun
-
-
-def _run_events(events: pd.DataFrame, name: str) -> pd.DataFrame:
-    """:func:`run_events` of a live run's ``events``: they are its one case's and, but for a
-    late tag, in time order already, so only the robots' column is made as there (not the
-    whole run filtered and sorted again at every look)."""
-    if schema.ROBOT not in events.columns or (np.diff(_nanos(events[schema.TIMESTAMP])) < 0).any():
-        return run_events(events, name)
-    robots = events[schema.ROBOT].astype("string").fillna(NO_ROBOT).astype(str)
-    return events.assign(**{schema.ROBOT: robots})
 
 
 def _joined(kept: pd.DataFrame, made: pd.DataFrame) -> pd.DataFrame:
