@@ -18,6 +18,7 @@ from robotale.neo4j_server.server import (
     LocalServer,
     PortInUse,
     ServerOptions,
+    collector,
     free_port,
     free_ports,
 )
@@ -157,6 +158,15 @@ def test_the_overlay_changes_defaults_but_not_what_robotale_owns(tmp_path):
         "(robotale's server always asks for a password).",
     ]
     assert overlay.read_text() == text
+
+
+def test_an_overlay_that_chooses_a_collector_replaces_robotales_choice():
+    # the JVM refuses to start with two collectors chosen
+    assert collector(()) == ("-XX:+UseParallelGC",)
+    assert collector(("-Dmine=yes",)) == ("-XX:+UseParallelGC",)
+    assert collector(("-XX:+UseG1GC",)) == ()
+    assert collector(("-XX:+UseZGC", "-Dmine=yes")) == ()
+    assert collector(("-XX:-UseG1GC",)) == ("-XX:+UseParallelGC",)
 
 
 def test_an_overlay_line_that_is_no_setting_names_file_and_line(tmp_path):
