@@ -24,7 +24,6 @@ from robotale.eventlog.options import PrepareOptions
 from robotale.eventlog.preparing import kept_runs
 from robotale.eventlog.reading import format_reading
 from robotale.neo4j_server.server import LocalServer
-from robotale.results.site import keep_sites, run_sites
 from robotale.results.storing import default_keys, describe, pages_when, prepare_pages
 from robotale.timings import stage, watch_server
 
@@ -128,6 +127,9 @@ def ingest_command(
     # a bulk build restarted the server: new connections, with no bookmarks of the old store
     with session_driver() as driver:
         if opened.kind is RECORDINGS:
+            # here, not at the top: the simulation's modules are a recording's only
+            from robotale.results.site import keep_sites, run_sites
+
             # the Mission page's map: the simulated runs' fields, bases and objects
             keep_sites(driver, name, run_sites(path))
         with stage("the dashboard's pages"):
