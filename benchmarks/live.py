@@ -29,8 +29,8 @@ Printed per robot count:
   that minute, so growth over a long run shows, with the part before the monitor stored the
   tag and the CPU per look in each minute, and this process' CPU;
 - the growth verdict (:func:`growth`): the lag's p95 over the last two whole minutes of stamps
-  against the first two (a ratio; "no growth" up to :data:`GROWTH_ALLOWED`), and the
-  least-squares slope of the per-minute p95;
+  against minutes 2 and 3 (a ratio; the first minute is the start; "no growth" up to
+  :data:`GROWTH_ALLOWED`), and the least-squares slope of the per-minute p95 from minute 2;
 - the store's append rate: tags stored in Neo4j per second, against tags published per second;
 - the monitor process' CPU (user + system) per robot, in % of one core;
 - the check: the tags stored are the tags published (robot, activity, lifecycle, stamp).
@@ -543,24 +543,23 @@ GROWTH_ALLOWED = 1.10
 
 def growth(measured: list[tuple[float, float]]) -> tuple[float, float] | None:
     """How the lag's p95 changes over the run: the p95 of the tags stamped in the last two
-    whole minutes over that of the first two (a ratio), and the least-squares slope of the
-    per-minute p95 in seconds per minute; None for a run shorter than four whole minutes.
-    A partial last minute (the run's end) is left out."""
+    whole minutes over that of minutes 2 and 3 (a ratio), and the least-squares slope of the
+    per-minute p95 from minute 2 on, in seconds per minute; None for a run shorter than five
+    whole minutes. The first minute holds the start (DDS discovery, the monitor's, the
+    server's and the reader's first work) and a partial last minute the end: both are left
+    out."""
     import numpy as np
 
     if not measured:
         return None
     first = measured[0][0]
-    span = measured[-1][0] - first
-    whole = int(span // 60)
+    whole = int((measured[-1][0] - first) // 60)
     minutes = _by_minute([m for m in measured if m[0] < first + 60 * whole], first)
-    if whole < 4 or len(minutes) < 4:
+    if whole < 5 or any(m not in minutes for m in range(1, whole)):
         return None
-    p95s = [quantiles(minutes[m])[1] for m in sorted(minutes)]
-    ratio = (
-        quantiles(minutes[whole - 2] + minutes[whole - 1])[1]
-        / quantiles(minutes[0] + minutes[1])[1]
-    )
+    p95s = [quantiles(minutes[m])[1] for m in range(1, whole)]
+    last = quantiles(minutes[whole - 2] + minutes[whole - 1])[1]
+    ratio = last / quantiles(minutes[1] + minutes[2])[1]
     slope = float(np.polyfit(np.arange(len(p95s)), p95s, 1)[0])
     return ratio, slope
 
@@ -568,12 +567,12 @@ def growth(measured: list[tuple[float, float]]) -> tuple[float, float] | None:
 def _print_growth(measured: list[tuple[float, float]]) -> None:
     found = growth(measured)
     if found is None:
-        print("  growth: not judged (fewer than four whole minutes of tags)")
+        print("  growth: not judged (fewer than five whole minutes of tags)")
         return
     ratio, slope = found
     verdict = "no growth" if ratio <= GROWTH_ALLOWED else "GROWS"
-    print(f"  growth: p95 of the last two minutes / p95 of the first two {ratio:.2f}x, per-minute "
-          f"p95 slope {1000 * slope:+.1f} ms per minute (target no growth, at most "
+    print(f"  growth: p95 of the last two minutes / p95 of minutes 2-3 {ratio:.2f}x, per-minute "
+          f"p95 slope from minute 2 {1000 * slope:+.1f} ms per minute (target no growth, at most "
           f"{GROWTH_ALLOWED:.2f}x: {verdict})")  # fmt: skip
 
 
