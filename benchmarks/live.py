@@ -26,7 +26,11 @@ Printed per robot count:
   the lag before the monitor stored the tag (to the resolution of the counts taken before each
   look); the CPU time of this thread per look that found tags; then the
   lag per minute of stamps beside the load average and the machine's CPU (``/proc/stat``) in
-  that minute, so growth over a long run shows, and this process' CPU;
+  that minute, so growth over a long run shows, with the part before the monitor stored the
+  tag and the CPU per look in each minute, and this process' CPU;
+- the growth verdict (:func:`growth`): the lag's p95 over the last two whole minutes of stamps
+  against minutes 2 and 3 (a ratio; the first minute is the start; "no growth" up to
+  :data:`GROWTH_ALLOWED`), and the least-squares slope of the per-minute p95 from minute 2;
 - the store's append rate: tags stored in Neo4j per second, against tags published per second;
 - the monitor process' CPU (user + system) per robot, in % of one core;
 - the check: the tags stored are the tags published (robot, activity, lifecycle, stamp).
@@ -341,6 +345,7 @@ def measure(
     began = time.time()
     seen: dict[Key, float] = {}
     looks: list[float] = []  # CPU seconds of this thread each look that found tags took
+    looked: list[float] = []  # the wall time each of those looks ended
     waits: list[float] = []  # of which in the summary's request (its checks while waiting)
     counts: list[tuple[float, int]] = []  # (wall time, tags stored then)
     held: dict | None = None  # what the page holds: the run's length and number of events
@@ -355,6 +360,7 @@ def measure(
             continue  # the wait ran out: nothing new
         now = time.time()
         looks.append(time.thread_time() - cpu)
+        looked.append(now)
         waits.append(waited)
         held = summary
         start = _epoch(summary["start"])
@@ -389,10 +395,12 @@ def measure(
           f"{1000 * quantiles(waits)[0]:.0f} ms), load average "
           f"{os.getloadavg()[0]:.1f}")  # fmt: skip
     _print_lags("stamp -> Mission state API", api_lags, dds_lags)
-    s50, s95 = quantiles(_stored_lags(published, stored, counts))
+    stored_lags = _stored_lags(published, stored, counts)
+    s50, s95 = quantiles([lag for _, lag in stored_lags])
     print(f"  of which stamp -> stored by the monitor (seen by this process' count before "
           f"each look): p50 {s50:.3f} s, p95 {s95:.3f} s")  # fmt: skip
-    _print_minutes(api_lags, machine)
+    _print_minutes(api_lags, machine, stored_lags, list(zip(looked, looks, strict=True)))
+    _print_growth(api_lags)
     busy, load = machine.busy(began, ended), machine.load(began, ended)
     share = 100 * own / (ended - began)
     print(f"  this process (the API's looks and the plain reader): {share:.0f} % of a core "
@@ -490,26 +498,87 @@ class Machine:
         return sum(s[1] for s in inside) / len(inside) if inside else float("nan")
 
 
-def _print_minutes(measured: list[tuple[float, float]], machine: Machine) -> None:
-    """The lag per minute of stamps, beside the machine's load and CPU in that minute: a lag
-    that grows with the run shows here."""
+def _print_minutes(
+    measured: list[tuple[float, float]],
+    machine: Machine,
+    stored: list[tuple[float, float]],
+    looks: list[tuple[float, float]],
+) -> None:
+    """The lag per minute of stamps, beside the part of it before the monitor stored the tag
+    (by stamp too), the CPU of this thread per look that found tags (by the wall time the
+    look ended) and the machine's load and CPU in that minute: a lag that grows with the run
+    shows here, and whether the monitor's storing or the looks grow."""
     if not measured:
         return
     first = measured[0][0]
-    minutes: dict[int, list[float]] = {}
-    for stamp, lag in measured:
-        minutes.setdefault(int((stamp - first) // 60), []).append(lag)
+    minutes, stores, cpus = (
+        _by_minute(measured, first),
+        _by_minute(stored, first),
+        _by_minute(looks, first),
+    )
     for minute, values in sorted(minutes.items()):
         p50, p95 = quantiles(values)
+        _, s95 = quantiles(stores.get(minute, []))
+        c50, _ = quantiles(cpus.get(minute, []))
         start, end = first + 60 * minute, first + 60 * (minute + 1)
         print(f"    minute {minute + 1:2d}: lag p50 {p50:.3f} s, p95 {p95:.3f} s "
-              f"({len(values)} tags); load average {machine.load(start, end):.1f}, CPU "
+              f"({len(values)} tags); of which stored p95 {s95:.3f} s; look CPU median "
+              f"{1000 * c50:.0f} ms; load average {machine.load(start, end):.1f}, CPU "
               f"{machine.busy(start, end):.0f} % busy")  # fmt: skip
 
 
+def _by_minute(values: list[tuple[float, float]], first: float) -> dict[int, list[float]]:
+    """The values of ``(time, value)`` pairs grouped by whole minutes since ``first``."""
+    minutes: dict[int, list[float]] = {}
+    for at, value in values:
+        if at >= first:
+            minutes.setdefault(int((at - first) // 60), []).append(value)
+    return minutes
+
+
+#: the lag's growth allowed before the verdict says it grows: the last two minutes' p95 at
+#: most this much above the first two minutes'
+GROWTH_ALLOWED = 1.10
+
+
+def growth(measured: list[tuple[float, float]]) -> tuple[float, float] | None:
+    """How the lag's p95 changes over the run: the p95 of the tags stamped in the last two
+    whole minutes over that of minutes 2 and 3 (a ratio), and the least-squares slope of the
+    per-minute p95 from minute 2 on, in seconds per minute; None for a run shorter than five
+    whole minutes. The first minute holds the start (DDS discovery, the monitor's, the
+    server's and the reader's first work) and a partial last minute the end: both are left
+    out."""
+    import numpy as np
+
+    if not measured:
+        return None
+    first = measured[0][0]
+    whole = int((measured[-1][0] - first) // 60)
+    minutes = _by_minute([m for m in measured if m[0] < first + 60 * whole], first)
+    if whole < 5 or any(m not in minutes for m in range(1, whole)):
+        return None
+    p95s = [quantiles(minutes[m])[1] for m in range(1, whole)]
+    last = quantiles(minutes[whole - 2] + minutes[whole - 1])[1]
+    ratio = last / quantiles(minutes[1] + minutes[2])[1]
+    slope = float(np.polyfit(np.arange(len(p95s)), p95s, 1)[0])
+    return ratio, slope
+
+
+def _print_growth(measured: list[tuple[float, float]]) -> None:
+    found = growth(measured)
+    if found is None:
+        print("  growth: not judged (fewer than five whole minutes of tags)")
+        return
+    ratio, slope = found
+    verdict = "no growth" if ratio <= GROWTH_ALLOWED else "GROWS"
+    print(f"  growth: p95 of the last two minutes / p95 of minutes 2-3 {ratio:.2f}x, per-minute "
+          f"p95 slope from minute 2 {1000 * slope:+.1f} ms per minute (target no growth, at most "
+          f"{GROWTH_ALLOWED:.2f}x: {verdict})")  # fmt: skip
+
+
 def _stored_lags(published: list[Key], stored: list[Key], counts: list[tuple[float, int]]):
-    """Seconds from each stored tag's stamp to the first count that held it (the tags are
-    numbered as stored), for the tags published: how late the monitor stores a tag, to the
+    """(stamp, seconds from it to the first count that held the tag) of each stored tag (the
+    tags are numbered as stored), for the tags published: how late the monitor stores a tag, to the
     resolution of the counts."""
     import numpy as np
 
@@ -518,7 +587,7 @@ def _stored_lags(published: list[Key], stored: list[Key], counts: list[tuple[flo
     sent = {k[3] for k in published}
     firsts = np.searchsorted(held, np.arange(1, len(stored) + 1))
     return [
-        times[first] - tag[3] / 1e6
+        (tag[3] / 1e6, times[first] - tag[3] / 1e6)
         for tag, first in zip(stored, firsts, strict=True)
         if tag[3] in sent and first < len(times)
     ]

@@ -231,9 +231,7 @@ class MissionRun:
     @cached_property
     def _control_times(self) -> np.ndarray:
         """The times (to the microsecond) of the control events, sorted."""
-        control = self.events[LIFECYCLE].astype("string").fillna("").to_numpy() != NONE
-        times: np.ndarray = np.sort(self.events["s"].to_numpy(float)[control].round(6))
-        return times
+        return _control_times_of(self.events)
 
     def _event_times(self, since: float) -> list[float]:
         """The distinct times (to the microsecond) of the control events at or after
@@ -272,16 +270,26 @@ class MissionRun:
         """:attr:`instances` as JSON records, row by row."""
         return _records(self.instances)
 
-    def grown_from(self, earlier: MissionRun, kept: int) -> None:
+    def grown_from(self, earlier: MissionRun, kept: int, events: int = 0) -> None:
         """Take over what ``earlier``, this run before events came after its first ``kept``
-        activity instances, read of those instances (they are the same rows at the same
-        seconds), so only the later ones are read again."""
-        records = earlier.__dict__.get("instance_records")
-        if records is None or earlier.start != self.start or len(records) < kept:
+        activity instances and its first ``events`` events, read of those (they are the same
+        rows at the same seconds), so only the later ones are read again."""
+        if earlier.start != self.start:
             return
-        later = _records(self.instances.iloc[kept:])
-        # cached_property keeps its value in the instance's dict
-        self.__dict__["instance_records"] = records[:kept] + later
+        # cached_property keeps its values in the instance's dict
+        records = earlier.__dict__.get("instance_records")
+        if records is not None and len(records) >= kept:
+            self.__dict__["instance_records"] = records[:kept] + _records(
+                self.instances.iloc[kept:]
+            )
+        times = earlier.__dict__.get("_control_times")
+        if times is not None and 0 < events <= len(earlier.events):
+            # the events are in time order and a time's rounding keeps that order, so the
+            # control times of the first events lead the sorted times, as many as there are
+            # control events among them: those of the later events, few, are counted
+            first = len(times) - _control_count(earlier.events.iloc[events:])
+            later = _control_times_of(self.events.iloc[events:])
+            self.__dict__["_control_times"] = np.concatenate([times[:first], later])
 
     def with_positions(self, positions: pd.DataFrame, tracks: Tracks) -> MissionRun:
         """The same run with other positions (``tracks`` holding them per robot): what is
@@ -289,7 +297,7 @@ class MissionRun:
         moved = dataclasses.replace(self, positions=positions, tracks=tracks)
         # cached_property keeps its values in the instance's dict: the ones that do not
         # depend on the positions are handed on
-        for name in ("facts", "_made_of_events", "instance_records"):
+        for name in ("facts", "_made_of_events", "instance_records", "_control_times"):
             if name in self.__dict__:
                 moved.__dict__[name] = self.__dict__[name]
         return moved
@@ -537,6 +545,22 @@ def _slow(slow: pd.DataFrame, instances: pd.DataFrame) -> list[dict[str, Any]]:
         }
         for i in np.flatnonzero(slower)
     ]
+
+
+def _is_control(events: pd.DataFrame) -> np.ndarray:
+    """Which ``events`` are no message or reading alone (a step of the page's cursor)."""
+    control: np.ndarray = events[LIFECYCLE].astype("string").fillna("").to_numpy() != NONE
+    return control
+
+
+def _control_count(events: pd.DataFrame) -> int:
+    return int(_is_control(events).sum())
+
+
+def _control_times_of(events: pd.DataFrame) -> np.ndarray:
+    """The times (to the microsecond) of the control ``events``, sorted."""
+    times: np.ndarray = np.sort(events["s"].to_numpy(float)[_is_control(events)].round(6))
+    return times
 
 
 def _event_times(events: pd.DataFrame) -> list[float]:

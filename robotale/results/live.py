@@ -151,7 +151,7 @@ class _Kept:
         run = lone_run(events_of_run, name, found, self._told(name, events_of_run, kept))
         before = self.replay.runs.get(name) if self.replay is not None else None
         if unchanged and before is not None:
-            run.grown_from(before, unchanged)
+            run.grown_from(before, unchanged, kept)
         self.events, self.found = events, found
         return events, run
 

@@ -227,3 +227,19 @@ def test_the_live_benchmark_times_a_tag_from_the_first_answer_within_two_microse
     assert live.shown(published, seen) == {published[0]: 10.5}
     stamps = {k: k[3] / 1e6 for k in published}
     assert live.lags(stamps, live.shown(published, seen)) == [(10.0, 0.5)]
+
+
+def test_the_live_benchmark_judges_growth_from_minutes_2_3_and_the_last_two(live):
+    """Six whole minutes of lags, one tag a second: 5 s in minute 1 (the start, left out),
+    0.2 s in minutes 2-3, 0.3 s in 4, 0.5 s in 5-6, and a partial seventh minute of 9 s left
+    out. By hand: last two over minutes 2-3 0.5 / 0.2 = 2.5x; the per-minute p95s 0.2, 0.2,
+    0.3, 0.5, 0.5 at minutes 0-4 have a least-squares slope of 0.9 / 10 s per minute (their
+    co-deviation over the minutes' squared deviation). The same lag throughout: 1.0x, slope
+    0. Under five whole minutes: not judged."""
+    levels = [5.0, 0.2, 0.2, 0.3, 0.5, 0.5]
+    measured = [(100.0 + s, levels[s // 60]) for s in range(360)] + [(470.0, 9.0)]
+    ratio, slope = live.growth(measured)
+    assert ratio == pytest.approx(2.5) and slope == pytest.approx(0.09)
+    flat = [(100.0 + s, 0.3) for s in range(360)]
+    assert live.growth(flat) == (pytest.approx(1.0), pytest.approx(0.0))
+    assert live.growth(flat[:300]) is None

@@ -55,14 +55,16 @@ def batches(tags: list[Tag], seed: int) -> list[list[Tag]]:
 def test_the_run_grown_look_by_look_equals_the_run_made_of_all_tags_heard(monkeypatch, seed):
     """Over random splits of a recorded run: after each batch, the run the reader grew equals
     :func:`mission_run` of every tag heard (its tables, robots, length, summary whole and
-    since a moment, windows and the state at moments throughout), and some looks made only
-    the tail again."""
+    since a moment, the sorted control times it counts earlier times by, windows and the state
+    at moments throughout), and some looks made only the tail again and took the earlier
+    control times over."""
     name = f"live_{uuid.uuid4().hex[:8]}"
     stored: list[Tag] = []
     monkeypatch.setattr(
         reading, "live_since", lambda _driver, _log, tags, _poses: (stored[tags:], [])
     )
     remade: list[tuple[int, int]] = []  # (tags made again, tags held) at each making
+    carried: list[bool] = []
     tag_frame = reading._tag_frame
 
     def counted(log, held, heard, chosen):
@@ -76,7 +78,10 @@ def test_the_run_grown_look_by_look_equals_the_run_made_of_all_tags_heard(monkey
             replay = reading.live_replay(None, name)  # type: ignore[arg-type]
             assert replay is not None
             run = replay.run(name)
+            # the control times taken over from the last look, not read again of every event
+            carried.append("_control_times" in run.__dict__)
             whole = mission_run(reading.tags_events(name, stored), name)
+            assert run._control_times.tolist() == whole._control_times.tolist()
             for table in ("events", "instances", "messages", "moments"):
                 pd.testing.assert_frame_equal(getattr(run, table), getattr(whole, table), obj=table)
             assert (run.robots, run.duration) == (whole.robots, whole.duration)
@@ -89,6 +94,7 @@ def test_the_run_grown_look_by_look_equals_the_run_made_of_all_tags_heard(monkey
     finally:
         reading._kept.pop(name, None)
     assert any(chosen < held for chosen, held in remade)
+    assert any(carried)
 
 
 def test_looks_asking_at_once_after_the_store_changed_make_the_run_once(monkeypatch):

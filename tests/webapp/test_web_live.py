@@ -96,28 +96,35 @@ def test_the_window_and_state_asked_with_the_summarys_events_answer_on_that_run(
 
 
 def test_a_new_run_of_the_same_name_replaces_the_one_read(client, live, neo4j_driver):
-    """A reader that kept a longer run of that name reads the new one from its start."""
+    """A reader that kept a longer run of that name reads the new one from its start; the
+    run's count is the new run's."""
     from robotale.ekg.live import LiveLog
+    from robotale.results.live import live_counts
 
     api = f"/api/mission/{live.name}/{live.name}"
     tags(live, [(0, "rover", "survey", "start"), (1, "rover", "survey", "complete")])
     tags(live, [(2, "rover", "dock", "start")])
     assert client.get(api).json["duration"] == pytest.approx(2.0, abs=1e-6)
+    assert live_counts(neo4j_driver, live.name) == (3, 0)
     again = LiveLog(neo4j_driver, live.name)  # the monitor started again: a new run
+    assert live_counts(neo4j_driver, live.name) == (0, 0)
     tags(again, [(10, "drone", "scan", "start"), (13, "drone", "scan", "complete")])
+    assert live_counts(neo4j_driver, live.name) == (2, 0)
     grown = client.get(api).json
     assert grown["robots"] == ["drone"] and grown["duration"] == pytest.approx(3.0, abs=1e-6)
 
 
-def test_the_state_follows_odometry_stored_in_batches_late_ones_too(client, live):
+def test_the_state_follows_odometry_stored_in_batches_late_ones_too(client, live, neo4j_driver):
     """Poses come in batches beside the tags, a later batch holding a sample older than one
     already read: at moments between the samples, each robot's pose and heading are its
-    last sample's and last move's among all the samples written, read here with pandas."""
+    last sample's and last move's among all the samples written, read here with pandas; the
+    run's counts are the tags and samples written."""
     import math
 
     import pandas as pd
 
     from robotale.ekg.live import Pose
+    from robotale.results.live import live_counts
 
     api = f"/api/mission/{live.name}/{live.name}"
     tags(live, [(0, "rover", "survey", "start"), (0, "drone", "scan", "start")])
@@ -132,6 +139,7 @@ def test_the_state_follows_odometry_stored_in_batches_late_ones_too(client, live
     for batch in batches:
         live.poses(batch)
         written += batch
+        assert live_counts(neo4j_driver, live.name) == (2, len(written))
         table = pd.DataFrame(written).sort_values("stamp", kind="stable")
         table["s"] = table["stamp"] - T0
         assert client.get(api).status_code == 200
