@@ -30,13 +30,16 @@ from __future__ import annotations
 
 import shlex
 import time
+import weakref
 from collections.abc import Callable, Sequence
+from contextlib import suppress
 from dataclasses import asdict, dataclass, replace
 from typing import Any
 
 import numpy as np
 import pandas as pd
 from neo4j import Driver
+from neo4j.exceptions import DriverError, Neo4jError
 from neo4j.time import DateTime
 
 from robotale.ekg.build import ensure_schema, undo_after_failure
@@ -49,8 +52,8 @@ from robotale.ekg.logs import log_info
 from robotale.ekg.spec import AggrStep
 from robotale.ekg.where import Condition, parse_where
 from robotale.ekg.where_table import matching
-from robotale.ekg.writelock import log_write_lock
-from robotale.errors import InputError
+from robotale.ekg.writelock import log_write_lock, log_write_lock_reading
+from robotale.errors import InputError, LogNotFound
 from robotale.queries import cypher, statements
 
 #: the properties every aggregate has; a group-by key of one of these names is only in ``name``
@@ -87,11 +90,17 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
     """Run ``steps`` on the stored log ``log``, each stacked on the ones before (also those
     of earlier runs). Every step is checked against the log before the first one runs, so a
     specification that names something the log lacks writes nothing."""
-    info = log_info(driver, log)
     _ensure_schema(driver)
-    with log_write_lock(driver, log, "aggregating"):
-        _refuse_legacy(driver, log)
-        first = _last_step(driver, log) + 1
+    # what the run checks is read with the lock, in its transaction: one commit, no more
+    with log_write_lock_reading(
+        driver, log, "aggregating", [cypher("aggr_run_state"), cypher("aggr_steps")], log=log
+    ) as held:
+        state, stored = held.rows
+        if not state:
+            raise LogNotFound(log)
+        info = state[0]
+        _refuse_legacy(log, stored)
+        first = int(stored[-1]["step"]) + 1 if stored else 1
         edges = LogEdges.of_log(driver, log, info.get("entityTypes") or [])
         keys = _node_keys(driver, log, [s.ent_type for s in steps if s.ent_type is not None])
         keys[None] = _event_keys(edges.events)
@@ -99,17 +108,25 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
         results: list[StepResult] = []
         if first > 1:
             edges.read_memberships(driver, log)
-        events, entities = _unaggregated(driver, log, edges)
+        events = len(edges.free_events())
+        entities = int(info["entities"]) - edges.held_entities()
         grouped: list[tuple[_Plan, pd.DataFrame, float]] = []
         for plan in plans:  # in memory, each on what the ones before it left
             started = time.perf_counter()
             table = _group(driver, log, plan, edges)
             grouped.append((plan, table, time.perf_counter() - started))
-        for plan, table, seconds in grouped:
-            result = _write_or_undo(driver, log, plan, table, edges, first, (events, entities))
-            result = replace(result, seconds=result.seconds + seconds)
-            events, entities = result.final_events, result.final_entities
-            results.append(result)
+        try:
+            for plan, table, seconds in grouped:
+                result = _write_or_undo(driver, log, plan, table, edges, first, (events, entities))
+                result = replace(result, seconds=result.seconds + seconds)
+                events, entities = result.final_events, result.final_entities
+                results.append(result)
+        except BaseException:  # the steps before the one that failed are kept, complete
+            with suppress(Neo4jError, DriverError, OSError):  # else they stay 'writing'
+                _finish(driver, log, results)
+            raise
+        if results:  # recorded complete as the lock is given back, in its transaction
+            held.with_release(cypher("aggr_step_finish"), log=log, steps=_finished(results))
         return results
 
 
@@ -387,7 +404,8 @@ def _write(
 ) -> None:
     """Step ``number``: its record, aggregates, member lists, and the lifted edges it owns:
     those of its aggregates whose other end stands, at the level its run ends at, at this
-    step or an earlier one (an edge to an aggregate of a later step is that step's)."""
+    step or an earlier one (an edge to an aggregate of a later step is that step's). The
+    record says 'writing' until :func:`_finish`."""
     record: dict[str, Any] = {"step": number, "spec": step.text(), "run": run}
     if not len(table):  # else the aggregates' first batch writes the record
         driver.execute_query(cypher("aggr_step_begin"), record, log=log, database_=database())
@@ -418,13 +436,6 @@ def _write(
         _write_members(driver, log, number, apart, between_batches)
         lifted = edges.lift(edges.aggregates_of(number), upto=number)
         _write_lifted(driver, log, number, lifted, edges, between_batches)
-    driver.execute_query(
-        cypher("aggr_step_finish"),
-        log=log,
-        step=number,
-        counts={"aggregates": len(table), "members": int(table["count"].sum())},
-        database_=database(),
-    )
 
 
 def _write_lifted(
@@ -544,40 +555,49 @@ def _storable(column: pd.Series) -> list[Any]:
 _AGGREGATION_CONSTRAINTS = ["ekg_aggregate_key", "ekg_aggregation_step_key"]
 
 
+#: the drivers (and their databases) whose schema a run has seen to: once per process
+_SCHEMA_SEEN: weakref.WeakKeyDictionary[Driver, set[str]] = weakref.WeakKeyDictionary()
+
+
 def _ensure_schema(driver: Driver) -> None:
     """:func:`ensure_schema` unless the aggregation's constraints are there already (a log
-    built by this version has them): one question instead of ten statements a run."""
+    built by this version has them): one question instead of ten statements, asked once per
+    driver and database (constraints, once there, stay: nothing of robotale drops them)."""
+    seen = _SCHEMA_SEEN.setdefault(driver, set())
+    if database() in seen:
+        return
     records, _, _ = driver.execute_query(
         cypher("aggr_schema_present"), names=_AGGREGATION_CONSTRAINTS, database_=database()
     )
     if int(records[0]["present"]) < len(_AGGREGATION_CONSTRAINTS):
         ensure_schema(driver)
+    seen.add(database())
 
 
-def _last_step(driver: Driver, log: str) -> int:
-    steps = list_steps(driver, log)
-    return int(steps[-1]["step"]) if steps else 0
+def _finish(driver: Driver, log: str, results: Sequence[StepResult]) -> None:
+    """Record the steps ``results`` as complete, with their counts (a step's record says
+    'writing' until then, as a run cut short leaves its last step)."""
+    if results:
+        driver.execute_query(
+            cypher("aggr_step_finish"), log=log, steps=_finished(results), database_=database()
+        )
 
 
-def _unaggregated(driver: Driver, log: str, edges: LogEdges) -> tuple[int, int]:
-    """How many events and entities no aggregate holds."""
-    records, _, _ = driver.execute_query(cypher("aggr_unaggregated"), log=log, database_=database())
-    return len(edges.free_events()), int(records[0]["entities"]) - edges.held_entities()
+def _finished(results: Sequence[StepResult]) -> list[dict[str, int]]:
+    """The parameter ``$steps`` of ``aggr_step_finish``: all of a run's steps in one write."""
+    return [{"step": r.step, "aggregates": r.aggregates, "members": r.members} for r in results]
 
 
-def _legacy_steps(driver: Driver, log: str, step: int = 1) -> list[int]:
-    """The steps from ``step`` on that earlier versions of robotale wrote: their members are
-    marked on the nodes themselves, not listed."""
-    records, _, _ = driver.execute_query(
-        cypher("aggr_legacy_steps"), log=log, step=step, database_=database()
-    )
-    return [int(n) for n in records[0]["steps"]]
+def _legacy_steps(stored: Sequence[dict[str, Any]], step: int = 1) -> list[int]:
+    """The steps from ``step`` on of ``stored`` (:func:`list_steps`) that earlier versions
+    of robotale wrote: their members are marked on the nodes themselves, not listed."""
+    return [int(row["step"]) for row in stored if row["legacy"] and int(row["step"]) >= step]
 
 
-def _refuse_legacy(driver: Driver, log: str) -> None:
+def _refuse_legacy(log: str, stored: Sequence[dict[str, Any]]) -> None:
     """A step stacked on steps whose members are not listed would collapse those members
     again: refuse, saying how to redo them."""
-    legacy = _legacy_steps(driver, log)
+    legacy = _legacy_steps(stored)
     if legacy:
         listed = ", ".join(map(str, legacy))
         raise InputError(
@@ -588,7 +608,7 @@ def _refuse_legacy(driver: Driver, log: str) -> None:
 
 
 def _delete_steps(driver: Driver, log: str, step: int) -> None:
-    legacy = _legacy_steps(driver, log, step)
+    legacy = _legacy_steps(list_steps(driver, log), step)
     with driver.session(database=database()) as session:
         if legacy:  # their members carry marks, which go with them
             for statement in statements("aggr_undo_marks"):

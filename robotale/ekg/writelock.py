@@ -13,13 +13,13 @@ from __future__ import annotations
 import os
 import socket
 import uuid
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager, suppress
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
-from neo4j import Driver, RoutingControl
+from neo4j import Driver, ManagedTransaction, RoutingControl
 from neo4j.exceptions import ConstraintError, DriverError, Neo4jError
 
 from robotale.ekg.connection import database
@@ -97,10 +97,47 @@ def log_write_lock(driver: Driver, name: str, doing: str = "writing") -> Iterato
         release(driver, name, run)
 
 
+@dataclass
+class Held:
+    """A lock held by :func:`log_write_lock_reading`: what its read queries found, and the
+    block's last write if it gave one (:meth:`with_release`)."""
+
+    rows: list[list[dict[str, Any]]]
+    closing: tuple[str, dict[str, Any]] | None = None
+
+    def with_release(self, query: str, **parameters: Any) -> None:
+        """Write ``query`` in the transaction that gives the lock back, once the block has
+        ended without failure: the block's last write costs no commit of its own, and the
+        lock is free only once it is written."""
+        self.closing = (query, parameters)
+
+
+@contextmanager
+def log_write_lock_reading(
+    driver: Driver, name: str, doing: str, queries: Sequence[str], **parameters: Any
+) -> Iterator[Held]:
+    """:func:`log_write_lock`, the read ``queries`` (with ``parameters``) run in the
+    transaction that takes the lock, their rows in the :class:`Held` it yields (one list per
+    query). What a writer checks before it writes is then read as of the moment the lock is
+    its, without a transaction and round trips of its own (one commit for the lock and the
+    checks)."""
+    run, rows = _take(driver, name, doing, queries, parameters)
+    held = Held(rows)
+    try:
+        yield held
+    except BaseException:
+        release(driver, name, run)
+        raise
+    if held.closing is None:
+        release(driver, name, run)
+    else:
+        _release_after(driver, name, run, *held.closing)
+
+
 def take(driver: Driver, name: str, doing: str = "writing") -> str:
     """Take the write lock of ``name`` (as :func:`log_write_lock` does); returns the run's
     id, which :func:`release` needs: for a writer whose driver changes meanwhile."""
-    return _take(driver, name, doing)
+    return _take(driver, name, doing)[0]
 
 
 def release(driver: Driver, name: str, run: str) -> None:
@@ -112,21 +149,54 @@ def release(driver: Driver, name: str, run: str) -> None:
         s.run(cypher("ekg_lock_release"), name=name, run=run).consume()
 
 
-def _take(driver: Driver, name: str, doing: str) -> str:
+def _release_after(
+    driver: Driver, name: str, run: str, query: str, parameters: dict[str, Any]
+) -> None:
+    """Write ``query`` and give back the lock of ``name`` that ``run`` holds, in one
+    transaction; if that fails, the lock alone is given back and the failure raised."""
+    _ACTIVE.discard(run)
+    try:
+        with driver.session(database=database()) as session, session.begin_transaction() as tx:
+            tx.run(query, parameters).consume()
+            tx.run(cypher("ekg_lock_release"), name=name, run=run).consume()
+            tx.commit()
+    except BaseException:
+        release(driver, name, run)
+        raise
+
+
+def _take(
+    driver: Driver,
+    name: str,
+    doing: str,
+    queries: Sequence[str] = (),
+    parameters: dict[str, Any] | None = None,
+) -> tuple[str, list[list[dict[str, Any]]]]:
+    """The run's id and the rows of ``queries``, run after the lock's ``CREATE`` in its
+    transaction (a writer refused the lock reads nothing)."""
     run = uuid.uuid4().hex
+    lock = {
+        "name": name,
+        "run": run,
+        "host": socket.gethostname(),
+        "pid": os.getpid(),
+        "pidStart": _process_start(os.getpid()),
+    }
+
+    def transaction(tx: ManagedTransaction) -> list[list[dict[str, Any]]]:
+        tx.run(cypher("ekg_lock_take"), lock).consume()
+        return [tx.run(query, parameters or {}).data() for query in queries]
+
     for _ in range(2):  # the second time after removing a stale lock
         try:
-            driver.execute_query(
-                cypher("ekg_lock_take"),
-                name=name,
-                run=run,
-                host=socket.gethostname(),
-                pid=os.getpid(),
-                pidStart=_process_start(os.getpid()),
-                database_=database(),
-            )
+            if queries:
+                with driver.session(database=database()) as session:
+                    rows = session.execute_write(transaction)
+            else:  # one query: the driver's shortest way
+                driver.execute_query(cypher("ekg_lock_take"), lock, database_=database())
+                rows = []
             _ACTIVE.add(run)
-            return run
+            return run, rows
         except ConstraintError:
             other = holder(driver, name)
             if other is not None and other.alive():

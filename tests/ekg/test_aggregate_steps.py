@@ -195,7 +195,10 @@ def test_stacked_steps_undo_as_units(neo4j_driver, small, graph_counts):
         {"aggr_type": "EVENTS", "group_by": ["activity"], "where": "robot = 'r1'"},
         {"aggr_type": "EVENTS", "group_by": ["activity"]},
     ))  # fmt: skip
-    assert [s["step"] for s in list_steps(neo4j_driver, small)] == [1, 2, 3]
+    # each step recorded complete, with its counts, by the run's one write at its end
+    assert [(s["step"], s["status"], s["legacy"]) for s in list_steps(neo4j_driver, small)] == [
+        (1, "complete", False), (2, "complete", False), (3, "complete", False)
+    ]  # fmt: skip
     assert undo(neo4j_driver, small) == [3]
     assert set(aggregates(neo4j_driver, small)) == {"parcel", "move", "spray"}
     # step 3 took e3 and e4 (the events step 2 left); undone, they are free again
@@ -382,5 +385,25 @@ def test_a_later_step_that_fails_leaves_the_earlier_ones_as_if_run_alone(neo4j_d
     )
     with pytest.raises(ServerError, match=r"Aggregation step 2 of .* failed"):
         run_spec(neo4j_driver, small, steps(ROBOTS, ACTIVITIES))
-    assert [s["step"] for s in list_steps(neo4j_driver, small)] == [1]
+    # the step before the failing one is kept, and recorded complete before the error
+    assert [(s["step"], s["status"]) for s in list_steps(neo4j_driver, small)] == [(1, "complete")]
     assert lifted(neo4j_driver, small, "CORR") == ROBOTS_ALONE
+
+
+def test_a_run_on_a_log_being_written_is_refused_and_the_lock_given_back(
+    neo4j_driver, small, graph_counts
+):
+    from robotale.ekg.writelock import LogBusy, holder, log_write_lock
+
+    before = graph_counts()
+    spec = steps(ACTIVITIES)
+    busy = pytest.raises(LogBusy, match="aggregating it now is refused")
+    with log_write_lock(neo4j_driver, small, "writing"), busy:  # another writer of the log
+        run_spec(neo4j_driver, small, spec)
+    assert graph_counts() == before
+    with pytest.raises(InputError, match="no log named"):  # the lock taken, then given back
+        run_spec(neo4j_driver, "no such log", spec)
+    assert holder(neo4j_driver, "no such log") is None
+    run_spec(neo4j_driver, small, spec)  # the run's lock given back: undo takes it again
+    assert holder(neo4j_driver, small) is None
+    assert undo(neo4j_driver, small) == [1]
