@@ -37,6 +37,8 @@ from robotale.queries import cypher
 
 #: a node no aggregate holds
 FREE = -1
+#: the kinds of edge a step lifts, in the order of their codes in :attr:`LogEdges.kinds`
+KINDS = np.asarray(["CORR", "DF", "COMM"], dtype=object)
 
 
 @dataclass
@@ -48,10 +50,11 @@ class LogEdges:
     keys: np.ndarray  # per code: the node's id (events, entities) or the aggregate's id
     element_ids: np.ndarray  # per code: an aggregate's element id; None for the others
     stored: np.ndarray  # per code: an event's or entity's element id once read; else None
-    kinds: np.ndarray  # 'CORR', 'DF', 'COMM' per edge
+    kinds: np.ndarray  # per edge: its kind's position in :data:`KINDS`
     sources: np.ndarray  # codes
     targets: np.ndarray
-    entity_types: np.ndarray  # a DF edge's entity type, '' for the others
+    entity_types: np.ndarray  # per edge: a DF edge's entity type's position in ``type_names``
+    type_names: np.ndarray  # None (the edges but DF), then the DF edges' entity types
     holder: np.ndarray  # per code: the code of the aggregate holding it, or FREE
     levels: np.ndarray  # per code: an aggregate's step; 0 for events and entities
     corr: pd.DataFrame  # ``event``, ``entity`` (codes): what each event is correlated to
@@ -67,13 +70,14 @@ class LogEdges:
         count = len(events)
         corr = tables.corr["entity"].to_numpy() + count
         df, comm = tables.df, tables.comm
+        # kinds and entity types as small integers: millions of edges as Python strings cost
+        # more to make, and to group, than the rest of the lifting
+        df_types, names = pd.factorize(df["entityType"])
         frames = [
-            ("CORR", tables.corr["event"].to_numpy(), corr, np.full(len(corr), "", object)),
-            ("DF", df["source"].to_numpy(), df["target"].to_numpy(),
-             df["entityType"].astype(object).to_numpy()),
-            ("COMM", comm["source"].to_numpy(), comm["target"].to_numpy(),
-             np.full(len(comm), "", object)),
-        ]  # fmt: skip
+            (tables.corr["event"].to_numpy(), corr, np.zeros(len(corr), np.int64)),
+            (df["source"].to_numpy(), df["target"].to_numpy(), df_types.astype(np.int64) + 1),
+            (comm["source"].to_numpy(), comm["target"].to_numpy(), np.zeros(len(comm), np.int64)),
+        ]
         codes = count + len(entities)
         return cls(
             events=events,
@@ -85,10 +89,11 @@ class LogEdges:
             ),
             element_ids=np.full(codes, None, dtype=object),
             stored=np.full(codes, None, dtype=object),
-            kinds=np.concatenate([np.full(len(f[1]), f[0], object) for f in frames]),
-            sources=np.concatenate([np.asarray(f[1], np.int64) for f in frames]),
-            targets=np.concatenate([np.asarray(f[2], np.int64) for f in frames]),
-            entity_types=np.concatenate([f[3] for f in frames]),
+            kinds=np.concatenate([np.full(len(f[0]), k, np.int64) for k, f in enumerate(frames)]),
+            sources=np.concatenate([np.asarray(f[0], np.int64) for f in frames]),
+            targets=np.concatenate([np.asarray(f[1], np.int64) for f in frames]),
+            entity_types=np.concatenate([f[2] for f in frames]),
+            type_names=np.asarray([None, *np.asarray(names, dtype=object)], dtype=object),
             holder=np.full(codes, FREE, dtype=np.int64),
             levels=np.zeros(codes, dtype=np.int64),
             corr=pd.DataFrame({"event": tables.corr["event"].to_numpy(), "entity": corr}),
@@ -246,18 +251,23 @@ class LogEdges:
         chosen = (in_step[source] & other[target]) | (
             in_step[target] & ~in_step[source] & other[source]
         )
-        frame = pd.DataFrame(
+        # one integer per (source, target, entity type, kind), counted by a sort of integers
+        nodes, types = len(self.keys), len(self.type_names)
+        edge = (source[chosen] * nodes + target[chosen]) * types + self.entity_types[chosen]
+        edge = edge * len(KINDS) + self.kinds[chosen]
+        found, counts = np.unique(edge, return_counts=True)
+        found, kind = np.divmod(found, len(KINDS))
+        found, entity_type = np.divmod(found, types)
+        source, target = np.divmod(found, nodes)
+        return pd.DataFrame(
             {
-                "kind": self.kinds[chosen],
-                "source": source[chosen],
-                "target": target[chosen],
-                "entityType": self.entity_types[chosen],
+                "kind": KINDS[kind],
+                "source": source,
+                "target": target,
+                "entityType": self.type_names[entity_type],
+                "count": counts,
             }
         )
-        lifted = frame.groupby(["kind", "source", "target", "entityType"], sort=False).size()
-        lifted = lifted.rename("count").reset_index()
-        lifted["entityType"] = lifted["entityType"].where(lifted["entityType"] != "", None)
-        return lifted
 
     # -- earlier steps -------------------------------------------------------------------
 
