@@ -58,6 +58,9 @@ class LogEdges:
     holder: np.ndarray  # per code: the code of the aggregate holding it, or FREE
     levels: np.ndarray  # per code: an aggregate's step; 0 for events and entities
     corr: pd.DataFrame  # ``event``, ``entity`` (codes): what each event is correlated to
+    #: the lifted edges of every step at the level the nodes are held now, with their
+    #: ``step``; None until asked for, and again when a node's holder changes
+    owned: pd.DataFrame | None = None
 
     @classmethod
     def of_log(cls, driver: Driver, log: str, entity_types: Sequence[str]) -> LogEdges:
@@ -166,6 +169,7 @@ class LogEdges:
         elements = np.asarray(list(element_ids), dtype=object)[first]
         codes = self._append(np.full(len(names), None, object), names, elements, step)
         self.holder[nodes] = codes[positions]
+        self.owned = None
         return codes[positions]
 
     def aggregates_of(self, step: int) -> np.ndarray:
@@ -184,6 +188,7 @@ class LogEdges:
         held = self.holder >= 0
         freed = np.flatnonzero(held & (self.levels[np.maximum(self.holder, 0)] >= step))
         self.holder[freed] = FREE
+        self.owned = None
         return freed
 
     def ends(self, driver: Driver, log: str, codes: np.ndarray) -> np.ndarray:
@@ -228,6 +233,21 @@ class LogEdges:
         """The positions of the events no aggregate holds."""
         return np.flatnonzero(self.holder[: len(self.events)] == FREE)
 
+    def lift_level(self, step: int) -> pd.DataFrame:
+        """The lifted edges step ``step`` owns (as :meth:`lift` of its aggregates ``upto`` it
+        gives them): each edge belongs to the later step of the two ends standing for its
+        nodes, so every step's are found in one pass over the log's edges, kept until a
+        node's holder changes."""
+        if self.owned is None:
+            lifted = self._lifted(np.ones(len(self.sources), dtype=bool))
+            ends = (
+                self.levels[lifted["source"].to_numpy()],
+                self.levels[lifted["target"].to_numpy()],
+            )
+            self.owned = lifted.assign(step=np.maximum(*ends))
+        owned = self.owned[self.owned["step"].to_numpy() == step]
+        return owned.drop(columns="step").reset_index(drop=True)
+
     def lift(
         self, step: np.ndarray, upto: int | None = None, others: np.ndarray | None = None
     ) -> pd.DataFrame:
@@ -251,7 +271,23 @@ class LogEdges:
         chosen = (in_step[source] & other[target]) | (
             in_step[target] & ~in_step[source] & other[source]
         )
+        return self._lifted(chosen, source, target)
+
+    def _lifted(
+        self,
+        chosen: np.ndarray,
+        source: np.ndarray | None = None,
+        target: np.ndarray | None = None,
+    ) -> pd.DataFrame:
+        """The ``chosen`` edges (a mask) between what stands for their ends (``source``,
+        ``target``: codes per edge, by default what holds each end now) counted per pair,
+        kind and entity type; an edge between two free nodes is no lifted edge."""
+        if source is None or target is None:
+            standing = np.where(self.holder >= 0, self.holder, np.arange(len(self.keys)))
+            source, target = standing[self.sources], standing[self.targets]
+            chosen = chosen & ((self.holder[self.sources] >= 0) | (self.holder[self.targets] >= 0))
         # one integer per (source, target, entity type, kind), counted by a sort of integers
+        # (below 2**63 while there are fewer than some hundred million nodes)
         nodes, types = len(self.keys), len(self.type_names)
         edge = (source[chosen] * nodes + target[chosen]) * types + self.entity_types[chosen]
         edge = edge * len(KINDS) + self.kinds[chosen]

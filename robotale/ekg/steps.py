@@ -428,7 +428,7 @@ def _write(
         )
         edges.written(table["id"].tolist(), created, number)
         _write_members(driver, log, number, apart, between_batches)
-        lifted = edges.lift(edges.aggregates_of(number), upto=number)
+        lifted = edges.lift_level(number)
         _write_lifted(driver, log, number, lifted, edges, between_batches)
     driver.execute_query(
         cypher("aggr_step_finish"),
