@@ -152,7 +152,7 @@ PARTS = [
     ("events and their where", steps, "_event_nodes"),
     ("grouping", steps, "aggregate_table"),
     ("member lists", steps, "_write_members"),
-    ("lifting in memory", lift.LogEdges, "lift"),
+    ("lifting in memory", lift.LogEdges, "lift_level"),
     ("creating the lifted edges", steps, "_write_lifted"),
 ]
 

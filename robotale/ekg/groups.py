@@ -31,24 +31,68 @@ def aggregate_table(
     """One row per aggregate of ``nodes`` (columns ``node`` and the properties the step reads;
     the properties in ``times`` hold Unix nanoseconds): ``id``, ``name``, ``count``,
     ``members`` (node ids), a column per group key and per attribute output."""
-    keys = pd.DataFrame({key.name: group_values(key, nodes, times) for key in step.group_by})
-    names = keys.astype(object).where(keys.notna(), UNKNOWN).astype(str)
-    label = names.iloc[:, 0]
-    for column in names.columns[1:]:
-        label = label.str.cat(names[column], sep="|")
-    frame = pd.DataFrame({"name": label.to_numpy(), "node": nodes["node"].to_numpy()})
-    grouped = frame.groupby("name", sort=True)
-    table = pd.DataFrame({"count": grouped.size(), "members": grouped["node"].agg(list)})
-    first = keys.groupby(label.to_numpy(), sort=True).first()
-    for key in step.group_by:
-        table[key.name] = first[key.name]
-    labels = label.to_numpy()
+    group, names, firsts = _groups(step.group_by, nodes, times)
+    counts = np.bincount(group, minlength=len(names))
+    # each aggregate's members in the nodes' order: one stable sort, then split
+    order = np.argsort(group, kind="stable")
+    ordered = nodes["node"].to_numpy(dtype=np.int64)[order]
+    members = np.split(ordered, np.cumsum(counts)[:-1]) if len(names) else []
+    table = pd.DataFrame(
+        {"name": names, "count": counts, "members": pd.Series(members, dtype=object)}
+    )
+    for key, values in zip(step.group_by, firsts, strict=True):
+        table[key.name] = values
     for attr in step.attr_aggrs:
-        for output, values in attribute_values(attr, nodes[attr.name], labels, attr.name in times):
-            table[output] = values
-    table = table.reset_index(names="name")
-    table.insert(0, "id", [f"{number}:{name}" for name in table["name"]])
+        for output, found in attribute_values(attr, nodes[attr.name], group, attr.name in times):
+            table[output] = found
+    table.insert(0, "id", [f"{number}:{name}" for name in names])
     return table
+
+
+def _groups(
+    keys: Sequence[GroupKey], nodes: pd.DataFrame, times: set[str]
+) -> tuple[np.ndarray, np.ndarray, list[np.ndarray]]:
+    """The aggregate of each node (codes in the order of the aggregates' names), the names
+    (the key values joined by ``|``, a missing one as :data:`UNKNOWN`) and, per key, each
+    aggregate's first value of it that is not missing.
+
+    Each key's values are coded once as integers and only each combination's first row is
+    turned into text: a name per node cost more than the rest of the grouping. Combinations
+    whose names are the same text are one aggregate, as when the names themselves were grouped.
+    """
+    coded = [_key_codes(key, nodes, times) for key in keys]
+    combined = np.zeros(len(nodes), dtype=np.int64)
+    for codes, values in coded:  # re-coded after each key: the integers stay below len(nodes)
+        combined = pd.factorize(combined * (len(values) + 1) + codes + 1)[0].astype(np.int64)
+    _, first_rows, combination = np.unique(combined, return_index=True, return_inverse=True)
+    texts = [
+        [UNKNOWN if c < 0 else str(values[c]) for c in codes[first_rows]] for codes, values in coded
+    ]
+    labels = ["|".join(parts) for parts in zip(*texts, strict=True)] if texts else []
+    by_name, names = pd.factorize(np.asarray(labels, dtype=object), sort=True)
+    group = by_name.astype(np.int64)[combination.reshape(-1)]
+    firsts = []
+    for codes, values in coded:
+        rows = np.flatnonzero(codes >= 0)
+        found, at = np.unique(group[rows], return_index=True)  # rows ascend: the first row
+        first = np.full(len(names), None, dtype=object)
+        first[found] = values[codes[rows[at]]]
+        firsts.append(first)
+    return group, np.asarray(names, dtype=object), firsts
+
+
+def _key_codes(
+    key: GroupKey, nodes: pd.DataFrame, times: set[str]
+) -> tuple[np.ndarray, np.ndarray]:
+    """The value of ``key`` for each node as a code (-1: missing) into the distinct values."""
+    if key.kind == "property":  # coded as the column holds them, the distinct values shown
+        codes, uniques = pd.factorize(nodes[key.inputs[0]])
+        shown = pd.Series(np.asarray(uniques, dtype=object), dtype=object)
+        values = _property(key, pd.DataFrame({key.inputs[0]: shown}), times)
+    else:
+        codes, uniques = pd.factorize(group_values(key, nodes, times))
+        values = pd.Series(np.asarray(uniques, dtype=object), dtype=object)
+    return codes.astype(np.int64), np.asarray([_plain(v) for v in values], dtype=object)
 
 
 def group_values(key: GroupKey, nodes: pd.DataFrame, times: set[str]) -> pd.Series:
@@ -134,9 +178,9 @@ _GROUPERS: dict[str, Callable[[GroupKey, pd.DataFrame, set[str]], pd.Series]] = 
 def attribute_values(
     attr: AttrAggr, values: pd.Series, labels: np.ndarray, is_time: bool
 ) -> list[tuple[str, list[object]]]:
-    """(aggregate property, value per group, groups in the order of their labels) for one
-    attribute aggregation. Missing values are left out, as Cypher's aggregating functions
-    leave out nulls."""
+    """(aggregate property, value per group, groups in the order of their labels: the
+    aggregates' names, or their codes) for one attribute aggregation. Missing values are
+    left out, as Cypher's aggregating functions leave out nulls."""
     outputs = attr.outputs()
     if attr.function == "MULTISET":
         return [(outputs[0], [multiset(part) for _, part in values.groupby(labels, sort=True)])]
@@ -180,7 +224,7 @@ def multiset(values: Sequence[object] | pd.Series) -> list[str]:
 
 
 def _missing(value: object) -> bool:
-    return value is None or (isinstance(value, float) and np.isnan(value))
+    return value is None or value is pd.NA or (isinstance(value, float) and np.isnan(value))
 
 
 def _plain(value: object) -> object:

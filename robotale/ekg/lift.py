@@ -37,6 +37,8 @@ from robotale.queries import cypher
 
 #: a node no aggregate holds
 FREE = -1
+#: the kinds of edge a step lifts, in the order of their codes in :attr:`LogEdges.kinds`
+KINDS = np.asarray(["CORR", "DF", "COMM"], dtype=object)
 
 
 @dataclass
@@ -48,13 +50,17 @@ class LogEdges:
     keys: np.ndarray  # per code: the node's id (events, entities) or the aggregate's id
     element_ids: np.ndarray  # per code: an aggregate's element id; None for the others
     stored: np.ndarray  # per code: an event's or entity's element id once read; else None
-    kinds: np.ndarray  # 'CORR', 'DF', 'COMM' per edge
+    kinds: np.ndarray  # per edge: its kind's position in :data:`KINDS`
     sources: np.ndarray  # codes
     targets: np.ndarray
-    entity_types: np.ndarray  # a DF edge's entity type, '' for the others
+    entity_types: np.ndarray  # per edge: a DF edge's entity type's position in ``type_names``
+    type_names: np.ndarray  # None (the edges but DF), then the DF edges' entity types
     holder: np.ndarray  # per code: the code of the aggregate holding it, or FREE
     levels: np.ndarray  # per code: an aggregate's step; 0 for events and entities
     corr: pd.DataFrame  # ``event``, ``entity`` (codes): what each event is correlated to
+    #: the lifted edges of every step at the level the nodes are held now, with their
+    #: ``step``; None until asked for, and again when a node's holder changes
+    owned: pd.DataFrame | None = None
 
     @classmethod
     def of_log(cls, driver: Driver, log: str, entity_types: Sequence[str]) -> LogEdges:
@@ -67,13 +73,14 @@ class LogEdges:
         count = len(events)
         corr = tables.corr["entity"].to_numpy() + count
         df, comm = tables.df, tables.comm
+        # kinds and entity types as small integers: millions of edges as Python strings cost
+        # more to make, and to group, than the rest of the lifting
+        df_types, names = pd.factorize(df["entityType"])
         frames = [
-            ("CORR", tables.corr["event"].to_numpy(), corr, np.full(len(corr), "", object)),
-            ("DF", df["source"].to_numpy(), df["target"].to_numpy(),
-             df["entityType"].astype(object).to_numpy()),
-            ("COMM", comm["source"].to_numpy(), comm["target"].to_numpy(),
-             np.full(len(comm), "", object)),
-        ]  # fmt: skip
+            (tables.corr["event"].to_numpy(), corr, np.zeros(len(corr), np.int64)),
+            (df["source"].to_numpy(), df["target"].to_numpy(), df_types.astype(np.int64) + 1),
+            (comm["source"].to_numpy(), comm["target"].to_numpy(), np.zeros(len(comm), np.int64)),
+        ]
         codes = count + len(entities)
         return cls(
             events=events,
@@ -85,10 +92,11 @@ class LogEdges:
             ),
             element_ids=np.full(codes, None, dtype=object),
             stored=np.full(codes, None, dtype=object),
-            kinds=np.concatenate([np.full(len(f[1]), f[0], object) for f in frames]),
-            sources=np.concatenate([np.asarray(f[1], np.int64) for f in frames]),
-            targets=np.concatenate([np.asarray(f[2], np.int64) for f in frames]),
-            entity_types=np.concatenate([f[3] for f in frames]),
+            kinds=np.concatenate([np.full(len(f[0]), k, np.int64) for k, f in enumerate(frames)]),
+            sources=np.concatenate([np.asarray(f[0], np.int64) for f in frames]),
+            targets=np.concatenate([np.asarray(f[1], np.int64) for f in frames]),
+            entity_types=np.concatenate([f[2] for f in frames]),
+            type_names=np.asarray([None, *np.asarray(names, dtype=object)], dtype=object),
             holder=np.full(codes, FREE, dtype=np.int64),
             levels=np.zeros(codes, dtype=np.int64),
             corr=pd.DataFrame({"event": tables.corr["event"].to_numpy(), "entity": corr}),
@@ -161,6 +169,7 @@ class LogEdges:
         elements = np.asarray(list(element_ids), dtype=object)[first]
         codes = self._append(np.full(len(names), None, object), names, elements, step)
         self.holder[nodes] = codes[positions]
+        self.owned = None
         return codes[positions]
 
     def aggregates_of(self, step: int) -> np.ndarray:
@@ -179,6 +188,7 @@ class LogEdges:
         held = self.holder >= 0
         freed = np.flatnonzero(held & (self.levels[np.maximum(self.holder, 0)] >= step))
         self.holder[freed] = FREE
+        self.owned = None
         return freed
 
     def ends(self, driver: Driver, log: str, codes: np.ndarray) -> np.ndarray:
@@ -223,6 +233,21 @@ class LogEdges:
         """The positions of the events no aggregate holds."""
         return np.flatnonzero(self.holder[: len(self.events)] == FREE)
 
+    def lift_level(self, step: int) -> pd.DataFrame:
+        """The lifted edges step ``step`` owns (as :meth:`lift` of its aggregates ``upto`` it
+        gives them): each edge belongs to the later step of the two ends standing for its
+        nodes, so every step's are found in one pass over the log's edges, kept until a
+        node's holder changes."""
+        if self.owned is None:
+            lifted = self._lifted(np.ones(len(self.sources), dtype=bool))
+            ends = (
+                self.levels[lifted["source"].to_numpy()],
+                self.levels[lifted["target"].to_numpy()],
+            )
+            self.owned = lifted.assign(step=np.maximum(*ends))
+        owned = self.owned[self.owned["step"].to_numpy() == step]
+        return owned.drop(columns="step").reset_index(drop=True)
+
     def lift(
         self, step: np.ndarray, upto: int | None = None, others: np.ndarray | None = None
     ) -> pd.DataFrame:
@@ -246,18 +271,39 @@ class LogEdges:
         chosen = (in_step[source] & other[target]) | (
             in_step[target] & ~in_step[source] & other[source]
         )
-        frame = pd.DataFrame(
+        return self._lifted(chosen, source, target)
+
+    def _lifted(
+        self,
+        chosen: np.ndarray,
+        source: np.ndarray | None = None,
+        target: np.ndarray | None = None,
+    ) -> pd.DataFrame:
+        """The ``chosen`` edges (a mask) between what stands for their ends (``source``,
+        ``target``: codes per edge, by default what holds each end now) counted per pair,
+        kind and entity type; an edge between two free nodes is no lifted edge."""
+        if source is None or target is None:
+            standing = np.where(self.holder >= 0, self.holder, np.arange(len(self.keys)))
+            source, target = standing[self.sources], standing[self.targets]
+            chosen = chosen & ((self.holder[self.sources] >= 0) | (self.holder[self.targets] >= 0))
+        # one integer per (source, target, entity type, kind), counted by a sort of integers
+        # (below 2**63 while there are fewer than some hundred million nodes)
+        nodes, types = len(self.keys), len(self.type_names)
+        edge = (source[chosen] * nodes + target[chosen]) * types + self.entity_types[chosen]
+        edge = edge * len(KINDS) + self.kinds[chosen]
+        found, counts = np.unique(edge, return_counts=True)
+        found, kind = np.divmod(found, len(KINDS))
+        found, entity_type = np.divmod(found, types)
+        source, target = np.divmod(found, nodes)
+        return pd.DataFrame(
             {
-                "kind": self.kinds[chosen],
-                "source": source[chosen],
-                "target": target[chosen],
-                "entityType": self.entity_types[chosen],
+                "kind": KINDS[kind],
+                "source": source,
+                "target": target,
+                "entityType": self.type_names[entity_type],
+                "count": counts,
             }
         )
-        lifted = frame.groupby(["kind", "source", "target", "entityType"], sort=False).size()
-        lifted = lifted.rename("count").reset_index()
-        lifted["entityType"] = lifted["entityType"].where(lifted["entityType"] != "", None)
-        return lifted
 
     # -- earlier steps -------------------------------------------------------------------
 

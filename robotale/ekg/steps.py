@@ -31,7 +31,7 @@ from __future__ import annotations
 import shlex
 import time
 import weakref
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Collection, Sequence
 from contextlib import suppress
 from dataclasses import asdict, dataclass, replace
 from typing import Any
@@ -324,9 +324,11 @@ def _event_nodes(edges: LogEdges, plan: _Plan) -> pd.DataFrame:
     nanoseconds); for an entity type a group-by names, what the event is correlated to
     there (the id of the aggregate holding the entity, else the entity's id; joined by ``,``)."""
     free = edges.free_events()
-    table = edges.events.iloc[free].reset_index(drop=True).assign(order=free)
+    # only the columns the where and the step read: taking every column's rows cost more
+    # than the rest of the step
+    table = _event_columns(edges, plan.condition.names, free)
     chosen = free[matching(plan.condition, table[[n for n in plan.condition.names if n in table]])]
-    rows = edges.events.iloc[chosen].reset_index(drop=True).assign(order=chosen)
+    rows = _event_columns(edges, plan.reads, chosen)
     frame = pd.DataFrame({"node": chosen})
     for name in plan.reads:
         column = rows[name] if name in rows else pd.Series([None] * len(rows), dtype=object)
@@ -336,38 +338,48 @@ def _event_nodes(edges: LogEdges, plan: _Plan) -> pd.DataFrame:
     return frame
 
 
+def _event_columns(edges: LogEdges, names: Collection[str], rows: np.ndarray) -> pd.DataFrame:
+    """The rows ``rows`` (positions) of the event table's columns among ``names``, and
+    ``order`` (the positions)."""
+    present = [n for n in dict.fromkeys(names) if n in edges.events.columns]
+    return edges.events[present].iloc[rows].reset_index(drop=True).assign(order=rows)
+
+
 def _as_stored(column: pd.Series, is_time: bool) -> pd.Series:
-    """A column of the event table as Neo4j returns it (times: Unix nanoseconds)."""
+    """A column of the event table as Neo4j returns it (times: Unix nanoseconds); text stays
+    in its column (grouped as it is: made Python strings, a million events' cost seconds)."""
+    if isinstance(column.dtype, pd.StringDtype):
+        return column
     if is_time:
         ticks = column.dt.tz_convert("UTC").dt.as_unit("ns")
         return pd.Series(ticks.array.asi8, dtype="Int64").where(ticks.notna().to_numpy(), None)
     return pd.Series(neo4j_values(column), dtype=object)
 
 
-def _correlated(edges: LogEdges, events: np.ndarray, kind: str) -> list[str | None]:
+def _correlated(edges: LogEdges, events: np.ndarray, kind: str) -> np.ndarray:
     """For each of ``events`` (positions): what stands for its entities of type ``kind``,
     distinct, sorted and joined by ``,`` (None when it has none)."""
-    corr = edges.corr
-    corr = corr[edges.types[corr["entity"].to_numpy()] == kind]
+    event, entity = edges.corr["event"].to_numpy(), edges.corr["entity"].to_numpy()
     wanted = np.zeros(len(edges.events), dtype=bool)
     wanted[events] = True
-    corr = corr[wanted[corr["event"].to_numpy()]]
-    pairs = pd.DataFrame(
-        {"event": corr["event"].to_numpy(), "value": edges.standing(corr["entity"].to_numpy())}
-    )
-    pairs["value"] = pairs["value"].astype(str)
-    pairs = pairs.drop_duplicates().sort_values(["event", "value"], kind="stable")
-    at, values = pairs["event"].to_numpy(), pairs["value"].to_numpy(dtype=object)
+    keep = wanted[event] & (edges.types[entity] == kind)
+    event, entity = event[keep], entity[keep]
+    held = edges.holder[entity]
+    # (event, code of what stands for the entity) as one integer: distinct, by event
+    nodes = len(edges.keys)
+    at, code = np.divmod(np.unique(event * nodes + np.where(held >= 0, held, entity)), nodes)
+    found = np.full(len(edges.events), None, dtype=object)
     if not len(at):
-        return [None] * len(events)
-    # one value per event but for a few: joining each group in Python cost more than the rest
+        none: np.ndarray = found[events]
+        return none
     starts = np.flatnonzero(np.r_[True, at[1:] != at[:-1]])
     ends = np.r_[starts[1:], len(at)]
-    joined = values[starts]
-    for several in np.flatnonzero(ends - starts > 1):
-        joined[several] = ",".join(values[starts[several] : ends[several]])
-    found = pd.Series(joined, index=at[starts], dtype=object).reindex(events)
-    return [None if pd.isna(v) else v for v in found.tolist()]
+    found[at[starts]] = edges.keys[code[starts]]
+    # one value per event but for a few: joining each group in Python cost more than the rest
+    for first, last in zip(starts[ends - starts > 1], ends[ends - starts > 1], strict=True):
+        found[at[first]] = ",".join(sorted(str(k) for k in edges.keys[code[first:last]]))
+    values: np.ndarray = found[events]
+    return values
 
 
 def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.DataFrame:
@@ -434,7 +446,7 @@ def _write(
         )
         edges.written(table["id"].tolist(), created, number)
         _write_members(driver, log, number, apart, between_batches)
-        lifted = edges.lift(edges.aggregates_of(number), upto=number)
+        lifted = edges.lift_level(number)
         _write_lifted(driver, log, number, lifted, edges, between_batches)
 
 

@@ -35,6 +35,8 @@ from dataclasses import dataclass
 
 import numpy as np
 import pandas as pd
+import pyarrow as pa
+import pyarrow.compute as pc
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
@@ -181,9 +183,15 @@ def entity_ids(values: pd.Series) -> pd.Series:
         return pd.Series([], dtype="string")
     if _may_hold_lists(values):
         values = values.explode().dropna()
-    text = values.astype("string").str.strip()
-    if text.str.contains(_SEPARATOR, regex=False).any():
-        text = text.str.split(_SEPARATOR).explode().str.strip()
+    # split and trimmed by Arrow in one pass: a Python split per cell cost seconds per
+    # million events, most of the aggregation's reading of a log with several ids per cell
+    cells = pa.array(values.astype("string").array)
+    parts = pc.split_pattern(cells, _SEPARATOR)
+    at = pc.list_parent_indices(parts).to_numpy()
+    text = pd.Series(
+        pd.array(pc.utf8_trim_whitespace(pc.list_flatten(parts)), dtype="string"),
+        index=values.index[at],
+    )
     return text[text != ""]
 
 
