@@ -18,6 +18,9 @@ The translation follows BPMN's token semantics where a place/transition net can:
   sub-process while its parent runs; a process with a none start event runs once;
 - the net has no end place: a process is finished when no token is left (its final marking is
   empty), so branches may end at different end events;
+- an activity with a loop marker is tagged once per pass: a multi-instance one of a written
+  cardinality (and no completion condition) is that many steps in a row, any other marker
+  repeats it at will;
 - a sub-process or a resolved call activity is expanded in place; it completes when one of its
   end events is reached (a branch still running inside it may finish later);
 - terminate end events, interrupting event sub-processes and interrupting boundary events on
