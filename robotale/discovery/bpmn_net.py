@@ -18,6 +18,9 @@ The translation follows BPMN's token semantics where a place/transition net can:
   sub-process while its parent runs; a process with a none start event runs once;
 - the net has no end place: a process is finished when no token is left (its final marking is
   empty), so branches may end at different end events;
+- an activity with a loop marker is tagged once per pass: a multi-instance one of a written
+  cardinality (and no completion condition) is that many steps in a row, any other marker
+  repeats it at will;
 - a sub-process or a resolved call activity is expanded in place; it completes when one of its
   end events is reached (a branch still running inside it may finish later);
 - terminate end events, interrupting event sub-processes and interrupting boundary events on
@@ -245,7 +248,7 @@ class _Builder:
         done = self.place(scope, f"done_{node.id}")
         content = self.content(node)
         if content is None:
-            self.transition(node.id, label, [ready], [done])
+            self.repeated(node, label, scope, ready, done)
             for boundary, outs in boundaries:  # it fired while the activity ran
                 stays = [] if boundary.cancel_activity else [done]
                 self.transition(boundary.id, self.event_label(boundary), [done], [*stays, *outs])
@@ -270,6 +273,31 @@ class _Builder:
                 self.transition(name, boundary_label, [active], [active, *outs])
         scope.places.extend(inner.places)
         return done
+
+    def repeated(self, node, label: str, scope: _Scope, ready, done) -> None:
+        """The activity's transition from ``ready`` to ``done``, as many times as its loop
+        marker runs it: the engine tags each pass, so a multi-instance activity of a fixed
+        cardinality (a discovered model's repeats, ``loopCardinality`` 3) is that many
+        transitions in a row (parallel instances of an atomic step interleave to the same
+        language); any other marker (a standard loop, a cardinality read from data) repeats it
+        at will, none at all when it may test before the first pass."""
+        loop = node.loop
+        if loop is None:
+            self.transition(node.id, label, [ready], [done])
+            return
+        times = _fixed_cardinality(loop)
+        if times is not None:
+            here = ready
+            for _ in range(times - 1):
+                after = self.place(scope, f"pass_{node.id}")
+                self.transition(node.id, label, [here], [after])
+                here = after
+            self.transition(node.id, label, [here], [done])
+            return
+        self.transition(node.id, label, [ready], [done])
+        self.transition(f"again_{node.id}", None, [done], [ready])
+        if loop.test_before or loop.kind != "standard":
+            self.transition(f"skip_{node.id}", None, [ready], [done])
 
     def content(self, node):
         if node.kind != Kind.CALL_ACTIVITY:
@@ -337,6 +365,15 @@ _EVENT_AND_GATEWAY_KINDS = frozenset(
         *SUBSET_GATEWAYS,
     }
 )
+
+
+def _fixed_cardinality(loop) -> int | None:
+    """A multi-instance marker's cardinality when it is a whole number written out (at least
+    1) and no completion condition may cut the passes short, else ``None``."""
+    if loop.kind == "standard" or loop.cardinality is None or loop.collection or loop.condition:
+        return None
+    text = loop.cardinality.text.strip()
+    return int(text) if text.isdigit() and int(text) >= 1 else None
 
 
 def _by(items, attribute: str) -> dict[str, list]:

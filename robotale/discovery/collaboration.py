@@ -591,12 +591,12 @@ def discover_collaboration(
         )
     events = filter_log(log, selection)
     instances = typed_instances(events[[c for c in events.columns if c in _READ]])
-    pools = []
+    pools, first = [], {}
+    records_aborts = bool(instances["_aborted"].any())
     for name, mine_ in instances.groupby(ROBOT_TYPE, sort=False):
-        pools.append(_pool(str(name), mine_, noise, bool(instances["_aborted"].any())))
-    pools.sort(
-        key=lambda pool: instances.loc[instances[ROBOT_TYPE] == pool.name, START_TIMESTAMP].min()
-    )
+        pools.append(_pool(str(name), mine_, noise, records_aborts))
+        first[str(name)] = mine_[START_TIMESTAMP].min()  # the group at hand: no text compare
+    pools.sort(key=lambda pool: first[pool.name])
     info = {
         "filter": selection.describe() if selection else {},
         "events": len(events),

@@ -46,7 +46,13 @@ def constant_repeats(
             if (str(kind), label) in looped:
                 runs.setdefault((str(kind), label), set()).add(sum(1 for _ in group))
         for loop in rounds[str(kind)]:
-            for times in _rounds(labels, *_steps(loop)):
+            body, redo = _steps(loop)
+            found = _rounds(labels, body, redo)
+            if not found and set(body) <= set(labels):
+                # the trace did the loop's steps, never in a row: it went round in another
+                # order (steps interleaved), so no count holds for every trace
+                found = [0]
+            for times in found:
                 runs.setdefault((str(kind), loop_key(loop)), set()).add(times)
     return {key: next(iter(n)) for key, n in runs.items() if len(n) == 1 and min(n) > 1}
 

@@ -64,6 +64,17 @@ RUNS = {
         "errors.bpmn",
         {"robots": ["tractor_1"], "variables": tractors(fail_loudly="blade_jammed")},
     ),
+    # a multi-instance activity over a collection, by a cardinality read from a variable,
+    # cut short by its completion condition; standard loops tested after, before, capped
+    "loops": (
+        "loops.bpmn",
+        {
+            "variables": {
+                "rover": {"fields": ["a", "b", "c"], "blinks": 3, "depths": [5, 20, 35, 50]}
+                | {"steps": 0, "tries": 0}
+            }
+        },
+    ),
     "inclusive, two branches": (
         "inclusive.bpmn",
         {"variables": {"rover": {"jobs": ["clean", "photo"]}}},
