@@ -162,9 +162,10 @@ class Collaboration:
 # -- traces ------------------------------------------------------------------------------------
 
 
-def typed_instances(log: pd.DataFrame) -> pd.DataFrame:
+def typed_instances(log: pd.DataFrame, *, by_type: bool = False) -> pd.DataFrame:
     """Every activity instance with its robot's type and message role, in the order of the
-    robots' traces (case, robot, start)."""
+    robots' traces (case, robot, start); ``by_type``: each robot type's instances together
+    first (the types in the order they first come), so a type's are one slice of rows."""
     missing = [c for c in (*REQUIRED, ROBOT) if c not in log.columns]
     if missing:
         raise InputError(
@@ -180,8 +181,10 @@ def typed_instances(log: pd.DataFrame) -> pd.DataFrame:
     instances["_role"] = _roles(instances)
     instances["_aborted"] = interrupted(instances).to_numpy()
     # by case and robot, as a stable sort of the two columns orders them
-    order = np.lexsort((sort_codes(instances[ROBOT]), sort_codes(instances[CASE])))
-    return instances.take(order).reset_index(drop=True)
+    keys = [sort_codes(instances[ROBOT]), sort_codes(instances[CASE])]
+    if by_type:  # the rows split as a group-by in first-come order would, in one take
+        keys.append(pd.factorize(instances[ROBOT_TYPE])[0])
+    return instances.take(np.lexsort(keys)).reset_index(drop=True)
 
 
 def _types(instances: pd.DataFrame, robots: pd.Series) -> pd.Series:
@@ -218,8 +221,10 @@ def _roles(instances: pd.DataFrame) -> pd.Series:
     counts = np.bincount(
         label_codes * len(names) + role_codes, minlength=len(labels) * len(names)
     ).reshape(len(labels), len(names))
-    majority = names[counts.argmax(axis=1)]
-    return pd.Series(majority[label_codes], index=instances.index, dtype=str).replace("", None)
+    # no role is missing: set per distinct activity, not replaced over the rows
+    shown = np.array([name or None for name in names], dtype=object)
+    majority = shown[counts.argmax(axis=1)]
+    return pd.Series(majority[label_codes], index=instances.index, dtype=str)
 
 
 def triggers(instances: pd.DataFrame, traces: Traces, *, records_aborts: bool) -> set[str]:
@@ -590,11 +595,11 @@ def discover_collaboration(
             **{ROBOT_TYPE: log[ROBOT].astype("string").map(robot_type, na_action="ignore")}
         )
     events = filter_log(log, selection)
-    instances = typed_instances(events[[c for c in events.columns if c in _READ]])
+    instances = typed_instances(events[[c for c in events.columns if c in _READ]], by_type=True)
     pools, first = [], {}
     records_aborts = bool(instances["_aborted"].any())
-    for name, mine_ in instances.groupby(ROBOT_TYPE, sort=False):
-        pools.append(_pool(str(name), mine_, noise, records_aborts))
+    for name, mine_ in _by_type(instances):
+        pools.append(_pool(name, mine_, noise, records_aborts))
         first[str(name)] = mine_[START_TIMESTAMP].min()  # the group at hand: no text compare
     pools.sort(key=lambda pool: first[pool.name])
     info = {
@@ -604,6 +609,18 @@ def discover_collaboration(
         "miner": "pm4py inductive miner" + (f" (noise {noise:g})" if noise else ""),
     }
     return Collaboration(pools, _signals(instances), info)
+
+
+def _by_type(instances: pd.DataFrame) -> list[tuple[str, pd.DataFrame]]:
+    """Each robot type and its instances, from instances laid out ``by_type``
+    (:func:`typed_instances`): a slice of rows each, not a copy per group."""
+    types = instances[ROBOT_TYPE].to_numpy(object)
+    bounds = [0, *(np.flatnonzero(types[1:] != types[:-1]) + 1).tolist(), len(types)]
+    return [
+        (str(types[begin]), instances.iloc[begin:end])
+        for begin, end in itertools.pairwise(bounds)
+        if end > begin
+    ]
 
 
 def _pool(name: str, instances: pd.DataFrame, noise: float, records_aborts: bool) -> Pool:

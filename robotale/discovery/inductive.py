@@ -13,7 +13,10 @@ with the same result, object for object:
   to their groups;
 - the exclusive-choice cut's connected components, which pm4py finds through a networkx
   graph, its undirected copy and a copy of each component; here by union-find over the
-  pairs.
+  pairs;
+- the folding of the mined tree, which pm4py's ``fold`` starts with a deep copy of the tree
+  (and again at each round); the miner's tree is this module's own, so it is folded in
+  place, by pm4py's own steps.
 
 Everything else (the cuts' search, the other projections, base cases, fall-throughs, the noise
 filter) is pm4py's own. Only this module imports pm4py at its top: it costs 2 s and prints a
@@ -35,7 +38,7 @@ from pm4py.algo.discovery.inductive.variants.im import IMUVCL
 from pm4py.algo.discovery.inductive.variants.imf import IMFUVCL
 from pm4py.objects.dfg.obj import DFG
 from pm4py.objects.process_tree.obj import ProcessTree
-from pm4py.objects.process_tree.utils.generic import fold, tree_sort
+from pm4py.objects.process_tree.utils.generic import _fold, reduce_tau_leafs, tree_sort
 from pm4py.util import constants
 
 #: a log as pm4py's miner reads it: each distinct trace and how many cases followed it
@@ -54,8 +57,29 @@ def inductive_tree(traces: Sequence[Sequence[str]], noise: float) -> ProcessTree
         "disable_fallthroughs": False,
     }
     miner = _IMf(parameters) if noise > 0 else _IM(parameters)
-    tree = fold(miner.apply(_sub_log(variants), parameters))
+    tree = _folded(miner.apply(_sub_log(variants), parameters))
     tree_sort(tree)
+    return tree
+
+
+def _folded(tree: ProcessTree) -> ProcessTree:
+    """pm4py's ``fold`` (``pm4py.objects.process_tree.utils.generic``) step by step, without
+    its deep copy of the tree at each round: the tree is ours and not kept unfolded."""
+    tree = _fold(tree)
+    root = tree
+    while root.parent is None and len(tree.children) == 1:
+        root = tree.children[0]
+        root.parent = None
+        tree.children.clear()
+        tree = root
+    text = str(tree)
+    tree = reduce_tau_leafs(tree)
+    if len(str(tree)) != len(text):
+        tree = _folded(tree)
+        text = str(tree)
+    again = _fold(tree)
+    if len(str(again)) != len(text):
+        tree = _folded(again)
     return tree
 
 

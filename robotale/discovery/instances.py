@@ -46,18 +46,23 @@ FINISHED = "finished"
 START_KNOWN = "start_known"
 
 
+#: what a row's lifecycle means for pairing, as a small code (:func:`_kinds`)
+_OTHER, _START, _COMPLETE, _INSTANT = 0, 1, 2, 3
+_KIND_OF = {START: _START, COMPLETE: _COMPLETE, "none": _INSTANT}
+
+
 def control_flow_events(log: pd.DataFrame) -> pd.DataFrame:
     """The start, complete and instant events of ``log`` (no ``inprogress`` rows)."""
-    return log[_control_flow(log, _lifecycle(log))]
+    return log[_control_flow(log, _kinds(log))]
 
 
-def _control_flow(log: pd.DataFrame, lifecycle: pd.Series) -> np.ndarray:
-    """Which rows of ``log`` (``lifecycle``: their meanings) are starts, completes or
-    instants."""
-    keep = lifecycle.isin([START, COMPLETE, "none"])
+def _control_flow(log: pd.DataFrame, kinds: np.ndarray) -> np.ndarray:
+    """Which rows of ``log`` (``kinds``: their meanings, :func:`_kinds`) are starts,
+    completes or instants."""
+    keep = kinds != _OTHER
     if STATE in log.columns:
         keep &= log[STATE].astype("string").fillna("").str.lower().ne(INPROGRESS).to_numpy(bool)
-    return keep.to_numpy(bool)
+    return keep
 
 
 def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataFrame:
@@ -70,22 +75,23 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     start that never completes is an unfinished instance (no completion, no duration); a
     completion without a start, and an instant event, starts when it completes.
     """
-    # the lifecycle's meanings worked out once and kept beside the rows as they are chosen
-    # and ordered
-    lifecycle = _lifecycle(log)
-    keep = _control_flow(log, lifecycle)
+    # the lifecycle's meanings worked out once, as small codes kept beside the rows as they
+    # are chosen and ordered
+    kinds = _kinds(log)
+    keep = _control_flow(log, kinds)
     # the rows are chosen and ordered on the few columns that order and pair them; the
     # log's other columns are taken once, for the instances
     reading = [c for c in (CASE, ROBOT, ACTIVITY, TIMESTAMP, *INSTANCE_KEYS) if c in log.columns]
     at = np.flatnonzero(keep)
-    events, lifecycle = log[reading].iloc[at], lifecycle.iloc[at]
+    events, kinds = log[reading].iloc[at], kinds[at]
     if events.empty:
         return _empty_instances(log)
-    order = _tie_positions(events, lifecycle)
+    starts = kinds == _START
+    order = _tie_positions(events, starts)
     if order is not None:
-        events, lifecycle, at = events.iloc[order], lifecycle.iloc[order], at[order]
-    starts = (lifecycle == START).to_numpy()
-    completes = (lifecycle == COMPLETE).to_numpy()
+        events, kinds, at = events.iloc[order], kinds[order], at[order]
+        starts = starts[order]
+    completes = kinds == _COMPLETE
     begun = _paired_rows(_group_codes(events), starts, completes)
     # one row per instance: each completion or instant event, and each start nothing paired;
     # ``begun`` holds the row it started at (its own where the start is not in the log)
@@ -108,7 +114,7 @@ def activity_instances(log: pd.DataFrame, carry: Sequence[str] = ()) -> pd.DataF
     ended = instances[TIMESTAMP].where(finished, pd.NaT)
     instances[TIMESTAMP] = ended
     instances[FINISHED] = finished
-    instant = (lifecycle.iloc[rows] == "none").to_numpy()
+    instant = kinds[rows] == _INSTANT
     instances[START_KNOWN] = ~finished | (opened != rows) | instant
     instances[DURATION] = (ended - instances[START_TIMESTAMP]).dt.total_seconds()
     return instances
@@ -186,12 +192,12 @@ def in_tie_order(events: pd.DataFrame) -> pd.DataFrame:
     order stays: a robot's engine tags its events one after the other, so a sequence of
     activities that take no time (a simulated clock) keeps its order, which the activities'
     names would not."""
-    order = _tie_positions(events, _lifecycle(events))
+    order = _tie_positions(events, _kinds(events) == _START)
     return events if order is None else events.iloc[order]
 
 
-def _tie_positions(events: pd.DataFrame, lifecycle: pd.Series) -> np.ndarray | None:
-    """The positions of ``events`` (``lifecycle``: their meanings) in the order of
+def _tie_positions(events: pd.DataFrame, starts: np.ndarray) -> np.ndarray | None:
+    """The positions of ``events`` (``starts``: which are starts) in the order of
     :func:`in_tie_order`; ``None`` when they are in it already."""
     order = None
     if not events[TIMESTAMP].is_monotonic_increasing:  # logs usually come in time order
@@ -211,7 +217,7 @@ def _tie_positions(events: pd.DataFrame, lifecycle: pd.Series) -> np.ndarray | N
     if ROBOT in events.columns:
         values = events[ROBOT].iloc[at].astype("string").fillna("")
         keys.append(pd.factorize(values, sort=True)[0])
-    keys.append((lifecycle.iloc[at] != START).to_numpy(np.int8))
+    keys.append((~starts[at]).astype(np.int8))
     keys.append(times[rows])
     ordered = np.arange(len(events)) if order is None else order.copy()
     ordered[rows] = at[np.lexsort(keys)]
@@ -226,15 +232,18 @@ def _ticks(times: pd.Series) -> np.ndarray:
     return np.asarray(values.asi8)
 
 
-def _lifecycle(log: pd.DataFrame) -> pd.Series:
+def _kinds(log: pd.DataFrame) -> np.ndarray:
+    """What each row's lifecycle means for pairing: :data:`_START`, :data:`_COMPLETE`,
+    :data:`_INSTANT` or :data:`_OTHER` (an ``inprogress`` sample, say), worked out once per
+    distinct value; a row without a lifecycle completes."""
     if LIFECYCLE not in log.columns:
-        return pd.Series(COMPLETE, index=log.index)
+        return np.full(len(log), _COMPLETE, dtype=np.int8)
     codes, meaning = _meanings(log[LIFECYCLE])
     # an aborted or cancelled activity (XES' ``ate_abort`` ...) ended all the same: it pairs
     # with its start (the row keeps its own lifecycle, so the outcome stays visible)
     lowered = meaning.replace({ABORTED: COMPLETE, CANCELLED: COMPLETE})
-    lowered = pd.concat([lowered, pd.Series([COMPLETE], dtype="string")], ignore_index=True)
-    return pd.Series(lowered.array[codes], index=log.index)
+    kinds = [_KIND_OF.get(value, _OTHER) for value in lowered.tolist()]
+    return np.array([*kinds, _COMPLETE], dtype=np.int8)[codes]
 
 
 def interrupted(instances: pd.DataFrame) -> pd.Series:
