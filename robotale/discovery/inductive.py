@@ -117,16 +117,28 @@ class _OnePassConcurrency(ConcurrencyCutUVCL):
         parameters: dict[str, Any] | None = None,
     ) -> list[IMDataStructureUVCL]:
         group_of = {activity: number for number, group in enumerate(groups) for activity in group}
-        logs: list[Variants] = [Counter() for _ in groups]
-        for trace, cases in obj.data_structure.items():
+        projected: list[list[tuple[str, ...]]] = [[] for _ in groups]  # each group's traces
+        for trace in obj.data_structure:
             parts: list[list[str]] = [[] for _ in groups]
             for activity in trace:
                 number = group_of.get(activity)
                 if number is not None:  # pm4py's filter drops what no group holds
                     parts[number].append(activity)
-            for log, part in zip(logs, parts, strict=True):
-                log[tuple(part)] += cases
-        return [_sub_log(log) for log in logs]
+            for traces, part in zip(projected, parts, strict=True):
+                traces.append(tuple(part))
+        return [_sub_log(_counted(traces, obj.data_structure)) for traces in projected]
+
+
+def _counted(traces: list[tuple[str, ...]], variants: Variants) -> Variants:
+    """The projected ``traces`` (one per variant of ``variants``, in its order) counted as
+    the variants' cases: each distinct trace in the order it first comes."""
+    cases = variants.values()
+    if all(count == 1 for count in cases):  # the usual log: each variant once
+        return Counter(traces)
+    log: Variants = Counter()
+    for trace, count in zip(traces, cases, strict=True):
+        log[trace] += count
+    return log
 
 
 class _UnionFindExclusiveChoice(ExclusiveChoiceCutUVCL):
