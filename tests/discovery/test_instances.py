@@ -1,3 +1,6 @@
+from collections import deque
+
+import numpy as np
 import pandas as pd
 
 from robotale.discovery.instances import activity_instances
@@ -70,3 +73,55 @@ def test_ties_follow_the_documented_rule():
         assert list(instances[ACTIVITY]) == [first, ({"go_home", "fly_back"} - {first}).pop()]
         assert instances["duration"].tolist() == [0.0, 0.0]
         assert instances["finished"].all()
+
+
+def _loop_pairing(log: pd.DataFrame) -> list[tuple]:
+    """Activity instances by hand: the events in time order, one queue of open starts per
+    case, robot and activity, each end taking the oldest open start."""
+    ends = {"complete", "ate_abort", "withdraw", None}  # a missing lifecycle completes
+    open_starts: dict[tuple, deque] = {}
+    found = []
+    for event in log.sort_values(TIMESTAMP).to_dict("records"):
+        key = (event[CASE], event[ROBOT], event[ACTIVITY])
+        when = event[TIMESTAMP]
+        lifecycle = None if pd.isna(event[LIFECYCLE]) else event[LIFECYCLE]
+        queue = open_starts.setdefault(key, deque())
+        if lifecycle == "start":
+            queue.append(when)
+        elif lifecycle == "none":
+            found.append((*key, lifecycle, when, when, True, True))
+        elif lifecycle in ends:
+            began = queue.popleft() if queue else None
+            found.append((*key, lifecycle, began or when, when, True, began is not None))
+    for key, queue in open_starts.items():
+        found += [(*key, "start", began, pd.NaT, False, True) for began in queue]
+    return sorted(found, key=lambda instance: (instance[0], instance[4]))
+
+
+def test_pairing_equals_a_loop_on_random_logs():
+    # interleaved starts and ends of one activity, ends without a start, starts that never
+    # end, aborted and withdrawn ends, instants, a missing lifecycle and one pairing ignores
+    lifecycles = ["start", "start", "complete", "ate_abort", "withdraw", "none", None, "sample"]
+    for seed in range(20):
+        rng = np.random.default_rng(seed)
+        size = 40
+        log = pd.DataFrame(
+            {
+                CASE: rng.choice(["c1", "c2"], size),
+                ROBOT: rng.choice(["r1", "r2"], size),
+                ACTIVITY: rng.choice(["scan", "move"], size),
+                LIFECYCLE: rng.choice(np.array(lifecycles, dtype=object), size),
+                # distinct times, the rows not in time order
+                TIMESTAMP: T0 + pd.to_timedelta(rng.permutation(size), unit="s"),
+            }
+        )
+        instances = activity_instances(log)
+        columns = [CASE, ROBOT, ACTIVITY, LIFECYCLE, "start_timestamp", TIMESTAMP]
+        found = [
+            tuple(None if pd.isna(value) else value for value in row)
+            for row in instances[[*columns, "finished", "start_known"]].to_numpy(object)
+        ]
+        expected = [
+            tuple(None if pd.isna(value) else value for value in row) for row in _loop_pairing(log)
+        ]
+        assert found == expected, seed
