@@ -12,8 +12,12 @@ console and Discover read it while it grows.
 Usually a batch only extends each entity's DF chain from its last stored event; an event
 placed before stored ones (an in-progress sample, known once its activity completes, or a
 message's receive heard before its send) splices into the chain instead. DF_C and BEGINS are
-written again for the classes each time: they are few, and an exact median needs every
-duration.
+computed again from the whole log (an exact median needs every duration), but written only
+where they changed: the edges written last are kept in memory, an edge whose count, mean,
+median or cases changed gets its new values, a new one is created and one the events no
+longer give is deleted. Neo4j's work per update thus follows what the batch touched, not
+how long the run has gone on (every edge was rewritten before, a growing cost over a long
+run). Where events vanished (a log that shrank), every DF_C and BEGINS edge is written again.
 
 Events are told apart across updates by a hash of their values (every property but the id,
 which is a position), the n-th of equal rows matched to the n-th.
@@ -69,6 +73,9 @@ class _Stored:
     classes: dict[tuple[str, str], str] = field(default_factory=dict)  # (type, id) -> element
     df: set[tuple[str, str, str, str]] = field(default_factory=set)  # keys, type, entity id
     comm: set[tuple[str, str, str]] = field(default_factory=set)  # send, receive keys, msg id
+    #: (source class, target class, entity type) element ids -> (count, mean, median seconds)
+    df_c: dict[tuple[str, str, str], tuple[int, float, float]] = field(default_factory=dict)
+    begins: dict[tuple[str, str], int] = field(default_factory=dict)  # (entity, class) -> cases
 
 
 @dataclass
@@ -235,10 +242,16 @@ def _write(
     after.comm = _comm(loader, tables, keys, event_nodes, before.comm)
     for kind, nodes in zip(change.classes, class_nodes, strict=True):
         between_batches()
-        tx.run(cypher("ekg_ocel_delete_df_c"), log=name, type=kind.type).consume()
-        write_df_c(loader, kind, nodes)
-        tx.run(cypher("ekg_live_delete_begins"), log=name, type=kind.type).consume()
-        write_begins(loader, kind.entries, entity_nodes, nodes, new_log=True)
+        if gone:  # classes and entities may have gone and come again: write every edge
+            tx.run(cypher("ekg_ocel_delete_df_c"), log=name, type=kind.type).consume()
+            write_df_c(loader, kind, nodes)
+            tx.run(cypher("ekg_live_delete_begins"), log=name, type=kind.type).consume()
+            write_begins(loader, kind.entries, entity_nodes, nodes, new_log=True)
+        after.df_c |= df_c_edges(kind, nodes)
+        after.begins |= begins_edges(kind, entity_nodes, nodes)
+    if not gone:
+        _write_changed_df_c(loader, tx, name, before.df_c, after.df_c)
+        _write_changed_begins(loader, tx, name, before.begins, after.begins)
     tx.run(cypher("ekg_log_summary"), log=name, summary=summary).consume()
     change.after = after
 
@@ -433,3 +446,101 @@ def _comm(
             },
         )
     return now
+
+
+def df_c_edges(
+    kind: ClassTables, nodes: np.ndarray
+) -> dict[tuple[str, str, str], tuple[int, float, float]]:
+    """The DF_C edges of ``kind`` by their ends' element ids and entity type, with their
+    count, mean and median seconds (what :func:`~robotale.ekg.build.write_df_c` writes)."""
+    df_c = kind.df_c
+    ends = zip(
+        nodes[df_c["source"].to_numpy()].tolist(),
+        nodes[df_c["target"].to_numpy()].tolist(),
+        df_c["entityType"].astype(str).tolist(),
+        strict=True,
+    )
+    values = zip(
+        df_c["count"].astype(int).tolist(),
+        df_c["meanSeconds"].astype(float).tolist(),
+        df_c["medianSeconds"].astype(float).tolist(),
+        strict=True,
+    )
+    return dict(zip(ends, values, strict=True))
+
+
+def begins_edges(
+    kind: ClassTables, entity_nodes: np.ndarray, nodes: np.ndarray
+) -> dict[tuple[str, str], int]:
+    """The BEGINS edges of ``kind`` by their ends' element ids, with their cases."""
+    entries = kind.entries
+    ends = zip(
+        entity_nodes[entries["entity"].to_numpy()].tolist(),
+        nodes[entries["class"].to_numpy()].tolist(),
+        strict=True,
+    )
+    return dict(zip(ends, entries["cases"].astype(int).tolist(), strict=True))
+
+
+def _write_changed_df_c(
+    loader: Loader,
+    tx: ManagedTransaction,
+    name: str,
+    before: dict[tuple[str, str, str], tuple[int, float, float]],
+    now: dict[tuple[str, str, str], tuple[int, float, float]],
+) -> None:
+    """Make the graph's DF_C edges ``now`` from ``before``, touching only those that differ."""
+    stale = sorted(set(before) - set(now))
+    if stale:
+        tx.run(
+            cypher("ekg_live_delete_df_c_edges"),
+            log=name,
+            sources=[e[0] for e in stale],
+            targets=[e[1] for e in stale],
+            entityTypes=[e[2] for e in stale],
+        ).consume()
+    changed = sorted(e for e in now if e in before and before[e] != now[e])
+    added = sorted(e for e in now if e not in before)
+    for query, edges in (("ekg_live_set_df_c", changed), ("ekg_create_df_c", added)):
+        if edges:
+            loader.run(
+                query,
+                {
+                    "sources": [e[0] for e in edges],
+                    "targets": [e[1] for e in edges],
+                    "entityTypes": [e[2] for e in edges],
+                    "counts": [now[e][0] for e in edges],
+                    "means": [now[e][1] for e in edges],
+                    "medians": [now[e][2] for e in edges],
+                },
+            )
+
+
+def _write_changed_begins(
+    loader: Loader,
+    tx: ManagedTransaction,
+    name: str,
+    before: dict[tuple[str, str], int],
+    now: dict[tuple[str, str], int],
+) -> None:
+    """Make the graph's BEGINS edges ``now`` from ``before``, touching only those that differ."""
+    stale = sorted(set(before) - set(now))
+    if stale:
+        tx.run(
+            cypher("ekg_live_delete_begins_edges"),
+            log=name,
+            entities=[e[0] for e in stale],
+            classes=[e[1] for e in stale],
+        ).consume()
+    changed = sorted(e for e in now if e in before and before[e] != now[e])
+    added = sorted(e for e in now if e not in before)
+    for query, edges in (("ekg_live_set_begins", changed), ("ekg_create_begins", added)):
+        if edges:
+            loader.run(
+                query,
+                {
+                    "entities": [e[0] for e in edges],
+                    "classes": [e[1] for e in edges],
+                    "cases": [now[e] for e in edges],
+                },
+            )
