@@ -21,7 +21,6 @@ from robotale.errors import InputError
 from robotale.eventlog.logkinds import RECORDINGS
 from robotale.eventlog.logsource import log_name, open_log
 from robotale.eventlog.options import PrepareOptions
-from robotale.eventlog.preparing import kept_runs
 from robotale.eventlog.reading import format_reading
 from robotale.neo4j_server.server import LocalServer
 from robotale.results.storing import default_keys, describe, pages_when, prepare_pages
@@ -135,6 +134,9 @@ def ingest_command(
         with stage("the dashboard's pages"):
             prepare_pages(driver, name, pages)
     if skipped is not None and opened.kind is RECORDINGS:
+        # here, not at the top: the recordings' preparation is a recording's import only
+        from robotale.eventlog.preparing import kept_runs
+
         print(kept_runs(events["case:concept:name"].nunique(), skipped))
     return 0
 

@@ -231,7 +231,10 @@ def neo4j_values(column: pd.Series) -> list[Any]:
     if pd.api.types.is_bool_dtype(column) or pd.api.types.is_integer_dtype(column):
         return list(column.astype(object).where(column.notna(), None).tolist())
     if pd.api.types.is_float_dtype(column):
-        return [None if math.isnan(v) else v for v in column.to_numpy(float).tolist()]
+        values = column.to_numpy(float)
+        if not np.isnan(values).any():  # a column without gaps: no test per value
+            return list(values.tolist())
+        return [None if math.isnan(v) else v for v in values.tolist()]
     if pd.api.types.is_datetime64_any_dtype(column):
         return [None if pd.isna(v) else v.to_pydatetime() for v in column]
     if pd.api.types.infer_dtype(column, skipna=True) == "string":  # the usual log's columns

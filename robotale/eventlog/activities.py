@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 
 from robotale.eventlog import schema
-from robotale.eventlog.rosbag import TIME
+from robotale.eventlog.bagfiles import TIME
 
 SOURCE_TOPIC, SOURCE_INDEX = schema.SOURCE_TOPIC, schema.SOURCE_INDEX
 #: the column of a topic's table that numbers its messages (added by the preparation)

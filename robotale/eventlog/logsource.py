@@ -14,7 +14,6 @@ from robotale.errors import InputError
 from robotale.eventlog.logkinds import PARQUET, RECORDINGS, LogKind, kind_of
 from robotale.eventlog.objects import Objects
 from robotale.eventlog.options import PrepareOptions
-from robotale.eventlog.preparing import prepare_recordings
 from robotale.eventlog.readers import Gap, parse_mapping, read_with_objects
 from robotale.eventlog.reading import Reading
 
@@ -46,6 +45,10 @@ def open_log(
     kind = kind_of(path)
     if kind is RECORDINGS:
         _refuse_file_options(path, mapping, case, case_gap, objects)
+        # here, not at the top: the recordings' preparation (the bag reader, ROS types, the
+        # worker pools) is measured start-up a CSV's or Parquet's ingest does not need
+        from robotale.eventlog.preparing import prepare_recordings
+
         events = prepare_recordings(path, preparation, skipped=skipped)
         return OpenedLog(events, None, None, kind)
     events, reading, found = read_with_objects(

@@ -19,7 +19,6 @@ from pathlib import Path
 from typing import Any
 
 import pandas as pd
-from lxml import etree
 
 from robotale.errors import InputError
 from robotale.eventlog.objects import (
@@ -234,6 +233,10 @@ _XML_VALUES: dict[str, Callable[[str], Any]] = {
 
 
 def _read_xml(path: Path) -> ObjectLog:
+    # here, not at the top: lxml is measured start-up that only an OCEL XML file needs (every
+    # ingest imports this module to tell a log's kind)
+    from lxml import etree
+
     parser = etree.XMLParser(resolve_entities=False, no_network=True, huge_tree=True)
     try:
         root = etree.parse(str(path), parser).getroot()

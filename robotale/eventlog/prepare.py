@@ -22,7 +22,7 @@ from concurrent.futures import as_completed
 from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import pandas as pd
@@ -30,6 +30,7 @@ from tqdm import tqdm
 
 from robotale.errors import InputError
 from robotale.eventlog import activities, dataset, schema, sources
+from robotale.eventlog.bagfiles import RECORDED
 from robotale.eventlog.dataset import PartWritten
 from robotale.eventlog.enrich import (
     BUILTIN,
@@ -41,7 +42,6 @@ from robotale.eventlog.enrich import (
 )
 from robotale.eventlog.interfaces import message_types
 from robotale.eventlog.lifecycles import LIFECYCLE_MODES
-from robotale.eventlog.rosbag import RECORDED, Bag
 from robotale.eventlog.runs import (
     find_runs,
     is_recording,
@@ -63,6 +63,10 @@ from robotale.eventlog.typesys import check_distro
 from robotale.executors import open_executor, parse_executor, worker_lost
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.storage import Place, place
+
+if TYPE_CHECKING:
+    from robotale.eventlog.rosbag import Bag
+
 
 TAG_TOPICS = "/*/tag"
 DEFAULT_PERSPECTIVES = ("odom", "battery")
@@ -200,6 +204,10 @@ def _read_here(
 ) -> list[tuple[pd.DataFrame, dict[str, pd.DataFrame]] | None]:
     """Every run read in this process, with a progress bar over their messages; None for a
     run that could not be read when ``skip_bad`` was told of it."""
+    # the bag reader (rosbags, MCAP, zstandard) only when a recording is read: a CSV's
+    # preparation shares this module and was paid a quarter of its import time for it
+    from robotale.eventlog.rosbag import Bag
+
     extra_types = message_types([Path(p) for p in msg_files])
     globs = [reading.tags, *(glob for p in reading.perspectives for glob in p.topic.split("|"))]
     with tqdm(
@@ -282,6 +290,10 @@ def _read_alone(
     """:func:`_read_run` in a worker process: warnings and reports are kept to be said by
     the process that asked, as they would not reach its terminal from here. ``skipping``: a
     run that cannot be read is returned with why, for the batch to skip, instead of raised."""
+    # the bag reader (rosbags, MCAP, zstandard) only when a recording is read: a CSV's
+    # preparation shares this module and was paid a quarter of its import time for it
+    from robotale.eventlog.rosbag import Bag
+
     reported: list[str] = []
     with warnings.catch_warnings(record=True) as caught:
         warnings.simplefilter("always", PreparationWarning)
@@ -422,6 +434,10 @@ def _prepare_into(run: Path, job: Job, target: Place, skipping: bool = False) ->
     here); its warnings and reports are kept to be said by the process that asked.
     ``skipping``: a run that cannot be read is returned with why (nothing of it written)
     instead of raised; a failure to write stays one."""
+    # the bag reader (rosbags, MCAP, zstandard) only when a recording is read: a CSV's
+    # preparation shares this module and was paid a quarter of its import time for it
+    from robotale.eventlog.rosbag import Bag
+
     reported: list[str] = []
     perspectives = job.reading.perspectives
     with warnings.catch_warnings(record=True) as caught:

@@ -30,7 +30,6 @@ from typing import TypeAlias
 import numpy as np
 import pandas as pd
 import pyarrow as pa
-import pyarrow.dataset as pads
 import pyarrow.parquet as pq
 from lxml import etree
 
@@ -332,6 +331,10 @@ def _parquet_table(path: Path) -> pa.Table:
             return dataset.read_table(folder, manifest)
     try:
         if path.is_dir():
+            # here, not at the top: pyarrow's datasets are measured start-up that only a
+            # folder of Parquet files needs (a CSV's ingest imports this module)
+            import pyarrow.dataset as pads
+
             return pads.dataset(path, format="parquet", partitioning="hive").to_table()
         return pq.read_table(path)
     except (pa.ArrowException, OSError) as error:

@@ -39,6 +39,7 @@ from rosbags.typesys.store import Typestore
 from tqdm import tqdm
 
 from robotale.errors import InputError
+from robotale.eventlog.bagfiles import RECORDED, TIME, is_bag, without_metadata
 from robotale.eventlog.cdrlayout import Layout, columns
 from robotale.eventlog.interfaces import (
     definition_file,
@@ -60,34 +61,6 @@ from robotale.eventlog.typesys import (
 
 if TYPE_CHECKING:
     from rosbags.interfaces.typing import Typesdict
-
-TIME = "time"
-#: the column of a table holding when the bag recorded each message (ns since the epoch), when
-#: asked for: the recording's order of messages from different topics
-RECORDED = "_recorded"
-
-
-def is_bag(path: Path) -> bool:
-    """Whether ``path`` is a rosbag2 directory (it has a ``metadata.yaml``)."""
-    return path.is_dir() and (path / "metadata.yaml").is_file()
-
-
-def storage_files(path: Path) -> list[Path]:
-    """The rosbag2 storage files (``.db3``, ``.mcap``) directly in ``path``."""
-    return sorted([*path.glob("*.db3"), *path.glob("*.mcap")]) if path.is_dir() else []
-
-
-def without_metadata(path: Path) -> str:
-    """Why a folder without ``metadata.yaml`` is not read, and what would make it a bag."""
-    storage = storage_files(path)
-    if not storage:
-        return f"{path} is not a rosbag2 directory (it has no metadata.yaml and no storage file)."
-    return (
-        f"{path} holds {storage[0].name}"
-        + (f" and {len(storage) - 1} more storage file(s)" if len(storage) > 1 else "")
-        + " but no metadata.yaml (was the recording interrupted?); `ros2 bag reindex "
-        f"{path}` writes it from the storage files, then prepare the folder again."
-    )
 
 
 @dataclass
@@ -551,16 +524,3 @@ def _shortest_float32(values: pd.Series) -> pd.Series:
     """float32 readings as the decimals they were written as (0.98, not 0.9800000190734863)."""
     as_text = values.to_numpy(np.float32).astype(str)
     return pd.Series(as_text.astype(np.float64), index=values.index)
-
-
-def namespace(topic: str) -> str:
-    """The namespace of a topic: ``/tractor_1/odom`` -> ``tractor_1``; ``/odom`` -> ``""``.
-
-    An action's topics are in the namespace of the action, not in the action's own:
-    ``/r1/navigate_to_pose/_action/feedback`` -> ``r1``; a service's events in the service's:
-    ``/r1/get_plan/_service_event`` -> ``r1``.
-    """
-    if "/_action/" in topic:
-        topic = topic.rsplit("/_action/", 1)[0]
-    topic = topic.removesuffix("/_service_event")
-    return topic.strip("/").rpartition("/")[0]

@@ -14,7 +14,7 @@ import yaml
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
-from robotale.eventlog.rosbag import is_bag, storage_files, without_metadata
+from robotale.eventlog.bagfiles import is_bag, storage_files, without_metadata
 from robotale.fame_runtime.manifest import RunManifest
 
 

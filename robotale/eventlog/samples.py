@@ -11,8 +11,8 @@ import pandas as pd
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
+from robotale.eventlog.bagfiles import TIME, namespace
 from robotale.eventlog.enrich import Perspective, PreparationWarning, robots_without_samples
-from robotale.eventlog.rosbag import TIME, namespace
 
 
 def perspective_samples(

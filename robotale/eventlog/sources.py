@@ -19,11 +19,13 @@ from rosbags.interfaces import Nodetype
 from robotale.errors import InputError
 from robotale.eventlog import activities
 from robotale.eventlog.activities import ACTION_STATUS, BT_FIELDS, INDEX, STATUS_TYPE
-from robotale.eventlog.rosbag import Bag, namespace
+from robotale.eventlog.bagfiles import namespace
 from robotale.eventlog.typesys import field_type
 
 if TYPE_CHECKING:
     from rosbags.interfaces.typing import ConstValue, Typesdict
+
+    from robotale.eventlog.rosbag import Bag  # typing only: a CSV does not import the reader
 
 #: the field of a state topic read when none is named, in this order of preference
 STATE_FIELDS = ("data", "state", "mode", "status", "value")

@@ -11,15 +11,19 @@ import warnings
 from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, fields, replace
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import pandas as pd
 
 from robotale.errors import InputError
 from robotale.eventlog import schema
 from robotale.eventlog.activities import INDEX
+from robotale.eventlog.bagfiles import TIME, namespace
 from robotale.eventlog.enrich import PreparationWarning
 from robotale.eventlog.lifecycles import lifecycles
-from robotale.eventlog.rosbag import TIME, Bag, namespace
+
+if TYPE_CHECKING:  # the reader only types a bag here: a CSV's preparation does not import it
+    from robotale.eventlog.rosbag import Bag
 
 #: the robot of tags that name none, on a topic without a namespace (a single-robot bag).
 DEFAULT_ROBOT = "robot"

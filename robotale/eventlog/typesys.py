@@ -13,8 +13,7 @@ import functools
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, cast
 
-from rosbags.interfaces import Connection, MessageDefinitionFormat, Nodetype
-from rosbags.rosbag2 import Reader
+from rosbags.interfaces import MessageDefinitionFormat, Nodetype
 from rosbags.typesys import (
     Stores,
     TypesysError,
@@ -29,7 +28,11 @@ from robotale.eventlog.interfaces import RELEASES, normalized, shipped, stored_t
 from robotale.fame_runtime.tags import TAG_MSGDEF, TAG_TYPE
 
 if TYPE_CHECKING:
+    # a bag's reader and connections only typed here: the reader (rosbags.rosbag2, its
+    # storages and YAML) is not imported where a CSV is prepared
+    from rosbags.interfaces import Connection
     from rosbags.interfaces.typing import FieldDesc, Typesdict
+    from rosbags.rosbag2 import Reader
 
 
 HEADER_TYPE = "std_msgs/msg/Header"
