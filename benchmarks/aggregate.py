@@ -56,7 +56,7 @@ from ekg_build import private_neo4j  # noqa: E402
 from ocean_shaped import LOGISTICS_SPEC, logistics  # noqa: E402
 from whole_ingest import process_cpu  # noqa: E402
 
-from robotale.ekg import lift, steps  # noqa: E402
+from robotale.ekg import lift, steps, writelock  # noqa: E402
 from robotale.ekg.build import build_ekg  # noqa: E402
 from robotale.ekg.connection import database  # noqa: E402
 from robotale.ekg.load import Loader  # noqa: E402
@@ -147,13 +147,16 @@ def measure(driver, size: int, repeat: int, server: int) -> None:
 #: robotale's parts timed in each of its runs: (label, owner, attribute)
 PARTS = [
     ("reading the copy and deriving its edges", lift.LogEdges, "of_log"),
-    ("the entities' keys", steps, "_node_keys"),
+    # the lock's transaction: the run's checks, its Log node's build, the entities' keys
+    ("the lock and the run's reads", writelock, "_take"),
     ("reading entities", steps, "_read_nodes"),
     ("events and their where", steps, "_event_nodes"),
     ("grouping", steps, "aggregate_table"),
     ("member lists", steps, "_write_members"),
     ("lifting in memory", lift.LogEdges, "lift_level"),
     ("creating the lifted edges", steps, "_write_lifted"),
+    # a part of the one above: the one read of the element ids of the edges' free ends
+    ("(of which the ends' element ids)", lift.LogEdges, "_read_stored"),
 ]
 
 

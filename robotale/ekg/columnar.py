@@ -80,7 +80,12 @@ class Build:
 
 def log_build(driver: Driver, name: str, hint: str | None = None) -> Build:
     """The current build of the stored log ``name`` (a :class:`LogNotFound` if none)."""
-    row = log_build_row(driver, name, hint)
+    return build_of(name, log_build_row(driver, name, hint))
+
+
+def build_of(name: str, row: dict[str, Any]) -> Build:
+    """The build of the log ``name`` that ``row`` (a row of ``cypher/ekg_log_build``) tells:
+    for a writer that read the row in a transaction of its own, with its lock."""
     return Build(
         name=name,
         status=str(row["status"]),
@@ -155,11 +160,14 @@ def _recorded(columns: pa.Schema) -> bytes:
     return serialized
 
 
-def stored_table(driver: Driver, name: str, hint: str | None = None) -> pd.DataFrame:
+def stored_table(
+    driver: Driver, name: str, hint: str | None = None, build: Build | None = None
+) -> pd.DataFrame:
     """The events of the stored log ``name`` as a canonical event log: its columnar copy when
     it belongs to the log's current build, else read from the graph (and kept, if the log is
-    complete)."""
-    build = log_build(driver, name, hint)
+    complete). ``build``: the current build when the caller has read it already."""
+    if build is None:
+        build = log_build(driver, name, hint)
     if not build.complete:  # still being written, or failed: the graph is all there is
         return _graph_table(driver, build).to_pandas()
     path = build_folder(build) / EVENTS

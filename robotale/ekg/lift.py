@@ -9,8 +9,8 @@ aggregates. Which aggregate holds each node is kept per code. A step's edges are
 numpy, their ends mapped to what stands for them at this level (the aggregate holding the
 node, else the node), counted per pair, kind and entity type with pandas. The aggregates'
 element ids are known from their creation; those of the events and entities a lifted edge
-reaches are read once per run, the events' or an entity type's all together (looking each
-up by its key as an edge is written costs Neo4j more than the edge itself).
+reaches are read once per run, only those, all in one query (looking each up by its key as
+an edge is written costs Neo4j more than the edge itself).
 
 The rules are those of a step lifted in Cypher: an edge from a member becomes an edge from
 its aggregate; an edge into a member from a node no aggregate of the same step holds becomes
@@ -29,7 +29,7 @@ import numpy as np
 import pandas as pd
 from neo4j import Driver
 
-from robotale.ekg.columnar import stored_table
+from robotale.ekg.columnar import Build, stored_table
 from robotale.ekg.connection import database
 from robotale.ekg.tables import GraphTables, graph_tables
 from robotale.errors import InputError
@@ -63,9 +63,13 @@ class LogEdges:
     owned: pd.DataFrame | None = None
 
     @classmethod
-    def of_log(cls, driver: Driver, log: str, entity_types: Sequence[str]) -> LogEdges:
-        """The edges of the stored log ``log`` built with ``entity_types``."""
-        return cls.of_tables(graph_tables(stored_table(driver, log), list(entity_types)))
+    def of_log(
+        cls, driver: Driver, log: str, entity_types: Sequence[str], build: Build | None = None
+    ) -> LogEdges:
+        """The edges of the stored log ``log`` built with ``entity_types`` (``build``: its
+        current build, when the caller has read it)."""
+        table = stored_table(driver, log, build=build)
+        return cls.of_tables(graph_tables(table, list(entity_types)))
 
     @classmethod
     def of_tables(cls, tables: GraphTables) -> LogEdges:
@@ -192,19 +196,12 @@ class LogEdges:
         return freed
 
     def ends(self, driver: Driver, log: str, codes: np.ndarray) -> np.ndarray:
-        """The element ids of ``codes``: an aggregate's as created; the events' and each
-        entity type's read from Neo4j the first time one of them is asked for."""
-        nodes = codes[pd.isna(self.element_ids[codes]) & pd.isna(self.stored[codes])]
-        if nodes.size and (nodes < len(self.events)).any():
-            ids, elements = self._read(driver, cypher("aggr_event_element_ids"), log=log)
-            at = pd.Index(self.events["id"].astype(object)).get_indexer(pd.Index(ids, dtype=object))
-            self.stored[at[at >= 0]] = elements[at >= 0]
-        for kind in pd.unique(self.types[nodes[nodes >= len(self.events)]]):
-            ids, elements = self._read(
-                driver, cypher("aggr_entity_element_ids"), log=log, type=kind
-            )
-            found = self.entity_codes(str(kind), ids.tolist())  # may grow the arrays: first
-            self.stored[found] = elements
+        """The element ids of ``codes``: an aggregate's as created; the events' and entities'
+        read from Neo4j the first time one of them is asked for, together with every other
+        event and entity the lifted edges of any step reach (one read per run)."""
+        unread = codes[pd.isna(self.element_ids[codes]) & pd.isna(self.stored[codes])]
+        if unread.size:
+            self._read_stored(driver, log, np.union1d(unread, self._free_ends()))
         ends: np.ndarray = np.where(
             pd.isna(self.element_ids[codes]), self.stored[codes], self.element_ids[codes]
         )
@@ -216,11 +213,34 @@ class LogEdges:
             )
         return ends
 
-    @staticmethod
-    def _read(driver: Driver, query: str, **parameters: object) -> tuple[np.ndarray, np.ndarray]:
-        records, _, _ = driver.execute_query(query, parameters, database_=database())
+    def _free_ends(self) -> np.ndarray:
+        """The events and entities (no aggregates) that the lifted edges of every step at this
+        level reach and whose element ids are not read yet; none before :meth:`lift_level`."""
+        if self.owned is None:
+            return np.empty(0, dtype=np.int64)
+        reached = np.union1d(self.owned["source"].to_numpy(), self.owned["target"].to_numpy())
+        found: np.ndarray = reached[(self.levels[reached] == 0) & pd.isna(self.stored[reached])]
+        return found
+
+    def _read_stored(self, driver: Driver, log: str, codes: np.ndarray) -> None:
+        """Read the element ids of the events and entities ``codes`` (by their keys, one
+        query) into :attr:`stored`."""
+        events = codes[codes < len(self.events)]
+        entities = codes[codes >= len(self.events)]
+        records, _, _ = driver.execute_query(
+            cypher("aggr_element_ids"),
+            log=log,
+            events=[str(k) for k in self.keys[events]],
+            entities=[str(k) for k in self.keys[entities]],
+            types=[str(t) for t in self.types[entities]],
+            database_=database(),
+        )
         row = records[0]
-        return np.asarray(row["ids"], dtype=object), np.asarray(row["elements"], dtype=object)
+        for nodes, found, elements in (
+            (events, row["eventsFound"], row["eventElements"]),
+            (entities, row["entitiesFound"], row["entityElements"]),
+        ):
+            self.stored[nodes[np.asarray(found, dtype=np.int64)]] = np.asarray(elements, object)
 
     def standing(self, codes: np.ndarray) -> np.ndarray:
         """What stands for each code at this level: the id of the aggregate holding it, else

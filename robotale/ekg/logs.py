@@ -25,6 +25,9 @@ FAILED = "failed"
 # without completing it (killed): what it holds is consistent, but the run went on unheard.
 LIVE, INTERRUPTED = "live", "interrupted"
 
+#: the query of a log's build (:func:`log_build_row`; parameter ``$log``): for a writer that
+#: reads it in the transaction that takes the log's lock
+BUILD_QUERY = "ekg_log_build"
 #: within a look (:func:`start_look`): what each Log node said, by what was asked and log name
 _LOOK: ContextVar[dict[tuple[str, str], Any] | None] = ContextVar("log_look", default=None)
 _Read = TypeVar("_Read")
@@ -102,7 +105,7 @@ def log_run(driver: Driver, name: str) -> str | None:
 def log_build_row(driver: Driver, name: str, hint: str | None = None) -> dict[str, Any]:
     """What the Log node of ``name`` records of its current build (``status``, ``created``,
     ``run``, ``appended``, ``properties``, ``columns``), for its columnar copy."""
-    rows = _looked("build", name, lambda: _rows(driver, "ekg_log_build", log=name))
+    rows = _looked("build", name, lambda: _rows(driver, BUILD_QUERY, log=name))
     if not rows:
         raise LogNotFound(name, hint)
     return dict(rows[0])

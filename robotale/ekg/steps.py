@@ -43,12 +43,13 @@ from neo4j.exceptions import DriverError, Neo4jError
 from neo4j.time import DateTime
 
 from robotale.ekg.build import ensure_schema, undo_after_failure
+from robotale.ekg.columnar import build_of
 from robotale.ekg.connection import database
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.lift import FREE, LogEdges
 from robotale.ekg.load import BATCH, Loader, neo4j_values
-from robotale.ekg.logs import log_info
+from robotale.ekg.logs import BUILD_QUERY, log_info
 from robotale.ekg.spec import AggrStep
 from robotale.ekg.where import Condition, parse_where
 from robotale.ekg.where_table import matching
@@ -64,6 +65,15 @@ MEMBERS_PART = 100_000
 #: Neo4j creates edges on one node from two transactions without waiting (measured on a
 #: busy 2-core machine: no slower than one at a time; on a quiet one the second core helps)
 LIFT_WORKERS = 2
+#: what a run reads in the transaction that takes the log's lock (parameters ``$log`` and
+#: ``$types``, the entity types its steps name): the Log node's description and counts, the
+#: steps stored, the build its columnar copy belongs to, the entities' property keys
+_RUN_READS = [
+    cypher("aggr_run_state"),
+    cypher("aggr_steps"),
+    cypher(BUILD_QUERY),
+    cypher("aggr_node_keys"),
+]
 #: the marker in ``aggr_read_*.cypher`` that a step's checked condition replaces
 _WHERE_MARKER = "true /*WHERE*/"
 
@@ -91,18 +101,22 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
     of earlier runs). Every step is checked against the log before the first one runs, so a
     specification that names something the log lacks writes nothing."""
     _ensure_schema(driver)
-    # what the run checks is read with the lock, in its transaction: one commit, no more
+    # what the run checks and reads of the Log node (the build its columnar copy belongs to)
+    # and of its entities' keys is read with the lock, in its transaction: one commit, and
+    # no round trip of its own
+    types = sorted({s.ent_type for s in steps if s.ent_type is not None})
     with log_write_lock_reading(
-        driver, log, "aggregating", [cypher("aggr_run_state"), cypher("aggr_steps")], log=log
+        driver, log, "aggregating", _RUN_READS, log=log, types=types
     ) as held:
-        state, stored = held.rows
-        if not state:
+        state, stored, build, node_keys = held.rows
+        if not state or not build:
             raise LogNotFound(log)
         info = state[0]
         _refuse_legacy(log, stored)
         first = int(stored[-1]["step"]) + 1 if stored else 1
-        edges = LogEdges.of_log(driver, log, info.get("entityTypes") or [])
-        keys = _node_keys(driver, log, [s.ent_type for s in steps if s.ent_type is not None])
+        types_built = info.get("entityTypes") or []
+        edges = LogEdges.of_log(driver, log, types_built, build_of(log, build[0]))
+        keys = _node_keys(node_keys)
         keys[None] = _event_keys(edges.events)
         plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
         results: list[StepResult] = []
@@ -306,16 +320,11 @@ def _event_keys(events: pd.DataFrame) -> tuple[set[str], list[str]]:
     return keys, times
 
 
-def _node_keys(
-    driver: Driver, log: str, entity_types: Sequence[str]
-) -> dict[str | None, tuple[set[str], list[str]]]:
-    """The property keys of the entities of each of ``entity_types`` (read from all of them,
-    every type in one query) and those that hold zoned times; a type without entities is
-    left out."""
-    records, _, _ = driver.execute_query(
-        cypher("aggr_node_keys"), log=log, types=sorted(set(entity_types)), database_=database()
-    )
-    return {str(row["type"]): (set(row["keys"]) - {"log"}, list(row["times"])) for row in records}
+def _node_keys(rows: Sequence[dict[str, Any]]) -> dict[str | None, tuple[set[str], list[str]]]:
+    """The property keys of the entities of each type the run's steps name and those that
+    hold zoned times, from the ``rows`` of ``aggr_node_keys`` (read with the lock); a type
+    without entities is left out."""
+    return {str(row["type"]): (set(row["keys"]) - {"log"}, list(row["times"])) for row in rows}
 
 
 def _event_nodes(edges: LogEdges, plan: _Plan) -> pd.DataFrame:
