@@ -63,6 +63,10 @@ from robotale.queries import cypher, statements
 LIVE_SOURCE = "robotale monitor"
 
 
+#: a class edge by the element ids (and entity type) of its ends -> its values
+EdgeValues = dict[tuple[str, ...], tuple[Any, ...]]
+
+
 @dataclass
 class _Stored:
     """What the graph holds of the log, by event key (see :func:`event_keys`)."""
@@ -74,8 +78,9 @@ class _Stored:
     df: set[tuple[str, str, str, str]] = field(default_factory=set)  # keys, type, entity id
     comm: set[tuple[str, str, str]] = field(default_factory=set)  # send, receive keys, msg id
     #: (source class, target class, entity type) element ids -> (count, mean, median seconds)
-    df_c: dict[tuple[str, str, str], tuple[int, float, float]] = field(default_factory=dict)
-    begins: dict[tuple[str, str], int] = field(default_factory=dict)  # (entity, class) -> cases
+    df_c: EdgeValues = field(default_factory=dict)
+    #: (entity, class) element ids -> (cases,)
+    begins: EdgeValues = field(default_factory=dict)
 
 
 @dataclass
@@ -250,8 +255,8 @@ def _write(
         after.df_c |= df_c_edges(kind, nodes)
         after.begins |= begins_edges(kind, entity_nodes, nodes)
     if not gone:
-        _write_changed_df_c(loader, tx, name, before.df_c, after.df_c)
-        _write_changed_begins(loader, tx, name, before.begins, after.begins)
+        _write_changed(loader, tx, name, _DF_C, before.df_c, after.df_c)
+        _write_changed(loader, tx, name, _BEGINS, before.begins, after.begins)
     tx.run(cypher("ekg_log_summary"), log=name, summary=summary).consume()
     change.after = after
 
@@ -448,9 +453,7 @@ def _comm(
     return now
 
 
-def df_c_edges(
-    kind: ClassTables, nodes: np.ndarray
-) -> dict[tuple[str, str, str], tuple[int, float, float]]:
+def df_c_edges(kind: ClassTables, nodes: np.ndarray) -> EdgeValues:
     """The DF_C edges of ``kind`` by their ends' element ids and entity type, with their
     count, mean and median seconds (what :func:`~robotale.ekg.build.write_df_c` writes)."""
     df_c = kind.df_c
@@ -469,78 +472,68 @@ def df_c_edges(
     return dict(zip(ends, values, strict=True))
 
 
-def begins_edges(
-    kind: ClassTables, entity_nodes: np.ndarray, nodes: np.ndarray
-) -> dict[tuple[str, str], int]:
-    """The BEGINS edges of ``kind`` by their ends' element ids, with their cases."""
+def begins_edges(kind: ClassTables, entity_nodes: np.ndarray, nodes: np.ndarray) -> EdgeValues:
+    """The BEGINS edges of ``kind`` by their ends' element ids, with their cases (a 1-tuple)."""
     entries = kind.entries
     ends = zip(
         entity_nodes[entries["entity"].to_numpy()].tolist(),
         nodes[entries["class"].to_numpy()].tolist(),
         strict=True,
     )
-    return dict(zip(ends, entries["cases"].astype(int).tolist(), strict=True))
+    cases = ((count,) for count in entries["cases"].astype(int).tolist())
+    return dict(zip(ends, cases, strict=True))
 
 
-def _write_changed_df_c(
+@dataclass(frozen=True)
+class _ClassEdges:
+    """One kind of class edge the live log writes where it changed: its queries (each takes
+    the ends, and the set and create queries the values, as parallel lists) and the names of
+    those lists."""
+
+    delete: str
+    update: str
+    create: str
+    ends: tuple[str, ...]
+    values: tuple[str, ...]
+
+
+_DF_C = _ClassEdges(
+    "ekg_live_delete_df_c_edges",
+    "ekg_live_set_df_c",
+    "ekg_create_df_c",
+    ("sources", "targets", "entityTypes"),
+    ("counts", "means", "medians"),
+)
+_BEGINS = _ClassEdges(
+    "ekg_live_delete_begins_edges",
+    "ekg_live_set_begins",
+    "ekg_create_begins",
+    ("entities", "classes"),
+    ("cases",),
+)
+
+
+def _write_changed(
     loader: Loader,
     tx: ManagedTransaction,
     name: str,
-    before: dict[tuple[str, str, str], tuple[int, float, float]],
-    now: dict[tuple[str, str, str], tuple[int, float, float]],
+    kind: _ClassEdges,
+    before: EdgeValues,
+    now: EdgeValues,
 ) -> None:
-    """Make the graph's DF_C edges ``now`` from ``before``, touching only those that differ."""
+    """Make the graph's ``kind`` edges ``now`` from ``before``, touching only those that
+    differ: the stale deleted, the changed given their values, the new created."""
     stale = sorted(set(before) - set(now))
     if stale:
-        tx.run(
-            cypher("ekg_live_delete_df_c_edges"),
-            log=name,
-            sources=[e[0] for e in stale],
-            targets=[e[1] for e in stale],
-            entityTypes=[e[2] for e in stale],
-        ).consume()
+        tx.run(cypher(kind.delete), {"log": name, **_columns(kind.ends, stale)}).consume()
     changed = sorted(e for e in now if e in before and before[e] != now[e])
     added = sorted(e for e in now if e not in before)
-    for query, edges in (("ekg_live_set_df_c", changed), ("ekg_create_df_c", added)):
+    for query, edges in ((kind.update, changed), (kind.create, added)):
         if edges:
-            loader.run(
-                query,
-                {
-                    "sources": [e[0] for e in edges],
-                    "targets": [e[1] for e in edges],
-                    "entityTypes": [e[2] for e in edges],
-                    "counts": [now[e][0] for e in edges],
-                    "means": [now[e][1] for e in edges],
-                    "medians": [now[e][2] for e in edges],
-                },
-            )
+            values = _columns(kind.values, [now[e] for e in edges])
+            loader.run(query, {**_columns(kind.ends, edges), **values})
 
 
-def _write_changed_begins(
-    loader: Loader,
-    tx: ManagedTransaction,
-    name: str,
-    before: dict[tuple[str, str], int],
-    now: dict[tuple[str, str], int],
-) -> None:
-    """Make the graph's BEGINS edges ``now`` from ``before``, touching only those that differ."""
-    stale = sorted(set(before) - set(now))
-    if stale:
-        tx.run(
-            cypher("ekg_live_delete_begins_edges"),
-            log=name,
-            entities=[e[0] for e in stale],
-            classes=[e[1] for e in stale],
-        ).consume()
-    changed = sorted(e for e in now if e in before and before[e] != now[e])
-    added = sorted(e for e in now if e not in before)
-    for query, edges in (("ekg_live_set_begins", changed), ("ekg_create_begins", added)):
-        if edges:
-            loader.run(
-                query,
-                {
-                    "entities": [e[0] for e in edges],
-                    "classes": [e[1] for e in edges],
-                    "cases": [now[e] for e in edges],
-                },
-            )
+def _columns(names: tuple[str, ...], rows: list[tuple[Any, ...]]) -> dict[str, list[Any]]:
+    """``rows`` as one list per column, named ``names``: a query's parallel parameters."""
+    return {column: [row[i] for row in rows] for i, column in enumerate(names)}

@@ -11,11 +11,10 @@ from __future__ import annotations
 
 import hashlib
 import random
-from pathlib import Path
 
-import pandas as pd
 import pytest
 from ekg_graph import graph
+from live_logs import recorded_tags
 
 from robotale.ekg import growing as growing_module
 from robotale.ekg.build import build_ekg
@@ -53,6 +52,20 @@ def status(driver, name: str) -> str:
     return next(log["status"] for log in list_logs(driver) if log["name"] == name)
 
 
+def build_in_one_go(driver, log, name: str) -> None:
+    """``log`` built as ``name`` in one go, as ``robotale ingest`` builds it."""
+    entities = default_entities(log.columns)
+    build_ekg(
+        driver,
+        log,
+        name,
+        entities=entities,
+        aggregate=built_keys(entities),
+        replace=True,
+        progress=False,
+    )
+
+
 def test_a_live_log_grown_batch_by_batch_is_the_graph_of_one_ingest_after_each(
     neo4j_driver, log_name, whole
 ):
@@ -63,16 +76,7 @@ def test_a_live_log_grown_batch_by_batch_is_the_graph_of_one_ingest_after_each(
             heard += batch
             log = tags_events("run", heard)
             new = growing.update(log)
-            entities = default_entities(log.columns)
-            build_ekg(
-                neo4j_driver,
-                log,
-                whole,
-                entities=entities,
-                aggregate=built_keys(entities),
-                replace=True,
-                progress=False,
-            )
+            build_in_one_go(neo4j_driver, log, whole)
             expected = graph(neo4j_driver, whole)
             assert graph(neo4j_driver, log_name) == expected
             assert stored_events(neo4j_driver, log_name) == len(log) == growing.events
@@ -94,9 +98,6 @@ def test_a_live_log_grown_batch_by_batch_is_the_graph_of_one_ingest_after_each(
     assert graph(neo4j_driver, whole) == expected
 
 
-#: a recorded run: the thesis' agricultural mission (drone and tractors, their messages)
-RECORDING = Path(__file__).resolve().parents[2] / "examples" / "thesis" / "robotic_data.csv"
-
 # each relationship of a log by its type, its two ends (by their keys, not Neo4j's ids) and
 # its properties
 _RELATIONSHIPS = """
@@ -117,24 +118,6 @@ def relationships(driver, name: str) -> tuple[int, str]:
     return len(rows), hashlib.sha256("\n".join(rows).encode()).hexdigest()
 
 
-def recorded_tags(count: int, seed: int) -> list[Tag]:
-    """The first ``count`` tags of the recording as a monitor might hear them: some
-    neighbours of different robots swapped (a tag heard late)."""
-    rows = pd.read_csv(RECORDING, nrows=count, dtype=str, keep_default_na=False)
-    times = pd.to_datetime(rows["time"], utc=True, format="ISO8601")
-    stamps = (times - pd.Timestamp(0, tz="UTC")).dt.total_seconds()
-    tags = [
-        Tag(float(stamp), row.resource, row.activity, row.lifecycle, row.msg_id, row.msg_role,
-            row.msg_payload)
-        for stamp, row in zip(stamps, rows.itertuples(index=False), strict=True)
-    ]  # fmt: skip
-    draw = random.Random(seed)
-    for i in draw.sample(range(count - 1), count // 10):
-        if tags[i].robot != tags[i + 1].robot:
-            tags[i], tags[i + 1] = tags[i + 1], tags[i]
-    return tags
-
-
 @pytest.mark.parametrize("seed", [1, 2])
 def test_over_random_splits_every_relationship_is_the_one_go_builds(
     neo4j_driver, log_name, whole, monkeypatch, seed
@@ -142,28 +125,20 @@ def test_over_random_splits_every_relationship_is_the_one_go_builds(
     tags, draw = recorded_tags(70, seed), random.Random(seed)
     cuts = [*sorted(draw.sample(range(1, len(tags)), 5)), len(tags)]
     incremental = []  # the DF_C edges each update found written already
-    write_changed = growing_module._write_changed_df_c
+    write_changed = growing_module._write_changed
 
-    def counted(loader, tx, name, before, now):
-        incremental.append(len(before))
-        write_changed(loader, tx, name, before, now)
+    def counted(loader, tx, name, kind, before, now):
+        if kind is growing_module._DF_C:
+            incremental.append(len(before))
+        write_changed(loader, tx, name, kind, before, now)
 
-    monkeypatch.setattr(growing_module, "_write_changed_df_c", counted)
+    monkeypatch.setattr(growing_module, "_write_changed", counted)
     growing = GrowingLog(neo4j_driver, log_name)
     try:
         for cut in cuts:
             log = tags_events("run", tags[:cut])
             growing.update(log)
-            entities = default_entities(log.columns)
-            build_ekg(
-                neo4j_driver,
-                log,
-                whole,
-                entities=entities,
-                aggregate=built_keys(entities),
-                replace=True,
-                progress=False,
-            )
+            build_in_one_go(neo4j_driver, log, whole)
             grown, expected = (
                 relationships(neo4j_driver, log_name),
                 relationships(neo4j_driver, whole),
