@@ -7,38 +7,18 @@ from __future__ import annotations
 import random
 import threading
 import uuid
-from pathlib import Path
 
 import pandas as pd
 import pytest
+from live_logs import recorded_tags
 
 from robotale.enhancement.mission import mission_run
 from robotale.fame_runtime.tags import Tag
 from robotale.results import live as reading
 
-#: a recorded run: the thesis' agricultural mission (drone and tractors, their messages)
-RECORDING = Path(__file__).resolve().parents[2] / "examples" / "thesis" / "robotic_data.csv"
-#: the first tags of it, heard one by one (enough for messages, repeats and late tags)
+#: the first tags of the recorded run (`live_logs.RECORDING`), heard one by one: enough for
+#: messages, repeats and late tags
 HEARD = 90
-
-
-def recorded_tags(count: int, seed: int) -> list[Tag]:
-    """The first ``count`` tags of the recording in the order a monitor might hear them:
-    the recording's order, with some neighbours of different robots swapped (a robot's tag
-    heard after a later one of another robot: a late tag)."""
-    rows = pd.read_csv(RECORDING, nrows=count, dtype=str, keep_default_na=False)
-    times = pd.to_datetime(rows["time"], utc=True, format="ISO8601")
-    stamps = (times - pd.Timestamp(0, tz="UTC")).dt.total_seconds()
-    tags = [
-        Tag(float(stamp), row.resource, row.activity, row.lifecycle, row.msg_id, row.msg_role,
-            row.msg_payload)
-        for stamp, row in zip(stamps, rows.itertuples(index=False), strict=True)
-    ]  # fmt: skip
-    draw = random.Random(seed)
-    for i in draw.sample(range(count - 1), count // 10):
-        if tags[i].robot != tags[i + 1].robot:
-            tags[i], tags[i + 1] = tags[i + 1], tags[i]
-    return tags
 
 
 def batches(tags: list[Tag], seed: int) -> list[list[Tag]]:
