@@ -137,3 +137,57 @@ def test_the_tractors_cut_grass_when_closest_tractor_names_them(thesis_days):
     cut = starts[names == "cut_grass"]
     assert mine.groupby("robot").size().to_dict() == cut.groupby("robot").size().to_dict()
     assert sum(Test("name", None).holds(one) for one in caught) == len(cut)
+
+
+def test_conformance_precision_is_the_hand_count_and_pm4pys_on_its_own_net(tmp_path, capsys):
+    """A choice of three first steps, two of which the replayed runs take: ETConformance by
+    hand, over the prefixes of the three runs (the empty one allows b, c and e where b and c
+    were seen, three times; after b or c only d is allowed, three times): 1 - 3 / 12. pm4py's
+    token-based precision on its own inductive miner's net of the same traces agrees, and
+    ``discover conformance`` prints it and writes it."""
+    import json
+
+    import pandas as pd
+    import pm4py
+
+    from robotale.discovery.bpmn_writer import write_bpmn
+
+    def log_of(traces: list[str]) -> pd.DataFrame:
+        t0 = pd.Timestamp("2024-01-01", tz="UTC")
+        rows = [
+            (str(n), step, t0 + pd.Timedelta(hours=n, seconds=i), "rover")
+            for n, trace in enumerate(traces)
+            for i, step in enumerate(trace)
+        ]
+        return pd.DataFrame(
+            rows, columns=["case:concept:name", "concept:name", "time:timestamp", "robot"]
+        )
+
+    mined, replayed = log_of(["bd", "cd", "ed"]), log_of(["bd", "bd", "cd"])
+    model = tmp_path / "choice.bpmn"
+    model.write_text(write_bpmn(discover_collaboration(mined)))
+    robots = check_conformance(replayed, model).robots
+    assert robots["fitness"].tolist() == [1.0]
+    assert robots["precision"].tolist() == [pytest.approx(1 - 3 / 12)]
+    net, initial, final = pm4py.discover_petri_net_inductive(mined)
+    assert pm4py.precision_token_based_replay(replayed, net, initial, final) == pytest.approx(
+        1 - 3 / 12
+    )
+    csv, out = tmp_path / "replayed.csv", tmp_path / "conformance.json"
+    replayed.to_csv(csv, index=False)
+    assert (
+        main(["discover", "conformance", str(csv), "--model", str(model), "--json", str(out)]) == 0
+    )
+    header, row = capsys.readouterr().out.splitlines()[:2]
+    assert header.split() == [
+        "robot",
+        "pool",
+        "runs",
+        "fitness",
+        "precision",
+        "fitting_runs",
+        "method",
+    ]
+    assert row.split()[3:5] == ["1.000", "0.750"]
+    written = json.loads(out.read_text(encoding="utf-8"))["robots"]
+    assert [r["precision"] for r in written] == [pytest.approx(0.75)]

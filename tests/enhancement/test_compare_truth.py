@@ -1,0 +1,203 @@
+"""``compare`` against the truth of small written batches (``tests/conventions.py``): each run
+of a drone and two tractors drawn at random, so every value per run the comparison tests
+(the run's duration, each activity's mean duration and count per robot type, the messages'
+latency and loss, the battery each robot used, the variant it follows) is known here from
+the truth's own instances, messages and samples, never from the code under test; and many
+pairs of batches of the same settings, whose changes called significant are counted against
+the chance the procedure allows."""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+from conventions import GroundTruth, RunWriter, Sample, write_robotale_csv
+
+from robotale.enhancement.bottlenecks import ALPHA
+from robotale.enhancement.compare import compare_logs
+from robotale.enhancement.performance import ARROW
+from robotale.eventlog.readers import read_log
+
+ROBOTS = {"drone": "Drone", "tractor_1": "Tractor", "tractor_2": "Tractor"}
+RUNS = 10
+#: false alarms allowed in twenty pairs of batches of the same settings
+BOUND = 4
+#: the messages of a run: (number, receiver, seconds after the start it is sent)
+SENT = ((1, "tractor_1", 10.0), (2, "tractor_2", 15.0), (3, "tractor_1", 20.0))
+
+
+def batch(
+    seed: int,
+    *,
+    explore: float = 1.0,
+    latency: float = 1.0,
+    loss: float = 0.2,
+    drain: float = 0.2,
+    check: bool = False,
+) -> GroundTruth:
+    """``RUNS`` runs: the drone takes off, explores (``explore`` scales its time), sends
+    three weed positions (each lost with chance ``loss``, else received after ``latency``
+    times 1-2 s) and lands; the tractors move to the weeds (tractor_1 checks first when
+    ``check``); times in eighths of a second (see :func:`_tick`). Activities start at fixed
+    moments, so a run's variant depends only on which messages were lost; battery samples
+    fall by ``drain`` times 0.8-1.2 points a second."""
+    rng = np.random.default_rng(seed)
+    truth = GroundTruth(cases=[f"s{seed}r{n}" for n in range(RUNS)], robots=dict(ROBOTS))
+    for n, case in enumerate(truth.cases):
+        run = RunWriter(truth, case, pd.Timestamp("2024-05-01T08:00:00Z") + pd.Timedelta(hours=n))
+        run.instance("drone", "takeoff", 0, 5)
+        run.instance("tractor_2", "wait", 1, 24)
+        run.instance("drone", "explore", 6, _tick(6 + explore * rng.uniform(30, 40)))
+        for number, to, sent in SENT:
+            lost = rng.random() < loss
+            run.message(
+                number, to, sent, None if lost else _tick(sent + latency * rng.uniform(1, 2))
+            )
+        if check:
+            run.instance("tractor_1", "check", 24, _tick(24 + rng.uniform(1, 2)))
+        run.instance("tractor_1", "move_to_weed", 26, _tick(26 + rng.uniform(15, 25)))
+        run.instance("tractor_2", "move_to_weed", 27, _tick(27 + rng.uniform(15, 25)))
+        run.instance("drone", "land", 80, _tick(80 + rng.uniform(3, 5)))
+        for robot, activity, seconds, rate in (
+            ("drone", "explore", (10, 20, 30), drain * rng.uniform(0.8, 1.2)),
+            ("tractor_1", "move_to_weed", (30, 35, 40), 0.1),
+        ):
+            for second in seconds:
+                level = round(100.0 - rate * second, 3)
+                truth.samples.append(Sample(case, robot, activity, run.at(second), level))
+    return truth
+
+
+def _tick(seconds: float) -> float:
+    """``seconds`` to an eighth of a second: exact in binary, so the CSV's milliseconds
+    hold it whole."""
+    return round(seconds * 8) / 8
+
+
+def read(truth: GroundTruth, folder: Path, name: str) -> pd.DataFrame:
+    return read_log(write_robotale_csv(truth, folder / f"{name}.csv"))
+
+
+def _instances(truth: GroundTruth) -> pd.DataFrame:
+    instances = truth.instance_table()
+    return instances.assign(who=instances["robot"].map(ROBOTS))
+
+
+def expected_per_run(truth: GroundTruth, other: GroundTruth) -> pd.DataFrame:
+    """(measure, subject, who, run) -> value, from the truth alone; an activity only the
+    ``other`` batch did is done 0 times in each run of this one."""
+    instances = _instances(truth)
+    rows = []
+    for case, own in instances.groupby("case"):
+        rows.append(("run duration", "runs", "", case, (own["end"].max() - own["start"].min())))
+    durations = instances.groupby(["activity", "who", "case"])["seconds"].mean()
+    rows += [("activity duration", a, w, c, v) for (a, w, c), v in durations.items()]
+    counts = instances.groupby(["activity", "who", "case"]).size().unstack("case", fill_value=0)
+    both = counts.index.union(_instances(other).set_index(["activity", "who"]).index.unique())
+    counts = counts.reindex(index=both, columns=truth.cases, fill_value=0)
+    rows += [("activity frequency", a, w, c, float(v)) for (a, w), r in counts.iterrows()
+             for c, v in r.items()]  # fmt: skip
+    messages = pd.DataFrame([m.__dict__ for m in truth.messages])
+    messages["lost"] = messages["received"].isna().astype(float)
+    messages["latency"] = (messages["received"] - messages["sent"]).dt.total_seconds()
+    for case, own in messages.groupby("case"):
+        rows.append(("message loss", "weed_position", "", case, own["lost"].mean()))
+        if own["latency"].notna().any():
+            rows.append(("message latency", "weed_position", "", case, own["latency"].mean()))
+    samples = pd.DataFrame([s.__dict__ for s in truth.samples]).sort_values("time")
+    levels = samples.groupby(["robot", "case"])["battery"]
+    used = levels.first() - levels.last()
+    rows += [("battery used", "battery", robot, case, v) for (robot, case), v in used.items()]
+    table = pd.DataFrame(rows, columns=["measure", "subject", "who", "run", "value"])
+    seconds = table["value"].map(lambda v: v.total_seconds() if hasattr(v, "seconds") else v)
+    return table.assign(value=seconds.astype(float)).set_index(["measure", "subject", "who", "run"])
+
+
+def variants(truth: GroundTruth) -> pd.Series:
+    """Per run, every robot's activities in start order (no two start at one moment)."""
+    instances = truth.instance_table().sort_values(["case", "start"])
+    return instances.groupby("case")["activity"].agg(tuple)
+
+
+@pytest.fixture(scope="module")
+def injected(tmp_path_factory):
+    """A, and B with the drone exploring 1.5 times as long, messages twice as slow and lost
+    half the time, its battery draining twice as fast and tractor_1 checking first."""
+    folder = tmp_path_factory.mktemp("truth")
+    a = batch(1)
+    b = batch(2, explore=1.5, latency=2.0, loss=0.5, drain=0.4, check=True)
+    return a, b, compare_logs(read(a, folder, "a"), read(b, folder, "b"))
+
+
+def test_every_value_per_run_is_the_truths(injected):
+    a, b, comparison = injected
+    got = comparison.per_run.set_index(["measure", "subject", "who", "run"])
+    for side, truth, other in ((0, a, b), (1, b, a)):
+        expected = expected_per_run(truth, other)
+        mine = got[got["side"] == side]["value"]
+        mine = mine[mine.index.get_level_values("measure").isin(expected.index.levels[0])]
+        assert sorted(mine.index) == sorted(expected.index)
+        assert mine.sort_index().to_numpy() == pytest.approx(
+            expected["value"].sort_index().to_numpy(), abs=1e-6
+        )
+
+
+def test_the_injected_changes_are_called_with_their_direction(injected):
+    a, b, comparison = injected
+    changes = comparison.changes.set_index(["measure", "subject", "who"]).sort_index()
+    for key, sign in (
+        (("activity duration", "explore", "Drone"), 1),
+        (("message latency", "weed_position", ""), 1),
+        (("battery used", "battery", "drone"), 1),
+    ):
+        row = changes.loc[key]
+        truth = [
+            expected_per_run(t, o).sort_index().loc[key]["value"].mean()
+            for t, o in ((a, b), (b, a))
+        ]
+        assert (row["a"], row["b"]) == pytest.approx(truth)
+        assert row["q_value"] < ALPHA and np.sign(row["difference"]) == sign
+    # a step of tractor_1's that A never did: new in B, in each of its runs
+    assert f"New in B: check by Tractor (in {RUNS} of {RUNS} runs of B)." in comparison.sentences
+
+
+def test_variants_appeared_and_vanished_as_the_truth_has_them(injected):
+    a, b, comparison = injected
+    old, new = variants(a), variants(b)
+    table = comparison.variants.assign(
+        steps=comparison.variants["variant"].map(lambda v: tuple(v.split(ARROW)))
+    ).set_index("steps")
+    assert set(table.index) == set(old) | set(new)
+    for steps, row in table.iterrows():
+        assert (row["runs_a"], row["runs_b"]) == ((old == steps).sum(), (new == steps).sum())
+        status = "both" if steps in set(old) and steps in set(new) else None
+        status = status or ("appeared" if steps in set(new) else "vanished")
+        assert row["status"] == status
+    # tractor_1 checks in every run of B: no variant of A is left
+    assert (table["status"] != "both").all()
+
+
+@pytest.mark.slow
+def test_same_settings_call_no_more_than_chance_over_many_pairs(tmp_path):
+    """Twenty pairs of batches of the same settings, different seeds: nothing changed, so a
+    pair with any change called significant (adjusted p below ``ALPHA``) is a false alarm,
+    which the procedure allows in at most ``ALPHA`` of the pairs: more than ``BOUND`` in 20
+    happens by chance less than once in a hundred. Each pair tests a dozen or more
+    measures; that the same procedure sees a real change is checked on the injected
+    batches above."""
+    pairs, alarms, tested = 20, 0, []
+    for n in range(pairs):
+        logs = [read(batch(1000 + 2 * n + side), tmp_path, f"{n}_{side}") for side in (0, 1)]
+        changes = compare_logs(*logs).changes
+        tested.append(int(changes["q_value"].notna().sum()))
+        alarms += bool((changes["q_value"] < ALPHA).any())
+    assert min(tested) >= 10, tested
+    tail = sum(
+        math.comb(pairs, k) * ALPHA**k * (1 - ALPHA) ** (pairs - k)
+        for k in range(BOUND + 1, pairs + 1)
+    )
+    assert tail < 0.01
+    assert alarms <= BOUND, alarms
