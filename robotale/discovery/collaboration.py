@@ -236,7 +236,9 @@ def triggers(instances: pd.DataFrame, traces: Traces, *, records_aborts: bool) -
     the engine tags at the same instant. Where the log records none at all (the thesis' log),
     an activity is a trigger when it comes at most once in a trace, never first, not sent,
     and cuts in: the activity just before it is followed by it in less than half of its
-    occurrences, so it happens between steps rather than as one.
+    occurrences, so it happens between steps rather than as one; unless another such
+    activity comes both just before and just after it in the log: the two are done side by
+    side (a parallel block), not one interrupting the other.
     """
     aborted = instances[instances["_aborted"]]
     if records_aborts:
@@ -366,7 +368,10 @@ def _behaving_triggers(traces: Traces) -> set[str]:
         codes[:-1][within] * kinds + codes[1:][within], minlength=kinds * kinds
     ).reshape(kinds, kinds)
     cuts_in = ((follows > 0) & (follows * 2 < occurs[:, None])).any(axis=0)
-    return {str(names[code]) for code in np.flatnonzero(candidate & cuts_in)}
+    # two candidates seen in both orders are steps done side by side (a parallel block of
+    # once-per-run steps cuts into whatever came before it just as often), not interruptions
+    swapped = (follows > 0) & (follows.T > 0) & candidate[:, None] & candidate[None, :]
+    return {str(names[code]) for code in np.flatnonzero(candidate & cuts_in & ~swapped.any(0))}
 
 
 @dataclass(slots=True)
