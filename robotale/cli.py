@@ -1006,7 +1006,8 @@ def _add_compare(commands: argparse._SubParsersAction) -> None:
         "bottlenecks, messages, battery",
         description="Compare two batches of runs (A, the reference, and B): plain sentences "
         "of what changed, largest and surest first, each difference tested run against run "
-        "(Mann-Whitney U, Benjamini-Hochberg adjusted), then the table of changes.",
+        "(Mann-Whitney U and Welch's t, Benjamini-Hochberg adjusted), then the table of "
+        "changes.",
     )
     for name, which in (("log_a", "A, the reference"), ("log_b", "B")):
         compare.add_argument(

@@ -539,8 +539,9 @@ def _sentences(
     sure = int((changes["q_value"] < ALPHA).sum())
     ranked = int(changes["ranked"].sum())
     sentences.append(
-        f"{tested} differences were tested, run against run (Mann-Whitney U), with the "
-        f"p-values adjusted for their number (Benjamini-Hochberg): {sure} with p < {ALPHA:g}, "
+        f"{tested} differences were tested, run against run (Mann-Whitney U and Welch's t), "
+        f"with the p-values adjusted for their number (Benjamini-Hochberg): {sure} with "
+        f"p < {ALPHA:g}, "
         f"{ranked} of them also worth at least {MIN_SHARE:.0%} of a run."
     )
     return sentences

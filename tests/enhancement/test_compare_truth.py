@@ -201,3 +201,26 @@ def test_same_settings_call_no_more_than_chance_over_many_pairs(tmp_path):
     )
     assert tail < 0.01
     assert alarms <= BOUND, alarms
+
+
+def test_the_first_bottleneck_moved_to_the_injected_wait(tmp_path):
+    """The mission with injected findings (``tests/mission_findings.py``): B has a third of
+    its runs wait for a refill, A none. B's first bottleneck is that wait, its cost per run
+    what the runs with it take longer than the others (counted here from each run's first
+    and last event) times their share; compared the other way round it is A's."""
+    import mission_findings as mission
+
+    from robotale.eventlog.schema import CASE, TIMESTAMP
+
+    full = read_log(mission.write_injected("robotale.csv", tmp_path / "mission.csv"))
+    calm = full[~full[CASE].isin(mission.REFILL_RUNS)].reset_index(drop=True)
+    times = full.groupby(CASE)[TIMESTAMP]
+    seconds = (times.max() - times.min()).dt.total_seconds()
+    refill = seconds.index.isin(sorted(mission.REFILL_RUNS))
+    cost = (seconds[refill].mean() - seconds[~refill].mean()) * refill.mean()
+    said = f"activity at {mission.REFILL} by tractor_1, {cost:.1f}s per run"
+    moved = [s for s in compare_logs(calm, full).sentences if "first bottleneck" in s]
+    assert len(moved) == 1 and moved[0].startswith("The first bottleneck moved (in A: ")
+    assert moved[0].endswith(f"in B: {said}).")
+    back = [s for s in compare_logs(full, calm).sentences if "first bottleneck" in s]
+    assert back[0].startswith(f"The first bottleneck moved (in A: {said}; in B: ")
