@@ -10,7 +10,7 @@ import re
 import numpy as np
 import pandas as pd
 import pytest
-from collaboration_checks import read
+from collaboration_checks import overlaps, read, unshaped
 from conventions import GroundTruth, Message, RunWriter, write_robotale_csv
 
 from robotale.discovery.bpmn_writer import write_bpmn
@@ -109,6 +109,18 @@ def test_no_pool_for_a_receiver_outside_the_log(tmp_path):
     assert not [n for n in names if re.search("base", n, re.I)]
 
 
+def _positions(root) -> dict[str, tuple[float, float]]:
+    """Element name -> the top left corner of its shape."""
+    names = {e.get("id"): e.get("name") for e in root.iter() if e.get("name")}
+    corners = {}
+    for shape in root.iter("{http://www.omg.org/spec/BPMN/20100524/DI}BPMNShape"):
+        bounds = shape.find("{http://www.omg.org/spec/DD/20100524/DC}Bounds")
+        name = names.get(shape.get("bpmnElement"))
+        if name:
+            corners[name] = (float(bounds.get("x")), float(bounds.get("y")))
+    return corners
+
+
 def _shape(block) -> str:
     """A mined block as text: ``seq(xor(a, b), ...)``, children in their order."""
     from robotale.discovery.layout import Operator
@@ -156,6 +168,13 @@ def test_choices_parallel_steps_and_loops_become_gateways(tmp_path):
         kind: len(list(root.iter(f"{B}{kind}"))) for kind in ("exclusiveGateway", "parallelGateway")
     }
     assert gateways == {"exclusiveGateway": 4, "parallelGateway": 2}
+    # drawn left to right in the order the robot did them; a choice's and a parallel
+    # block's branches one below the other, the loop's redo part below its body
+    at = _positions(root)
+    assert at["Scan"][0] == at["Photo"][0] < at["Drive"][0] == at["Arm"][0] < at["Cut"][0]
+    assert at["Cut"][0] < at["Park"][0] and at["Turn"][1] > at["Cut"][1]
+    assert at["Scan"][1] != at["Photo"][1] and at["Drive"][1] != at["Arm"][1]
+    assert overlaps(root) == [] and unshaped(root) == []
     robots = check_conformance(log, tmp_path / "discovered.bpmn").robots
     tree = pm4py.parse_process_tree(
         "->(X('scan', 'photo'), +('drive', 'arm'), *('cut', 'turn'), 'park')"
