@@ -219,3 +219,20 @@ def test_samples_are_no_instances(neo4j_driver, tmp_path):
         assert graph.node("land").count == 1
     finally:
         delete_log(neo4j_driver, name)
+
+
+def test_discover_bpmn_of_a_stored_log_is_the_files(
+    stored, neo4j_server, thesis_csv, tmp_path, capsys
+):
+    """``discover bpmn --log NAME --robot-type Tractor`` writes what the same command writes
+    from the file the log was stored from: one pool, the tractors'."""
+    from_log, from_file = tmp_path / "log.bpmn", tmp_path / "file.bpmn"
+    common = ["--robot-type", "Tractor", "--out"]
+    assert main(["discover", "bpmn", "--log", stored, *common, str(from_log)]) == 0
+    assert main(["discover", "bpmn", str(thesis_csv), *common, str(from_file)]) == 0
+    printed = capsys.readouterr().out
+    assert "pool Tractor (tractor_1, tractor_2)" in printed and "pool Drone" not in printed
+    assert from_log.read_text(encoding="utf-8") == from_file.read_text(encoding="utf-8")
+    assert re.findall(r'<bpmn:participant [^>]*name="([^"]*)"', from_file.read_text()) == [
+        "Tractor"
+    ]
