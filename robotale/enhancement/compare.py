@@ -4,12 +4,12 @@ Every comparison takes the run as its unit: a run is one independent draw of the
 while the activities inside one run share its weeds, its batteries and its timing. Each
 measure is therefore reduced to one value per run first (a run's duration; the mean duration
 of an activity in the run, per robot type; how often the run does it; the mean wait of a
-transition; the mean latency and the share lost of a message type; the battery a robot used;
-whether the run follows a variant), and B's runs are compared with A's by the Mann-Whitney U
-test (:func:`mann_whitney`: the statistic of :mod:`robotale.enhancement.effects`, for every
-measure at once) and by Welch's t-test of the means (:func:`welch`), which sees a mean moved
-by a few runs that the ranks barely notice; a measure's p-value is the smaller of the two,
-Bonferroni-corrected (:func:`either`).
+transition; the mean latency, the share lost and the resends of a message type; the battery a
+robot used; whether the run follows a variant), and B's runs are compared with A's by the
+Mann-Whitney U test (:func:`mann_whitney`: the statistic of
+:mod:`robotale.enhancement.effects`, for every measure at once) and by Welch's t-test of the
+means (:func:`welch`), which sees a mean moved by a few runs that the ranks barely notice;
+a measure's p-value is the smaller of the two, Bonferroni-corrected (:func:`either`).
 
 A comparison of two batches asks many questions at once, so some p-values come out small by
 chance alone; the p-values are adjusted by the Benjamini-Hochberg procedure across all of
@@ -62,6 +62,7 @@ MEASURES = (
     "transition wait",
     "message latency",
     "message loss",
+    "message resends",
     "battery used",
     "variant share",
 )
@@ -217,15 +218,17 @@ def _frequencies(instances: pd.DataFrame, who: Callable, runs: pd.Index) -> pd.D
 
 
 def _message_values(analysis: LogAnalysis) -> dict[str, pd.DataFrame]:
-    """Per run and message type: the mean latency of the received, the share lost."""
+    """Per run and message type: the mean latency of the received, the share lost and how
+    many times its messages were sent again (under the same id or a new one)."""
     messages = communication_perspective(analysis)
     if not messages.has_data or messages.tables["messages"].empty:
         empty = _long([], [], [], [])
-        return {"message latency": empty, "message loss": empty}
+        return {"message latency": empty, "message loss": empty, "message resends": empty}
     table = messages.tables["messages"]
     table = table.assign(
         _type=table["message_type"].astype(str).str.rstrip("!?"),
         _lost=table["lost"].astype(float),
+        _resends=table["resends"].astype(float),
         **{CASE: table["case"].astype(str)},
     )
 
@@ -236,6 +239,7 @@ def _message_values(analysis: LogAnalysis) -> dict[str, pd.DataFrame]:
     return {
         "message latency": _per_run(received, nobody, "_type", "latency"),
         "message loss": _per_run(table, nobody, "_type", "_lost"),
+        "message resends": _per_run(table, nobody, "_type", "_resends", "sum"),
     }
 
 
@@ -618,6 +622,11 @@ def change_sentence(row: dict) -> str:
         return f"{subject} messages take {percent} {how} to arrive ({means}, {evidence})."
     if measure == "message loss":
         return f"{row['b']:.0%} of {subject} messages are lost against {row['a']:.0%} ({evidence})."
+    if measure == "message resends":
+        return (
+            f"{subject} messages are sent again {row['b']:.1f} times per run instead of "
+            f"{row['a']:.1f} ({evidence})."
+        )
     if measure == "battery used":
         how = "more" if more else "less"
         return (

@@ -25,8 +25,10 @@ ROBOTS = {"drone": "Drone", "tractor_1": "Tractor", "tractor_2": "Tractor"}
 RUNS = 10
 #: false alarms allowed in twenty pairs of batches of the same settings
 BOUND = 4
-#: the messages of a run: (number, receiver, seconds after the start it is sent)
-SENT = ((1, "tractor_1", 10.0), (2, "tractor_2", 15.0), (3, "tractor_1", 20.0))
+#: the messages of a run: (number, receiver, seconds after the start it is sent, whether it
+#: may be lost): tractor_2's never is, so a lost message's receiver is tractor_1's, the
+#: drone's usual receiver, for the truth and for a reader of the log alike
+SENT = ((1, "tractor_1", 10.0, True), (2, "tractor_2", 15.0, False), (3, "tractor_1", 20.0, True))
 
 
 def batch(
@@ -39,11 +41,12 @@ def batch(
     check: bool = False,
 ) -> GroundTruth:
     """``RUNS`` runs: the drone takes off, explores (``explore`` scales its time), sends
-    three weed positions (each lost with chance ``loss``, else received after ``latency``
-    times 1-2 s) and lands; the tractors move to the weeds (tractor_1 checks first when
-    ``check``); times in eighths of a second (see :func:`_tick`). Activities start at fixed
-    moments, so a run's variant depends only on which messages were lost; battery samples
-    fall by ``drain`` times 0.8-1.2 points a second."""
+    three weed positions (tractor_1's each lost with chance ``loss``, the second of them
+    then a resend of the first; received after ``latency`` times 1-2 s) and lands; the
+    tractors move to the weeds (tractor_1 checks first when ``check``); times in eighths of
+    a second (see :func:`_tick`). Activities start at fixed moments, so a run's variant
+    depends only on which messages were lost; battery samples fall by ``drain`` times
+    0.8-1.2 points a second."""
     rng = np.random.default_rng(seed)
     truth = GroundTruth(cases=[f"s{seed}r{n}" for n in range(RUNS)], robots=dict(ROBOTS))
     for n, case in enumerate(truth.cases):
@@ -51,11 +54,14 @@ def batch(
         run.instance("drone", "takeoff", 0, 5)
         run.instance("tractor_2", "wait", 1, 24)
         run.instance("drone", "explore", 6, _tick(6 + explore * rng.uniform(30, 40)))
-        for number, to, sent in SENT:
-            lost = rng.random() < loss
-            run.message(
-                number, to, sent, None if lost else _tick(sent + latency * rng.uniform(1, 2))
-            )
+        first_lost = None
+        for number, to, sent, losable in SENT:
+            lost = losable and rng.random() < loss
+            arrives = None if lost else _tick(sent + latency * rng.uniform(1, 2))
+            # the next position for tractor_1 repeats the first when that one was lost
+            again = first_lost if number == 3 else None
+            message = run.message(number, to, sent, arrives, resend_of=again)
+            first_lost = message if number == 1 and lost else first_lost
         if check:
             run.instance("tractor_1", "check", 24, _tick(24 + rng.uniform(1, 2)))
         run.instance("tractor_1", "move_to_weed", 26, _tick(26 + rng.uniform(15, 25)))
@@ -105,6 +111,8 @@ def expected_per_run(truth: GroundTruth, other: GroundTruth) -> pd.DataFrame:
     messages["latency"] = (messages["received"] - messages["sent"]).dt.total_seconds()
     for case, own in messages.groupby("case"):
         rows.append(("message loss", "weed_position", "", case, own["lost"].mean()))
+        resends = float(own["resend_of"].notna().sum())
+        rows.append(("message resends", "weed_position", "", case, resends))
         if own["latency"].notna().any():
             rows.append(("message latency", "weed_position", "", case, own["latency"].mean()))
     samples = pd.DataFrame([s.__dict__ for s in truth.samples]).sort_values("time")
