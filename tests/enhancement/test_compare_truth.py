@@ -1,7 +1,8 @@
 """``compare`` against the truth of small written batches (``tests/conventions.py``): each run
 of a drone and two tractors drawn at random, so every value per run the comparison tests
-(the run's duration, each activity's mean duration and count per robot type, the messages'
-latency and loss, the battery each robot used, the variant it follows) is known here from
+(the run's duration, each activity's mean duration and count per robot type, each robot
+type's waits between two steps, the messages' latency, loss and resends, the battery each
+robot used, the variant it follows) is known here from
 the truth's own instances, messages and samples, never from the code under test; and many
 pairs of batches of the same settings, whose changes called significant are counted against
 the chance the procedure allows."""
@@ -106,6 +107,16 @@ def expected_per_run(truth: GroundTruth, other: GroundTruth) -> pd.DataFrame:
     counts = counts.reindex(index=both, columns=truth.cases, fill_value=0)
     rows += [("activity frequency", a, w, c, float(v)) for (a, w), r in counts.iterrows()
              for c, v in r.items()]  # fmt: skip
+    # a robot waits from the latest end of its activities so far to its next start
+    ordered = instances.sort_values(["case", "robot", "start"])
+    by_robot = ordered.groupby(["case", "robot"])
+    steps = ordered.assign(
+        target=by_robot["activity"].shift(-1),
+        wait=(by_robot["start"].shift(-1) - by_robot["end"].cummax()).dt.total_seconds(),
+    ).dropna(subset=["target"])
+    steps["step"] = steps["activity"] + ARROW + steps["target"]
+    waits = steps.assign(wait=steps["wait"].clip(lower=0)).groupby(["step", "who", "case"])
+    rows += [("transition wait", st, w, c, v) for (st, w, c), v in waits["wait"].mean().items()]
     messages = pd.DataFrame([m.__dict__ for m in truth.messages])
     messages["lost"] = messages["received"].isna().astype(float)
     messages["latency"] = (messages["received"] - messages["sent"]).dt.total_seconds()
