@@ -4,9 +4,9 @@ Every comparison takes the run as its unit: a run is one independent draw of the
 while the activities inside one run share its weeds, its batteries and its timing. Each
 measure is therefore reduced to one value per run first (a run's duration; the mean duration
 of an activity in the run, per robot type; how often the run does it; the mean wait of a
-transition; the mean latency, the share lost and the resends of a message type; the battery a
-robot used; whether the run follows a variant), and B's runs are compared with A's by the
-Mann-Whitney U test (:func:`mann_whitney`: the statistic of
+transition and how often the run takes it; the mean latency, the share lost and the resends
+of a message type; the battery a robot used; whether the run follows a variant), and B's runs
+are compared with A's by the Mann-Whitney U test (:func:`mann_whitney`: the statistic of
 :mod:`robotale.enhancement.effects`, for every measure at once) and by Welch's t-test of the
 means (:func:`welch`), which sees a mean moved by a few runs that the ranks barely notice;
 a measure's p-value is the smaller of the two, Bonferroni-corrected (:func:`either`).
@@ -60,6 +60,7 @@ MEASURES = (
     "activity duration",
     "activity frequency",
     "transition wait",
+    "transition frequency",
     "message latency",
     "message loss",
     "message resends",
@@ -67,7 +68,13 @@ MEASURES = (
     "variant share",
 )
 #: the measures in seconds, whose share is the time they add to a run
-TIMED = ("run duration", "activity duration", "activity frequency", "transition wait")
+TIMED = (
+    "run duration",
+    "activity duration",
+    "activity frequency",
+    "transition wait",
+    "transition frequency",
+)
 COLUMNS = [
     "measure",
     "subject",
@@ -165,6 +172,7 @@ def batch(log: pd.DataFrame, name: str) -> Batch:
     steps = shared_steps(analysis)
     steps = steps.assign(_step=steps["source"].astype(str) + ARROW + steps["target"].astype(str))
     found.values["transition wait"] = _per_run(steps.dropna(subset=[WAIT]), who, "_step", WAIT)
+    found.values["transition frequency"] = _frequencies(steps, who, runs.index, "_step")
     found.values.update(_message_values(analysis))
     found.values["battery used"] = _battery_values(analysis)
     paths = shared_case_variants(analysis)
@@ -203,11 +211,14 @@ def _per_run(
     return grouped.dropna().reset_index()
 
 
-def _frequencies(instances: pd.DataFrame, who: Callable, runs: pd.Index) -> pd.DataFrame:
-    """How often each run does each activity (per robot type), 0 in the runs without it."""
-    # only the columns counted: the instances' others are not copied
-    read = [c for c in (ROBOT, ACTIVITY, CASE) if c in instances.columns]
-    counted = _per_run(instances[read].assign(_one=1.0), who, ACTIVITY, "_one", "sum")
+def _frequencies(
+    rows: pd.DataFrame, who: Callable, runs: pd.Index, subject: str = ACTIVITY
+) -> pd.DataFrame:
+    """How often each run does each activity (or takes each step: ``subject``) per robot
+    type, 0 in the runs without it."""
+    # only the columns counted: the rows' others are not copied
+    read = [c for c in (ROBOT, subject, CASE) if c in rows.columns]
+    counted = _per_run(rows[read].assign(_one=1.0), who, subject, "_one", "sum")
     if counted.empty:
         return counted
     wide = counted.pivot_table(
@@ -296,7 +307,7 @@ def _values(part: Batch, other: Batch, side: int) -> pd.DataFrame:
     tables[0].insert(0, "measure", "run duration")
     for measure in MEASURES[1:-1]:
         values = part.values[measure]
-        if measure == "activity frequency":
+        if measure in ("activity frequency", "transition frequency"):
             # a run without an activity did it 0 times, even when no run of its batch did it
             values = _with_zeros(values, other.values[measure], part.runs.index)
         tables.append(values.assign(measure=measure))
@@ -447,7 +458,7 @@ def _shares(table: pd.DataFrame, first: Batch, second: Batch) -> pd.Series:
 def _occurrences_per_run(table: pd.DataFrame, first: Batch, second: Batch) -> pd.Series:
     """How many times per run a row's time counts: an activity's and a transition's times
     as often as B's runs (else A's) do them; a frequency's difference times the activity's
-    mean duration; a run's once."""
+    mean duration or the transition's mean wait; a run's once."""
     frequency = {}
     durations = {}
     for part in (first, second):  # B's figures replace A's where both have them
@@ -458,11 +469,13 @@ def _occurrences_per_run(table: pd.DataFrame, first: Batch, second: Batch) -> pd
         if not timed.empty:
             durations.update(timed.groupby(["subject", "who"])["value"].mean().to_dict())
     steps = {}
+    waited = {}
     for part in (first, second):
         waits = part.values["transition wait"]
         if not waits.empty:
             per_run = waits.groupby(["subject", "who"])["run"].size() / max(len(part.runs), 1)
             steps.update(per_run.to_dict())
+            waited.update(waits.groupby(["subject", "who"])["value"].mean().to_dict())
     times = []
     for row in table.to_dict("records"):
         key = (row["subject"], row["who"])
@@ -471,6 +484,7 @@ def _occurrences_per_run(table: pd.DataFrame, first: Batch, second: Batch) -> pd
                 "activity duration": frequency.get(key, 1.0),
                 "activity frequency": durations.get(key, 0.0),
                 "transition wait": steps.get(key, 1.0),
+                "transition frequency": waited.get(key, 0.0),
             }.get(row["measure"], 1.0)
         )
     return pd.Series(times, index=table.index, dtype=float)
@@ -616,6 +630,13 @@ def change_sentence(row: dict) -> str:
         return (
             f"{owner or 'The '}wait between {source} and {target} is {percent} {how} "
             f"({means}, {evidence})."
+        )
+    if measure == "transition frequency":
+        source, _, target = subject.partition(ARROW)
+        doer = who or "The robots"
+        return (
+            f"{doer} {'goes' if who else 'go'} from {source} to {target} {row['b']:.1f} times "
+            f"per run instead of {row['a']:.1f} ({evidence})."
         )
     if measure == "message latency":
         how = "longer" if more else "less time"

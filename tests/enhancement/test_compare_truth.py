@@ -1,11 +1,11 @@
 """``compare`` against the truth of small written batches (``tests/conventions.py``): each run
 of a drone and two tractors drawn at random, so every value per run the comparison tests
 (the run's duration, each activity's mean duration and count per robot type, each robot
-type's waits between two steps, the messages' latency, loss and resends, the battery each
-robot used, the variant it follows) is known here from
-the truth's own instances, messages and samples, never from the code under test; and many
-pairs of batches of the same settings, whose changes called significant are counted against
-the chance the procedure allows."""
+type's waits between two steps and how often it took each, the messages' latency, loss and
+resends, the battery each robot used, the variant it follows) is known here from the truth's
+own instances, messages and samples, never from the code under test; and many pairs of
+batches of the same settings, whose changes called significant are counted against the
+chance the procedure allows."""
 
 from __future__ import annotations
 
@@ -93,6 +93,18 @@ def _instances(truth: GroundTruth) -> pd.DataFrame:
     return instances.assign(who=instances["robot"].map(ROBOTS))
 
 
+def _steps(instances: pd.DataFrame) -> pd.DataFrame:
+    """Each robot's consecutive activities in a run, and its wait between them: from the
+    latest end of its activities so far to the next start."""
+    ordered = instances.sort_values(["case", "robot", "start"])
+    by_robot = ordered.groupby(["case", "robot"])
+    steps = ordered.assign(
+        target=by_robot["activity"].shift(-1),
+        wait=(by_robot["start"].shift(-1) - by_robot["end"].cummax()).dt.total_seconds(),
+    ).dropna(subset=["target"])
+    return steps.assign(step=steps["activity"] + ARROW + steps["target"])
+
+
 def expected_per_run(truth: GroundTruth, other: GroundTruth) -> pd.DataFrame:
     """(measure, subject, who, run) -> value, from the truth alone; an activity only the
     ``other`` batch did is done 0 times in each run of this one."""
@@ -107,16 +119,14 @@ def expected_per_run(truth: GroundTruth, other: GroundTruth) -> pd.DataFrame:
     counts = counts.reindex(index=both, columns=truth.cases, fill_value=0)
     rows += [("activity frequency", a, w, c, float(v)) for (a, w), r in counts.iterrows()
              for c, v in r.items()]  # fmt: skip
-    # a robot waits from the latest end of its activities so far to its next start
-    ordered = instances.sort_values(["case", "robot", "start"])
-    by_robot = ordered.groupby(["case", "robot"])
-    steps = ordered.assign(
-        target=by_robot["activity"].shift(-1),
-        wait=(by_robot["start"].shift(-1) - by_robot["end"].cummax()).dt.total_seconds(),
-    ).dropna(subset=["target"])
-    steps["step"] = steps["activity"] + ARROW + steps["target"]
+    steps = _steps(instances)
     waits = steps.assign(wait=steps["wait"].clip(lower=0)).groupby(["step", "who", "case"])
     rows += [("transition wait", st, w, c, v) for (st, w, c), v in waits["wait"].mean().items()]
+    taken = steps.groupby(["step", "who", "case"]).size().unstack("case", fill_value=0)
+    both = taken.index.union(_steps(_instances(other)).set_index(["step", "who"]).index.unique())
+    taken = taken.reindex(index=both, columns=truth.cases, fill_value=0)
+    rows += [("transition frequency", st, w, c, float(v)) for (st, w), r in taken.iterrows()
+             for c, v in r.items()]  # fmt: skip
     messages = pd.DataFrame([m.__dict__ for m in truth.messages])
     messages["lost"] = messages["received"].isna().astype(float)
     messages["latency"] = (messages["received"] - messages["sent"]).dt.total_seconds()
