@@ -117,3 +117,27 @@ def test_compare_page_draws_each_batchs_runs(page, two_logs):
         assert sorted(got) == sorted(spans.index)
         for run, seconds in spans.items():
             assert got[run] == pytest.approx(seconds, abs=1e-3)
+
+
+def test_a_figure_names_its_unit(tmp_path):
+    """The y axis of a measure's figure: counts per run for a frequency and for resends,
+    seconds for a duration or a wait, the measure itself for a share."""
+    from robotale.eventlog.readers import read_log
+    from robotale.webapp.views.compare import _figure
+
+    full = read_log(mission.write_injected("robotale.csv", tmp_path / "mission.csv"))
+    calm = full[~full[CASE].isin(mission.REFILL_RUNS)].reset_index(drop=True)
+    values = compare_logs(calm, full).per_run
+    for measure, unit in (
+        ("activity frequency", "times per run"),
+        ("transition frequency", "times per run"),
+        ("message resends", "times per run"),
+        ("activity duration", "seconds"),
+        ("transition wait", "seconds"),
+        ("message loss", "message loss"),
+    ):
+        first = values[values["measure"] == measure].iloc[0]
+        key = ["measure", "subject", "who"]
+        mine = values[(values[key] == first[key]).all(axis=1)]
+        figure = _figure(measure, first["subject"], first["who"], mine, ("A", "B"))
+        assert figure["layout"]["yaxis"]["title"]["text"] == unit, measure

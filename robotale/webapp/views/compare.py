@@ -97,7 +97,10 @@ def _figure(
                 "hovertemplate": "run %{text}: %{y}<extra></extra>",
             }
         )
-    unit = "seconds" if measure in TIMED or measure == "message latency" else measure
+    # a frequency's share is counted in seconds, its values are counts
+    counted = measure.endswith("frequency") or measure == "message resends"
+    timed = measure in TIMED or measure == "message latency"
+    unit = "times per run" if counted else "seconds" if timed else measure
     layout = {"title": {"text": title}, "showlegend": False, "yaxis": {"title": {"text": unit}}}
     return {"data": data, "layout": layout, "measure": measure, "subject": subject, "who": who}
 
