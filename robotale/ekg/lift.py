@@ -69,7 +69,7 @@ class LogEdges:
         """The edges of the stored log ``log`` built with ``entity_types`` (``build``: its
         current build, when the caller has read it)."""
         table = stored_table(driver, log, build=build)
-        return cls.of_tables(graph_tables(table, list(entity_types)))
+        return cls.of_tables(graph_tables(table, list(entity_types), lifting=True))
 
     @classmethod
     def of_tables(cls, tables: GraphTables) -> LogEdges:
@@ -78,8 +78,13 @@ class LogEdges:
         corr = tables.corr["entity"].to_numpy() + count
         df, comm = tables.df, tables.comm
         # kinds and entity types as small integers: millions of edges as Python strings cost
-        # more to make, and to group, than the rest of the lifting
-        df_types, names = pd.factorize(df["entityType"])
+        # more to make, and to group, than the rest of the lifting (tables derived for
+        # lifting name a DF edge's entity by its row: its type's code is looked up)
+        if "entity" in df.columns:
+            codes, names = pd.factorize(entities["type"])
+            df_types = codes[df["entity"].to_numpy()]
+        else:
+            df_types, names = pd.factorize(df["entityType"])
         frames = [
             (tables.corr["event"].to_numpy(), corr, np.zeros(len(corr), np.int64)),
             (df["source"].to_numpy(), df["target"].to_numpy(), df_types.astype(np.int64) + 1),

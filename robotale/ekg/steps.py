@@ -481,7 +481,8 @@ def _write_lifted(
         "aggr_create_lifted",
         {
             "kinds": lifted["kind"].tolist(),
-            "entityTypes": lifted["entityType"].tolist(),
+            # None, not a text column's NaN, where an edge has no entity type (not DF)
+            "entityTypes": neo4j_values(lifted["entityType"]),
             "counts": lifted["count"].astype(int).tolist(),
             "sources": edges.ends(driver, log, source).tolist(),
             "targets": edges.ends(driver, log, target).tolist(),

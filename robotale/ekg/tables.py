@@ -97,10 +97,15 @@ def check_name(name: object, what: str) -> str:
     return name
 
 
-def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> GraphTables:
+def graph_tables(
+    log: pd.DataFrame, entities: Sequence[str], first: int = 0, lifting: bool = False
+) -> GraphTables:
     """Check ``log`` (a canonical event log) and derive the tables of its EKG; ``first`` is
     the position its first event takes in the stored log (the number of events already
-    stored when it is appended)."""
+    stored when it is appended). ``lifting``: only what an aggregation lifts (``df`` with
+    ``source``, ``target`` and ``entity``, the entity's row, instead of its type and id as
+    text; no ``follows``): the texts and the instances' chains cost a million-event log's
+    aggregation a second of its reading."""
     events = event_table(log, first)
     types = entity_types([property_name(c) for c in log.columns], entities)
     corr, entity_table = _correlations(events, types)
@@ -110,7 +115,7 @@ def graph_tables(log: pd.DataFrame, entities: Sequence[str], first: int = 0) -> 
             f"{', '.join(types)}, so no entity and no DF edge would be built; name the columns "
             "that identify what the events belong to with --entities (e.g. --entities case)."
         )
-    df, starts, follows = _directly_follows(events, corr, entity_table)
+    df, starts, follows = _directly_follows(events, corr, entity_table, lifting)
     return GraphTables(
         events=events,
         entities=entity_table,
@@ -238,10 +243,11 @@ def _correlations(events: pd.DataFrame, types: list[str]) -> tuple[pd.DataFrame,
 
 
 def _directly_follows(
-    events: pd.DataFrame, corr: pd.DataFrame, entities: pd.DataFrame
+    events: pd.DataFrame, corr: pd.DataFrame, entities: pd.DataFrame, lifting: bool = False
 ) -> tuple[pd.DataFrame, pd.DataFrame, pd.DataFrame]:
     """DF edges, the events that begin each entity's chain in each case, and the DF edges of
-    the activity instances (the chains without the events that end no instance)."""
+    the activity instances (the chains without the events that end no instance; none when
+    ``lifting``, whose DF edges name their entity by its row, :func:`graph_tables`)."""
     event = corr["event"].to_numpy().astype(np.int64)
     entity = corr["entity"].to_numpy().astype(np.int64)
     # one integer per entity and case: two rows are in one chain when it is equal (a missing
@@ -258,6 +264,12 @@ def _directly_follows(
     # Python strings would be converted into one again, which costs more than the rest
     kinds = entities["type"].array
     sources = ordered_entity[:-1][same]
+    # A chain begins where no DF edge arrives: the first row, and every row after a last one.
+    begins = np.concatenate([[True], ~same]) if len(order) else np.zeros(0, dtype=bool)
+    starts = pd.DataFrame({"event": ordered_event[begins], "entity": ordered_entity[begins]})
+    if lifting:
+        lifted = {"source": ordered_event[:-1][same], "target": ordered_event[1:][same]}
+        return pd.DataFrame(lifted | {"entity": sources}), starts, pd.DataFrame()
     df = pd.DataFrame(
         {
             "source": ordered_event[:-1][same],
@@ -266,9 +278,6 @@ def _directly_follows(
             "entityId": entities["id"].array.take(sources),
         }
     )
-    # A chain begins where no DF edge arrives: the first row, and every row after a last one.
-    begins = np.concatenate([[True], ~same]) if len(order) else np.zeros(0, dtype=bool)
-    starts = pd.DataFrame({"event": ordered_event[begins], "entity": ordered_entity[begins]})
     return (
         df,
         starts,
