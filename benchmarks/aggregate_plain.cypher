@@ -183,3 +183,12 @@ CALL () {
   RETURN b AS a, a AS b
 }
 RETURN elementId(a) AS source, elementId(b) AS target;
+
+// running: the transactions of the log's database but this one (those of a run the benchmark
+// stopped: Neo4j goes on with a query whose client went away)
+SHOW TRANSACTIONS YIELD transactionId, currentQuery
+WHERE NOT currentQuery CONTAINS 'SHOW TRANSACTIONS'
+RETURN transactionId;
+
+// terminate: the transactions $ids
+TERMINATE TRANSACTIONS $ids;

@@ -15,6 +15,7 @@ objects the events name), which the tests set on the Entity nodes.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 
 import numpy as np
 import pandas as pd
@@ -62,12 +63,27 @@ def _referenced(events: pd.DataFrame, kind: str) -> set[str]:
     return {name for names in cells for name in names}
 
 
-def logistics(n: int, seed: int = 3) -> ObjectLog:
-    rng = np.random.default_rng(seed)
-    activities = ["Register Customer Order", "Create Transport Document", "Book Vehicles",
-                  "Order Empty Containers", "Pick Up Empty Container", "Load Truck",
-                  "Drive to Terminal", "Weigh", "Place in Stock", "Bring to Loading Bay",
-                  "Load to Vehicle", "Depart"]  # fmt: skip
+LOGISTICS_ACTIVITIES = ["Register Customer Order", "Create Transport Document",
+                        "Book Vehicles", "Order Empty Containers", "Pick Up Empty Container",
+                        "Load Truck", "Drive to Terminal", "Weigh", "Place in Stock",
+                        "Bring to Loading Bay", "Load to Vehicle", "Depart"]  # fmt: skip
+LOGISTICS_SHARES = {"Container": 0.8, "Customer_Order": 0.5, "Forklift": 0.3, "Truck": 0.3,
+                    "Vehicle": 0.2}  # fmt: skip
+
+
+@dataclass(frozen=True)
+class _Draws:
+    """The logistics log as integers (no text per event): what :func:`logistics` builds at
+    once and :func:`write_logistics` writes a slice at a time, drawn in the same order."""
+
+    seconds: np.ndarray  # since START, sorted
+    activities: np.ndarray  # index into LOGISTICS_ACTIVITIES
+    pools: dict[str, np.ndarray]  # type -> object names
+    first: dict[str, np.ndarray]  # type -> index into its pool per event, -1: no object
+    second: dict[str, np.ndarray]  # type -> a second object's index, -1: none
+
+
+def _logistics_draws(rng: np.random.Generator, n: int) -> _Draws:
     pools = {
         "Container": _objects(rng, "cr", max(n // 6, 4)),
         "Customer_Order": _objects(rng, "co", max(n // 15, 4)),
@@ -75,13 +91,51 @@ def logistics(n: int, seed: int = 3) -> ObjectLog:
         "Truck": _objects(rng, "tr", 12),
         "Vehicle": _objects(rng, "vh", max(n // 60, 3)),
     }
-    shares = {"Container": 0.8, "Customer_Order": 0.5, "Forklift": 0.3, "Truck": 0.3,
-              "Vehicle": 0.2}  # fmt: skip
-    columns = _frame(rng, n, activities, 120)
+    seconds = np.sort(rng.integers(0, 120 * 86400, n))
+    # rng.choice over a list draws these same integers
+    activities = rng.integers(0, len(LOGISTICS_ACTIVITIES), n).astype(np.int8)
+    first, second = {}, {}
     for kind, pool in pools.items():
-        columns[kind] = _cells(rng, pool, n, shares[kind], 2 if kind == "Container" else 1)
-    events = pd.DataFrame(columns)
-    objects = {kind: pd.DataFrame({"id": sorted(_referenced(events, kind))}) for kind in pools}
+        # as _cells draws them: up to two distinct objects, none for 1 - share of the events
+        most = 2 if kind == "Container" else 1
+        sizes = rng.integers(1, most + 1, n)
+        one = rng.integers(0, len(pool), n)
+        stride = rng.integers(1, max(len(pool) // most, 1) + 1, n)
+        absent = rng.random(n) >= LOGISTICS_SHARES[kind]
+        first[kind] = np.where(absent, -1, one).astype(np.int32)
+        other = np.where(sizes > 1, (one + stride) % len(pool), -1)
+        second[kind] = np.where(absent, -1, other).astype(np.int32)
+        del sizes, one, stride, absent, other
+    return _Draws(seconds, activities, pools, first, second)
+
+
+def _logistics_events(draws: _Draws, start: int, stop: int) -> pd.DataFrame:
+    """Events ``start`` .. ``stop`` - 1 as text, the columns a CSV of the log has."""
+    columns = {
+        "time": (START + pd.to_timedelta(draws.seconds[start:stop], unit="s")).strftime(
+            "%Y-%m-%dT%H:%M:%SZ"
+        ),
+        "activity": np.array(LOGISTICS_ACTIVITIES, dtype=object)[draws.activities[start:stop]],
+        "event_id": [f"ev{i}" for i in range(start, stop)],
+    }
+    for kind, pool in draws.pools.items():
+        one, other = draws.first[kind][start:stop], draws.second[kind][start:stop]
+        cells = pd.Series(pool[np.maximum(one, 0)], dtype=object)
+        two = other >= 0
+        cells[two] = cells[two] + "," + pd.Series(pool[other[two]], dtype=object).to_numpy()
+        cells[one < 0] = None
+        columns[kind] = cells.tolist()
+    return pd.DataFrame(columns)
+
+
+def _logistics_objects(rng: np.random.Generator, draws: _Draws) -> dict[str, pd.DataFrame]:
+    """One table per type: the objects some event names, sorted by id, and their attributes
+    (drawn after the events, as :func:`logistics` always did)."""
+    objects = {}
+    for kind, pool in draws.pools.items():
+        named = np.concatenate([draws.first[kind], draws.second[kind]])
+        used = np.unique(named[named >= 0])
+        objects[kind] = pd.DataFrame({"id": sorted(pool[used].tolist())})
     containers = objects["Container"]
     containers["Status"] = rng.choice(["empty", "loaded", "in stock"], len(containers))
     containers["Weight"] = np.round(rng.uniform(1000, 30000, len(containers)), 1)
@@ -91,7 +145,30 @@ def logistics(n: int, seed: int = 3) -> ObjectLog:
     orders["Amount_of_Goods"] = rng.integers(100, 3000, len(orders))
     vehicles = objects["Vehicle"]
     vehicles["Capacity"] = rng.integers(10, 60, len(vehicles))
-    return ObjectLog(events, objects, list(pools))
+    return objects
+
+
+def logistics(n: int, seed: int = 3) -> ObjectLog:
+    rng = np.random.default_rng(seed)
+    draws = _logistics_draws(rng, n)
+    events = _logistics_events(draws, 0, n)
+    return ObjectLog(events, _logistics_objects(rng, draws), list(draws.pools))
+
+
+def write_logistics(n: int, folder: Path, seed: int = 3, chunk: int = 200_000) -> list[str]:
+    """:func:`logistics` written to ``folder`` a slice of ``chunk`` events at a time (the same
+    log, byte for byte, without holding its text): ``events.csv`` and ``objects/<Type>.csv``
+    (as ``robotale ingest --objects`` reads them). Returns the object types."""
+    rng = np.random.default_rng(seed)
+    draws = _logistics_draws(rng, n)
+    events = folder / "events.csv"
+    for start in range(0, n, chunk):
+        part = _logistics_events(draws, start, min(start + chunk, n))
+        part.to_csv(events, index=False, header=start == 0, mode="w" if start == 0 else "a")
+    (folder / "objects").mkdir(exist_ok=True)
+    for kind, table in _logistics_objects(rng, draws).items():
+        table.to_csv(folder / "objects" / f"{kind}.csv", index=False)
+    return list(draws.pools)
 
 
 def order_management(n: int, seed: int = 5) -> ObjectLog:

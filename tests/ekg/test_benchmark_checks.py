@@ -8,6 +8,7 @@ import signal
 import sys
 from pathlib import Path
 
+import pandas as pd
 import pytest
 from pandas import Timedelta
 
@@ -243,3 +244,85 @@ def test_the_live_benchmark_judges_growth_from_minutes_2_3_and_the_last_two(live
     flat = [(100.0 + s, 0.3) for s in range(360)]
     assert live.growth(flat) == (pytest.approx(1.0), pytest.approx(0.0))
     assert live.growth(flat[:300]) is None
+
+
+# -- aggregate.py: robotale's aggregation against the plain queries ----------------------------
+
+
+@pytest.fixture(scope="module")
+def aggregation():
+    return benchmark("aggregate")
+
+
+def test_the_aggregation_log_is_written_a_slice_at_a_time_as_it_is_made_whole(tmp_path):
+    """At 5M events the benchmark writes the logistics log a slice at a time: the same file and
+    object tables as the log made at once and written by pandas."""
+    from ocean_shaped import logistics, write_logistics
+
+    whole = logistics(1_000)
+    whole.events.to_csv(tmp_path / "whole.csv", index=False)
+    assert write_logistics(1_000, tmp_path, chunk=333) == whole.types
+    assert (tmp_path / "events.csv").read_bytes() == (tmp_path / "whole.csv").read_bytes()
+    for kind, table in whole.objects.items():
+        written = pd.read_csv(tmp_path / "objects" / f"{kind}.csv", dtype={"id": str})
+        pd.testing.assert_frame_equal(written, table)
+
+
+def test_robotale_and_the_plain_queries_are_checked_equal_and_a_changed_edge_told_apart(
+    tmp_path, capsys, neo4j_driver, log_name, aggregation
+):
+    from ocean_shaped import write_logistics
+
+    from robotale.cli import main
+    from robotale.ekg.connection import database
+
+    types = write_logistics(600, tmp_path)
+    code = main(["ingest", str(tmp_path / "events.csv"), "--log", log_name,
+                 "--entities", ",".join(types)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+    aggregation.set_attributes(neo4j_driver, tmp_path / "objects", log_name, types)
+    spec = aggregation.parse_spec(aggregation.LOGISTICS_SPEC)
+    aggregation.run_spec(neo4j_driver, log_name, spec)
+    ours = aggregation.output(neo4j_driver, log_name)
+    aggregation.restore(neo4j_driver, log_name, "robotale")
+    aggregation.run_plain(neo4j_driver, log_name)
+    theirs = aggregation.output(neo4j_driver, log_name)
+    # OCEAN's five steps: three container statuses, two order types twice, then events
+    assert len(ours[0]) > 3 + 2 + 2 + 12 and ours[1] > 100
+    assert ours == theirs
+    # one lifted edge counted once more on the plain side: the same number, another hash
+    neo4j_driver.execute_query(
+        "MATCH (a:Aggregate {log: $log})-[r:CORR]->() WITH r LIMIT 1 SET r.count = r.count + 1",
+        log=log_name,
+        database_=database(),
+    )
+    changed = aggregation.output(neo4j_driver, log_name)
+    assert changed[:2] == theirs[:2] and changed[2] != theirs[2]
+    aggregation.restore(neo4j_driver, log_name, "plain")
+    nothing = aggregation.hashlib.sha256().hexdigest()
+    assert aggregation.output(neo4j_driver, log_name) == ([], 0, nothing)
+
+
+def test_a_run_past_its_time_is_stopped_and_its_writes_removed(
+    tmp_path, capsys, neo4j_server, neo4j_driver, log_name, aggregation
+):
+    """A side still running at its time limit is ended (its process, its server-side
+    transactions) and said not to have finished; the graph is as before it."""
+    from ocean_shaped import write_logistics
+
+    from robotale.cli import main
+
+    types = write_logistics(300, tmp_path)
+    code = main(["ingest", str(tmp_path / "events.csv"), "--log", log_name,
+                 "--entities", ",".join(types)])  # fmt: skip
+    assert code == 0, capsys.readouterr().err
+
+    class NoServer:  # the test server's pid is not this test's to watch
+        def pid(self) -> int:
+            return 0
+
+    limits = aggregation.Limits(seconds=0.5, available=0)
+    run = aggregation.run_side("plain", neo4j_server, log_name, 0, limits, NoServer())
+    assert run.failed.startswith("did not finish in")
+    aggregation.restore(neo4j_driver, log_name, "plain")
+    assert aggregation.output(neo4j_driver, log_name)[:2] == ([], 0)
