@@ -21,6 +21,12 @@ run). Where events vanished (a log that shrank), every DF_C and BEGINS edge is w
 
 Events are told apart across updates by a hash of their values (every property but the id,
 which is a position), the n-th of equal rows matched to the n-th.
+
+The monitor tells each update how many first events are the last update's, row for row (it
+makes the run's events again from the earliest activity still open on, not whole): their
+keys, element ids, places and DF edges are taken over, and only the events after them are
+hashed and compared with the graph, so the update's own work follows what is new rather than
+the run's length. The graph and class tables are still made of the whole log.
 """
 
 from __future__ import annotations
