@@ -217,8 +217,8 @@ class GrowingLog:
         change = _Change(tables, classes, keys, self.stored, same)
         self.reused += same
         new = len(change.new)
-        if not new and len(keys.keys) == len(self.stored.nodes):
-            return 0  # the same events: their edges are the same too
+        if not new and keys.keys.tolist() == self.stored.keys.keys.tolist():
+            return 0  # the same events in the same places: their edges are the same too
         if not self.begun:
             self._begin(tables, classes)
             self.begun = True
