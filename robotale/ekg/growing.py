@@ -21,6 +21,12 @@ run). Where events vanished (a log that shrank), every DF_C and BEGINS edge is w
 
 Events are told apart across updates by a hash of their values (every property but the id,
 which is a position), the n-th of equal rows matched to the n-th.
+
+The monitor tells each update how many first events are the last update's, row for row (it
+makes the run's events again from the earliest activity still open on, not whole): their
+keys, element ids, places and DF edges are taken over, and only the events after them are
+hashed and compared with the graph, so the update's own work follows what is new rather than
+the run's length. The graph and class tables are still made of the whole log.
 """
 
 from __future__ import annotations
@@ -54,6 +60,7 @@ from robotale.ekg.tables import (
     class_tables,
     graph_tables,
     log_values,
+    utc_ticks,
 )
 from robotale.ekg.writelock import log_write_lock
 from robotale.errors import InputError, LogNotFound
@@ -73,9 +80,18 @@ class _Stored:
 
     nodes: dict[str, str] = field(default_factory=dict)  # event key -> element id
     placed: dict[str, tuple[str, int]] = field(default_factory=dict)  # key -> (id, order)
+    #: the log's events in order: their keys, hashes and element ids, and how many events
+    #: share each hash; the column types of the event table they were made of
+    keys: EventKeys = field(default_factory=lambda: EventKeys())
+    event_nodes: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=object))
+    dtypes: tuple[str, ...] = ()
     entities: dict[tuple[str, str], str] = field(default_factory=dict)  # (type, id) -> element
     classes: dict[tuple[str, str], str] = field(default_factory=dict)  # (type, id) -> element
-    df: set[tuple[str, str, str, str]] = field(default_factory=set)  # keys, type, entity id
+    #: the DF edges (their ends' keys, type, entity id), ordered by the later position of
+    #: their two ends, and those positions: the edges touching the events from a position
+    #: on are a tail of the list
+    df: list[tuple[str, str, str, str]] = field(default_factory=list)
+    df_last: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.int64))
     comm: set[tuple[str, str, str]] = field(default_factory=set)  # send, receive keys, msg id
     #: (source class, target class, entity type) element ids -> (count, mean, median seconds)
     df_c: EdgeValues = field(default_factory=dict)
@@ -85,18 +101,50 @@ class _Stored:
 
 @dataclass
 class _Change:
-    """One update: the log's tables now, their event keys, and the store before it."""
+    """One update: the log's tables now, their event keys, the store before it, and how
+    many of the first events are the last update's (``same``: the same values, ids and
+    places; only the events after them are compared with what the graph holds)."""
 
     tables: GraphTables
     classes: list[ClassTables]
-    keys: np.ndarray
+    keys: EventKeys
     before: _Stored
+    same: int = 0
     after: _Stored = field(default_factory=_Stored)
+    #: what the transaction changes of the store's dicts by event key, applied once it
+    #: committed (:meth:`commit`): a dict of the run's length is not copied each update,
+    #: and a transaction tried again finds the store as it was
+    replaced: list[tuple[dict[str, Any], list[str], dict[str, Any]]] = field(default_factory=list)
+
+    def commit(self) -> _Stored:
+        """The store after the update: each dict without the keys gone, with the new values."""
+        for held, gone, new in self.replaced:
+            for key in gone:
+                del held[key]
+            held.update(new)
+        return self.after
 
     @property
     def new(self) -> np.ndarray:
-        """Positions of the events the graph does not hold yet."""
-        return np.flatnonzero([key not in self.before.nodes for key in self.keys])
+        """Positions of the events the graph does not hold yet (none of the first ``same``)."""
+        tail = self.keys.keys[self.same :].tolist()
+        return self.same + np.flatnonzero([key not in self.before.nodes for key in tail])
+
+    @property
+    def tail(self) -> dict[str, int]:
+        """The positions of the events after the first ``same``, by key."""
+        return {key: self.same + k for k, key in enumerate(self.keys.keys[self.same :].tolist())}
+
+    def position(self, key: str, tail: dict[str, int]) -> int:
+        """Where the event ``key`` is now: among the ``tail`` or, before it, where it was."""
+        at = tail.get(key)
+        return self.before.placed[key][1] if at is None else at
+
+    @property
+    def gone(self) -> list[str]:
+        """The keys of the events the graph holds and the log no longer has."""
+        now = set(self.keys.keys[self.same :].tolist())
+        return sorted(k for k in self.before.keys.keys[self.same :].tolist() if k not in now)
 
 
 class GrowingLog:
@@ -121,6 +169,8 @@ class GrowingLog:
         self.summary: dict[str, Any] = {}
         self.types: list[str] = []
         self.keys: list[list[str]] = []
+        #: events whose keys and places updates took over from the last (for tests)
+        self.reused = 0
 
     @property
     def events(self) -> int:
@@ -143,9 +193,16 @@ class GrowingLog:
         delete_log(self.driver, self.name)
         delete_copies(self.name)
 
-    def update(self, log: pd.DataFrame) -> int:
+    def update(self, log: pd.DataFrame, same: int = 0) -> int:
         """Make the stored log the graph of ``log`` (a canonical event log: the whole run so
-        far); returns how many events were new. Nothing is written when nothing changed."""
+        far); returns how many events were new. Nothing is written when nothing changed.
+
+        ``same``: how many of the first rows of ``log`` are those of the log of the last
+        update, row for row (what :class:`~robotale.results.live.LiveEvents` keeps): their
+        keys and places are taken over and only the rows after them compared with the graph,
+        so the work in Python follows the rows made again, not the run's length. Taken as 0
+        when the event table's column types changed or a later row is older than one of them
+        (their DF edges could then change)."""
         if log.empty:
             return 0
         if not self.types:
@@ -155,16 +212,19 @@ class GrowingLog:
         check_keys(tables.events, self.keys)
         check_key_sizes(tables, self.keys)
         classes = [class_tables(tables, key) for key in self.keys]
-        change = _Change(tables, classes, event_keys(tables.events), self.stored)
+        same = _same(tables.events, self.stored, same)
+        keys = self.stored.keys.grown(tables.events, same)
+        change = _Change(tables, classes, keys, self.stored, same)
+        self.reused += same
         new = len(change.new)
-        if not new and len(change.keys) == len(self.stored.nodes):
-            return 0  # the same events: their edges are the same too
+        if not new and keys.keys.tolist() == self.stored.keys.keys.tolist():
+            return 0  # the same events in the same places: their edges are the same too
         if not self.begun:
             self._begin(tables, classes)
             self.begun = True
         summary = {"events": len(tables.events)} | log_values(tables.events)
         write_transaction(self.driver, self.name, _write, self.name, change, summary)
-        self.stored, self.log, self.summary = change.after, log, summary
+        self.stored, self.log, self.summary = change.commit(), log, summary
         return new
 
     def _begin(self, tables: GraphTables, classes: list[ClassTables]) -> None:
@@ -197,18 +257,58 @@ class GrowingLog:
         self._stack.close()
 
 
-def event_keys(events: pd.DataFrame) -> np.ndarray:
+@dataclass(frozen=True)
+class EventKeys:
     """One text per event that stays the same while the log grows: a 64-bit hash of its
     values but the id (a position), and how many equal events come before it. Texts of the
     values themselves cost ten times more; two different events share a hash with a chance
-    of about n²/2⁶⁵ (1 in 4·10⁹ for 100,000 events)."""
-    hashes = pd.util.hash_pandas_object(events.drop(columns="id"), index=False)
-    seen = hashes.groupby(hashes, sort=False).cumcount().to_numpy()
-    keys: np.ndarray = np.array(
-        [f"{h:016x}#{n}" for h, n in zip(hashes.to_numpy().tolist(), seen.tolist(), strict=True)],
-        dtype=object,
-    )
-    return keys
+    of about n²/2⁶⁵ (1 in 4·10⁹ for 100,000 events). With the hashes, and how many events
+    share each, so a grown log's keys are made of its new rows only."""
+
+    keys: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=object))
+    hashes: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=np.uint64))
+    counts: dict[int, int] = field(default_factory=dict)
+
+    def grown(self, events: pd.DataFrame, same: int) -> EventKeys:
+        """The keys of ``events``, whose first ``same`` rows are those these keys are of."""
+        counts = dict(self.counts)
+        for h in self.hashes[same:].tolist():  # the rows after them: gone or made again
+            counts[h] -= 1
+        tail = pd.util.hash_pandas_object(events.iloc[same:].drop(columns="id"), index=False)
+        hashes = tail.to_numpy().tolist()
+        keys = []
+        for h in hashes:
+            seen = counts.get(h, 0)
+            keys.append(f"{h:016x}#{seen}")
+            counts[h] = seen + 1
+        return EventKeys(
+            np.concatenate([self.keys[:same], np.array(keys, dtype=object)]),
+            np.concatenate([self.hashes[:same], np.array(hashes, dtype=np.uint64)]),
+            counts,
+        )
+
+
+def event_keys(events: pd.DataFrame) -> np.ndarray:
+    """The keys of ``events`` (:class:`EventKeys`) made of all of them."""
+    return EventKeys().grown(events, 0).keys
+
+
+def _same(events: pd.DataFrame, stored: _Stored, same: int) -> int:
+    """``same`` (how many first rows of ``events`` are the last update's, as the caller
+    says), or 0 where taking them over could be wrong: the column types changed (a value's
+    hash depends on its column's type), or a later event is older than one of them (it
+    would fall between them in an entity's DF chain)."""
+    same = min(same, len(events), len(stored.keys.keys))
+    if same <= 0 or _dtypes(events) != stored.dtypes:
+        return 0
+    ticks = utc_ticks(events)
+    if same < len(events) and ticks[same:].min() < ticks[:same].max():
+        return 0
+    return same
+
+
+def _dtypes(events: pd.DataFrame) -> tuple[str, ...]:
+    return tuple(f"{name}:{dtype}" for name, dtype in events.dtypes.items())
 
 
 def _write(
@@ -220,9 +320,10 @@ def _write(
 ) -> None:
     """The transaction of one update; fills ``change.after`` with what the graph then holds."""
     loader = Loader(None, name, None, between_batches, tx=tx)
-    tables, keys, before = change.tables, change.keys, change.before
+    tables, keys, before = change.tables, change.keys.keys, change.before
     after = _Stored(entities=dict(before.entities), classes=dict(before.classes))
-    gone = sorted(set(before.nodes) - set(keys))
+    after.keys, after.dtypes = change.keys, _dtypes(tables.events)
+    gone = change.gone
     if gone:
         deleted = [before.nodes[key] for key in gone]
         for statement in statements("ekg_live_delete_events"):
@@ -241,9 +342,16 @@ def _write(
         ids = kind.classes["id"].astype(str).tolist()
         after.classes |= {(kind.type, c): n for c, n in zip(ids, nodes, strict=True)}
     event_nodes = _events(loader, change, entity_nodes, class_nodes)
-    after.nodes = dict(zip(keys.tolist(), event_nodes.tolist(), strict=True))
-    after.placed = _renumber(tx, name, tables.events, keys, before, event_nodes)
-    after.df = _edges(loader, tx, name, tables, keys, event_nodes, before.df)
+    tail = change.tail
+    # the first ``same`` events' keys and element ids stay; the rest are the tail's
+    after.event_nodes = event_nodes
+    fresh = {key: event_nodes[at] for key, at in tail.items()}
+    # the events after the first ``same`` of the last update's replaced by the tail's
+    out = before.keys.keys[change.same :].tolist()
+    places = _renumber(tx, name, change, tail, event_nodes)
+    after.nodes, after.placed = before.nodes, before.placed
+    change.replaced = [(before.nodes, out, fresh), (before.placed, out, places)]
+    after.df, after.df_last = _edges(loader, tx, name, change, tail, event_nodes)
     after.comm = _comm(loader, tables, keys, event_nodes, before.comm)
     for kind, nodes in zip(change.classes, class_nodes, strict=True):
         between_batches()
@@ -302,8 +410,9 @@ def _events(
 ) -> np.ndarray:
     """The element ids of every event of the log, the new ones created now with their CORR
     and OBSERVED edges, under ids of their own until :func:`_renumber` places them."""
-    tables, keys, before = change.tables, change.keys, change.before
-    nodes = np.array([before.nodes.get(key) for key in keys.tolist()], dtype=object)
+    tables, keys, before, same = change.tables, change.keys.keys, change.before, change.same
+    tail = [before.nodes.get(key) for key in keys[same:].tolist()]
+    nodes = np.concatenate([before.event_nodes[:same], np.array(tail, dtype=object)])
     new = change.new
     if not len(new):
         return nodes
@@ -340,18 +449,19 @@ _PLACING = "\x00placing "
 def _renumber(
     tx: ManagedTransaction,
     name: str,
-    events: pd.DataFrame,
-    keys: np.ndarray,
-    before: _Stored,
+    change: _Change,
+    tail: dict[str, int],
     nodes: np.ndarray,
 ) -> dict[str, tuple[str, int]]:
     """Give every event whose id or position changed (and every new one) its own; moved
-    events first get ids of their own, so no two events share an id on the way."""
-    ids = events["id"].astype(str).tolist()
-    placed = {key: (ids[order], order) for order, key in enumerate(keys.tolist())}
-    moved = [k for k, (key, place) in enumerate(placed.items()) if before.placed.get(key) != place]
+    events first get ids of their own, so no two events share an id on the way. The first
+    ``change.same`` events keep theirs."""
+    before, keys, same = change.before, change.keys.keys, change.same
+    ids = change.tables.events["id"].iloc[same:].astype(str).tolist()
+    places = {key: (ids[at - same], at) for key, at in tail.items()}
+    moved = [at for key, at in tail.items() if before.placed.get(key) != places[key]]
     if not moved:
-        return placed
+        return places
     stored = [k for k in moved if keys[k] in before.placed]
     query = cypher("ekg_live_renumber")
     if stored:
@@ -366,57 +476,73 @@ def _renumber(
         query,
         log=name,
         nodes=nodes[moved].tolist(),
-        ids=[placed[keys[k]][0] for k in moved],
+        ids=[places[keys[k]][0] for k in moved],
         orders=moved,
     ).consume()
-    return placed
+    return places
 
 
 def _edges(
     loader: Loader,
     tx: ManagedTransaction,
     name: str,
-    tables: GraphTables,
-    keys: np.ndarray,
+    change: _Change,
+    tail: dict[str, int],
     nodes: np.ndarray,
-    before: set[tuple[str, str, str, str]],
-) -> set[tuple[str, str, str, str]]:
-    """The DF edges of the log now: those that vanished deleted, the new ones created."""
-    df = tables.df
-    now = set(
+) -> tuple[list[tuple[str, str, str, str]], np.ndarray]:
+    """The DF edges of the log now (see :attr:`_Stored.df`): those that vanished deleted, the
+    new ones created. Only the edges touching the events after the first ``change.same``
+    are compared: the edges between those events are the last update's (no later event is
+    older than they are, so none falls between them in a chain)."""
+    df, keys, before, same = change.tables.df, change.keys.keys, change.before, change.same
+    sources, targets = df["source"].to_numpy(), df["target"].to_numpy()
+    last = np.maximum(sources, targets)
+    touching = np.flatnonzero(last >= same)
+    touching = touching[np.argsort(last[touching], kind="stable")]
+    now = list(
         zip(
-            keys[df["source"].to_numpy()].tolist(),
-            keys[df["target"].to_numpy()].tolist(),
-            df["entityType"].astype(str).tolist(),
-            df["entityId"].astype(str).tolist(),
+            keys[sources[touching]].tolist(),
+            keys[targets[touching]].tolist(),
+            df["entityType"].take(touching).astype(str).tolist(),
+            df["entityId"].take(touching).astype(str).tolist(),
             strict=True,
         )
     )
-    known = set(keys.tolist())  # the edges of deleted events went with them
-    stale = [edge for edge in before - now if edge[0] in known and edge[1] in known]
-    at = {key: k for k, key in enumerate(keys.tolist())}
+    first = int(np.searchsorted(before.df_last, same))
+    held = set(before.df[first:])
+    fresh = set(now)
+    # the edges of deleted events went with them
+    stale = [e for e in held - fresh if _holds(change, tail, e[0]) and _holds(change, tail, e[1])]
     if stale:
         tx.run(
             cypher("ekg_live_delete_df"),
             log=name,
-            sources=[nodes[at[e[0]]] for e in stale],
-            targets=[nodes[at[e[1]]] for e in stale],
+            sources=[nodes[change.position(e[0], tail)] for e in stale],
+            targets=[nodes[change.position(e[1], tail)] for e in stale],
             entityTypes=[e[2] for e in stale],
             entityIds=[e[3] for e in stale],
         ).consume()
-    added = sorted(now - before)
+    added = sorted(fresh - held)
     for entity_type in sorted({e[2] for e in added}):
         part = [e for e in added if e[2] == entity_type]
         loader.run(
             "ekg_create_df",
             {
-                "sources": [nodes[at[e[0]]] for e in part],
-                "targets": [nodes[at[e[1]]] for e in part],
+                "sources": [nodes[change.position(e[0], tail)] for e in part],
+                "targets": [nodes[change.position(e[1], tail)] for e in part],
                 "entityIds": [e[3] for e in part],
             },
             entityType=entity_type,
         )
-    return now
+    return before.df[:first] + now, np.concatenate([before.df_last[:first], last[touching]])
+
+
+def _holds(change: _Change, tail: dict[str, int], key: str) -> bool:
+    """Whether the log now has the event ``key`` (one of the first ``same``, or the tail's)."""
+    if key in tail:
+        return True
+    place = change.before.placed.get(key)
+    return place is not None and place[1] < change.same
 
 
 def _comm(

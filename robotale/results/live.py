@@ -118,41 +118,31 @@ class _Kept:
     """What a reader holds of a live run: every tag and sample read so far, the events and
     activity instances made of the tags, and the replay built of them."""
 
-    tags: list[Tag] = field(default_factory=list)
-    heard: Heard = field(default_factory=lambda: Heard())
+    made: LiveEvents = field(default_factory=lambda: LiveEvents())
     positions: Positions = field(default_factory=Positions)
-    events: pd.DataFrame | None = None
-    #: :func:`activity_instances` of the run's events
-    found: pd.DataFrame | None = None
     replay: LiveReplay | None = None
-    #: which of :attr:`events` the run's messages were read of (:func:`carrying`), and what
-    #: :func:`case_messages` read of them
+    #: which of the run's events the run's messages were read of (:func:`carrying`), and
+    #: what :func:`case_messages` read of them
     carried: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=bool))
     told: tuple[pd.DataFrame, set[str]] | None = None
     #: how many times the run's events were made (the first look's and each one that
     #: found tags), for :func:`live_builds`
     builds: int = 0
 
+    @property
+    def tags(self) -> list[Tag]:
+        return self.made.tags
+
     def grow(self, name: str, tags: list[Tag]) -> tuple[pd.DataFrame, MissionRun]:
-        """Take the newly read ``tags`` in; the events and the run they make with the ones
-        held. Only the tail is made again, from the earliest activity still open at the last
-        look on, with the starts of the activities that straddle that moment (so their ends
-        pair as in the whole run): the events and instances before it are kept. The whole
-        run is made again when a new tag is older than that moment, or when the enrichment
-        and the activity instances would not pair the same starts across it."""
-        self.tags += tags
-        self.heard.add(tags)
-        fresh = self.heard.nanos[len(self.tags) - len(tags) :]
-        # made again whole when the tail will not do
-        made = self._made(name, self._tail(fresh)) or self._made(name, None)
-        assert made is not None  # the whole run is always made
-        events, found, unchanged, kept = made
+        """Take the newly read ``tags`` in; the events (:meth:`LiveEvents.add`) and the run
+        they make, the run's tables before the events made again taken over from the last
+        look's run."""
+        events, found, unchanged, kept = self.made.add(name, tags)
         events_of_run = run_events(events, name)
         run = lone_run(events_of_run, name, found, self._told(name, events_of_run, kept))
         before = self.replay.runs.get(name) if self.replay is not None else None
         if unchanged and before is not None:
             run.grown_from(before, unchanged, kept)
-        self.events, self.found = events, found
         return events, run
 
     def _told(self, name: str, events: pd.DataFrame, kept: int) -> tuple[pd.DataFrame, set[str]]:
@@ -167,6 +157,36 @@ class _Kept:
             self.told = case_messages(events[rows], name)
         self.carried = rows
         return self.told
+
+
+class LiveEvents:
+    """A live run's events made as its tags come (what :func:`tags_events` makes of every tag
+    heard so far), each time only the tail made again: from the earliest activity still open
+    at the last time on, with the starts of the activities that straddle that moment (so
+    their ends pair as in the whole run); the events and activity instances before it are
+    kept. The whole run is made again when a new tag is older than that moment, or when the
+    enrichment and the activity instances would not pair the same starts across it. The
+    reader of the pages and the monitor's graph each keep one."""
+
+    def __init__(self) -> None:
+        self.tags: list[Tag] = []
+        self.heard = Heard()
+        self.events: pd.DataFrame | None = None
+        #: :func:`activity_instances` of the run's events
+        self.found: pd.DataFrame | None = None
+
+    def add(self, name: str, tags: list[Tag]) -> tuple[pd.DataFrame, pd.DataFrame, int, int]:
+        """Take the newly heard ``tags`` in: the run's events and activity instances now, how
+        many of the first instances and how many of the first events are the last ones'
+        (kept as they were, row for row)."""
+        self.tags += tags
+        self.heard.add(tags)
+        fresh = self.heard.nanos[len(self.tags) - len(tags) :]
+        # made again whole when the tail will not do
+        made = self._made(name, self._tail(fresh)) or self._made(name, None)
+        assert made is not None  # the whole run is always made
+        self.events, self.found = made[0], made[1]
+        return made
 
     def _made(
         self, name: str, tail: tuple[int, np.ndarray] | None

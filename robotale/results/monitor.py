@@ -26,7 +26,7 @@ from robotale.fame_runtime.clock import RunningClock
 from robotale.fame_runtime.node import KEEP_ALL
 from robotale.fame_runtime.qos import DEFAULT_QOS
 from robotale.fame_runtime.tags import START, TAG_TYPE, Tag, tag_line, tag_topic
-from robotale.results.live import tags_events
+from robotale.results.live import LiveEvents
 from robotale.thresholds import LOW_BATTERY_PERCENT
 
 #: where alerts are published, as JSON text in a std_msgs/msg/String
@@ -84,6 +84,8 @@ class Monitor:
         self.alert_buses = [bus] if relay is None else [bus, relay]
         #: the live run's event knowledge graph, appended to every BATCH seconds
         self.graph = graph
+        #: the run's events as the graph was last given them, made again of its new tags only
+        self.graph_events = LiveEvents()
         self.tags: list[Tag] = []
         self.store_live = Writer(self._write_live)
         self.store_graph = Writer(self._write_graph)
@@ -183,8 +185,13 @@ class Monitor:
         self.live.poses(poses)
 
     def _write_graph(self, heard: list[Tag]) -> None:
+        """The graph given the events of the tags ``heard`` (all so far): made again from
+        the earliest activity still open on, the graph told how many first events are as
+        they were, so neither makes the whole run again each time."""
         assert self.graph is not None  # only started with a graph
-        self.graph.update(tags_events(self.live.name, heard))
+        made = self.graph_events
+        events, _, _, kept = made.add(self.live.name, heard[len(made.tags) :])
+        self.graph.update(events, same=kept)
 
     def finish(self) -> None:
         """The watch ended: the last tags, alerts and events stored, the live graph complete."""

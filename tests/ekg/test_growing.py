@@ -24,7 +24,7 @@ from robotale.ekg.keys import built_keys, default_entities
 from robotale.ekg.logs import delete_log, list_logs, log_info, stored_events
 from robotale.errors import InputError
 from robotale.fame_runtime.tags import Tag
-from robotale.results.live import tags_events
+from robotale.results.live import LiveEvents, tags_events
 
 T0 = 1_800_000_000.0
 
@@ -122,8 +122,12 @@ def relationships(driver, name: str) -> tuple[int, str]:
 def test_over_random_splits_every_relationship_is_the_one_go_builds(
     neo4j_driver, log_name, whole, monkeypatch, seed
 ):
+    """Grown as the monitor grows it: the events made again of the new tags only
+    (:class:`LiveEvents`), the update told how many first events are as they were; some
+    updates took events over that way (their keys and places not made again)."""
     tags, draw = recorded_tags(70, seed), random.Random(seed)
-    cuts = [*sorted(draw.sample(range(1, len(tags)), 5)), len(tags)]
+    cuts = [*sorted(draw.sample(range(1, len(tags)), 7)), len(tags)]
+    made = LiveEvents()
     incremental = []  # the DF_C edges each update found written already
     write_changed = growing_module._write_changed
 
@@ -136,8 +140,9 @@ def test_over_random_splits_every_relationship_is_the_one_go_builds(
     growing = GrowingLog(neo4j_driver, log_name)
     try:
         for cut in cuts:
-            log = tags_events("run", tags[:cut])
-            growing.update(log)
+            log, _, _, same = made.add("run", tags[len(made.tags) : cut])
+            growing.update(log, same=same)
+            log = tags_events("run", tags[:cut])  # the one go's, made independently
             build_in_one_go(neo4j_driver, log, whole)
             grown, expected = (
                 relationships(neo4j_driver, log_name),
@@ -151,3 +156,4 @@ def test_over_random_splits_every_relationship_is_the_one_go_builds(
         database_=database())[0]}  # fmt: skip
     assert {"DF", "COMM", "DF_C", "BEGINS"} <= kinds
     assert any(incremental)  # some updates kept the DF_C edges written before
+    assert growing.reused > 0  # some took the first events over
