@@ -2,7 +2,7 @@
 
     python benchmarks/ekg_build.py [--sizes 100000 1000000] [--baseline-sizes 20000 100000]
     python benchmarks/ekg_build.py --whole-command --sizes 100000 1000000 10000000
-        [--build auto|online|bulk]
+        [--build auto|online|bulk] [--promg-server stock|robotale]
     python benchmarks/ekg_build.py --df-c-only --sizes 100000 1000000 [--repeat 5]
 
 ``--whole-command`` times whole ``robotale ingest`` processes against PromG's whole build
@@ -143,6 +143,14 @@ def main() -> int:
         help="with --whole-command: the ingests' --build (auto, the default, as a user runs it)",
     )
     parser.add_argument(
+        "--promg-server",
+        default="stock",
+        choices=("stock", "robotale"),
+        help="with --whole-command: PromG's server as its users run it (stock: Neo4j's own "
+        "launcher and stock neo4j.conf, the default) or started by robotale's code (robotale's "
+        "JVM options); both with robotale's server's heap and page cache",
+    )
+    parser.add_argument(
         "--df-c-only",
         action="store_true",
         help="only part 3, at each of --sizes: directly-follows counts against pm4py",
@@ -152,7 +160,13 @@ def main() -> int:
         from whole_ingest import main as whole_command
 
         return whole_command(
-            args.sizes, max(args.repeat, 1), args.heap, args.promg_venv, args.pages, args.build
+            args.sizes,
+            max(args.repeat, 1),
+            args.heap,
+            args.promg_venv,
+            args.pages,
+            args.build,
+            args.promg_server,
         )
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
     if args.df_c_only:

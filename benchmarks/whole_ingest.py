@@ -1,14 +1,19 @@
 """The command a user runs, whole, against PromG's whole build of the same log.
 
     python benchmarks/ekg_build.py --whole-command [--sizes 100000 1000000] [--repeat 2]
-        [--pages background|visit] [--promg-venv VENV]
+        [--pages background|visit] [--promg-venv VENV] [--promg-server stock|robotale]
 
 For each size, ``ekg_build.py``'s synthetic log is written once as a CSV (robotale's input)
 and once as PromG's records (``peers.py``); then, interleaved (robotale, PromG, robotale,
-PromG ...) on emptied databases of two private servers: one with APOC for PromG
-(``peers.py``'s), and one without plugins for robotale, as robotale sets a server up for a
-user (plugins cost a restart the time to load their classes: about 27 s for APOC core and
-extended at 1M events and load 15, a cost robotale's user does not pay):
+PromG ...) on emptied databases of two private servers: one with APOC for PromG, and one
+without plugins for robotale, as robotale sets a server up for a user (plugins cost a restart
+the time to load their classes: about 27 s for APOC core and extended at 1M events and load
+15, a cost robotale's user does not pay). PromG's server is, with ``--promg-server stock``
+(the default), Neo4j as PromG's users run it: Neo4j's own launcher and stock ``neo4j.conf``
+(``stock_neo4j.py``: G1 and the other stock JVM options; only the ports, data folder,
+password and APOC changed, and the heap and page cache set as robotale's server's: the same
+memory); with ``--promg-server robotale``, a server started by robotale's own launch code
+(``peers.py``'s: robotale's JVM options, the parallel collector). The pairing is printed:
 
 - robotale: the process ``python -m robotale ingest LOG.csv --entities robot,msg_id
   --aggregate activity --build BUILD`` from its start to its exit (reading the CSV, the build,
@@ -56,6 +61,10 @@ sys.path.insert(0, str(HERE))
 import importer_bound  # noqa: E402
 import peers  # noqa: E402
 from ekg_build import event_properties, synthetic_log  # noqa: E402
+from stock_neo4j import describe_pairing, stock_neo4j  # noqa: E402
+
+#: how PromG's server is started: as its users run it (the default), or by robotale's code
+PROMG_SERVERS = ("stock", "robotale")
 
 #: the rows both builders make the same of one log: (row, robotale's key, PromG's key)
 SAME_ROWS = ("events", "entities", "CORR", "classes", "OBSERVED")
@@ -80,12 +89,15 @@ def main(
     venv: Path | None = None,
     pages: str = "background",
     build: str = "auto",
+    promg_server: str = "stock",
 ) -> int:
     # each line as it is printed: a run stopped from outside (a time limit, the kernel's
     # out-of-memory killer) leaves what was measured until then, not an empty output
     sys.stdout.reconfigure(line_buffering=True)  # type: ignore[union-attr]
     signal.signal(signal.SIGTERM, stopped)
     print(f"load average before: {os.getloadavg()[0]:.1f} on {os.cpu_count()} cores")
+    pairing = describe_pairing(promg_server, heap)
+    print(pairing)
     with tempfile.TemporaryDirectory(prefix="robotale-whole-") as folder:
         work = Path(folder)
         # the ingests' columnar copies and prepared pages in a home of the benchmark's own;
@@ -107,15 +119,24 @@ def main(
             with ExitStack() as stack:
                 theirs = None
                 if python is not None:
-                    peer, peer_server = stack.enter_context(peers.private_neo4j(work, heap))
-                    theirs = (peer, peer_server)
+                    theirs = stack.enter_context(promg_neo4j(promg_server, work, heap))
                 for size in sizes:
                     measure(
                         size, repeat, work, (ours, server), theirs, python, why_not, pages, build
                     )
+                    print(f"  ({pairing})")
             ours.release()
     print(f"load average after: {os.getloadavg()[0]:.1f}")
     return 0
+
+
+def promg_neo4j(kind: str, work: Path, heap: str):
+    """PromG's private server (``with``: its driver and server) of the pairing ``kind``."""
+    if kind == "stock":
+        return stock_neo4j(work / "promg-server", heap)
+    if kind == "robotale":
+        return peers.private_neo4j(work, heap)
+    raise ValueError(f"--promg-server {kind!r}: give one of {', '.join(PROMG_SERVERS)}")
 
 
 class Reconnecting:
