@@ -2,8 +2,10 @@
 of a drone and two tractors drawn at random, so every value per run the comparison tests
 (the run's duration, each activity's mean duration and count per robot type, each robot
 type's waits between two steps and how often it took each, the messages' latency, loss and
-resends, the battery each robot used, the variant it follows) is known here from the truth's
-own instances, messages and samples, never from the code under test; and many pairs of
+resends, the battery each robot used, the variant it follows; and, with positions written
+on a straight drive, each robot's distance, region and meetings) is known here from the
+truth's own instances, messages, samples and drives, never from the code under test; and
+many pairs of
 batches of the same settings, whose changes called significant are counted against the
 chance the procedure allows."""
 
