@@ -5,7 +5,9 @@ while the activities inside one run share its weeds, its batteries and its timin
 measure is therefore reduced to one value per run first (a run's duration; the mean duration
 of an activity in the run, per robot type; how often the run does it; the mean wait of a
 transition and how often the run takes it; the mean latency, the share lost and the resends
-of a message type; the battery a robot used; whether the run follows a variant), and B's runs
+of a message type; the battery a robot used; how far each robot type travelled, the area of
+the box its positions span and how often robots of two types met, the findings' third
+question; whether the run follows a variant), and B's runs
 are compared with A's by the Mann-Whitney U test (:func:`mann_whitney`: the statistic of
 :mod:`robotale.enhancement.effects`, for every measure at once) and by Welch's t-test of the
 means (:func:`welch`), which sees a mean moved by a few runs that the ranks barely notice;
@@ -42,6 +44,7 @@ from robotale.enhancement.battery import battery_perspective
 from robotale.enhancement.bottlenecks import ALPHA, MIN_SHARE, find_bottlenecks
 from robotale.enhancement.communication import communication_perspective
 from robotale.enhancement.context import LogAnalysis
+from robotale.enhancement.encounters import encounters, positions
 from robotale.enhancement.findings import seconds_text, trusted_first
 from robotale.enhancement.performance import (
     ARROW,
@@ -52,7 +55,7 @@ from robotale.enhancement.performance import (
     shared_cases,
     shared_steps,
 )
-from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, ROBOT_TYPE
+from robotale.eventlog.schema import ACTIVITY, CASE, ROBOT, ROBOT_TYPE, TIMESTAMP, X, Y, Z
 
 #: the measures, in the order of the tables; each compares one value per run
 MEASURES = (
@@ -65,8 +68,13 @@ MEASURES = (
     "message loss",
     "message resends",
     "battery used",
+    "distance travelled",
+    "region area",
+    "encounters",
     "variant share",
 )
+#: the measures of where the robots worked (the findings' third question)
+SPATIAL = ("distance travelled", "region area", "encounters")
 #: the measures in seconds, whose share is the time they add to a run
 TIMED = (
     "run duration",
@@ -106,6 +114,8 @@ class Batch:
     robots: list[str]
     values: dict[str, pd.DataFrame] = field(default_factory=dict)
     variants: pd.Series = field(default_factory=lambda: pd.Series(dtype=str))
+    #: whether the log has positions (x and y of a robot): without, nothing spatial is known
+    placed: bool = False
 
 
 @dataclass(slots=True)
@@ -149,6 +159,7 @@ def compare_logs(
         "runs": [len(first.runs), len(second.runs)],
         "robots": [first.robots, second.robots],
         "tested": int(changes["q_value"].notna().sum()),
+        "positions": [first.placed, second.placed],
         "significant": int((changes["q_value"] < ALPHA).sum()),
         "alpha": ALPHA,
     }
@@ -175,6 +186,8 @@ def batch(log: pd.DataFrame, name: str) -> Batch:
     found.values["transition frequency"] = _frequencies(steps, who, runs.index, "_step")
     found.values.update(_message_values(analysis))
     found.values["battery used"] = _battery_values(analysis)
+    found.placed, spatial = _spatial_values(log, who)
+    found.values.update(spatial)
     paths = shared_case_variants(analysis)
     found.variants = pd.Series(paths[VARIANT].to_numpy(), index=paths[CASE].astype(str))
     return found
@@ -268,6 +281,67 @@ def _battery_values(analysis: LogAnalysis) -> pd.DataFrame:
     )
 
 
+def _spatial_values(log: pd.DataFrame, who: Callable) -> tuple[bool, dict[str, pd.DataFrame]]:
+    """Whether the log has positions and, per run: how far each robot travelled (metres, in
+    3D, straight between consecutive positions, as :mod:`robotale.enhancement.spatial` takes
+    a path), the area of the x-y box its positions span (the findings' region, on the
+    ground), both as the mean of a robot type's robots and per robot where its type has
+    several (matched by name with the other batch's); and how many times robots of two
+    types met (an encounter of :mod:`robotale.enhancement.encounters`), per pair of
+    types."""
+    empty = {measure: _long([], [], [], []) for measure in SPATIAL}
+    placed = positions(log)
+    if placed.empty:
+        return False, empty
+    placed = placed.assign(
+        **{CASE: placed[CASE].astype(str), ROBOT: placed[ROBOT].astype(str)}
+    ).sort_values([CASE, ROBOT, TIMESTAMP], kind="stable")
+    xyz = placed[[X, Y, Z]].to_numpy(float)
+    same = (placed[CASE].to_numpy()[1:] == placed[CASE].to_numpy()[:-1]) & (
+        placed[ROBOT].to_numpy()[1:] == placed[ROBOT].to_numpy()[:-1]
+    )
+    # a step between two positions of one robot in one run; the first of each path is 0
+    steps = np.r_[0.0, np.where(same, np.sqrt((np.diff(xyz, axis=0) ** 2).sum(axis=1)), 0.0)]
+    paths = placed.assign(_step=steps).groupby([CASE, ROBOT], sort=True)
+    robots = paths.agg(
+        distance=("_step", "sum"), x0=(X, "min"), x1=(X, "max"), y0=(Y, "min"), y1=(Y, "max")
+    ).reset_index()
+    robots["area"] = (robots["x1"] - robots["x0"]) * (robots["y1"] - robots["y0"])
+    robots["_type"] = who(robots[ROBOT]).to_numpy()
+    # a robot on its own only where its type has several in the batch: else it is its type
+    kinds = robots.drop_duplicates(ROBOT)["_type"].value_counts()
+    own = robots[robots["_type"].map(kinds).gt(1) & robots[ROBOT].ne(robots["_type"])]
+    values = {}
+    for measure, column in (("distance travelled", "distance"), ("region area", "area")):
+        typed = robots.groupby(["_type", CASE], sort=True)[column].mean().reset_index()
+        values[measure] = _long(
+            [measure.split()[0]] * (len(typed) + len(own)),
+            [*typed["_type"], *own[ROBOT]],
+            [*typed[CASE], *own[CASE]],
+            [*typed[column], *own[column]],
+        )
+    values["encounters"] = _encounter_counts(placed, who)
+    return True, values
+
+
+def _encounter_counts(placed: pd.DataFrame, who: Callable) -> pd.DataFrame:
+    """Per run and pair of robot types, how many times two of their robots met; 0 in the
+    runs where none did (a run with positions)."""
+    runs = pd.Index(sorted(placed[CASE].unique()), name="run")
+    met = encounters(placed)
+    if met.empty:
+        return _long([], [], [], [])
+    kinds = np.sort(
+        np.c_[who(met["robot"].astype(str)).to_numpy(str), who(met["other"]).to_numpy(str)],
+        axis=1,
+    )
+    pairs = pd.Series([f"{a} and {b}" for a, b in kinds], index=met.index)
+    counts = pd.crosstab(met[CASE].astype(str).to_numpy(), pairs.to_numpy())
+    counts = counts.reindex(runs, fill_value=0).rename_axis(index="run", columns="who")
+    table = counts.stack().rename("value").reset_index()
+    return _long(["encounters"] * len(table), table["who"], table["run"], table["value"])
+
+
 def _long(subject, who, run, value) -> pd.DataFrame:
     return pd.DataFrame(
         {
@@ -307,8 +381,11 @@ def _values(part: Batch, other: Batch, side: int) -> pd.DataFrame:
     tables[0].insert(0, "measure", "run duration")
     for measure in MEASURES[1:-1]:
         values = part.values[measure]
-        if measure in ("activity frequency", "transition frequency"):
-            # a run without an activity did it 0 times, even when no run of its batch did it
+        if measure in ("activity frequency", "transition frequency") or (
+            measure == "encounters" and part.placed
+        ):
+            # a run without an activity did it 0 times, even when no run of its batch did it;
+            # robots that never met in a run with positions met 0 times
             values = _with_zeros(values, other.values[measure], part.runs.index)
         tables.append(values.assign(measure=measure))
     tables.append(_variant_values(part, other))
@@ -452,7 +529,10 @@ def _shares(table: pd.DataFrame, first: Batch, second: Batch) -> pd.Series:
     seconds = table["difference"].abs() * per_run
     shares = shares.where(~timed, seconds / run_time)
     proportions = table["measure"].isin(("message loss", "variant share"))
-    return shares.where(~proportions, table["difference"].abs()).astype(float)
+    shares = shares.where(~proportions, table["difference"].abs())
+    # robots that never met in A and meet in B: no relative change, a whole one
+    new = table["measure"].eq("encounters") & table["a"].eq(0) & table["difference"].ne(0)
+    return shares.where(~new, 1.0).astype(float)
 
 
 def _occurrences_per_run(table: pd.DataFrame, first: Batch, second: Batch) -> pd.Series:
@@ -553,6 +633,7 @@ def _sentences(
     sentences += _activity_sentences(first, second)
     sentences.append(_variant_sentence(variants, first, second))
     sentences.append(_bottleneck_sentence(bottlenecks, first.name, second.name))
+    sentences.append(_spatial_sentence(first, second, changes))
     tested = int(changes["q_value"].notna().sum())
     sure = int((changes["q_value"] < ALPHA).sum())
     ranked = int(changes["ranked"].sum())
@@ -654,6 +735,23 @@ def change_sentence(row: dict) -> str:
             f"{who} uses {percent} {how} battery per run ({row['b']:.1f} against "
             f"{row['a']:.1f} percentage points, {evidence})."
         )
+    if measure == "distance travelled":
+        how = "farther" if more else "less far"
+        return (
+            f"{who} {'travels' if who else 'travel'} {percent} {how} per run ({row['b']:.1f} m "
+            f"against {row['a']:.1f} m, {evidence})."
+        )
+    if measure == "region area":
+        how = "larger" if more else "smaller"
+        return (
+            f"{owner}region (the x-y box of its positions per run) is {percent} {how} "
+            f"({row['b']:.1f} m² against {row['a']:.1f} m², {evidence})."
+        )
+    if measure == "encounters":
+        return (
+            f"{who} robots meet {row['b']:.1f} times per run instead of {row['a']:.1f} "
+            f"({evidence})."
+        )
     return (
         f"{row['b']:.0%} of the runs follow the variant {_short(subject)} against "
         f"{row['a']:.0%} ({evidence})."
@@ -685,6 +783,30 @@ def _done(part: Batch) -> dict[tuple[str, str], int]:
         return {}
     did = counts[counts["value"] > 0].groupby(["subject", "who"])["run"].nunique()
     return {key: int(n) for key, n in did.items()}
+
+
+def _spatial_sentence(first: Batch, second: Batch, changes: pd.DataFrame) -> str:
+    """Where the robots worked: which batch has no positions, else whether any spatial
+    measure changed surely and largely (those changes are sentences of their own)."""
+    unplaced = [part.name for part in (first, second) if not part.placed]
+    if len(unplaced) == 2:
+        return (
+            f"Neither {first.name} nor {second.name} has positions, so where the robots "
+            "worked is not compared."
+        )
+    if unplaced:
+        return f"{unplaced[0]} has no positions, so where the robots worked is not compared."
+    spatial = changes[changes["measure"].isin(SPATIAL)]
+    moved, tested = int(spatial["ranked"].sum()), int(spatial["q_value"].notna().sum())
+    if moved:
+        return (
+            f"Where the robots worked changed in {moved} of {tested} spatial measures tested "
+            "(distance travelled, region area, encounters; above)."
+        )
+    return (
+        "Where the robots worked did not change significantly (distance travelled, region "
+        f"area and encounters per run, {tested} tested)."
+    )
 
 
 def _plural(number: int, noun: str) -> str:

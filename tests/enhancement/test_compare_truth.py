@@ -2,8 +2,10 @@
 of a drone and two tractors drawn at random, so every value per run the comparison tests
 (the run's duration, each activity's mean duration and count per robot type, each robot
 type's waits between two steps and how often it took each, the messages' latency, loss and
-resends, the battery each robot used, the variant it follows) is known here from the truth's
-own instances, messages and samples, never from the code under test; and many pairs of
+resends, the battery each robot used, the variant it follows; and, with positions written
+on a straight drive, each robot's distance, region and meetings) is known here from the
+truth's own instances, messages, samples and drives, never from the code under test; and
+many pairs of
 batches of the same settings, whose changes called significant are counted against the
 chance the procedure allows."""
 
@@ -253,3 +255,124 @@ def test_the_first_bottleneck_moved_to_the_injected_wait(tmp_path):
     assert moved[0].endswith(f"in B: {said}).")
     back = [s for s in compare_logs(full, calm).sentences if "first bottleneck" in s]
     assert back[0].startswith(f"The first bottleneck moved (in A: {said}; in B: ")
+
+
+# -- where the robots worked (the findings' third question) ----------------------------------
+
+#: each robot drives straight at this speed (m/s) along x, and half as fast along y, from its
+#: lane's start at the run's first event; the drone 10 m up, so it never meets a tractor
+SPEEDS = {"drone": 2.0, "tractor_1": 0.5, "tractor_2": 0.5}
+HEIGHT = {"drone": 10.0, "tractor_1": 0.0, "tractor_2": 0.0}
+
+
+def placed(log: pd.DataFrame, lanes: dict[str, float], scale: float = 1.0) -> pd.DataFrame:
+    """The log with a position on every event: ``scale`` times each robot's speed times the
+    seconds since its run began, in x, half that in y from the robot's lane."""
+    from robotale.eventlog.schema import CASE, ROBOT, TIMESTAMP
+
+    since = (log[TIMESTAMP] - log.groupby(CASE)[TIMESTAMP].transform("min")).dt.total_seconds()
+    speed = log[ROBOT].map(SPEEDS) * scale
+    return log.assign(
+        x=speed * since, y=log[ROBOT].map(lanes) + 0.5 * speed * since, z=log[ROBOT].map(HEIGHT)
+    )
+
+
+def spatial_truth(log: pd.DataFrame, scale: float) -> pd.DataFrame:
+    """(measure, subject, who, run) -> value: a robot drives straight, so its distance is
+    its speed (x and y together) times the seconds between its first and last event and its
+    region is the x and y it covered multiplied; a robot type's is its robots' mean, and a
+    robot has its own only beside another of its type."""
+    from robotale.eventlog.schema import CASE, ROBOT, TIMESTAMP
+
+    times = log.groupby([CASE, ROBOT])[TIMESTAMP]
+    seconds = (times.max() - times.min()).dt.total_seconds()
+    speed = seconds.index.get_level_values(ROBOT).map(SPEEDS).to_numpy() * scale
+    along_x = speed * seconds
+    robots = pd.DataFrame(
+        {"distance": np.hypot(1.0, 0.5) * along_x, "region": along_x * 0.5 * along_x}
+    ).reset_index()
+    rows = []
+    for measure, column in (("distance travelled", "distance"), ("region area", "region")):
+        for (case, robot), value in robots.set_index([CASE, ROBOT])[column].items():
+            if robot != "drone":  # the only drone is its type, Drone
+                rows.append((measure, column, robot, case, value))
+        typed = robots.assign(who=robots[ROBOT].map(ROBOTS)).groupby(["who", CASE])[column]
+        rows += [(measure, column, w, c, v) for (w, c), v in typed.mean().items()]
+    table = pd.DataFrame(rows, columns=["measure", "subject", "who", "run", "value"])
+    return table.set_index(["measure", "subject", "who", "run"])
+
+
+def meetings(log: pd.DataFrame) -> pd.Series:
+    """Per run, how many times the tractors met when they drive side by side 1 m apart:
+    each stretch of tractor_1's positions (in time order) with one of tractor_2's at most
+    1 s away, since within 1 s they are at most 1.8 m apart."""
+    from robotale.eventlog.schema import CASE, ROBOT, TIMESTAMP
+
+    counts = {}
+    for case, run in log.groupby(CASE):
+        mine = np.sort(run.loc[run[ROBOT] == "tractor_1", TIMESTAMP].to_numpy())
+        theirs = run.loc[run[ROBOT] == "tractor_2", TIMESTAMP].to_numpy()
+        gaps = np.abs(mine[:, None] - theirs[None, :]).min(axis=1)
+        near = gaps <= np.timedelta64(1, "s")
+        counts[case] = int(np.sum(near & ~np.r_[False, near[:-1]]))
+    return pd.Series(counts, dtype=float)
+
+
+@pytest.fixture(scope="module")
+def driven(tmp_path_factory):
+    """A with the tractors 50 m apart; B driving twice as far, its tractors side by side."""
+    folder = tmp_path_factory.mktemp("driven")
+    a, b = read(batch(3), folder, "a"), read(batch(4), folder, "b")
+    a = placed(a, {"drone": -100.0, "tractor_1": 0.0, "tractor_2": 50.0})
+    b = placed(b, {"drone": -100.0, "tractor_1": 0.0, "tractor_2": 1.0}, scale=2.0)
+    return a, b, compare_logs(a, b)
+
+
+def test_where_the_robots_worked_is_the_truths_per_run(driven):
+    a, b, comparison = driven
+    got = comparison.per_run.set_index(["measure", "subject", "who", "run"])
+    for side, log, scale in ((0, a, 1.0), (1, b, 2.0)):
+        expected = spatial_truth(log, scale)
+        mine = got[got["side"] == side]["value"]
+        mine = mine[mine.index.get_level_values("measure").isin(expected.index.levels[0])]
+        assert sorted(mine.index) == sorted(expected.index)
+        assert mine.sort_index().to_numpy() == pytest.approx(
+            expected["value"].sort_index().to_numpy(), rel=1e-9
+        )
+    met = got[got.index.get_level_values("measure") == "encounters"]
+    assert set(met.index.get_level_values("who")) == {"Tractor and Tractor"}
+    # A's tractors, 50 m apart, never meet: 0 in each of its runs
+    for side, expected in ((0, meetings(a) * 0), (1, meetings(b))):
+        counts = met[met["side"] == side]["value"].droplevel(["measure", "subject", "who"])
+        assert counts.sort_index().to_dict() == expected.sort_index().to_dict()
+
+
+def test_driving_twice_as_far_is_called_with_its_sign(driven):
+    a, b, comparison = driven
+    changes = comparison.changes.set_index(["measure", "subject", "who"])
+    for who in ("Drone", "Tractor", "tractor_1"):
+        row = changes.loc[("distance travelled", "distance", who)]
+        key = ("distance travelled", "distance", who)
+        truth = [spatial_truth(log, s).sort_index().xs(key)["value"]
+                 for log, s in ((a, 1.0), (b, 2.0))]  # fmt: skip
+        assert (row["a"], row["b"]) == pytest.approx([t.mean() for t in truth])
+        assert row["q_value"] < ALPHA and row["difference"] > 0 and row["ranked"]
+    assert any(s.startswith("Tractor travels ") and " farther per run" in s
+               for s in comparison.sentences)  # fmt: skip
+    met = changes.loc[("encounters", "encounters", "Tractor and Tractor")]
+    assert met["a"] == 0 and met["b"] > 0 and met["q_value"] < ALPHA
+    assert comparison.to_dict()["facts"]["positions"] == [True, True]
+
+
+def test_a_log_without_positions_says_so(driven, injected):
+    a, _, _ = driven
+    without = injected[2]
+    assert (
+        "Neither A nor B has positions, so where the robots worked is not compared."
+        in without.sentences
+    )
+    assert not without.changes["measure"].isin(("distance travelled", "encounters")).any()
+    one_sided = compare_logs(a, a.drop(columns=["x", "y", "z"]))
+    assert "B has no positions, so where the robots worked is not compared." in (
+        one_sided.sentences
+    )

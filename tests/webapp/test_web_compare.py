@@ -7,6 +7,7 @@ from __future__ import annotations
 import uuid
 
 import mission_findings as mission
+import pandas as pd
 import pytest
 from playwright.sync_api import expect
 
@@ -121,7 +122,8 @@ def test_compare_page_draws_each_batchs_runs(page, two_logs):
 
 def test_a_figure_names_its_unit(tmp_path):
     """The y axis of a measure's figure: counts per run for a frequency and for resends,
-    seconds for a duration or a wait, the measure itself for a share."""
+    seconds for a duration or a wait, metres for a distance or an area, the measure itself
+    for a share."""
     from robotale.eventlog.readers import read_log
     from robotale.webapp.views.compare import _figure
 
@@ -140,4 +142,13 @@ def test_a_figure_names_its_unit(tmp_path):
         key = ["measure", "subject", "who"]
         mine = values[(values[key] == first[key]).all(axis=1)]
         figure = _figure(measure, first["subject"], first["who"], mine, ("A", "B"))
+        assert figure["layout"]["yaxis"]["title"]["text"] == unit, measure
+    # where the robots worked (this mission has no positions: two runs written here)
+    for measure, unit in (
+        ("distance travelled", "metres per run"),
+        ("region area", "square metres"),
+        ("encounters", "times per run"),
+    ):
+        mine = pd.DataFrame({"run": ["r1", "r2"], "value": [1.0, 2.0], "side": [0, 1]})
+        figure = _figure(measure, "distance", "Tractor", mine, ("A", "B"))
         assert figure["layout"]["yaxis"]["title"]["text"] == unit, measure

@@ -26,6 +26,8 @@ CHANGE_COLUMNS = {
     "ranked": "ranked",
 }
 VARIANT_COLUMNS = {"variant": "variant", "runs_a": "runs of A", "runs_b": "runs of B", "status": ""}
+#: the figures' units of the measures of where the robots worked
+UNITS = {"distance travelled": "metres per run", "region area": "square metres"}
 #: how many changes the page draws as figures: the runs' durations, then the first changes
 FIGURES = 6
 
@@ -98,9 +100,9 @@ def _figure(
             }
         )
     # a frequency's share is counted in seconds, its values are counts
-    counted = measure.endswith("frequency") or measure == "message resends"
+    counted = measure.endswith("frequency") or measure in ("message resends", "encounters")
     timed = measure in TIMED or measure == "message latency"
-    unit = "times per run" if counted else "seconds" if timed else measure
+    unit = "times per run" if counted else "seconds" if timed else UNITS.get(measure, measure)
     layout = {"title": {"text": title}, "showlegend": False, "yaxis": {"title": {"text": unit}}}
     return {"data": data, "layout": layout, "measure": measure, "subject": subject, "who": who}
 
