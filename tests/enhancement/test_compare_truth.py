@@ -163,17 +163,21 @@ def injected(tmp_path_factory):
     return a, b, compare_logs(read(a, folder, "a"), read(b, folder, "b"))
 
 
+def assert_side_is(got, side, expected, **tolerance):
+    """One side's per-run values of the measures ``expected`` holds equal those values."""
+    mine = got[got["side"] == side]["value"]
+    mine = mine[mine.index.get_level_values("measure").isin(expected.index.levels[0])]
+    assert sorted(mine.index) == sorted(expected.index)
+    assert mine.sort_index().to_numpy() == pytest.approx(
+        expected["value"].sort_index().to_numpy(), **tolerance
+    )
+
+
 def test_every_value_per_run_is_the_truths(injected):
     a, b, comparison = injected
     got = comparison.per_run.set_index(["measure", "subject", "who", "run"])
     for side, truth, other in ((0, a, b), (1, b, a)):
-        expected = expected_per_run(truth, other)
-        mine = got[got["side"] == side]["value"]
-        mine = mine[mine.index.get_level_values("measure").isin(expected.index.levels[0])]
-        assert sorted(mine.index) == sorted(expected.index)
-        assert mine.sort_index().to_numpy() == pytest.approx(
-            expected["value"].sort_index().to_numpy(), abs=1e-6
-        )
+        assert_side_is(got, side, expected_per_run(truth, other), abs=1e-6)
 
 
 def test_the_injected_changes_are_called_with_their_direction(injected):
@@ -332,13 +336,7 @@ def test_where_the_robots_worked_is_the_truths_per_run(driven):
     a, b, comparison = driven
     got = comparison.per_run.set_index(["measure", "subject", "who", "run"])
     for side, log, scale in ((0, a, 1.0), (1, b, 2.0)):
-        expected = spatial_truth(log, scale)
-        mine = got[got["side"] == side]["value"]
-        mine = mine[mine.index.get_level_values("measure").isin(expected.index.levels[0])]
-        assert sorted(mine.index) == sorted(expected.index)
-        assert mine.sort_index().to_numpy() == pytest.approx(
-            expected["value"].sort_index().to_numpy(), rel=1e-9
-        )
+        assert_side_is(got, side, spatial_truth(log, scale), rel=1e-9)
     met = got[got.index.get_level_values("measure") == "encounters"]
     assert set(met.index.get_level_values("who")) == {"Tractor and Tractor"}
     # A's tractors, 50 m apart, never meet: 0 in each of its runs
