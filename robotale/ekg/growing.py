@@ -12,7 +12,7 @@ console and Discover read it while it grows.
 Usually a batch only extends each entity's DF chain from its last stored event; an event
 placed before stored ones (an in-progress sample, known once its activity completes, or a
 message's receive heard before its send) splices into the chain instead. DF_C and BEGINS are
-computed again from the whole log (an exact median needs every duration), but written only
+the whole log's (an exact median needs every duration: each pair's are kept), but written only
 where they changed: the edges written last are kept in memory, an edge whose count, mean,
 median or cases changed gets its new values, a new one is created and one the events no
 longer give is deleted. Neo4j's work per update thus follows what the batch touched, not
@@ -26,7 +26,10 @@ The monitor tells each update how many first events are the last update's, row f
 makes the run's events again from the earliest activity still open on, not whole): their
 keys, element ids, places and DF edges are taken over, and only the events after them are
 hashed and compared with the graph, so the update's own work follows what is new rather than
-the run's length. The graph and class tables are still made of the whole log.
+the run's length. The class tables are grown the same way
+(:class:`~robotale.ekg.classgrowth.GrowingClasses`: the first events' classes and instance
+edges kept, each class pair's seconds kept sorted, only the pairs the tail touches summed
+again); the graph tables are still made of the whole log.
 """
 
 from __future__ import annotations
@@ -49,6 +52,7 @@ from robotale.ekg.build import (
     write_begins,
     write_df_c,
 )
+from robotale.ekg.classgrowth import GrowingClasses, growing_classes
 from robotale.ekg.columnar import delete_copies, store_copy
 from robotale.ekg.connection import database
 from robotale.ekg.keys import built_keys, default_entities
@@ -57,7 +61,6 @@ from robotale.ekg.logs import LIVE, delete_log, log_exists, log_info
 from robotale.ekg.tables import (
     ClassTables,
     GraphTables,
-    class_tables,
     graph_tables,
     log_values,
     utc_ticks,
@@ -169,8 +172,12 @@ class GrowingLog:
         self.summary: dict[str, Any] = {}
         self.types: list[str] = []
         self.keys: list[list[str]] = []
+        #: what the events of the last update gave each key's class tables
+        self.classes: list[GrowingClasses] = []
         #: events whose keys and places updates took over from the last (for tests)
         self.reused = 0
+        #: instance DF edges the class tables took over from the last update (for tests)
+        self.classes_reused = 0
 
     @property
     def events(self) -> int:
@@ -211,11 +218,13 @@ class GrowingLog:
         tables = graph_tables(log, self.types)
         check_keys(tables.events, self.keys)
         check_key_sizes(tables, self.keys)
-        classes = [class_tables(tables, key) for key in self.keys]
         same = _same(tables.events, self.stored, same)
+        grown = [kept.grown(tables, same) for kept in self.classes or growing_classes(self.keys)]
+        classes = [made for _, made in grown]
         keys = self.stored.keys.grown(tables.events, same)
         change = _Change(tables, classes, keys, self.stored, same)
         self.reused += same
+        self.classes_reused += sum(int(np.searchsorted(kept.last, same)) for kept in self.classes)
         new = len(change.new)
         if not new and keys.keys.tolist() == self.stored.keys.keys.tolist():
             return 0  # the same events in the same places: their edges are the same too
@@ -225,6 +234,7 @@ class GrowingLog:
         summary = {"events": len(tables.events)} | log_values(tables.events)
         write_transaction(self.driver, self.name, _write, self.name, change, summary)
         self.stored, self.log, self.summary = change.commit(), log, summary
+        self.classes = [kept for kept, _ in grown]
         return new
 
     def _begin(self, tables: GraphTables, classes: list[ClassTables]) -> None:

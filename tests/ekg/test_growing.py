@@ -157,3 +157,4 @@ def test_over_random_splits_every_relationship_is_the_one_go_builds(
     assert {"DF", "COMM", "DF_C", "BEGINS"} <= kinds
     assert any(incremental)  # some updates kept the DF_C edges written before
     assert growing.reused > 0  # some took the first events over
+    assert growing.classes_reused > 0  # and their class tables' instance edges
