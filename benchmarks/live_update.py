@@ -8,17 +8,19 @@ each, starts and completes of survey, measure, report in turn) are made in memor
 moment of ``--at`` (seconds into the run) a monitor's graph is grown up to 20 s before it (an
 update every 10 s), then ``--updates`` updates follow, one per second of run, as the monitor
 makes them: the events made again of the new tags only (:class:`LiveEvents`) and the update
-told how many first events are as they were (``incremental``), against the events made of
-every tag heard and the update given the whole log (``whole``, what the monitor did before).
-The two ways and the moments are interleaved update by update. Neo4j is left out (its
+told how many first events are as they were (``incremental``), the same with the class tables
+made of the whole log at each update (``tablesbefore``, as before they were grown), and the
+events made of every tag heard and the update given the whole log, class tables whole
+(``whole``, what the monitor did first). The ways and the moments are interleaved update by
+update. Neo4j is left out (its
 transaction replaced by one that answers element ids): this measures the process' own part,
 which ran every second whatever Neo4j did.
 
 Printed per moment and way: the median and p90 CPU time of an update (this thread's) and its
 median wall time, the events held then; the growth of each way (its median CPU at the last
 moment over the first); the load average before and after. Checked after the updates: the
-incremental way's events equal those made of every tag, and its event keys and DF edges equal
-the whole way's.
+incremental way's events equal those made of every tag, its event keys and DF edges the whole
+way's, and its DF_C values (count, mean, median) those of ``tablesbefore``.
 """
 
 from __future__ import annotations
@@ -100,7 +102,31 @@ def _graph() -> Any:
     graph.driver, graph.name, graph.run, graph.begun = None, "run", "bench", True
     graph.stored, graph.log, graph.summary = _Stored(), None, {}
     graph.types, graph.keys, graph.reused = [], [], 0
+    graph.classes, graph.classes_reused = [], 0
     return graph
+
+
+class _WholeClasses:
+    """The class tables made of the whole log at each update, as before they were grown."""
+
+    last = np.empty(0, dtype=np.int64)
+
+    def __init__(self, key: list[str]) -> None:
+        self.key = key
+
+    def grown(self, tables: Any, _same: int) -> tuple[_WholeClasses, Any]:
+        from robotale.ekg.tables import class_tables
+
+        return self, class_tables(tables, self.key)
+
+
+def _whole_classes(graph: Any, events: Any) -> None:
+    """``graph`` makes its class tables of the whole log (from its first update on)."""
+    from robotale.ekg.keys import built_keys, default_entities
+
+    if not graph.classes:
+        keys = built_keys(default_entities(events.columns))
+        graph.classes = [_WholeClasses(key.split(",")) for key in keys]
 
 
 class Incremental:
@@ -117,6 +143,16 @@ class Incremental:
         self.graph.update(events, same=kept)
 
 
+class Tablesbefore(Incremental):
+    """The monitor's way with the class tables made of the whole log (as before they grew)."""
+
+    def upto(self, heard: int) -> None:
+        events, _, _, kept = self.made.add("run", self.tags[self.heard : heard])
+        self.heard = heard
+        _whole_classes(self.graph, events)
+        self.graph.update(events, same=kept)
+
+
 class Whole:
     """The way before: the events made of every tag heard, the whole log compared."""
 
@@ -126,7 +162,9 @@ class Whole:
     def upto(self, heard: int) -> None:
         from robotale.results.live import tags_events
 
-        self.graph.update(tags_events("run", self.tags[:heard]))
+        events = tags_events("run", self.tags[:heard])
+        _whole_classes(self.graph, events)
+        self.graph.update(events)
 
 
 def main() -> int:
@@ -144,7 +182,11 @@ def main() -> int:
     def heard(seconds: float) -> int:
         return int(np.searchsorted(stamps, T0 + seconds))
 
-    ways = {(way.__name__.lower(), at): way(tags) for at in args.at for way in (Incremental, Whole)}
+    ways = {
+        (way.__name__.lower(), at): way(tags)
+        for at in args.at
+        for way in (Incremental, Tablesbefore, Whole)
+    }
     for (_, at), side in ways.items():
         for seconds in np.arange(10.0, at - 20, 10.0):
             side.upto(heard(seconds))
@@ -164,7 +206,7 @@ def main() -> int:
               f"median {p50:6.1f} ms, p90 {p90:6.1f} ms; wall median "
               f"{1000 * np.median(wall[key]):6.1f} ms")  # fmt: skip
     first, last = min(args.at), max(args.at)
-    for way in ("incremental", "whole"):
+    for way in ("incremental", "tablesbefore", "whole"):
         ratio = np.median(cpu[(way, last)]) / np.median(cpu[(way, first)])
         print(f"growth of {way}: median CPU at {last:.0f} s over {first:.0f} s {ratio:.2f}x")
     print(f"check: {_check(ways, tags, heard, args)}")
@@ -180,13 +222,23 @@ def _check(ways: dict[tuple[str, float], Any], tags: list[Any], heard: Any, args
 
     for at in args.at:
         grown, whole = ways[("incremental", at)], ways[("whole", at)]
+        before = ways[("tablesbefore", at)].graph.stored
+        assert (len(before.df_c), len(before.begins)) == (
+            len(grown.graph.stored.df_c),
+            len(grown.graph.stored.begins),
+        ), at
+        assert sorted(before.df_c.values()) == sorted(grown.graph.stored.df_c.values()), at
         count = heard(at - 20 + args.updates)
         pd.testing.assert_frame_equal(grown.made.events, tags_events("run", tags[:count]))
         mine, theirs = grown.graph.stored, whole.graph.stored
         assert mine.keys.keys.tolist() == theirs.keys.keys.tolist(), at
         assert set(mine.df) == set(theirs.df) and len(mine.df) == len(theirs.df), at
         assert grown.graph.reused > 0, "the first events were never taken over"
-    return "events, event keys and DF edges equal the whole way's at every moment: yes"
+        assert grown.graph.classes_reused > 0, "the class tables' edges were never kept"
+    return (
+        "events, event keys and DF edges equal the whole way's, DF_C values those of the "
+        "class tables made whole, at every moment: yes"
+    )
 
 
 if __name__ == "__main__":

@@ -477,9 +477,16 @@ def _df_c(tables: GraphTables, codes: np.ndarray) -> pd.DataFrame:
 
 
 def _entries(starts: pd.DataFrame, codes: np.ndarray) -> pd.DataFrame:
-    begins = pd.DataFrame({"entity": starts["entity"].to_numpy()})
-    begins["class"] = codes[starts["event"].to_numpy()]
-    return begins.groupby(["entity", "class"], sort=True).size().rename("cases").reset_index()
+    """``entity``, ``class``, ``cases``: how often each entity begins at each class, ordered
+    by entity and class (one integer per pair: numpy counts it faster than a pandas groupby,
+    a fixed cost each live update pays)."""
+    entity = starts["entity"].to_numpy(dtype=np.int64)
+    found = codes[starts["event"].to_numpy()].astype(np.int64)
+    classes = int(codes.max()) + 1 if len(codes) else 1
+    pairs, cases = np.unique(entity * classes + found, return_counts=True)
+    return pd.DataFrame(
+        {"entity": pairs // classes, "class": pairs % classes, "cases": cases.astype(np.int64)}
+    )
 
 
 #: what the Log node keeps of a log's values (Discover's filters, the Model page's robots)
