@@ -9,6 +9,7 @@ derived keys of robot logs (grid cell, region, time window, value band) are comp
 from __future__ import annotations
 
 import datetime as dt
+import itertools
 from collections import Counter
 from collections.abc import Callable, Sequence
 
@@ -183,7 +184,10 @@ def attribute_values(
     left out, as Cypher's aggregating functions leave out nulls."""
     outputs = attr.outputs()
     if attr.function == "MULTISET":
-        return [(outputs[0], [multiset(part) for _, part in values.groupby(labels, sort=True)])]
+        found = _text_multisets(values, labels)
+        if found is None:
+            found = [multiset(part) for _, part in values.groupby(labels, sort=True)]
+        return [(outputs[0], found)]
     if attr.function in ("SUM", "AVG"):
         numbers = pd.to_numeric(values, errors="coerce")
         if (numbers.isna() & values.notna()).any():
@@ -221,6 +225,29 @@ def multiset(values: Sequence[object] | pd.Series) -> list[str]:
     in the order of the values' text."""
     counts = Counter(str(_plain(v)) for v in values if not _missing(v))
     return [f"{value}:{count}" for value, count in sorted(counts.items())]
+
+
+def _text_multisets(values: pd.Series, labels: np.ndarray) -> list[object] | None:
+    """:func:`multiset` of each group of ``labels`` (in the order of ``groupby(labels,
+    sort=True)``) when every value is text (an entity's ids are), counted on integer codes:
+    a Counter per group cost a Python call per value. None for other values, whose text may
+    join values that are unequal (``1`` and ``"1"``)."""
+    if pd.api.types.infer_dtype(values, skipna=True) not in ("string", "empty"):
+        return None
+    groups, names = pd.factorize(labels, sort=True)  # groupby's order; -1: no group
+    # sorted as Python sorts texts (by code point), the order multiset() writes them in
+    codes, texts = pd.factorize(values, sort=True)  # -1: missing, left out
+    keep = (groups >= 0) & (codes >= 0)
+    width = max(len(texts), 1)
+    pairs, counts = np.unique(
+        groups[keep].astype(np.int64) * width + codes[keep], return_counts=True
+    )
+    group, text = np.divmod(pairs, width)
+    words = np.asarray(texts, dtype=object)[text]
+    items = [f"{word}:{count}" for word, count in zip(words, counts.tolist(), strict=True)]
+    bounds = np.searchsorted(group, np.arange(len(names) + 1)).tolist()
+    lists: list[object] = [items[a:b] for a, b in itertools.pairwise(bounds)]
+    return lists
 
 
 def _missing(value: object) -> bool:

@@ -513,10 +513,11 @@ def _member_parts(table: pd.DataFrame, edges: LogEdges) -> list[list[_Part]]:
     of at most :data:`MEMBERS_PART`."""
     parts: list[list[_Part]] = []
     for aggregate, group in zip(table["id"], table["members"], strict=True):
-        keys = edges.keys[np.asarray(group, dtype=np.int64)]
+        # the keys are texts already: one list of them, sliced, instead of a str() per member
+        keys = edges.keys[np.asarray(group, dtype=np.int64)].tolist()
         parts.append(
             [
-                (aggregate, part, [str(k) for k in keys[start : start + MEMBERS_PART]])
+                (aggregate, part, keys[start : start + MEMBERS_PART])
                 for part, start in enumerate(range(0, len(keys), MEMBERS_PART))
             ]
         )
