@@ -89,3 +89,17 @@ def test_reading_the_csv_is_checked_against_pandas_and_a_changed_file_told_apart
     moved = tmp_path / "moved.csv"
     later.to_csv(moved, index=False)
     assert not read_csv.same(ours, read_csv.pandas_read(moved))
+
+
+def test_the_bpmn_benchmark_checks_both_models_hold_the_same_activities(log):
+    bpmn = benchmark("discover_bpmn")
+    typed = bpmn.typed(log)
+    ours, theirs = bpmn.robotale_run(typed), bpmn.pm4py_from_log(typed)
+    # by hand: the activities of the log's start events
+    started = set(log.loc[log[schema.LIFECYCLE].eq("start"), schema.ACTIVITY])
+    assert ours == theirs == started
+    assert bpmn.same_activities({"robotale": ours, "pm4py": theirs})
+    # pm4py given the log without one activity: another model
+    gone = sorted(started)[0]
+    fewer = bpmn.pm4py_from_log(typed[typed[schema.ACTIVITY].ne(gone)])
+    assert not bpmn.same_activities({"robotale": ours, "pm4py": fewer})
