@@ -103,3 +103,20 @@ def test_the_bpmn_benchmark_checks_both_models_hold_the_same_activities(log):
     gone = sorted(started)[0]
     fewer = bpmn.pm4py_from_log(typed[typed[schema.ACTIVITY].ne(gone)])
     assert not bpmn.same_activities({"robotale": ours, "pm4py": fewer})
+
+
+def test_the_compare_benchmark_checks_the_runs_mean_durations_against_the_findings():
+    from robotale.enhancement.compare import compare_logs
+    from robotale.enhancement.findings import find
+
+    compare = benchmark("compare")
+    template = benchmark("dashboard").thesis_runs(3_000)
+    first, second = compare.batch(template, 3_000, 1, 1.0), compare.batch(template, 3_000, 2, 1.1)
+    reported, means = compare.mean_durations(
+        compare_logs(first, second), [find(first), find(second)]
+    )
+    assert reported == pytest.approx(means)
+    # the findings of a slower batch: other work, told apart
+    slower = compare.batch(template, 3_000, 2, 1.3)
+    _, other = compare.mean_durations(compare_logs(first, second), [find(first), find(slower)])
+    assert reported != pytest.approx(other)
