@@ -76,6 +76,11 @@ def pm4py_from_log(log) -> set[str]:
     return pm4py_run(starts)
 
 
+def same_activities(outputs: dict[str, set[str]]) -> bool:
+    """Whether every side's model holds the same activities."""
+    return len({frozenset(found) for found in outputs.values()}) == 1
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--sizes", type=int, nargs="+", default=[10_000, 100_000])
@@ -108,7 +113,7 @@ def main() -> None:
                 outputs[name] = run(data)
                 cpu[name].append(time.process_time() - began_cpu)
                 wall[name].append(time.perf_counter() - began)
-        same = len({frozenset(found) for found in outputs.values()}) == 1
+        same = same_activities(outputs)
         best = {name: min(times) for name, times in wall.items()}
         best_cpu = {name: min(times) for name, times in cpu.items()}
         paired = statistics.median(

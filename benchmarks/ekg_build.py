@@ -26,7 +26,8 @@ usual cache) and, in the same run:
    ratio to the thesis' (target: at least 5x at 20k and at 100k). The thesis' queries get
    ``--thesis-limit`` seconds per size; a size they cannot finish in that time is reported
    as such, with a quadratic extrapolation from the largest size they finished, labelled as
-   an extrapolation;
+   an extrapolation. The events, entities, CORR and DF edges of each finished thesis build
+   are counted against robotale's and the differences printed (the thesis' DF crosses runs);
 3. times the directly-follows counts by activity as an ingest computes them, from the event
    table (DF edges, classes, DF_C) against ``pm4py.discover_dfg`` on the same DataFrame with
    each robot's flow in each run as a case, interleaved, wall and CPU time, the two DFGs
@@ -298,15 +299,12 @@ def compare_with_thesis(
     log = synthetic_log(size)
     entities = ["case", "robot", "msg_id"]
     repeat = repeat if size <= 20_000 else 1
-    ours, theirs = [], []
+    ours, theirs, graphs = [], [], []
     for _ in range(repeat):  # in turns (A B A B), so a busy machine slows both alike
-        ours.append(
-            (
-                timed_build(driver, log, "bench_same", entities, aggregate=())[0],
-                timed_build(driver, log, "bench_whole", entities)[0],
-            )
-        )
-        theirs.append(thesis_build(driver, log, entities, limit))
+        same, summary = timed_build(driver, log, "bench_same", entities, aggregate=())
+        ours.append((same, timed_build(driver, log, "bench_whole", entities)[0]))
+        theirs.append(thesis_build(driver, log, entities, limit, graphs))
+    differ = [d for graph in graphs for d in same_graph(built_counts(log, summary), graph)]
     same_work, whole = (min(times) for times in zip(*ours, strict=True))
     if None in theirs:
         if finished is None:
@@ -330,12 +328,35 @@ def compare_with_thesis(
         f"the same entity types {', '.join(entities)} on both sides; load average "
         f"{os.getloadavg()[0]:.1f})"
     )
+    said = "; ".join(dict.fromkeys(differ)) if differ else "the same"
+    print(f"  events, entities, CORR and DF of the {len(graphs)} finished thesis builds: {said}")
     return finished
 
 
-def thesis_build(driver, log: pd.DataFrame, entity_types: list[str], limit: float) -> float | None:
+SAME_WORK = ("events", "entities", "corr", "df")
+
+
+def built_counts(log: pd.DataFrame, summary) -> dict[str, int]:
+    """robotale's events, entities, CORR and DF edges, from its build's summary."""
+    entities, df = sum(summary.entities.values()), sum(summary.df.values())
+    return {"events": len(log), "entities": entities, "corr": summary.corr, "df": df}
+
+
+def same_graph(ours: dict[str, int], theirs: dict[str, int]) -> list[str]:
+    """Where robotale's graph and the thesis' differ in SAME_WORK's counts (empty: none)."""
+    return [
+        f"{what}: robotale {ours[what]:,}, thesis {theirs[what]:,}"
+        for what in SAME_WORK
+        if ours[what] != theirs[what]
+    ]
+
+
+def thesis_build(
+    driver, log: pd.DataFrame, entity_types: list[str], limit: float, graphs: list | None = None
+) -> float | None:
     """The thesis' queries (section 7.1.2) on an empty database; returns their seconds, or
-    None when they took longer than ``limit`` (Neo4j stops them)."""
+    None when they took longer than ``limit`` (Neo4j stops them). A finished build's counts
+    (``ekg_thesis_counts``) are added to ``graphs`` before it is removed."""
     from neo4j import Query
     from neo4j.exceptions import Neo4jError
 
@@ -362,6 +383,8 @@ def thesis_build(driver, log: pd.DataFrame, entity_types: list[str], limit: floa
         if "timeout" not in str(error).lower() and "terminated" not in str(error).lower():
             raise
         seconds = None
+    if seconds is not None and graphs is not None:
+        graphs.append(driver.execute_query(cypher("ekg_thesis_counts")).records[0].data())
     with driver.session() as session:
         session.run(cypher("ekg_thesis_cleanup")).consume()
     return seconds
