@@ -25,6 +25,11 @@ ENVIRONMENT = "ROBOTALE_TIMINGS"
 #: the Neo4j server's process id, or None while none runs (set by :func:`watch_server`)
 _server: list[Callable[[], int | None]] = []
 
+#: the watched server's (process id, CPU seconds) when watching began: a stage that began
+#: before (the command's own, around the whole command) counts the server from then on, not
+#: the CPU it spent starting and in earlier commands
+_watched_from: list[tuple[int, float]] = []
+
 
 def enabled() -> bool:
     return os.environ.get(ENVIRONMENT, "") not in ("", "0")
@@ -34,6 +39,8 @@ def watch_server(pid: Callable[[], int | None]) -> None:
     """Count the CPU time of the server whose process id ``pid()`` gives (asked at each
     stage's start and end: a restart makes a new process, whose time counts from its start)."""
     _server[:] = [pid]
+    began = _server_cpu() if enabled() else None
+    _watched_from[:] = [began] if began is not None else []
 
 
 @contextmanager
@@ -75,8 +82,8 @@ def _server_cpu() -> tuple[int, float] | None:
 def _server_spent(before: tuple[int, float] | None, after: tuple[int, float] | None) -> float:
     if after is None:
         return 0.0
-    if before is None or before[0] != after[0]:  # started (again) within the stage
-        return after[1]
+    if before is None or before[0] != after[0]:  # watched or started (again) within the stage
+        return after[1] - dict(_watched_from).get(after[0], 0.0)
     return after[1] - before[1]
 
 

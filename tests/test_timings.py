@@ -43,6 +43,23 @@ def test_a_stage_prints_the_cpu_time_the_kernel_counted(monkeypatch, capsys):
     assert float(found["children"]) == 0.0
 
 
+def test_a_server_watched_within_a_stage_counts_from_then(monkeypatch, capsys):
+    # the command's stage opens before the ingest names its server: the CPU the server spent
+    # before (its start, earlier commands) is not this command's
+    monkeypatch.setenv(timings.ENVIRONMENT, "1")
+    monkeypatch.setattr(timings, "_server", [])
+    monkeypatch.setattr(timings, "_watched_from", [])
+    _busy(0.3)  # this process stands for the server: CPU spent before it is watched
+    with timings.stage("the command"):
+        timings.watch_server(os.getpid)
+        before = _own_cpu()
+        _busy(0.2)
+        spent = _own_cpu() - before
+    found = LINE.search(capsys.readouterr().err)
+    assert found is not None
+    assert abs(float(found["server"]) - spent) < 0.05
+
+
 def test_nothing_is_printed_unless_asked(monkeypatch, capsys):
     monkeypatch.setenv(timings.ENVIRONMENT, "0")
     with timings.stage("quiet"):
