@@ -44,7 +44,7 @@ from neo4j.time import DateTime
 
 from robotale.ekg.build import ensure_schema, undo_after_failure
 from robotale.ekg.columnar import build_of
-from robotale.ekg.connection import database
+from robotale.ekg.connection import database, read_autocommit
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.lift import FREE, LogEdges
@@ -65,6 +65,8 @@ MEMBERS_PART = 100_000
 #: Neo4j creates edges on one node from two transactions without waiting (measured on a
 #: busy 2-core machine: no slower than one at a time; on a quiet one the second core helps)
 LIFT_WORKERS = 2
+#: the most lifted edges a step writes in one transaction per worker
+LIFT_BATCH_MOST = 10_000
 #: what a run reads in the transaction that takes the log's lock (parameters ``$log`` and
 #: ``$types``, the entity types its steps name): the Log node's description and counts, the
 #: steps stored, the build its columnar copy belongs to, the entities' property keys
@@ -402,10 +404,8 @@ def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.Da
         "times": [t for t in plan.times if t in reads],
         "type": step.ent_type,
     }
-    records, _, _ = driver.execute_query(
-        text, {**condition.parameters, **parameters}, database_=database()
-    )
-    row = records[0]
+    # with the lock held: one round trip, no commit of its own
+    row = read_autocommit(driver, text, {**condition.parameters, **parameters})[0]
     values = row["values"]
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
     codes = edges.entity_codes(str(step.ent_type), [str(i) for i in row["ids"]])
@@ -476,7 +476,9 @@ def _write_lifted(
     reached = np.where(pd.isna(edges.element_ids[source]), target, source)
     order = np.argsort(reached, kind="stable")
     lifted, source, target = lifted.iloc[order], source[order], target[order]
-    loader = Loader(driver, log, None, between_batches, workers=LIFT_WORKERS)
+    loader = Loader(
+        driver, log, None, between_batches, workers=LIFT_WORKERS, batch=_lift_batch(len(lifted))
+    )
     loader.run(
         "aggr_create_lifted",
         {
@@ -489,6 +491,15 @@ def _write_lifted(
         },
         step=number,
     )
+
+
+def _lift_batch(edges: int) -> int:
+    """Rows per transaction of a step's ``edges`` lifted edges: one batch per worker when
+    those are at most :data:`LIFT_BATCH_MOST` rows each (each batch costs two round trips,
+    its query and its commit: at 35k events batches of :data:`BATCH` were most of the run's
+    round trips), else :data:`BATCH` as before (a large step's transactions keep their size)."""
+    each = -(-edges // LIFT_WORKERS)
+    return max(BATCH, each) if each <= LIFT_BATCH_MOST else BATCH
 
 
 def _relink(driver: Driver, log: str, edges: LogEdges, steps: range, freed: np.ndarray) -> None:
@@ -589,8 +600,8 @@ def _ensure_schema(driver: Driver) -> None:
     seen = _SCHEMA_SEEN.setdefault(driver, set())
     if database() in seen:
         return
-    records, _, _ = driver.execute_query(
-        cypher("aggr_schema_present"), names=_AGGREGATION_CONSTRAINTS, database_=database()
+    records = read_autocommit(
+        driver, cypher("aggr_schema_present"), {"names": _AGGREGATION_CONSTRAINTS}
     )
     if int(records[0]["present"]) < len(_AGGREGATION_CONSTRAINTS):
         ensure_schema(driver)
