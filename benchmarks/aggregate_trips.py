@@ -10,10 +10,11 @@ the rows sent (the longest list parameter), whether rows came back, the server's
 sending to the summary; a commit is a round trip of its own and is printed as one.
 
 With ``--ab`` the runs alternate between robotale as it is (B) and its round-trip structure
-before the reads' commits were dropped and a small step's lifted edges were written one
-batch per worker (A, restored by replacing those functions), each run's output checked
-equal to the first's; each run's wall time, its process's and Neo4j's CPU time and the load
-are printed, and the best of each.
+before the reads' commits were dropped, a small step's lifted edges were written one batch
+per worker and the entity steps' reads were started beside the columnar copy's (A, restored
+by replacing those functions), each run's output checked equal to the first's; each
+run's wall time, its process's and Neo4j's CPU time and the load are printed, and the best
+of each.
 """
 
 from __future__ import annotations
@@ -124,12 +125,14 @@ def read_with_commit(driver, query, parameters):  # type: ignore[no-untyped-def]
     return records
 
 
-NOW = (steps.read_autocommit, lift.read_autocommit, steps._lift_batch)
-BEFORE = (read_with_commit, read_with_commit, lambda edges: BATCH)
+NOW = (steps.read_autocommit, lift.read_autocommit, steps._lift_batch, steps._start_entity_reads)
+BEFORE = (read_with_commit, read_with_commit, lambda edges: BATCH, lambda *_: {})
 
 
 def use(functions) -> None:  # type: ignore[no-untyped-def]
-    steps.read_autocommit, lift.read_autocommit, steps._lift_batch = functions
+    (steps.read_autocommit, lift.read_autocommit, steps._lift_batch, steps._start_entity_reads) = (
+        functions
+    )
 
 
 def print_trips() -> None:
