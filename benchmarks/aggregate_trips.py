@@ -12,9 +12,9 @@ sending to the summary; a commit is a round trip of its own and is printed as on
 With ``--ab`` the runs alternate between robotale as it is (B) and its round-trip structure
 before the reads' commits were dropped, a small step's lifted edges were written one batch
 per worker and the entity steps' reads were started beside the columnar copy's (A, restored
-by replacing those functions), each run's output checked equal to the first's; each
-run's wall time, its process's and Neo4j's CPU time and the load are printed, and the best
-of each.
+by replacing those functions; ``--before`` names which of them), each run's output checked
+equal to the first's; each run's wall time, its process's and Neo4j's CPU time and the load
+are printed, and the best of each.
 """
 
 from __future__ import annotations
@@ -127,6 +127,14 @@ def read_with_commit(driver, query, parameters):  # type: ignore[no-untyped-def]
 
 NOW = (steps.read_autocommit, lift.read_autocommit, steps._lift_batch, steps._start_entity_reads)
 BEFORE = (read_with_commit, read_with_commit, lambda edges: BATCH, lambda *_: {})
+#: which of BEFORE's functions ``--before`` names
+PARTS = {"reads": (0, 1), "lift": (2,), "prefetch": (3,)}
+
+
+def before(parts: list[str]) -> tuple:  # type: ignore[type-arg]
+    """NOW with the functions of ``parts`` as they were."""
+    chosen = {i for part in parts for i in PARTS[part]}
+    return tuple(BEFORE[i] if i in chosen else NOW[i] for i in range(len(NOW)))
 
 
 def use(functions) -> None:  # type: ignore[no-untyped-def]
@@ -151,6 +159,11 @@ def main() -> int:
     parser.add_argument("--size", type=int, default=35_000)
     parser.add_argument("--runs", type=int, default=2)
     parser.add_argument("--ab", action="store_true", help="alternate before (A) and now (B)")
+    parser.add_argument(
+        "--before",
+        default="reads,lift,prefetch",
+        help="what A puts back, of reads, lift, prefetch (all)",
+    )
     args = parser.parse_args()
     sys.stdout.reconfigure(line_buffering=True)  # type: ignore[union-attr]
     with private_server("3g", "2g") as server:
@@ -165,7 +178,7 @@ def main() -> int:
             best: dict[str, list[float]] = {}
             for turn in range(args.runs * (2 if args.ab else 1)):
                 side = ("A" if turn % 2 == 0 else "B") if args.ab else "B"
-                use(BEFORE if side == "A" else NOW)
+                use(before(args.before.split(",")) if side == "A" else NOW)
                 TRIPS.clear()
                 began, cpu = time.perf_counter(), cpu_seconds(server.pid())
                 own = sum(os.times()[:2])
