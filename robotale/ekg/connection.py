@@ -144,6 +144,15 @@ def read_rows(driver: Driver, query: str, **parameters: Any) -> list[dict[str, A
     return [_row(record) for record in records]
 
 
+def read_autocommit(driver: Driver, query: str, parameters: dict[str, Any]) -> list[Record]:
+    """The records of ``query``, which only reads, run as an auto-commit transaction on the
+    leader: one round trip, where ``execute_query``'s managed transaction costs a second
+    (its commit). For a writer's reads of what no other writer changes (it holds the log's
+    lock), so there is nothing a retry would be for."""
+    with driver.session(database=database()) as session:
+        return list(session.run(query, parameters))
+
+
 #: values a record holds as they are: the driver's own conversion (``Record.data``) would walk
 #: a byte array byte by byte (a recorded Arrow schema: thousands of calls per read)
 _AS_THEY_ARE = (str, int, float, bool, bytes, bytearray, type(None))

@@ -30,7 +30,7 @@ import pandas as pd
 from neo4j import Driver
 
 from robotale.ekg.columnar import Build, stored_table
-from robotale.ekg.connection import database
+from robotale.ekg.connection import read_autocommit
 from robotale.ekg.tables import GraphTables, graph_tables
 from robotale.errors import InputError
 from robotale.queries import cypher
@@ -232,15 +232,14 @@ class LogEdges:
         query) into :attr:`stored`."""
         events = codes[codes < len(self.events)]
         entities = codes[codes >= len(self.events)]
-        records, _, _ = driver.execute_query(
-            cypher("aggr_element_ids"),
-            log=log,
-            events=[str(k) for k in self.keys[events]],
-            entities=[str(k) for k in self.keys[entities]],
-            types=[str(t) for t in self.types[entities]],
-            database_=database(),
-        )
-        row = records[0]
+        parameters = {
+            "log": log,
+            "events": [str(k) for k in self.keys[events]],
+            "entities": [str(k) for k in self.keys[entities]],
+            "types": [str(t) for t in self.types[entities]],
+        }
+        # one round trip: no commit of its own for a read
+        row = read_autocommit(driver, cypher("aggr_element_ids"), parameters)[0]
         for nodes, found, elements in (
             (events, row["eventsFound"], row["eventElements"]),
             (entities, row["entitiesFound"], row["entityElements"]),
@@ -338,10 +337,7 @@ class LogEdges:
 
     def read_memberships(self, driver: Driver, log: str) -> None:
         """Record which aggregate of earlier steps holds each node they collapsed."""
-        records, _, _ = driver.execute_query(
-            cypher("aggr_read_memberships"), log=log, database_=database()
-        )
-        for row in records:
+        for row in read_autocommit(driver, cypher("aggr_read_memberships"), {"log": log}):
             members = [str(m) for m in row["members"]]
             if row["type"] is None:
                 codes = self.event_codes(members)

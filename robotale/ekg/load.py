@@ -62,6 +62,7 @@ class Loader:
         between_batches: Callable[[], None] = lambda: None,
         tx: ManagedTransaction | None = None,
         workers: int | None = None,
+        batch: int = BATCH,
     ) -> None:
         self.driver = driver
         self.log = log
@@ -72,6 +73,7 @@ class Loader:
         self.tx = tx
         # batches that all reach the same few nodes only wait on each other's locks: one
         self.workers = build_workers() if workers is None else workers
+        self.batch = batch  # rows per transaction
 
     def run(
         self,
@@ -93,20 +95,22 @@ class Loader:
 
         def write(start: int) -> list[str]:
             self.between_batches()
-            params: dict[str, Any] = {n: _slice(values, start) for n, values in columns.items()}
+            params: dict[str, Any] = {
+                n: _slice(values, start, self.batch) for n, values in columns.items()
+            }
             for name, columns_of_map in (maps or {}).items():
-                params[name] = {k: _slice(v, start) for k, v in columns_of_map.items()}
+                params[name] = {k: _slice(v, start, self.batch) for k, v in columns_of_map.items()}
             for name, values in (batches or {}).items():
-                params[name] = values[start // BATCH]
+                params[name] = values[start // self.batch]
             records = self._execute(text, params | constants | {"log": self.log})
             if self.progress is not None:
-                self.progress.update(min(BATCH, size - start))
+                self.progress.update(min(self.batch, size - start))
             created = records[0].get("nodes") if records else None
             return [node for _, node in sorted(created or [])]
 
         if self.tx is not None:
-            return [node for start in range(0, size, BATCH) for node in write(start)]
-        return _in_flight(write, range(0, size, BATCH), self.workers)
+            return [node for start in range(0, size, self.batch) for node in write(start)]
+        return _in_flight(write, range(0, size, self.batch), self.workers)
 
     def together(self, *parts: Callable[[], None]) -> None:
         """Run ``parts``, writes of which no two touch the same node, at the same time, each in
@@ -222,8 +226,8 @@ def _in_flight(
     return nodes
 
 
-def _slice(values: Sequence[Any], start: int) -> Sequence[Any]:
-    return values[start : start + BATCH]
+def _slice(values: Sequence[Any], start: int, batch: int = BATCH) -> Sequence[Any]:
+    return values[start : start + batch]
 
 
 def neo4j_values(column: pd.Series) -> list[Any]:

@@ -32,6 +32,7 @@ import shlex
 import time
 import weakref
 from collections.abc import Callable, Collection, Sequence
+from concurrent.futures import Future, ThreadPoolExecutor
 from contextlib import suppress
 from dataclasses import asdict, dataclass, replace
 from typing import Any
@@ -44,7 +45,7 @@ from neo4j.time import DateTime
 
 from robotale.ekg.build import ensure_schema, undo_after_failure
 from robotale.ekg.columnar import build_of
-from robotale.ekg.connection import database
+from robotale.ekg.connection import database, read_autocommit
 from robotale.ekg.groups import aggregate_table
 from robotale.ekg.interrupt import DeferredInterrupt
 from robotale.ekg.lift import FREE, LogEdges
@@ -65,6 +66,8 @@ MEMBERS_PART = 100_000
 #: Neo4j creates edges on one node from two transactions without waiting (measured on a
 #: busy 2-core machine: no slower than one at a time; on a quiet one the second core helps)
 LIFT_WORKERS = 2
+#: the most lifted edges a step writes in one transaction per worker
+LIFT_BATCH_MOST = 10_000
 #: what a run reads in the transaction that takes the log's lock (parameters ``$log`` and
 #: ``$types``, the entity types its steps name): the Log node's description and counts, the
 #: steps stored, the build its columnar copy belongs to, the entities' property keys
@@ -115,10 +118,14 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
         _refuse_legacy(log, stored)
         first = int(stored[-1]["step"]) + 1 if stored else 1
         types_built = info.get("entityTypes") or []
-        edges = LogEdges.of_log(driver, log, types_built, build_of(log, build[0]))
         keys = _node_keys(node_keys)
-        keys[None] = _event_keys(edges.events)
-        plans = [_plan(driver, log, info, step, n, keys) for n, step in enumerate(steps, first)]
+        with ThreadPoolExecutor(max_workers=1) as pool:
+            # the entity steps' nodes read from Neo4j while the log's copy is read here
+            entity_rows = _start_entity_reads(pool, driver, log, info, steps, first, keys)
+            edges = LogEdges.of_log(driver, log, types_built, build_of(log, build[0]))
+            keys[None] = _event_keys(edges.events)
+            plans = [_plan(driver, log, info, s, n, keys) for n, s in enumerate(steps, first)]
+            read = {number: rows.result() for number, rows in entity_rows.items()}
         results: list[StepResult] = []
         if first > 1:
             edges.read_memberships(driver, log)
@@ -127,7 +134,7 @@ def run_spec(driver: Driver, log: str, steps: Sequence[AggrStep]) -> list[StepRe
         grouped: list[tuple[_Plan, pd.DataFrame, float]] = []
         for plan in plans:  # in memory, each on what the ones before it left
             started = time.perf_counter()
-            table = _group(driver, log, plan, edges)
+            table = _group(driver, log, plan, edges, read.get(plan.number))
             grouped.append((plan, table, time.perf_counter() - started))
         try:
             for plan, table, seconds in grouped:
@@ -197,14 +204,17 @@ def level_graph(driver: Driver, log: str, level: int) -> dict[str, list[dict[str
     }
 
 
-def _group(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.DataFrame:
+def _group(
+    driver: Driver, log: str, plan: _Plan, edges: LogEdges, read: dict[str, Any] | None = None
+) -> pd.DataFrame:
     """The aggregates of ``plan``'s step (one row each, with its members' codes), recorded in
-    ``edges`` as holding their members (their element ids once they are written)."""
+    ``edges`` as holding their members (their element ids once they are written); ``read``:
+    an entity step's nodes as :func:`_entity_rows` read them, if they are read already."""
     step, number = plan.step, plan.number
     if step.origin == "Event":
         nodes = _event_nodes(edges, plan)
     else:
-        nodes = _read_nodes(driver, log, plan, edges)
+        nodes = _read_nodes(driver, log, plan, edges, read)
     table = aggregate_table(step, number, nodes, set(plan.times) & set(plan.reads))
     if len(table):
         sizes = table["count"].astype(int).to_numpy()
@@ -391,9 +401,32 @@ def _correlated(edges: LogEdges, events: np.ndarray, kind: str) -> np.ndarray:
     return values
 
 
-def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.DataFrame:
-    """One row per entity the step collapses: ``node`` (its code) and a column per property
-    read; read from Neo4j (an entity's attributes may be set after the log was built)."""
+def _start_entity_reads(
+    pool: ThreadPoolExecutor,
+    driver: Driver,
+    log: str,
+    info: dict[str, Any],
+    steps: Sequence[AggrStep],
+    first: int,
+    keys: dict[str | None, tuple[set[str], list[str]]],
+) -> dict[int, Future[dict[str, Any]]]:
+    """The reads of the entity steps' nodes (:func:`_entity_rows`), by step number, started
+    in ``pool``: Neo4j answers them while this process reads the log's columnar copy (at 35k
+    events the reads were a tenth of the run, waited for one after the other). None when a
+    step does not pass its check: the checks are made again, in order, to say which."""
+    plans: list[_Plan] = []
+    for number, step in enumerate(steps, first):
+        if step.origin == "Entity":
+            try:
+                plans.append(_plan(driver, log, info, step, number, keys))
+            except InputError:
+                return {}
+    return {plan.number: pool.submit(_entity_rows, driver, log, plan) for plan in plans}
+
+
+def _entity_rows(driver: Driver, log: str, plan: _Plan) -> dict[str, Any]:
+    """The entities an entity step reads (those an earlier step collapses among them), as one
+    row of columns: ``ids`` and ``values`` (a list of the properties read per entity)."""
     step, reads, condition = plan.step, plan.reads, plan.condition
     text = cypher("aggr_read_entities").replace(_WHERE_MARKER, condition.cypher)
     parameters: dict[str, Any] = {
@@ -402,13 +435,22 @@ def _read_nodes(driver: Driver, log: str, plan: _Plan, edges: LogEdges) -> pd.Da
         "times": [t for t in plan.times if t in reads],
         "type": step.ent_type,
     }
-    records, _, _ = driver.execute_query(
-        text, {**condition.parameters, **parameters}, database_=database()
-    )
-    row = records[0]
+    # with the lock held: one round trip, no commit of its own
+    return dict(read_autocommit(driver, text, {**condition.parameters, **parameters})[0])
+
+
+def _read_nodes(
+    driver: Driver, log: str, plan: _Plan, edges: LogEdges, row: dict[str, Any] | None = None
+) -> pd.DataFrame:
+    """One row per entity the step collapses: ``node`` (its code) and a column per property
+    read; read from Neo4j (an entity's attributes may be set after the log was built), unless
+    ``row`` holds them read already (:func:`_entity_rows`)."""
+    if row is None:
+        row = _entity_rows(driver, log, plan)
+    reads = plan.reads
     values = row["values"]
     frame = pd.DataFrame(values, columns=reads) if values else pd.DataFrame(columns=reads)
-    codes = edges.entity_codes(str(step.ent_type), [str(i) for i in row["ids"]])
+    codes = edges.entity_codes(str(plan.step.ent_type), [str(i) for i in row["ids"]])
     frame.insert(0, "node", codes)
     return frame[edges.holder[codes] == FREE].reset_index(drop=True)
 
@@ -476,7 +518,9 @@ def _write_lifted(
     reached = np.where(pd.isna(edges.element_ids[source]), target, source)
     order = np.argsort(reached, kind="stable")
     lifted, source, target = lifted.iloc[order], source[order], target[order]
-    loader = Loader(driver, log, None, between_batches, workers=LIFT_WORKERS)
+    loader = Loader(
+        driver, log, None, between_batches, workers=LIFT_WORKERS, batch=_lift_batch(len(lifted))
+    )
     loader.run(
         "aggr_create_lifted",
         {
@@ -489,6 +533,15 @@ def _write_lifted(
         },
         step=number,
     )
+
+
+def _lift_batch(edges: int) -> int:
+    """Rows per transaction of a step's ``edges`` lifted edges: one batch per worker when
+    those are at most :data:`LIFT_BATCH_MOST` rows each (each batch costs two round trips,
+    its query and its commit: at 35k events batches of :data:`BATCH` were most of the run's
+    round trips), else :data:`BATCH` as before (a large step's transactions keep their size)."""
+    each = -(-edges // LIFT_WORKERS)
+    return max(BATCH, each) if each <= LIFT_BATCH_MOST else BATCH
 
 
 def _relink(driver: Driver, log: str, edges: LogEdges, steps: range, freed: np.ndarray) -> None:
@@ -589,8 +642,8 @@ def _ensure_schema(driver: Driver) -> None:
     seen = _SCHEMA_SEEN.setdefault(driver, set())
     if database() in seen:
         return
-    records, _, _ = driver.execute_query(
-        cypher("aggr_schema_present"), names=_AGGREGATION_CONSTRAINTS, database_=database()
+    records = read_autocommit(
+        driver, cypher("aggr_schema_present"), {"names": _AGGREGATION_CONSTRAINTS}
     )
     if int(records[0]["present"]) < len(_AGGREGATION_CONSTRAINTS):
         ensure_schema(driver)
