@@ -4,25 +4,16 @@ check on a small input, once where both are the same and once where one computed
 from __future__ import annotations
 
 import copy
-import importlib.util
-import sys
-from pathlib import Path
 
 import pytest
+from benchmark_scripts import benchmark
 
 from robotale.discovery.ekg_table import table_class_graph
-
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
 
 
 @pytest.fixture(scope="module")
 def check():
-    if str(BENCHMARKS) not in sys.path:  # the benchmark imports its sibling scripts by name
-        sys.path.insert(0, str(BENCHMARKS))
-    spec = importlib.util.spec_from_file_location("class_graph", BENCHMARKS / "class_graph.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module.differences
+    return benchmark("class_graph").differences
 
 
 @pytest.fixture(scope="module")

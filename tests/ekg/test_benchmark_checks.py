@@ -3,30 +3,16 @@ input, once where both sides compute the same and once where one computes someth
 
 from __future__ import annotations
 
-import importlib.util
 import signal
 import sys
-from pathlib import Path
 
 import pandas as pd
 import pytest
+from benchmark_scripts import benchmark
 from pandas import Timedelta
 
 from robotale.enhancement.findings import find
 from robotale.eventlog.schema import ACTIVITY, CASE, LIFECYCLE, MSG_ID, TIMESTAMP
-
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
-
-
-def benchmark(name: str):
-    """A module of ``benchmarks/`` (they import each other by name, as scripts)."""
-    if str(BENCHMARKS) not in sys.path:
-        sys.path.insert(0, str(BENCHMARKS))
-    spec = importlib.util.spec_from_file_location(name, BENCHMARKS / f"{name}.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules[name] = module
-    spec.loader.exec_module(module)
-    return module
 
 
 @pytest.fixture(scope="module")

@@ -3,26 +3,17 @@ with only what the benchmark must change, and its plugins leave the server's cla
 
 from __future__ import annotations
 
-import importlib.util
-import sys
 import zipfile
 from pathlib import Path
 
 import pytest
-
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
+from benchmark_scripts import benchmark
 
 
 @pytest.fixture(scope="module")
 def stock():
     """``benchmarks/stock_neo4j.py`` (the benchmarks import each other by name, as scripts)."""
-    if str(BENCHMARKS) not in sys.path:
-        sys.path.insert(0, str(BENCHMARKS))
-    spec = importlib.util.spec_from_file_location("stock_neo4j", BENCHMARKS / "stock_neo4j.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["stock_neo4j"] = module  # its dataclasses look their module up there
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("stock_neo4j")
 
 
 def settings(text: str) -> tuple[dict[str, str], list[str]]:

@@ -3,25 +3,16 @@ on a small log's perspectives, once the same and once where the log lost a messa
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
+from benchmark_scripts import benchmark
 
 from robotale.cli import main
 from robotale.eventlog import schema
 from robotale.eventlog.readers import read_log
 from robotale.eventlog.writers import write_csv
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
-
 
 def stored_log():
-    if str(BENCHMARKS) not in sys.path:  # the benchmark imports its sibling scripts by name
-        sys.path.insert(0, str(BENCHMARKS))
-    spec = importlib.util.spec_from_file_location("stored_log", BENCHMARKS / "stored_log.py")
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("stored_log")
 
 
 def test_the_stored_logs_outputs_are_checked_against_the_csvs(tmp_path, capsys, thesis_csv):

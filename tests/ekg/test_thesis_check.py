@@ -4,23 +4,13 @@ log, where the thesis' DF crosses runs (robotale's stays within one) and where i
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
+from benchmark_scripts import benchmark
 
 from robotale.eventlog.schema import CASE
 
-BENCHMARKS = Path(__file__).resolve().parents[2] / "benchmarks"
-
 
 def ekg_build():
-    if str(BENCHMARKS) not in sys.path:  # the benchmark imports its sibling scripts by name
-        sys.path.insert(0, str(BENCHMARKS))
-    spec = importlib.util.spec_from_file_location("ekg_build", BENCHMARKS / "ekg_build.py")
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["ekg_build"] = module
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("ekg_build")
 
 
 def test_the_thesis_graph_is_counted_against_robotales(neo4j_driver, log_name):

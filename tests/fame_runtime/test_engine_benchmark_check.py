@@ -3,19 +3,11 @@ scripts to the same variables, and tells a model run otherwise apart."""
 
 from __future__ import annotations
 
-import importlib.util
-import sys
-from pathlib import Path
-
-BENCHMARK = Path(__file__).resolve().parents[2] / "benchmarks" / "engine_throughput.py"
+from benchmark_scripts import benchmark
 
 
 def load():
-    spec = importlib.util.spec_from_file_location("engine_throughput", BENCHMARK)
-    module = importlib.util.module_from_spec(spec)
-    sys.modules["engine_throughput"] = module
-    spec.loader.exec_module(module)
-    return module
+    return benchmark("engine_throughput")
 
 
 def test_both_engines_leave_the_same_variables_and_other_scripts_are_told_apart(tmp_path):

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import base64
 import hashlib
-import importlib.util
 import json
 import math
 import sys
@@ -20,6 +19,7 @@ from typing import Any
 
 import numpy as np
 import pandas as pd
+from benchmark_scripts import benchmark
 from neo4j import Driver
 
 from robotale.ekg.build import build_ekg
@@ -27,7 +27,6 @@ from robotale.ekg.columnar import results_folder
 from robotale.ekg.keys import DEFAULT_AGGREGATE
 from robotale.results.logdata import current_build
 
-ROOT = Path(__file__).resolve().parents[2]
 #: the digests of the prepared results of the benchmark's synthetic logs, by size
 FIXTURE = Path(__file__).with_name("prepared_digests.json")
 SIZES = (10_000, 100_000)
@@ -39,14 +38,7 @@ BITS = 30
 def synthetic_log(events: int) -> pd.DataFrame:
     """The benchmarks' multi-robot log (``benchmarks/ekg_build.py``): robots, messages,
     positions and battery, so every page has something to show."""
-    spec = importlib.util.spec_from_file_location("ekg_build", ROOT / "benchmarks" / "ekg_build.py")
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    benchmarks = str(ROOT / "benchmarks")
-    if benchmarks not in sys.path:  # the benchmark imports its sibling scripts by name
-        sys.path.insert(0, benchmarks)
-    spec.loader.exec_module(module)
-    return module.synthetic_log(events)
+    return benchmark("ekg_build").synthetic_log(events)
 
 
 def store(driver: Driver, log: pd.DataFrame, name: str, aggregate=None) -> None:
