@@ -384,8 +384,10 @@ def _assembled(
     instances = _instances(found, start)
     messages = _messages(run_messages, start)
     positions = _positions(events)
-    # a robot whose only activity is still running (a live run's) has no bar yet, but a lane
-    robots = sorted(lanes | set(positions["robot"]) | set(instances["robot"]))
+    # a robot whose only activity is still running (a live run's) has no bar yet, but a lane;
+    # the names told apart by unique() (a set of a column iterates its every row, a live
+    # run's look would pay for the whole run)
+    robots = sorted(lanes | set(positions["robot"].unique()) | set(instances["robot"].unique()))
     return MissionRun(
         case=case,
         start=start,

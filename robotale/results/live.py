@@ -64,28 +64,41 @@ class LiveReplay(Replay):
 
 class Positions:
     """A live run's odometry samples as they come: the positions table (robot, s, x, y, z in
-    time order, by robot where two share a time) and each robot's track, grown in place while
-    the samples come in time order, made again whole when one comes late or the run's start
-    moves."""
+    time order, by robot where two share a time) and each robot's track. While the samples
+    come in time order both grow in place: the table's columns are arrays with room to grow
+    (doubled when full), the table a view of their filled part, so a look that found samples
+    costs what it found, not the run's length (a look waiting for tags finds samples at each
+    of its checks). Made again whole when one comes late or the run's start moves."""
 
     def __init__(self) -> None:
         self.poses: list[Pose] = []
         self.at: float | None = None
-        self.table = _positions([], 0.0)
+        #: how many samples the columns hold, and the columns (room for more)
+        self.size = 0
+        self.columns = _Columns()
         self.tracks = Tracks()
+        self._table: pd.DataFrame | None = None
 
     @property
     def count(self) -> int:
         return len(self.poses)
 
+    @property
+    def table(self) -> pd.DataFrame:
+        """The positions held, a view of the columns' filled part (made once per size)."""
+        if self._table is None or len(self._table) != self.size:
+            self._table = self.columns.view(self.size)
+        return self._table
+
     def add(self, poses: list[Pose]) -> None:
         self.poses += poses
         if self.at is None or not poses:
             return
-        chunk = _positions(poses, self.at)
-        ahead = self.table.empty or chunk["s"].min() > self.table["s"].iloc[-1]
-        if ahead and self.tracks.extended(chunk):
-            self.table = pd.concat([self.table, chunk], ignore_index=True)
+        chunk = _Columns.of(poses, self.at)
+        ahead = not self.size or chunk.s.min() > self.columns.s[self.size - 1]
+        if ahead and self.tracks.extended(chunk.view(len(poses))):
+            self.columns.put(self.size, chunk)
+            self.size += len(poses)
         else:
             self.at = None  # made again whole when next asked
 
@@ -93,24 +106,70 @@ class Positions:
         """The positions in seconds since ``start``, and their tracks."""
         at = start.timestamp()
         if at != self.at:
-            self.at, self.table = at, _positions(self.poses, at)
+            self.at, self.columns = at, _Columns.of(self.poses, at)
+            self.size, self._table = len(self.poses), None
             self.tracks = Tracks.of(self.table)
         return self.table, self.tracks
 
 
+@dataclass
+class _Columns:
+    """The positions table's columns as arrays: robot (objects: a view of them is a column
+    as it is, where a column of strings would be copied), s, x, y, z."""
+
+    robot: np.ndarray = field(default_factory=lambda: np.empty(0, dtype=object))
+    s: np.ndarray = field(default_factory=lambda: np.empty(0))
+    x: np.ndarray = field(default_factory=lambda: np.empty(0))
+    y: np.ndarray = field(default_factory=lambda: np.empty(0))
+    z: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    @classmethod
+    def of(cls, poses: list[Pose], at: float) -> _Columns:
+        """``poses`` in time order (by robot where two share a time), s in seconds since
+        ``at``."""
+        s = np.array([p.stamp for p in poses], dtype=float) - at
+        order = sorted(range(len(poses)), key=lambda i: (s[i], poses[i].robot))
+        chosen = [poses[i] for i in order]
+        return cls(
+            np.array([p.robot for p in chosen], dtype=object),
+            s[order] if len(order) else s,
+            np.array([p.x for p in chosen], dtype=float),
+            np.array([p.y for p in chosen], dtype=float),
+            np.array([p.z for p in chosen], dtype=float),
+        )
+
+    def put(self, at: int, chunk: _Columns) -> None:
+        """Write ``chunk`` from row ``at`` on, the room doubled when it does not fit."""
+        end = at + len(chunk.s)
+        if end > len(self.s):
+            room = max(2 * len(self.s), end, 1024)
+            for name in ("robot", "s", "x", "y", "z"):
+                grown = np.empty(room, dtype=getattr(self, name).dtype)
+                grown[:at] = getattr(self, name)[:at]
+                setattr(self, name, grown)
+        for name in ("robot", "s", "x", "y", "z"):
+            getattr(self, name)[at:end] = getattr(chunk, name)
+
+    def view(self, size: int) -> pd.DataFrame:
+        """The first ``size`` rows as a table, not copied (later rows are written past them
+        only, so the view stays as it was made)."""
+        return pd.DataFrame(
+            {
+                "robot": pd.Series(self.robot[:size], dtype=object, copy=False),
+                "s": self.s[:size],
+                "x": self.x[:size],
+                "y": self.y[:size],
+                "z": self.z[:size],
+            },
+            copy=False,
+        )
+
+
 def _positions(poses: list[Pose], at: float) -> pd.DataFrame:
     """Where each robot was, by its odometry: robot, s (seconds since ``at``), x, y, z, in
-    time order (by robot where two share a time)."""
-    table = pd.DataFrame(
-        {
-            "robot": [p.robot for p in poses],
-            "s": np.array([p.stamp for p in poses], dtype=float) - at,
-            "x": np.array([p.x for p in poses], dtype=float),
-            "y": np.array([p.y for p in poses], dtype=float),
-            "z": np.array([p.z for p in poses], dtype=float),
-        }
-    )
-    return table.sort_values(["s", "robot"], kind="stable").reset_index(drop=True)
+    time order (by robot where two share a time); the robot column of objects, as
+    :class:`Positions` holds it."""
+    return _Columns.of(poses, at).view(len(poses)).copy()
 
 
 @dataclass
