@@ -62,7 +62,7 @@ class Loader:
         between_batches: Callable[[], None] = lambda: None,
         tx: ManagedTransaction | None = None,
         workers: int | None = None,
-        batch: int = BATCH,
+        batch: int | None = None,
     ) -> None:
         self.driver = driver
         self.log = log
@@ -73,7 +73,9 @@ class Loader:
         self.tx = tx
         # batches that all reach the same few nodes only wait on each other's locks: one
         self.workers = build_workers() if workers is None else workers
-        self.batch = batch  # rows per transaction
+        # rows per transaction; the module's BATCH read now, not when this was defined (the
+        # edges' ``batches`` and :func:`within_batches` are cut by it: they must agree)
+        self.batch = BATCH if batch is None else batch
 
     def run(
         self,
@@ -226,7 +228,7 @@ def _in_flight(
     return nodes
 
 
-def _slice(values: Sequence[Any], start: int, batch: int = BATCH) -> Sequence[Any]:
+def _slice(values: Sequence[Any], start: int, batch: int) -> Sequence[Any]:
     return values[start : start + batch]
 
 
