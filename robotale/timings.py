@@ -25,10 +25,10 @@ ENVIRONMENT = "ROBOTALE_TIMINGS"
 #: the Neo4j server's process id, or None while none runs (set by :func:`watch_server`)
 _server: list[Callable[[], int | None]] = []
 
-#: the watched server's (process id, CPU seconds) when watching began: a stage that began
-#: before (the command's own, around the whole command) counts the server from then on, not
-#: the CPU it spent starting and in earlier commands
-_watched_from: list[tuple[int, float]] = []
+#: the watched server's CPU seconds when watching began, by its process id: a stage that
+#: began before (the command's own, around the whole command) counts the server from then on,
+#: not the CPU it spent starting and in earlier commands
+_watched_from: dict[int, float] = {}
 
 
 def enabled() -> bool:
@@ -40,7 +40,9 @@ def watch_server(pid: Callable[[], int | None]) -> None:
     stage's start and end: a restart makes a new process, whose time counts from its start)."""
     _server[:] = [pid]
     began = _server_cpu() if enabled() else None
-    _watched_from[:] = [began] if began is not None else []
+    _watched_from.clear()
+    if began is not None:
+        _watched_from[began[0]] = began[1]
 
 
 @contextmanager
@@ -83,7 +85,7 @@ def _server_spent(before: tuple[int, float] | None, after: tuple[int, float] | N
     if after is None:
         return 0.0
     if before is None or before[0] != after[0]:  # watched or started (again) within the stage
-        return after[1] - dict(_watched_from).get(after[0], 0.0)
+        return after[1] - _watched_from.get(after[0], 0.0)
     return after[1] - before[1]
 
 

@@ -48,7 +48,7 @@ def test_a_server_watched_within_a_stage_counts_from_then(monkeypatch, capsys):
     # before (its start, earlier commands) is not this command's
     monkeypatch.setenv(timings.ENVIRONMENT, "1")
     monkeypatch.setattr(timings, "_server", [])
-    monkeypatch.setattr(timings, "_watched_from", [])
+    monkeypatch.setattr(timings, "_watched_from", {})
     _busy(0.3)  # this process stands for the server: CPU spent before it is watched
     with timings.stage("the command"):
         timings.watch_server(os.getpid)
