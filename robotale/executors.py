@@ -11,8 +11,8 @@ from __future__ import annotations
 import multiprocessing
 import os
 import re
-from collections.abc import Iterator
-from concurrent.futures import Executor
+from collections.abc import Iterable, Iterator
+from concurrent.futures import Executor, Future, wait
 from concurrent.futures import ProcessPoolExecutor as _Pool
 from concurrent.futures.process import BrokenProcessPool
 from contextlib import contextmanager
@@ -103,6 +103,15 @@ def _dask_executor(spec: ExecutorSpec) -> Iterator[tuple[Executor, int]]:
         yield client.get_executor(pure=False), workers
     finally:
         client.close()
+
+
+def stop_all(futures: Iterable[Future[object]], error: BaseException) -> None:
+    """After ``error`` stopped a caller collecting ``futures``: those not started are
+    cancelled and, unless the user interrupted, those running are waited for, so nothing a
+    worker writes lands after the caller has removed what the failed work left behind."""
+    pending = [future for future in futures if not future.cancel()]
+    if isinstance(error, Exception):
+        wait(pending)
 
 
 def worker_lost(error: BaseException) -> bool:

@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import warnings
 from collections.abc import Callable, Sequence
-from concurrent.futures import as_completed
+from concurrent.futures import Future, as_completed
 from dataclasses import dataclass
 from fnmatch import fnmatchcase
 from pathlib import Path
@@ -60,7 +60,7 @@ from robotale.eventlog.tagrows import (
     warn_foreign,
 )
 from robotale.eventlog.typesys import check_distro
-from robotale.executors import open_executor, parse_executor, worker_lost
+from robotale.executors import open_executor, parse_executor, stop_all, worker_lost
 from robotale.fame_runtime.manifest import read_manifests
 from robotale.storage import Place, place
 
@@ -416,17 +416,24 @@ def _on_executor(
     done: dict[Path, Any] = {}
     with open_executor(parse_executor(executor), len(runs)) as (pool, _):
         futures = {pool.submit(task, run.resolve(), *arguments): run for run in runs}
-        for future in as_completed(futures):
-            try:
-                done[futures[future]] = future.result()
-            except Exception as error:
-                if worker_lost(error):
-                    raise InputError(
-                        f"{futures[future]}: the worker process {doing} it died"
-                    ) from None
-                raise
-            bar.update()
+        try:
+            for future in as_completed(futures):
+                done[futures[future]] = _result(future, futures[future], doing)
+                bar.update()
+        except BaseException as error:
+            stop_all(futures, error)
+            raise
     return [done[run] for run in runs]
+
+
+def _result(future: Future[Any], run: Path, doing: str) -> Any:
+    """What ``future`` computed for ``run``; a worker that died is said as one sentence."""
+    try:
+        return future.result()
+    except Exception as error:
+        if worker_lost(error):
+            raise InputError(f"{run}: the worker process {doing} it died") from None
+        raise
 
 
 def _prepare_into(run: Path, job: Job, target: Place, skipping: bool = False) -> _RunPrepared:

@@ -33,7 +33,13 @@ from typing import Any, TextIO
 from tqdm import tqdm
 
 from robotale.errors import InputError
-from robotale.executors import ExecutorSpec, open_executor, parse_executor, worker_lost
+from robotale.executors import (
+    ExecutorSpec,
+    open_executor,
+    parse_executor,
+    stop_all,
+    worker_lost,
+)
 from robotale.fame_runtime.manifest import (
     MANIFEST,
     RunManifest,
@@ -223,9 +229,8 @@ def _pool_round(
                     if not worker_lost(error):
                         raise
                     lost.append(futures[future])
-        except BaseException:
-            for future in futures:
-                future.cancel()
+        except BaseException as error:
+            stop_all(futures, error)
             raise
     return sorted(lost, key=lambda p: p.index), workers
 
