@@ -64,11 +64,14 @@ class LiveReplay(Replay):
 
 class Positions:
     """A live run's odometry samples as they come: the positions table (robot, s, x, y, z in
-    time order, by robot where two share a time) and each robot's track. While the samples
-    come in time order both grow in place: the table's columns are arrays with room to grow
-    (doubled when full), the table a view of their filled part, so a look that found samples
-    costs what it found, not the run's length (a look waiting for tags finds samples at each
-    of its checks). Made again whole when one comes late or the run's start moves."""
+    time order, by robot where two share a time) and each robot's track. Both grow in place:
+    the table's columns are arrays with room to grow (doubled when full), the table a view of
+    their filled part, so a look that found samples costs what it found, not the run's length
+    (a look waiting for tags finds samples at each of its checks). Samples of different robots
+    come a little out of time order (robots publish from several processes, and the monitor
+    stores them as they arrive, a batch every tenth of a second): a batch earlier than the
+    last rows held is merged into the rows from its first time on only. Made again whole when
+    a robot's own sample comes late or the run's start moves."""
 
     def __init__(self) -> None:
         self.poses: list[Pose] = []
@@ -78,6 +81,9 @@ class Positions:
         self.columns = _Columns()
         self.tracks = Tracks()
         self._table: pd.DataFrame | None = None
+        #: how many rows of the columns the tables handed out cover: a run made earlier
+        #: holds its table, so those rows are never written again in place
+        self.shown = 0
 
     @property
     def count(self) -> int:
@@ -88,6 +94,7 @@ class Positions:
         """The positions held, a view of the columns' filled part (made once per size)."""
         if self._table is None or len(self._table) != self.size:
             self._table = self.columns.view(self.size)
+            self.shown = max(self.shown, self.size)
         return self._table
 
     def add(self, poses: list[Pose]) -> None:
@@ -95,19 +102,26 @@ class Positions:
         if self.at is None or not poses:
             return
         chunk = _Columns.of(poses, self.at)
-        ahead = not self.size or chunk.s.min() > self.columns.s[self.size - 1]
-        if ahead and self.tracks.extended(chunk.view(len(poses))):
-            self.columns.put(self.size, chunk)
-            self.size += len(poses)
-        else:
-            self.at = None  # made again whole when next asked
+        if not self.tracks.extended(chunk.view(len(poses))):
+            self.at = None  # a robot's own sample came late: made again whole when next asked
+            return
+        # the rows held from the batch's first time on (none while samples come in order)
+        # are merged with it; those before stay as they are
+        first = int(np.searchsorted(self.columns.s[: self.size], chunk.s[0], side="left"))
+        if first < self.size:
+            chunk = _Columns.merged(self.columns.part(first, self.size), chunk)
+            if first < self.shown:  # rows a table handed out shows: written to new arrays
+                self.columns, self.shown = self.columns.copied(first), 0
+        self.columns.put(first, chunk)
+        self.size = first + len(chunk.s)
+        self._table = None
 
     def since(self, start: pd.Timestamp) -> tuple[pd.DataFrame, Tracks]:
         """The positions in seconds since ``start``, and their tracks."""
         at = start.timestamp()
         if at != self.at:
             self.at, self.columns = at, _Columns.of(self.poses, at)
-            self.size, self._table = len(self.poses), None
+            self.size, self._table, self.shown = len(self.poses), None, 0
             self.tracks = Tracks.of(self.table)
         return self.table, self.tracks
 
@@ -122,6 +136,8 @@ class _Columns:
     x: np.ndarray = field(default_factory=lambda: np.empty(0))
     y: np.ndarray = field(default_factory=lambda: np.empty(0))
     z: np.ndarray = field(default_factory=lambda: np.empty(0))
+
+    NAMES = ("robot", "s", "x", "y", "z")
 
     @classmethod
     def of(cls, poses: list[Pose], at: float) -> _Columns:
@@ -138,16 +154,45 @@ class _Columns:
             np.array([p.z for p in chosen], dtype=float),
         )
 
+    @classmethod
+    def merged(cls, held: _Columns, chunk: _Columns) -> _Columns:
+        """The rows ``held`` and those of ``chunk`` (heard after them), each in order, in
+        one order: by time, then robot, then as heard (as :meth:`of` orders them all)."""
+        s = np.concatenate([held.s, chunk.s])
+        robot = np.concatenate([held.robot, chunk.robot])
+        order = sorted(range(len(s)), key=lambda i: (s[i], robot[i]))
+        return cls(
+            robot[order],
+            s[order],
+            np.concatenate([held.x, chunk.x])[order],
+            np.concatenate([held.y, chunk.y])[order],
+            np.concatenate([held.z, chunk.z])[order],
+        )
+
+    def part(self, first: int, end: int) -> _Columns:
+        """Rows ``first`` to ``end`` (copies: the rows are written again after)."""
+        return _Columns(*(getattr(self, n)[first:end].copy() for n in _Columns.NAMES))
+
+    def copied(self, size: int) -> _Columns:
+        """New arrays of the same room holding the first ``size`` rows."""
+        fresh = _Columns()
+        for name in _Columns.NAMES:
+            held = getattr(self, name)
+            grown = np.empty(len(held), dtype=held.dtype)
+            grown[:size] = held[:size]
+            setattr(fresh, name, grown)
+        return fresh
+
     def put(self, at: int, chunk: _Columns) -> None:
         """Write ``chunk`` from row ``at`` on, the room doubled when it does not fit."""
         end = at + len(chunk.s)
         if end > len(self.s):
             room = max(2 * len(self.s), end, 1024)
-            for name in ("robot", "s", "x", "y", "z"):
+            for name in _Columns.NAMES:
                 grown = np.empty(room, dtype=getattr(self, name).dtype)
                 grown[:at] = getattr(self, name)[:at]
                 setattr(self, name, grown)
-        for name in ("robot", "s", "x", "y", "z"):
+        for name in _Columns.NAMES:
             getattr(self, name)[at:end] = getattr(chunk, name)
 
     def view(self, size: int) -> pd.DataFrame:
@@ -340,7 +385,24 @@ def _joined(kept: pd.DataFrame, made: pd.DataFrame) -> pd.DataFrame:
     for column in made.columns:
         if column in kept.columns and kept[column].dtype != made[column].dtype:
             events[column] = pd.Series(events[column].tolist(), name=column)
+        else:
+            events[column] = _one_chunk(events[column])
     return events
+
+
+def _one_chunk(column: pd.Series) -> pd.Series:
+    """``column`` with its values in one piece. A column of strings is held by pyarrow in
+    pieces, and concatenating keeps every piece of both sides: the events kept at each look
+    would be in one piece more per look, and every slice, mask and take of them cost as many
+    pieces (at 20 robots, hundreds after ten minutes: the looks' CPU grew with the run)."""
+    values = column.array
+    if not isinstance(values, pd.arrays.ArrowExtensionArray):
+        return column
+    pieces = values.__arrow_array__()
+    if pieces.num_chunks <= 1:
+        return column
+    whole = pd.array(pieces.combine_chunks(), dtype=column.dtype)
+    return pd.Series(whole, index=column.index, name=column.name)
 
 
 def _same_starts(kept: pd.DataFrame, made: pd.DataFrame) -> bool:

@@ -71,10 +71,22 @@ def test_the_run_grown_look_by_look_equals_the_run_made_of_all_tags_heard(monkey
                 assert run.summary(t) == whole.summary(t), t
                 assert run.state(t) == whole.state(t), t
                 assert run.window(t, whole.duration) == whole.window(t, whole.duration), t
+            # the events kept stay in one piece: pyarrow's pieces of a column of strings
+            # would add up look by look (each slice and take of them costing as many)
+            assert max(_pieces(run.events), default=1) == 1
     finally:
         reading._kept.pop(name, None)
     assert any(chosen < held for chosen, held in remade)
     assert any(carried)
+
+
+def _pieces(table: pd.DataFrame) -> list[int]:
+    """How many pieces pyarrow holds each column of strings of ``table`` in."""
+    return [
+        table[column].array.__arrow_array__().num_chunks
+        for column in table.columns
+        if isinstance(table[column].array, pd.arrays.ArrowExtensionArray)
+    ]
 
 
 def test_looks_asking_at_once_after_the_store_changed_make_the_run_once(monkeypatch):

@@ -80,3 +80,59 @@ def test_positions_grown_batch_by_batch_equal_the_table_made_of_all_samples(monk
         for window in ((-1.0, 100.0), (2.0, 5.05), (7.3, 7.3)):
             assert tracks.between(*window) == fresh.between(*window), window
     assert len(whole) < len(batches) / 2, whole
+
+
+def arriving(seed: int) -> list[list[Pose]]:
+    """Batches as the monitor stores the samples of three robots published from different
+    processes: each robot's samples in its own order, but they arrive up to a quarter of a
+    second late, so a batch may hold one robot's sample later than another's in the next."""
+    draw, samples, last = random.Random(seed), [], dict.fromkeys(ROBOTS, 0.0)
+    for tick in range(120):
+        for robot in ROBOTS:
+            stamp = START.timestamp() + tick / 10 + (0.003 if robot == "rover_3" else 0.0)
+            last[robot] = max(last[robot], stamp + draw.uniform(0.0, 0.25))
+            samples.append((last[robot], Pose(stamp, robot, draw.uniform(-5, 5), 0.0, 0.0)))
+    samples.sort(key=lambda arrived: arrived[0])
+    batches, first = [], 0
+    while first < len(samples):
+        size = draw.randint(1, 8)
+        batches.append([pose for _, pose in samples[first : first + size]])
+        first += size
+    return batches
+
+
+@pytest.mark.parametrize("seed", [4, 5])
+def test_positions_of_robots_out_of_step_are_merged_not_made_again(monkeypatch, seed):
+    """Samples of different robots out of time order (each robot's in order): after each
+    batch the table and tracks equal those made afresh, the table is never made again whole
+    (the batch is merged into the rows from its first time on), and a table handed out
+    earlier still shows what it showed (a run made then holds it)."""
+    whole: list[int] = []
+    of = Tracks.of.__func__  # type: ignore[attr-defined]
+
+    def counted(cls: type[Tracks], table: pd.DataFrame) -> Tracks:
+        whole.append(len(table))
+        return of(cls, table)
+
+    monkeypatch.setattr(mission_state.Tracks, "of", classmethod(counted))
+    positions, seen, handed = Positions(), [], []
+    positions.since(START)  # the run's start known from the first look on
+    late = 0
+    for batch in arriving(seed):
+        late += bool(positions.size) and min(p.stamp for p in batch) < START.timestamp() + float(
+            positions.table["s"].iloc[-1]
+        )
+        positions.add(batch)
+        seen += batch
+        table, tracks = positions.since(START)
+        expected = afresh(seen)
+        pd.testing.assert_frame_equal(table, expected)
+        handed.append((table, expected))
+        fresh = Tracks.of(expected)
+        whole.pop()
+        for window in ((-1.0, 100.0), (2.0, 5.05)):
+            assert tracks.between(*window) == fresh.between(*window), window
+    for table, expected in handed:
+        pd.testing.assert_frame_equal(table, expected)
+    assert late > 10  # the case this test is about happened
+    assert whole == [0], whole  # only the first look's, of no samples
