@@ -18,7 +18,9 @@ robotale, PromG ...) on an emptied database:
 
 The logs are the thesis authors' (``examples/thesis/robotic_data.csv``, or ``--log``) and a
 synthetic one of ``--synthetic`` events (``0`` skips it). For each it prints both build times,
-their ratio (PromG's time over robotale's) and the node and edge counts side by side. When
+their ratio (PromG's time over robotale's) by wall time and by CPU time (each side's process
+and the Neo4j server's during its build, read from ``/proc``), the load average at each turn,
+and the node and edge counts side by side. When
 PromG cannot be installed or fails, it prints why and what was tried, and robotale's figures
 alone.
 """
@@ -28,6 +30,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import subprocess
 import sys
 import tempfile
@@ -68,6 +71,11 @@ class Build:
     version: str = ""
     #: the whole process, from its start to its exit (PromG: its import and setup included)
     process_seconds: float = 0.0
+    #: CPU seconds of the side's own process during the build (robotale: this process while
+    #: it builds; PromG: its driver process, from its start to its exit)
+    cpu: float = 0.0
+    #: CPU seconds of the Neo4j server's process during the build
+    server_cpu: float = 0.0
 
 
 def main() -> int:
@@ -100,10 +108,13 @@ def main() -> int:
             for title, log in logs:
                 mine, built = [], []
                 for _ in range(args.repeat):  # in turns (A B A B): both see the same machine
-                    mine.append(robotale_build(driver, log))
+                    mine.append(robotale_build(driver, server, log))
+                    _said("robotale", mine[-1])
                     if python is not None and (not built or built[-1] is not None):
                         build, why_not = promg_build(python, driver, server, log, work, args)
                         built.append(build)
+                        if build is not None:
+                            _said("PromG", build)
                 done = [build for build in built if build is not None]
                 report(title, len(log), fastest(mine), fastest(done) if done else None, why_not)
     print(f"load average after: {os.getloadavg()[0]:.1f}")
@@ -117,14 +128,46 @@ def fastest(builds) -> Build:
     return min(builds, key=lambda build: build.seconds)
 
 
-def robotale_build(driver, log: pd.DataFrame) -> Build:
+def robotale_build(driver, server, log: pd.DataFrame) -> Build:
     from robotale.ekg.build import build_ekg
 
     clear(driver)
+    served, cpu = server_cpu(server), time.process_time()
     started = time.perf_counter()
     build_ekg(driver, log, "peers", entities=ENTITIES, aggregate=["activity"], progress=False)
     seconds = time.perf_counter() - started
-    return Build(seconds, counts(driver))
+    cpu, served = time.process_time() - cpu, server_cpu(server) - served
+    return Build(seconds, counts(driver), cpu=cpu, server_cpu=served)
+
+
+def server_cpu(server) -> float:
+    """CPU seconds the Neo4j server's process has used so far (0 when unknown)."""
+    from robotale.timings import process_seconds
+
+    running = server.running()
+    return (process_seconds(running.pid) or 0.0) if running is not None else 0.0
+
+
+def children_cpu() -> float:
+    """CPU seconds of this process' children that have ended (PromG's driver process)."""
+    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return usage.ru_utime + usage.ru_stime
+
+
+def ratios(ours: Build, theirs: Build) -> tuple[float, float]:
+    """PromG's build over robotale's: by wall time, and by CPU time (each side's process and
+    the server's during its build)."""
+    wall = theirs.seconds / ours.seconds
+    cpu = (theirs.cpu + theirs.server_cpu) / (ours.cpu + ours.server_cpu)
+    return wall, cpu
+
+
+def _said(who: str, build: Build) -> None:
+    print(
+        f"  turn: {who} {build.seconds:.2f} s wall, {build.cpu:.1f} s CPU "
+        f"(+ Neo4j {build.server_cpu:.1f} s); load average {os.getloadavg()[0]:.1f}",
+        flush=True,
+    )
 
 
 def promg_build(
@@ -150,6 +193,7 @@ def promg_build(
     }
     (folder / "settings.json").write_text(json.dumps(settings))
     (server.home / "import").mkdir(exist_ok=True)  # PromG writes its CSVs there
+    served, cpu = server_cpu(server), children_cpu()
     started = time.perf_counter()
     result = subprocess.run(
         [str(python), str(HERE / "peers_promg.py"), str(folder / "settings.json")],
@@ -159,13 +203,15 @@ def promg_build(
         check=False,
     )
     process_seconds = time.perf_counter() - started
+    cpu, served = children_cpu() - cpu, server_cpu(server) - served
     if result.returncode != 0:
         # PromG reports a failed query on stdout, and Python its traceback on stderr.
         lines = result.stdout.strip().splitlines()[-6:] + result.stderr.strip().splitlines()[-3:]
         tail = "\n    ".join(lines)
         return None, f"PromG's build failed (exit {result.returncode}):\n    {tail}"
     answer = json.loads((folder / "result.json").read_text())
-    return Build(answer["seconds"], counts(driver), answer["promg"], process_seconds), None
+    found = counts(driver)
+    return Build(answer["seconds"], found, answer["promg"], process_seconds, cpu, served), None
 
 
 def promg_records(log: pd.DataFrame) -> pd.DataFrame:
@@ -370,9 +416,12 @@ def report(title: str, events: int, ours: Build, theirs: Build | None, why_not: 
         print(f"  robotale {ours.seconds:.2f} s; PromG: not run. {why_not}")
         _table(ours, None)
         return
+    wall, cpu = ratios(ours, theirs)
     print(
-        f"  robotale {ours.seconds:.2f} s, PromG {theirs.version} {theirs.seconds:.2f} s: "
-        f"ratio {theirs.seconds / ours.seconds:.1f} (PromG's time / robotale's)"
+        f"  robotale {ours.seconds:.2f} s wall, {ours.cpu:.1f} s CPU (+ Neo4j "
+        f"{ours.server_cpu:.1f} s); PromG {theirs.version} {theirs.seconds:.2f} s wall, "
+        f"{theirs.cpu:.1f} s CPU of its whole process (+ Neo4j {theirs.server_cpu:.1f} s): "
+        f"ratio {wall:.1f} wall, {cpu:.1f} CPU (PromG's / robotale's; the fastest turn of each)"
     )
     _table(ours, theirs)
 

@@ -60,6 +60,21 @@ def verify_once(path: Path, options: dict):
     return verify(parse(path), library=Library(path.parent), **options)
 
 
+def findings_of(verdict) -> list[tuple[str, str]]:
+    """What a repeat is checked by: each finding's kind and sentence, in order."""
+    return [(finding.kind, finding.sentence) for finding in verdict.findings]
+
+
+def differing_findings(first: list[tuple[str, str]], other: list[tuple[str, str]]) -> str:
+    """Empty when a repeat found what the first did; else the first finding that differs."""
+    for number, (one, two) in enumerate(zip(first, other, strict=False), start=1):
+        if one != two:
+            return f"finding {number}: {one[1]!r} against {two[1]!r}"
+    if len(first) != len(other):
+        return f"{len(first)} findings against {len(other)}"
+    return ""
+
+
 def engine_once(path: Path, options: dict) -> float:
     skills = options.get("skills")
     mission = Mission(
@@ -93,11 +108,10 @@ def main() -> int:
             wall, cpu, verdict = timed(lambda p=path, o=options: verify_once(p, o))
             walls.append(wall)
             cpus.append(cpu)
-            summary = [(f.kind, f.sentence) for f in verdict.findings]
             if first is None:
-                first = (verdict, summary)
-            elif summary != first[1]:
-                print(f"{name}: the findings differ between runs", file=sys.stderr)
+                first = (verdict, findings_of(verdict))
+            elif difference := differing_findings(first[1], findings_of(verdict)):
+                print(f"{name}: the findings differ between runs: {difference}", file=sys.stderr)
                 return 1
             try:
                 engine_cpus.append(timed(lambda p=path, o=options: engine_once(p, o))[1])
