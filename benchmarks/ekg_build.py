@@ -46,6 +46,7 @@ import os
 import sys
 import tempfile
 import time
+from collections.abc import Callable
 from pathlib import Path
 
 import importer_bound
@@ -176,14 +177,18 @@ def main() -> int:
                 compare_df_c_with_pm4py(driver, size, args.repeat)
         print(f"load average after: {os.getloadavg()[0]:.1f}")
         return 0
-    with private_neo4j(args.heap) as driver:
+    neo4j = private_neo4j(args.heap)
+    with neo4j as driver:
         # Neo4j compiles each query once and its JIT warms up: measure a warm server.
         timed_build(driver, synthetic_log(10_000), "warmup", ["case", "robot", "msg_id"])
         for size in args.sizes:
             measure_build(driver, size, args.repeat if size <= 100_000 else 1)
         finished: tuple[int, float] | None = None
+        spent = cpu_spent(neo4j.pid)
         for size in args.baseline_sizes:
-            finished = compare_with_thesis(driver, size, args.repeat, args.thesis_limit, finished)
+            finished = compare_with_thesis(
+                driver, size, args.repeat, args.thesis_limit, finished, spent
+            )
         compare_df_c_with_pm4py(driver, min(args.sizes), args.repeat)
         compare_appends(driver, min(args.sizes), parts=10)
         compare_workers(driver, min(args.sizes))
@@ -205,6 +210,7 @@ class private_neo4j:
         self.server = LocalServer(Path(self.home.name))
         options = ServerOptions(free_port(), free_port(), heap=self.heap, pagecache="2g")
         running = self.server.start(options)
+        self.pid = running.pid
         password = self.server.password() or ""
         self.driver = connect(Settings(running.bolt_uri, "neo4j", password, True))
         os.environ.update(NEO4J_URI=running.bolt_uri, NEO4J_PASSWORD=password)
@@ -222,18 +228,32 @@ def timed_build(
     name: str,
     entities: list[str],
     aggregate: tuple[str, ...] = ("activity",),
+    cpus: list[float] | None = None,
+    spent: Callable[[], float] | None = None,
 ):
-    """Build, time and delete one log; returns (seconds, summary)."""
+    """Build, time and delete one log; returns (seconds, summary). With ``spent`` (see
+    :func:`cpu_spent`), the build's CPU seconds are added to ``cpus``."""
     from robotale.ekg.build import build_ekg
     from robotale.ekg.logs import delete_log
 
+    cpu = spent() if spent else 0.0
     started = time.perf_counter()
     summary = build_ekg(
         driver, log, name, entities=entities, aggregate=list(aggregate), progress=False
     )
     seconds = time.perf_counter() - started
+    if spent is not None and cpus is not None:
+        cpus.append(spent() - cpu)
     delete_log(driver, name)
     return seconds, summary
+
+
+def cpu_spent(pid: int) -> Callable[[], float]:
+    """CPU seconds so far of this process and of the Neo4j server ``pid``: a build's client
+    and server together, as both sides of a comparison spend them."""
+    from robotale.timings import process_seconds
+
+    return lambda: time.process_time() + (process_seconds(pid) or 0.0)
 
 
 def measure_build(driver, size: int, repeat: int) -> None:
@@ -292,18 +312,28 @@ def plain_writes(driver, nodes: int, properties: int, edges: int) -> float:
 
 
 def compare_with_thesis(
-    driver, size: int, repeat: int, limit: float, finished: tuple[int, float] | None
+    driver,
+    size: int,
+    repeat: int,
+    limit: float,
+    finished: tuple[int, float] | None,
+    spent: Callable[[], float] | None = None,
 ) -> tuple[int, float] | None:
     """Print robotale against the thesis' queries at ``size`` events; returns the largest
-    (size, seconds) the thesis' queries finished, for extrapolating beyond it."""
+    (size, seconds) the thesis' queries finished, for extrapolating beyond it. With
+    ``spent`` (:func:`cpu_spent`) the CPU time of the same work is printed beside."""
     log = synthetic_log(size)
     entities = ["case", "robot", "msg_id"]
     repeat = repeat if size <= 20_000 else 1
     ours, theirs, graphs = [], [], []
+    our_cpus: list[float] = []
+    their_cpus: list[float] = []
     for _ in range(repeat):  # in turns (A B A B), so a busy machine slows both alike
-        same, summary = timed_build(driver, log, "bench_same", entities, aggregate=())
+        same, summary = timed_build(
+            driver, log, "bench_same", entities, aggregate=(), cpus=our_cpus, spent=spent
+        )
         ours.append((same, timed_build(driver, log, "bench_whole", entities)[0]))
-        theirs.append(thesis_build(driver, log, entities, limit, graphs))
+        theirs.append(thesis_build(driver, log, entities, limit, graphs, their_cpus, spent))
     differ = [d for graph in graphs for d in same_graph(built_counts(log, summary), graph)]
     same_work, whole = (min(times) for times in zip(*ours, strict=True))
     if None in theirs:
@@ -330,6 +360,12 @@ def compare_with_thesis(
     )
     said = "; ".join(dict.fromkeys(differ)) if differ else "the same"
     print(f"  events, entities, CORR and DF of the {len(graphs)} finished thesis builds: {said}")
+    if our_cpus and their_cpus:
+        mine, other = min(our_cpus), min(their_cpus)
+        print(
+            f"  CPU (this process and the Neo4j server, best of each): thesis Cypher "
+            f"{other:.1f} s, robotale same work {mine:.1f} s = {other / mine:.1f}x"
+        )
     return finished
 
 
@@ -352,11 +388,18 @@ def same_graph(ours: dict[str, int], theirs: dict[str, int]) -> list[str]:
 
 
 def thesis_build(
-    driver, log: pd.DataFrame, entity_types: list[str], limit: float, graphs: list | None = None
+    driver,
+    log: pd.DataFrame,
+    entity_types: list[str],
+    limit: float,
+    graphs: list | None = None,
+    cpus: list[float] | None = None,
+    spent: Callable[[], float] | None = None,
 ) -> float | None:
     """The thesis' queries (section 7.1.2) on an empty database; returns their seconds, or
     None when they took longer than ``limit`` (Neo4j stops them). A finished build's counts
-    (``ekg_thesis_counts``) are added to ``graphs`` before it is removed."""
+    (``ekg_thesis_counts``) are added to ``graphs`` before it is removed, and with ``spent``
+    (:func:`cpu_spent`) its CPU seconds to ``cpus``."""
     from neo4j import Query
     from neo4j.exceptions import Neo4jError
 
@@ -366,6 +409,7 @@ def thesis_build(
     rows = short.astype(object).where(short.notna(), None)
     rows["time"] = log[schema.TIMESTAMP].map(lambda t: t.isoformat())
     records = rows.to_dict("records")
+    cpu = spent() if spent else 0.0
     started = time.perf_counter()
 
     def run(name: str, **parameters) -> None:
@@ -379,6 +423,8 @@ def thesis_build(
             run("ekg_thesis_corr", entitytype=entity_type)
             run("ekg_thesis_df", entitytype=entity_type)
         seconds: float | None = time.perf_counter() - started
+        if spent is not None and cpus is not None:
+            cpus.append(spent() - cpu)
     except Neo4jError as error:
         if "timeout" not in str(error).lower() and "terminated" not in str(error).lower():
             raise
