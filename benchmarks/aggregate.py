@@ -66,7 +66,8 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests" / "ekg"))
 from ocean_shaped import LOGISTICS_SPEC, write_logistics  # noqa: E402
-from whole_ingest import children_cpu, high_water_mb, process_cpu  # noqa: E402
+from peers import children_cpu  # noqa: E402
+from whole_ingest import high_water_mb, process_cpu  # noqa: E402
 
 from robotale.ekg import lift, steps, writelock  # noqa: E402
 from robotale.ekg.connection import Settings, connect, database  # noqa: E402

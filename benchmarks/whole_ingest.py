@@ -41,7 +41,6 @@ from __future__ import annotations
 import json
 import os
 import re
-import resource
 import signal
 import subprocess
 import sys
@@ -61,6 +60,7 @@ sys.path.insert(0, str(HERE))
 import importer_bound  # noqa: E402
 import peers  # noqa: E402
 from ekg_build import event_properties, synthetic_log  # noqa: E402
+from peers import children_cpu, server_cpu  # noqa: E402
 from stock_neo4j import describe_pairing, stock_neo4j  # noqa: E402
 
 #: how PromG's server is started: as its users run it (the default), or by robotale's code
@@ -210,11 +210,6 @@ def canonical_csv(log: pd.DataFrame) -> pd.DataFrame:
     return schema.to_csv_names(log)
 
 
-def server_cpu(server) -> float:
-    """CPU seconds the Neo4j server's process has used so far."""
-    return process_cpu(server.running().pid)
-
-
 class ServerCpu:
     """The CPU seconds the server's processes spend from now on: the last reading of each
     process seen (one that ended keeps its last reading)."""
@@ -237,11 +232,6 @@ class ServerCpu:
 def process_cpu(pid: int) -> float:
     """CPU seconds the process ``pid`` has used so far (0 when it is gone)."""
     return process_seconds(pid) or 0.0
-
-
-def children_cpu() -> float:
-    usage = resource.getrusage(resource.RUSAGE_CHILDREN)
-    return usage.ru_utime + usage.ru_stime
 
 
 def timed_process(command: list[str], server, **options) -> tuple[Run, int, str, str]:
